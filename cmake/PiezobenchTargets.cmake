@@ -1,0 +1,44 @@
+# Shared compile settings and the helpers that declare modules, tests and benchmarks.
+
+add_library(piezobench_options INTERFACE)
+add_library(piezobench::options ALIAS piezobench_options)
+target_compile_features(piezobench_options INTERFACE cxx_std_20)
+target_compile_options(piezobench_options INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align -Wunused
+  -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
+  $<$<BOOL:${PIEZOBENCH_WERROR}>:-Werror>)
+if(PIEZOBENCH_SANITIZE)
+  target_compile_options(piezobench_options INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  target_link_options(piezobench_options INTERFACE -fsanitize=address,undefined -fno-sanitize-recover=all)
+endif()
+
+# piezobench_add_module(NAME <name> SOURCES <files...> [DEPS <targets...>])
+# Declares the library piezobench_<name> with the alias piezobench::<name>. Its public headers live
+# in include/piezobench/<name>/; its sources and private headers in src/<name>/.
+function(piezobench_add_module)
+  cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS" ${ARGN})
+  set(target piezobench_${ARG_NAME})
+  add_library(${target} STATIC ${ARG_SOURCES})
+  add_library(piezobench::${ARG_NAME} ALIAS ${target})
+  target_include_directories(${target}
+    PUBLIC "${PROJECT_SOURCE_DIR}/include" "${PROJECT_BINARY_DIR}/generated"
+    PRIVATE "${PROJECT_SOURCE_DIR}/src")
+  target_link_libraries(${target} PUBLIC piezobench::options ${ARG_DEPS})
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+endfunction()
+
+# piezobench_add_test(NAME <name> SOURCES <files...> DEPS <targets...>)
+# One GoogleTest executable per module; each TEST becomes a CTest test.
+function(piezobench_add_test)
+  cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS" ${ARGN})
+  add_executable(${ARG_NAME} ${ARG_SOURCES})
+  target_include_directories(${ARG_NAME} PRIVATE "${PROJECT_SOURCE_DIR}/tests" "${PROJECT_SOURCE_DIR}/src")
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} piezobench::testutil GTest::gtest GTest::gmock GTest::gtest_main)
+  target_compile_definitions(${ARG_NAME} PRIVATE
+    PIEZOBENCH_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    PIEZOBENCH_FIXTURE_DIR="${PROJECT_SOURCE_DIR}/tests/fixtures"
+    PIEZOBENCH_SHARED_DATA_DIR="${PROJECT_SOURCE_DIR}/../shared/data"
+    PIEZOBENCH_BINARY="$<TARGET_FILE:piezobench>")
+  gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+endfunction()

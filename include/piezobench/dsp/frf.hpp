@@ -1,0 +1,37 @@
+#pragma once
+// A measured (or computed) frequency response: one input, one or more named outputs, on a common
+// frequency grid, with the coherence where it is known and how it was obtained.
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+namespace piezobench::dsp {
+
+// How an FRF was estimated (empty / zero where it does not apply, e.g. an FRF read from a file
+// that does not say).
+struct FrfProvenance {
+  std::string source;        // file the time series came from
+  std::string estimator;     // "H1" or "H2"
+  std::string window;        // e.g. "hann-periodic"
+  Eigen::Index nfft = 0;     // segment length, samples
+  double overlap = 0.0;      // fraction of nfft
+  std::string detrend;       // "none", "mean", "linear"
+  Eigen::Index averages = 0; // number of segments averaged
+  double sample_rate = 0.0;  // Hz
+};
+
+struct Frf {
+  Eigen::VectorXd freq_hz;                 // Hz, strictly increasing
+  std::string input;                       // input channel name
+  std::vector<std::string> outputs;        // output channel names
+  std::vector<Eigen::VectorXcd> H;         // H[i](k): output i / input at freq_hz(k)
+  std::vector<Eigen::VectorXd> coherence;  // same layout as H; empty vector = unknown
+  FrfProvenance provenance;
+
+  // Index of the named output; throws InputError (field "output", expected one of the names).
+  [[nodiscard]] Eigen::Index output_index(const std::string& name) const;
+  // Throws InputError for inconsistent sizes, non-finite values or a non-increasing grid.
+  void validate(const std::string& source = "") const;
+};
+
+}  // namespace piezobench::dsp
