@@ -5,7 +5,7 @@ add_library(piezobench::options ALIAS piezobench_options)
 target_compile_features(piezobench_options INTERFACE cxx_std_20)
 target_compile_options(piezobench_options INTERFACE
   -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align -Wunused
-  -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
+  -Woverloaded-virtual -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
   $<$<BOOL:${PIEZOBENCH_WERROR}>:-Werror>)
 if(PIEZOBENCH_SANITIZE)
   target_compile_options(piezobench_options INTERFACE

@@ -1,0 +1,209 @@
+#include "piezobench/io/lti_toml.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+#include <vector>
+
+#include "piezobench/core/error.hpp"
+#include "piezobench/lti/conversions.hpp"
+#include "piezobench/lti/transfer_function.hpp"
+
+namespace piezobench::io {
+namespace {
+
+std::string describe(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer:
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array of " + std::to_string(node.as_array()->size());
+    case toml::node_type::table: return "a table";
+    default: return "a date or time";
+  }
+}
+
+class Reader {
+ public:
+  Reader(const toml::table& table, std::string source) : table_(table), source_(std::move(source)) {}
+
+  [[nodiscard]] bool has(const char* key) const { return table_.contains(key); }
+
+  [[nodiscard]] double number(const std::string& key, const toml::node& node) const {
+    const auto value = node.value<double>();
+    if (!node.is_number() || !value) throw InputError(source_, key, "a number", describe(node));
+    if (!std::isfinite(*value)) throw InputError(source_, key, "a finite number", std::to_string(*value));
+    return *value;
+  }
+
+  [[nodiscard]] double number(const char* key) const { return number(key, *table_.get(key)); }
+
+  [[nodiscard]] const toml::array& array(const std::string& key, const toml::node& node) const {
+    const toml::array* a = node.as_array();
+    if (a == nullptr) throw InputError(source_, key, "an array", describe(node));
+    return *a;
+  }
+
+  [[nodiscard]] lti::Vector vector(const char* key) const {
+    const toml::array& a = array(key, *table_.get(key));
+    if (a.empty()) throw InputError(source_, key, "a non-empty array of numbers", "an empty array");
+    lti::Vector v(static_cast<lti::Index>(a.size()));
+    for (std::size_t i = 0; i < a.size(); ++i) v(static_cast<lti::Index>(i)) = number(key_at(key, i), a[i]);
+    return v;
+  }
+
+  // A list of real numbers or [re, im] pairs; may be empty.
+  [[nodiscard]] lti::CVector complex_vector(const char* key) const {
+    const toml::array& a = array(key, *table_.get(key));
+    lti::CVector v(static_cast<lti::Index>(a.size()));
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string k = key_at(key, i);
+      if (a[i].is_array()) {
+        const toml::array& pair = *a[i].as_array();
+        if (pair.size() != 2) throw InputError(source_, k, "a number or a pair [re, im]", describe(a[i]));
+        v(static_cast<lti::Index>(i)) = lti::Complex(number(k + "[0]", pair[0]), number(k + "[1]", pair[1]));
+      } else {
+        v(static_cast<lti::Index>(i)) = number(k, a[i]);
+      }
+    }
+    return v;
+  }
+
+  // A matrix as a list of rows of equal length; an empty list is a matrix with no rows.
+  [[nodiscard]] lti::Matrix matrix(const char* key, lti::Index cols_if_empty) const {
+    const toml::array& rows = array(key, *table_.get(key));
+    if (rows.empty()) return lti::Matrix(0, cols_if_empty);
+    std::vector<std::vector<double>> values;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const toml::array& row = array(key_at(key, i), rows[i]);
+      std::vector<double> r;
+      for (std::size_t j = 0; j < row.size(); ++j) r.push_back(number(key_at(key_at(key, i), j), row[j]));
+      if (!values.empty() && r.size() != values.front().size()) {
+        throw InputError(source_, key_at(key, i), "a row of " + std::to_string(values.front().size()) + " numbers",
+                         std::to_string(r.size()) + " numbers");
+      }
+      values.push_back(std::move(r));
+    }
+    lti::Matrix m(static_cast<lti::Index>(values.size()), static_cast<lti::Index>(values.front().size()));
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      for (std::size_t j = 0; j < values[i].size(); ++j) m(static_cast<lti::Index>(i), static_cast<lti::Index>(j)) = values[i][j];
+    }
+    return m;
+  }
+
+  [[nodiscard]] const std::string& source() const { return source_; }
+
+ private:
+  static std::string key_at(const std::string& key, std::size_t i) { return key + "[" + std::to_string(i) + "]"; }
+
+  const toml::table& table_;
+  std::string source_;
+};
+
+const std::set<std::string>& known_keys() {
+  static const std::set<std::string> keys = {"num", "den", "zeros", "poles", "gain", "A", "B", "C", "D",
+                                             "delay", "sample_time", "description"};
+  return keys;
+}
+
+LtiFile build(const toml::table& table, const std::string& source) {
+  for (const auto& [key, node] : table) {
+    if (known_keys().count(std::string(key.str())) == 0) {
+      throw InputError(source, std::string(key.str()),
+                       "one of num, den, zeros, poles, gain, A, B, C, D, delay, sample_time, description",
+                       "an unknown key");
+    }
+  }
+  const Reader r(table, source);
+  const bool tf = r.has("num") || r.has("den");
+  const bool zpk = r.has("zeros") || r.has("poles") || r.has("gain");
+  const bool ss = r.has("A") || r.has("B") || r.has("C") || r.has("D");
+  if (int(tf) + int(zpk) + int(ss) != 1) {
+    throw InputError(source, "form", "exactly one of a transfer function (num, den), a zpk (zeros, poles, gain) "
+                     "or a state space (A, B, C, D)", tf + zpk + ss == 0 ? std::string("none") : std::string("a mix"));
+  }
+  const double ts = r.has("sample_time") ? r.number("sample_time") : 0.0;
+  const double delay = r.has("delay") ? r.number("delay") : 0.0;
+  if (ts < 0.0) throw InputError(source, "sample_time", "a sample time >= 0 s", std::to_string(ts));
+  if (delay < 0.0) throw InputError(source, "delay", "a delay >= 0 s", std::to_string(delay));
+
+  LtiFile out;
+  if (const auto* d = table.get("description")) {
+    const auto text = d->value<std::string>();
+    if (!text) throw InputError(source, "description", "a string", describe(*d));
+    out.description = *text;
+  }
+  auto require = [&](const char* key) {
+    if (!r.has(key)) throw InputError(source, key, "a value (this form requires the key)", "no such key");
+  };
+  try {
+    if (tf) {
+      require("num");
+      require("den");
+      out.form = LtiForm::kTransferFunction;
+      const lti::TransferFunction h(r.vector("num"), r.vector("den"), ts, delay);
+      h.validate(source);
+      out.system = lti::to_state_space(h);
+    } else if (zpk) {
+      require("zeros");
+      require("poles");
+      require("gain");
+      out.form = LtiForm::kZpk;
+      const lti::Zpk h(r.complex_vector("zeros"), r.complex_vector("poles"), r.number("gain"), ts, delay);
+      h.validate(source);
+      out.system = lti::to_state_space(h);
+    } else {
+      require("A");
+      require("B");
+      require("C");
+      out.form = LtiForm::kStateSpace;
+      lti::Matrix a = r.matrix("A", 0);
+      lti::Matrix b = r.matrix("B", 0);
+      lti::Matrix c = r.matrix("C", a.cols());
+      lti::Matrix d = r.has("D") ? r.matrix("D", b.cols()) : lti::Matrix::Zero(c.rows(), b.cols());
+      if (a.rows() == 0 && b.rows() == 0) b.resize(0, d.cols());
+      out.system = lti::StateSpace(a, b, c, d, ts);
+      if (delay > 0.0) out.system.input_delay = lti::Vector::Constant(out.system.inputs(), delay);
+      out.system.validate(source);
+    }
+  } catch (const InputError& e) {
+    if (e.source().empty()) throw e.with_source(source);
+    throw;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string to_string(LtiForm form) {
+  switch (form) {
+    case LtiForm::kTransferFunction: return "tf";
+    case LtiForm::kZpk: return "zpk";
+    case LtiForm::kStateSpace: return "ss";
+  }
+  return "ss";
+}
+
+LtiFile parse_lti_toml(const std::string& text, const std::string& source) {
+  toml::table table;
+  try {
+    table = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream where;
+    where << "line " << e.source().begin.line << ", column " << e.source().begin.column;
+    throw InputError(source, where.str(), "valid TOML", std::string(e.description()));
+  }
+  return build(table, source);
+}
+
+LtiFile read_lti_toml(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string(), "", "a readable file", "none (cannot open it)");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_lti_toml(ss.str(), path.string());
+}
+
+}  // namespace piezobench::io

@@ -1,1 +1,112 @@
+#include "piezobench/io/lti_toml.hpp"
+
 #include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "piezobench/core/error.hpp"
+#include "piezobench/lti/freqresp.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::io {
+namespace {
+
+using test::near;
+
+// |H(j w)| of the parsed system at one frequency.
+lti::Complex response_at(const LtiFile& f, double w) {
+  lti::Vector omega(1);
+  omega << w;
+  return lti::freqresp(f.system, omega).H.front()(0, 0);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_lti_toml(text, "sys.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(LtiToml, TransferFunctionMatchesItsPolynomials) {
+  const LtiFile f = parse_lti_toml("num = [2.0, 6.0]\nden = [1, 3.0, 2.0]\ndescription = 'test'\n", "sys.toml");
+  EXPECT_EQ(f.form, LtiForm::kTransferFunction);
+  EXPECT_EQ(f.description, "test");
+  const lti::Complex s(0.0, 1.7);
+  const lti::Complex expected = (2.0 * s + 6.0) / (s * s + 3.0 * s + 2.0);
+  EXPECT_TRUE(test::near(response_at(f, 1.7), expected, {test::kRoundoff, 0.0}));
+}
+
+TEST(LtiToml, ZpkAcceptsRealAndComplexEntries) {
+  const LtiFile f = parse_lti_toml("zeros = [-1.0]\npoles = [[-1.0, 2.0], [-1.0, -2.0], -5]\ngain = 3.0\n", "z.toml");
+  EXPECT_EQ(f.form, LtiForm::kZpk);
+  const lti::Complex s(0.0, 0.9);
+  const lti::Complex expected = 3.0 * (s + 1.0) / ((s - lti::Complex(-1, 2)) * (s - lti::Complex(-1, -2)) * (s + 5.0));
+  EXPECT_TRUE(test::near(response_at(f, 0.9), expected, {test::kRoundoff, 0.0}));
+}
+
+TEST(LtiToml, StateSpaceWithDelayAndDefaultD) {
+  const LtiFile f = parse_lti_toml("A = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\ndelay = 0.01\n", "s.toml");
+  EXPECT_EQ(f.form, LtiForm::kStateSpace);
+  ASSERT_EQ(f.system.D.rows(), 1);
+  EXPECT_EQ(f.system.D(0, 0), 0.0);
+  const double w = 3.0;
+  const lti::Complex s(0.0, w);
+  const lti::Complex expected = std::exp(-s * 0.01) / (s * s + 0.4 * s + 4.0);
+  EXPECT_TRUE(test::near(response_at(f, w), expected, {test::kRoundoff, 0.0}));
+}
+
+TEST(LtiToml, MalformedTomlNamesTheLine) {
+  const std::string e = error_of("num = [1.0\nden = [1.0]\n");
+  EXPECT_NE(e.find("sys.toml: line"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected valid TOML"), std::string::npos) << e;
+}
+
+TEST(LtiToml, ZeroLeadingDenominatorCoefficientIsRejected) {
+  const std::string e = error_of("num = [1.0]\nden = [0.0, 1.0, 2.0]\n");
+  EXPECT_NE(e.find("sys.toml: den"), std::string::npos) << e;
+}
+
+TEST(LtiToml, ImproperTransferFunctionIsRejected) {
+  const std::string e = error_of("num = [1.0, 2.0, 3.0]\nden = [1.0, 2.0]\n");
+  EXPECT_NE(e.find("sys.toml: num"), std::string::npos) << e;
+  EXPECT_NE(e.find("proper"), std::string::npos) << e;
+}
+
+TEST(LtiToml, WrongMatrixSizesNameTheMatrix) {
+  EXPECT_NE(error_of("A = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [1.0], [2.0]]\nC = [[1.0, 0.0]]\n").find("sys.toml: B"),
+            std::string::npos);
+  EXPECT_NE(error_of("A = [[0.0, 1.0], [-4.0]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\n").find("sys.toml: A[1]"),
+            std::string::npos);
+  EXPECT_NE(error_of("A = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0, 2.0]]\n").find("sys.toml: C"),
+            std::string::npos);
+}
+
+TEST(LtiToml, UnknownMissingAndMixedKeysAreNamed) {
+  EXPECT_NE(error_of("num = [1.0]\nden = [1.0, 1.0]\ngian = 2\n").find("sys.toml: gian: expected one of"), std::string::npos);
+  EXPECT_NE(error_of("num = [1.0]\n").find("sys.toml: den"), std::string::npos);
+  EXPECT_NE(error_of("num = [1.0]\nden = [1.0, 1.0]\nzeros = []\n").find("sys.toml: form"), std::string::npos);
+  EXPECT_NE(error_of("").find("found none"), std::string::npos);
+}
+
+TEST(LtiToml, NonFiniteAndWrongTypesAreRejected) {
+  EXPECT_NE(error_of("num = [nan]\nden = [1.0, 1.0]\n").find("sys.toml: num[0]: expected a finite number"), std::string::npos);
+  EXPECT_NE(error_of("num = ['one']\nden = [1.0, 1.0]\n").find("sys.toml: num[0]: expected a number, found a string"),
+            std::string::npos);
+  EXPECT_NE(error_of("num = 1.0\nden = [1.0, 1.0]\n").find("sys.toml: num: expected an array"), std::string::npos);
+  EXPECT_NE(error_of("zeros = []\npoles = [[1.0, 2.0, 3.0]]\ngain = 1\n").find("sys.toml: poles[0]"), std::string::npos);
+  EXPECT_NE(error_of("num = [1.0]\nden = [1.0, 1.0]\ndelay = -1.0\n").find("sys.toml: delay"), std::string::npos);
+}
+
+TEST(LtiToml, MissingFileIsAnInputError) {
+  try {
+    read_lti_toml("/nonexistent/plant.toml");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/plant.toml"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace piezobench::io

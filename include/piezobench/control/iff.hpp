@@ -1,0 +1,70 @@
+#pragma once
+// Integral Force Feedback (IFF): the report's plant model (eq. 2.3) and controller (eq. 2.4), and
+// the root locus of the loop of the report's Figure 2.9.
+//
+// Loop convention (Figure 2.9): the DAC voltage is u = u' + g K0(s) Vs, with Vs = G(s) u the
+// force-sensor voltage, K0 the controller at g = 1 and u' the new ("damped plant") input. The
+// closed-loop characteristic equation is 1 - g K0(s) G(s) = 0, i.e. the negative-feedback root
+// locus (lti/rlocus.hpp) of the open loop L = -K0 G; with the report's K0 (negative gain), damping
+// grows with g > 0.
+#include <optional>
+#include <vector>
+
+#include "piezobench/lti/rlocus.hpp"
+#include "piezobench/lti/state_space.hpp"
+#include "piezobench/lti/transfer_function.hpp"
+
+namespace piezobench::control {
+
+// G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
+// from u (V) to Vs (V). Defaults: the report's manual fit (section 2.6).
+struct IffPlantParams {
+  double g0 = 0.64;                    // V/V
+  double wz = 2.0 * M_PI * 42.7;       // rad/s, anti-resonance
+  double xz = 0.004;                   // damping ratio of the zero
+  double wp = 2.0 * M_PI * 95.2;       // rad/s, resonance
+  double xp = 0.02;                    // damping ratio of the pole
+  double w_hpf = 2.0 * M_PI * 0.4;     // rad/s, high-pass corner of the resistor across the sensor stack
+  double delay = 0.0;                  // s (the report adds 200 us to match the phase)
+  void validate() const;               // InputError naming the field
+};
+lti::TransferFunction iff_plant(const IffPlantParams& params = {});
+
+// K0(s) = gain * s/(s + w_hpf) * 1/(s + w_lpf) * 1/(s + w_robust): eq. 2.4 at g = 1 (gain = -10).
+struct IffControllerParams {
+  double gain = -10.0;                 // 1/s^2 scaling of the report's controller
+  double w_hpf = 2.0 * M_PI * 2.0;     // rad/s, high-pass that limits the low-frequency gain
+  double w_lpf = 2.0 * M_PI * 20.0;    // rad/s, integral action above it
+  double w_robust = 2.0 * M_PI * 2000.0;  // rad/s, roll-off for robustness to high-frequency modes
+  void validate() const;
+};
+lti::Zpk iff_controller(const IffControllerParams& params = {});
+
+struct IffLoopOptions {
+  // Pade order used for a delay of the plant or controller (root loci need finite states).
+  int pade_order = 6;
+  // Frequency (rad/s) of the resonance whose branch is optimized; empty = the plant's complex pole
+  // with the smallest damping ratio.
+  std::optional<double> resonance = std::nullopt;
+  lti::RootLocusOptions locus;
+  void validate() const;
+};
+
+// L = -K0 G as a SISO state space, delays replaced by Pade approximants of options.pade_order.
+lti::StateSpace iff_open_loop(const lti::StateSpace& plant, const lti::StateSpace& controller,
+                              const IffLoopOptions& options = {});
+
+struct IffRootLocus {
+  lti::RootLocus locus;            // closed-loop poles at each gain g
+  lti::Complex resonance_pole;     // open-loop pole the optimized branch starts from
+  lti::BranchOptimum optimum;      // gain of maximum damping on that branch
+  // Index (in each poles vector of `locus`) of the optimized branch.
+  lti::Index resonance_branch = 0;
+};
+
+// Root locus at the given gains (automatic grid when `gains` is empty) and the optimum on the
+// resonance branch. Throws InputError for non-SISO plant/controller or a plant with no complex pole.
+IffRootLocus iff_root_locus(const lti::StateSpace& plant, const lti::StateSpace& controller,
+                            const std::vector<double>& gains, const IffLoopOptions& options = {});
+
+}  // namespace piezobench::control

@@ -1,0 +1,19 @@
+#pragma once
+// JSON encodings shared by every command: complex numbers as [re, im], vectors as arrays,
+// non-finite numbers as the strings "inf", "-inf" and "nan" (JSON has no such numbers).
+#include <Eigen/Dense>
+#include <complex>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+namespace piezobench::io {
+
+nlohmann::json to_json(double value);
+nlohmann::json to_json(std::complex<double> value);
+nlohmann::json to_json(const Eigen::VectorXd& values);
+nlohmann::json to_json(const Eigen::VectorXcd& values);
+nlohmann::json to_json(const std::vector<double>& values);
+// A matrix as a list of rows.
+nlohmann::json to_json(const Eigen::MatrixXd& values);
+
+}  // namespace piezobench::io

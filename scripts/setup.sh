@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Sets piezobench up on a Debian machine and runs one job.
+#
+#   scripts/setup.sh demo [--sanitize]   install what is missing, build, run the main job
+#   scripts/setup.sh test [--sanitize]   install what is missing, build, run the whole test suite
+#   scripts/setup.sh build [--sanitize]  install what is missing and build
+#
+# Installing is idempotent: packages already present are left alone, and nothing is installed
+# (not even an `apt-get update`) when everything is there. --sanitize builds in build-sanitize/
+# with AddressSanitizer and UndefinedBehaviorSanitizer; the normal build lives in build/.
+set -euo pipefail
+
+job="${1:-}"
+shift || true
+sanitize=0
+for arg in "$@"; do
+  case "$arg" in
+    --sanitize) sanitize=1 ;;
+    *) echo "setup.sh: unknown option '$arg' (expected --sanitize)" >&2; exit 2 ;;
+  esac
+done
+case "$job" in
+  demo|test|build) ;;
+  *) echo "usage: scripts/setup.sh demo|test|build [--sanitize]" >&2; exit 2 ;;
+esac
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+
+# Build tools and every library piezobench links, all from Debian's archive.
+packages=(
+  g++ cmake ninja-build pkg-config
+  libeigen3-dev libfftw3-dev libmatio-dev libsuitesparse-dev libspectra-dev
+  libcli11-dev libfmt-dev nlohmann-json3-dev libtomlplusplus-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if [ "$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null)" != "install ok installed" ]; then
+    missing+=("$p")
+  fi
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup.sh: installing ${missing[*]}" >&2
+  sudo_cmd=()
+  if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+  "${sudo_cmd[@]}" apt-get update -q
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+if [ "$sanitize" -eq 1 ]; then
+  build_dir="$root/build-sanitize"
+  config=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DPIEZOBENCH_SANITIZE=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF)
+else
+  build_dir="$root/build"
+  config=(-DCMAKE_BUILD_TYPE=Release)
+fi
+jobs="$(nproc 2>/dev/null || echo 2)"
+
+echo "setup.sh: configuring and building in $build_dir" >&2
+cmake -S "$root" -B "$build_dir" -G Ninja "${config[@]}" >/dev/null
+cmake --build "$build_dir" -j "$jobs"
+
+case "$job" in
+  demo)
+    # The main job. Until `piezobench demo` (the campaign) exists, the most complete command is the
+    # IFF root locus of the report's plant and controller.
+    "$build_dir/app/piezobench" iff rlocus --gains 0,1000,3000,10000,30000,100000,300000,1000000
+    ;;
+  test)
+    export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
+    export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
+    ;;
+  build) ;;
+esac
