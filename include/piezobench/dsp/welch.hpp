@@ -1,0 +1,110 @@
+#pragma once
+// Welch's averaged modified periodograms (P. D. Welch, "The use of fast Fourier transform for the
+// estimation of power spectra", IEEE Trans. Audio Electroacoust. 15(2), 1967): auto and cross
+// spectral densities of one input u and several outputs y_i, and from them the H1 and H2
+// frequency-response estimators and the coherence (Bendat & Piersol, "Engineering applications of
+// correlation and spectral analysis", 2nd ed., 1993, ch. 3 and 9).
+//
+// Conventions (docs/dsp-conventions.md), identical to scipy.signal.csd/welch/coherence and to
+// Octave's cpsd/pwelch/tfestimate/mscohere for the same window, overlap and detrending:
+//  - segments of nfft samples start every nfft - noverlap samples, noverlap = floor(overlap*nfft);
+//    the last incomplete segment is dropped; each segment is detrended, then windowed, then
+//    transformed (no zero padding: the segment length is the FFT length, any integer >= 2);
+//  - Suy(f) = C * mean_segments( conj(U(f)) * Y(f) )   (scipy csd(u, y); Octave cpsd(u, y))
+//  - density scaling C = 1 / (fs * sum(w^2)), one-sided: bins 1 .. ceil(nfft/2)-1 are doubled,
+//    DC is not, and for even nfft neither is the Nyquist bin nfft/2;
+//  - frequencies k * fs / nfft, k = 0 .. floor(nfft/2), in Hz;
+//  - H1 = Suy / Suu, H2 = Syy / Syu with Syu = conj(Suy), coherence = |Suy|^2 / (Suu * Syy).
+//
+// Cost: each channel's segment is transformed once (FFTW r2c, one plan per nfft shared by the
+// process), so the whole estimate costs (1 + outputs) * segments real FFTs plus O(nfft) work per
+// segment and channel; nothing is allocated per segment. Segments are split into a fixed number of
+// contiguous chunks that are summed in order, so the result does not depend on the thread count.
+#include <Eigen/Dense>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "piezobench/dsp/detrend.hpp"
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/window.hpp"
+
+namespace piezobench::dsp {
+
+enum class FrfEstimator {
+  kH1,  // "H1" = Suy / Suu: unbiased by noise on the output
+  kH2,  // "H2" = Syy / Syu: unbiased by noise on the input
+};
+std::string to_string(FrfEstimator estimator);
+FrfEstimator frf_estimator_from_string(const std::string& name);  // InputError field "estimator"
+
+struct WelchOptions {
+  WindowType window = WindowType::kHannPeriodic;  // scipy's default window
+  Eigen::Index nfft = 1024;   // segment length = FFT length, samples; any integer >= 2
+  double overlap = 0.5;       // fraction of nfft shared by consecutive segments, in [0, 1)
+  Detrend detrend = Detrend::kNone;  // NB scipy's default is "constant" (= kMean)
+  FrfEstimator estimator = FrfEstimator::kH1;  // used by estimate_frf
+  int threads = 0;            // worker threads; 0 = all cores
+
+  // InputError naming the bad field ("nfft", "overlap", "threads"), prefixed with `source`.
+  void validate(const std::string& source = "") const;
+  // Samples shared by consecutive segments: floor(overlap * nfft), as Octave's pwelch (scipy takes
+  // the count itself: pass noverlap = this value to scipy).
+  [[nodiscard]] Eigen::Index noverlap() const;
+};
+
+// A named, borrowed record of samples (the caller keeps the storage alive during the call).
+struct Channel {
+  std::string name;
+  std::span<const double> samples;
+};
+// Convenience: a Channel viewing an Eigen vector (which must outlive it; temporaries, e.g. an
+// expression like x.head(n), are refused at compile time).
+Channel channel(std::string name, const Eigen::VectorXd& samples);
+Channel channel(std::string name, Eigen::VectorXd&& samples) = delete;
+
+// One-sided spectral densities of one input and several outputs.
+struct CrossSpectra {
+  Eigen::VectorXd freq_hz;              // k * fs / nfft, k = 0 .. floor(nfft/2)
+  std::string input;                    // input channel name
+  std::vector<std::string> outputs;     // output channel names
+  Eigen::VectorXd Suu;                  // input PSD, [u]^2/Hz
+  std::vector<Eigen::VectorXd> Syy;     // Syy[i]: PSD of output i, [y_i]^2/Hz
+  std::vector<Eigen::VectorXcd> Suy;    // Suy[i]: CSD conj(U) Y_i, [u][y_i]/Hz (scipy csd(u, y_i))
+  WindowType window = WindowType::kHannPeriodic;
+  Detrend detrend = Detrend::kNone;
+  Eigen::Index nfft = 0;
+  Eigen::Index noverlap = 0;
+  Eigen::Index averages = 0;            // number of segments
+  double sample_rate = 0.0;             // Hz
+};
+
+// All spectra in one pass over the data. Preconditions checked (InputError, prefixed with
+// `source`, field = the channel name): sample_rate_hz finite and > 0 (field "sample rate"), every
+// output as long as the input, every sample finite (the message gives the first bad index), the
+// record at least nfft samples long. Zero outputs are allowed (then only Suu is computed).
+CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& outputs,
+                           double sample_rate_hz, const WelchOptions& options,
+                           const std::string& source = "");
+
+// H1 or H2 and the coherence of every output. InputError (field = input name) when the input has
+// zero power at every frequency; for H2 also when an output has. A bin where a denominator is
+// exactly zero gives NaN there (and Frf::validate will reject the result).
+Frf frf_from_spectra(const CrossSpectra& spectra, FrfEstimator estimator, const std::string& source = "");
+
+// |Suy|^2 / (Suu Syy) of output `output` (NaN where the denominator is zero).
+Eigen::VectorXd coherence(const CrossSpectra& spectra, Eigen::Index output);
+
+struct FrfEstimate {
+  Frf frf;               // options.estimator; provenance filled in (source, window, nfft, ...)
+  CrossSpectra spectra;  // the raw densities it was computed from
+};
+FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_hz,
+                         const WelchOptions& options, const std::string& source = "");
+
+// Single-channel conveniences (same conventions): scipy welch(x) and csd(x, y).
+Eigen::VectorXd welch_psd(const Eigen::VectorXd& x, double sample_rate_hz, const WelchOptions& options);
+Eigen::VectorXcd welch_csd(const Eigen::VectorXd& x, const Eigen::VectorXd& y, double sample_rate_hz,
+                           const WelchOptions& options);
+
+}  // namespace piezobench::dsp

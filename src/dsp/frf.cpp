@@ -1,0 +1,73 @@
+#include "piezobench/dsp/frf.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::dsp {
+
+using Eigen::Index;
+
+Index Frf::output_index(const std::string& name) const {
+  std::string known;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (outputs[i] == name) return static_cast<Index>(i);
+    known += (known.empty() ? "" : ", ") + outputs[i];
+  }
+  throw InputError(provenance.source, "output", "one of " + (known.empty() ? std::string("(no outputs)") : known),
+                   "\"" + name + "\"");
+}
+
+void Frf::validate(const std::string& source) const {
+  const std::string src = source.empty() ? provenance.source : source;
+  const Index n = freq_hz.size();
+  if (n < 1) throw InputError(src, "freq_hz", "at least one frequency", "none");
+  for (Index k = 0; k < n; ++k) {
+    if (!std::isfinite(freq_hz(k))) {
+      throw InputError(src, "freq_hz", "finite frequencies", "non-finite value at index " + std::to_string(k));
+    }
+    if (k > 0 && !(freq_hz(k) > freq_hz(k - 1))) {
+      throw InputError(src, "freq_hz", "strictly increasing frequencies",
+                       std::to_string(freq_hz(k - 1)) + " then " + std::to_string(freq_hz(k)) + " at index " +
+                           std::to_string(k));
+    }
+  }
+  if (outputs.empty()) throw InputError(src, "outputs", "at least one output", "none");
+  if (H.size() != outputs.size()) {
+    throw InputError(src, "H", std::to_string(outputs.size()) + " responses (one per output)", std::to_string(H.size()));
+  }
+  std::set<std::string> names;
+  for (const auto& name : outputs) {
+    if (!names.insert(name).second) throw InputError(src, "outputs", "distinct output names", "\"" + name + "\" twice");
+  }
+  if (!coherence.empty() && coherence.size() != outputs.size()) {
+    throw InputError(src, "coherence", "none or " + std::to_string(outputs.size()) + " (one per output)",
+                     std::to_string(coherence.size()));
+  }
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (H[i].size() != n) {
+      throw InputError(src, outputs[i], std::to_string(n) + " values (one per frequency)", std::to_string(H[i].size()));
+    }
+    for (Index k = 0; k < n; ++k) {
+      if (!std::isfinite(H[i](k).real()) || !std::isfinite(H[i](k).imag())) {
+        throw InputError(src, outputs[i], "finite response values",
+                         "non-finite value at " + std::to_string(freq_hz(k)) + " Hz (index " + std::to_string(k) + ")");
+      }
+    }
+    if (!coherence.empty()) {
+      if (coherence[i].size() != n) {
+        throw InputError(src, outputs[i] + " coherence", std::to_string(n) + " values (one per frequency)",
+                         std::to_string(coherence[i].size()));
+      }
+      for (Index k = 0; k < n; ++k) {
+        if (!std::isfinite(coherence[i](k))) {
+          throw InputError(src, outputs[i] + " coherence", "finite values",
+                           "non-finite value at " + std::to_string(freq_hz(k)) + " Hz (index " + std::to_string(k) + ")");
+        }
+      }
+    }
+  }
+}
+
+}  // namespace piezobench::dsp

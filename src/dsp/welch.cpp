@@ -1,0 +1,317 @@
+#include "piezobench/dsp/welch.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <thread>
+
+#include "dsp/fft.hpp"
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::dsp {
+
+using Eigen::Index;
+using Complex = std::complex<double>;
+
+namespace {
+
+// Segments are summed in this many contiguous chunks, each by one thread, and the chunk sums are
+// added in chunk order: the result is the same whatever the number of threads.
+constexpr Index kChunks = 16;
+// Below this many samples transformed in total, threads cost more than they save.
+constexpr double kMinWorkForThreads = 1 << 18;
+
+void check_channel(const Channel& ch, Index expected_length, const std::string& source) {
+  const auto n = static_cast<Index>(ch.samples.size());
+  if (n != expected_length) {
+    throw InputError(source, ch.name, std::to_string(expected_length) + " samples (as the input)",
+                     std::to_string(n));
+  }
+  for (Index i = 0; i < n; ++i) {
+    if (!std::isfinite(ch.samples[static_cast<std::size_t>(i)])) {
+      throw InputError(source, ch.name, "finite samples",
+                       std::string(std::isnan(ch.samples[static_cast<std::size_t>(i)]) ? "NaN" : "Inf") +
+                           " at sample " + std::to_string(i) + " (0-based)");
+    }
+  }
+}
+
+// Detrends and windows one segment of nfft samples into `out`.
+class SegmentLoader {
+ public:
+  SegmentLoader(const Eigen::VectorXd& window, Detrend detrend) : w_(window), detrend_(detrend) {
+    const double n = static_cast<double>(w_.size());
+    tc_ = 0.5 * (n - 1.0);
+    stt_ = n * (n * n - 1.0) / 12.0;
+  }
+
+  void load(const double* x, double* out) const {
+    const Index n = w_.size();
+    const double* w = w_.data();
+    switch (detrend_) {
+      case Detrend::kNone:
+        for (Index i = 0; i < n; ++i) out[i] = w[i] * x[i];
+        return;
+      case Detrend::kMean: {
+        double sum = 0.0;
+        for (Index i = 0; i < n; ++i) sum += x[i];
+        const double mean = sum / static_cast<double>(n);
+        for (Index i = 0; i < n; ++i) out[i] = w[i] * (x[i] - mean);
+        return;
+      }
+      case Detrend::kLinear: {
+        // Same line as detrend_in_place: mean + slope (t - tc).
+        double sum = 0.0;
+        double sxt = 0.0;
+        for (Index i = 0; i < n; ++i) {
+          sum += x[i];
+          sxt += (static_cast<double>(i) - tc_) * x[i];
+        }
+        const double mean = sum / static_cast<double>(n);
+        const double slope = stt_ > 0.0 ? sxt / stt_ : 0.0;
+        for (Index i = 0; i < n; ++i) out[i] = w[i] * (x[i] - mean - slope * (static_cast<double>(i) - tc_));
+        return;
+      }
+    }
+  }
+
+ private:
+  const Eigen::VectorXd& w_;
+  Detrend detrend_;
+  double tc_ = 0.0;
+  double stt_ = 0.0;
+};
+
+}  // namespace
+
+std::string to_string(FrfEstimator estimator) { return estimator == FrfEstimator::kH1 ? "H1" : "H2"; }
+
+FrfEstimator frf_estimator_from_string(const std::string& name) {
+  if (name == "H1") return FrfEstimator::kH1;
+  if (name == "H2") return FrfEstimator::kH2;
+  throw InputError("", "estimator", "one of H1, H2", "\"" + name + "\"");
+}
+
+void WelchOptions::validate(const std::string& source) const {
+  if (nfft < 2) throw InputError(source, "nfft", "an integer >= 2", std::to_string(nfft));
+  if (nfft > std::numeric_limits<int>::max()) {
+    throw InputError(source, "nfft", "at most " + std::to_string(std::numeric_limits<int>::max()),
+                     std::to_string(nfft));
+  }
+  if (!(overlap >= 0.0 && overlap < 1.0)) {
+    throw InputError(source, "overlap", "a fraction in [0, 1)", std::to_string(overlap));
+  }
+  if (threads < 0) throw InputError(source, "threads", ">= 0 (0 = all cores)", std::to_string(threads));
+}
+
+Index WelchOptions::noverlap() const {
+  return static_cast<Index>(std::floor(overlap * static_cast<double>(nfft)));
+}
+
+Channel channel(std::string name, const Eigen::VectorXd& samples) {
+  return Channel{std::move(name), std::span<const double>(samples.data(), static_cast<std::size_t>(samples.size()))};
+}
+
+CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_hz,
+                           const WelchOptions& options, const std::string& source) {
+  options.validate(source);
+  if (!(std::isfinite(sample_rate_hz) && sample_rate_hz > 0.0)) {
+    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_hz));
+  }
+  const auto n = static_cast<Index>(input.samples.size());
+  check_channel(input, n, source);
+  for (const auto& out : outputs) check_channel(out, n, source);
+  const Index nfft = options.nfft;
+  if (n < nfft) {
+    throw InputError(source, input.name, "a record of at least nfft = " + std::to_string(nfft) + " samples",
+                     std::to_string(n) + " samples");
+  }
+
+  const Index noverlap = options.noverlap();
+  const Index step = nfft - noverlap;
+  const Index nseg = (n - nfft) / step + 1;
+  const Index nout = static_cast<Index>(outputs.size());
+  const Index chunks = std::min(kChunks, nseg);
+
+  const Eigen::VectorXd window = make_window(options.window, nfft);
+  const SegmentLoader loader(window, options.detrend);
+  const detail::RealForwardFft fft(nfft);
+  const Index nbins = fft.bins();
+
+  // Per-chunk sums, allocated once: [chunk][bin] and [chunk][output][bin].
+  std::vector<double> acc_uu(static_cast<std::size_t>(chunks * nbins), 0.0);
+  std::vector<double> acc_yy(static_cast<std::size_t>(chunks * nout * nbins), 0.0);
+  std::vector<Complex> acc_uy(static_cast<std::size_t>(chunks * nout * nbins), Complex(0.0, 0.0));
+
+  int threads = options.threads == 0 ? static_cast<int>(std::max(1U, std::thread::hardware_concurrency()))
+                                     : options.threads;
+  const double work = static_cast<double>(nseg) * static_cast<double>(nfft) * static_cast<double>(1 + nout);
+  if (work < kMinWorkForThreads) threads = 1;
+  threads = static_cast<int>(std::min<Index>(threads, chunks));
+
+  struct Workspace {
+    detail::FftwBuffer<double> segment;
+    detail::FftwBuffer<Complex> u;
+    detail::FftwBuffer<Complex> y;
+  };
+  std::vector<Workspace> workspaces;
+  workspaces.reserve(static_cast<std::size_t>(threads));
+  for (int t = 0; t < threads; ++t) {
+    workspaces.push_back(Workspace{detail::FftwBuffer<double>(nfft), detail::FftwBuffer<Complex>(nbins),
+                                   detail::FftwBuffer<Complex>(nbins)});
+  }
+
+  std::atomic<Index> next_chunk{0};
+  auto worker = [&](Workspace& ws) {
+    for (Index c = next_chunk.fetch_add(1); c < chunks; c = next_chunk.fetch_add(1)) {
+      const Index first = c * nseg / chunks;
+      const Index last = (c + 1) * nseg / chunks;
+      double* suu = acc_uu.data() + c * nbins;
+      for (Index s = first; s < last; ++s) {
+        const Index start = s * step;
+        loader.load(input.samples.data() + start, ws.segment.data());
+        fft.execute(ws.segment.data(), ws.u.data());
+        // Written out on (re, im) pairs: std::complex's operator* checks for NaN/Inf (C99 Annex G)
+        // and would not vectorize; the spectra here are finite by construction.
+        const double* U = reinterpret_cast<const double*>(ws.u.data());
+        for (Index k = 0; k < nbins; ++k) suu[k] += U[2 * k] * U[2 * k] + U[2 * k + 1] * U[2 * k + 1];
+        for (Index o = 0; o < nout; ++o) {
+          loader.load(outputs[static_cast<std::size_t>(o)].samples.data() + start, ws.segment.data());
+          fft.execute(ws.segment.data(), ws.y.data());
+          const double* Y = reinterpret_cast<const double*>(ws.y.data());
+          double* syy = acc_yy.data() + (c * nout + o) * nbins;
+          double* suy = reinterpret_cast<double*>(acc_uy.data() + (c * nout + o) * nbins);
+          for (Index k = 0; k < nbins; ++k) {
+            const double ur = U[2 * k], ui = U[2 * k + 1], yr = Y[2 * k], yi = Y[2 * k + 1];
+            syy[k] += yr * yr + yi * yi;
+            suy[2 * k] += ur * yr + ui * yi;      // Re(conj(U) Y)
+            suy[2 * k + 1] += ur * yi - ui * yr;  // Im(conj(U) Y)
+          }
+        }
+      }
+    }
+  };
+  if (threads == 1) {
+    worker(workspaces[0]);
+  } else {
+    std::vector<std::jthread> pool;
+    pool.reserve(static_cast<std::size_t>(threads - 1));
+    for (int t = 1; t < threads; ++t) pool.emplace_back([&, t] { worker(workspaces[static_cast<std::size_t>(t)]); });
+    worker(workspaces[0]);
+  }  // jthreads join here
+
+  CrossSpectra result;
+  result.input = input.name;
+  for (const auto& out : outputs) result.outputs.push_back(out.name);
+  result.window = options.window;
+  result.detrend = options.detrend;
+  result.nfft = nfft;
+  result.noverlap = noverlap;
+  result.averages = nseg;
+  result.sample_rate = sample_rate_hz;
+  result.freq_hz.resize(nbins);
+  for (Index k = 0; k < nbins; ++k) {
+    result.freq_hz(k) = static_cast<double>(k) * sample_rate_hz / static_cast<double>(nfft);
+  }
+
+  // Density scaling 1 / (fs sum w^2), averaged over the segments, one-sided: every bin that has a
+  // negative-frequency twin (all but DC and, for even nfft, Nyquist) counts twice.
+  const double scale = 1.0 / (sample_rate_hz * window.squaredNorm() * static_cast<double>(nseg));
+  Eigen::VectorXd factor = Eigen::VectorXd::Constant(nbins, 2.0 * scale);
+  factor(0) = scale;
+  if (nfft % 2 == 0) factor(nbins - 1) = scale;
+
+  result.Suu = Eigen::VectorXd::Zero(nbins);
+  for (Index c = 0; c < chunks; ++c) {
+    result.Suu += Eigen::Map<const Eigen::VectorXd>(acc_uu.data() + c * nbins, nbins);
+  }
+  result.Suu.array() *= factor.array();
+  for (Index o = 0; o < nout; ++o) {
+    Eigen::VectorXd syy = Eigen::VectorXd::Zero(nbins);
+    Eigen::VectorXcd suy = Eigen::VectorXcd::Zero(nbins);
+    for (Index c = 0; c < chunks; ++c) {
+      syy += Eigen::Map<const Eigen::VectorXd>(acc_yy.data() + (c * nout + o) * nbins, nbins);
+      suy += Eigen::Map<const Eigen::VectorXcd>(acc_uy.data() + (c * nout + o) * nbins, nbins);
+    }
+    syy.array() *= factor.array();
+    suy.array() *= factor.array().cast<Complex>();
+    result.Syy.push_back(std::move(syy));
+    result.Suy.push_back(std::move(suy));
+  }
+  return result;
+}
+
+Eigen::VectorXd coherence(const CrossSpectra& spectra, Index output) {
+  assert(output >= 0 && output < static_cast<Index>(spectra.Suy.size()));
+  const auto& suy = spectra.Suy[static_cast<std::size_t>(output)];
+  const auto& syy = spectra.Syy[static_cast<std::size_t>(output)];
+  Eigen::VectorXd gamma2(suy.size());
+  for (Index k = 0; k < suy.size(); ++k) {
+    const double den = spectra.Suu(k) * syy(k);
+    gamma2(k) = den > 0.0 ? std::norm(suy(k)) / den : std::numeric_limits<double>::quiet_NaN();
+  }
+  return gamma2;
+}
+
+Frf frf_from_spectra(const CrossSpectra& spectra, FrfEstimator estimator, const std::string& source) {
+  if (!(spectra.Suu.array() > 0.0).any()) {
+    throw InputError(source, spectra.input, "an input with non-zero power", "zero power at every frequency");
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Frf frf;
+  frf.freq_hz = spectra.freq_hz;
+  frf.input = spectra.input;
+  frf.outputs = spectra.outputs;
+  for (std::size_t o = 0; o < spectra.Suy.size(); ++o) {
+    const auto& suy = spectra.Suy[o];
+    const auto& syy = spectra.Syy[o];
+    Eigen::VectorXcd h(suy.size());
+    if (estimator == FrfEstimator::kH1) {
+      for (Index k = 0; k < h.size(); ++k) h(k) = spectra.Suu(k) != 0.0 ? suy(k) / spectra.Suu(k) : Complex(nan, nan);
+    } else {
+      if (!(syy.array() > 0.0).any()) {
+        throw InputError(source, spectra.outputs[o], "an output with non-zero power (H2 divides by it)",
+                         "zero power at every frequency");
+      }
+      // H2 = Syy / Syu, Syu = conj(Suy): for y = H u both equal H.
+      for (Index k = 0; k < h.size(); ++k) h(k) = suy(k) != 0.0 ? syy(k) / std::conj(suy(k)) : Complex(nan, nan);
+    }
+    frf.H.push_back(std::move(h));
+    frf.coherence.push_back(coherence(spectra, static_cast<Index>(o)));
+  }
+  frf.provenance.source = source;
+  frf.provenance.estimator = to_string(estimator);
+  frf.provenance.window = to_string(spectra.window);
+  frf.provenance.nfft = spectra.nfft;
+  frf.provenance.overlap =
+      spectra.nfft > 0 ? static_cast<double>(spectra.noverlap) / static_cast<double>(spectra.nfft) : 0.0;
+  frf.provenance.detrend = to_string(spectra.detrend);
+  frf.provenance.averages = spectra.averages;
+  frf.provenance.sample_rate = spectra.sample_rate;
+  return frf;
+}
+
+FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_hz,
+                         const WelchOptions& options, const std::string& source) {
+  if (outputs.empty()) throw InputError(source, "outputs", "at least one output channel", "none");
+  FrfEstimate estimate;
+  estimate.spectra = cross_spectra(input, outputs, sample_rate_hz, options, source);
+  estimate.frf = frf_from_spectra(estimate.spectra, options.estimator, source);
+  // The fraction the user asked for (noverlap / nfft may differ from it by the floor).
+  estimate.frf.provenance.overlap = options.overlap;
+  return estimate;
+}
+
+Eigen::VectorXd welch_psd(const Eigen::VectorXd& x, double sample_rate_hz, const WelchOptions& options) {
+  return cross_spectra(channel("x", x), {}, sample_rate_hz, options).Suu;
+}
+
+Eigen::VectorXcd welch_csd(const Eigen::VectorXd& x, const Eigen::VectorXd& y, double sample_rate_hz,
+                           const WelchOptions& options) {
+  return cross_spectra(channel("x", x), {channel("y", y)}, sample_rate_hz, options).Suy[0];
+}
+
+}  // namespace piezobench::dsp

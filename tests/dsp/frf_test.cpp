@@ -1,0 +1,79 @@
+#include "piezobench/dsp/frf.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::dsp {
+namespace {
+
+Frf two_outputs() {
+  Frf f;
+  f.freq_hz = Eigen::VectorXd::LinSpaced(5, 1.0, 5.0);
+  f.input = std::string("u");  // (assigning the literal trips GCC 12 -Wrestrict, PR 105651)
+  f.outputs.emplace_back("d_e");
+  f.outputs.emplace_back("V_s");
+  f.H = {Eigen::VectorXcd::Constant(5, {1.0, -1.0}), Eigen::VectorXcd::Constant(5, 2.0)};
+  f.coherence = {Eigen::VectorXd::Ones(5), Eigen::VectorXd::Ones(5)};
+  f.provenance.source = "run.mat";
+  return f;
+}
+
+TEST(Frf, OutputIndexByName) {
+  const Frf f = two_outputs();
+  EXPECT_EQ(f.output_index("V_s"), 1);
+  try {
+    (void)f.output_index("force");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "output");
+    const std::string what = e.what();
+    EXPECT_NE(what.find("d_e, V_s"), std::string::npos) << what;
+    EXPECT_NE(what.find("run.mat"), std::string::npos) << what;
+  }
+}
+
+TEST(Frf, ValidateAcceptsAConsistentFrfAndNoCoherence) {
+  Frf f = two_outputs();
+  EXPECT_NO_THROW(f.validate());
+  f.coherence.clear();
+  EXPECT_NO_THROW(f.validate());
+}
+
+TEST(Frf, ValidateRejectsEachKindOfInconsistency) {
+  auto expect_field = [](const Frf& f, const std::string& field) {
+    try {
+      f.validate("file.uff");
+      ADD_FAILURE() << "no error for " << field;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), field);
+      EXPECT_NE(std::string(e.what()).find("file.uff"), std::string::npos);
+    }
+  };
+  Frf f = two_outputs();
+  f.freq_hz(3) = f.freq_hz(2);
+  expect_field(f, "freq_hz");
+  f = two_outputs();
+  f.H[1](2) = std::numeric_limits<double>::quiet_NaN();
+  expect_field(f, "V_s");
+  f = two_outputs();
+  f.H[0].resize(4);
+  expect_field(f, "d_e");
+  f = two_outputs();
+  f.H.pop_back();
+  expect_field(f, "H");
+  f = two_outputs();
+  f.coherence[0](0) = std::numeric_limits<double>::infinity();
+  expect_field(f, "d_e coherence");
+  f = two_outputs();
+  f.outputs[1] = "d_e";
+  expect_field(f, "outputs");
+  f = two_outputs();
+  f.coherence.pop_back();
+  expect_field(f, "coherence");
+}
+
+}  // namespace
+}  // namespace piezobench::dsp
