@@ -7,8 +7,8 @@
 
 namespace piezobench::lti {
 
-// Eigenvalues of A, computed on the balanced matrix; sorted by increasing magnitude, then by
-// imaginary part (conjugate pairs adjacent, negative imaginary part first).
+// Eigenvalues of A, computed on the balanced matrix; sorted by increasing magnitude, then by real
+// part, then by imaginary part (conjugate pairs adjacent, negative imaginary part first).
 CVector poles(const StateSpace& sys);
 
 // Transmission (invariant) zeros: the finite generalized eigenvalues of the system pencil
@@ -18,6 +18,12 @@ CVector poles(const StateSpace& sys);
 // system and then on its dual, with rank decisions on SVDs of the scaled system; the zeros are then
 // the eigenvalues of the regular remaining pencil (QZ). Works for MIMO systems of full normal rank
 // (square or not). Same sort order as poles().
+// Rank decisions: the system is first balanced (powers of two), frequency-scaled so that ||A|| ~ 1
+// and its input columns / output rows normalized (none of which moves a zero); a singular value
+// counts as nonzero above 10 eps max(n+p, n+m) ||[A B; C D]||_F of that scaled system.
+// As with any backward-stable method (SLICOT AB08ND, MATLAB tzero), a zero at infinity that is not
+// structural in the given basis (e.g. CB = 0 only up to round-off) can come out as a large finite
+// zero, far beyond the largest pole.
 CVector zeros(const StateSpace& sys);
 
 // H(0) (continuous) or H(1) (discrete); an entry is +-infinity where a pole at the origin (at z = 1)

@@ -11,7 +11,8 @@
 namespace piezobench::lti {
 
 // Roots of the polynomial with coefficients in descending powers (leading zeros dropped):
-// eigenvalues of the balanced companion matrix. Zero-degree polynomial -> empty vector.
+// eigenvalues of the balanced companion matrix (trailing zero coefficients give exact roots at 0),
+// sorted as lti::poles. Zero-degree polynomial -> empty vector.
 CVector roots(const Vector& coefficients);
 // Monic real polynomial whose roots are `r` (conjugate pairs required; the imaginary round-off of
 // the product is dropped). Descending powers, size r.size() + 1.

@@ -28,6 +28,8 @@ struct StateSpace {
   Vector output_delay;       // s, size outputs() or empty (no delay)
 
   StateSpace() = default;
+  // Validates (InputError, see validate()). Conveniences: without states, B and C may be given
+  // empty (any shape); with states, an empty D means no feedthrough.
   StateSpace(Matrix a, Matrix b, Matrix c, Matrix d, double ts = 0.0);
 
   // A static gain y = D u (no states).

@@ -15,7 +15,7 @@ struct TransferFunction {
   double delay = 0.0;        // s
 
   TransferFunction() = default;
-  TransferFunction(Vector numerator, Vector denominator, double ts = 0.0, double delay_s = 0.0);
+  TransferFunction(Vector numerator, Vector denominator, double ts = 0.0, double delay_s = 0.0);  // validates
 
   [[nodiscard]] bool is_discrete() const { return sample_time > 0.0; }
   // Degree of the denominator.
@@ -36,10 +36,11 @@ struct Zpk {
   double delay = 0.0;
 
   Zpk() = default;
-  Zpk(CVector z, CVector p, double k, double ts = 0.0, double delay_s = 0.0);
+  Zpk(CVector z, CVector p, double k, double ts = 0.0, double delay_s = 0.0);  // validates
 
   [[nodiscard]] bool is_discrete() const { return sample_time > 0.0; }
-  // Throws InputError: non-finite values, unpaired complex values, more zeros than poles.
+  // Throws InputError: non-finite values, unpaired complex values (a pair matches to 1e-8
+  // relative), more zeros than poles, negative delay or sample time.
   void validate(const std::string& source = "") const;
 };
 
