@@ -1,0 +1,68 @@
+#pragma once
+// Frequency response functions (dsp::Frf) in files that other tools read: CSV, MATLAB .mat and
+// Universal File Format dataset 58 (ASCII; binary 58b is read too), so modal-analysis tools can
+// exchange FRFs with piezobench.
+//
+// Layouts
+//  CSV   header `freq_Hz,re_NAME,im_NAME,coh_NAME` repeated per output (CLI.md), values %.17g, so
+//        a round trip is exact. On read, coh_ columns are optional, lines starting with '#' and
+//        blank lines are ignored; the input name is not stored (read back as "").
+//  .mat  `freq_Hz` (column, Hz), per output `H_<name>` (complex column) and `coh_<name>` (when the
+//        coherence is known), `input` and `outputs` (char rows; outputs comma-separated, keeps the
+//        order) and `provenance` (struct). Exact round trip. Names must be MATLAB identifiers.
+//  .uff  (also .unv, .uf) one dataset 58 per output: function type 4 (FRF), ordinate type 6
+//        (complex double, 4E20.12 i.e. 13 significant digits), abscissa in Hz (specific data
+//        type 18), evenly spaced (record 7 holds min and increment, E13.5) when the grid is
+//        uniform to 1e-9 relative, else unevenly spaced (E13.5 abscissa per point). So a round trip
+//        keeps H to ~5e-13 relative and the frequencies to 6 significant digits (the format's).
+//        Coherence, when known, follows as a dataset 58 of function type 6 (real double). Node and
+//        direction: response node k+1 for output k, reference node `reference_node`, direction +Z
+//        (3) for both. Channel names go in ID line 2 ("piezobench response: NAME"), ID line 4
+//        ("piezobench reference: NAME") and the ordinate / denominator axis labels; ID line 5
+//        holds the provenance ("welch: est=H1 win=hann-periodic nfft=.. ovl=.. dtr=.. avg=.. fs=..",
+//        whole fields only, within 80 columns).
+//        Reading accepts any mix of ASCII 58 and binary 58b datasets (byte order 1 little / 2 big
+//        endian, IEEE floats, abscissa of uneven binary data as float32 or float64), skips other
+//        datasets, and gathers every function-type-4 dataset (all must share the abscissa and the
+//        reference); names come from the ID lines written above, else the axis labels, else the
+//        entity name / node / direction ("1+Z").
+//
+// Every reader validates the FRF it returns and throws InputError naming the file and the field
+// (column, variable, dataset and record); writers write a temporary file and rename it, so a
+// failure never leaves a partial file.
+#include <filesystem>
+#include <string>
+
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/io/timeseries.hpp"
+
+namespace piezobench::io {
+
+enum class FrfFormat { kCsv, kMat, kUff58 };
+[[nodiscard]] std::string to_string(FrfFormat f);                       // "csv", "mat", "uff58"
+[[nodiscard]] FrfFormat frf_format_from_string(const std::string& s);   // also "uff", "unv"
+// From the extension: .csv, .mat, .uff/.unv/.uf (case-insensitive); InputError otherwise.
+[[nodiscard]] FrfFormat frf_format_from_path(const std::filesystem::path& file);
+
+struct FrfWriteOptions {
+  MatVersion mat_version = MatVersion::kV5;  // .mat only
+  int reference_node = 1000;                 // UFF: node number of the input (reference) DOF
+  std::string date;                          // UFF ID line 3 (e.g. "21-NOV-25 10:48:00"); "" = NONE
+
+  void validate() const;  // InputError naming the field
+};
+
+// Writes `frf` (validated first) in the format of the file's extension.
+void write_frf(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
+void write_frf_csv(const dsp::Frf& frf, const std::filesystem::path& file);
+void write_frf_mat(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
+void write_frf_uff58(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
+
+// Reads an FRF in the format of the file's extension. provenance.source is the time-series file
+// recorded in a .mat FRF, else the FRF file itself.
+[[nodiscard]] dsp::Frf read_frf(const std::filesystem::path& file);
+[[nodiscard]] dsp::Frf read_frf_csv(const std::filesystem::path& file);
+[[nodiscard]] dsp::Frf read_frf_mat(const std::filesystem::path& file);
+[[nodiscard]] dsp::Frf read_frf_uff58(const std::filesystem::path& file);
+
+}  // namespace piezobench::io

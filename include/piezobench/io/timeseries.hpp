@@ -1,0 +1,99 @@
+#pragma once
+// Sampled measurement records (time series) and the files they live in.
+//
+// Readers: MATLAB .mat (v5/v7 and v7.3, through matio) and CSV with a header row. Writers: .mat
+// (v5 by default, v7.3 on request) and CSV. Every reader validates what it returns and throws
+// InputError naming the file, the field or channel, what was expected and what was found: unknown
+// channel (the message lists the available ones), lengths that differ, NaN/Inf (channel and sample
+// index), an empty record, a non-numeric variable, a non-monotonic or non-uniform time vector `t`,
+// a sample rate that contradicts `t`. Every writer writes a temporary file in the target's
+// directory and renames it over the target only when complete, so a failed write leaves no file
+// (and an existing target untouched).
+//
+// File layouts
+//  .mat  one real double vector per channel (row or column; single and integer classes are
+//        converted to double), optionally `t` (s). Written files also hold `fs` (Hz, scalar),
+//        `channels` (char row, the names comma-separated in order: v7.3 lists variables by name),
+//        `units` (struct: one char field per channel that has a unit) and `settings` (struct: one
+//        field per setting, a char row or a real scalar). Channels may instead be the fields of a
+//        1x1 struct variable (ReadOptions::group), as in `data.u`, `data.de`.
+//  .csv  comma-separated; blank lines and lines starting with '#' are ignored; the first other
+//        line is the header. A header cell is a channel name optionally followed by its unit in
+//        square brackets, e.g. `de [m]`. A column named `t` is the time vector (s). A comment
+//        `# sample_rate_Hz: 10000` before the header gives the rate of a file without `t` (the
+//        writer adds it then).
+#include <Eigen/Dense>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace piezobench::io {
+
+using Setting = std::variant<double, std::string>;
+
+struct TimeSeries {
+  std::vector<std::string> names;    // channel names, unique, not "t"
+  Eigen::MatrixXd data;              // samples x channels; column j is channel names[j] (SI units)
+  double sample_rate = 0.0;          // Hz, > 0
+  Eigen::VectorXd t;                 // s, same length as data.rows(); empty when the file has none
+  std::vector<std::string> units;    // per channel ("" = unknown); empty or names.size() entries
+  std::map<std::string, Setting> settings;  // how the record was made (experiment, seed, ...)
+  std::string source;                // file it was read from ("" when built in memory)
+
+  [[nodiscard]] Eigen::Index samples() const { return data.rows(); }
+  [[nodiscard]] Eigen::Index channels() const { return data.cols(); }
+  // Column index of a channel; throws InputError (source, field "channel") listing the names.
+  [[nodiscard]] Eigen::Index index(const std::string& name) const;
+  // The samples of one channel (see index()).
+  [[nodiscard]] Eigen::Ref<const Eigen::VectorXd> channel(const std::string& name) const;
+  // Unit of a channel ("" when unknown).
+  [[nodiscard]] std::string unit(const std::string& name) const;
+  // Throws InputError naming `source` for: no channel or no sample, duplicate or empty names,
+  // sizes that differ, NaN/Inf (channel and sample index), sample_rate <= 0 or not finite, a `t`
+  // that is not strictly increasing.
+  void validate() const;
+};
+
+struct ReadOptions {
+  // Sample rate in Hz; 0 = take it from the time vector `t` (or, for files written by piezobench,
+  // the scalar `fs`). When both this and `t` are present they must agree within time_tolerance.
+  double fs = 0.0;
+  // Channels to read, in this order; empty = every numeric vector in the file except `t`.
+  std::vector<std::string> channels;
+  // .mat only: name of a 1x1 struct variable whose fields are the channels ("" = top level; if
+  // the top level holds no vector but exactly one struct does, that struct is used).
+  std::string group;
+  // Largest accepted deviation of t[k] from t[0] + k / fs, as a fraction of the sample period.
+  // Also the largest accepted relative difference between an explicit fs and the one from `t`.
+  double time_tolerance = 1e-6;
+
+  // Throws InputError (source "ReadOptions") naming the bad field.
+  void validate() const;
+};
+
+enum class MatVersion { kV5, kV73 };
+[[nodiscard]] std::string to_string(MatVersion v);        // "v5", "v7.3"
+[[nodiscard]] MatVersion mat_version_from_string(const std::string& s);  // also "7.3", "-v7.3", "v7"
+
+struct MatWriteOptions {
+  MatVersion version = MatVersion::kV5;  // v5 (MATLAB -v7 compatible) unless v7.3 is asked for
+  bool compress = false;                 // zlib compression of v5 variables (ignored for v7.3)
+};
+
+// Reads a time series; the format comes from the extension (.mat or .csv, case-insensitive).
+[[nodiscard]] TimeSeries read_timeseries(const std::filesystem::path& file, const ReadOptions& options = {});
+[[nodiscard]] TimeSeries read_timeseries_mat(const std::filesystem::path& file, const ReadOptions& options = {});
+[[nodiscard]] TimeSeries read_timeseries_csv(const std::filesystem::path& file, const ReadOptions& options = {});
+
+// Writes `ts` (validated first) as .mat or CSV (format from the extension). Channel names must be
+// MATLAB identifiers (letter, then letters, digits, '_'; at most 63 characters) other than the
+// reserved fs, units, settings, channels for .mat.
+// Throws InputError (source = file) when the data are invalid or the file cannot be written.
+void write_timeseries(const TimeSeries& ts, const std::filesystem::path& file, const MatWriteOptions& options = {});
+void write_timeseries_mat(const TimeSeries& ts, const std::filesystem::path& file, const MatWriteOptions& options = {});
+// CSV: header `t [s],name [unit],...` (t only when present, units only when known), %.17g values.
+void write_timeseries_csv(const TimeSeries& ts, const std::filesystem::path& file);
+
+}  // namespace piezobench::io

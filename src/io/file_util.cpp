@@ -1,0 +1,747 @@
+#include "io/file_util.hpp"
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <random>
+#include <sstream>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::io::detail {
+namespace fs = std::filesystem;
+
+// ---- atomic files ---------------------------------------------------------------------------
+
+namespace {
+
+std::string errno_text(int err) { return std::strerror(err); }
+
+// A name that no other writer (thread or process) picks: pid, a per-process counter and a random
+// tag; O_EXCL below makes a collision an error rather than a shared file.
+fs::path temp_name_for(const fs::path& target) {
+  static std::atomic<unsigned> counter{0};
+  static thread_local std::mt19937_64 rng{std::random_device{}()};
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  char tag[64];
+  std::snprintf(tag, sizeof tag, ".tmp-%d-%u-%08llx", static_cast<int>(::getpid()), counter.fetch_add(1),
+                static_cast<unsigned long long>(rng() & 0xffffffffULL));
+  // Hidden, and the target's extension stays last so tools that sniff extensions behave.
+  return dir / ("." + target.filename().string() + tag + target.extension().string());
+}
+
+void fsync_path(const fs::path& path, int flags) {
+  const int fd = ::open(path.c_str(), flags);
+  if (fd < 0) return;
+  (void)::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
+  if (target_.empty() || !target_.has_filename()) {
+    throw InputError(target_.string(), "output file", "a file name", "an empty name or a directory");
+  }
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    temp_ = temp_name_for(target_);
+    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      ::close(fd);
+      return;
+    }
+    if (errno != EEXIST) {
+      const int err = errno;
+      temp_.clear();
+      throw InputError(target_.string(), "output file", "a writable location",
+                       "cannot create a file in that directory (" + errno_text(err) + ")");
+    }
+  }
+  temp_.clear();
+  throw InputError(target_.string(), "output file", "a free temporary name", "16 collisions");
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_ && !temp_.empty()) {
+    std::error_code ec;
+    fs::remove(temp_, ec);
+  }
+}
+
+void AtomicFile::commit() {
+  // Data first, then the name: after a crash the target is either the old file or the new one.
+  fsync_path(temp_, O_RDONLY | O_CLOEXEC);
+  if (std::rename(temp_.c_str(), target_.c_str()) != 0) {
+    const int err = errno;
+    throw InputError(target_.string(), "output file", "a replaceable file",
+                     "cannot rename the temporary file onto it (" + errno_text(err) + ")");
+  }
+  committed_ = true;
+  fsync_path(target_.has_parent_path() ? target_.parent_path() : fs::path("."), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+}
+
+void write_atomically(const fs::path& target, const std::function<void(std::ostream&)>& body) {
+  AtomicFile out(target);
+  {
+    std::ofstream stream(out.temp_path(), std::ios::binary | std::ios::trunc);
+    if (!stream) {
+      throw InputError(target.string(), "output file", "a writable file", "cannot open the temporary file");
+    }
+    body(stream);
+    stream.flush();
+    if (!stream) {
+      throw InputError(target.string(), "output file", "a complete write",
+                       "a write error (disk full or file size limit?)");
+    }
+    stream.close();
+    if (stream.fail()) {
+      throw InputError(target.string(), "output file", "a complete write", "an error when closing the file");
+    }
+  }
+  out.commit();
+}
+
+std::string read_file(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw InputError(file.string(), "file", "an existing file", "no such file");
+  if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "a regular file", "a directory");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string(), "file", "a readable file", "cannot open it");
+  std::string content;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw InputError(file.string(), "file", "a readable file", "cannot determine its size");
+  content.resize(static_cast<size_t>(size));
+  in.seekg(0, std::ios::beg);
+  in.read(content.data(), size);
+  if (in.gcount() != size) throw InputError(file.string(), "file", "a readable file", "a read error");
+  return content;
+}
+
+// ---- text -----------------------------------------------------------------------------------
+
+std::string to_lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string lower_extension(const fs::path& file) { return to_lower(file.extension().string()); }
+
+std::string_view trim(std::string_view s) {
+  const auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; };
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> split(std::string_view s, char sep) {
+  std::vector<std::string_view> parts;
+  size_t start = 0;
+  for (;;) {
+    const size_t pos = s.find(sep, start);
+    if (pos == std::string_view::npos) {
+      parts.push_back(s.substr(start));
+      return parts;
+    }
+    parts.push_back(s.substr(start, pos - start));
+    start = pos + 1;
+  }
+}
+
+std::optional<double> parse_double(std::string_view token, bool fortran) {
+  token = trim(token);
+  if (token.empty()) return std::nullopt;
+  std::string buffer;
+  if (fortran && token.find_first_of("dD") != std::string_view::npos) {
+    buffer.assign(token);
+    std::replace(buffer.begin(), buffer.end(), 'd', 'e');
+    std::replace(buffer.begin(), buffer.end(), 'D', 'E');
+    token = buffer;
+  }
+  // from_chars rejects a leading '+', which spreadsheets and Fortran write.
+  if (token.front() == '+') {
+    token.remove_prefix(1);
+    if (token.empty() || token.front() == '-' || token.front() == '+') return std::nullopt;
+  }
+  double value = 0.0;
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec == std::errc::result_out_of_range) {
+    // Overflow is a non-finite value for the caller to report; underflow is a zero.
+    std::string copy(token);
+    return std::strtod(copy.c_str(), nullptr);
+  }
+  if (ec != std::errc() || ptr != token.data() + token.size()) return std::nullopt;
+  return value;
+}
+
+std::optional<long long> parse_int(std::string_view token) {
+  token = trim(token);
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  if (token.empty()) return std::nullopt;
+  long long value = 0;
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || ptr != token.data() + token.size()) return std::nullopt;
+  return value;
+}
+
+std::string format_g17(double v) {
+  char buf[32];
+  const int n = std::snprintf(buf, sizeof buf, "%.17g", v);
+  return std::string(buf, static_cast<size_t>(n));
+}
+
+std::string quote(std::string_view text) {
+  std::string out = "'";
+  const size_t limit = 40;
+  for (size_t i = 0; i < text.size() && i < limit; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (std::isprint(c) != 0) {
+      out += static_cast<char>(c);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  if (text.size() > limit) out += "...";
+  return out + "'";
+}
+
+std::string join(const std::vector<std::string>& items, const std::string& sep) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) out += sep;
+    out += items[i];
+  }
+  return out;
+}
+
+bool is_matlab_identifier(const std::string& name) {
+  if (name.empty() || name.size() > 63) return false;
+  if (std::isalpha(static_cast<unsigned char>(name.front())) == 0) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_'; });
+}
+
+// ---- matio ----------------------------------------------------------------------------------
+
+namespace {
+thread_local std::string matio_message;
+
+void matio_log(int log_level, char* message) {
+  // Errors and warnings are kept for our own messages; matio's debug chatter is dropped. Nothing
+  // goes to stderr: the command's stderr is for our progress lines.
+  if ((log_level & (MATIO_LOG_LEVEL_ERROR | MATIO_LOG_LEVEL_CRITICAL | MATIO_LOG_LEVEL_WARNING)) != 0 &&
+      message != nullptr) {
+    matio_message = message;
+  }
+}
+}  // namespace
+
+void install_matio_logger() {
+  static std::once_flag once;
+  std::call_once(once, [] { Mat_LogInitFunc("piezobench", &matio_log); });
+}
+
+std::string take_matio_message() {
+  std::string m = std::move(matio_message);
+  matio_message.clear();
+  return m;
+}
+
+void MatCloser::operator()(mat_t* mat) const {
+  if (mat != nullptr) Mat_Close(mat);
+}
+void MatVarFreer::operator()(matvar_t* var) const {
+  if (var != nullptr) Mat_VarFree(var);
+}
+
+namespace {
+std::string with_matio_reason(const std::string& text) {
+  const std::string reason = take_matio_message();
+  return reason.empty() ? text : text + " (matio: " + reason + ")";
+}
+
+// The first bytes decide whether matio may look at the file at all: a v5/v7 file has a 128-byte
+// header with the version 0x0100 and an endian indicator "IM"/"MI" at bytes 126..127; a v7.3 file
+// is an HDF5 file with the same 128-byte MATLAB header in its user block (or a bare HDF5 file).
+// Anything else (a CSV renamed .mat, a truncated header) is rejected here with a clear message.
+void check_mat_header(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string(), "file", "a readable file", "cannot open it");
+  char header[128] = {};
+  in.read(header, sizeof header);
+  const std::streamsize got = in.gcount();
+  static const char kHdf5[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+  if (got >= 8 && std::memcmp(header, kHdf5, 8) == 0) return;
+  if (got < 128) {
+    throw InputError(file.string(), "file", "a MAT file (128-byte header)",
+                     std::to_string(got) + " bytes in total");
+  }
+  const bool little = header[126] == 'I' && header[127] == 'M';
+  const bool big = header[126] == 'M' && header[127] == 'I';
+  if (!little && !big) {
+    throw InputError(file.string(), "file", "a MAT file (v5, v7 or v7.3)",
+                     "no MATLAB header (bytes 126-127 are " + quote(std::string_view(header + 126, 2)) + ")");
+  }
+  // Version 0x0200 is v7.3: an HDF5 file (at byte 512) that HDF5 itself checks.
+  const auto version = static_cast<unsigned>(
+      little ? (static_cast<unsigned char>(header[124]) | (static_cast<unsigned char>(header[125]) << 8))
+             : ((static_cast<unsigned char>(header[124]) << 8) | static_cast<unsigned char>(header[125])));
+  if (version == 0x0200) return;
+  // matio stops at the first variable it cannot read and reports the ones before it as if the
+  // file ended there, so a truncated file would silently lose channels. Walking the top-level
+  // data element tags (type, byte count) against the file size catches that up front.
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<unsigned long long>(in.tellg());
+  const bool swap = (little != (std::endian::native == std::endian::little));
+  const auto u32 = [&](const unsigned char* p) {
+    std::uint32_t v;
+    std::memcpy(&v, p, 4);
+    return swap ? ((v >> 24) | ((v >> 8) & 0xff00u) | ((v << 8) & 0xff0000u) | (v << 24)) : v;
+  };
+  unsigned long long pos = 128;
+  int index = 0;
+  while (pos < size) {
+    ++index;
+    if (pos + 8 > size) {
+      throw InputError(file.string(), "file", "complete variables",
+                       "a truncated file (variable " + std::to_string(index) + " at byte " + std::to_string(pos) + " has no complete tag)");
+    }
+    unsigned char tag[8];
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(pos));
+    in.read(reinterpret_cast<char*>(tag), 8);
+    const std::uint32_t type = u32(tag);
+    if ((type >> 16) != 0) {  // small data element: type and size share the first 4 bytes
+      pos += 8;
+      continue;
+    }
+    const unsigned long long nbytes = u32(tag + 4);
+    unsigned long long next = pos + 8 + nbytes;
+    if (type != 15) next = (next + 7) / 8 * 8;  // miCOMPRESSED elements are not padded
+    if (pos + 8 + nbytes > size) {
+      throw InputError(file.string(), "file", "complete variables",
+                       "a truncated file (variable " + std::to_string(index) + " at byte " + std::to_string(pos) + " declares " +
+                           std::to_string(nbytes) + " bytes, " + std::to_string(size - pos - 8) + " are left)");
+    }
+    pos = next;
+  }
+}
+}  // namespace
+
+MatFilePtr open_mat_for_reading(const fs::path& file) {
+  install_matio_logger();
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw InputError(file.string(), "file", "an existing file", "no such file");
+  if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "a regular file", "a directory");
+  check_mat_header(file);
+  (void)take_matio_message();
+  MatFilePtr mat(Mat_Open(file.c_str(), MAT_ACC_RDONLY));
+  if (!mat) {
+    throw InputError(file.string(), "file", "a MAT file (v5, v7 or v7.3)", with_matio_reason("matio cannot open it"));
+  }
+  return mat;
+}
+
+std::vector<MatVarInfo> list_mat_variables(mat_t* mat, const fs::path& file) {
+  std::vector<MatVarInfo> out;
+  if (Mat_Rewind(mat) != 0) throw InputError(file.string(), "file", "a readable MAT file", with_matio_reason("cannot rewind"));
+  // A corrupt file can make matio loop on garbage; a real file never holds this many variables.
+  constexpr size_t kMaxVariables = 1u << 20;
+  for (;;) {
+    MatVarPtr var(Mat_VarReadNextInfo(mat));
+    if (!var) break;
+    MatVarInfo info;
+    info.name = var->name != nullptr ? var->name : "";
+    info.class_type = var->class_type;
+    info.is_complex = var->isComplex != 0;
+    if (var->dims != nullptr) info.dims.assign(var->dims, var->dims + std::max(var->rank, 0));
+    out.push_back(std::move(info));
+    if (out.size() > kMaxVariables) {
+      throw InputError(file.string(), "file", "a well-formed MAT file", "more than 2^20 variables (corrupt?)");
+    }
+  }
+  const std::string reason = take_matio_message();
+  if (out.empty() && !reason.empty()) {
+    throw InputError(file.string(), "file", "a well-formed MAT file", "matio: " + reason);
+  }
+  return out;
+}
+
+MatVarPtr read_mat_variable(mat_t* mat, const fs::path& file, const std::string& name) {
+  (void)take_matio_message();
+  MatVarPtr var(Mat_VarRead(mat, name.c_str()));
+  if (!var) {
+    throw InputError(file.string(), name, "a readable variable", with_matio_reason("matio cannot read it (missing or corrupt)"));
+  }
+  // matio may return the header of a variable whose data it could not read (truncated file).
+  if (var->class_type != MAT_C_STRUCT && var->class_type != MAT_C_CELL && var->class_type != MAT_C_EMPTY &&
+      element_count(*var) > 0 && var->data == nullptr) {
+    throw InputError(file.string(), name, "a complete variable", with_matio_reason("its data cannot be read (truncated file?)"));
+  }
+  return var;
+}
+
+bool read_double_vector_into(mat_t* mat, const std::string& name, Eigen::Ref<Eigen::VectorXd> out) {
+  if (out.size() == 0 || out.size() > std::numeric_limits<int>::max() || out.innerStride() != 1) return false;
+  MatVarPtr info(Mat_VarReadInfo(mat, name.c_str()));
+  if (!info || info->class_type != MAT_C_DOUBLE || info->isComplex != 0 || info->isLogical != 0 ||
+      info->compression != MAT_COMPRESSION_NONE || static_cast<Eigen::Index>(element_count(*info)) != out.size()) {
+    (void)take_matio_message();
+    return false;
+  }
+  const bool ok = Mat_VarReadDataLinear(mat, info.get(), out.data(), 0, 1, static_cast<int>(out.size())) == 0;
+  (void)take_matio_message();
+  return ok;
+}
+
+namespace {
+const char* class_name(matio_classes c) {
+  switch (c) {
+    case MAT_C_EMPTY: return "empty";
+    case MAT_C_CELL: return "cell";
+    case MAT_C_STRUCT: return "struct";
+    case MAT_C_OBJECT: return "object";
+    case MAT_C_CHAR: return "char";
+    case MAT_C_SPARSE: return "sparse";
+    case MAT_C_DOUBLE: return "double";
+    case MAT_C_SINGLE: return "single";
+    case MAT_C_INT8: return "int8";
+    case MAT_C_UINT8: return "uint8";
+    case MAT_C_INT16: return "int16";
+    case MAT_C_UINT16: return "uint16";
+    case MAT_C_INT32: return "int32";
+    case MAT_C_UINT32: return "uint32";
+    case MAT_C_INT64: return "int64";
+    case MAT_C_UINT64: return "uint64";
+    case MAT_C_FUNCTION: return "function";
+    case MAT_C_OPAQUE: return "opaque";
+  }
+  return "unknown";
+}
+
+template <typename T>
+void copy_as_double(const void* data, size_t n, double* out) {
+  const T* p = static_cast<const T*>(data);
+  for (size_t i = 0; i < n; ++i) out[i] = static_cast<double>(p[i]);
+}
+
+// Converts n elements of a numeric class to double.
+void to_doubles(matio_classes c, const void* data, size_t n, double* out) {
+  switch (c) {
+    case MAT_C_DOUBLE: std::memcpy(out, data, n * sizeof(double)); return;
+    case MAT_C_SINGLE: copy_as_double<float>(data, n, out); return;
+    case MAT_C_INT8: copy_as_double<mat_int8_t>(data, n, out); return;
+    case MAT_C_UINT8: copy_as_double<mat_uint8_t>(data, n, out); return;
+    case MAT_C_INT16: copy_as_double<mat_int16_t>(data, n, out); return;
+    case MAT_C_UINT16: copy_as_double<mat_uint16_t>(data, n, out); return;
+    case MAT_C_INT32: copy_as_double<mat_int32_t>(data, n, out); return;
+    case MAT_C_UINT32: copy_as_double<mat_uint32_t>(data, n, out); return;
+    case MAT_C_INT64: copy_as_double<mat_int64_t>(data, n, out); return;
+    case MAT_C_UINT64: copy_as_double<mat_uint64_t>(data, n, out); return;
+    default: break;
+  }
+}
+
+bool is_vector_shape(const matvar_t& var) {
+  if (var.rank < 1 || var.dims == nullptr) return false;
+  int non_singleton = 0;
+  for (int i = 0; i < var.rank; ++i) {
+    if (var.dims[i] != 1) ++non_singleton;
+  }
+  return non_singleton <= 1;
+}
+
+std::string name_of(const matvar_t& var, const std::string& field) {
+  return field.empty() && var.name != nullptr ? std::string(var.name) : field;
+}
+}  // namespace
+
+bool is_numeric_class(matio_classes c) {
+  switch (c) {
+    case MAT_C_DOUBLE: case MAT_C_SINGLE: case MAT_C_INT8: case MAT_C_UINT8: case MAT_C_INT16:
+    case MAT_C_UINT16: case MAT_C_INT32: case MAT_C_UINT32: case MAT_C_INT64: case MAT_C_UINT64:
+      return true;
+    default:
+      return false;
+  }
+}
+
+size_t element_count(const matvar_t& var) {
+  if (var.rank < 1 || var.dims == nullptr) return 0;
+  size_t n = 1;
+  for (int i = 0; i < var.rank; ++i) n *= var.dims[i];
+  return n;
+}
+
+std::string describe(const matvar_t& var) {
+  std::string out = var.isComplex != 0 ? "complex " : "";
+  out += var.isLogical != 0 ? "logical" : class_name(var.class_type);
+  out += " ";
+  for (int i = 0; i < var.rank && var.dims != nullptr; ++i) {
+    if (i > 0) out += "x";
+    out += std::to_string(var.dims[i]);
+  }
+  return out;
+}
+
+void copy_real_vector(const matvar_t& var, const std::string& source, const std::string& field, Eigen::Ref<Eigen::VectorXd> out) {
+  const std::string f = name_of(var, field);
+  if (!is_numeric_class(var.class_type) || var.isComplex != 0 || !is_vector_shape(var)) {
+    throw InputError(source, f, "a real numeric vector", describe(var));
+  }
+  const size_t n = element_count(var);
+  if (static_cast<Eigen::Index>(n) != out.size()) {
+    throw InputError(source, f, std::to_string(out.size()) + " samples", std::to_string(n));
+  }
+  if (n > 0) {
+    if (var.data == nullptr) throw InputError(source, f, "a complete variable", "no data (truncated file?)");
+    to_doubles(var.class_type, var.data, n, out.data());
+  }
+}
+
+Eigen::VectorXd to_real_vector(const matvar_t& var, const std::string& source, const std::string& field) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(element_count(var)));
+  copy_real_vector(var, source, field, out);
+  return out;
+}
+
+Eigen::VectorXcd to_complex_vector(const matvar_t& var, const std::string& source, const std::string& field) {
+  const std::string f = name_of(var, field);
+  if (!is_numeric_class(var.class_type) || !is_vector_shape(var)) {
+    throw InputError(source, f, "a numeric (complex) vector", describe(var));
+  }
+  if (var.isComplex == 0) return to_real_vector(var, source, field).cast<std::complex<double>>();
+  const size_t n = element_count(var);
+  Eigen::VectorXcd out(static_cast<Eigen::Index>(n));
+  if (n == 0) return out;
+  const auto* split_data = static_cast<const mat_complex_split_t*>(var.data);
+  if (split_data == nullptr || split_data->Re == nullptr || split_data->Im == nullptr) {
+    throw InputError(source, f, "a complete variable", "no data (truncated file?)");
+  }
+  Eigen::VectorXd re(static_cast<Eigen::Index>(n)), im(static_cast<Eigen::Index>(n));
+  to_doubles(var.class_type, split_data->Re, n, re.data());
+  to_doubles(var.class_type, split_data->Im, n, im.data());
+  out.real() = re;
+  out.imag() = im;
+  return out;
+}
+
+std::string to_text(const matvar_t& var, const std::string& source, const std::string& field) {
+  const std::string f = name_of(var, field);
+  if (var.class_type == MAT_C_EMPTY || element_count(var) == 0) return "";
+  if (var.class_type != MAT_C_CHAR || !is_vector_shape(var) || var.data == nullptr) {
+    throw InputError(source, f, "a char row", describe(var));
+  }
+  const size_t n = element_count(var);
+  std::string out;
+  out.reserve(n);
+  switch (var.data_type) {
+    case MAT_T_UINT16:
+    case MAT_T_UTF16:
+    case MAT_T_INT16: {
+      // MATLAB stores char as UTF-16 code units; piezobench names are ASCII.
+      const auto* p = static_cast<const mat_uint16_t*>(var.data);
+      for (size_t i = 0; i < n; ++i) out += p[i] < 128 ? static_cast<char>(p[i]) : '?';
+      break;
+    }
+    case MAT_T_UINT8:
+    case MAT_T_INT8:
+    case MAT_T_UTF8: {
+      const auto* p = static_cast<const char*>(var.data);
+      out.assign(p, n);
+      break;
+    }
+    default:
+      throw InputError(source, f, "a char row", std::string("char data of matio type ") + std::to_string(var.data_type));
+  }
+  return out;
+}
+
+MatVarPtr make_real_column(const std::string& name, const Eigen::VectorXd& v) {
+  size_t dims[2] = {static_cast<size_t>(v.size()), 1};
+  // matio copies the data (no MAT_F_DONT_COPY_DATA), so the variable owns it.
+  MatVarPtr var(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims,
+                              const_cast<double*>(v.data()), 0));
+  if (!var) throw InputError(name, "", "a variable matio can create", with_matio_reason("Mat_VarCreate failed"));
+  return var;
+}
+
+MatVarPtr make_complex_column(const std::string& name, const Eigen::VectorXcd& v) {
+  size_t dims[2] = {static_cast<size_t>(v.size()), 1};
+  Eigen::VectorXd re = v.real(), im = v.imag();
+  mat_complex_split_t split_data{re.data(), im.data()};
+  MatVarPtr var(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &split_data, MAT_F_COMPLEX));
+  if (!var) throw InputError(name, "", "a variable matio can create", with_matio_reason("Mat_VarCreate failed"));
+  return var;
+}
+
+MatVarPtr make_scalar(const std::string& name, double v) {
+  size_t dims[2] = {1, 1};
+  MatVarPtr var(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &v, 0));
+  if (!var) throw InputError(name, "", "a variable matio can create", with_matio_reason("Mat_VarCreate failed"));
+  return var;
+}
+
+MatVarPtr make_text(const std::string& name, const std::string& text) {
+  size_t dims[2] = {1, text.size()};
+  std::string copy = text;
+  MatVarPtr var(Mat_VarCreate(name.c_str(), MAT_C_CHAR, MAT_T_UTF8, 2, dims, copy.empty() ? nullptr : copy.data(), 0));
+  if (!var) throw InputError(name, "", "a variable matio can create", with_matio_reason("Mat_VarCreate failed"));
+  return var;
+}
+
+MatVarPtr make_struct(const std::string& name, std::vector<std::pair<std::string, MatVarPtr>> fields) {
+  size_t dims[2] = {1, 1};
+  std::vector<const char*> names;
+  names.reserve(fields.size());
+  for (const auto& f : fields) names.push_back(f.first.c_str());
+  names.push_back(nullptr);  // the field list is NULL-terminated
+  MatVarPtr var(Mat_VarCreateStruct2(name.c_str(), 2, dims, names.data()));
+  if (!var) throw InputError(name, "", "a struct matio can create", with_matio_reason("Mat_VarCreateStruct2 failed"));
+  for (auto& f : fields) {
+    // The struct takes ownership of the field variable.
+    Mat_VarSetStructFieldByName(var.get(), f.first.c_str(), 0, f.second.release());
+  }
+  return var;
+}
+
+void MatWriter::write(const MatVarPtr& var) {
+  const std::string name = var->name != nullptr ? var->name : "";
+  (void)take_matio_message();
+  if (Mat_VarWrite(mat_, var.get(), compress_ ? MAT_COMPRESSION_ZLIB : MAT_COMPRESSION_NONE) != 0) {
+    throw InputError(file_.string(), name, "a variable written completely", with_matio_reason("matio write failed"));
+  }
+  written_.push_back(name);
+}
+
+namespace {
+
+// Creates the file, writes the variables and closes it; returns the written names.
+std::vector<std::string> create_and_fill(const fs::path& temp, const fs::path& file, bool v73, bool compress,
+                                         const std::function<void(MatWriter&)>& fill) {
+  (void)take_matio_message();
+  MatFilePtr mat(Mat_CreateVer(temp.c_str(), nullptr, v73 ? MAT_FT_MAT73 : MAT_FT_MAT5));
+  if (!mat) {
+    throw InputError(file.string(), "output file", "a MAT file matio can create", with_matio_reason("Mat_CreateVer failed"));
+  }
+  MatWriter writer(mat.get(), file, compress && !v73);
+  fill(writer);
+  mat_t* raw = mat.release();
+  if (Mat_Close(raw) != 0) {
+    throw InputError(file.string(), "output file", "a complete write", with_matio_reason("closing the MAT file failed"));
+  }
+  return writer.written();
+}
+
+// HDF5 keeps a file it failed to flush (disk full, file size limit) in its global table and
+// crashes on it when the process exits. A v7.3 file is therefore written by a forked child: a
+// failure there cannot leave state behind in this process. The child reports an error message
+// through a pipe and exits without running exit handlers.
+std::vector<std::string> create_and_fill_isolated(const fs::path& temp, const fs::path& file, bool compress,
+                                                  const std::function<void(MatWriter&)>& fill) {
+  int fds[2];
+  if (::pipe(fds) != 0) {
+    const int err = errno;
+    throw InputError(file.string(), "output file", "a pipe for the writer process", errno_text(err));
+  }
+  std::fflush(nullptr);  // buffered output must not be written twice
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int err = errno;
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw InputError(file.string(), "output file", "a writer process", "fork failed (" + errno_text(err) + ")");
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    int code = 0;
+    std::string message;
+    try {
+      const std::vector<std::string> names = create_and_fill(temp, file, true, compress, fill);
+      message = "\n" + join(names, "\n");  // leading newline: success
+    } catch (const std::exception& e) {
+      message = e.what();
+      code = 1;
+    } catch (...) {
+      message = "unknown error";
+      code = 1;
+    }
+    size_t done = 0;
+    while (done < message.size()) {
+      const ssize_t w = ::write(fds[1], message.data() + done, message.size() - done);
+      if (w <= 0) break;
+      done += static_cast<size_t>(w);
+    }
+    ::close(fds[1]);
+    ::_exit(code);
+  }
+  ::close(fds[1]);
+  std::string message;
+  char buf[4096];
+  for (;;) {
+    const ssize_t r = ::read(fds[0], buf, sizeof buf);
+    if (r > 0) {
+      message.append(buf, static_cast<size_t>(r));
+    } else if (r == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && !message.empty() && message.front() == '\n') {
+    std::vector<std::string> names;
+    for (std::string_view n : split(std::string_view(message).substr(1), '\n')) {
+      if (!n.empty()) names.emplace_back(n);
+    }
+    return names;
+  }
+  if (WIFSIGNALED(status)) {
+    throw InputError(file.string(), "output file", "a complete write",
+                     "the v7.3 writer process died (signal " + std::to_string(WTERMSIG(status)) + ")");
+  }
+  // The child's InputError message already names the file.
+  throw InputError(message.empty() ? file.string() + ": output file: the v7.3 writer failed" : message);
+}
+
+}  // namespace
+
+void write_mat_atomically(const fs::path& file, bool v73, bool compress, const std::function<void(MatWriter&)>& fill) {
+  install_matio_logger();
+  AtomicFile out(file);
+  const std::vector<std::string> written =
+      v73 ? create_and_fill_isolated(out.temp_path(), file, compress, fill) : create_and_fill(out.temp_path(), file, false, compress, fill);
+  // matio does not report every failed fwrite (disk full, file size limit); reading the variables
+  // back is cheap next to writing them and proves the file complete before it gets its name.
+  {
+    MatFilePtr check(Mat_Open(out.temp_path().c_str(), MAT_ACC_RDONLY));
+    if (!check) throw InputError(file.string(), "output file", "a complete write", with_matio_reason("the written file does not open"));
+    for (const std::string& name : written) {
+      MatVarPtr var(Mat_VarRead(check.get(), name.c_str()));
+      if (!var || (var->class_type != MAT_C_STRUCT && element_count(*var) > 0 && var->data == nullptr)) {
+        throw InputError(file.string(), name, "a variable written completely", with_matio_reason("it does not read back"));
+      }
+    }
+  }
+  out.commit();
+}
+
+}  // namespace piezobench::io::detail

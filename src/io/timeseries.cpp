@@ -1,0 +1,752 @@
+#include "piezobench/io/timeseries.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+#include "io/file_util.hpp"
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::io {
+namespace fs = std::filesystem;
+using detail::quote;
+
+namespace {
+
+constexpr const char* kTime = "t";
+constexpr const char* kFs = "fs";
+constexpr const char* kUnits = "units";
+constexpr const char* kSettings = "settings";
+constexpr const char* kChannelOrder = "channels";  // comma-separated names, in order (v7.3 lists alphabetically)
+
+std::string format_number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+// NaN/Inf check with the channel and the first bad sample in the message.
+void check_finite(const std::string& source, const std::string& channel, const Eigen::Ref<const Eigen::VectorXd>& v) {
+  if (v.allFinite()) return;
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    if (!std::isfinite(v(k))) {
+      throw InputError(source, channel, "finite samples",
+                       (std::isnan(v(k)) ? std::string("NaN") : std::string(v(k) > 0 ? "Inf" : "-Inf")) +
+                           " at sample " + std::to_string(k));
+    }
+  }
+}
+
+// Strictly increasing and uniform within tol sample periods; returns the sample rate in Hz.
+double sample_rate_from_time(const std::string& source, const Eigen::VectorXd& t, double tol) {
+  check_finite(source, kTime, t);
+  const Eigen::Index n = t.size();
+  for (Eigen::Index k = 1; k < n; ++k) {
+    if (!(t(k) > t(k - 1))) {
+      throw InputError(source, kTime, "a strictly increasing time vector",
+                       "t[" + std::to_string(k) + "] = " + format_number(t(k)) + " after t[" + std::to_string(k - 1) +
+                           "] = " + format_number(t(k - 1)));
+    }
+  }
+  const double dt = (t(n - 1) - t(0)) / static_cast<double>(n - 1);
+  // The reference line t0 + k dt is exact at both ends; measuring deviations from it (instead of
+  // from consecutive differences) catches slow drifts and single jitters alike.
+  for (Eigen::Index k = 1; k + 1 < n; ++k) {
+    const double expected = t(0) + static_cast<double>(k) * dt;
+    const double deviation = std::abs(t(k) - expected) / dt;
+    if (deviation > tol) {
+      throw InputError(source, kTime, "uniform sampling (deviation <= " + format_number(tol) + " sample periods)",
+                       "t[" + std::to_string(k) + "] = " + format_number(t(k)) + ", " + format_number(deviation) +
+                           " periods away from uniform");
+    }
+  }
+  return 1.0 / dt;
+}
+
+bool agree(double a, double b, double tol) { return std::abs(a - b) <= tol * std::abs(b); }
+
+// Sample rate from, in order of precedence for the value returned: an explicit fs, the file's own
+// `fs`, the time vector. Every pair that is present must agree.
+double resolve_sample_rate(const std::string& source, const Eigen::VectorXd& t, double fs_option,
+                           std::optional<double> fs_file, double tol) {
+  std::optional<double> fs_time;
+  if (t.size() >= 2) fs_time = sample_rate_from_time(source, t, tol);
+  if (t.size() == 1) check_finite(source, kTime, t);
+  if (fs_file && !(std::isfinite(*fs_file) && *fs_file > 0.0)) {
+    throw InputError(source, kFs, "a positive finite sample rate in Hz", format_number(*fs_file));
+  }
+  if (fs_option > 0.0 && fs_time && !agree(fs_option, *fs_time, tol)) {
+    throw InputError(source, "fs", "a sample rate consistent with t (" + format_number(*fs_time) + " Hz from t)",
+                     "fs = " + format_number(fs_option) + " Hz given");
+  }
+  if (fs_option > 0.0 && fs_file && !agree(fs_option, *fs_file, tol)) {
+    throw InputError(source, "fs", "a sample rate consistent with the file's fs = " + format_number(*fs_file) + " Hz",
+                     "fs = " + format_number(fs_option) + " Hz given");
+  }
+  if (fs_file && fs_time && !agree(*fs_file, *fs_time, tol)) {
+    throw InputError(source, kFs, "a sample rate consistent with t (" + format_number(*fs_time) + " Hz from t)",
+                     "fs = " + format_number(*fs_file) + " Hz in the file");
+  }
+  if (fs_option > 0.0) return fs_option;
+  if (fs_file) return *fs_file;
+  if (fs_time) return *fs_time;
+  throw InputError(source, "fs", "a time vector t (2 samples or more) or a sample rate (--fs)", "neither");
+}
+
+std::vector<std::string> available_names(const std::vector<std::string>& names) {
+  std::vector<std::string> sorted = names;
+  std::sort(sorted.begin(), sorted.end());
+  return sorted;
+}
+
+[[noreturn]] void throw_unknown_channel(const std::string& source, const std::string& name,
+                                        const std::vector<std::string>& available) {
+  throw InputError(source, "channel " + name,
+                   "one of the channels in the file (" + detail::join(available_names(available)) + ")",
+                   quote(name));
+}
+
+// Channels to read: the requested ones (validated against what exists), or all.
+std::vector<std::string> select_channels(const std::string& source, const ReadOptions& options,
+                                         const std::vector<std::string>& available) {
+  if (options.channels.empty()) {
+    if (available.empty()) throw InputError(source, "channels", "at least one numeric channel", "none");
+    return available;
+  }
+  std::set<std::string> seen;
+  for (const std::string& name : options.channels) {
+    if (std::find(available.begin(), available.end(), name) == available.end()) {
+      throw_unknown_channel(source, name, available);
+    }
+    if (!seen.insert(name).second) throw InputError(source, "channels", "distinct channel names", quote(name) + " twice");
+  }
+  return options.channels;
+}
+
+void check_lengths(const std::string& source, const std::vector<std::string>& names,
+                   const std::vector<Eigen::Index>& lengths, Eigen::Index t_length) {
+  for (size_t j = 1; j < names.size(); ++j) {
+    if (lengths[j] != lengths[0]) {
+      throw InputError(source, names[j], "the length of " + names[0] + " (" + std::to_string(lengths[0]) + " samples)",
+                       std::to_string(lengths[j]) + " samples");
+    }
+  }
+  if (t_length >= 0 && !names.empty() && t_length != lengths[0]) {
+    throw InputError(source, kTime, "the length of " + names[0] + " (" + std::to_string(lengths[0]) + " samples)",
+                     std::to_string(t_length) + " samples");
+  }
+  if (!names.empty() && lengths[0] == 0) throw InputError(source, names[0], "at least one sample", "an empty record");
+}
+
+}  // namespace
+
+// ---- TimeSeries -----------------------------------------------------------------------------
+
+Eigen::Index TimeSeries::index(const std::string& name) const {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) throw_unknown_channel(source, name, names);
+  return static_cast<Eigen::Index>(it - names.begin());
+}
+
+Eigen::Ref<const Eigen::VectorXd> TimeSeries::channel(const std::string& name) const { return data.col(index(name)); }
+
+std::string TimeSeries::unit(const std::string& name) const {
+  const Eigen::Index j = index(name);
+  return units.empty() ? std::string() : units[static_cast<size_t>(j)];
+}
+
+void TimeSeries::validate() const {
+  if (names.empty() || data.cols() == 0) throw InputError(source, "channels", "at least one channel", "none");
+  if (static_cast<Eigen::Index>(names.size()) != data.cols()) {
+    throw InputError(source, "names", std::to_string(data.cols()) + " names (one per data column)",
+                     std::to_string(names.size()));
+  }
+  if (data.rows() == 0) throw InputError(source, names.front(), "at least one sample", "an empty record");
+  std::set<std::string> seen;
+  for (const std::string& name : names) {
+    if (name.empty()) throw InputError(source, "names", "non-empty channel names", "an empty name");
+    if (name == kTime) throw InputError(source, "names", "the time vector in t, not among the channels", quote(name));
+    if (!seen.insert(name).second) throw InputError(source, "names", "distinct channel names", quote(name) + " twice");
+  }
+  if (!units.empty() && units.size() != names.size()) {
+    throw InputError(source, "units", std::to_string(names.size()) + " units (one per channel) or none",
+                     std::to_string(units.size()));
+  }
+  if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) {
+    throw InputError(source, "sample_rate", "a positive finite rate in Hz", format_number(sample_rate));
+  }
+  for (Eigen::Index j = 0; j < data.cols(); ++j) check_finite(source, names[static_cast<size_t>(j)], data.col(j));
+  if (t.size() > 0) {
+    if (t.size() != data.rows()) {
+      throw InputError(source, kTime, std::to_string(data.rows()) + " samples", std::to_string(t.size()));
+    }
+    check_finite(source, kTime, t);
+    for (Eigen::Index k = 1; k < t.size(); ++k) {
+      if (!(t(k) > t(k - 1))) {
+        throw InputError(source, kTime, "a strictly increasing time vector",
+                         "t[" + std::to_string(k) + "] <= t[" + std::to_string(k - 1) + "]");
+      }
+    }
+  }
+}
+
+void ReadOptions::validate() const {
+  if (!(std::isfinite(fs) && fs >= 0.0)) throw InputError("ReadOptions", "fs", "0 (from t) or a positive rate in Hz", format_number(fs));
+  if (!(std::isfinite(time_tolerance) && time_tolerance > 0.0 && time_tolerance < 0.5)) {
+    throw InputError("ReadOptions", "time_tolerance", "a fraction of a sample period in (0, 0.5)", format_number(time_tolerance));
+  }
+  std::set<std::string> seen;
+  for (const std::string& c : channels) {
+    if (c.empty()) throw InputError("ReadOptions", "channels", "non-empty names", "an empty name");
+    if (!seen.insert(c).second) throw InputError("ReadOptions", "channels", "distinct names", quote(c) + " twice");
+  }
+}
+
+std::string to_string(MatVersion v) {
+  switch (v) {
+    case MatVersion::kV5: return "v5";
+    case MatVersion::kV73: return "v7.3";
+  }
+  return "v5";
+}
+
+MatVersion mat_version_from_string(const std::string& s) {
+  const std::string l = detail::to_lower(s);
+  if (l == "v5" || l == "5" || l == "-v5" || l == "v7" || l == "7" || l == "-v7" || l == "v6" || l == "-v6") return MatVersion::kV5;
+  if (l == "v7.3" || l == "7.3" || l == "-v7.3" || l == "v73") return MatVersion::kV73;
+  throw InputError("", "mat version", "v5, v7 or v7.3", quote(s));
+}
+
+// ---- readers --------------------------------------------------------------------------------
+
+TimeSeries read_timeseries(const fs::path& file, const ReadOptions& options) {
+  const std::string ext = detail::lower_extension(file);
+  if (ext == ".mat") return read_timeseries_mat(file, options);
+  if (ext == ".csv") return read_timeseries_csv(file, options);
+  throw InputError(file.string(), "file", "a .mat or .csv file", "extension " + quote(ext));
+}
+
+namespace {
+
+// Where the channels of a MAT file live: the top level or the fields of one struct.
+struct MatLayout {
+  std::vector<std::string> channels;  // numeric vectors (excluding t and fs)
+  std::string group;                  // "" = top level
+  detail::MatVarPtr group_var;        // the struct, read with data, when group is set
+};
+
+bool is_numeric_vector(const detail::MatVarInfo& v) {
+  if (!detail::is_numeric_class(v.class_type) || v.is_complex) return false;
+  int non_singleton = 0;
+  size_t count = 1;
+  for (size_t d : v.dims) {
+    if (d != 1) ++non_singleton;
+    count *= d;
+  }
+  return non_singleton <= 1 && count > 1;
+}
+
+std::vector<std::string> struct_channels(const matvar_t& var) {
+  std::vector<std::string> out;
+  const unsigned nfields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
+  char* const* names = Mat_VarGetStructFieldnames(&var);
+  for (unsigned i = 0; i < nfields && names != nullptr; ++i) {
+    if (names[i] == nullptr || std::string(names[i]) == kTime) continue;
+    matvar_t* field = Mat_VarGetStructFieldByIndex(const_cast<matvar_t*>(&var), i, 0);
+    if (field == nullptr) continue;
+    detail::MatVarInfo info;
+    info.class_type = field->class_type;
+    info.is_complex = field->isComplex != 0;
+    if (field->dims != nullptr) info.dims.assign(field->dims, field->dims + std::max(field->rank, 0));
+    if (is_numeric_vector(info)) out.emplace_back(names[i]);
+  }
+  return out;
+}
+
+detail::MatVarPtr read_group(mat_t* mat, const fs::path& file, const std::string& group) {
+  detail::MatVarPtr var = detail::read_mat_variable(mat, file, group);
+  if (var->class_type != MAT_C_STRUCT || detail::element_count(*var) != 1) {
+    throw InputError(file.string(), group, "a 1x1 struct holding the channels", detail::describe(*var));
+  }
+  return var;
+}
+
+MatLayout mat_layout(mat_t* mat, const fs::path& file, const ReadOptions& options,
+                     const std::vector<detail::MatVarInfo>& vars) {
+  MatLayout layout;
+  if (!options.group.empty()) {
+    const bool exists = std::any_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == options.group; });
+    if (!exists) {
+      std::vector<std::string> names;
+      for (const auto& v : vars) names.push_back(v.name);
+      throw InputError(file.string(), "group " + options.group, "a struct variable of the file (" + detail::join(names) + ")",
+                       quote(options.group));
+    }
+    layout.group = options.group;
+    layout.group_var = read_group(mat, file, options.group);
+    layout.channels = struct_channels(*layout.group_var);
+    return layout;
+  }
+  std::vector<std::string> structs;
+  for (const auto& v : vars) {
+    if (v.name == kTime || v.name == kFs) continue;
+    if (is_numeric_vector(v)) layout.channels.push_back(v.name);
+    if (v.class_type == MAT_C_STRUCT && v.name != kUnits && v.name != kSettings) structs.push_back(v.name);
+  }
+  // Files written by piezobench list their channels in order (HDF5 lists variables by name).
+  const auto order_var = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return v.name == kChannelOrder; });
+  if (order_var != vars.end() && order_var->class_type == MAT_C_CHAR) {
+    const std::string list = detail::to_text(*detail::read_mat_variable(mat, file, kChannelOrder), file.string(), kChannelOrder);
+    std::vector<std::string> ordered;
+    for (std::string_view part : detail::split(list, ',')) ordered.emplace_back(detail::trim(part));
+    std::vector<std::string> sorted_listed = ordered, sorted_found = layout.channels;
+    std::sort(sorted_listed.begin(), sorted_listed.end());
+    std::sort(sorted_found.begin(), sorted_found.end());
+    if (sorted_listed == sorted_found) layout.channels = ordered;
+  }
+  // Channels saved as fields of one struct (`data.u`, `data.de`): used when the top level holds
+  // no vector at all, or when the requested channels are fields of that struct.
+  if (structs.size() == 1) {
+    const bool top_level_has_requested =
+        !options.channels.empty() &&
+        std::all_of(options.channels.begin(), options.channels.end(), [&](const std::string& c) {
+          return std::find(layout.channels.begin(), layout.channels.end(), c) != layout.channels.end();
+        });
+    if (layout.channels.empty() || (!options.channels.empty() && !top_level_has_requested)) {
+      detail::MatVarPtr candidate = read_group(mat, file, structs.front());
+      std::vector<std::string> fields = struct_channels(*candidate);
+      const bool fits = options.channels.empty()
+                            ? !fields.empty()
+                            : std::all_of(options.channels.begin(), options.channels.end(), [&](const std::string& c) {
+                                return std::find(fields.begin(), fields.end(), c) != fields.end();
+                              });
+      if (fits) {
+        layout.group = structs.front();
+        layout.group_var = std::move(candidate);
+        layout.channels = std::move(fields);
+      }
+    }
+  }
+  return layout;
+}
+
+// Text fields of a struct (units) or text/scalar fields (settings); other fields are ignored.
+std::map<std::string, Setting> read_struct_settings(const matvar_t& var, const std::string& source, const std::string& field) {
+  std::map<std::string, Setting> out;
+  if (var.class_type != MAT_C_STRUCT || detail::element_count(var) != 1) {
+    throw InputError(source, field, "a 1x1 struct", detail::describe(var));
+  }
+  const unsigned nfields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
+  char* const* names = Mat_VarGetStructFieldnames(&var);
+  for (unsigned i = 0; i < nfields && names != nullptr; ++i) {
+    matvar_t* f = Mat_VarGetStructFieldByIndex(const_cast<matvar_t*>(&var), i, 0);
+    if (f == nullptr || names[i] == nullptr) continue;
+    const std::string name = names[i];
+    if (f->class_type == MAT_C_CHAR) {
+      out[name] = detail::to_text(*f, source, field + "." + name);
+    } else if (detail::is_numeric_class(f->class_type) && f->isComplex == 0 && detail::element_count(*f) == 1) {
+      out[name] = detail::to_real_vector(*f, source, field + "." + name)(0);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options) {
+  options.validate();
+  const std::string source = file.string();
+  detail::MatFilePtr mat = detail::open_mat_for_reading(file);
+  const std::vector<detail::MatVarInfo> vars = detail::list_mat_variables(mat.get(), file);
+  if (vars.empty()) throw InputError(source, "variables", "at least one variable", "an empty MAT file");
+
+  MatLayout layout = mat_layout(mat.get(), file, options, vars);
+  // A requested channel that exists but is not a numeric vector gets its own message.
+  if (!options.channels.empty()) {
+    for (const std::string& c : options.channels) {
+      if (std::find(layout.channels.begin(), layout.channels.end(), c) != layout.channels.end()) continue;
+      matvar_t* found = nullptr;
+      detail::MatVarPtr top;
+      if (layout.group_var) {
+        found = Mat_VarGetStructFieldByName(layout.group_var.get(), c.c_str(), 0);
+      } else if (std::any_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == c; })) {
+        top = detail::read_mat_variable(mat.get(), file, c);
+        found = top.get();
+      }
+      if (found != nullptr) {
+        const std::string field = layout.group.empty() ? c : layout.group + "." + c;
+        throw InputError(source, field, "a real numeric vector (2 samples or more)", detail::describe(*found));
+      }
+    }
+  }
+  std::vector<std::string> available = layout.channels;
+  const std::vector<std::string> names = select_channels(source, options, available);
+
+  // Lengths come from the variables' headers, so the matrix is allocated once and every channel
+  // is copied straight into its column (records reach 10^7 samples: no second copy).
+  const auto field_of = [&](const std::string& name) {
+    return layout.group_var ? Mat_VarGetStructFieldByName(layout.group_var.get(), name.c_str(), 0) : nullptr;
+  };
+  std::vector<Eigen::Index> lengths;
+  for (const std::string& name : names) {
+    if (layout.group_var) {
+      lengths.push_back(static_cast<Eigen::Index>(detail::element_count(*field_of(name))));
+    } else {
+      const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; });
+      size_t count = 1;
+      for (size_t d : info->dims) count *= d;
+      lengths.push_back(static_cast<Eigen::Index>(count));
+    }
+  }
+
+  TimeSeries ts;
+  ts.source = source;
+  // The time vector: inside the group if it has one, else at the top level.
+  Eigen::Index t_length = -1;
+  matvar_t* t_in_group = field_of(kTime);
+  if (t_in_group != nullptr) {
+    ts.t = detail::to_real_vector(*t_in_group, source, layout.group + ".t");
+    t_length = ts.t.size();
+  } else if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kTime; })) {
+    detail::MatVarPtr tv = detail::read_mat_variable(mat.get(), file, kTime);
+    ts.t = detail::to_real_vector(*tv, source, kTime);
+    t_length = ts.t.size();
+  }
+  check_lengths(source, names, lengths, t_length);
+
+  std::optional<double> fs_file;
+  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kFs; })) {
+    detail::MatVarPtr fv = detail::read_mat_variable(mat.get(), file, kFs);
+    const Eigen::VectorXd f = detail::to_real_vector(*fv, source, kFs);
+    if (f.size() != 1) throw InputError(source, kFs, "a scalar sample rate in Hz", detail::describe(*fv));
+    fs_file = f(0);
+  }
+
+  ts.names = names;
+  ts.data.resize(lengths.front(), static_cast<Eigen::Index>(names.size()));
+  for (size_t j = 0; j < names.size(); ++j) {
+    const std::string field = layout.group.empty() ? names[j] : layout.group + "." + names[j];
+    const auto col = static_cast<Eigen::Index>(j);
+    if (layout.group_var) {
+      detail::copy_real_vector(*field_of(names[j]), source, field, ts.data.col(col));
+    } else if (!detail::read_double_vector_into(mat.get(), names[j], ts.data.col(col))) {
+      const detail::MatVarPtr v = detail::read_mat_variable(mat.get(), file, names[j]);
+      detail::copy_real_vector(*v, source, field, ts.data.col(col));
+    }
+    check_finite(source, field, ts.data.col(col));
+  }
+  ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_file, options.time_tolerance);
+
+  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kUnits; })) {
+    detail::MatVarPtr uv = detail::read_mat_variable(mat.get(), file, kUnits);
+    if (uv->class_type == MAT_C_STRUCT) {
+      const auto units = read_struct_settings(*uv, source, kUnits);
+      ts.units.assign(names.size(), "");
+      for (size_t j = 0; j < names.size(); ++j) {
+        const auto it = units.find(names[j]);
+        if (it != units.end() && std::holds_alternative<std::string>(it->second)) ts.units[j] = std::get<std::string>(it->second);
+      }
+    }
+  }
+  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kSettings; })) {
+    detail::MatVarPtr sv = detail::read_mat_variable(mat.get(), file, kSettings);
+    if (sv->class_type == MAT_C_STRUCT) ts.settings = read_struct_settings(*sv, source, kSettings);
+  }
+  ts.validate();
+  return ts;
+}
+
+namespace {
+
+struct HeaderCell {
+  std::string name;
+  std::string unit;
+};
+
+std::string unquote(std::string_view s) {
+  s = detail::trim(s);
+  if (s.size() >= 2 && s.front() == '"' && s.back() == '"') s = detail::trim(s.substr(1, s.size() - 2));
+  return std::string(s);
+}
+
+HeaderCell parse_header_cell(std::string_view cell, const std::string& source, size_t line_no, size_t column) {
+  std::string text = unquote(cell);
+  HeaderCell out;
+  const size_t open = text.find('[');
+  if (open != std::string::npos) {
+    const size_t close = text.find(']', open);
+    if (close == std::string::npos || detail::trim(std::string_view(text).substr(close + 1)).size() != 0) {
+      throw InputError(source, "header (line " + std::to_string(line_no) + ", column " + std::to_string(column + 1) + ")",
+                       "NAME or NAME [UNIT]", quote(text));
+    }
+    out.unit = std::string(detail::trim(std::string_view(text).substr(open + 1, close - open - 1)));
+    out.name = std::string(detail::trim(std::string_view(text).substr(0, open)));
+  } else {
+    out.name = text;
+  }
+  if (out.name.empty()) {
+    throw InputError(source, "header (line " + std::to_string(line_no) + ", column " + std::to_string(column + 1) + ")",
+                     "a channel name", quote(text));
+  }
+  return out;
+}
+
+bool is_comment_or_blank(std::string_view line) {
+  const std::string_view t = detail::trim(line);
+  return t.empty() || t.front() == '#';
+}
+
+}  // namespace
+
+TimeSeries read_timeseries_csv(const fs::path& file, const ReadOptions& options) {
+  options.validate();
+  const std::string source = file.string();
+  const std::string content = detail::read_file(file);
+  if (content.find('\0') != std::string::npos) {
+    throw InputError(source, "file", "a text (CSV) file", "binary data (a NUL byte at offset " +
+                                                              std::to_string(content.find('\0')) + ")");
+  }
+  const std::string_view text(content);
+
+  size_t pos = 0;
+  size_t line_no = 0;
+  auto next_line = [&](std::string_view& line) {
+    if (pos >= text.size()) return false;
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    line = text.substr(pos, end - pos);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    pos = end + 1;
+    ++line_no;
+    return true;
+  };
+
+  std::string_view line;
+  bool have_header = false;
+  std::optional<double> fs_comment;
+  while (next_line(line)) {
+    if (!is_comment_or_blank(line)) {
+      have_header = true;
+      break;
+    }
+    // "# sample_rate_Hz: 10000", written by write_timeseries_csv when there is no time column.
+    const std::string_view body = detail::trim(line);
+    constexpr std::string_view kRateKey = "sample_rate_Hz:";
+    if (body.size() > 1) {
+      const std::string_view rest = detail::trim(body.substr(1));
+      if (rest.substr(0, kRateKey.size()) == kRateKey) {
+        fs_comment = detail::parse_double(rest.substr(kRateKey.size()));
+        if (!fs_comment) {
+          throw InputError(source, "sample_rate_Hz (line " + std::to_string(line_no) + ")", "a number in Hz",
+                           quote(rest.substr(kRateKey.size())));
+        }
+      }
+    }
+  }
+  if (!have_header) throw InputError(source, "header", "a header row (channel names)", "no line other than comments");
+
+  const std::vector<std::string_view> cells = detail::split(line, ',');
+  std::vector<HeaderCell> header;
+  header.reserve(cells.size());
+  for (size_t c = 0; c < cells.size(); ++c) header.push_back(parse_header_cell(cells[c], source, line_no, c));
+  std::set<std::string> seen;
+  std::vector<std::string> available;
+  int time_column = -1;
+  for (size_t c = 0; c < header.size(); ++c) {
+    if (!seen.insert(header[c].name).second) {
+      throw InputError(source, "header", "distinct column names", quote(header[c].name) + " twice");
+    }
+    if (header[c].name == kTime) {
+      time_column = static_cast<int>(c);
+      if (!header[c].unit.empty() && header[c].unit != "s") {
+        throw InputError(source, "t", "time in seconds (unit [s])", "unit " + quote(header[c].unit));
+      }
+    } else {
+      available.push_back(header[c].name);
+    }
+  }
+  const std::vector<std::string> names = select_channels(source, options, available);
+  // For each CSV column, the TimeSeries column it fills (-1: not read, -2: the time vector).
+  std::vector<int> target(header.size(), -1);
+  for (size_t j = 0; j < names.size(); ++j) {
+    for (size_t c = 0; c < header.size(); ++c) {
+      if (header[c].name == names[j]) target[c] = static_cast<int>(j);
+    }
+  }
+  if (time_column >= 0) target[static_cast<size_t>(time_column)] = -2;
+
+  // Upper bound of the number of rows, so the matrix is allocated once.
+  const auto max_rows = static_cast<Eigen::Index>(std::count(text.begin() + static_cast<std::ptrdiff_t>(pos), text.end(), '\n') + 1);
+  Eigen::MatrixXd data(max_rows, static_cast<Eigen::Index>(names.size()));
+  Eigen::VectorXd t(time_column >= 0 ? max_rows : 0);
+  Eigen::Index rows = 0;
+  const size_t ncols = header.size();
+  while (next_line(line)) {
+    if (is_comment_or_blank(line)) continue;
+    size_t start = 0;
+    for (size_t c = 0; c < ncols; ++c) {
+      const size_t comma = c + 1 < ncols ? line.find(',', start) : std::string_view::npos;
+      if (c + 1 < ncols && comma == std::string_view::npos) {
+        throw InputError(source, "line " + std::to_string(line_no), std::to_string(ncols) + " comma-separated fields",
+                         std::to_string(c + 1));
+      }
+      const std::string_view cell = line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+      if (c + 1 == ncols && cell.find(',') != std::string_view::npos) {
+        throw InputError(source, "line " + std::to_string(line_no), std::to_string(ncols) + " comma-separated fields",
+                         std::to_string(ncols + static_cast<size_t>(std::count(cell.begin(), cell.end(), ','))));
+      }
+      start = comma + 1;
+      if (target[c] == -1) continue;
+      const std::optional<double> v = detail::parse_double(cell);
+      const std::string& name = header[c].name;
+      if (!v) {
+        throw InputError(source, name + " (line " + std::to_string(line_no) + ")", "a number",
+                         detail::trim(cell).empty() ? std::string("an empty cell") : quote(detail::trim(cell)));
+      }
+      if (!std::isfinite(*v)) {
+        throw InputError(source, name, "finite samples",
+                         quote(detail::trim(cell)) + " at sample " + std::to_string(rows) + " (line " + std::to_string(line_no) + ")");
+      }
+      if (target[c] == -2) {
+        t(rows) = *v;
+      } else {
+        data(rows, target[c]) = *v;
+      }
+    }
+    ++rows;
+  }
+  if (rows == 0) throw InputError(source, "data", "at least one data row after the header", "none");
+
+  TimeSeries ts;
+  ts.source = source;
+  ts.names = names;
+  ts.data = data.topRows(rows);
+  if (time_column >= 0) ts.t = t.head(rows);
+  ts.units.assign(names.size(), "");
+  for (size_t j = 0; j < names.size(); ++j) {
+    for (const HeaderCell& h : header) {
+      if (h.name == names[j]) ts.units[j] = h.unit;
+    }
+  }
+  if (std::all_of(ts.units.begin(), ts.units.end(), [](const std::string& u) { return u.empty(); })) ts.units.clear();
+  ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_comment, options.time_tolerance);
+  ts.validate();
+  return ts;
+}
+
+// ---- writers --------------------------------------------------------------------------------
+
+void write_timeseries(const TimeSeries& ts, const fs::path& file, const MatWriteOptions& options) {
+  const std::string ext = detail::lower_extension(file);
+  if (ext == ".mat") return write_timeseries_mat(ts, file, options);
+  if (ext == ".csv") return write_timeseries_csv(ts, file);
+  throw InputError(file.string(), "output file", "a .mat or .csv file", "extension " + quote(ext));
+}
+
+namespace {
+
+// Validates for writing: the data, and the names the format needs. Errors name the target file.
+void validate_for_writing(const TimeSeries& ts, const fs::path& file, bool mat) {
+  try {
+    ts.validate();
+  } catch (const InputError& e) {
+    throw e.with_source(file.string());
+  }
+  const std::string target = file.string();
+  if (!mat) {
+    for (const std::string& name : ts.names) {
+      if (name.find_first_of(",\n\r[]\"") != std::string::npos || name.front() == '#' || name != detail::trim(name)) {
+        throw InputError(target, "channel " + name, "a name without ',', brackets, quotes, line breaks or edge spaces", quote(name));
+      }
+    }
+    for (const std::string& unit : ts.units) {
+      if (unit.find_first_of(",\n\r[]\"") != std::string::npos) {
+        throw InputError(target, "units", "units without ',', brackets, quotes or line breaks", quote(unit));
+      }
+    }
+    return;
+  }
+  for (const std::string& name : ts.names) {
+    if (!detail::is_matlab_identifier(name)) {
+      throw InputError(target, "channel " + name, "a MATLAB variable name (letter, then letters, digits, _; <= 63)", quote(name));
+    }
+    if (name == kFs || name == kUnits || name == kSettings || name == kChannelOrder) {
+      throw InputError(target, "channel " + name, "a name other than the reserved t, fs, units, settings, channels", quote(name));
+    }
+  }
+  for (const auto& [key, value] : ts.settings) {
+    if (!detail::is_matlab_identifier(key)) {
+      throw InputError(target, "settings", "MATLAB field names (letter, then letters, digits, _)", quote(key));
+    }
+  }
+}
+
+}  // namespace
+
+void write_timeseries_mat(const TimeSeries& ts, const fs::path& file, const MatWriteOptions& options) {
+  validate_for_writing(ts, file, /*mat=*/true);
+  const bool v73 = options.version == MatVersion::kV73;
+  detail::write_mat_atomically(file, v73, options.compress, [&](detail::MatWriter& w) {
+    if (ts.t.size() > 0) w.write(detail::make_real_column(kTime, ts.t));
+    for (Eigen::Index j = 0; j < ts.data.cols(); ++j) {
+      w.write(detail::make_real_column(ts.names[static_cast<size_t>(j)], ts.data.col(j)));
+    }
+    w.write(detail::make_scalar(kFs, ts.sample_rate));
+    w.write(detail::make_text(kChannelOrder, detail::join(ts.names, ",")));
+    std::vector<std::pair<std::string, detail::MatVarPtr>> unit_fields;
+    if (ts.t.size() > 0) unit_fields.emplace_back(kTime, detail::make_text(kTime, "s"));
+    for (size_t j = 0; j < ts.units.size(); ++j) {
+      if (!ts.units[j].empty()) unit_fields.emplace_back(ts.names[j], detail::make_text(ts.names[j], ts.units[j]));
+    }
+    if (!ts.units.empty()) unit_fields.emplace_back(kFs, detail::make_text(kFs, "Hz"));
+    if (!unit_fields.empty() && !ts.units.empty()) w.write(detail::make_struct(kUnits, std::move(unit_fields)));
+    if (!ts.settings.empty()) {
+      std::vector<std::pair<std::string, detail::MatVarPtr>> fields;
+      for (const auto& [key, value] : ts.settings) {
+        if (std::holds_alternative<double>(value)) {
+          fields.emplace_back(key, detail::make_scalar(key, std::get<double>(value)));
+        } else {
+          fields.emplace_back(key, detail::make_text(key, std::get<std::string>(value)));
+        }
+      }
+      w.write(detail::make_struct(kSettings, std::move(fields)));
+    }
+  });
+}
+
+void write_timeseries_csv(const TimeSeries& ts, const fs::path& file) {
+  validate_for_writing(ts, file, /*mat=*/false);
+  detail::write_atomically(file, [&](std::ostream& out) {
+    const bool has_t = ts.t.size() > 0;
+    std::string line;
+    // CSV has no other place for the rate: without a time column it goes in a comment line
+    // that read_timeseries_csv understands (and other tools skip as a comment).
+    if (!has_t) out << "# sample_rate_Hz: " << detail::format_g17(ts.sample_rate) << '\n';
+    if (has_t) line += "t [s]";
+    for (size_t j = 0; j < ts.names.size(); ++j) {
+      if (has_t || j > 0) line += ',';
+      line += ts.names[j];
+      if (!ts.units.empty() && !ts.units[j].empty()) line += " [" + ts.units[j] + "]";
+    }
+    out << line << '\n';
+    char buf[32];
+    for (Eigen::Index k = 0; k < ts.data.rows(); ++k) {
+      line.clear();
+      if (has_t) line += detail::format_g17(ts.t(k));
+      for (Eigen::Index j = 0; j < ts.data.cols(); ++j) {
+        if (has_t || j > 0) line += ',';
+        const int n = std::snprintf(buf, sizeof buf, "%.17g", ts.data(k, j));
+        line.append(buf, static_cast<size_t>(n));
+      }
+      line += '\n';
+      out << line;
+      if (!out) return;  // write_atomically reports the stream failure
+    }
+  });
+}
+
+}  // namespace piezobench::io

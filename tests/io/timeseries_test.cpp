@@ -1,0 +1,447 @@
+// Time-series files: .mat (v5, v7.3, compressed, made by scipy) and CSV; validation messages;
+// atomic writes.
+#include "piezobench/io/timeseries.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+
+#include <csignal>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "io/file_util.hpp"
+#include "piezobench/core/error.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::io {
+namespace {
+
+namespace fs = std::filesystem;
+using test::all_near;
+using test::TempDir;
+using test::Tolerance;
+
+constexpr Tolerance kExact{0.0, 0.0};
+
+// A record with a time vector, three channels with units and two settings.
+TimeSeries sample_series(Eigen::Index n = 257) {
+  TimeSeries ts;
+  ts.names = {"u", "de", "Vs"};
+  ts.sample_rate = 10000.0;
+  ts.t.resize(n);
+  ts.data.resize(n, 3);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    ts.t(k) = static_cast<double>(k) / ts.sample_rate;
+    ts.data(k, 0) = std::sin(0.1 * static_cast<double>(k)) + 0.1;
+    ts.data(k, 1) = -1.7e-5 * std::cos(0.37 * static_cast<double>(k)) / 3.0;
+    ts.data(k, 2) = std::exp(-1e-3 * static_cast<double>(k)) / 7.0;
+  }
+  ts.units = {"V", "m", "V"};
+  ts.settings["experiment"] = std::string("frf-noise");
+  ts.settings["seed"] = 42.0;
+  return ts;
+}
+
+void expect_same(const TimeSeries& got, const TimeSeries& want) {
+  EXPECT_EQ(got.names, want.names);
+  EXPECT_TRUE(all_near(got.data, want.data, kExact));
+  EXPECT_TRUE(all_near(got.t, want.t, kExact));
+  EXPECT_EQ(got.sample_rate, want.sample_rate);
+  EXPECT_EQ(got.units, want.units);
+}
+
+// The message of the InputError thrown by f (fails the test if none is thrown).
+template <typename F>
+std::string input_error(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not an InputError: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "no exception";
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+nlohmann::json expected_json() {
+  return nlohmann::json::parse(test::read_text(test::fixture_path("io/scipy_mat_expected.json")));
+}
+
+// ---- round trips ----------------------------------------------------------------------------
+
+TEST(TimeSeriesMat, V5RoundTripIsExact) {
+  TempDir dir;
+  const TimeSeries ts = sample_series();
+  const fs::path file = dir.path() / "rec.mat";
+  write_timeseries(ts, file);
+  const TimeSeries back = read_timeseries(file);
+  expect_same(back, ts);
+  EXPECT_EQ(back.source, file.string());
+  ASSERT_EQ(back.settings.size(), 2u);
+  EXPECT_EQ(std::get<std::string>(back.settings.at("experiment")), "frf-noise");
+  EXPECT_EQ(std::get<double>(back.settings.at("seed")), 42.0);
+}
+
+TEST(TimeSeriesMat, V73RoundTripIsExact) {
+  TempDir dir;
+  const TimeSeries ts = sample_series();
+  const fs::path file = dir.path() / "rec73.mat";
+  write_timeseries_mat(ts, file, {.version = MatVersion::kV73});
+  // A v7.3 file is HDF5 underneath.
+  const std::string head = test::read_text(file).substr(512, 4);
+  EXPECT_EQ(head, "\x89HDF");
+  const TimeSeries back = read_timeseries_mat(file);
+  expect_same(back, ts);
+  EXPECT_EQ(std::get<std::string>(back.settings.at("experiment")), "frf-noise");
+}
+
+TEST(TimeSeriesMat, CompressedRoundTripAndChannelSelection) {
+  TempDir dir;
+  const TimeSeries ts = sample_series(1000);
+  const fs::path file = dir.path() / "rec.mat";
+  write_timeseries_mat(ts, file, {.version = MatVersion::kV5, .compress = true});
+  ReadOptions options;
+  options.channels = {"Vs", "u"};
+  const TimeSeries back = read_timeseries_mat(file, options);
+  ASSERT_EQ(back.names, (std::vector<std::string>{"Vs", "u"}));
+  EXPECT_TRUE(all_near(back.channel("Vs"), ts.channel("Vs"), kExact));
+  EXPECT_TRUE(all_near(back.channel("u"), ts.channel("u"), kExact));
+  EXPECT_EQ(back.unit("Vs"), "V");
+}
+
+TEST(TimeSeriesMat, WithoutTimeVectorTheRateComesFromFs) {
+  TempDir dir;
+  TimeSeries ts = sample_series();
+  ts.t.resize(0);
+  ts.sample_rate = 12345.678;
+  const fs::path file = dir.path() / "no_t.mat";
+  write_timeseries_mat(ts, file);
+  const TimeSeries back = read_timeseries_mat(file);
+  EXPECT_EQ(back.sample_rate, 12345.678);
+  EXPECT_EQ(back.t.size(), 0);
+  // An explicit rate that contradicts the file's fs is an error naming both.
+  ReadOptions options;
+  options.fs = 1000.0;
+  const std::string msg = input_error([&] { (void)read_timeseries_mat(file, options); });
+  EXPECT_TRUE(contains(msg, "fs")) << msg;
+  EXPECT_TRUE(contains(msg, "12345.678")) << msg;
+}
+
+TEST(TimeSeriesCsv, RoundTripIsExact) {
+  TempDir dir;
+  const TimeSeries ts = sample_series();
+  const fs::path file = dir.path() / "rec.csv";
+  write_timeseries(ts, file);
+  const std::string text = test::read_text(file);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "t [s],u [V],de [m],Vs [V]");
+  const TimeSeries back = read_timeseries(file);
+  expect_same(back, ts);
+}
+
+TEST(TimeSeriesCsv, WithoutTimeVectorTheRateIsKeptInAComment) {
+  TempDir dir;
+  TimeSeries ts = sample_series(10);
+  ts.t.resize(0);
+  ts.units.clear();
+  ts.sample_rate = 3333.3333333333335;
+  const fs::path file = dir.path() / "no_t.csv";
+  write_timeseries_csv(ts, file);
+  const TimeSeries back = read_timeseries_csv(file);
+  EXPECT_EQ(back.sample_rate, ts.sample_rate);
+  EXPECT_TRUE(all_near(back.data, ts.data, kExact));
+}
+
+TEST(TimeSeriesCsv, CommentsUnitsAndExplicitRate) {
+  TempDir dir;
+  const fs::path file = dir.path() / "hand.csv";
+  write_text(file, "# bench 2, unit 3\n\n u , de [um] ,Vs[V]\r\n# a comment in the data\n1,2,3\r\n4,5e-1,+6\n7, -8 ,9\n");
+  ReadOptions options;
+  options.fs = 500.0;
+  const TimeSeries ts = read_timeseries_csv(file, options);
+  EXPECT_EQ(ts.names, (std::vector<std::string>{"u", "de", "Vs"}));
+  EXPECT_EQ(ts.units, (std::vector<std::string>{"", "um", "V"}));
+  Eigen::MatrixXd expected(3, 3);
+  expected << 1, 2, 3, 4, 0.5, 6, 7, -8, 9;
+  EXPECT_TRUE(all_near(ts.data, expected, kExact));
+  EXPECT_EQ(ts.sample_rate, 500.0);
+  // Without t and without fs there is no rate.
+  const std::string msg = input_error([&] { (void)read_timeseries_csv(file); });
+  EXPECT_TRUE(contains(msg, file.string()) && contains(msg, "fs")) << msg;
+}
+
+TEST(TimeSeriesCsv, RateFromTimeAndConsistencyWithFs) {
+  TempDir dir;
+  const fs::path file = dir.path() / "t.csv";
+  std::string text = "t,x\n";
+  for (int k = 0; k < 100; ++k) text += detail::format_g17(k * 0.001) + "," + std::to_string(k) + "\n";
+  write_text(file, text);
+  EXPECT_NEAR(read_timeseries_csv(file).sample_rate, 1000.0, 1e-9);
+  ReadOptions ok;
+  ok.fs = 1000.0;
+  EXPECT_EQ(read_timeseries_csv(file, ok).sample_rate, 1000.0);
+  ReadOptions bad;
+  bad.fs = 1001.0;
+  const std::string msg = input_error([&] { (void)read_timeseries_csv(file, bad); });
+  EXPECT_TRUE(contains(msg, file.string()) && contains(msg, "fs") && contains(msg, "1001")) << msg;
+}
+
+// ---- files made elsewhere (scipy.io.savemat, scripts/fixtures/make_io_fixtures.py) ------------
+
+TEST(TimeSeriesScipy, TwoOutputsFileReadsExactly) {
+  const nlohmann::json expected = expected_json()["two_outputs"];
+  for (const char* name : {"io/scipy_two_outputs.mat", "io/scipy_compressed.mat"}) {
+    SCOPED_TRACE(name);
+    const TimeSeries ts = read_timeseries(test::fixture_path(name));
+    EXPECT_EQ(ts.names, expected["names"].get<std::vector<std::string>>());
+    ASSERT_EQ(ts.samples(), expected["samples"].get<Eigen::Index>());
+    EXPECT_TRUE(test::near(ts.sample_rate, expected["fs"].get<double>(), test::kRoundoff));
+    for (const std::string channel : {"u_dac", "d_enc", "V_force"}) {
+      const auto first = expected["first"][channel].get<std::vector<double>>();
+      for (size_t k = 0; k < first.size(); ++k) EXPECT_EQ(ts.channel(channel)(static_cast<Eigen::Index>(k)), first[k]) << channel;
+      EXPECT_EQ(ts.channel(channel)(ts.samples() - 1), expected["last"][channel].get<double>()) << channel;
+      const double sum = ts.channel(channel).sum();
+      const double scale = ts.channel(channel).cwiseAbs().sum();
+      EXPECT_TRUE(test::near(sum, expected["sum"][channel].get<double>(), Tolerance{0.0, 1e-13 * scale})) << channel;
+    }
+    EXPECT_EQ(ts.t(4), expected["first"]["t"][4].get<double>());
+  }
+}
+
+TEST(TimeSeriesScipy, ChannelsInAStruct) {
+  const nlohmann::json expected = expected_json()["struct"];
+  const fs::path file = test::fixture_path("io/scipy_struct.mat");
+  const TimeSeries ts = read_timeseries(file);  // the only struct is found without being named
+  EXPECT_EQ(ts.names, (std::vector<std::string>{"u", "y"}));
+  EXPECT_TRUE(test::near(ts.sample_rate, expected["fs"].get<double>(), test::kRoundoff));
+  EXPECT_EQ(ts.channel("y")(ts.samples() - 1), expected["y_last"].get<double>());
+  ReadOptions options;
+  options.group = "meas";
+  options.channels = {"y"};
+  const TimeSeries y = read_timeseries(file, options);
+  EXPECT_EQ(y.names, std::vector<std::string>{"y"});
+  EXPECT_EQ(y.channel("y")(y.samples() - 1), expected["y_last"].get<double>());
+  ReadOptions wrong;
+  wrong.group = "operator";
+  const std::string msg = input_error([&] { (void)read_timeseries(file, wrong); });
+  EXPECT_TRUE(contains(msg, "operator") && contains(msg, "struct") && contains(msg, "char")) << msg;
+}
+
+TEST(TimeSeriesScipy, NumericClassesAreConvertedAndOtherVariablesRejected) {
+  const nlohmann::json expected = expected_json()["types"];
+  const fs::path file = test::fixture_path("io/scipy_types.mat");
+  ReadOptions options;
+  options.channels = {"a", "b"};
+  const TimeSeries ts = read_timeseries(file, options);
+  const auto a = expected["a"].get<std::vector<double>>(), b = expected["b"].get<std::vector<double>>();
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(ts.channel("a")(static_cast<Eigen::Index>(k)), a[k]);
+    EXPECT_EQ(ts.channel("b")(static_cast<Eigen::Index>(k)), b[k]);
+  }
+  for (const auto& [channel, found] : std::vector<std::pair<std::string, std::string>>{
+           {"c", "complex double"}, {"M", "double 3x2"}, {"note", "char"}}) {
+    ReadOptions o;
+    o.channels = {channel};
+    const std::string msg = input_error([&] { (void)read_timeseries(file, o); });
+    EXPECT_TRUE(contains(msg, file.string()) && contains(msg, channel) && contains(msg, found)) << msg;
+  }
+}
+
+TEST(TimeSeriesScipy, NonUniformTimeIsAnErrorNamingFileAndT) {
+  const fs::path file = test::fixture_path("io/scipy_bad_time.mat");
+  const std::string msg = input_error([&] { (void)read_timeseries(file); });
+  EXPECT_TRUE(contains(msg, file.string()) && contains(msg, ": t: ") && contains(msg, "t[17]")) << msg;
+}
+
+// ---- validation -----------------------------------------------------------------------------
+
+TEST(TimeSeriesValidation, UnknownChannelListsTheAvailableOnes) {
+  const fs::path file = test::fixture_path("io/scipy_two_outputs.mat");
+  ReadOptions options;
+  options.channels = {"u_dac", "de"};
+  const std::string msg = input_error([&] { (void)read_timeseries(file, options); });
+  EXPECT_TRUE(contains(msg, file.string()) && contains(msg, "'de'") && contains(msg, "V_force, d_enc, u_dac")) << msg;
+  const TimeSeries ts = read_timeseries(file);
+  const std::string msg2 = input_error([&] { (void)ts.channel("Vs"); });
+  EXPECT_TRUE(contains(msg2, "u_dac")) << msg2;
+}
+
+// A .mat file written with matio directly (no validation on the way in).
+void write_raw_mat(const fs::path& file, const std::vector<std::pair<std::string, Eigen::VectorXd>>& vars, bool v73 = false) {
+  detail::write_mat_atomically(file, v73, false, [&](detail::MatWriter& w) {
+    for (const auto& [name, v] : vars) w.write(detail::make_real_column(name, v));
+  });
+}
+
+TEST(TimeSeriesValidation, LengthsThatDiffer) {
+  TempDir dir;
+  const fs::path file = dir.path() / "len.mat";
+  write_raw_mat(file, {{"t", Eigen::VectorXd::LinSpaced(10, 0, 0.9)}, {"a", Eigen::VectorXd::Ones(10)}, {"b", Eigen::VectorXd::Ones(9)}});
+  const std::string msg = input_error([&] { (void)read_timeseries(file); });
+  EXPECT_TRUE(contains(msg, file.string()) && contains(msg, "b: ") && contains(msg, "10 samples") && contains(msg, "found 9")) << msg;
+  const fs::path file2 = dir.path() / "len_t.mat";
+  write_raw_mat(file2, {{"t", Eigen::VectorXd::LinSpaced(11, 0, 1.0)}, {"a", Eigen::VectorXd::Ones(10)}});
+  const std::string msg2 = input_error([&] { (void)read_timeseries(file2); });
+  EXPECT_TRUE(contains(msg2, ": t: ") && contains(msg2, "found 11")) << msg2;
+}
+
+TEST(TimeSeriesValidation, NanAndInfNameChannelAndSample) {
+  TempDir dir;
+  Eigen::VectorXd x = Eigen::VectorXd::Ones(20);
+  x(13) = std::numeric_limits<double>::quiet_NaN();
+  const fs::path file = dir.path() / "nan.mat";
+  write_raw_mat(file, {{"t", Eigen::VectorXd::LinSpaced(20, 0, 1.9)}, {"ok", Eigen::VectorXd::Ones(20)}, {"bad", x}}, /*v73=*/true);
+  const std::string msg = input_error([&] { (void)read_timeseries(file); });
+  EXPECT_TRUE(contains(msg, file.string()) && contains(msg, "bad") && contains(msg, "NaN at sample 13")) << msg;
+
+  const fs::path csv = dir.path() / "inf.csv";
+  write_text(csv, "t,a,b\n0,1,2\n0.1,1,inf\n");
+  const std::string msg2 = input_error([&] { (void)read_timeseries(csv); });
+  EXPECT_TRUE(contains(msg2, csv.string()) && contains(msg2, "b") && contains(msg2, "sample 1 (line 3)")) << msg2;
+}
+
+TEST(TimeSeriesValidation, EmptyAndNonMonotonicTime) {
+  TempDir dir;
+  const fs::path empty = dir.path() / "empty.mat";
+  write_raw_mat(empty, {{"a", Eigen::VectorXd()}});
+  EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(empty); }), empty.string()));
+  const fs::path back = dir.path() / "back.mat";
+  Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(8, 0, 0.7);
+  std::swap(t(3), t(4));
+  write_raw_mat(back, {{"t", t}, {"a", Eigen::VectorXd::Ones(8)}});
+  const std::string msg = input_error([&] { (void)read_timeseries(back); });
+  EXPECT_TRUE(contains(msg, ": t: ") && contains(msg, "strictly increasing") && contains(msg, "t[4]")) << msg;
+}
+
+TEST(TimeSeriesValidation, MalformedCsvFiles) {
+  TempDir dir;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"", "header"},
+      {"# only a comment\n", "header"},
+      {"a,b\n", "data row"},
+      {"a,b\n1,2\n3\n", "line 3"},
+      {"a,b\n1,2\n3,4,5\n", "line 3"},
+      {"a,b\n1,x2\n", "b (line 2)"},
+      {"a,b\n1,\n", "empty cell"},
+      {"a,a\n1,2\n", "twice"},
+      {"t [ms],a\n0,1\n1,2\n", "unit 'ms'"},
+      {"a,b [V\n1,2\n", "NAME [UNIT]"},
+      {std::string("a,b\n1,2\0\n", 10), "binary"},
+  };
+  for (const auto& [text, expected] : cases) {
+    const fs::path file = dir.path() / "bad.csv";
+    write_text(file, text);
+    ReadOptions options;
+    options.fs = 100.0;
+    const std::string msg = input_error([&] { (void)read_timeseries(file, options); });
+    EXPECT_TRUE(contains(msg, file.string()) && contains(msg, expected)) << "case " << detail::quote(text) << ": " << msg;
+  }
+  EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(dir.path() / "missing.csv"); }), "no such file"));
+  EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(dir.path() / "x.txt"); }), ".txt"));
+}
+
+TEST(TimeSeriesValidation, TruncatedAndCorruptMatFilesAreInputErrors) {
+  TempDir dir;
+  const fs::path v5 = dir.path() / "full5.mat";
+  const fs::path v73 = dir.path() / "full73.mat";
+  write_timeseries_mat(sample_series(300), v5);
+  write_timeseries_mat(sample_series(300), v73, {.version = MatVersion::kV73});
+  const std::string compressed = test::read_text(test::fixture_path("io/scipy_compressed.mat"));
+  for (const auto& [name, content] : std::vector<std::pair<std::string, std::string>>{
+           {"v5", test::read_text(v5)}, {"v73", test::read_text(v73)}, {"zlib", compressed}}) {
+    for (const double fraction : {0.0, 0.01, 0.05, 0.2, 0.5, 0.8, 0.95, 0.999}) {
+      const size_t size = static_cast<size_t>(fraction * static_cast<double>(content.size()));
+      SCOPED_TRACE(name + " truncated to " + std::to_string(size) + " bytes");
+      const fs::path file = dir.path() / "cut.mat";
+      write_text(file, content.substr(0, size));
+      const std::string msg = input_error([&] { (void)read_timeseries(file); });
+      EXPECT_TRUE(contains(msg, file.string())) << msg;
+    }
+  }
+  // A MATLAB header followed by garbage.
+  std::string garbage = test::read_text(v5).substr(0, 128);
+  for (int i = 0; i < 4096; ++i) garbage += static_cast<char>((i * 7919) & 0xff);
+  const fs::path file = dir.path() / "garbage.mat";
+  write_text(file, garbage);
+  EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(file); }), file.string()));
+  // A CSV renamed .mat.
+  write_text(file, "t,a\n0,1\n");
+  EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(file); }), "MAT file"));
+}
+
+// ---- writers --------------------------------------------------------------------------------
+
+TEST(TimeSeriesWrite, InvalidDataWritesNothing) {
+  TempDir dir;
+  TimeSeries ts = sample_series(50);
+  ts.data(7, 1) = std::numeric_limits<double>::infinity();
+  for (const char* name : {"x.mat", "x.csv"}) {
+    const fs::path file = dir.path() / name;
+    const std::string msg = input_error([&] { write_timeseries(ts, file); });
+    EXPECT_TRUE(contains(msg, file.string()) && contains(msg, "de") && contains(msg, "sample 7")) << msg;
+    EXPECT_FALSE(fs::exists(file));
+  }
+  TimeSeries bad_name = sample_series(5);
+  bad_name.names[1] = "2de";
+  EXPECT_TRUE(contains(input_error([&] { write_timeseries(bad_name, dir.path() / "y.mat"); }), "MATLAB"));
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(TimeSeriesWrite, FailingWriteLeavesNoFileAndKeepsTheOldOne) {
+  TempDir dir;
+  const fs::path file = dir.path() / "rec.mat";
+  const TimeSeries small = sample_series(10);
+  write_timeseries_mat(small, file);
+  const std::string before = test::read_text(file);
+  // A file-size limit makes matio's writes fail part-way, as a full disk would.
+  struct rlimit old_limit {};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  struct rlimit limit = old_limit;
+  limit.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  std::string msg_v5, msg_csv, msg_v73;
+  const TimeSeries big = sample_series(20000);  // ~640 kB
+  msg_v5 = input_error([&] { write_timeseries_mat(big, file); });
+  msg_v73 = input_error([&] { write_timeseries_mat(big, dir.path() / "new73.mat", {.version = MatVersion::kV73}); });
+  msg_csv = input_error([&] { write_timeseries_csv(big, dir.path() / "new.csv"); });
+  setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_TRUE(contains(msg_v5, file.string())) << msg_v5;
+  EXPECT_TRUE(contains(msg_v73, "new73.mat")) << msg_v73;
+  EXPECT_TRUE(contains(msg_csv, "new.csv")) << msg_csv;
+  EXPECT_EQ(test::read_text(file), before);
+  // Only the old file is left: no temporary, no partial new file.
+  size_t count = 0;
+  for (const auto& entry : fs::directory_iterator(dir.path())) {
+    ++count;
+    EXPECT_EQ(entry.path().filename(), "rec.mat");
+  }
+  EXPECT_EQ(count, 1u);
+}
+
+TEST(TimeSeriesOptions, ValidateNamesTheField) {
+  ReadOptions o;
+  o.fs = -1.0;
+  EXPECT_TRUE(contains(input_error([&] { o.validate(); }), "fs"));
+  o = ReadOptions{};
+  o.time_tolerance = 0.0;
+  EXPECT_TRUE(contains(input_error([&] { o.validate(); }), "time_tolerance"));
+  o = ReadOptions{};
+  o.channels = {"a", "a"};
+  EXPECT_TRUE(contains(input_error([&] { o.validate(); }), "channels"));
+  EXPECT_EQ(mat_version_from_string("-v7.3"), MatVersion::kV73);
+  EXPECT_EQ(mat_version_from_string(to_string(MatVersion::kV5)), MatVersion::kV5);
+  EXPECT_THROW((void)mat_version_from_string("v4"), InputError);
+}
+
+}  // namespace
+}  // namespace piezobench::io
