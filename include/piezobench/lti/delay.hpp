@@ -6,7 +6,8 @@
 namespace piezobench::lti {
 
 // The [order/order] Pade approximant of exp(-s * delay) (continuous), as MATLAB's pade(T, N):
-// all-pass, unit DC gain. order 0 is the constant 1. Throws InputError for delay < 0 or order < 0.
+// all-pass, unit DC gain, monic denominator. order 0 (or delay 0) is the constant 1. Throws
+// InputError for delay < 0 or order < 0.
 TransferFunction pade(double delay, int order);
 // The system with each input and output delay replaced by its Pade approximant of `order` in
 // series (continuous systems). Discrete systems: delays that are whole multiples of Ts become

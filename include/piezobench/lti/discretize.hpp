@@ -42,10 +42,11 @@ struct TimeResponse {
 // zero). Delays must be whole multiples of the sample time (InputError otherwise) and shift the
 // signals by that many samples.
 TimeResponse lsim(const StateSpace& discrete_sys, const Matrix& u, const Vector& x0 = Vector());
-// Unit-step and unit-impulse responses (impulse: a discrete unit pulse of area 1 / Ts for
-// continuous systems, so that the samples approximate the continuous impulse response; the
-// discrete impulse is the unit sample). Continuous systems are first discretized with ZOH at
-// `sample_time` (exact at the samples for a step). One column of y per output, input `input`.
+// Unit-step and unit-impulse responses (impulse: for continuous systems a pulse of height 1 / Ts
+// held over the first sample (area 1), so that the samples approximate the continuous impulse
+// response; for discrete systems the unit sample). Continuous systems are first discretized with
+// ZOH at `sample_time` (exact at the samples for a step); for discrete systems `sample_time` must
+// be 0 or the system's own (InputError otherwise). One column of y per output, input `input`.
 TimeResponse step(const StateSpace& sys, double sample_time, Index samples, Index input = 0);
 TimeResponse impulse(const StateSpace& sys, double sample_time, Index samples, Index input = 0);
 

@@ -1,7 +1,9 @@
 #pragma once
 // Frequency responses of LTI systems.
 //
-// State space: A is reduced once to upper Hessenberg form H = Q^T A Q (with balancing); at each
+// State space: A is reduced once to upper Hessenberg form H = Q^T A Q (after balancing, and after
+// reversing the state order when that brings A closer to upper Hessenberg form, as for the block
+// lower-triangular realizations of cascades: the reduction is then exact or nearly so). At each
 // frequency (sI - H) X = Q^T B is solved by Gaussian elimination on the Hessenberg matrix with
 // adjacent-row pivoting, O(n^2) per frequency and input instead of a dense O(n^3) solve (Laub,
 // "Efficient multivariable frequency response computations", IEEE TAC 26(2), 1981; SLICOT TB05AD).
@@ -47,7 +49,9 @@ FrequencyResponse freqresp(const StateSpace& sys, const Vector& omega);
 CVector freqresp(const Zpk& zpk, const Vector& omega);
 CVector freqresp(const TransferFunction& tf, const Vector& omega);
 
-// n points logarithmically spaced from 10^lo to 10^hi (as MATLAB's logspace).
+// n points logarithmically spaced from 10^lo to 10^hi (as MATLAB's logspace, without its special
+// case for hi == pi); n = 1 gives 10^hi, n = 0 an empty vector; InputError for n < 0 or non-finite
+// exponents.
 Vector logspace(double lo_exponent, double hi_exponent, Index n);
 
 }  // namespace piezobench::lti
