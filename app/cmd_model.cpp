@@ -1,0 +1,277 @@
+// `piezobench model 2dof`, `piezobench model tune` and `piezobench piezo`: the 2-DoF actuator
+// model of report section 3, its tuning to measured FRFs, and the stack sensitivities of eq. 4.1.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "cli_common.hpp"
+#include "piezobench/apa/piezo.hpp"
+#include "piezobench/apa/tuning.hpp"
+#include "piezobench/apa/two_dof.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/io/frf_file.hpp"
+#include "piezobench/io/json.hpp"
+#include "piezobench/lti/freqresp.hpp"
+
+namespace piezobench::app {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr const char* kCommandLine = "command line";
+
+// ------------------------------------------------------------------------------ params TOML
+// Keys m, k1, c1, ke, ce, ka, ca, ga, gs (SI); each a number; unknown keys rejected by name.
+apa::TwoDofParams read_params_toml(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "a readable file", "none (cannot open it)");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  toml::table table;
+  try {
+    table = toml::parse(ss.str(), path);
+  } catch (const toml::parse_error& e) {
+    throw InputError(path, fmt::format("line {}, column {}", e.source().begin.line, e.source().begin.column),
+                     "valid TOML", std::string(e.description()));
+  }
+  std::map<std::string, double> values;
+  for (const auto& [key, node] : table) {
+    const std::string name(key.str());
+    const auto value = node.value<double>();
+    // Unknown keys first, so that a misspelt key is reported as such whatever its value.
+    apa::TwoDofParams probe;
+    probe.set(name, 0.0, path);
+    if (!node.is_number() || !value) throw InputError(path, name, "a number (SI units)", "a non-number");
+    values[name] = *value;
+  }
+  return apa::two_dof_params_from_map(values, path);
+}
+
+nlohmann::json params_json(const apa::TwoDofParams& p) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& n : apa::TwoDofParams::names()) j[n] = io::to_json(p.get(n));
+  return j;
+}
+
+nlohmann::json complex_list(const lti::CVector& v) {
+  nlohmann::json j = nlohmann::json::array();
+  for (lti::Index i = 0; i < v.size(); ++i) j.push_back(io::to_json(v(i)));
+  return j;
+}
+
+// ------------------------------------------------------------------------------ model 2dof
+struct TwoDofCommand {
+  std::string params_file;
+  double fmin = 1.0;
+  double fmax = 10000.0;
+  int points = 500;
+  apa::TwoDofBench bench;
+  bool json = false;
+};
+
+int run_two_dof(const TwoDofCommand& o) {
+  if (!(std::isfinite(o.fmin) && o.fmin > 0.0)) throw InputError("", "--fmin", "a frequency > 0 Hz", fmt::format("{}", o.fmin));
+  if (!(std::isfinite(o.fmax) && o.fmax > o.fmin)) {
+    throw InputError("", "--fmax", fmt::format("a frequency above --fmin = {} Hz", o.fmin), fmt::format("{}", o.fmax));
+  }
+  const apa::TwoDofParams p = o.params_file.empty() ? apa::TwoDofParams{} : read_params_toml(o.params_file);
+  o.bench.validate(kCommandLine);
+  const apa::TwoDofCharacteristics c = apa::characterize(p, o.bench);
+  const lti::Vector f = lti::logspace(std::log10(o.fmin), std::log10(o.fmax), o.points);
+  const lti::FrequencyResponse fr = lti::freqresp(apa::two_dof_bench(p, o.bench), kTwoPi * f);
+  const lti::CVector h_de = fr.channel(apa::kOutputDe, 0);
+  const lti::CVector h_vs = fr.channel(apa::kOutputVs, 0);
+
+  if (o.json) {
+    print_json({{"model", "2dof"},
+                {"params", params_json(p)},
+                {"params_source", o.params_file.empty() ? std::string("report Table 3.1") : o.params_file},
+                {"bench",
+                 {{"amplifier_gain", o.bench.amplifier_gain},
+                  {"moving_mass_kg", o.bench.moving_mass(p)},
+                  {"hpf_resistance_Ohm", o.bench.hpf_resistance},
+                  {"hpf_capacitance_F", o.bench.hpf_capacitance},
+                  {"hpf_corner_Hz", o.bench.hpf_corner() / kTwoPi},
+                  {"delay_s", o.bench.delay}}},
+                {"input", "u (V at the DAC, amplifier included)"},
+                {"poles", complex_list(c.poles)},
+                {"zeros_Vs", complex_list(c.zeros_vs)},
+                {"static_gain_de_um_per_V", io::to_json(c.static_gain_de * 1e6)},
+                {"static_gain_Vs_V_per_V", io::to_json(c.static_gain_vs)},
+                {"static_gain_Vs_before_hpf_V_per_V", io::to_json(c.static_gain_vs_actuator)},
+                {"resonance_Hz", io::to_json(c.resonance / kTwoPi)},
+                {"resonance_damping", io::to_json(c.resonance_damping)},
+                {"antiresonance_Hz", io::to_json(c.antiresonance / kTwoPi)},
+                {"antiresonance_damping", io::to_json(c.antiresonance_damping)},
+                {"units", {{"poles", "rad/s"}, {"zeros_Vs", "rad/s"}, {"H_de", "m/V"}, {"H_Vs", "V/V"}}},
+                {"freq_Hz", io::to_json(f)},
+                {"H_de", complex_list(h_de)},
+                {"H_Vs", complex_list(h_vs)}});
+    return 0;
+  }
+  fmt::print("2-DoF APA model (report section 3), parameters from {}\n",
+             o.params_file.empty() ? "Table 3.1" : o.params_file);
+  fmt::print("  m = {:.4g} kg, k1 = {:.4g} N/um, c1 = {:.4g} Ns/m\n", p.m, p.k1 * 1e-6, p.c1);
+  fmt::print("  ke = {:.4g} N/um, ce = {:.4g} Ns/m, ka = {:.4g} N/um, ca = {:.4g} Ns/m\n", p.ke * 1e-6, p.ce,
+             p.ka * 1e-6, p.ca);
+  fmt::print("  ga = {:.4g} N/V, gs = {:.4g} V/um, k_tot = {:.4g} N/um\n", p.ga, p.gs * 1e-6,
+             p.total_stiffness() * 1e-6);
+  fmt::print("bench: amplifier {:.4g} V/V, moving mass {:.4g} kg", o.bench.amplifier_gain, o.bench.moving_mass(p));
+  if (o.bench.has_hpf()) fmt::print(", high-pass on Vs at {:.4g} Hz", o.bench.hpf_corner() / kTwoPi);
+  if (o.bench.delay > 0.0) fmt::print(", delay {:.4g} us", o.bench.delay * 1e6);
+  fmt::print("\n");
+  fmt::print("static gain u -> d_e: {:.4g} um/V\n", c.static_gain_de * 1e6);
+  fmt::print("static gain u -> Vs:  {:.4g} V/V{}\n", c.static_gain_vs,
+             o.bench.has_hpf() ? fmt::format(" ({:.4g} V/V before the high-pass)", c.static_gain_vs_actuator) : "");
+  fmt::print("resonance:      {:.4g} Hz, damping {:.4g}\n", c.resonance / kTwoPi, c.resonance_damping);
+  fmt::print("anti-resonance: {:.4g} Hz, damping {:.4g} (u -> Vs)\n", c.antiresonance / kTwoPi,
+             c.antiresonance_damping);
+  fmt::print("poles [rad/s]:");
+  for (lti::Index i = 0; i < c.poles.size(); ++i) fmt::print(" {:.6g}{:+.6g}j", c.poles(i).real(), c.poles(i).imag());
+  fmt::print("\n");
+  return 0;
+}
+
+// ------------------------------------------------------------------------------ model tune
+struct TuneCommand {
+  std::string frf_file;
+  apa::TuningOptions options;
+  bool no_refine = false;
+  bool json = false;
+};
+
+int run_tune(const TuneCommand& c) {
+  apa::TuningOptions o = c.options;
+  o.refine = !c.no_refine;
+  o.validate();
+  const dsp::Frf frf = io::read_frf(c.frf_file);
+  if (!c.json) log_line(fmt::format("tuning the 2-DoF model on {} ({} frequencies)", c.frf_file, frf.freq_hz.size()));
+  const apa::TwoDofTuning t = apa::tune_two_dof(frf, o);
+  if (c.json) {
+    print_json({{"source", c.frf_file},
+                {"model_2dof", params_json(t.params)},
+                {"fit_error", {{"de", io::to_json(t.fit_error_de)}, {"Vs", io::to_json(t.fit_error_vs)}}},
+                {"fit_error_definition", "rms over the frequencies used of |H_model / H_data - 1| per output"},
+                {"initial", params_json(t.initial)},
+                {"initial_fit_error", {{"de", io::to_json(t.initial_fit_error_de)}, {"Vs", io::to_json(t.initial_fit_error_vs)}}},
+                {"features",
+                 {{"resonance_Hz", io::to_json(t.features.resonance / kTwoPi)},
+                  {"resonance_damping", io::to_json(t.features.resonance_damping)},
+                  {"antiresonance_Hz", io::to_json(t.features.antiresonance / kTwoPi)},
+                  {"antiresonance_damping", io::to_json(t.features.antiresonance_damping)},
+                  {"static_gain_de_um_per_V", io::to_json(t.features.static_gain_de * 1e6)},
+                  {"static_gain_Vs_V_per_V", io::to_json(t.features.static_gain_vs)}}},
+                {"amplifier_gain", o.bench.amplifier_gain},
+                {"stack_stiffness_ratio", o.stack_stiffness_ratio},
+                {"points", t.points},
+                {"iterations", t.iterations},
+                {"status", apa::to_string(t.status)},
+                {"message", t.message}});
+    return 0;
+  }
+  const apa::TwoDofParams& p = t.params;
+  fmt::print("2-DoF model tuned on {} (mass {:.4g} kg, amplifier {:.4g} V/V)\n", c.frf_file, p.m, o.bench.amplifier_gain);
+  fmt::print("  k1 = {:.4g} N/um, c1 = {:.4g} Ns/m\n", p.k1 * 1e-6, p.c1);
+  fmt::print("  ke = {:.4g} N/um, ce = {:.4g} Ns/m, ka = {:.4g} N/um, ca = {:.4g} Ns/m\n", p.ke * 1e-6, p.ce,
+             p.ka * 1e-6, p.ca);
+  fmt::print("  ga = {:.4g} N/V, gs = {:.4g} V/um\n", p.ga, p.gs * 1e-6);
+  fmt::print("{}\n{}\n", t.brief_report(), t.message);
+  return 0;
+}
+
+// ------------------------------------------------------------------------------ piezo
+struct PiezoCommand {
+  apa::PiezoConstants constants;
+  bool json = false;
+};
+
+int run_piezo(const PiezoCommand& c) {
+  c.constants.validate(kCommandLine);
+  const apa::PiezoSensitivities s = apa::piezo_sensitivities(c.constants);
+  const apa::PiezoConstants& k = c.constants;
+  if (c.json) {
+    print_json({{"ga_N_per_V", io::to_json(s.ga)},
+                {"gs_V_per_m", io::to_json(s.gs)},
+                {"ka_N_per_m", io::to_json(s.ka)},
+                {"formulas", "ka = cE A / L, ga = d33 n ka, gs = d33 / (eps_T sD n) (report eq. 4.1)"},
+                {"constants",
+                 {{"d33_m_per_V", k.d33},
+                  {"eps_t_F_per_m", k.eps_t},
+                  {"s_d_m2_per_N", k.s_d},
+                  {"c_e_N_per_m2", k.c_e},
+                  {"length_m", k.length},
+                  {"area_m2", k.area},
+                  {"layers", k.layers}}}});
+    return 0;
+  }
+  fmt::print("stack sensitivities from piezo constants (report eq. 4.1)\n");
+  fmt::print("  ka = cE A / L           = {:.6g} N/m ({:.4g} N/um)\n", s.ka, s.ka * 1e-6);
+  fmt::print("  ga = d33 n ka           = {:.6g} N/V\n", s.ga);
+  fmt::print("  gs = d33 / (eps_T sD n) = {:.6g} V/m ({:.4g} V/um)\n", s.gs, s.gs * 1e-6);
+  return 0;
+}
+
+void add_bench_options(CLI::App* cmd, apa::TwoDofBench& b) {
+  cmd->add_option("--amplifier-gain", b.amplifier_gain, "voltage amplifier gain Va/u, V/V")->capture_default_str();
+  cmd->add_option("--hpf-r", b.hpf_resistance, "resistor across the sensor stack, Ohm (with --hpf-c: high-pass on Vs)");
+  cmd->add_option("--hpf-c", b.hpf_capacitance, "sensor stack capacitance, F (with --hpf-r)");
+  cmd->add_option("--delay", b.delay, "pure delay on u, s");
+}
+
+}  // namespace
+
+void add_model_commands(CLI::App& app, Action& action) {
+  CLI::App* model = app.add_subcommand("model", "Actuator models: the 2-DoF model of the APA and its tuning");
+  model->require_subcommand(1);
+
+  auto t = std::make_shared<TwoDofCommand>();
+  CLI::App* two = model->add_subcommand("2dof", "Poles, zeros, static gains and FRFs u -> d_e, u -> Vs of the 2-DoF model");
+  two->add_option("--params", t->params_file, "TOML file with m, k1, c1, ke, ce, ka, ca, ga, gs (SI); default Table 3.1")
+      ->check(CLI::ExistingFile);
+  two->add_option("--fmin", t->fmin, "lowest frequency of the FRF, Hz")->capture_default_str();
+  two->add_option("--fmax", t->fmax, "highest frequency of the FRF, Hz")->capture_default_str();
+  two->add_option("--points", t->points, "number of log-spaced frequencies")->check(CLI::Range(2, 1000000))->capture_default_str();
+  add_bench_options(two, t->bench);
+  two->add_option("--added-mass", t->bench.added_mass, "mass added on the suspended mass, kg");
+  two->add_option("--suspended-mass", t->bench.suspended_mass, "suspended mass replacing the model's m, kg");
+  two->add_flag("--json", t->json, "print one JSON document on stdout");
+  two->callback([t, &action] { action = [t] { return run_two_dof(*t); }; });
+
+  auto u = std::make_shared<TuneCommand>();
+  CLI::App* tune = model->add_subcommand("tune", "Fit the 9 parameters of the 2-DoF model to measured FRFs u -> de, u -> Vs");
+  tune->add_option("--frf", u->frf_file, "FRF file (.csv, .mat, .uff) with outputs de and Vs, input u")
+      ->required()
+      ->check(CLI::ExistingFile);
+  tune->add_option("--mass", u->options.mass, "known moving mass m, kg")->capture_default_str();
+  add_bench_options(tune, u->options.bench);
+  tune->add_option("--fmin", u->options.fmin_hz, "lowest frequency used, Hz (default: all)");
+  tune->add_option("--fmax", u->options.fmax_hz, "highest frequency used, Hz (default: all)");
+  tune->add_option("--min-coherence", u->options.min_coherence, "leave out frequencies with a lower coherence");
+  tune->add_option("--stack-ratio", u->options.stack_stiffness_ratio, "ke/ka kept during the refinement (0 = free)")
+      ->capture_default_str();
+  tune->add_option("--de-output", u->options.de_output, "name of the displacement output")->capture_default_str();
+  tune->add_option("--vs-output", u->options.vs_output, "name of the force-sensor output")->capture_default_str();
+  tune->add_flag("--no-refine", u->no_refine, "stop after the report's procedure (no least-squares refinement)");
+  tune->add_flag("--json", u->json, "print one JSON document on stdout");
+  tune->callback([u, &action] { action = [u] { return run_tune(*u); }; });
+
+  auto pz = std::make_shared<PiezoCommand>();
+  CLI::App* piezo = app.add_subcommand("piezo", "Stack sensitivities ga, gs and stiffness ka from piezo constants (eq. 4.1)");
+  apa::PiezoConstants& k = pz->constants;
+  piezo->add_option("--d33", k.d33, "piezoelectric constant d33, m/V")->capture_default_str();
+  piezo->add_option("--eps-t", k.eps_t, "permittivity at constant stress, F/m")->capture_default_str();
+  piezo->add_option("--s-d", k.s_d, "compliance at constant electric displacement, m^2/N")->capture_default_str();
+  piezo->add_option("--c-e", k.c_e, "Young's modulus at constant field, N/m^2")->capture_default_str();
+  piezo->add_option("--length", k.length, "stack length, m")->capture_default_str();
+  piezo->add_option("--area", k.area, "stack cross-section, m^2")->capture_default_str();
+  piezo->add_option("--layers", k.layers, "number of layers per stack (integer >= 1)")->capture_default_str();
+  piezo->add_flag("--json", pz->json, "print one JSON document on stdout");
+  piezo->callback([pz, &action] { action = [pz] { return run_piezo(*pz); }; });
+}
+
+}  // namespace piezobench::app

@@ -1,0 +1,37 @@
+#pragma once
+// Actuator and sensor sensitivities of a piezoelectric stack from its material constants
+// (report section 4, eq. 4.1, Table 4.1):
+//   ka = cE A / L                  (N/m, stack stiffness at constant field)
+//   ga = d33 n ka                  (N/V, blocked force per volt: F_a = ga V_a)        eq. 4.1b
+//   gs = d33 / (eps_T sD n)        (V/m, open-circuit voltage per metre of extension) eq. 4.1a
+// Sources: A. Preumont, "Vibration Control of Active Structures", 4th ed., p. 123 (sensor);
+// Fleming and Leang, "Design, Modeling and Control of Nanopositioning Systems" (actuator).
+// Defaults are Table 4.1 (THP5H-like soft PZT): ga = 26.11 N/V, gs = 5.06e6 V/m, ka = 2.4e8 N/m.
+#include <string>
+
+namespace piezobench::apa {
+
+struct PiezoConstants {
+  double d33 = 680e-12;   // m/V, piezoelectric charge constant
+  double eps_t = 4.0e-8;  // F/m, permittivity at constant stress
+  double s_d = 21e-12;    // m^2/N, elastic compliance at constant electric displacement
+  double c_e = 48e9;      // N/m^2, Young's modulus at constant field
+  double length = 20e-3;  // m, stack length
+  double area = 1e-4;     // m^2, stack cross-section
+  double layers = 160;    // number of layers n in the stack: an integer >= 1
+
+  // InputError (source "piezo constants" unless given) naming the field: every constant positive
+  // and finite, layers an integer >= 1.
+  void validate(const std::string& source = "") const;
+};
+
+struct PiezoSensitivities {
+  double ka = 0.0;  // N/m
+  double ga = 0.0;  // N/V
+  double gs = 0.0;  // V/m
+};
+
+// Eq. 4.1 (validates the constants).
+PiezoSensitivities piezo_sensitivities(const PiezoConstants& c);
+
+}  // namespace piezobench::apa

@@ -1,0 +1,331 @@
+#include "piezobench/apa/tuning.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+#include <numbers>
+#include <tuple>
+#include <vector>
+
+#include "apa/levenberg_marquardt.hpp"
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::apa {
+
+std::string to_string(TuningStatus s) {
+  switch (s) {
+    case TuningStatus::kConverged: return "converged";
+    case TuningStatus::kMaxIterations: return "max-iterations";
+    case TuningStatus::kNoProgress: return "no-progress";
+    case TuningStatus::kNotRefined: return "not-refined";
+  }
+  return "unknown";
+}
+
+TuningStatus tuning_status_from_string(const std::string& s) {
+  for (const TuningStatus v :
+       {TuningStatus::kConverged, TuningStatus::kMaxIterations, TuningStatus::kNoProgress, TuningStatus::kNotRefined}) {
+    if (to_string(v) == s) return v;
+  }
+  throw InputError("", "status", "one of converged, max-iterations, no-progress, not-refined", "'" + s + "'");
+}
+
+void TuningOptions::validate() const {
+  const std::string src = "tuning options";
+  auto num = [](double v) { return fmt::format("{:.6g}", v); };
+  if (!(std::isfinite(mass) && mass > 0.0)) throw InputError(src, "mass", "a mass > 0 kg", num(mass));
+  bench.validate(src);
+  if (bench.suspended_mass != 0.0 || bench.added_mass != 0.0) {
+    throw InputError(src, "bench.suspended_mass", "0 (the tuned mass is `mass`)",
+                     num(bench.suspended_mass) + " / added " + num(bench.added_mass));
+  }
+  if (!(std::isfinite(fmin_hz) && fmin_hz >= 0.0)) throw InputError(src, "fmin_hz", "a frequency >= 0 Hz", num(fmin_hz));
+  if (!(std::isfinite(fmax_hz) && fmax_hz >= 0.0)) throw InputError(src, "fmax_hz", "a frequency >= 0 Hz", num(fmax_hz));
+  if (fmax_hz > 0.0 && fmax_hz <= fmin_hz) {
+    throw InputError(src, "fmax_hz", fmt::format("a frequency above fmin_hz = {} Hz (or 0)", num(fmin_hz)), num(fmax_hz));
+  }
+  if (!(min_coherence >= 0.0 && min_coherence < 1.0)) {
+    throw InputError(src, "min_coherence", "a value in [0, 1)", num(min_coherence));
+  }
+  if (!(std::isfinite(stack_stiffness_ratio) && stack_stiffness_ratio >= 0.0)) {
+    throw InputError(src, "stack_stiffness_ratio", "a ratio ke/ka > 0 (or 0 = free)", num(stack_stiffness_ratio));
+  }
+  if (!(std::isfinite(stack_damping_ratio) && stack_damping_ratio >= 0.0)) {
+    throw InputError(src, "stack_damping_ratio", "a ratio ce/ca > 0 (or 0 = free)", num(stack_damping_ratio));
+  }
+  if (max_iterations < 1) throw InputError(src, "max_iterations", "at least 1", std::to_string(max_iterations));
+  if (de_output.empty()) throw InputError(src, "de_output", "an output name", "an empty name");
+  if (vs_output.empty()) throw InputError(src, "vs_output", "an output name", "an empty name");
+}
+
+std::string TwoDofTuning::brief_report() const {
+  return fmt::format("2-DoF tuning: {} after {} iterations on {} points; rms relative error d_e {:.3g} (initial {:.3g}), "
+                     "Vs {:.3g} (initial {:.3g})",
+                     to_string(status), iterations, points, fit_error_de, initial_fit_error_de, fit_error_vs,
+                     initial_fit_error_vs);
+}
+
+namespace {
+
+using lti::Complex;
+using lti::CVector;
+using lti::Index;
+using lti::Vector;
+
+// The data the fit works on: input Va (amplifier divided out), high-pass and delay removed.
+struct FitData {
+  Vector omega;  // rad/s
+  CVector de;    // m/V
+  CVector vs;    // V/V
+};
+
+FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& source) {
+  const Index ide = frf.output_index(o.de_output);
+  const Index ivs = frf.output_index(o.vs_output);
+  const auto has_coh = [&](Index i) {
+    return static_cast<std::size_t>(i) < frf.coherence.size() && frf.coherence[static_cast<std::size_t>(i)].size() > 0;
+  };
+  std::vector<Index> used;
+  for (Index k = 0; k < frf.freq_hz.size(); ++k) {
+    const double f = frf.freq_hz(k);
+    if (f <= 0.0 || f < o.fmin_hz || (o.fmax_hz > 0.0 && f > o.fmax_hz)) continue;
+    if (o.min_coherence > 0.0) {
+      if (has_coh(ide) && frf.coherence[static_cast<std::size_t>(ide)](k) < o.min_coherence) continue;
+      if (has_coh(ivs) && frf.coherence[static_cast<std::size_t>(ivs)](k) < o.min_coherence) continue;
+    }
+    used.push_back(k);
+  }
+  // 8 unknowns at most, 4 real equations per frequency; the peak picking needs a few more points.
+  if (used.size() < 8) {
+    throw InputError(source, "freq_Hz", "at least 8 frequencies > 0 in the band (and above the coherence threshold)",
+                     std::to_string(used.size()));
+  }
+  FitData d;
+  const auto n = static_cast<Index>(used.size());
+  d.omega.resize(n);
+  d.de.resize(n);
+  d.vs.resize(n);
+  const double wc = o.bench.hpf_corner();
+  for (Index i = 0; i < n; ++i) {
+    const Index k = used[static_cast<std::size_t>(i)];
+    const double w = 2.0 * std::numbers::pi * frf.freq_hz(k);
+    const Complex s(0.0, w);
+    Complex chain = o.bench.amplifier_gain * std::exp(-s * o.bench.delay);
+    d.omega(i) = w;
+    d.de(i) = frf.H[static_cast<std::size_t>(ide)](k) / chain;
+    if (wc > 0.0) chain *= s / (s + wc);
+    d.vs(i) = frf.H[static_cast<std::size_t>(ivs)](k) / chain;
+    for (const auto& [value, name] : {std::pair{d.de(i), o.de_output}, std::pair{d.vs(i), o.vs_output}}) {
+      if (!(std::isfinite(value.real()) && std::isfinite(value.imag())) || value == Complex(0.0)) {
+        throw InputError(source, name, "finite nonzero values",
+                         fmt::format("{} + {}j at {} Hz", value.real(), value.imag(), frf.freq_hz(k)));
+      }
+    }
+  }
+  return d;
+}
+
+// Vertex of the parabola through (x[i-1..i+1], y[i-1..i+1]): (x, y).
+std::pair<double, double> vertex(double x0, double x1, double x2, double y0, double y1, double y2) {
+  // Newton form: y = y0 + a (x - x0) + b (x - x0)(x - x1)
+  const double a = (y1 - y0) / (x1 - x0);
+  const double b = ((y2 - y1) / (x2 - x1) - a) / (x2 - x0);
+  if (b == 0.0) return {x1, y1};
+  const double xv = 0.5 * (x0 + x1) - a / (2.0 * b);
+  const double xc = std::clamp(xv, x0, x2);
+  return {xc, y0 + a * (xc - x0) + b * (xc - x0) * (xc - x1)};
+}
+
+// Extremum of |h| over indices [lo, hi] (interior), refined in log-log: (omega, |h|).
+std::pair<double, double> extremum(const Vector& omega, const CVector& h, Index lo, Index hi, bool maximum,
+                                   const char* what) {
+  Index best = -1;
+  for (Index k = lo; k <= hi; ++k) {
+    if (best < 0 || (maximum ? std::abs(h(k)) > std::abs(h(best)) : std::abs(h(k)) < std::abs(h(best)))) best = k;
+  }
+  if (best <= 0 || best >= omega.size() - 1 || best <= lo || best >= hi) {
+    throw NumericalError("2-DoF tuning", fmt::format("no {} inside the frequency band (the extremum of the "
+                                                     "magnitude is at its edge)", what),
+                         /*retry_may_help=*/true);
+  }
+  const auto [x, y] = vertex(std::log(omega(best - 1)), std::log(omega(best)), std::log(omega(best + 1)),
+                             std::log(std::abs(h(best - 1))), std::log(std::abs(h(best))),
+                             std::log(std::abs(h(best + 1))));
+  return {std::exp(x), std::exp(y)};
+}
+
+// Free parameters of the refinement, as logarithms.
+struct Layout {
+  double mass = 0.0;
+  double ga_sign = 1.0, gs_sign = 1.0;
+  double ke_ratio = 0.0;  // 0 = ke free
+  double ce_ratio = 0.0;  // 0 = ce free
+
+  [[nodiscard]] Vector pack(const TwoDofParams& p) const {
+    std::vector<double> v = {p.k1, p.c1, p.ka, p.ca, std::abs(p.ga), std::abs(p.gs)};
+    if (ke_ratio == 0.0) v.push_back(p.ke);
+    if (ce_ratio == 0.0) v.push_back(p.ce);
+    Vector x(static_cast<Index>(v.size()));
+    for (std::size_t i = 0; i < v.size(); ++i) x(static_cast<Index>(i)) = std::log(v[i]);
+    return x;
+  }
+  [[nodiscard]] TwoDofParams unpack(const Vector& x) const {
+    TwoDofParams p;
+    p.m = mass;
+    p.k1 = std::exp(x(0));
+    p.c1 = std::exp(x(1));
+    p.ka = std::exp(x(2));
+    p.ca = std::exp(x(3));
+    p.ga = ga_sign * std::exp(x(4));
+    p.gs = gs_sign * std::exp(x(5));
+    Index next = 6;
+    p.ke = ke_ratio == 0.0 ? std::exp(x(next++)) : ke_ratio * p.ka;
+    p.ce = ce_ratio == 0.0 ? std::exp(x(next++)) : ce_ratio * p.ca;
+    return p;
+  }
+};
+
+bool usable(const TwoDofParams& p) {
+  for (const auto& n : TwoDofParams::names()) {
+    if (!std::isfinite(p.get(n))) return false;
+  }
+  return p.k1 > 0.0 && p.ke > 0.0 && p.ka > 0.0 && p.ca + p.ce > 0.0 && p.ga != 0.0 && p.gs != 0.0;
+}
+
+// Relative complex errors H_model / H_data - 1, [Re, Im] of d_e then of Vs, each output divided by
+// sqrt(points); NaN when the parameters are out of range.
+Vector residuals(const TwoDofParams& p, const FitData& d) {
+  const Index n = d.omega.size();
+  Vector r(4 * n);
+  if (!usable(p)) return Vector::Constant(4 * n, std::numeric_limits<double>::quiet_NaN());
+  TwoDofBench bare;
+  bare.amplifier_gain = 1.0;
+  const lti::CMatrix h = two_dof_response(p, bare, d.omega);
+  const double w = 1.0 / std::sqrt(static_cast<double>(n));
+  for (Index k = 0; k < n; ++k) {
+    const Complex ede = (h(k, kOutputDe) / d.de(k) - 1.0) * w;
+    const Complex evs = (h(k, kOutputVs) / d.vs(k) - 1.0) * w;
+    r(2 * k) = ede.real();
+    r(2 * k + 1) = ede.imag();
+    r(2 * n + 2 * k) = evs.real();
+    r(2 * n + 2 * k + 1) = evs.imag();
+  }
+  return r;
+}
+
+std::pair<double, double> fit_errors(const TwoDofParams& p, const FitData& d) {
+  const Vector r = residuals(p, d);
+  const Index n = d.omega.size();
+  // The residuals carry 1/sqrt(n): their squared norm per output is already the mean.
+  return {std::sqrt(r.head(2 * n).squaredNorm()), std::sqrt(r.tail(2 * n).squaredNorm())};
+}
+
+}  // namespace
+
+TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
+  o.validate();
+  const std::string source = frf.provenance.source.empty() ? "FRF" : frf.provenance.source;
+  frf.validate(source);
+  const FitData d = prepare(frf, o, source);
+  const Index n = d.omega.size();
+  const double m = o.mass;
+  const double rk = o.stack_stiffness_ratio > 0.0 ? o.stack_stiffness_ratio : 2.0;
+  const double rc = o.stack_damping_ratio > 0.0 ? o.stack_damping_ratio : 2.0;
+
+  // ---- Step 1: the report's procedure.
+  TwoDofTuning out;
+  out.points = n;
+  const auto [wp, peak] = extremum(d.omega, d.de, 0, n - 1, /*maximum=*/true, "resonance peak of u -> d_e");
+  // The lowest frequency, corrected for the resonance's static amplification 1/(1 - w^2/wp^2).
+  const double w0 = d.omega(0);
+  const double de0 = std::abs(d.de(0)) * std::abs(1.0 - (w0 / wp) * (w0 / wp));
+  // Peak over static = quality factor 1/(2 zeta) (exact at the undamped natural frequency).
+  const double zeta_p = std::clamp(de0 / (2.0 * peak), 1e-5, 0.5);
+  // The dip of Vs must lie below the resonance.
+  Index below = 0;
+  while (below + 1 < n && d.omega(below + 1) < wp) ++below;
+  const auto [wz, dip] = extremum(d.omega, d.vs, 0, below, /*maximum=*/false, "anti-resonance of u -> Vs below the resonance");
+  // Near the zero, Vs ~ K (1 - w^2/wz^2 + 2 j zeta_z w/wz) / (1 - w^2/wp^2): the depth gives zeta_z.
+  const double vs0 = std::abs(d.vs(0)) * std::abs(1.0 - (w0 / wp) * (w0 / wp)) / std::abs(1.0 - (w0 / wz) * (w0 / wz));
+  const double zeta_z = std::clamp(dip * std::abs(1.0 - (wz / wp) * (wz / wp)) / (2.0 * vs0), 1e-6, 0.5);
+
+  TwoDofParams p;
+  p.m = m;
+  p.k1 = m * wz * wz;
+  p.c1 = 2.0 * zeta_z * std::sqrt(p.k1 * m);
+  const double ktot = m * wp * wp;
+  if (!(ktot > p.k1)) {
+    throw NumericalError("2-DoF tuning",
+                         fmt::format("the resonance ({:.4g} Hz) is not above the anti-resonance ({:.4g} Hz) of u -> Vs",
+                                     wp / (2 * std::numbers::pi), wz / (2 * std::numbers::pi)),
+                         /*retry_may_help=*/true);
+  }
+  const double series = rk / (1.0 + rk);  // ke ka/(ke + ka) = series ka when ke = rk ka
+  p.ka = (ktot - p.k1) / series;
+  p.ke = rk * p.ka;
+  // Same series factor for the dampers when ce = rc ca with rc = rk (the report's case); otherwise
+  // a first guess that the refinement corrects. A floor keeps the damping positive when the
+  // estimate of zeta_p is below the shell's share.
+  const double c_crit = 2.0 * std::sqrt(ktot * m);
+  p.ca = std::max(zeta_p * c_crit - p.c1, 1e-3 * c_crit) * (1.0 + rc) / rc;
+  p.ce = rc * p.ca;
+  // Gains: linear least squares of the relative error with unit gains.
+  p.ga = 1.0;
+  p.gs = 1.0;
+  {
+    TwoDofBench bare;
+    bare.amplifier_gain = 1.0;
+    const lti::CMatrix h = two_dof_response(p, bare, d.omega);
+    double num = 0.0, den = 0.0;
+    for (Index k = 0; k < n; ++k) {
+      const Complex a = h(k, kOutputDe) / d.de(k);
+      num += a.real();
+      den += std::norm(a);
+    }
+    p.ga = num / den;
+    num = den = 0.0;
+    for (Index k = 0; k < n; ++k) {
+      const Complex b = p.ga * h(k, kOutputVs) / d.vs(k);
+      num += b.real();
+      den += std::norm(b);
+    }
+    p.gs = num / den;
+  }
+  if (!usable(p) || p.ga == 0.0 || p.gs == 0.0) {
+    throw NumericalError("2-DoF tuning", "the initial gains ga, gs came out zero or not finite", /*retry_may_help=*/false);
+  }
+  const double g = o.bench.amplifier_gain;
+  out.features = {wp, zeta_p, wz, zeta_z, g * std::copysign(de0, d.de(0).real()), g * std::copysign(vs0, d.vs(0).real())};
+  out.initial = p;
+  std::tie(out.initial_fit_error_de, out.initial_fit_error_vs) = fit_errors(p, d);
+  out.params = p;
+  out.fit_error_de = out.initial_fit_error_de;
+  out.fit_error_vs = out.initial_fit_error_vs;
+  out.status = TuningStatus::kNotRefined;
+  out.message = "report's procedure only (refinement disabled)";
+  if (!o.refine) return out;
+
+  // ---- Step 2: Levenberg-Marquardt on the log-parameters.
+  Layout layout;
+  layout.mass = m;
+  layout.ga_sign = p.ga > 0.0 ? 1.0 : -1.0;
+  layout.gs_sign = p.gs > 0.0 ? 1.0 : -1.0;
+  layout.ke_ratio = o.stack_stiffness_ratio;
+  layout.ce_ratio = o.stack_damping_ratio;
+  detail::LmOptions lm;
+  lm.max_iterations = o.max_iterations;
+  const detail::LmResult r = detail::levenberg_marquardt(
+      [&](const Vector& x) { return residuals(layout.unpack(x), d); }, layout.pack(p), lm);
+  out.params = layout.unpack(r.x);
+  out.iterations = r.iterations;
+  std::tie(out.fit_error_de, out.fit_error_vs) = fit_errors(out.params, d);
+  out.status = r.converged() ? TuningStatus::kConverged
+               : r.status == detail::LmStatus::kMaxIterations ? TuningStatus::kMaxIterations
+                                                              : TuningStatus::kNoProgress;
+  out.message = fmt::format("Levenberg-Marquardt: {} after {} steps ({} evaluations), cost {:.4g} -> {:.4g}",
+                            detail::to_string(r.status), r.iterations, r.evaluations, r.initial_cost, r.cost);
+  return out;
+}
+
+}  // namespace piezobench::apa
