@@ -1,0 +1,376 @@
+#include "piezobench/fem/craig_bampton.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Eigenvalues>
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsShiftSolver.h>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <set>
+
+#include "fem/text.hpp"
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::fem {
+namespace {
+
+const char* const kSource = "Craig-Bampton";
+// CHOLMOD supernodal Cholesky; the subclass only exposes the factor's size.
+class Factor : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
+ public:
+  // CHOLMOD would print "not positive definite" on stderr; we report it as a NumericalError.
+  Factor() { cholmod().print = 0; }
+  [[nodiscard]] Index stored_entries() const {
+    const cholmod_factor* L = m_cholmodFactor;
+    if (L == nullptr) return 0;
+    return L->is_super ? static_cast<Index>(L->xsize) : static_cast<Index>(L->nzmax);
+  }
+};
+
+// Interior problems at most this large are solved densely (Spectra needs ncv <= n anyway).
+constexpr Index kDenseInterior = 400;
+
+void report(const ProgressCallback& progress, const std::string& step, double fraction) {
+  if (progress) progress(step, std::clamp(fraction, 0.0, 1.0));
+}
+
+// y = (K_ii - sigma M_ii)^-1 x through a CHOLMOD factor, as Spectra's shift-invert operator.
+class ShiftInvertOp {
+ public:
+  using Scalar = double;
+  ShiftInvertOp(const SparseMatrix& K, const SparseMatrix& M, const Factor& k_factor, const ProgressCallback& progress)
+      : K_(K), M_(M), k_factor_(k_factor), progress_(progress) {}
+
+  [[nodiscard]] Index rows() const { return K_.rows(); }
+  [[nodiscard]] Index cols() const { return K_.cols(); }
+
+  void set_shift(double sigma) {
+    if (sigma == 0.0) {
+      factor_ = &k_factor_;
+      return;
+    }
+    report(progress_, "factorizing K_ii - sigma M_ii", 0.0);
+    shifted_ = std::make_unique<Factor>();
+    const SparseMatrix A = K_ - sigma * M_;
+    shifted_->compute(A);
+    if (shifted_->info() != Eigen::Success) {
+      throw NumericalError("Craig-Bampton (CHOLMOD factorization of K_ii - sigma M_ii)",
+                           "not positive definite for the shift " + detail::g17(sigma) + " (rad/s)^2", true);
+    }
+    factor_ = shifted_.get();
+  }
+
+  void perform_op(const double* x_in, double* y_out) const {
+    Eigen::Map<const Eigen::VectorXd> x(x_in, rows());
+    Eigen::Map<Eigen::VectorXd> y(y_out, rows());
+    y = factor_->solve(x);
+    ++operations_;
+    if (progress_ && operations_ % 20 == 0) {
+      // The number of solves is not known in advance; Lanczos typically needs two to three bases.
+      report(progress_, "fixed-interface modes (" + std::to_string(operations_) + " solves)",
+             static_cast<double>(operations_) / static_cast<double>(operations_ + 100));
+    }
+  }
+  [[nodiscard]] Index operations() const { return operations_; }
+
+ private:
+  const SparseMatrix& K_;
+  const SparseMatrix& M_;
+  const Factor& k_factor_;
+  const ProgressCallback& progress_;
+  const Factor* factor_ = nullptr;
+  std::unique_ptr<Factor> shifted_;
+  mutable Index operations_ = 0;
+};
+
+struct Partition {
+  std::vector<DofLabel> labels;      // retained DOF labels of the super element
+  std::vector<Index> boundary;       // model rows of the retained DOF (same order)
+  std::vector<Index> interior;       // model rows of the interior DOF (ascending)
+  std::vector<long> point_nodes;     // node numbering each interface point
+};
+
+Partition partition(const SparseModel& model, const std::vector<InterfacePoint>& interface) {
+  std::map<std::pair<long, int>, Index> row_of;
+  for (std::size_t i = 0; i < model.dofs.size(); ++i) {
+    row_of[{model.dofs[i].node, static_cast<int>(model.dofs[i].direction)}] = static_cast<Index>(i);
+  }
+  const auto find = [&](long node, int dir) -> std::optional<Index> {
+    const auto it = row_of.find({node, dir});
+    if (it == row_of.end()) return std::nullopt;
+    return it->second;
+  };
+  Partition p;
+  std::vector<char> retained(static_cast<std::size_t>(model.size()), 0);
+  const auto keep = [&](Index row, DofLabel label, const std::string& field) {
+    if (retained[static_cast<std::size_t>(row)] != 0) {
+      throw InputError(kSource, field, "interface points that share no DOF", "DOF " + model.dofs[static_cast<std::size_t>(row)].to_string() + " twice");
+    }
+    retained[static_cast<std::size_t>(row)] = 1;
+    p.boundary.push_back(row);
+    p.labels.push_back(label);
+  };
+  if (interface.empty()) throw InputError(kSource, "interface", "at least one interface point", "none");
+  std::set<long> names;
+  for (std::size_t k = 0; k < interface.size(); ++k) {
+    const InterfacePoint& ip = interface[k];
+    const std::string field = "interface[" + std::to_string(k) + "]";
+    if (!names.insert(ip.node).second) throw InputError(kSource, field, "each interface node once", "node " + std::to_string(ip.node) + " again");
+    p.point_nodes.push_back(ip.node);
+    if (ip.rot_node < 0) {
+      bool any = false;
+      for (int d = 1; d <= 6; ++d) {
+        if (const auto row = find(ip.node, d)) {
+          keep(*row, DofLabel::nodal(ip.node, static_cast<Direction>(d)), field);
+          any = true;
+        }
+      }
+      if (!any) throw InputError(model.source, field, "a node of the model (in the .dof list)", "node " + std::to_string(ip.node));
+      continue;
+    }
+    for (int d = 1; d <= 3; ++d) {
+      const auto t = find(ip.node, d);
+      if (!t) {
+        throw InputError(model.source, field, "a *RIGID BODY REF NODE with translations 1..3 in the model",
+                         "node " + std::to_string(ip.node) + " lacks direction " + std::to_string(d));
+      }
+      keep(*t, DofLabel::nodal(ip.node, static_cast<Direction>(d)), field);
+    }
+    for (int d = 1; d <= 3; ++d) {
+      const auto r = find(ip.rot_node, d);
+      if (!r) {
+        throw InputError(model.source, field, "a *RIGID BODY ROT NODE with translations 1..3 in the model",
+                         "node " + std::to_string(ip.rot_node) + " lacks direction " + std::to_string(d));
+      }
+      if (names.count(ip.rot_node) != 0) {
+        throw InputError(kSource, field, "a ROT NODE that is not an interface node", "node " + std::to_string(ip.rot_node));
+      }
+      keep(*r, DofLabel::nodal(ip.node, static_cast<Direction>(d + 3)), field);
+    }
+  }
+  for (Index i = 0; i < model.size(); ++i) {
+    if (retained[static_cast<std::size_t>(i)] == 0) p.interior.push_back(i);
+  }
+  return p;
+}
+
+// Blocks of a symmetric sparse matrix for the partition: A_ii (sparse), A_ib (sparse), A_bb (dense).
+struct Blocks {
+  SparseMatrix ii, ib;
+  Eigen::MatrixXd bb;
+};
+
+Blocks split(const SparseMatrix& A, const Partition& p) {
+  const Index n = A.rows();
+  std::vector<Index> local(static_cast<std::size_t>(n));
+  std::vector<char> is_b(static_cast<std::size_t>(n), 0);
+  for (std::size_t k = 0; k < p.boundary.size(); ++k) {
+    local[static_cast<std::size_t>(p.boundary[k])] = static_cast<Index>(k);
+    is_b[static_cast<std::size_t>(p.boundary[k])] = 1;
+  }
+  for (std::size_t k = 0; k < p.interior.size(); ++k) local[static_cast<std::size_t>(p.interior[k])] = static_cast<Index>(k);
+  const auto ni = static_cast<Index>(p.interior.size());
+  const auto nb = static_cast<Index>(p.boundary.size());
+  Blocks out;
+  out.bb = Eigen::MatrixXd::Zero(nb, nb);
+  std::vector<Eigen::Triplet<double, int>> tib;
+  // A_ii keeps the column structure of A (interior columns in ascending order): fill it directly.
+  SparseMatrix ii(ni, ni);
+  Eigen::VectorXi counts = Eigen::VectorXi::Zero(ni);
+  for (Index c = 0; c < n; ++c) {
+    if (is_b[static_cast<std::size_t>(c)] != 0) continue;
+    int count = 0;
+    for (SparseMatrix::InnerIterator it(A, c); it; ++it) count += is_b[static_cast<std::size_t>(it.row())] == 0 ? 1 : 0;
+    counts(local[static_cast<std::size_t>(c)]) = count;
+  }
+  ii.reserve(counts);
+  for (Index c = 0; c < n; ++c) {
+    const Index lc = local[static_cast<std::size_t>(c)];
+    const bool cb = is_b[static_cast<std::size_t>(c)] != 0;
+    for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
+      const Index r = it.row();
+      const Index lr = local[static_cast<std::size_t>(r)];
+      const bool rb = is_b[static_cast<std::size_t>(r)] != 0;
+      if (!rb && !cb) {
+        ii.insert(lr, lc) = it.value();
+      } else if (!rb && cb) {
+        tib.emplace_back(static_cast<int>(lr), static_cast<int>(lc), it.value());
+      } else if (rb && cb) {
+        out.bb(lr, lc) = it.value();
+      }
+    }
+  }
+  ii.makeCompressed();
+  out.ii = std::move(ii);
+  out.ib.resize(ni, nb);
+  out.ib.setFromTriplets(tib.begin(), tib.end());
+  return out;
+}
+
+}  // namespace
+
+InterfacePoint InterfacePoint::parse(const std::string& text, const std::string& field) {
+  const std::string form = "NODE or REF_NODE:ROT_NODE";
+  InterfacePoint p;
+  const auto colon = text.find(':');
+  const auto node = detail::parse_int(std::string_view(text).substr(0, colon));
+  if (!node || *node < 0) throw InputError("", field, form, "'" + text + "'");
+  p.node = static_cast<long>(*node);
+  if (colon != std::string::npos) {
+    const auto rot = detail::parse_int(std::string_view(text).substr(colon + 1));
+    if (!rot || *rot < 0 || *rot == *node) throw InputError("", field, form, "'" + text + "'");
+    p.rot_node = static_cast<long>(*rot);
+  }
+  return p;
+}
+
+void CraigBamptonOptions::validate() const {
+  if (modes < 0) throw InputError("Craig-Bampton options", "modes", "a number of modes >= 0", std::to_string(modes));
+  if (!(std::isfinite(shift) && shift <= 0.0)) {
+    throw InputError("Craig-Bampton options", "shift", "a finite shift <= 0 (rad/s)^2", detail::g17(shift));
+  }
+  if (!(tolerance > 0.0 && tolerance < 1.0)) {
+    throw InputError("Craig-Bampton options", "tolerance", "a value in (0, 1)", detail::g17(tolerance));
+  }
+  if (max_iterations < 1) throw InputError("Craig-Bampton options", "max_iterations", "a value >= 1", std::to_string(max_iterations));
+  if (ncv < 0) throw InputError("Craig-Bampton options", "ncv", "0 (automatic) or a basis size", std::to_string(ncv));
+}
+
+CraigBamptonResult craig_bampton(const SparseModel& model, const std::vector<InterfacePoint>& interface,
+                                 const CraigBamptonOptions& options) {
+  options.validate();
+  const auto start = std::chrono::steady_clock::now();
+  if (model.K.rows() != model.K.cols() || model.M.rows() != model.K.rows() || model.M.cols() != model.K.cols() ||
+      static_cast<Index>(model.dofs.size()) != model.K.rows()) {
+    throw InputError(model.source, "size", "K, M and the DOF list of the same size",
+                     std::to_string(model.K.rows()) + ", " + std::to_string(model.M.rows()) + " and " + std::to_string(model.dofs.size()));
+  }
+  const Partition p = partition(model, interface);
+  const auto ni = static_cast<Index>(p.interior.size());
+  const auto nb = static_cast<Index>(p.boundary.size());
+  const Index nm = options.modes;
+  if (ni == 0) throw InputError(kSource, "interface", "fewer retained DOF than the model has", "every DOF retained");
+  if (nm >= ni) {
+    throw InputError(kSource, "modes", "fewer modes than interior DOF (" + std::to_string(ni) + ")", std::to_string(nm));
+  }
+  CraigBamptonResult out;
+  out.interior_dofs = ni;
+  out.interface_dofs = nb;
+
+  report(options.progress, "partitioning", 0.0);
+  Blocks k = split(model.K, p);
+  Blocks m = split(model.M, p);
+
+  report(options.progress, "factorizing K_ii (CHOLMOD)", 0.0);
+  Factor factor;
+  factor.compute(k.ii);
+  if (factor.info() != Eigen::Success) {
+    throw NumericalError("Craig-Bampton (CHOLMOD Cholesky of K_ii)",
+                         "K_ii is not positive definite: the interior is not held by the interface DOF (retain more "
+                         "DOF, e.g. a whole interface face)",
+                         false);
+  }
+  out.factor_nonzeros = factor.stored_entries();
+  report(options.progress, "factorizing K_ii (CHOLMOD)", 1.0);
+
+  // Static constraint modes Psi = -K_ii^-1 K_ib.
+  report(options.progress, "constraint modes", 0.0);
+  const Eigen::MatrixXd Kib = Eigen::MatrixXd(k.ib);
+  const Eigen::MatrixXd Psi = -factor.solve(Kib);
+  if (factor.info() != Eigen::Success || !Psi.allFinite()) {
+    throw NumericalError("Craig-Bampton (constraint modes)", "the solve with the factor of K_ii failed", false);
+  }
+  report(options.progress, "constraint modes", 1.0);
+
+  // Fixed-interface modes.
+  Eigen::VectorXd lambda(nm);
+  Eigen::MatrixXd Phi(ni, nm);
+  if (nm > 0) {
+    report(options.progress, "fixed-interface modes", 0.0);
+    if (ni <= kDenseInterior) {
+      const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(k.ii), Eigen::MatrixXd(m.ii));
+      if (es.info() != Eigen::Success) {
+        throw NumericalError("Craig-Bampton (dense fixed-interface eigenproblem)", "M_ii is not positive definite", false);
+      }
+      lambda = es.eigenvalues().head(nm);
+      Phi = es.eigenvectors().leftCols(nm);
+    } else {
+      ShiftInvertOp op(k.ii, m.ii, factor, options.progress);
+      Spectra::SparseSymMatProd<double> bop(m.ii);
+      const Index ncv = std::min<Index>(ni, options.ncv > 0 ? std::max<Index>(options.ncv, nm + 1) : std::max<Index>(2 * nm + 1, nm + 20));
+      Spectra::SymGEigsShiftSolver<ShiftInvertOp, Spectra::SparseSymMatProd<double>, Spectra::GEigsMode::ShiftInvert> eigs(
+          op, bop, nm, ncv, options.shift);
+      eigs.init();
+      eigs.compute(Spectra::SortRule::LargestMagn, options.max_iterations, options.tolerance, Spectra::SortRule::SmallestAlge);
+      out.eigensolver_iterations = eigs.num_iterations();
+      out.eigensolver_operations = op.operations();
+      if (eigs.info() != Spectra::CompInfo::Successful) {
+        throw NumericalError("Craig-Bampton (Spectra shift-invert Lanczos)",
+                             "the " + std::to_string(nm) + " fixed-interface modes did not converge in " +
+                                 std::to_string(options.max_iterations) + " restarts (ncv " + std::to_string(ncv) + ")",
+                             true);
+      }
+      lambda = eigs.eigenvalues();
+      Phi = eigs.eigenvectors();
+      // Ascending order.
+      std::vector<Index> order(static_cast<std::size_t>(nm));
+      for (Index i = 0; i < nm; ++i) order[static_cast<std::size_t>(i)] = i;
+      std::sort(order.begin(), order.end(), [&](Index a, Index b) { return lambda(a) < lambda(b); });
+      Eigen::VectorXd l2(nm);
+      Eigen::MatrixXd P2(ni, nm);
+      for (Index i = 0; i < nm; ++i) {
+        l2(i) = lambda(order[static_cast<std::size_t>(i)]);
+        P2.col(i) = Phi.col(order[static_cast<std::size_t>(i)]);
+      }
+      lambda = std::move(l2);
+      Phi = std::move(P2);
+    }
+    // Mass-normalize explicitly (whatever the solver's convention).
+    const Eigen::MatrixXd MPhi = m.ii * Phi;
+    for (Index i = 0; i < nm; ++i) Phi.col(i) /= std::sqrt(Phi.col(i).dot(MPhi.col(i)));
+    report(options.progress, "fixed-interface modes", 1.0);
+  }
+
+  report(options.progress, "reduced matrices", 0.0);
+  const Index n = nb + nm;
+  SuperElement& se = out.reduced;
+  se.K = Eigen::MatrixXd::Zero(n, n);
+  se.M = Eigen::MatrixXd::Zero(n, n);
+  se.K.topLeftCorner(nb, nb) = k.bb + Kib.transpose() * Psi;
+  const Eigen::MatrixXd MiiPsi = m.ii * Psi;
+  const Eigen::MatrixXd Mib = Eigen::MatrixXd(m.ib);
+  const Eigen::MatrixXd MibtPsi = Mib.transpose() * Psi;
+  se.M.topLeftCorner(nb, nb) = m.bb + MibtPsi + MibtPsi.transpose() + Psi.transpose() * MiiPsi;
+  if (nm > 0) {
+    se.K.bottomRightCorner(nm, nm) = lambda.asDiagonal();
+    se.M.bottomRightCorner(nm, nm).setIdentity();
+    const Eigen::MatrixXd Mbq = (Mib + MiiPsi).transpose() * Phi;
+    se.M.topRightCorner(nb, nm) = Mbq;
+    se.M.bottomLeftCorner(nm, nb) = Mbq.transpose();
+  }
+  se.K = 0.5 * (se.K + se.K.transpose()).eval();
+  se.M = 0.5 * (se.M + se.M.transpose()).eval();
+  se.dofs = p.labels;
+  for (Index i = 0; i < nm; ++i) se.dofs.push_back(DofLabel::modal(static_cast<int>(i + 1)));
+  for (long node : p.point_nodes) {
+    const auto it = model.coordinates.find(node);
+    if (it != model.coordinates.end()) se.coordinates[node] = it->second;
+  }
+  se.source = model.source + " (Craig-Bampton: " + std::to_string(nb) + " interface DOF, " + std::to_string(nm) + " modes)";
+  out.fixed_interface_Hz = lambda.unaryExpr([](double l) { return std::copysign(std::sqrt(std::abs(l)), l) / (2 * std::numbers::pi); });
+  try {
+    se.validate();
+  } catch (const InputError& e) {
+    throw NumericalError("Craig-Bampton (reduced matrices)", e.what(), false);
+  }
+  const RigidBodyCheck check = check_rigid_body_modes(se);
+  if (check.spoiled) se.warnings.push_back(check.message);
+  report(options.progress, "reduced matrices", 1.0);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace piezobench::fem
