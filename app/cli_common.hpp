@@ -13,7 +13,10 @@ namespace piezobench::app {
 using Action = std::function<int()>;
 
 // Each command module adds its subcommands to `app`; the selected one stores its work in `action`.
-void add_iff_commands(CLI::App& app, Action& action);
+void add_frf_commands(CLI::App& app, Action& action);  // frf, fit
+void add_iff_commands(CLI::App& app, Action& action);  // iff rlocus
+void add_model_commands(CLI::App& app, Action& action);  // model 2dof, model tune, piezo
+void add_superelement_commands(CLI::App& app, Action& action);  // superelement
 
 // Prints exactly one JSON document on stdout (round-trip precision for doubles).
 void print_json(const nlohmann::json& document);

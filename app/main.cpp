@@ -15,7 +15,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("piezobench ") + piezobench::kVersion);
   app.require_subcommand(1);
   Action action;
+  piezobench::app::add_frf_commands(app, action);
   piezobench::app::add_iff_commands(app, action);
+  piezobench::app::add_model_commands(app, action);
+  piezobench::app::add_superelement_commands(app, action);
 
   try {
     app.parse(argc, argv);

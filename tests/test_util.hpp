@@ -100,7 +100,9 @@ class TempDir {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::string name = "piezobench-test-";
     if (info != nullptr) name += std::string(info->test_suite_name()) + "-" + info->name() + "-";
-    path_ = std::filesystem::temp_directory_path() / (name + std::to_string(::getpid()));
+    static int counter = 0;  // several TempDirs may live in one test
+    path_ = std::filesystem::temp_directory_path() /
+            (name + std::to_string(::getpid()) + "-" + std::to_string(counter++));
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }

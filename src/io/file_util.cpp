@@ -1,5 +1,7 @@
 #include "io/file_util.hpp"
 
+#include "piezobench/io/atomic_file.hpp"
+
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -745,3 +747,11 @@ void write_mat_atomically(const fs::path& file, bool v73, bool compress, const s
 }
 
 }  // namespace piezobench::io::detail
+
+namespace piezobench::io {
+
+void write_text_atomically(const std::filesystem::path& target, const std::string& text) {
+  detail::write_atomically(target, [&](std::ostream& out) { out << text; });
+}
+
+}  // namespace piezobench::io

@@ -1,63 +1,41 @@
 // End-to-end tests of the piezobench command, run as a subprocess like a user or script would.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <complex>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "run_cli.hpp"
 #include "test_util.hpp"
 
 namespace piezobench {
 namespace {
 
-struct Run {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-Run run(const std::string& args) {
-  test::TempDir dir;
-  const auto out = dir.path() / "stdout";
-  const auto err = dir.path() / "stderr";
-  const std::string command = std::string(PIEZOBENCH_BINARY) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(command.c_str());
-  Run r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = test::read_text(out);
-  r.err = test::read_text(err);
-  return r;
-}
-
-std::string write_file(const test::TempDir& dir, const std::string& name, const std::string& text) {
-  const auto path = dir.path() / name;
-  std::ofstream(path) << text;
-  return path.string();
-}
+using test::run_cli;
+using Outcome = test::CliRun;
 
 TEST(Cli, VersionAndHelp) {
-  const Run v = run("--version");
+  const Outcome v = run_cli("--version");
   EXPECT_EQ(v.exit_code, 0);
   EXPECT_NE(v.out.find("piezobench 0."), std::string::npos) << v.out;
-  const Run h = run("--help");
+  const Outcome h = run_cli("--help");
   EXPECT_EQ(h.exit_code, 0);
   EXPECT_NE(h.out.find("iff"), std::string::npos);
-  const Run hr = run("iff rlocus --help");
+  const Outcome hr = run_cli("iff rlocus --help");
   EXPECT_EQ(hr.exit_code, 0);
   EXPECT_NE(hr.out.find("--gains"), std::string::npos);
 }
 
 TEST(Cli, BadCommandLineExitsWithTwo) {
-  EXPECT_EQ(run("").exit_code, 2);
-  EXPECT_EQ(run("no-such-command").exit_code, 2);
-  EXPECT_EQ(run("iff rlocus --no-such-option").exit_code, 2);
-  EXPECT_EQ(run("iff rlocus --pade-order 0").exit_code, 2);
+  EXPECT_EQ(run_cli("").exit_code, 2);
+  EXPECT_EQ(run_cli("no-such-command").exit_code, 2);
+  EXPECT_EQ(run_cli("iff rlocus --no-such-option").exit_code, 2);
+  EXPECT_EQ(run_cli("iff rlocus --pade-order 0").exit_code, 2);
 }
 
 TEST(Cli, RlocusJsonHasTheContractKeys) {
-  const Run r = run("iff rlocus --gains 0,1000,10000,100000,1000000 --json");
+  const Outcome r = run_cli("iff rlocus --gains 0,1000,10000,100000,1000000 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["gains"].size(), 5U);
@@ -79,11 +57,11 @@ TEST(Cli, RlocusReadsPlantAndControllerFiles) {
   // G = g0 (s^2/wz^2 + 2 xz s/wz + 1) s / ((s^2/wp^2 + 2 xp s/wp + 1)(s + wh))
   tf << "num = [" << g0 / (wz * wz) << ", " << g0 * 2 * xz / wz << ", " << g0 << ", 0.0]\n"
      << "den = [" << 1 / (wp * wp) << ", " << 2 * xp / wp + wh / (wp * wp) << ", " << 1 + wh * 2 * xp / wp << ", " << wh << "]\n";
-  const std::string tf_file = write_file(dir, "plant_tf.toml", tf.str());
-  const std::string k_file = write_file(dir, "k.toml",
+  const std::string tf_file = test::write_text_file(dir, "plant_tf.toml", tf.str());
+  const std::string k_file = test::write_text_file(dir, "k.toml",
       "zeros = [0.0]\npoles = [-12.566370614359172, -125.66370614359172, -12566.370614359172]\ngain = -10.0\n");
-  const Run a = run("iff rlocus --json --gains 1e4");
-  const Run b = run("iff rlocus --json --gains 1e4 --plant " + tf_file + " --controller " + k_file);
+  const Outcome a = run_cli("iff rlocus --json --gains 1e4");
+  const Outcome b = run_cli("iff rlocus --json --gains 1e4 --plant " + tf_file + " --controller " + k_file);
   ASSERT_EQ(a.exit_code, 0) << a.err;
   ASSERT_EQ(b.exit_code, 0) << b.err;
   const auto ja = nlohmann::json::parse(a.out);
@@ -104,13 +82,13 @@ TEST(Cli, BadPlantFilesExitWithThreeAndNameTheField) {
       {"A = [[1.0, 0.0]]\nB = [[1.0]]\nC = [[1.0]]\n", "A"},
   };
   for (const auto& c : cases) {
-    const std::string f = write_file(dir, "bad.toml", c.text);
-    const Run r = run("iff rlocus --json --plant " + f);
+    const std::string f = test::write_text_file(dir, "bad.toml", c.text);
+    const Outcome r = run_cli("iff rlocus --json --plant " + f);
     EXPECT_EQ(r.exit_code, 3) << c.text << r.err;
     EXPECT_NE(r.err.find(f + ": " + c.needle), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
-  const Run gains = run("iff rlocus --gains 1,abc");
+  const Outcome gains = run_cli("iff rlocus --gains 1,abc");
   EXPECT_EQ(gains.exit_code, 3);
   EXPECT_NE(gains.err.find("--gains"), std::string::npos);
 }

@@ -1,6 +1,8 @@
 // Tests of the private io helpers: atomic output files and strict number parsing.
 #include "io/file_util.hpp"
 
+#include "piezobench/io/atomic_file.hpp"
+
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
@@ -122,3 +124,21 @@ TEST(MatlabIdentifier, FollowsMatlabRules) {
 
 }  // namespace
 }  // namespace piezobench::io::detail
+
+namespace piezobench::io {
+namespace {
+
+TEST(WriteTextAtomically, WritesTheWholeTextOrNothing) {
+  test::TempDir dir;
+  const auto target = dir.path() / "model.json";
+  write_text_atomically(target, "{\"a\": 1}\n");
+  EXPECT_EQ(test::read_text(target), "{\"a\": 1}\n");
+  EXPECT_THROW(write_text_atomically(dir.path() / "missing-dir" / "x.json", "x"), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "missing-dir"));
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path())) ++files;
+  EXPECT_EQ(files, 1U);  // no temporary left behind
+}
+
+}  // namespace
+}  // namespace piezobench::io

@@ -1,0 +1,128 @@
+// End-to-end tests of `piezobench frf` and `piezobench fit`.
+#include <gtest/gtest.h>
+
+#include <complex>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "run_cli.hpp"
+#include "test_util.hpp"
+
+namespace piezobench {
+namespace {
+
+using test::run_cli;
+
+std::complex<double> pair(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>()}; }
+
+TEST(FrfCli, MatFileMadeByScipyGivesScipysH1AndCoherence) {
+  const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();
+  const test::CliRun r = run_cli("frf " + mat + " --input u_dac --output d_enc,V_force --nfft 512 --overlap 0.5 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto got = nlohmann::json::parse(r.out);
+  const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("app/scipy_two_outputs_frf.json")));
+  ASSERT_EQ(got["freq_Hz"].size(), ref["freq_Hz"].size());
+  EXPECT_EQ(got["window"]["name"], "hann-periodic");
+  EXPECT_EQ(got["averages"], 15);  // (4096 - 512) / 256 + 1
+  for (std::size_t k = 0; k < ref["freq_Hz"].size(); ++k) {
+    EXPECT_TRUE(test::near(got["freq_Hz"][k].get<double>(), ref["freq_Hz"][k].get<double>(), {1e-12, 0.0}));
+  }
+  for (const char* name : {"d_enc", "V_force"}) {
+    const auto& g = got["outputs"][name];
+    const auto& e = ref["outputs"][name];
+    for (std::size_t k = 0; k < e["H"].size(); ++k) {
+      ASSERT_TRUE(test::near(pair(g["H"][k]), pair(e["H"][k]), {1e-9, 0.0})) << name << " bin " << k;
+      ASSERT_TRUE(test::near(g["coherence"][k].get<double>(), e["coherence"][k].get<double>(), {1e-9, 0.0}))
+          << name << " bin " << k;
+    }
+  }
+}
+
+TEST(FrfCli, WritesTheFrfThatFitReadsBack) {
+  test::TempDir dir;
+  const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();
+  const std::string csv = (dir.path() / "frf.csv").string();
+  const test::CliRun r = run_cli("frf " + mat + " --input u_dac --output d_enc --nfft 512 --out " + csv);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(test::read_text(csv).substr(0, 35), "freq_Hz,re_d_enc,im_d_enc,coh_d_enc");
+  // The file's d_enc is a 95 Hz mode with 2 % damping behind a Tustin discretization at 2 kHz:
+  // its fitted pole sits at the pre-image of that mode, 95 Hz within the resolution of the data.
+  const std::string model = (dir.path() / "model.json").string();
+  const test::CliRun f = run_cli("fit " + csv + " --order 2 --fmin 20 --fmax 400 --out " + model + " --json");
+  ASSERT_EQ(f.exit_code, 0) << f.err;
+  const auto j = nlohmann::json::parse(f.out);
+  ASSERT_EQ(j["poles"].size(), 2U);
+  const auto p = pair(j["poles"][1]);
+  EXPECT_NEAR(std::abs(p) / (2 * std::numbers::pi), 95.0, 2.0);
+  EXPECT_NEAR(-p.real() / std::abs(p), 0.02, 0.01);
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(model)), j);
+}
+
+TEST(FitCli, RecoversKnownPolesFromAnExactFrf) {
+  // H(s) = sum of three lightly damped modes (0.4 %, 1 %, 5 %), written as an FRF CSV.
+  test::TempDir dir;
+  const std::complex<double> poles[] = {{-0.004 * 2 * M_PI * 40, 2 * M_PI * 40 * std::sqrt(1 - 0.004 * 0.004)},
+                                        {-0.01 * 2 * M_PI * 95, 2 * M_PI * 95 * std::sqrt(1 - 1e-4)},
+                                        {-0.05 * 2 * M_PI * 400, 2 * M_PI * 400 * std::sqrt(1 - 0.0025)}};
+  const std::complex<double> residues[] = {{1.0, 2.0}, {-3.0, 0.5}, {10.0, -4.0}};
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "freq_Hz,re_y,im_y\n";
+  for (int k = 0; k < 400; ++k) {
+    const double f = 10.0 * std::pow(100.0, k / 399.0);
+    const std::complex<double> s(0.0, 2 * M_PI * f);
+    std::complex<double> h = 0.0;
+    for (int i = 0; i < 3; ++i) h += residues[i] / (s - poles[i]) + std::conj(residues[i]) / (s - std::conj(poles[i]));
+    csv << f << "," << h.real() << "," << h.imag() << "\n";
+  }
+  const std::string file = test::write_text_file(dir, "exact.csv", csv.str());
+  const test::CliRun r = run_cli("fit " + file + " --order 6 --asymptote none --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["poles"].size(), 6U);
+  for (const auto& expected : poles) {
+    double best = 1e300;
+    for (const auto& q : j["poles"]) best = std::min(best, std::abs(pair(q) - expected) / std::abs(expected));
+    EXPECT_LT(best, 1e-6) << expected;
+  }
+}
+
+TEST(FrfCli, BadInputNamesFileAndChannel) {
+  test::TempDir dir;
+  const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();
+  const test::CliRun unknown = run_cli("frf " + mat + " --input u_dac --output nope --json");
+  EXPECT_EQ(unknown.exit_code, 3);
+  EXPECT_NE(unknown.err.find("nope"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("scipy_two_outputs.mat"), std::string::npos) << unknown.err;
+  EXPECT_TRUE(unknown.out.empty());
+
+  const std::string out = (dir.path() / "frf.csv").string();
+  const test::CliRun too_short = run_cli("frf " + mat + " --input u_dac --output d_enc --nfft 100000 --out " + out);
+  EXPECT_EQ(too_short.exit_code, 3) << too_short.err;
+  EXPECT_FALSE(std::filesystem::exists(out));  // no partial output
+
+  const std::string nan_csv = test::write_text_file(dir, "nan.csv", "t,u,y\n0,1,2\n0.001,nan,3\n0.002,1,2\n");
+  const test::CliRun with_nan = run_cli("frf " + nan_csv + " --input u --output y --nfft 2");
+  EXPECT_EQ(with_nan.exit_code, 3);
+  EXPECT_NE(with_nan.err.find("u"), std::string::npos);
+
+  const std::string flat = test::write_text_file(dir, "zero.csv", "t,u,y\n0,0,1\n0.001,0,2\n0.002,0,3\n0.003,0,1\n");
+  const test::CliRun zero_power = run_cli("frf " + flat + " --input u --output y --nfft 2");
+  EXPECT_EQ(zero_power.exit_code, 3) << zero_power.err;
+
+  EXPECT_EQ(run_cli("frf " + mat + " --input u_dac --output d_enc --window triangle").exit_code, 3);
+}
+
+TEST(FitCli, TooHighAnOrderIsAClearError) {
+  test::TempDir dir;
+  const std::string file = test::write_text_file(dir, "few.csv", "freq_Hz,re_y,im_y\n1,1,0\n2,0.5,-0.5\n3,0.2,-0.4\n");
+  const test::CliRun r = run_cli("fit " + file + " --order 6 --json");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("poles"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+}  // namespace
+}  // namespace piezobench
