@@ -164,7 +164,11 @@ dsp::Frf select_band(const dsp::Frf& frf, const FitOptions& o) {
     Eigen::VectorXcd h(band.freq_hz.size());
     for (std::size_t k = 0; k < keep.size(); ++k) h(static_cast<Eigen::Index>(k)) = frf.H[ui](keep[k]);
     band.H.push_back(h);
-    band.coherence.emplace_back();
+    if (ui < frf.coherence.size() && frf.coherence[ui].size() > 0) {
+      Eigen::VectorXd c(band.freq_hz.size());
+      for (std::size_t k = 0; k < keep.size(); ++k) c(static_cast<Eigen::Index>(k)) = frf.coherence[ui](keep[k]);
+      band.coherence.push_back(c);
+    }
   }
   return band;
 }

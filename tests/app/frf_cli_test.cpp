@@ -47,8 +47,9 @@ TEST(FrfCli, WritesTheFrfThatFitReadsBack) {
   const test::CliRun r = run_cli("frf " + mat + " --input u_dac --output d_enc --nfft 512 --out " + csv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(test::read_text(csv).substr(0, 35), "freq_Hz,re_d_enc,im_d_enc,coh_d_enc");
-  // The file's d_enc is a 95 Hz mode with 2 % damping behind a Tustin discretization at 2 kHz:
-  // its fitted pole sits at the pre-image of that mode, 95 Hz within the resolution of the data.
+  // The file's d_enc is a 95 Hz mode with 2 % damping: the fitted pole sits at 95 Hz within the
+  // 3.9 Hz resolution of the estimate, and the Hann window's leakage at that resolution widens the
+  // peak, so the damping comes out above the true 2 % but well below 5 %.
   const std::string model = (dir.path() / "model.json").string();
   const test::CliRun f = run_cli("fit " + csv + " --order 2 --fmin 20 --fmax 400 --out " + model + " --json");
   ASSERT_EQ(f.exit_code, 0) << f.err;
@@ -56,7 +57,10 @@ TEST(FrfCli, WritesTheFrfThatFitReadsBack) {
   ASSERT_EQ(j["poles"].size(), 2U);
   const auto p = pair(j["poles"][1]);
   EXPECT_NEAR(std::abs(p) / (2 * std::numbers::pi), 95.0, 2.0);
-  EXPECT_NEAR(-p.real() / std::abs(p), 0.02, 0.01);
+  EXPECT_GT(-p.real() / std::abs(p), 0.02);
+  EXPECT_LT(-p.real() / std::abs(p), 0.05);
+  // 15 averages of a 4096-sample record with leakage at the peak: the estimate itself is rough.
+  EXPECT_LT(j["relative_rms_error"].get<double>(), 0.25);
   EXPECT_EQ(nlohmann::json::parse(test::read_text(model)), j);
 }
 
