@@ -6,17 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "lti/check.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::lti {
 namespace {
-
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
 
 void check_order(int order, const std::string& source) {
   if (order < 0) throw InputError(source, "order", "an approximation order >= 0", std::to_string(order));
@@ -93,7 +87,7 @@ StateSpace diagonal(const std::vector<StateSpace>& blocks, double ts) {
 }  // namespace
 
 TransferFunction pade(double delay, int order) {
-  if (!std::isfinite(delay) || delay < 0.0) throw InputError("pade", "delay", "a finite delay >= 0 s", num(delay));
+  if (!std::isfinite(delay) || delay < 0.0) throw InputError("pade", "delay", "a finite delay >= 0 s", detail::str(delay));
   check_order(order, "pade");
   if (order == 0 || delay == 0.0) return TransferFunction(Vector::Ones(1), Vector::Ones(1));
   const std::vector<double> q = pade_unit_denominator(order);
@@ -123,7 +117,7 @@ StateSpace pade(const StateSpace& sys, int order) {
     const double ratio = tau / ts;
     const double rounded = std::round(ratio);
     if (std::abs(ratio - rounded) > 1e-9 * std::max(1.0, rounded)) {
-      throw InputError("pade", field, "a whole multiple of the sample time " + num(ts) + " s", num(tau) + " s");
+      throw InputError("pade", field, "a whole multiple of the sample time " + detail::str(ts) + " s", detail::str(tau) + " s");
     }
     return unit_delays(static_cast<Index>(rounded), ts);
   };

@@ -10,19 +10,13 @@
 #include <sstream>
 #include <string>
 
+#include "lti/check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/freqresp.hpp"
 
 namespace piezobench::lti {
 namespace {
-
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
 
 void check_loop(const StateSpace& open_loop, const std::string& source) {
   open_loop.validate(source);
@@ -42,7 +36,7 @@ CVector poles_at(const StateSpace& loop, double gain) {
   const double d = loop.D(0, 0);
   const double den = 1.0 + gain * d;
   if (std::abs(den) <= 4.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(gain * d))) {
-    throw NumericalError("rlocus", "1 + k D = 0 at k = " + num(gain) + ": the closed loop is not proper",
+    throw NumericalError("rlocus", "1 + k D = 0 at k = " + detail::str(gain) + ": the closed loop is not proper",
                          /*retry_may_help=*/true);
   }
   StateSpace cl = loop;
@@ -221,24 +215,24 @@ double first_gain(const StateSpace& loop, const LoopScales& sc) {
 
 void RootLocusOptions::validate() const {
   if (!std::isfinite(gain_min) || gain_min < 0.0) {
-    throw InputError("rlocus", "gain_min", "a finite gain >= 0", num(gain_min));
+    throw InputError("rlocus", "gain_min", "a finite gain >= 0", detail::str(gain_min));
   }
   if (!std::isfinite(gain_max) || gain_max < 0.0 || (gain_max > 0.0 && gain_max <= gain_min)) {
-    throw InputError("rlocus", "gain_max", "0 (automatic) or a finite gain above gain_min = " + num(gain_min),
-                     num(gain_max));
+    throw InputError("rlocus", "gain_max", "0 (automatic) or a finite gain above gain_min = " + detail::str(gain_min),
+                     detail::str(gain_max));
   }
   if (!std::isfinite(max_relative_step) || max_relative_step <= 0.0 || max_relative_step > 1.0) {
-    throw InputError("rlocus", "max_relative_step", "a fraction in (0, 1]", num(max_relative_step));
+    throw InputError("rlocus", "max_relative_step", "a fraction in (0, 1]", detail::str(max_relative_step));
   }
   if (!std::isfinite(settle_fraction) || settle_fraction <= 0.0 || settle_fraction >= 1.0) {
-    throw InputError("rlocus", "settle_fraction", "a fraction in (0, 1)", num(settle_fraction));
+    throw InputError("rlocus", "settle_fraction", "a fraction in (0, 1)", detail::str(settle_fraction));
   }
   if (max_points < 2) throw InputError("rlocus", "max_points", "a count >= 2", std::to_string(max_points));
 }
 
 CVector closed_loop_poles(const StateSpace& open_loop, double gain) {
   check_loop(open_loop, "closed_loop_poles");
-  if (!std::isfinite(gain)) throw InputError("closed_loop_poles", "gain", "a finite gain", num(gain));
+  if (!std::isfinite(gain)) throw InputError("closed_loop_poles", "gain", "a finite gain", detail::str(gain));
   return poles_at(open_loop, gain);
 }
 
@@ -246,7 +240,7 @@ RootLocus rlocus(const StateSpace& open_loop, const std::vector<double>& gains) 
   check_loop(open_loop, "rlocus");
   for (size_t i = 0; i < gains.size(); ++i) {
     if (!std::isfinite(gains[i])) {
-      throw InputError("rlocus", "gains[" + std::to_string(i) + "]", "a finite gain", num(gains[i]));
+      throw InputError("rlocus", "gains[" + std::to_string(i) + "]", "a finite gain", detail::str(gains[i]));
     }
   }
   RootLocus rl;
