@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "dsp/fft.hpp"
+#include <fftw3.h>
 #include "piezobench/dsp/welch.hpp"
 
 namespace {
@@ -52,19 +52,23 @@ BENCHMARK(BM_WelchH1Coherence)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->U
 // The floor: the same 3597 transforms of length nfft and nothing else, one thread.
 void BM_FftsAlone(benchmark::State& state) {
   const Data& d = data();
-  const piezobench::dsp::detail::RealForwardFft fft(kNfft);
-  piezobench::dsp::detail::FftwBuffer<double> in(kNfft);
-  piezobench::dsp::detail::FftwBuffer<std::complex<double>> out(fft.bins());
+  // FFTW used directly (the peer): same plan flags as piezobench's (FFTW_ESTIMATE), aligned buffers.
+  double* in = fftw_alloc_real(kNfft);
+  fftw_complex* out = fftw_alloc_complex(kNfft / 2 + 1);
+  const fftw_plan plan = fftw_plan_dft_r2c_1d(static_cast<int>(kNfft), in, out, FFTW_ESTIMATE);
   const Eigen::Index segments = (kSamples - kNfft) / (kNfft / 2) + 1;
   for (auto _ : state) {
     for (Eigen::Index s = 0; s < segments; ++s) {
       for (const Eigen::VectorXd* x : {&d.u, &d.y1, &d.y2}) {
-        std::copy_n(x->data() + s * (kNfft / 2), kNfft, in.data());
-        fft.execute(in.data(), out.data());
-        benchmark::DoNotOptimize(out.data());
+        std::copy_n(x->data() + s * (kNfft / 2), kNfft, in);
+        fftw_execute(plan);
+        benchmark::DoNotOptimize(out);
       }
     }
   }
+  fftw_destroy_plan(plan);
+  fftw_free(out);
+  fftw_free(in);
 }
 BENCHMARK(BM_FftsAlone)->Unit(benchmark::kMillisecond)->UseRealTime();
 
