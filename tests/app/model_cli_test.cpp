@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "run_cli.hpp"
 #include "test_util.hpp"
 
 namespace piezobench {
@@ -20,36 +21,8 @@ using Complex = std::complex<double>;
 using test::near;
 constexpr double kTwoPi = 2.0 * M_PI;
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-// stdout and stderr go to files of their own: a test::TempDir here would share its name (test name
-// and pid) with the test's own TempDir and wipe the input files.
-Outcome run(const std::string& args) {
-  static int counter = 0;
-  const auto base = std::filesystem::temp_directory_path() /
-                    ("piezobench-model-cli-" + std::to_string(::getpid()) + "-" + std::to_string(++counter));
-  const auto out = base.string() + ".out";
-  const auto err = base.string() + ".err";
-  const std::string command = std::string(PIEZOBENCH_BINARY) + " " + args + " >" + out + " 2>" + err;
-  const int status = std::system(command.c_str());
-  Outcome r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = test::read_text(out);
-  r.err = test::read_text(err);
-  std::filesystem::remove(out);
-  std::filesystem::remove(err);
-  return r;
-}
-
-std::string write_file(const test::TempDir& dir, const std::string& name, const std::string& text) {
-  const auto path = dir.path() / name;
-  std::ofstream(path) << text;
-  return path.string();
-}
+using Outcome = test::CliRun;
+const auto run = test::run_cli;
 
 Complex cx(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>()}; }
 
@@ -91,7 +64,7 @@ TEST(ModelCli, TwoDofJsonHasTheReferenceNumbers) {
 
 TEST(ModelCli, TwoDofOptionsAndParamsFile) {
   test::TempDir dir;
-  const std::string params = write_file(dir, "p.toml", "m = 5.7\nk1 = 0.5e6\nga = -3\n");
+  const std::string params = test::write_text_file(dir, "p.toml", "m = 5.7\nk1 = 0.5e6\nga = -3\n");
   const Outcome r = run("model 2dof --json --params " + params + " --fmin 10 --fmax 1000 --points 11 --amplifier-gain 10");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -133,7 +106,7 @@ TEST(ModelCli, BadParamsExitWithThreeAndNameTheKey) {
       {"m = [1.0\n", "line"},
   };
   for (const auto& c : cases) {
-    const std::string f = write_file(dir, "bad.toml", c.text);
+    const std::string f = test::write_text_file(dir, "bad.toml", c.text);
     const Outcome r = run("model 2dof --json --params " + f);
     EXPECT_EQ(r.exit_code, 3) << c.text << r.err;
     EXPECT_NE(r.err.find(f + ": " + c.needle), std::string::npos) << r.err;
@@ -173,7 +146,7 @@ std::string frf_csv(double k1, double ke, double ka, double ce, double ca, doubl
 TEST(ModelCli, TuneRecoversTheParameters) {
   test::TempDir dir;
   const double k1 = 0.42e6, ke = 5.6e6, ka = 2.8e6, ce = 90.0, ca = 55.0, ga = -2.9, gs = 0.5e6;
-  const std::string f = write_file(dir, "frf.csv", frf_csv(k1, ke, ka, ce, ca, ga, gs, 0.01));
+  const std::string f = test::write_text_file(dir, "frf.csv", frf_csv(k1, ke, ka, ce, ca, ga, gs, 0.01));
   const Outcome r = run("model tune --frf " + f + " --mass 5.7 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -204,12 +177,12 @@ TEST(ModelCli, TuneRecoversTheParameters) {
 
 TEST(ModelCli, TuneBadInputExitsWithThree) {
   test::TempDir dir;
-  const std::string no_vs = write_file(dir, "novs.csv", "freq_Hz,re_de,im_de\n1,1,0\n2,1,0\n");
+  const std::string no_vs = test::write_text_file(dir, "novs.csv", "freq_Hz,re_de,im_de\n1,1,0\n2,1,0\n");
   const Outcome r = run("model tune --frf " + no_vs + " --json");
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("Vs"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
-  const std::string good = write_file(dir, "frf.csv", frf_csv(0.4e6, 5e6, 2.5e6, 100, 50, -2.5, 0.46e6, 0.0));
+  const std::string good = test::write_text_file(dir, "frf.csv", frf_csv(0.4e6, 5e6, 2.5e6, 100, 50, -2.5, 0.46e6, 0.0));
   EXPECT_EQ(run("model tune --frf " + good + " --mass -1").exit_code, 3);
   EXPECT_EQ(run("model tune --frf " + good + " --fmin 500 --fmax 501").exit_code, 3);
 }

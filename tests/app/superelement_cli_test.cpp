@@ -13,6 +13,7 @@
 #include <set>
 #include <unistd.h>
 
+#include "run_cli.hpp"
 #include "test_util.hpp"
 
 namespace piezobench {
@@ -24,30 +25,8 @@ const std::string kFiles = (kDir / "piezo_amplified_K.txt").string() + " " + (kD
                            (kDir / "piezo_amplified.txt").string();
 const std::string kCheck = " --fix 76429 --force 76430:76440:x --output 76423:y";
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-// Runs the command with stdout and stderr captured in files of a directory of its own (not a
-// test::TempDir: that one is named after the test, and the test's own input files live there).
-Outcome run(const std::string& args) {
-  static int counter = 0;
-  const fs::path dir = fs::temp_directory_path() /
-                       ("piezobench-superelement-cli-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-  fs::create_directories(dir);
-  const auto out = dir / "stdout";
-  const auto err = dir / "stderr";
-  const std::string command = std::string(PIEZOBENCH_BINARY) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(command.c_str());
-  Outcome r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = test::read_text(out);
-  r.err = test::read_text(err);
-  fs::remove_all(dir);
-  return r;
-}
+using Outcome = test::CliRun;
+const auto run = test::run_cli;
 
 std::vector<std::complex<double>> channel(const nlohmann::json& j, std::size_t index) {
   std::vector<std::complex<double>> h;
