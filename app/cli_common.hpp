@@ -21,6 +21,9 @@ void add_superelement_commands(CLI::App& app, Action& action);  // superelement
 // Prints exactly one JSON document on stdout (round-trip precision for doubles).
 void print_json(const nlohmann::json& document);
 
+// "de, Vs" -> {"de", "Vs"} (items trimmed); InputError naming `option` for an empty item.
+std::vector<std::string> split_list(const std::string& text, const std::string& option);
+
 // "0,1000,1e4" -> {0, 1000, 10000}; InputError naming `option` for anything else.
 std::vector<double> parse_number_list(const std::string& text, const std::string& option);
 

@@ -40,19 +40,6 @@ dsp::WindowType window_from_cli(const std::string& name) {
   return dsp::window_type_from_string(name);
 }
 
-std::vector<std::string> split_names(const std::string& text, const std::string& option) {
-  std::vector<std::string> names;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(',', start), text.size());
-    const std::string name = text.substr(start, end - start);
-    if (name.empty()) throw InputError("", option, "comma-separated channel names", "'" + text + "'");
-    names.push_back(name);
-    start = end + 1;
-  }
-  return names;
-}
-
 nlohmann::json frf_json(const dsp::Frf& frf) {
   nlohmann::json outputs = nlohmann::json::object();
   for (std::size_t i = 0; i < frf.outputs.size(); ++i) {
@@ -85,7 +72,7 @@ int run_frf(const FrfOptions& o) {
 
   io::ReadOptions read;
   read.fs = o.fs;
-  read.channels = split_names(o.outputs, "--output");
+  read.channels = split_list(o.outputs, "--output");
   read.channels.insert(read.channels.begin(), o.input);
   if (!o.json) log_line("reading " + o.file);
   const io::TimeSeries ts = io::read_timeseries(o.file, read);
@@ -151,7 +138,7 @@ dsp::Frf select_band(const dsp::Frf& frf, const FitOptions& o) {
   if (o.outputs.empty()) {
     for (std::size_t i = 0; i < frf.outputs.size(); ++i) outs.push_back(static_cast<Eigen::Index>(i));
   } else {
-    for (const auto& name : split_names(o.outputs, "--output")) outs.push_back(frf.output_index(name));
+    for (const auto& name : split_list(o.outputs, "--output")) outs.push_back(frf.output_index(name));
   }
   dsp::Frf band;
   band.input = frf.input;
