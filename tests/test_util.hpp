@@ -19,6 +19,8 @@
 #include <string>
 #include <unistd.h>
 
+#include "piezobench/core/error.hpp"
+
 namespace piezobench::test {
 
 // Double round-off accumulated through O(n) operations on well-conditioned data.
@@ -92,6 +94,27 @@ inline std::string read_text(const std::filesystem::path& path) {
   ss << in.rdbuf();
   return ss.str();
 }
+
+// Runs f, which must throw InputError; returns its message ("" and a test failure otherwise).
+// With a non-empty `field`, the error must also name that field.
+template <typename F>
+std::string input_error(F&& f, const std::string& field = "") {
+  try {
+    f();
+  } catch (const InputError& e) {
+    if (!field.empty()) {
+      EXPECT_EQ(e.field(), field) << e.what();
+    }
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not an InputError: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError" << (field.empty() ? std::string() : " for " + field);
+  return "";
+}
+
+inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // A fresh empty directory under the system temp dir, removed at destruction.
 class TempDir {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "test_util.hpp"
 
 namespace piezobench::lti {
 namespace {
@@ -21,18 +22,7 @@ StateSpace two_states() {
   return StateSpace(a, b, c, d);
 }
 
-// Runs f, which must throw InputError naming `field`; returns the message.
-template <typename F>
-std::string input_error(F&& f, const std::string& field) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), field) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError for " << field;
-  return "";
-}
+using test::input_error;
 
 TEST(StateSpace, SizesAndKind) {
   const StateSpace sys = two_states();

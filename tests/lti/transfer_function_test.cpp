@@ -8,21 +8,12 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "test_util.hpp"
 
 namespace piezobench::lti {
 namespace {
 
-template <typename F>
-std::string input_error(F&& f, const std::string& field) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), field) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError for " << field;
-  return "";
-}
+using test::input_error;
 
 CVector cvec(std::initializer_list<Complex> v) {
   CVector out(static_cast<Index>(v.size()));
