@@ -17,6 +17,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 #include <unistd.h>
 
 #include "piezobench/core/error.hpp"
@@ -115,6 +117,16 @@ std::string input_error(F&& f, const std::string& field = "") {
 }
 
 inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Expects an InputError whose message contains every one of `needles`.
+template <typename F>
+void expect_input_error(F&& f, const std::vector<std::string>& needles) {
+  const std::string what = input_error(std::forward<F>(f));
+  for (const auto& needle : needles) EXPECT_TRUE(contains(what, needle)) << "'" << needle << "' not in: " << what;
+}
+
+// Writes `text` to `path` (test input files).
+inline void write_text(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 // A fresh empty directory under the system temp dir, removed at destruction.
 class TempDir {

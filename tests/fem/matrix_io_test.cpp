@@ -13,24 +13,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
-template <typename F>
-void expect_input_error(F f, const std::vector<std::string>& needles) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    for (const auto& needle : needles) EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(MatrixIo, ReadsACalculixUpperTriangle) {
   test::TempDir dir;
   // 3 x 3: [[4, -1, 0], [-1, 4, -2], [0, -2, 5]] written as ccx does (column by column, upper).
-  write(dir.path() / "a.sti", "1 1  4.0000000000000e+00\n1 2 -1.0000000000000e+00\n2 2  4.0e+00\n2 3 -2.0e+00\n3 3  5.0e+00\n");
-  write(dir.path() / "a.mas", "1 1 2.0\n2 2 2.0\n3 3 2.0\n1 2 0.5\n");
-  write(dir.path() / "a.dof", "1.1\n1.2\n7.3\n");
+  test::write_text(dir.path() / "a.sti", "1 1  4.0000000000000e+00\n1 2 -1.0000000000000e+00\n2 2  4.0e+00\n2 3 -2.0e+00\n3 3  5.0e+00\n");
+  test::write_text(dir.path() / "a.mas", "1 1 2.0\n2 2 2.0\n3 3 2.0\n1 2 0.5\n");
+  test::write_text(dir.path() / "a.dof", "1.1\n1.2\n7.3\n");
   const SparseMatrix K = read_calculix_matrix(dir.path() / "a.sti", 3);
   const Eigen::MatrixXd expected = (Eigen::MatrixXd(3, 3) << 4, -1, 0, -1, 4, -2, 0, -2, 5).finished();
   EXPECT_TRUE(test::all_near(Eigen::MatrixXd(K), expected, {0, 0}));
@@ -45,25 +35,25 @@ TEST(MatrixIo, ReadsACalculixUpperTriangle) {
 TEST(MatrixIo, BadCalculixFiles) {
   test::TempDir dir;
   const auto f = dir.path() / "bad.sti";
-  write(f, "1 1 4.0\n2 2 4.0\n1 2 1.0\n2 1 1.0\n");  // both triangles: a repeated entry
-  expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "repeated"});
-  write(f, "1 1 4.0\n1 2 1.0\n");  // truncated: no diagonal for row 2
-  expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "row 2", "truncated"});
-  write(f, "1 1 4.0\n2 2 4.0\n1 3 1.0\n");
-  expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "line 3"});
-  write(f, "1 1 4.0\n2 2 nan\n");
-  expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "line 2", "finite"});
-  write(f, "1 1 4.0\n2 2 4.0 x\n");
-  expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "line 2"});
+  test::write_text(f, "1 1 4.0\n2 2 4.0\n1 2 1.0\n2 1 1.0\n");  // both triangles: a repeated entry
+  test::expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "repeated"});
+  test::write_text(f, "1 1 4.0\n1 2 1.0\n");  // truncated: no diagonal for row 2
+  test::expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "row 2", "truncated"});
+  test::write_text(f, "1 1 4.0\n2 2 4.0\n1 3 1.0\n");
+  test::expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "line 3"});
+  test::write_text(f, "1 1 4.0\n2 2 nan\n");
+  test::expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "line 2", "finite"});
+  test::write_text(f, "1 1 4.0\n2 2 4.0 x\n");
+  test::expect_input_error([&] { (void)read_calculix_matrix(f, 2); }, {f.string(), "line 2"});
   const auto d = dir.path() / "bad.dof";
-  write(d, "1.1\n1.7\n");
-  expect_input_error([&] { (void)read_calculix_dofs(d); }, {d.string(), "line 2"});
-  write(d, "1.1\n1.1\n");
-  expect_input_error([&] { (void)read_calculix_dofs(d); }, {d.string(), "line 2", "once"});
+  test::write_text(d, "1.1\n1.7\n");
+  test::expect_input_error([&] { (void)read_calculix_dofs(d); }, {d.string(), "line 2"});
+  test::write_text(d, "1.1\n1.1\n");
+  test::expect_input_error([&] { (void)read_calculix_dofs(d); }, {d.string(), "line 2", "once"});
   // .sti larger than the .dof list.
-  write(d, "1.1\n");
-  write(f, "1 1 4.0\n2 2 4.0\n");
-  expect_input_error([&] { (void)read_calculix_model(f, f, d); }, {f.string(), "line 2", "1..1"});
+  test::write_text(d, "1.1\n");
+  test::write_text(f, "1 1 4.0\n2 2 4.0\n");
+  test::expect_input_error([&] { (void)read_calculix_model(f, f, d); }, {f.string(), "line 2", "1..1"});
 }
 
 TEST(MatrixIo, MatrixMarketRoundTripAndKinds) {
@@ -73,27 +63,27 @@ TEST(MatrixIo, MatrixMarketRoundTripAndKinds) {
   write_matrix_market(f, A, "a test\nwith two lines");
   EXPECT_TRUE(test::all_near(Eigen::MatrixXd(read_matrix_market(f)), A, {0, 0}));  // 17 digits: exact
   // General storage and the upper triangle of a symmetric file are accepted too.
-  write(f, "%%MatrixMarket matrix coordinate real general\n% c\n2 2 4\n1 1 1\n1 2 2\n2 1 2\n2 2 3\n");
+  test::write_text(f, "%%MatrixMarket matrix coordinate real general\n% c\n2 2 4\n1 1 1\n1 2 2\n2 1 2\n2 2 3\n");
   EXPECT_TRUE(test::all_near(Eigen::MatrixXd(read_matrix_market(f)), (Eigen::MatrixXd(2, 2) << 1, 2, 2, 3).finished(), {0, 0}));
-  write(f, "%%MatrixMarket matrix coordinate integer symmetric\n2 2 3\n1 1 1\n1 2 2\n2 2 3\n");
+  test::write_text(f, "%%MatrixMarket matrix coordinate integer symmetric\n2 2 3\n1 1 1\n1 2 2\n2 2 3\n");
   EXPECT_TRUE(test::all_near(Eigen::MatrixXd(read_matrix_market(f)), (Eigen::MatrixXd(2, 2) << 1, 2, 2, 3).finished(), {0, 0}));
 }
 
 TEST(MatrixIo, BadMatrixMarketFiles) {
   test::TempDir dir;
   const auto f = dir.path() / "bad.mtx";
-  write(f, "%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 1\n2 1 2\n");
-  expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "entries", "3 entries", "truncated"});
-  write(f, "%%MatrixMarket matrix array real general\n2 2\n1\n2\n3\n4\n");
-  expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "header", "coordinate"});
-  write(f, "%%MatrixMarket matrix coordinate complex general\n1 1 1\n1 1 1 0\n");
-  expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "header", "real"});
-  write(f, "%%MatrixMarket matrix coordinate real general\n2 2 1\n3 1 1\n");
-  expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "line 3", "indices"});
-  write(f, "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n2 1 1\n1 2 1\n");
-  expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "repeated"});
-  write(f, "1 2 3\n");
-  expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "header"});
+  test::write_text(f, "%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 1\n2 1 2\n");
+  test::expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "entries", "3 entries", "truncated"});
+  test::write_text(f, "%%MatrixMarket matrix array real general\n2 2\n1\n2\n3\n4\n");
+  test::expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "header", "coordinate"});
+  test::write_text(f, "%%MatrixMarket matrix coordinate complex general\n1 1 1\n1 1 1 0\n");
+  test::expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "header", "real"});
+  test::write_text(f, "%%MatrixMarket matrix coordinate real general\n2 2 1\n3 1 1\n");
+  test::expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "line 3", "indices"});
+  test::write_text(f, "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n2 1 1\n1 2 1\n");
+  test::expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "repeated"});
+  test::write_text(f, "1 2 3\n");
+  test::expect_input_error([&] { (void)read_matrix_market(f); }, {f.string(), "header"});
 }
 
 TEST(MatrixIo, DofListRoundTrip) {
@@ -109,24 +99,24 @@ TEST(MatrixIo, DofListRoundTrip) {
   for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(back.dofs[i], se.dofs[i]) << i;
   ASSERT_EQ(back.coordinates.size(), 1U);  // node 11 has no coordinates
   EXPECT_TRUE(test::all_near(back.coordinates.at(10), se.coordinates.at(10), {0, 0}));
-  write(f, "1 UX\nMODE 1\n1 UY\n");
-  expect_input_error([&] { (void)read_dof_list(f); }, {f.string(), "line 3", "before the modal"});
-  write(f, "1 UX\nMODE 2\n");
-  expect_input_error([&] { (void)read_dof_list(f); }, {f.string(), "line 2", "MODE 1"});
-  write(f, "1 UW 0 0 0\n");
-  expect_input_error([&] { (void)read_dof_list(f); }, {f.string(), "line 1"});
+  test::write_text(f, "1 UX\nMODE 1\n1 UY\n");
+  test::expect_input_error([&] { (void)read_dof_list(f); }, {f.string(), "line 3", "before the modal"});
+  test::write_text(f, "1 UX\nMODE 2\n");
+  test::expect_input_error([&] { (void)read_dof_list(f); }, {f.string(), "line 2", "MODE 1"});
+  test::write_text(f, "1 UW 0 0 0\n");
+  test::expect_input_error([&] { (void)read_dof_list(f); }, {f.string(), "line 1"});
 }
 
 TEST(MatrixIo, InpNodesFollowIncludes) {
   test::TempDir dir;
-  write(dir.path() / "mesh.inp", "*NODE, NSET=ALL\n1, 0.0, 0.0, 0.0\n2, 1.0, 2.0, 3.0\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n");
-  write(dir.path() / "deck.inp", "** comment\n*INCLUDE, INPUT=mesh.inp\n*NODE\n3, 4.5, 0, -1e-3\n*NODE PRINT, NSET=ALL\nU\n");
+  test::write_text(dir.path() / "mesh.inp", "*NODE, NSET=ALL\n1, 0.0, 0.0, 0.0\n2, 1.0, 2.0, 3.0\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n");
+  test::write_text(dir.path() / "deck.inp", "** comment\n*INCLUDE, INPUT=mesh.inp\n*NODE\n3, 4.5, 0, -1e-3\n*NODE PRINT, NSET=ALL\nU\n");
   const auto nodes = read_inp_nodes(dir.path() / "deck.inp");
   ASSERT_EQ(nodes.size(), 3U);
   EXPECT_TRUE(test::all_near(nodes.at(2), Eigen::Vector3d(1, 2, 3), {0, 0}));
   EXPECT_TRUE(test::all_near(nodes.at(3), Eigen::Vector3d(4.5, 0, -1e-3), {0, 0}));
-  write(dir.path() / "bad.inp", "*NODE\n1, 0.0, abc, 0.0\n");
-  expect_input_error([&] { (void)read_inp_nodes(dir.path() / "bad.inp"); }, {"bad.inp", "line 2"});
+  test::write_text(dir.path() / "bad.inp", "*NODE\n1, 0.0, abc, 0.0\n");
+  test::expect_input_error([&] { (void)read_inp_nodes(dir.path() / "bad.inp"); }, {"bad.inp", "line 2"});
 }
 
 TEST(MatrixIo, SuperElementAndSimscapeWriters) {
@@ -152,7 +142,7 @@ TEST(MatrixIo, SuperElementAndSimscapeWriters) {
   EXPECT_NE(text.find("K = [\n  3 0.5 0 0 0 0 0\n"), std::string::npos) << text;
   // A node with only translations cannot be a Simscape frame.
   se.dofs[3] = DofLabel::nodal(6, Direction::kX);
-  expect_input_error([&] { (void)write_simscape(dir.path(), "se", se); }, {"dofs", "node 5"});
+  test::expect_input_error([&] { (void)write_simscape(dir.path(), "se", se); }, {"dofs", "node 5"});
 }
 
 }  // namespace

@@ -47,18 +47,7 @@ std::string replace_once(std::string text, const std::string& from, const std::s
   return text;
 }
 
-void write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
-// Runs `f`, expects an InputError whose message contains every needle.
-template <typename F>
-void expect_input_error(F f, const std::vector<std::string>& needles) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    for (const auto& needle : needles) EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(SuperElement, EnumsRoundTrip) {
   for (Direction d : {Direction::kX, Direction::kY, Direction::kZ, Direction::kRx, Direction::kRy, Direction::kRz}) {
@@ -186,9 +175,9 @@ class BadAnsysFiles : public ::testing::Test {
   fs::path mf() const { return dir.path() / "M.txt"; }
   fs::path lf() const { return dir.path() / "masters.txt"; }
   void write_all() {
-    write(kf(), k);
-    write(mf(), m);
-    write(lf(), masters);
+    test::write_text(kf(), k);
+    test::write_text(mf(), m);
+    test::write_text(lf(), masters);
   }
   SuperElement read() { return read_ansys_super_element(kf(), mf(), lf()); }
 };
@@ -205,37 +194,37 @@ TEST_F(BadAnsysFiles, TruncatedStiffness) {
   k = k.substr(0, k.size() / 2);
   k = k.substr(0, k.rfind('['));  // cut at an entry boundary: a whole-entry truncation
   write_all();
-  expect_input_error([&] { (void)read(); }, {kf().string(), "entries", "truncated"});
+  test::expect_input_error([&] { (void)read(); }, {kf().string(), "entries", "truncated"});
 }
 
 TEST_F(BadAnsysFiles, TruncatedInsideAnEntry) {
   k = k.substr(0, k.rfind("[108,108]") + 5);
   write_all();
-  expect_input_error([&] { (void)read(); }, {kf().string(), "line 110"});
+  test::expect_input_error([&] { (void)read(); }, {kf().string(), "line 110"});
 }
 
 TEST_F(BadAnsysFiles, MissingHeader) {
   k = replace_once(k, "MAT_K:", "");
   write_all();
-  expect_input_error([&] { (void)read(); }, {kf().string(), "header", "MAT_K"});
+  test::expect_input_error([&] { (void)read(); }, {kf().string(), "header", "MAT_K"});
 }
 
 TEST_F(BadAnsysFiles, AsymmetricStiffness) {
   k = replace_once(k, "[  2,  1]: 2.568e+04", "[  2,  1]: 2.600e+04");
   write_all();
-  expect_input_error([&] { (void)read(); }, {kf().string(), "K[2,1]", "symmetric"});
+  test::expect_input_error([&] { (void)read(); }, {kf().string(), "K[2,1]", "symmetric"});
 }
 
 TEST_F(BadAnsysFiles, NanEntry) {
   m = replace_once(m, "[  1,  1]: 3.913e-02", "[  1,  1]: nan");
   write_all();
-  expect_input_error([&] { (void)read(); }, {mf().string(), "[1,1]", "finite"});
+  test::expect_input_error([&] { (void)read(); }, {mf().string(), "[1,1]", "finite"});
 }
 
 TEST_F(BadAnsysFiles, MassNotPositiveDefinite) {
   m = replace_once(m, "[  1,  1]: 3.913e-02", "[  1,  1]:-3.913e-02");
   write_all();
-  expect_input_error([&] { (void)read(); }, {kf().string(), "M", "positive definite"});
+  test::expect_input_error([&] { (void)read(); }, {kf().string(), "M", "positive definite"});
 }
 
 TEST_F(BadAnsysFiles, ListingWithANodeMissingDoesNotMatchTheMatrices) {
@@ -245,7 +234,7 @@ TEST_F(BadAnsysFiles, ListingWithANodeMissingDoesNotMatchTheMatrices) {
     masters = replace_once(masters, std::string("   76440 ") + label + "\n", "");
   }
   write_all();
-  expect_input_error([&] { (void)read(); }, {lf().string(), "master DOF", "does not match"});
+  test::expect_input_error([&] { (void)read(); }, {lf().string(), "master DOF", "does not match"});
 }
 
 TEST_F(BadAnsysFiles, ListingLongerThanTheMatrices) {
@@ -254,7 +243,7 @@ TEST_F(BadAnsysFiles, ListingLongerThanTheMatrices) {
     for (const char* label : {"UX", "UY", "UZ", "ROTX", "ROTY", "ROTZ"}) extra += "   " + std::to_string(node) + " " + label + "\n";
   masters = replace_once(masters, "   76440 ROTZ\n", "   76440 ROTZ\n" + extra);
   write_all();
-  expect_input_error([&] { (void)read(); }, {lf().string(), "master DOF", "at most 108 rows", "114 rows"});
+  test::expect_input_error([&] { (void)read(); }, {lf().string(), "master DOF", "at most 108 rows", "114 rows"});
 }
 
 TEST_F(BadAnsysFiles, NodeWithoutCoordinates) {
@@ -262,14 +251,14 @@ TEST_F(BadAnsysFiles, NodeWithoutCoordinates) {
   const fs::path nlist = dir.path() / "nlist.txt";
   std::string text = test::read_text(kAnsysDir / "out_NLIST.txt");
   text = replace_once(text, "    76440  0.35000E-001", "    76441  0.35000E-001");
-  write(nlist, text);
-  expect_input_error([&] { (void)read_ansys_super_element(kf(), mf(), lf(), nlist); }, {nlist.string(), "node 76440"});
+  test::write_text(nlist, text);
+  test::expect_input_error([&] { (void)read_ansys_super_element(kf(), mf(), lf(), nlist); }, {nlist.string(), "node 76440"});
 }
 
 TEST_F(BadAnsysFiles, SizesOfKAndMDiffer) {
   m = m.substr(0, m.find("[108,  1]"));
   write_all();
-  expect_input_error([&] { (void)read(); }, {mf().string(), "entries"});
+  test::expect_input_error([&] { (void)read(); }, {mf().string(), "entries"});
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
+#include "lti/lti_test_util.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::lti {
@@ -23,31 +24,9 @@ using test::Tolerance;
 
 constexpr double kPi = 3.14159265358979323846;
 
-// s = -zeta w +- j w sqrt(1 - zeta^2), negative imaginary part first (the documented order).
-CVector pair(double w, double zeta) {
-  CVector p(2);
-  p << Complex(-zeta * w, -w * std::sqrt(1.0 - zeta * zeta)), Complex(-zeta * w, w * std::sqrt(1.0 - zeta * zeta));
-  return p;
-}
-
-CVector concat(std::initializer_list<CVector> parts) {
-  Index n = 0;
-  for (const auto& p : parts) n += p.size();
-  CVector out(n);
-  Index k = 0;
-  for (const auto& p : parts) {
-    out.segment(k, p.size()) = p;
-    k += p.size();
-  }
-  return out;
-}
-
-CVector real_values(std::initializer_list<double> v) {
-  CVector out(static_cast<Index>(v.size()));
-  Index k = 0;
-  for (const double x : v) out(k++) = Complex(x, 0.0);
-  return out;
-}
+using test::concat;
+using test::pair;
+using test::real_values;
 
 // Sort as poles()/zeros() document, for expected values written in any order.
 CVector sorted(CVector v) {

@@ -7,6 +7,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/analysis.hpp"
+#include "lti/lti_test_util.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::lti {
@@ -20,24 +21,10 @@ using test::Tolerance;
 
 constexpr double kPi = 3.14159265358979323846;
 
-CVector pair(double w, double zeta) {
-  CVector p(2);
-  p << Complex(-zeta * w, -w * std::sqrt(1.0 - zeta * zeta)), Complex(-zeta * w, w * std::sqrt(1.0 - zeta * zeta));
-  return p;
-}
+using test::cvec;
+using test::pair;
 
-CVector cvec(std::initializer_list<Complex> v) {
-  CVector out(static_cast<Index>(v.size()));
-  Index k = 0;
-  for (const Complex& x : v) out(k++) = x;
-  return out;
-}
-
-CVector concat(const CVector& a, const CVector& b) {
-  CVector out(a.size() + b.size());
-  out << a, b;
-  return out;
-}
+CVector concat(const CVector& a, const CVector& b) { return test::concat({a, b}); }
 
 // H(s) = D + C (sI - A)^-1 B of a SISO system, by a dense solve (independent of the library).
 Complex evaluate(const StateSpace& sys, Complex s) {
