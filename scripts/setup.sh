@@ -36,7 +36,11 @@ packages=(
   # External programs piezobench drives (`superelement from-step`) and the independent checks of
   # the test suite (scipy reads the virtual bench's files).
   gmsh calculix-ccx python3-scipy
+  # The report's plotting library comes from npm (src/report/js); its test runs headless Chromium.
+  nodejs chromium
 )
+# npm: Debian's package, unless the installed Node.js brings its own (NodeSource's conflicts with it).
+if ! command -v npm >/dev/null 2>&1; then packages+=(npm); fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -50,6 +54,15 @@ if [ ${#missing[@]} -gt 0 ]; then
   if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
   "${sudo_cmd[@]}" apt-get update -q
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# The plotting library inlined into report.html, at the versions package-lock.json pins; again
+# whenever the lock file is newer than the installed tree.
+report_js="$root/src/report/js"
+if [ ! -f "$report_js/node_modules/.package-lock.json" ] || \
+   [ "$report_js/package-lock.json" -nt "$report_js/node_modules/.package-lock.json" ]; then
+  echo "setup.sh: installing the report's plotting library with npm ci" >&2
+  npm ci --prefix "$report_js" --no-audit --no-fund --loglevel=error >/dev/null
 fi
 
 if [ "$sanitize" -eq 1 ]; then

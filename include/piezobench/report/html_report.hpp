@@ -23,10 +23,31 @@
 //                                "dash": false, "group": "APA 1" } ] } ] }
 //   Non-finite numbers in x/y are allowed as JSON null (gaps). "group" links traces of the same
 //   unit across panels (one legend entry, toggled together).
+//
+// Details and additions to the layout above (docs/report.md shows the page):
+//   - Required: "title", "results" (an object), "sections"; per section "title" and "figures"; per
+//     figure "id", "title" and "panels" (at least one); per trace "name", "x" and "y". Everything
+//     else is optional: "x_label"/"y_label" default to "", "x_log"/"y_log" and "dash" to false,
+//     "mode" to "lines", "group" to none (the trace is its own legend entry). Unknown keys in the
+//     document, sections, figures, panels and traces are errors (they are typos of known ones).
+//   - x and y have the same length. Their entries are numbers, null, or the strings "nan", "inf",
+//     "-inf" that io::to_json writes (all three are drawn as gaps). An x made only of strings is a
+//     category axis (unit names for batch comparisons); every trace of that figure then has one
+//     and "x_log" must be false.
+//   - "mode" may also be "bars" (a bar per x, bars of one x side by side).
+//   - Additions: section "id" ([a-z0-9-], unique, default "section-N"), figure "text" (a caption).
+//   - A trace's colour is its group's (its name's when it has no group), the same in every figure.
+//   - results.units: a list of objects with "id" (string or number, unique), "accepted" (bool) and
+//     "reasons" (a list of strings, at least one for a rejected unit). The key figures of the table
+//     are read where CLI.md puts them (flatness_um, capacitance_uF.{sensor,actuator}, stroke_um,
+//     stiffness_N_per_um.{k1,k2,resonance}, frf.{resonance_Hz,antiresonance_Hz,
+//     static_gain_um_per_V}, hpf_corner_Hz); a missing or null one reads "not measured". Other
+//     keys of results are ignored, except results.batch (shown in the batch summary: its numbers,
+//     strings, lists and nested objects) and results.iff.optimal_gain.
+//   Every string is escaped: a unit name or a reason cannot inject HTML or script.
 #include <filesystem>
-#include <string>
-
 #include <nlohmann/json_fwd.hpp>
+#include <string>
 
 namespace piezobench::report {
 

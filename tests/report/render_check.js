@@ -1,0 +1,376 @@
+#!/usr/bin/env node
+// Opens a report.html in headless Chromium (Debian's /usr/bin/chromium) and checks that it works
+// as a person would see it: every figure drawn as a Plotly SVG with all its traces, no console
+// error, no uncaught exception, no dialog (a sign of injected script), no request leaving the file
+// (the report must work offline). Saves a full-page screenshot and checks the PNG: its size is the
+// page's, and it is not blank.
+//
+//   node render_check.js REPORT.html SCREENSHOT.png
+//
+// Environment: PIEZOBENCH_CHROMIUM overrides /usr/bin/chromium. Exit code 0 when every check
+// passes, 1 otherwise (each failure printed). No npm package: it speaks the DevTools protocol to
+// Chromium over --remote-debugging-pipe (file descriptors 3 and 4).
+'use strict';
+const { spawn } = require('node:child_process');
+const fs = require('node:fs');
+const os = require('node:os');
+const path = require('node:path');
+const zlib = require('node:zlib');
+
+const WIDTH = 1280;
+const HEIGHT = 900;
+const TIMEOUT_MS = 30000;
+
+function usage() {
+  console.error('usage: node render_check.js REPORT.html SCREENSHOT.png');
+  process.exit(2);
+}
+
+// ---- PNG decoding (8-bit RGB/RGBA, not interlaced: what Chromium writes) -------------------------
+function decodePng(buffer) {
+  const signature = Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
+  if (buffer.length < 8 || !buffer.subarray(0, 8).equals(signature)) throw new Error('not a PNG file');
+  let offset = 8;
+  let width = 0, height = 0, depth = 0, colourType = 0, interlace = 0;
+  const idat = [];
+  while (offset + 8 <= buffer.length) {
+    const length = buffer.readUInt32BE(offset);
+    const type = buffer.toString('latin1', offset + 4, offset + 8);
+    const data = buffer.subarray(offset + 8, offset + 8 + length);
+    if (type === 'IHDR') {
+      width = data.readUInt32BE(0);
+      height = data.readUInt32BE(4);
+      depth = data[8];
+      colourType = data[9];
+      interlace = data[12];
+    } else if (type === 'IDAT') {
+      idat.push(data);
+    } else if (type === 'IEND') {
+      break;
+    }
+    offset += 12 + length;
+  }
+  const channels = { 2: 3, 6: 4 }[colourType];
+  if (depth !== 8 || channels === undefined || interlace !== 0) {
+    throw new Error(`unsupported PNG layout (depth ${depth}, colour type ${colourType}, interlace ${interlace})`);
+  }
+  const raw = zlib.inflateSync(Buffer.concat(idat));
+  const stride = width * channels;
+  if (raw.length !== height * (stride + 1)) throw new Error('PNG data has the wrong length');
+  const pixels = Buffer.alloc(height * stride);
+  for (let y = 0; y < height; ++y) {
+    const filter = raw[y * (stride + 1)];
+    const line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
+    const out = pixels.subarray(y * stride, (y + 1) * stride);
+    const prev = y > 0 ? pixels.subarray((y - 1) * stride, y * stride) : Buffer.alloc(stride);
+    for (let i = 0; i < stride; ++i) {
+      const a = i >= channels ? out[i - channels] : 0;
+      const b = prev[i];
+      const c = i >= channels ? prev[i - channels] : 0;
+      let v = line[i];
+      if (filter === 1) v += a;
+      else if (filter === 2) v += b;
+      else if (filter === 3) v += (a + b) >> 1;
+      else if (filter === 4) {
+        const p = a + b - c, pa = Math.abs(p - a), pb = Math.abs(p - b), pc = Math.abs(p - c);
+        v += pa <= pb && pa <= pc ? a : (pb <= pc ? b : c);
+      } else if (filter !== 0) throw new Error(`bad PNG filter ${filter}`);
+      out[i] = v & 0xff;
+    }
+  }
+  return { width, height, channels, pixels };
+}
+
+// Fraction of pixels that are not (near) white, and the number of distinct colours (capped).
+function inkStatistics(png) {
+  let ink = 0;
+  const colours = new Set();
+  const n = png.width * png.height;
+  for (let k = 0; k < n; ++k) {
+    const i = k * png.channels;
+    const r = png.pixels[i], g = png.pixels[i + 1], b = png.pixels[i + 2];
+    if (r < 235 || g < 235 || b < 235) ++ink;
+    if (colours.size < 5000) colours.add((r << 16) | (g << 8) | b);
+  }
+  return { inkFraction: ink / n, colours: colours.size };
+}
+
+// ---- DevTools protocol over a pipe -------------------------------------------------------------
+class Cdp {
+  constructor(writable, readable) {
+    this.writable = writable;
+    this.nextId = 1;
+    this.pending = new Map();
+    this.listeners = [];
+    let buffered = '';
+    readable.on('data', (chunk) => {
+      buffered += chunk.toString('utf8');
+      let end;
+      while ((end = buffered.indexOf('\0')) >= 0) {
+        const message = JSON.parse(buffered.slice(0, end));
+        buffered = buffered.slice(end + 1);
+        if (message.id !== undefined && this.pending.has(message.id)) {
+          const { resolve, reject, method } = this.pending.get(message.id);
+          this.pending.delete(message.id);
+          if (message.error) reject(new Error(`${method}: ${message.error.message}`));
+          else resolve(message.result);
+        } else if (message.method) {
+          for (const listener of this.listeners) listener(message);
+        }
+      }
+    });
+  }
+  send(method, params = {}, sessionId = undefined) {
+    const id = this.nextId++;
+    const message = { id, method, params };
+    if (sessionId) message.sessionId = sessionId;
+    return new Promise((resolve, reject) => {
+      this.pending.set(id, { resolve, reject, method });
+      this.writable.write(JSON.stringify(message) + '\0');
+    });
+  }
+  on(listener) { this.listeners.push(listener); }
+}
+
+const t0 = Date.now();
+function trace(what) { if (process.env.PIEZOBENCH_RENDER_CHECK_VERBOSE) console.error(`${Date.now() - t0} ms: ${what}`); }
+function sleep(ms) { return new Promise((resolve) => setTimeout(resolve, ms)); }
+
+async function main() {
+  const [reportArg, screenshotArg] = process.argv.slice(2);
+  if (!reportArg || !screenshotArg) usage();
+  const report = path.resolve(reportArg);
+  const screenshot = path.resolve(screenshotArg);
+  const chromium = process.env.PIEZOBENCH_CHROMIUM || '/usr/bin/chromium';
+  const failures = [];
+  if (!fs.existsSync(report)) throw new Error(`no report at ${report}`);
+  if (!fs.existsSync(chromium)) {
+    throw new Error(`${chromium} not found: install Debian's chromium package (scripts/setup.sh does)`);
+  }
+  fs.rmSync(screenshot, { force: true });
+
+  const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'piezobench-chromium-'));
+  const args = [
+    '--headless', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--disable-quic',
+    '--no-first-run', '--no-default-browser-check', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync', '--disable-extensions', '--mute-audio',
+    '--hide-scrollbars', '--remote-debugging-pipe', `--user-data-dir=${profile}`,
+    `--window-size=${WIDTH},${HEIGHT}`, 'about:blank',
+  ];
+  const browser = spawn(chromium, args, { stdio: ['ignore', 'ignore', 'pipe', 'pipe', 'pipe'] });
+  let browserLog = '';
+  browser.stderr.on('data', (d) => { browserLog = (browserLog + d.toString()).slice(-4000); });
+  const exited = new Promise((resolve) => browser.on('exit', resolve));
+  const timer = setTimeout(() => {
+    console.error(`render_check: timed out after ${TIMEOUT_MS / 1000} s\n${browserLog}`);
+    browser.kill('SIGKILL');
+    fs.rmSync(profile, { recursive: true, force: true });
+    process.exit(1);
+  }, TIMEOUT_MS);
+
+  try {
+    const cdp = new Cdp(browser.stdio[3], browser.stdio[4]);
+    trace('chromium started');
+    const { targetId } = await cdp.send('Target.createTarget', { url: 'about:blank' });
+    const { sessionId } = await cdp.send('Target.attachToTarget', { targetId, flatten: true });
+    const page = (method, params) => cdp.send(method, params, sessionId);
+
+    const consoleErrors = [];
+    cdp.on((m) => {
+      if (m.sessionId !== sessionId) return;
+      const p = m.params;
+      if (m.method === 'Runtime.consoleAPICalled' && (p.type === 'error' || p.type === 'assert')) {
+        consoleErrors.push('console.' + p.type + ': ' + p.args.map((a) => a.value ?? a.description ?? '').join(' '));
+      } else if (m.method === 'Runtime.exceptionThrown') {
+        const d = p.exceptionDetails;
+        consoleErrors.push('uncaught exception: ' + ((d.exception && d.exception.description) || d.text));
+      } else if (m.method === 'Log.entryAdded' && p.entry.level === 'error') {
+        consoleErrors.push('log error: ' + p.entry.text + (p.entry.url ? ' (' + p.entry.url + ')' : ''));
+      } else if (m.method === 'Page.javascriptDialogOpening') {
+        consoleErrors.push(`a ${p.type} dialog opened ("${p.message}"): injected script ran`);
+        page('Page.handleJavaScriptDialog', { accept: false }).catch(() => {});
+      } else if (m.method === 'Network.requestWillBeSent') {
+        const url = p.request.url;
+        if (!/^(file|data|blob|about):/.test(url)) consoleErrors.push('network request (not offline): ' + url);
+      }
+    });
+    await page('Runtime.enable');
+    await page('Log.enable');
+    await page('Page.enable');
+    await page('Network.enable');
+    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: HEIGHT, deviceScaleFactor: 1, mobile: false });
+
+    trace('page ready');
+    const started = Date.now();
+    await page('Page.navigate', { url: 'file://' + report });
+    const evaluate = async (expression) => {
+      const r = await page('Runtime.evaluate', { expression, returnByValue: true, awaitPromise: true });
+      if (r.exceptionDetails) {
+        const d = r.exceptionDetails;
+        throw new Error('evaluate failed: ' + ((d.exception && d.exception.description) || d.text));
+      }
+      return r.result.value;
+    };
+    let state = 'pending';
+    while (Date.now() - started < TIMEOUT_MS - 5000) {
+      state = await evaluate("(document.getElementById('pb-status') || {dataset: {}}).dataset.state || 'loading'");
+      if (state === 'rendered' || state === 'error') break;
+      await sleep(100);
+    }
+    const renderMs = Date.now() - started;
+    trace('rendered');
+    if (state !== 'rendered') {
+      const text = await evaluate("(document.getElementById('pb-status') || {}).textContent || ''");
+      failures.push(`report state is "${state}", not "rendered": ${text}`);
+    }
+
+    // Every figure of the embedded document has its div, an SVG drawn by Plotly and every trace.
+    const check = await evaluate(`(() => {
+      const data = JSON.parse(document.getElementById('pb-data').textContent);
+      const plotDivs = document.querySelectorAll('div.pb-plot');
+      const figures = data.figures.map((fig) => {
+        const div = document.getElementById('fig-' + fig.id);
+        const expectedTraces = fig.panels.reduce((n, p) => n + p.traces.length, 0);
+        return {
+          id: fig.id,
+          hasDiv: div !== null,
+          svg: div ? div.querySelectorAll('svg.main-svg').length : 0,
+          drawnTraces: div ? div.querySelectorAll('.cartesianlayer g.trace').length : 0,
+          expectedTraces,
+          legendEntries: div ? div.querySelectorAll('g.legend g.traces').length : 0,
+          height: div ? div.getBoundingClientRect().height : 0,
+        };
+      });
+      return {
+        declared: Number(document.getElementById('pb-status').dataset.figures),
+        plotDivs: plotDivs.length,
+        withSvg: Array.from(plotDivs).filter((d) => d.querySelector('svg.main-svg')).length,
+        figures,
+        injected: typeof window.__pbInjected !== 'undefined',
+        title: document.title,
+        pageHeight: Math.ceil(document.documentElement.scrollHeight),
+      };
+    })()`);
+    if (check.plotDivs !== check.figures.length || check.declared !== check.figures.length) {
+      failures.push(`${check.plotDivs} plot divs and ${check.declared} declared figures for ${check.figures.length} figures in the data`);
+    }
+    if (check.withSvg !== check.figures.length) {
+      failures.push(`${check.withSvg} of ${check.figures.length} plot divs hold a drawn plot`);
+    }
+    for (const f of check.figures) {
+      if (!f.hasDiv) failures.push(`figure ${f.id}: no div#fig-${f.id}`);
+      else if (f.svg === 0) failures.push(`figure ${f.id}: not drawn (no SVG)`);
+      else if (f.drawnTraces !== f.expectedTraces) {
+        failures.push(`figure ${f.id}: ${f.drawnTraces} traces drawn, ${f.expectedTraces} in the document`);
+      }
+      if (f.hasDiv && f.height < 100) failures.push(`figure ${f.id}: only ${f.height} px high`);
+    }
+    if (check.injected) failures.push('a script from the document ran (window.__pbInjected is set)');
+
+    trace('checked');
+    // Full-page screenshot at the page's size.
+    const height = Math.min(check.pageHeight, 16000);
+    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height, deviceScaleFactor: 1, mobile: false });
+    await sleep(200);
+    const shot = await page('Page.captureScreenshot', {
+      format: 'png', captureBeyondViewport: true, clip: { x: 0, y: 0, width: WIDTH, height, scale: 1 },
+    });
+    fs.writeFileSync(screenshot, Buffer.from(shot.data, 'base64'));
+    trace('screenshot');
+
+    // Interaction with a real mouse, on the first figure with several panels and a group:
+    // hovering a point shows its label; clicking the group's legend entry hides the group's
+    // traces in every panel, clicking again shows them.
+    const target = state !== 'rendered' ? undefined : await evaluate(`(() => {
+      const data = JSON.parse(document.getElementById('pb-data').textContent);
+      const fig = data.figures.find((f) => f.panels.length > 1 && f.panels[0].traces.some((t) => t.group));
+      if (!fig) return null;
+      const gd = document.getElementById('fig-' + fig.id);
+      const t = gd.data.findIndex((tr) => tr.legendgroup && tr.legendgroup.startsWith('group:'));
+      const trace = gd.data[t];
+      const xa = gd._fullLayout.xaxis, ya = gd._fullLayout[trace.yaxis.replace('y', 'yaxis')];
+      const k = Math.floor(trace.x.length / 3);
+      const box = gd.getBoundingClientRect();
+      const legend = Array.from(gd.querySelectorAll('g.legend g.traces'))
+        .find((g) => g.textContent === trace.name).querySelector('rect.legendtoggle').getBoundingClientRect();
+      return {
+        id: fig.id, group: trace.legendgroup, name: fig.panels[0].traces.find((x) => x.group).name,
+        members: gd.data.filter((tr) => tr.legendgroup === trace.legendgroup).length,
+        panels: new Set(gd.data.filter((tr) => tr.legendgroup === trace.legendgroup).map((tr) => tr.yaxis)).size,
+        point: { x: box.left + xa._offset + xa.l2p(xa.d2l(trace.x[k])), y: box.top + ya._offset + ya.l2p(ya.d2l(trace.y[k])) },
+        legend: { x: legend.left + legend.width / 2, y: legend.top + legend.height / 2 },
+      };
+    })()`);
+    if (target === undefined) {
+      // Not drawn: already a failure.
+    } else if (target === null) {
+      failures.push('no figure with several panels and grouped traces to check the interaction on');
+    } else {
+      const mouse = (type, p, extra = {}) => page('Input.dispatchMouseEvent', { type, x: p.x, y: p.y, ...extra });
+      await mouse('mouseMoved', target.point);
+      await sleep(300);
+      const hover = await evaluate(`Array.from(document.querySelectorAll('#fig-${target.id} .hoverlayer .hovertext')).map((h) => h.textContent).join(' | ')`);
+      if (!hover.includes(target.name)) failures.push(`hover on ${target.id}: label "${hover}" does not name "${target.name}"`);
+      await mouse('mouseMoved', { x: 2, y: 2 });
+      const hidden = (state) => `document.getElementById('fig-${target.id}')._fullData
+        .filter((tr) => tr.legendgroup === ${JSON.stringify(target.group)}).map((tr) => tr.visible === ${state})`;
+      for (const [round, state] of [[1, "'legendonly'"], [2, 'true']]) {
+        await mouse('mouseMoved', target.legend);
+        await mouse('mousePressed', target.legend, { button: 'left', clickCount: 1 });
+        await mouse('mouseReleased', target.legend, { button: 'left', clickCount: 1 });
+        let flags = [];
+        for (let i = 0; i < 30; ++i) {  // Plotly waits for a possible double click first
+          await sleep(100);
+          flags = await evaluate(hidden(state));
+          if (flags.length > 0 && flags.every(Boolean)) break;
+        }
+        if (flags.length !== target.members || !flags.every(Boolean)) {
+          failures.push(`legend click ${round} on ${target.id}: ${flags.filter(Boolean).length} of ${target.members} ` +
+            `traces of ${target.group} have visible=${state}`);
+        }
+      }
+      if (target.panels < 2) failures.push(`figure ${target.id}: group ${target.group} spans ${target.panels} panel`);
+    }
+    trace('interaction');
+    failures.push(...consoleErrors);
+
+    // The PNG as written: the expected size, and ink spread over it (not a blank page).
+    const png = decodePng(fs.readFileSync(screenshot));
+    if (png.width !== WIDTH || png.height !== height) {
+      failures.push(`screenshot is ${png.width} x ${png.height} px, expected ${WIDTH} x ${height}`);
+    }
+    const ink = inkStatistics(png);
+    if (ink.inkFraction < 0.02 || ink.colours < 50) {
+      failures.push(`screenshot looks blank: ${(100 * ink.inkFraction).toFixed(2)} % ink, ${ink.colours} colours`);
+    }
+
+    trace('png');
+    await cdp.send('Browser.close').catch(() => {});
+    trace('close sent');
+    if (failures.length === 0) {
+      const traces = check.figures.reduce((n, f) => n + f.drawnTraces, 0);
+      console.log(`render_check: ${check.figures.length} of ${check.figures.length} figures drawn (${traces} traces) ` +
+        `in ${renderMs} ms, no console error; hover label and legend toggle of ${target.group.slice(6)} across ` +
+        `${target.panels} panels of ${target.id} work; screenshot ${png.width} x ${png.height} px, ` +
+        `${(100 * ink.inkFraction).toFixed(1)} % ink, ${ink.colours}${ink.colours >= 5000 ? '+' : ''} colours: ${screenshot}`);
+    }
+  } finally {
+    clearTimeout(timer);
+    const closed = await Promise.race([exited.then(() => true), sleep(3000).then(() => false)]);
+    trace(closed ? 'chromium exited' : 'chromium killed');
+    if (!closed) browser.kill('SIGKILL');
+    fs.rmSync(profile, { recursive: true, force: true });
+    trace('profile removed');
+    // Chromium's helpers (crashpad) may hold the pipes a little longer: do not wait for them.
+    for (const stream of browser.stdio) if (stream) stream.destroy();
+  }
+  if (failures.length > 0) {
+    console.error('render_check: FAILED\n  ' + failures.join('\n  '));
+    process.exit(1);
+  }
+}
+
+main().then(() => process.exit(0)).catch((e) => {
+  console.error('render_check: ' + e.message);
+  process.exit(1);
+});
