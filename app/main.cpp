@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   piezobench::app::add_iff_commands(app, action);
   piezobench::app::add_model_commands(app, action);
   piezobench::app::add_superelement_commands(app, action);
+  piezobench::app::add_simulate_commands(app, action);
 
   try {
     app.parse(argc, argv);

@@ -4,23 +4,43 @@
 // SI units, its channels' units, and settings that say how it was made: `experiment`, `unit`,
 // `seed`, and the experiment's parameters below (written to .mat by io::write_timeseries).
 //
+// Every record also carries the settings `experiment`, `unit`, `seed` (a number up to 2^53, text
+// above), `defective`, `noise`, and for bench experiments `model` ("2dof" or "superelement"),
+// `superelement` (its TOML), `delay_s` (effective), `nmp_zero`, `hysteresis`, `creep` (1 or 0),
+// `amplifier_gain_V_per_V`, `va_min_V`, `va_max_V`, `suspended_mass_kg`, `hpf_resistance_ohm`.
+// Row k holds the instruments at t = k / fs, read before u[k] is applied (row 0: the bench at rest).
+//
 // Channels per experiment (the contract the campaign reads; docs/virtual-bench.md shows examples):
-//   stroke       t, u, Va, de     slow ramp of Va from va_min to va_max and back; de from a
-//                                 low-bandwidth probe (m). Settings: va_min_V, va_max_V, ramp_s.
-//   hysteresis   t, u, Va, de     1 Hz sine on Va around 65 V. Settings: amplitude_V, offset_V,
-//                                 frequency_Hz, periods.
-//   stiffness    t, de, added_mass  de (m) while a mass is put on at ~3 s and taken off at ~13 s;
-//                                 added_mass (kg) is the operator's log. Settings: added_mass_kg,
-//                                 t_on_s, t_off_s, gravity_m_per_s2.
-//   frf-noise    t, u, Va, de, Vs band-limited white noise on u. Settings: duration_s, rms_V, band_Hz.
-//   frf-sweep    t, u, Va, de, Vs logarithmic sine sweep on u. Settings: duration_s, f0_Hz, f1_Hz, amplitude_V.
+//   stroke       t, u, Va, de     slow ramp of Va 0 -> va_min -> va_max -> va_min -> 0 (10 s for
+//                                 va_min -> va_max, 1 s holds); de from a low-bandwidth probe (m,
+//                                 first order 2 Hz, 10 nm rms noise), recorded at 1 kHz.
+//                                 Settings: ramp_s, probe_bandwidth_Hz, probe_noise_m.
+//   hysteresis   t, u, Va, de     1 Hz sine on Va around (va_min + va_max)/2 = 65 V, 3 periods
+//                                 between 1 s raised-cosine ramps from and to 0 V. Settings:
+//                                 amplitude_V, offset_V, frequency_Hz, periods, ramp_s.
+//   stiffness    t, de, added_mass  de (m) at u = 0 while a mass is put on at 3 s and taken off at
+//                                 13 s (its weight ramped over 0.5 s each time; 20 s in all);
+//                                 added_mass (kg) is the operator's log of the weight carried.
+//                                 Settings: added_mass_kg, t_on_s, t_off_s, ramp_s,
+//                                 gravity_m_per_s2, duration_s.
+//   frf-noise    t, u, Va, de, Vs Gaussian noise on u, flat over [band_low_Hz, band_high_Hz]
+//                                 (0.1 .. 2000 Hz), periodic over the record. Settings: duration_s,
+//                                 rms_V (u), va_rms_V (at the stacks), band_low_Hz, band_high_Hz.
+//   frf-sweep    t, u, Va, de, Vs logarithmic sine sweep on u, 1 -> 2000 Hz. Settings: duration_s,
+//                                 f0_Hz, f1_Hz, amplitude_V (u), va_amplitude_V, sweep ("log").
 //   iff          t, u_prime, u, Va, de, Vs  closed loop u = u' + g K0 Vs (report's controller,
-//                                 eq. 2.4, discretized), noise on u'. Settings: gain, duration_s.
-//   hammer       t, F, v          fixed-free actuator: impact force (N) and vibrometer velocity
-//                                 (m/s) that shows both bending modes. Settings: impacts.
+//                                 eq. 2.4, control::DiscreteIff), noise on u' as in frf-noise, u
+//                                 clamped to the stack range. Settings: gain, duration_s, rms_V,
+//                                 va_rms_V, band_low_Hz, band_high_Hz, clamped_samples, controller.
+//   hammer       t, F, v          fixed-free actuator: 5 impacts (half-sine, 1 ms, 50..150 N, every
+//                                 2 s from 0.5 s), force (N) and vibrometer velocity (m/s) showing
+//                                 both bending modes. Settings: impacts, pulse_width_s,
+//                                 impact_spacing_s, force_noise_N, velocity_noise_m_per_s.
 //   flatness     x, y, z, interface  8 probe points (m; interface 1 = bottom, 2 = top, 4 each),
-//                                 one point per sample (sample_rate 1). Settings: probe_noise_m.
-//   capacitance  C_sensor, C_actuator  LCR readings (F), one sample. Settings: frequency_Hz.
+//                                 one point per sample (sample_rate 1, no t), probe error uniform
+//                                 within +-probe_noise_m. Settings: probe_noise_m.
+//   capacitance  C_sensor, C_actuator  LCR readings (F), one sample (no t), error uniform within
+//                                 +-accuracy_relative. Settings: frequency_Hz, accuracy_relative.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -42,12 +62,16 @@ const std::vector<Experiment>& all_experiments();
 
 struct ExperimentOptions {
   // Unset values take the experiment's default (the report's settings).
-  std::optional<double> amplitude;   // V at the stacks (hysteresis; default 20 V); refused, with
-                                     // the limit named, when offset +- amplitude leaves [va_min, va_max]
-  std::optional<double> duration;    // s (frf-noise 20 s, frf-sweep 20 s, iff 10 s), > 0
+  std::optional<double> amplitude;   // V at the stacks, > 0: hysteresis (sine amplitude, default
+                                     // 20 V), frf-noise and iff (rms, default 2 V), frf-sweep
+                                     // (amplitude, default 1 V). Refused, with the limit named, when
+                                     // the stack voltage would leave [va_min, va_max]: never clipped.
+  std::optional<double> duration;    // s (frf-noise 20 s, frf-sweep 20 s, iff 10 s), in (0, 1e5]
   std::optional<double> gain;        // IFF gain g (iff; default 280000 -> near the optimum)
   BenchOptions bench;
   void validate() const;             // InputError naming the field
+  // Also refuses an option the experiment does not take (e.g. --duration for stroke).
+  void validate(Experiment experiment) const;
 };
 
 // Progress in [0, 1], called from the simulating thread now and then (may be empty).

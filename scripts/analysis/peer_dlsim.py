@@ -1,0 +1,72 @@
+#!/usr/bin/python3
+"""Peer timing for bench/bench_sim.cpp: the linear part of the 2-DoF virtual bench (Table 3.1,
+amplifier 5 kHz, sensor stack with R = 80.6 kOhm, C = 4.95 uF, ground resistance 0.16 Ohm,
+anti-aliasing 1 kHz: the same six states as src/bench/plant.cpp) discretized by ZOH at 10 kHz and
+simulated over 1,000,000 samples with scipy.signal.dlsim (state space) and scipy.signal.lfilter
+(the two transfer functions u -> d_e and u -> Vs). No hysteresis, creep, noise or quantization:
+the peer does less work than the C++ bench.
+
+Usage: /usr/bin/python3 scripts/analysis/peer_dlsim.py [samples]
+"""
+import sys
+import time
+
+import numpy as np
+import scipy
+import scipy.signal
+
+m, k1, c1, ke, ce, ka, ca, ga, gs = 5.7, 0.38e6, 5.0, 5e6, 100.0, 2.5e6, 50.0, -2.58, 0.46e6
+G, wa, R, C_lcr, Ca, Rg, waa = 20.0, 2 * np.pi * 5000, 80.6e3, 4.95e-6, 9.87e-6, 0.16, 2 * np.pi * 1000
+K = ke + ka * k1 / (ka + k1)
+Cb = C_lcr * K / (K + gs * gs * C_lcr)
+alpha = gs * Cb
+kesc = ke - gs * alpha
+kappa = -Rg * Ca
+den = ca + ce
+# states Va, x, v, xn, V, y (Vs at the ADC); input u
+A = np.zeros((6, 6))
+B = np.zeros((6, 1))
+A[0, 0] = -wa
+B[0, 0] = wa * G
+A[1, 2] = 1.0
+xnd = np.array([ga, kesc, ce, -(ka + kesc), alpha, 0.0]) / den
+T = np.array([0.0, kesc, ce, -kesc, alpha, 0.0]) - ce * xnd
+A[2, :] = -T / m
+A[2, 1] -= k1 / m
+A[2, 2] -= c1 / m
+A[3, :] = xnd
+A[4, :] = -gs * xnd
+A[4, 2] += gs
+A[4, 4] -= 1.0 / (R * Cb)
+A[5, 4] = waa
+A[5, 0] = -waa * kappa * wa
+A[5, 5] = -waa
+B[5, 0] = waa * kappa * wa * G
+C = np.zeros((2, 6))
+C[0, 1] = 1.0
+C[1, 5] = 1.0
+D = np.zeros((2, 1))
+
+n = int(sys.argv[1]) if len(sys.argv) > 1 else 1_000_000
+fs = 10e3
+ad, bd, cd, dd, _ = scipy.signal.cont2discrete((A, B, C, D), 1 / fs, method="zoh")
+rng = np.random.default_rng(1)
+u = 0.1 * rng.standard_normal(n)
+t = np.arange(n) / fs
+
+best = np.inf
+for _ in range(3):
+    t0 = time.perf_counter()
+    _, y, _ = scipy.signal.dlsim((ad, bd, cd, dd, 1 / fs), u, t=t)
+    best = min(best, time.perf_counter() - t0)
+print(f"scipy {scipy.__version__} dlsim, 6 states, {n} samples: {best:.3f} s ({n / fs / best:.0f} x real time)")
+
+num_de, den_de = scipy.signal.ss2tf(ad, bd, cd[0:1], dd[0:1])
+num_vs, den_vs = scipy.signal.ss2tf(ad, bd, cd[1:2], dd[1:2])
+best = np.inf
+for _ in range(3):
+    t0 = time.perf_counter()
+    y1 = scipy.signal.lfilter(num_de[0], den_de, u)
+    y2 = scipy.signal.lfilter(num_vs[0], den_vs, u)
+    best = min(best, time.perf_counter() - t0)
+print(f"scipy {scipy.__version__} lfilter, both outputs, {n} samples: {best:.3f} s ({n / fs / best:.0f} x real time)")

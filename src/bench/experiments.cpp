@@ -1,0 +1,549 @@
+#include "piezobench/bench/experiments.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <span>
+
+#include "bench/flatness.hpp"
+#include "bench/random.hpp"
+#include "piezobench/control/discrete_iff.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/dsp/excitation.hpp"
+#include "piezobench/lti/discretize.hpp"
+
+namespace piezobench::bench {
+
+namespace {
+
+constexpr const char* kSource = "experiment options";
+
+struct Named {
+  Experiment e;
+  const char* name;
+};
+constexpr Named kNames[] = {{Experiment::kStroke, "stroke"},     {Experiment::kHysteresis, "hysteresis"},
+                            {Experiment::kStiffness, "stiffness"}, {Experiment::kFrfNoise, "frf-noise"},
+                            {Experiment::kFrfSweep, "frf-sweep"},  {Experiment::kIff, "iff"},
+                            {Experiment::kHammer, "hammer"},       {Experiment::kFlatness, "flatness"},
+                            {Experiment::kCapacitance, "capacitance"}};
+
+std::string known_names() {
+  std::string s;
+  for (const Named& n : kNames) s += (s.empty() ? "" : ", ") + std::string(n.name);
+  return s;
+}
+
+bool uses_amplitude(Experiment e) {
+  return e == Experiment::kHysteresis || e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
+}
+bool uses_duration(Experiment e) {
+  return e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
+}
+
+// The settings every record carries.
+void common_settings(io::TimeSeries& ts, Experiment e, const UnitTruth& unit, const BenchOptions& b, std::uint64_t seed,
+                     const VirtualBench* bench) {
+  ts.settings["experiment"] = to_string(e);
+  ts.settings["unit"] = static_cast<double>(unit.id);
+  // Seeds up to 2^53 are numbers; larger ones would lose digits as doubles, so they are text.
+  if (seed <= (std::uint64_t{1} << 53)) {
+    ts.settings["seed"] = static_cast<double>(seed);
+  } else {
+    ts.settings["seed"] = std::to_string(seed);
+  }
+  ts.settings["defective"] = unit.defective ? 1.0 : 0.0;
+  if (bench != nullptr) {
+    ts.settings["model"] = bench->model_name();
+    if (b.superelement) ts.settings["superelement"] = b.superelement->string();
+    ts.settings["delay_s"] = bench->effective_delay();
+    ts.settings["nmp_zero"] = b.nonminimum_phase_zero ? 1.0 : 0.0;
+    ts.settings["hysteresis"] = b.hysteresis ? 1.0 : 0.0;
+    ts.settings["creep"] = b.creep ? 1.0 : 0.0;
+    ts.settings["amplifier_gain_V_per_V"] = b.amplifier_gain;
+    ts.settings["va_min_V"] = b.va_min;
+    ts.settings["va_max_V"] = b.va_max;
+    ts.settings["suspended_mass_kg"] = b.suspended_mass;
+    ts.settings["hpf_resistance_ohm"] = b.hpf_resistance;
+  }
+  ts.settings["noise"] = b.noise ? 1.0 : 0.0;
+}
+
+io::TimeSeries make_record(const std::vector<std::string>& names, const std::vector<std::string>& units, Eigen::Index rows,
+                           double fs, bool with_t) {
+  io::TimeSeries ts;
+  ts.names = names;
+  ts.units = units;
+  ts.data.resize(rows, static_cast<Eigen::Index>(names.size()));
+  ts.sample_rate = fs;
+  if (with_t) ts.t = Eigen::VectorXd::LinSpaced(rows, 0.0, static_cast<double>(rows - 1) / fs);
+  return ts;
+}
+
+// Calls progress now and then: at most every 2^16 samples.
+struct Progressor {
+  const Progress& progress;
+  Eigen::Index total;
+  mutable Eigen::Index next = 0;
+  void operator()(Eigen::Index k) const {
+    if (progress && k >= next) {
+      progress(static_cast<double>(k) / static_cast<double>(std::max<Eigen::Index>(total, 1)));
+      next = k + 65536;
+    }
+  }
+  void done() const {
+    if (progress) progress(1.0);
+  }
+};
+
+// Runs the bench over the DAC commands u and writes the instruments into the columns of ts
+// (-1: not recorded). Row k holds the instruments at t = k Ts, read before u[k] is applied (row 0:
+// the bench at rest).
+void run_open_loop(VirtualBench& bench, const Eigen::VectorXd& u, io::TimeSeries& ts, Eigen::Index col_de,
+                   Eigen::Index col_vs, Eigen::Index col_va, const Progressor& progress) {
+  const Eigen::Index n = u.size();
+  constexpr Eigen::Index kBlock = 4096;
+  std::vector<BenchSample> block(static_cast<std::size_t>(kBlock));
+  BenchSample m = bench.step(0.0);
+  const auto record = [&](Eigen::Index k, const BenchSample& s) {
+    if (col_de >= 0) ts.data(k, col_de) = s.de;
+    if (col_vs >= 0) ts.data(k, col_vs) = s.vs;
+    if (col_va >= 0) ts.data(k, col_va) = s.va;
+  };
+  if (n > 0) record(0, m);
+  for (Eigen::Index k = 0; k + 1 < n; k += kBlock) {
+    const Eigen::Index count = std::min(kBlock, n - 1 - k);
+    bench.run(std::span<const double>(u.data() + k, static_cast<std::size_t>(count)),
+              std::span<BenchSample>(block.data(), static_cast<std::size_t>(count)));
+    for (Eigen::Index i = 0; i < count; ++i) record(k + 1 + i, block[static_cast<std::size_t>(i)]);
+    progress(k);
+  }
+  progress.done();
+}
+
+// Refuses an excitation whose stack voltage G u leaves [va_min, va_max], naming the limit.
+void check_range(const Eigen::VectorXd& u, const BenchOptions& b, const std::string& what) {
+  const double lo = b.amplifier_gain * u.minCoeff();
+  const double hi = b.amplifier_gain * u.maxCoeff();
+  if (lo < b.va_min - 1e-9 || hi > b.va_max + 1e-9) {
+    throw InputError(kSource, "amplitude",
+                     fmt::format("{} whose stack voltage stays within the actuator's range {:g} V .. {:g} V", what, b.va_min,
+                                 b.va_max),
+                     fmt::format("a stack voltage from {:.4g} V to {:.4g} V (limit {:g} V exceeded)", lo, hi,
+                                 hi > b.va_max + 1e-9 ? b.va_max : b.va_min));
+  }
+}
+
+std::uint64_t stream(Experiment e, std::uint64_t which) { return 1000 * (static_cast<std::uint64_t>(e) + 1) + which; }
+
+// ---------------------------------------------------------------------------------------------
+
+io::TimeSeries stroke(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kStroke, 0)));
+  const double fs = b.sample_rate;
+  const double ramp_s = 10.0;  // s for va_min -> va_max
+  const double rate = (b.va_max - b.va_min) / ramp_s;
+  const double hold = 1.0;
+  // 0 -> va_min -> va_max -> va_min -> 0, holds at both ends.
+  const double t1 = hold, t2 = t1 - b.va_min / rate, t3 = t2 + ramp_s, t4 = t3 + ramp_s, t5 = t4 - b.va_min / rate;
+  const double total = t5 + hold;
+  const auto n = static_cast<Eigen::Index>(std::ceil(total * fs));
+  Eigen::VectorXd u(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / fs;
+    double va = 0.0;
+    if (t < t1) {
+      va = 0.0;
+    } else if (t < t2) {
+      va = -rate * (t - t1);
+    } else if (t < t3) {
+      va = b.va_min + rate * (t - t2);
+    } else if (t < t4) {
+      va = b.va_max - rate * (t - t3);
+    } else if (t < t5) {
+      va = b.va_min + rate * (t - t4);
+    }
+    u(k) = va / b.amplifier_gain;
+  }
+  io::TimeSeries raw;  // de, Vs, Va at the bench's rate
+  raw.data.resize(n, 3);
+  run_open_loop(bench, u, raw, 0, 1, 2, {progress, n});
+  const Eigen::MatrixXd& y = raw.data;
+  // The displacement probe (Millimar 1318): first-order bandwidth, noise; recorded at 1 kHz.
+  const double probe_bw = 2.0;      // Hz
+  const double probe_noise = 10e-9;  // m rms
+  const auto decimation = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::llround(fs / 1000.0)));
+  const double a = -std::expm1(-2.0 * std::numbers::pi * probe_bw / fs);
+  detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kStroke, 1)));
+  const Eigen::Index rows = (n + decimation - 1) / decimation;
+  io::TimeSeries ts = make_record({"u", "Va", "de"}, {"V", "V", "m"}, rows, fs / static_cast<double>(decimation), true);
+  double probe = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    probe += a * (y(k, 0) - probe);
+    if (k % decimation == 0) {
+      const Eigen::Index r = k / decimation;
+      ts.data(r, 0) = u(k);
+      ts.data(r, 1) = y(k, 2);
+      ts.data(r, 2) = probe + (b.noise ? probe_noise * rng.normal() : 0.0);
+    }
+  }
+  common_settings(ts, Experiment::kStroke, unit, b, seed, &bench);
+  ts.settings["ramp_s"] = ramp_s;
+  ts.settings["probe_bandwidth_Hz"] = probe_bw;
+  ts.settings["probe_noise_m"] = probe_noise;
+  return ts;
+}
+
+io::TimeSeries hysteresis(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double amplitude = o.amplitude.value_or(20.0);
+  const double offset = 0.5 * (b.va_min + b.va_max);  // 65 V for -20..150 V
+  if (offset - amplitude < b.va_min - 1e-12 || offset + amplitude > b.va_max + 1e-12) {
+    throw InputError(kSource, "amplitude",
+                     fmt::format("an amplitude <= {:g} V (offset {:g} V, stack range {:g} V .. {:g} V)",
+                                 std::min(offset - b.va_min, b.va_max - offset), offset, b.va_min, b.va_max),
+                     fmt::format("{:g} V", amplitude));
+  }
+  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kHysteresis, 0)));
+  dsp::OffsetSineOptions s;
+  s.sample_rate = b.sample_rate;
+  s.rest = 0.0;
+  s.offset = offset / b.amplifier_gain;
+  s.amplitude = amplitude / b.amplifier_gain;
+  s.frequency = 1.0;
+  s.cycles = 3.0;
+  s.ramp_time = 1.0;
+  dsp::VoltageBounds bounds{b.va_min / b.amplifier_gain - 1e-9, b.va_max / b.amplifier_gain + 1e-9, dsp::BoundsPolicy::kReject};
+  const dsp::Excitation ex = dsp::offset_sine(s, bounds);
+  io::TimeSeries ts = make_record({"u", "Va", "de"}, {"V", "V", "m"}, ex.u.size(), b.sample_rate, true);
+  ts.data.col(0) = ex.u;
+  run_open_loop(bench, ex.u, ts, /*col_de=*/2, /*col_vs=*/-1, /*col_va=*/1, {progress, ex.u.size()});
+  common_settings(ts, Experiment::kHysteresis, unit, b, seed, &bench);
+  ts.settings["amplitude_V"] = amplitude;
+  ts.settings["offset_V"] = offset;
+  ts.settings["frequency_Hz"] = s.frequency;
+  ts.settings["periods"] = s.cycles;
+  ts.settings["ramp_s"] = s.ramp_time;
+  return ts;
+}
+
+io::TimeSeries stiffness(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  if (!(b.added_mass > 0.0)) throw InputError(kSource, "bench.added_mass", "a mass > 0 kg for the stiffness test", "0");
+  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kStiffness, 0)));
+  const double fs = b.sample_rate;
+  const double duration = 20.0, t_on = 3.0, t_off = 13.0, ramp = 0.5;
+  const auto n = static_cast<Eigen::Index>(std::llround(duration * fs));
+  io::TimeSeries ts = make_record({"de", "added_mass"}, {"m", "kg"}, n, fs, true);
+  const auto raised = [](double x) { return 0.5 - 0.5 * std::cos(std::numbers::pi * std::clamp(x, 0.0, 1.0)); };
+  const Progressor p{progress, n};
+  BenchSample m = bench.step(0.0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / fs;
+    double fraction = 0.0;
+    if (t >= t_on && t < t_off + ramp) fraction = t < t_off ? raised((t - t_on) / ramp) : 1.0 - raised((t - t_off) / ramp);
+    // The mass rides on the granite from the moment it touches it until it is lifted off.
+    bench.set_added_mass(t >= t_on && t < t_off + ramp ? b.added_mass : 0.0);
+    bench.set_load_fraction(fraction);
+    ts.data(k, 0) = m.de;
+    ts.data(k, 1) = fraction * b.added_mass;
+    m = bench.step(0.0);
+    p(k);
+  }
+  p.done();
+  common_settings(ts, Experiment::kStiffness, unit, b, seed, &bench);
+  ts.settings["added_mass_kg"] = b.added_mass;
+  ts.settings["t_on_s"] = t_on;
+  ts.settings["t_off_s"] = t_off;
+  ts.settings["ramp_s"] = ramp;
+  ts.settings["gravity_m_per_s2"] = b.gravity;
+  ts.settings["duration_s"] = duration;
+  return ts;
+}
+
+io::TimeSeries frf_noise(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double duration = o.duration.value_or(20.0);
+  const double va_rms = o.amplitude.value_or(2.0);
+  dsp::NoiseOptions no;
+  no.sample_rate = b.sample_rate;
+  no.samples = static_cast<Eigen::Index>(std::llround(duration * b.sample_rate));
+  no.f_low = std::max(0.1, b.sample_rate / static_cast<double>(std::max<Eigen::Index>(no.samples, 1)));
+  no.f_high = std::min(2000.0, 0.4 * b.sample_rate);
+  no.rms = va_rms / b.amplifier_gain;
+  no.seed = detail::derive_seed(seed, stream(Experiment::kFrfNoise, 1));
+  if (no.samples < 2 || no.f_low >= no.f_high) {
+    throw InputError(kSource, "duration", "a record long enough for the noise band (at least 2 samples)",
+                     fmt::format("{:g} s", duration));
+  }
+  dsp::VoltageBounds loose{-1e300, 1e300, dsp::BoundsPolicy::kReject};
+  const dsp::Excitation ex = dsp::band_limited_noise(no, loose);
+  check_range(ex.u, b, fmt::format("a noise of {:g} V rms at the stacks", va_rms));
+  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 0)));
+  io::TimeSeries ts = make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, ex.u.size(), b.sample_rate, true);
+  ts.data.col(0) = ex.u;
+  run_open_loop(bench, ex.u, ts, /*col_de=*/2, /*col_vs=*/3, /*col_va=*/1, {progress, ex.u.size()});
+  common_settings(ts, Experiment::kFrfNoise, unit, b, seed, &bench);
+  ts.settings["duration_s"] = duration;
+  ts.settings["rms_V"] = no.rms;
+  ts.settings["va_rms_V"] = va_rms;
+  ts.settings["band_low_Hz"] = no.f_low;
+  ts.settings["band_high_Hz"] = no.f_high;
+  return ts;
+}
+
+io::TimeSeries frf_sweep(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double duration = o.duration.value_or(20.0);
+  const double va_amplitude = o.amplitude.value_or(1.0);
+  if (va_amplitude > std::min(-b.va_min, b.va_max) + 1e-12) {
+    throw InputError(kSource, "amplitude",
+                     fmt::format("an amplitude <= {:g} V (a sweep about 0 V within the stack range {:g} V .. {:g} V)",
+                                 std::min(-b.va_min, b.va_max), b.va_min, b.va_max),
+                     fmt::format("{:g} V", va_amplitude));
+  }
+  dsp::SweepOptions so;
+  so.sample_rate = b.sample_rate;
+  so.duration = duration;
+  so.f_start = 1.0;
+  so.f_end = std::min(2000.0, 0.4 * b.sample_rate);
+  so.amplitude = va_amplitude / b.amplifier_gain;
+  so.ramp_time = std::min(0.1, 0.25 * duration);
+  so.type = dsp::SweepType::kLogarithmic;
+  const dsp::Excitation ex = dsp::sine_sweep(so, {-1e300, 1e300, dsp::BoundsPolicy::kReject});
+  check_range(ex.u, b, fmt::format("a sweep of {:g} V amplitude at the stacks", va_amplitude));
+  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kFrfSweep, 0)));
+  io::TimeSeries ts = make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, ex.u.size(), b.sample_rate, true);
+  ts.data.col(0) = ex.u;
+  run_open_loop(bench, ex.u, ts, /*col_de=*/2, /*col_vs=*/3, /*col_va=*/1, {progress, ex.u.size()});
+  common_settings(ts, Experiment::kFrfSweep, unit, b, seed, &bench);
+  ts.settings["duration_s"] = duration;
+  ts.settings["f0_Hz"] = so.f_start;
+  ts.settings["f1_Hz"] = so.f_end;
+  ts.settings["amplitude_V"] = so.amplitude;
+  ts.settings["va_amplitude_V"] = va_amplitude;
+  ts.settings["sweep"] = std::string("log");
+  return ts;
+}
+
+io::TimeSeries iff(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double duration = o.duration.value_or(10.0);
+  const double va_rms = o.amplitude.value_or(2.0);
+  const double gain = o.gain.value_or(280000.0);
+  dsp::NoiseOptions no;
+  no.sample_rate = b.sample_rate;
+  no.samples = static_cast<Eigen::Index>(std::llround(duration * b.sample_rate));
+  no.f_low = std::max(0.1, b.sample_rate / static_cast<double>(std::max<Eigen::Index>(no.samples, 1)));
+  no.f_high = std::min(2000.0, 0.4 * b.sample_rate);
+  no.rms = va_rms / b.amplifier_gain;
+  no.seed = detail::derive_seed(seed, stream(Experiment::kIff, 1));
+  if (no.samples < 2 || no.f_low >= no.f_high) {
+    throw InputError(kSource, "duration", "a record long enough for the noise band (at least 2 samples)",
+                     fmt::format("{:g} s", duration));
+  }
+  const dsp::Excitation ex = dsp::band_limited_noise(no, {-1e300, 1e300, dsp::BoundsPolicy::kReject});
+  check_range(ex.u, b, fmt::format("a noise of {:g} V rms at the stacks", va_rms));
+  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kIff, 0)));
+  control::DiscreteIffOptions co;
+  co.sample_rate = b.sample_rate;
+  control::DiscreteIff controller(control::IffControllerParams{}, co, gain);
+  // The real-time target's safety clamp: u stays inside the stack range seen at the DAC.
+  const double u_min = b.va_min / b.amplifier_gain, u_max = b.va_max / b.amplifier_gain;
+  const Eigen::Index n = ex.u.size();
+  io::TimeSeries ts = make_record({"u_prime", "u", "Va", "de", "Vs"}, {"V", "V", "V", "m", "V"}, n, b.sample_rate, true);
+  const Progressor p{progress, n};
+  BenchSample m = bench.step(0.0);
+  Eigen::Index clamped = 0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double y = controller.step(m.vs);
+    double u = ex.u(k) + y;
+    if (u < u_min || u > u_max) {
+      u = std::clamp(u, u_min, u_max);
+      controller.applied(u - ex.u(k));
+      ++clamped;
+    }
+    ts.data(k, 0) = ex.u(k);
+    ts.data(k, 1) = u;
+    ts.data(k, 2) = m.va;
+    ts.data(k, 3) = m.de;
+    ts.data(k, 4) = m.vs;
+    m = bench.step(u);
+    p(k);
+  }
+  p.done();
+  common_settings(ts, Experiment::kIff, unit, b, seed, &bench);
+  ts.settings["gain"] = gain;
+  ts.settings["duration_s"] = duration;
+  ts.settings["rms_V"] = no.rms;
+  ts.settings["va_rms_V"] = va_rms;
+  ts.settings["band_low_Hz"] = no.f_low;
+  ts.settings["band_high_Hz"] = no.f_high;
+  ts.settings["clamped_samples"] = static_cast<double>(clamped);
+  ts.settings["controller"] = std::string("K(s) = -10 g s/(s + 2 pi 2) / (s + 2 pi 20) / (s + 2 pi 2000), Tustin prewarped at 95.2 Hz");
+  return ts;
+}
+
+io::TimeSeries hammer(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double fs = b.sample_rate;
+  const int impacts = 5;
+  const double spacing = 2.0, first = 0.5, width = 1e-3;
+  const auto n = static_cast<Eigen::Index>(std::llround((first + spacing * impacts) * fs));
+  detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kHammer, 0)));
+  // Impact force: half-sine pulses of 1 ms, 50..150 N.
+  Eigen::VectorXd force = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < impacts; ++i) {
+    const double peak = 50.0 + 100.0 * rng.uniform();
+    const double t0 = first + spacing * i;
+    for (Eigen::Index k = static_cast<Eigen::Index>(std::floor(t0 * fs)); k < n; ++k) {
+      const double t = static_cast<double>(k) / fs - t0;
+      if (t > width) break;
+      if (t >= 0.0) force(k) = peak * std::sin(std::numbers::pi * t / width);
+    }
+  }
+  // Fixed-free actuator: two bending modes seen by the vibrometer, v = sum F / m_j s / (s^2 + 2 z w s + w^2).
+  const double modal_mass[2] = {0.35, 0.5};  // kg, at the impact and measurement points
+  const double freq[2] = {unit.mode_y_Hz, unit.mode_x_Hz};
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+  for (int j = 0; j < 2; ++j) {
+    const double w = 2.0 * std::numbers::pi * freq[j];
+    lti::Matrix a(2, 2), bm(2, 1), c(1, 2), d = lti::Matrix::Zero(1, 1);
+    a << 0.0, 1.0, -w * w, -2.0 * unit.mode_damping * w;
+    bm << 0.0, 1.0 / modal_mass[j];
+    c << 0.0, 1.0;
+    const lti::StateSpace sd = lti::c2d(lti::StateSpace(a, bm, c, d), 1.0 / fs);
+    double x0 = 0.0, x1 = 0.0;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      v(k) += x1;
+      const double n0 = sd.A(0, 0) * x0 + sd.A(0, 1) * x1 + sd.B(0, 0) * force(k);
+      const double n1 = sd.A(1, 0) * x0 + sd.A(1, 1) * x1 + sd.B(1, 0) * force(k);
+      x0 = n0;
+      x1 = n1;
+    }
+  }
+  const double force_noise = 0.02, velocity_noise = 1e-5;  // N rms, m/s rms
+  io::TimeSeries ts = make_record({"F", "v"}, {"N", "m/s"}, n, fs, true);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    ts.data(k, 0) = force(k) + (b.noise ? force_noise * rng.normal() : 0.0);
+    ts.data(k, 1) = v(k) + (b.noise ? velocity_noise * rng.normal() : 0.0);
+  }
+  if (progress) progress(1.0);
+  common_settings(ts, Experiment::kHammer, unit, b, seed, nullptr);
+  ts.settings["impacts"] = static_cast<double>(impacts);
+  ts.settings["pulse_width_s"] = width;
+  ts.settings["impact_spacing_s"] = spacing;
+  ts.settings["force_noise_N"] = force_noise;
+  ts.settings["velocity_noise_m_per_s"] = velocity_noise;
+  return ts;
+}
+
+io::TimeSeries flatness(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed) {
+  const double probe_noise = 0.5e-6;  // m: the probe's specified accuracy, a uniform error within +-
+  detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kFlatness, 0)));
+  const Eigen::Matrix<double, 8, 3> layout = detail::probe_layout();
+  const Eigen::Matrix<double, 8, 1> z = detail::probe_heights(unit);
+  // The part sits in its clamp with some tilt and height of its own (removed by the plane fit).
+  const double ax = 2e-4 * rng.symmetric(), ay = 2e-4 * rng.symmetric(), z0 = 1e-3 * rng.symmetric();
+  io::TimeSeries ts = make_record({"x", "y", "z", "interface"}, {"m", "m", "m", ""}, 8, 1.0, false);
+  for (int i = 0; i < 8; ++i) {
+    ts.data(i, 0) = layout(i, 0);
+    ts.data(i, 1) = layout(i, 1);
+    ts.data(i, 2) = z0 + ax * layout(i, 0) + ay * layout(i, 1) + z(i) + (o.bench.noise ? probe_noise * rng.symmetric() : 0.0);
+    ts.data(i, 3) = layout(i, 2);
+  }
+  common_settings(ts, Experiment::kFlatness, unit, o.bench, seed, nullptr);
+  ts.settings["probe_noise_m"] = probe_noise;
+  return ts;
+}
+
+io::TimeSeries capacitance(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed) {
+  const double accuracy = 5e-4;  // LCR-819: 0.05 %, a uniform error within +-
+  detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kCapacitance, 0)));
+  io::TimeSeries ts = make_record({"C_sensor", "C_actuator"}, {"F", "F"}, 1, 1.0, false);
+  const double e1 = o.bench.noise ? accuracy * rng.symmetric() : 0.0;
+  const double e2 = o.bench.noise ? accuracy * rng.symmetric() : 0.0;
+  ts.data(0, 0) = unit.capacitance_sensor * (1.0 + e1);
+  ts.data(0, 1) = unit.capacitance_actuator * (1.0 + e2);
+  common_settings(ts, Experiment::kCapacitance, unit, o.bench, seed, nullptr);
+  ts.settings["frequency_Hz"] = 1000.0;
+  ts.settings["accuracy_relative"] = accuracy;
+  return ts;
+}
+
+}  // namespace
+
+std::string to_string(Experiment e) {
+  for (const Named& n : kNames) {
+    if (n.e == e) return n.name;
+  }
+  return "unknown";
+}
+
+Experiment experiment_from_string(const std::string& name) {
+  for (const Named& n : kNames) {
+    if (name == n.name) return n.e;
+  }
+  throw InputError("", "experiment", "one of " + known_names(), "'" + name + "'");
+}
+
+const std::vector<Experiment>& all_experiments() {
+  static const std::vector<Experiment> all = [] {
+    std::vector<Experiment> v;
+    for (const Named& n : kNames) v.push_back(n.e);
+    return v;
+  }();
+  return all;
+}
+
+void ExperimentOptions::validate() const {
+  if (amplitude && !(std::isfinite(*amplitude) && *amplitude > 0.0)) {
+    throw InputError(kSource, "amplitude", "an amplitude > 0 V", fmt::format("{:g}", *amplitude));
+  }
+  if (duration && !(std::isfinite(*duration) && *duration > 0.0 && *duration <= 1e5)) {
+    throw InputError(kSource, "duration", "a duration in (0, 100000] s", fmt::format("{:g} s", *duration));
+  }
+  if (gain && !(std::isfinite(*gain) && *gain >= 0.0)) {
+    throw InputError(kSource, "gain", "an IFF gain >= 0", fmt::format("{:g}", *gain));
+  }
+  bench.validate();
+}
+
+void ExperimentOptions::validate(Experiment e) const {
+  validate();
+  const std::string name = to_string(e);
+  if (amplitude && !uses_amplitude(e)) {
+    throw InputError(kSource, "amplitude", "no amplitude: only hysteresis, frf-noise, frf-sweep and iff take one",
+                     "an amplitude for " + name);
+  }
+  if (duration && !uses_duration(e)) {
+    throw InputError(kSource, "duration", "no duration: only frf-noise, frf-sweep and iff take one", "a duration for " + name);
+  }
+  if (gain && e != Experiment::kIff) throw InputError(kSource, "gain", "no gain: only iff takes one", "a gain for " + name);
+}
+
+io::TimeSeries simulate(Experiment experiment, const UnitTruth& unit, const ExperimentOptions& options, std::uint64_t seed,
+                        const Progress& progress) {
+  options.validate(experiment);
+  unit.validate();
+  io::TimeSeries ts;
+  switch (experiment) {
+    case Experiment::kStroke: ts = stroke(unit, options, seed, progress); break;
+    case Experiment::kHysteresis: ts = hysteresis(unit, options, seed, progress); break;
+    case Experiment::kStiffness: ts = stiffness(unit, options, seed, progress); break;
+    case Experiment::kFrfNoise: ts = frf_noise(unit, options, seed, progress); break;
+    case Experiment::kFrfSweep: ts = frf_sweep(unit, options, seed, progress); break;
+    case Experiment::kIff: ts = iff(unit, options, seed, progress); break;
+    case Experiment::kHammer: ts = hammer(unit, options, seed, progress); break;
+    case Experiment::kFlatness: ts = flatness(unit, options, seed); break;
+    case Experiment::kCapacitance: ts = capacitance(unit, options, seed); break;
+  }
+  ts.validate();
+  return ts;
+}
+
+}  // namespace piezobench::bench

@@ -1,0 +1,29 @@
+#include "bench/nonlinear.hpp"
+
+#include <cmath>
+
+namespace piezobench::bench::detail {
+
+PlayHysteresis PlayHysteresis::bench_default(double scale) {
+  std::array<double, kOperators> r{};
+  std::array<double, kOperators> w{};
+  for (int i = 0; i < kOperators; ++i) {
+    r[static_cast<std::size_t>(i)] = 10.0 + 10.0 * i;
+    w[static_cast<std::size_t>(i)] = 0.163 * scale;
+  }
+  return {r, w};
+}
+
+PlayHysteresis::PlayHysteresis(const std::array<double, kOperators>& thresholds,
+                               const std::array<double, kOperators>& weights)
+    : thresholds_(Eigen::Map<const Array>(thresholds.data())), weights_(Eigen::Map<const Array>(weights.data())) {}
+
+Creep::Creep(double voltage_per_decade, double load_per_decade, double sample_time) {
+  for (int i = 0; i < kStates; ++i) {
+    alpha_(i) = -std::expm1(-kDecimation * sample_time / kTimeConstants[static_cast<std::size_t>(i)]);
+    voltage_(i) = voltage_per_decade;
+    load_(i) = load_per_decade;
+  }
+}
+
+}  // namespace piezobench::bench::detail

@@ -1,0 +1,104 @@
+#pragma once
+// The stacks' nonlinearities on the virtual bench: Prandtl-Ishlinskii hysteresis and creep.
+// Fixed-size state, no allocation, no virtual call: they run inside VirtualBench::step().
+#include <Eigen/Core>
+#include <array>
+
+namespace piezobench::bench::detail {
+
+// Prandtl-Ishlinskii model (M. Brokate and J. Sprekels, "Hysteresis and Phase Transitions",
+// Springer 1996; K. Kuhnen, "Modeling, identification and compensation of complex hysteretic
+// nonlinearities", Eur. J. Control 9(4), 2003): the effective stack voltage is
+//     Va_eff = Va + sum_i w_i P_{r_i}[Va],
+// where P_r is the play (backlash) operator of threshold r, P_r[v](t) = min(max(P(t-), v - r), v + r),
+// starting at 0 with the bench at rest. A play operator whose threshold exceeds the excursion of
+// the voltage is stuck and contributes nothing, so small signals see the linear model (gain 1) and
+// large ones a larger gain with a loop: for a sine of amplitude A about any offset, the loop's half
+// range is A + sum_{r_i < A} w_i (A - r_i) and its width at the offset sum_{r_i < A} 2 w_i min(r_i, A - r_i)
+// (exact once every operator has turned at least once). Width relative to stroke thus grows with
+// the amplitude (Figure 2.3).
+class PlayHysteresis {
+ public:
+  static constexpr int kOperators = 8;
+  using Array = Eigen::Array<double, kOperators, 1>;
+  // The bench's default: thresholds 10, 20, ..., 80 V, each weight 0.163 * scale (large-signal
+  // stroke over -20..150 V 1.6 times the small-signal gain; width/stroke 7.5 % at 20 V, 18 % at
+  // 80 V; below 10 V, the FRFs' excitation levels, linear).
+  static PlayHysteresis bench_default(double scale);
+
+  PlayHysteresis() = default;
+  PlayHysteresis(const std::array<double, kOperators>& thresholds, const std::array<double, kOperators>& weights);
+
+  // Advances every operator to the voltage v and returns sum_i w_i P_{r_i}[v] (V), the amount to
+  // add to v to get the effective voltage. (Eigen arrays: the operators run two by two in SIMD
+  // registers and the sum is a tree, which the bench's inner loop needs to stay fast.)
+  double update(double v) noexcept {
+    state_ = state_.max(v - thresholds_).min(v + thresholds_);
+    return (weights_ * state_).sum();
+  }
+  void reset() noexcept { state_.setZero(); }
+  [[nodiscard]] double threshold(int i) const { return thresholds_(i); }
+  [[nodiscard]] double weight(int i) const { return weights_(i); }
+
+ private:
+  Array thresholds_ = Array::Zero();
+  Array weights_ = Array::Zero();
+  Array state_ = Array::Zero();
+};
+
+// Creep of the actuator stacks as a generalized Kelvin chain (a Prony series, the usual linear
+// viscoelastic form of logarithmic creep): an extra actuator force F_c = sum_i c_i with
+//     tau_i c_i' = load_i (s_load - F_c - f_free) + voltage_i f_free,
+// where f_free = ga Va_eff is the force of the stack voltage (its free stroke times the stacks'
+// stiffness) and s_load - f_free - F_c = ka (xn - delta_creep) - f_free is the stacks' elastic
+// strain times their stiffness (s_load = ka xn). After a voltage step the stroke grows by
+// voltage_i per time constant; under a constant load the stacks keep compressing. With the
+// time constants one decade apart and equal coefficients, the creep grows by about the
+// coefficient per decade of time between the first and the last time constant.
+// Each state is advanced exactly for a target held over its update period
+// (c += (1 - exp(-T/tau)) (target - c), T = kDecimation Ts).
+class Creep {
+ public:
+  static constexpr int kStates = 3;
+  static constexpr std::array<double, kStates> kTimeConstants = {5.0, 50.0, 500.0};  // s
+  // The states advance once every kDecimation samples, driven by the mean of the drive over them
+  // (the fastest time constant is 50,000 samples at 10 kHz; the mean keeps fast content from
+  // aliasing into the creep). The force is held in between.
+  static constexpr int kDecimation = 8;
+
+  Creep() = default;
+  // Per decade coefficients (relative), sample time (s).
+  Creep(double voltage_per_decade, double load_per_decade, double sample_time);
+
+  [[nodiscard]] double force() const noexcept { return force_; }
+  void update(double f_free, double s_load) noexcept {
+    sum_free_ += f_free;
+    sum_load_ += s_load;
+    if (++count_ < kDecimation) return;
+    constexpr double kInv = 1.0 / kDecimation;
+    const double free = sum_free_ * kInv;
+    const double elastic = sum_load_ * kInv - force_ - free;
+    c_ += alpha_ * (load_ * elastic + voltage_ * free - c_);
+    force_ = c_.sum();
+    sum_free_ = sum_load_ = 0.0;
+    count_ = 0;
+  }
+  void reset() noexcept {
+    c_.setZero();
+    force_ = sum_free_ = sum_load_ = 0.0;
+    count_ = 0;
+  }
+
+ private:
+  // Padded to 4 (two SIMD registers); the fourth state has alpha = 0 and stays 0.
+  using Array = Eigen::Array<double, 4, 1>;
+  Array alpha_ = Array::Zero();
+  Array voltage_ = Array::Zero();
+  Array load_ = Array::Zero();
+  Array c_ = Array::Zero();
+  double force_ = 0.0;
+  double sum_free_ = 0.0, sum_load_ = 0.0;
+  int count_ = 0;
+};
+
+}  // namespace piezobench::bench::detail

@@ -1,0 +1,322 @@
+#include "bench/superelement_plant.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::bench::detail {
+namespace {
+
+std::string describe(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer:
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date or time";
+  }
+}
+
+class Keys {
+ public:
+  Keys(const toml::table& t, std::string source) : t_(t), source_(std::move(source)) {}
+
+  const toml::node* find(const char* key) {
+    used_.insert(key);
+    return t_.get(key);
+  }
+  const toml::node& required(const char* key) {
+    const toml::node* n = find(key);
+    if (n == nullptr) throw InputError(source_, key, "a value (required key)", "nothing");
+    return *n;
+  }
+  std::string string(const char* key, bool required, const std::string& fallback = "") {
+    const toml::node* n = required ? &this->required(key) : find(key);
+    if (n == nullptr) return fallback;
+    if (!n->is_string()) throw InputError(source_, key, "a string", describe(*n));
+    return *n->value<std::string>();
+  }
+  double number(const char* key, double fallback) {
+    const toml::node* n = find(key);
+    if (n == nullptr) return fallback;
+    if (!n->is_number()) throw InputError(source_, key, "a number", describe(*n));
+    const double v = *n->value<double>();
+    if (!std::isfinite(v)) throw InputError(source_, key, "a finite number", fmt::format("{}", v));
+    return v;
+  }
+  bool boolean(const char* key, bool fallback) {
+    const toml::node* n = find(key);
+    if (n == nullptr) return fallback;
+    if (!n->is_boolean()) throw InputError(source_, key, "true or false", describe(*n));
+    return *n->value<bool>();
+  }
+  std::vector<long> nodes(const char* key) {
+    const toml::node& n = required(key);
+    std::vector<long> out;
+    if (n.is_integer()) {
+      out.push_back(static_cast<long>(*n.value<std::int64_t>()));
+    } else if (const toml::array* a = n.as_array()) {
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const toml::node& e = *a->get(i);
+        if (!e.is_integer()) throw InputError(source_, fmt::format("{}[{}]", key, i), "a node number", describe(e));
+        out.push_back(static_cast<long>(*e.value<std::int64_t>()));
+      }
+    } else {
+      throw InputError(source_, key, "a node number or an array of node numbers", describe(n));
+    }
+    if (out.empty()) throw InputError(source_, key, "at least one node", "an empty array");
+    return out;
+  }
+  void check_unknown() const {
+    for (const auto& [k, v] : t_) {
+      (void)v;
+      if (used_.count(std::string(k.str())) == 0) {
+        throw InputError(source_, std::string(k.str()),
+                         "one of k_file, m_file, nodes_file, coordinates_file, format, fix, actuator, sensor, output, ga, gs, "
+                         "modal_damping, max_mode_Hz, guided",
+                         "an unknown key");
+      }
+    }
+  }
+
+ private:
+  const toml::table& t_;
+  std::string source_;
+  std::set<std::string> used_;
+};
+
+}  // namespace
+
+SuperElementSpec read_superelement_spec(const std::filesystem::path& file) {
+  const std::string source = file.string();
+  std::ifstream in(file);
+  if (!in) throw InputError(source, "file", "a readable super-element description (TOML)", "a file that cannot be opened");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  toml::table table;
+  try {
+    table = toml::parse(ss.str(), source);
+  } catch (const toml::parse_error& e) {
+    throw InputError(source, fmt::format("line {}", e.source().begin.line), "valid TOML", std::string(e.description()));
+  }
+  Keys keys(table, source);
+  SuperElementSpec s;
+  s.file = file;
+  const std::filesystem::path dir = file.parent_path();
+  const auto resolve = [&](const std::string& p) -> std::filesystem::path {
+    if (p.empty()) return {};
+    const std::filesystem::path path(p);
+    return path.is_absolute() ? path : dir / path;
+  };
+  s.k_file = resolve(keys.string("k_file", true));
+  s.m_file = resolve(keys.string("m_file", true));
+  s.nodes_file = resolve(keys.string("nodes_file", true));
+  s.coordinates_file = resolve(keys.string("coordinates_file", false));
+  const std::string format = keys.string("format", false, "auto");
+  if (format == "auto") {
+    s.format = fem::detect_format(s.k_file);
+  } else if (const auto f = fem::super_element_format_from_string(format)) {
+    s.format = *f;
+  } else {
+    throw InputError(source, "format", "auto, ansys, calculix or matrix-market", "'" + format + "'");
+  }
+  for (const auto& [key, path] : {std::pair{"k_file", s.k_file}, {"m_file", s.m_file}, {"nodes_file", s.nodes_file}}) {
+    if (!std::filesystem::is_regular_file(path)) throw InputError(source, key, "an existing file", "'" + path.string() + "'");
+  }
+  if (!s.coordinates_file.empty() && !std::filesystem::is_regular_file(s.coordinates_file)) {
+    throw InputError(source, "coordinates_file", "an existing file", "'" + s.coordinates_file.string() + "'");
+  }
+  s.fix = keys.nodes("fix");
+  const auto sourced = [&](auto parse) {
+    try {
+      return parse();
+    } catch (const InputError& e) {
+      throw e.with_source(source);
+    }
+  };
+  const std::string actuator = keys.string("actuator", true);
+  s.actuator = sourced([&] { return fem::ForcePair::parse(actuator, "actuator"); });
+  if (s.actuator.node_a < 0) throw InputError(source, "actuator", "a force pair A:B:DIR", "a single node");
+  const std::string sensor = keys.string("sensor", true);
+  s.sensor = sourced([&] { return fem::DisplacementOutput::parse(sensor, "sensor"); });
+  if (s.sensor.node_a < 0) throw InputError(source, "sensor", "a node pair A:B:DIR", "a single node");
+  const std::string output = keys.string("output", true);
+  s.output = sourced([&] { return fem::DisplacementOutput::parse(output, "output"); });
+  if (s.output.node_a >= 0) throw InputError(source, "output", "one node NODE:DIR (the moving interface)", "a node pair");
+  if (fem::is_rotation(s.output.direction)) throw InputError(source, "output", "a translation (x, y or z)", "a rotation");
+  s.ga = keys.number("ga", s.ga);
+  s.gs = keys.number("gs", s.gs);
+  if (s.ga == 0.0) throw InputError(source, "ga", "a nonzero actuator sensitivity (N/V)", "0");
+  if (s.gs == 0.0) throw InputError(source, "gs", "a nonzero sensor sensitivity (V/m)", "0");
+  s.modal_damping = keys.number("modal_damping", s.modal_damping);
+  if (!(s.modal_damping > 0.0 && s.modal_damping < 1.0)) {
+    throw InputError(source, "modal_damping", "a damping ratio in (0, 1)", fmt::format("{:g}", s.modal_damping));
+  }
+  s.max_mode_Hz = keys.number("max_mode_Hz", s.max_mode_Hz);
+  if (!(s.max_mode_Hz > 0.0)) throw InputError(source, "max_mode_Hz", "a frequency > 0 Hz", fmt::format("{:g}", s.max_mode_Hz));
+  s.guided = keys.boolean("guided", s.guided);
+  keys.check_unknown();
+  for (long n : s.fix) {
+    if (n == s.output.node_b) throw InputError(source, "fix", "nodes other than the output node", std::to_string(n));
+  }
+  return s;
+}
+
+SuperElementMechanics load_superelement(const std::filesystem::path& file) {
+  SuperElementMechanics m;
+  m.spec = read_superelement_spec(file);
+  const SuperElementSpec& s = m.spec;
+  try {
+    m.se = fem::read_super_element(s.format, s.k_file, s.m_file, s.nodes_file, s.coordinates_file);
+    const std::string source = s.file.string();
+    for (long n : s.fix) {
+      if (!m.se.has_node(n)) (void)m.se.index_of(n, fem::Direction::kX, source, "fix");
+    }
+    (void)m.se.index_of(s.actuator.node_a, s.actuator.direction, source, "actuator");
+    (void)m.se.index_of(s.actuator.node_b, s.actuator.direction, source, "actuator");
+    (void)m.se.index_of(s.sensor.node_a, s.sensor.direction, source, "sensor");
+    (void)m.se.index_of(s.sensor.node_b, s.sensor.direction, source, "sensor");
+    (void)m.se.index_of(s.output.node_b, s.output.direction, source, "output");
+  } catch (const InputError& e) {
+    if (e.source().empty()) throw e.with_source(s.file.string());
+    throw;
+  }
+  return m;
+}
+
+fem::StructuralModel bench_structure(const SuperElementMechanics& mech, double moving_mass) {
+  const SuperElementSpec& s = mech.spec;
+  fem::ModelOptions o;
+  o.fixed_nodes = s.fix;
+  o.masses.push_back({s.output.node_b, moving_mass, 0.0});
+  o.forces.push_back(s.actuator);
+  o.forces.push_back({-1, s.output.node_b, s.output.direction});
+  o.outputs.push_back(s.output);
+  o.outputs.push_back(s.sensor);
+  fem::StructuralModel model = fem::assemble(mech.se, o);
+  if (!s.guided) return model;
+  // The air bearing: the mass node keeps only its translation along the output direction.
+  std::vector<fem::Index> keep;
+  for (std::size_t i = 0; i < model.free_dofs.size(); ++i) {
+    const fem::DofLabel& d = mech.se.dofs[static_cast<std::size_t>(model.free_dofs[i])];
+    if (!d.is_modal() && d.node == s.output.node_b && d.direction != s.output.direction) continue;
+    keep.push_back(static_cast<fem::Index>(i));
+  }
+  fem::StructuralModel g;
+  const auto f = static_cast<fem::Index>(keep.size());
+  g.K.resize(f, f);
+  g.M.resize(f, f);
+  g.C.resize(f, f);
+  g.F.resize(f, model.F.cols());
+  g.T.resize(model.T.rows(), f);
+  for (fem::Index j = 0; j < f; ++j) {
+    const fem::Index jj = keep[static_cast<std::size_t>(j)];
+    for (fem::Index i = 0; i < f; ++i) {
+      const fem::Index ii = keep[static_cast<std::size_t>(i)];
+      g.K(i, j) = model.K(ii, jj);
+      g.M(i, j) = model.M(ii, jj);
+      g.C(i, j) = model.C(ii, jj);
+    }
+    g.F.row(j) = model.F.row(jj);
+    g.T.col(j) = model.T.col(jj);
+    g.free_dofs.push_back(model.free_dofs[static_cast<std::size_t>(jj)]);
+  }
+  g.input_names = model.input_names;
+  g.output_names = model.output_names;
+  return g;
+}
+
+ContinuousPlant superelement_plant(const SuperElementMechanics& mech, double moving_mass, double ga_factor,
+                                   const Electrics& e, SuperElementPlantInfo* info) {
+  const SuperElementSpec& s = mech.spec;
+  const std::string source = s.file.string();
+  const fem::StructuralModel model = bench_structure(mech, moving_mass);
+  const fem::Modes modes = fem::modes(model);
+  const fem::Index f = model.size();
+  if (!(modes.frequencies_Hz(0) > 0.0)) {
+    throw InputError(source, "fix", "a structure held by its fixed nodes (every mode above 0 Hz)",
+                     fmt::format("a mode at {:.4g} Hz", modes.frequencies_Hz(0)));
+  }
+  fem::Index nk = 0;
+  while (nk < f && modes.frequencies_Hz(nk) <= s.max_mode_Hz) ++nk;
+  if (nk == 0) {
+    throw InputError(source, "max_mode_Hz", fmt::format("at least the first mode ({:.6g} Hz)", modes.frequencies_Hz(0)),
+                     fmt::format("{:g} Hz", s.max_mode_Hz));
+  }
+  const Eigen::MatrixXd phi = modes.shapes.leftCols(nk);
+  const Eigen::VectorXd w = 2.0 * std::numbers::pi * modes.frequencies_Hz.head(nk);
+  // Static correction: what the truncated modes add at DC, T (K^-1 - Phi W^-2 Phi^T) F.
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(model.K);
+  if (ldlt.info() != Eigen::Success) {
+    throw NumericalError("super-element bench (static solve)", "the constrained stiffness matrix could not be factored", false);
+  }
+  const Eigen::MatrixXd static_full = model.T * ldlt.solve(model.F);
+  const Eigen::MatrixXd pf = phi.transpose() * model.F;                     // nk x 2
+  const Eigen::MatrixXd tp = model.T * phi;                                  // 2 x nk
+  const Eigen::MatrixXd residual = static_full - tp * w.cwiseInverse().cwiseAbs2().asDiagonal() * pf;  // 2 x 2
+
+  const double ga = s.ga * ga_factor;
+  const double gs = s.gs;
+  const double wa = e.amplifier_bandwidth;
+  const double wc = 1.0 / (e.hpf_resistance * e.capacitance_sensor);
+  const double kappa = -e.ground_resistance * e.capacitance_actuator;
+  const fem::Index n = 3 + 2 * nk;
+  const fem::Index iz = n - 2;  // high-pass state
+  const fem::Index iy = n - 1;  // anti-aliasing state: Vs as the ADC reads it
+  ContinuousPlant c;
+  c.A = lti::Matrix::Zero(n, n);
+  c.B = lti::Matrix::Zero(n, kInputs);
+  c.C = lti::Matrix::Zero(kOutputs, n);
+  c.D = lti::Matrix::Zero(kOutputs, kInputs);
+  c.A(0, 0) = -wa;
+  c.B(0, kInVa) = wa;
+  const double r_da = residual(0, 0), r_dm = residual(0, 1), r_sa = residual(1, 0), r_sm = residual(1, 1);
+  for (fem::Index i = 0; i < nk; ++i) {
+    const fem::Index q = 1 + i, v = 1 + nk + i;
+    c.A(q, v) = 1.0;
+    c.A(v, q) = -w(i) * w(i);
+    c.A(v, v) = -2.0 * s.modal_damping * w(i);
+    c.A(v, 0) = pf(i, 0) * ga;
+    c.B(v, kInForce) = pf(i, 0);
+    c.B(v, kInMass) = pf(i, 1);
+    c.A(iz, q) = wc * gs * tp(1, i);
+    c.C(kOutDe, q) = tp(0, i);
+  }
+  // High-pass: z' = wc (gs e_s - z); at the ADC: Vs_raw = gs e_s - z + kappa wa (va - Va), through the
+  // anti-aliasing low-pass y' = w_aa (Vs_raw - y), Vs = y.
+  c.A(iz, 0) = wc * gs * r_sa * ga;
+  c.A(iz, iz) = -wc;
+  c.B(iz, kInForce) = wc * gs * r_sa;
+  c.B(iz, kInMass) = wc * gs * r_sm;
+  const double waa = e.adc_bandwidth;
+  for (fem::Index i = 0; i < nk; ++i) c.A(iy, 1 + i) = waa * gs * tp(1, i);
+  c.A(iy, 0) = waa * (gs * r_sa * ga - kappa * wa);
+  c.A(iy, iz) = -waa;
+  c.A(iy, iy) = -waa;
+  c.B(iy, kInVa) = waa * kappa * wa;
+  c.B(iy, kInForce) = waa * gs * r_sa;
+  c.B(iy, kInMass) = waa * gs * r_sm;
+  c.C(kOutVa, 0) = 1.0;
+  c.C(kOutDe, 0) = r_da * ga;
+  c.D(kOutDe, kInForce) = r_da;
+  c.D(kOutDe, kInMass) = r_dm;
+  c.C(kOutVs, iy) = 1.0;
+  if (info != nullptr) {
+    info->kept_modes = static_cast<int>(nk);
+    info->total_modes = static_cast<int>(f);
+    info->first_mode_Hz = modes.frequencies_Hz(0);
+    info->last_kept_mode_Hz = modes.frequencies_Hz(nk - 1);
+  }
+  return c;
+}
+
+}  // namespace piezobench::bench::detail
