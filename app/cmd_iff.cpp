@@ -1,4 +1,5 @@
-// `piezobench iff rlocus`: root locus of the Integral Force Feedback loop (report section 2.6).
+// `piezobench iff rlocus`: root locus of the Integral Force Feedback loop (report section 2.6);
+// `piezobench iff study`: the damped-plant study on the virtual bench (Figure 2.10).
 #include <fmt/format.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/conversions.hpp"
+#include "piezobench/rt/damped_plant_study.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -121,6 +123,94 @@ int run_rlocus(const RlocusOptions& o) {
   return 0;
 }
 
+// `iff study`: the damped-plant study of Figure 2.10 on the virtual bench (rt/damped_plant_study.hpp).
+struct StudyOptions {
+  std::string gains = "0,20000,50000,100000,200000,240000,280000";
+  int unit = 1;
+  std::uint64_t seed = 1;
+  double duration = 10.0;
+  double settle = 2.0;
+  double amplitude = 0.05;
+  bool strict = false;
+  bool json = false;
+};
+
+int run_study(const StudyOptions& o) {
+  rt::DampedPlantStudyOptions so;
+  so.gains = parse_number_list(o.gains, "--gains");
+  so.unit = o.unit;
+  so.seed = o.seed;
+  so.duration = o.duration;
+  so.settle = o.settle;
+  so.excitation_rms = o.amplitude;
+  if (!o.json) log_line(fmt::format("damped-plant study: {} gains, {:g} s each on the virtual bench (lockstep)", so.gains.size(), o.settle + o.duration));
+  const rt::DampedPlantStudy s = rt::run_damped_plant_study(so);
+  const int exit_code = o.strict && !(s.within_tolerance && s.damping_increases_to_optimum) ? 5 : 0;
+  if (o.json) {
+    nlohmann::json gains = nlohmann::json::array(), id = nlohmann::json::array(), model = nlohmann::json::array(),
+                   err = nlohmann::json::array(), id_damping = nlohmann::json::array(),
+                   model_damping = nlohmann::json::array(), id_hz = nlohmann::json::array(),
+                   model_hz = nlohmann::json::array(), so_poles = nlohmann::json::array(),
+                   so_damping = nlohmann::json::array(), so_err = nlohmann::json::array(),
+                   frf_rms = nlohmann::json::array(), coherence = nlohmann::json::array(),
+                   fit_rms = nlohmann::json::array(), clamped = nlohmann::json::array();
+    for (const auto& p : s.points) {
+      gains.push_back(p.gain);
+      id.push_back(io::to_json(p.identified_pole));
+      model.push_back(io::to_json(p.model_pole));
+      err.push_back(p.relative_error);
+      id_damping.push_back(p.identified_damping);
+      model_damping.push_back(p.model_damping);
+      id_hz.push_back(p.identified_frequency_hz);
+      model_hz.push_back(p.model_frequency_hz);
+      so_poles.push_back(io::to_json(p.second_order_pole));
+      so_damping.push_back(p.second_order_damping);
+      so_err.push_back(p.second_order_relative_error);
+      frf_rms.push_back(p.frf_model_relative_rms);
+      coherence.push_back(p.mean_coherence);
+      fit_rms.push_back(p.fit_relative_rms_error);
+      clamped.push_back(p.clamped_samples);
+    }
+    print_json({{"convention", "u = u' + g K(z) Vs on the virtual bench; identified: u' -> d_e; model: root locus of linear_model() u -> Vs with K(s)"},
+                {"unit", o.unit},
+                {"seed", o.seed},
+                {"model", s.model},
+                {"delay_s", s.delay},
+                {"gains", gains},
+                {"identified_poles", id},
+                {"model_poles", model},
+                {"relative_errors", err},
+                {"identified_damping", id_damping},
+                {"model_damping", model_damping},
+                {"identified_frequency_Hz", id_hz},
+                {"model_frequency_Hz", model_hz},
+                {"second_order", {{"poles", so_poles}, {"damping", so_damping}, {"relative_errors", so_err}}},
+                {"fit_relative_rms_error", fit_rms},
+                {"frf_model_relative_rms", frf_rms},
+                {"mean_coherence", coherence},
+                {"clamped_samples", clamped},
+                {"open_loop_pole", io::to_json(s.open_loop_pole)},
+                {"optimal_gain", s.optimal_gain},
+                {"max_damping", s.max_damping},
+                {"max_relative_error", s.max_relative_error},
+                {"tolerance", so.tolerance},
+                {"within_tolerance", s.within_tolerance},
+                {"damping_increases_to_optimum", s.damping_increases_to_optimum}});
+    return exit_code;
+  }
+  fmt::print("damped plant u' -> d_e on the virtual bench (unit {}, seed {}), report Figure 2.10\n", o.unit, o.seed);
+  fmt::print("{:>10}  {:>22}  {:>22}  {:>7}  {:>16}\n", "gain g", "identified f [Hz], z", "model f [Hz], z", "error", "2nd-order error");
+  for (const auto& p : s.points) {
+    fmt::print("{:>10.4g}  {:>12.2f}, {:>7.4f}  {:>12.2f}, {:>7.4f}  {:>6.2f}%  {:>15.2f}%\n", p.gain, p.identified_frequency_hz,
+               p.identified_damping, p.model_frequency_hz, p.model_damping, 100 * p.relative_error,
+               100 * p.second_order_relative_error);
+  }
+  fmt::print("model optimum: g = {:.4g}, damping {:.4f}\n", s.optimal_gain, s.max_damping);
+  fmt::print("check: identified poles within {:g} % of the root locus: {}; damping grows with the gain up to the optimum: {}\n",
+             100 * so.tolerance, s.within_tolerance ? "yes" : "NO", s.damping_increases_to_optimum ? "yes" : "NO");
+  return exit_code;
+}
+
 }  // namespace
 
 void add_iff_commands(CLI::App& app, Action& action) {
@@ -141,6 +231,18 @@ void add_iff_commands(CLI::App& app, Action& action) {
                  "frequency of the resonance whose damping is optimized (default: the plant's least damped pole)");
   rl->add_flag("--json", o->json, "print one JSON document on stdout");
   rl->callback([o, &action] { action = [o] { return run_rlocus(*o); }; });
+
+  auto so = std::make_shared<StudyOptions>();
+  CLI::App* st = iff->add_subcommand("study", "Damped-plant study (Figure 2.10): identified poles vs the root locus, on the virtual bench");
+  st->add_option("--gains", so->gains, "comma-separated IFF gains g")->capture_default_str();
+  st->add_option("--unit", so->unit, "unit of the batch (1..7)")->capture_default_str();
+  st->add_option("--seed", so->seed, "unit, noise and excitation seed")->capture_default_str();
+  st->add_option("--duration", so->duration, "seconds analysed per gain (whole periods of 1 s)")->capture_default_str();
+  st->add_option("--settle", so->settle, "seconds discarded at the start of each run")->capture_default_str();
+  st->add_option("--amplitude", so->amplitude, "excitation u' rms, V at the DAC")->capture_default_str();
+  st->add_flag("--strict", so->strict, "exit with code 5 when a check fails");
+  st->add_flag("--json", so->json, "print one JSON document on stdout");
+  st->callback([so, &action] { action = [so] { return run_study(*so); }; });
 }
 
 }  // namespace piezobench::app

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   piezobench::app::add_model_commands(app, action);
   piezobench::app::add_superelement_commands(app, action);
   piezobench::app::add_simulate_commands(app, action);
+  piezobench::app::add_rt_commands(app, action);
 
   try {
     app.parse(argc, argv);

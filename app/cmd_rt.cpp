@@ -1,0 +1,248 @@
+// `piezobench rt`: the real-time IFF loop (report section 2.6, Figure 2.9) on the virtual bench or
+// on a replayed record, with the actuator's safety limits, a signal log and a timing report.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include "cli_common.hpp"
+#include "piezobench/bench/virtual_bench.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/dsp/excitation.hpp"
+#include "piezobench/io/json.hpp"
+#include "piezobench/rt/loop.hpp"
+#include "piezobench/rt/replay_backend.hpp"
+#include "piezobench/rt/virtual_backend.hpp"
+
+namespace piezobench::app {
+namespace {
+
+struct RtOptions {
+  std::string bench = "virtual";
+  std::string controller = "iff";
+  double gain = 0.0;
+  double rate = 10e3;
+  bool rate_given = false;
+  double duration = 1.0;
+  std::string log;
+  int unit = 1;
+  std::uint64_t seed = 1;
+  std::string excitation = "none";
+  double amplitude = 0.05;
+  std::string band = "1,1000";
+  std::string replay;
+  bool realtime = true;
+  rt::ActuatorLimits limits;
+  double ramp = 0.1;
+  int priority = 80;
+  bool json = false;
+};
+
+nlohmann::json summary(const rt::TimingSummary& s, bool percentiles = true) {
+  nlohmann::json j = {{"p50", s.p50}, {"max", s.max}, {"mean", s.mean}, {"count", s.count}};
+  if (percentiles) {
+    j["p99"] = s.p99;
+    j["p999"] = s.p999;
+  }
+  return j;
+}
+
+int run_rt(const RtOptions& o) {
+  if (o.controller != "iff" && o.controller != "off") {
+    throw InputError("", "--controller", "iff or off", "'" + o.controller + "'");
+  }
+  if (!(std::isfinite(o.rate) && o.rate > 0.0)) throw InputError("", "--rate", "a rate > 0 Hz", std::to_string(o.rate));
+  o.limits.validate();
+  std::unique_ptr<rt::Backend> backend;
+  nlohmann::json source;
+  if (o.bench == "virtual") {
+    if (!o.replay.empty()) throw InputError("", "--replay", "only with --bench replay", "'" + o.replay + "'");
+    bench::BenchOptions bo;
+    bo.sample_rate = o.rate;
+    bo.va_min = o.limits.va_min;
+    bo.va_max = o.limits.va_max;
+    bo.amplifier_gain = o.limits.amplifier_gain;
+    backend = std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(o.unit, o.seed), bo, o.seed);
+    source = {{"bench", "virtual"}, {"unit", o.unit}, {"seed", o.seed}};
+  } else if (o.bench == "replay") {
+    if (o.replay.empty()) throw InputError("", "--replay", "a recorded file (.mat or .csv with de and Vs)", "nothing");
+    auto replay = std::make_unique<rt::ReplayBackend>(std::filesystem::path(o.replay));
+    if (o.rate_given && std::abs(o.rate - replay->sample_rate()) > 1e-6 * replay->sample_rate()) {
+      throw InputError(o.replay, "--rate", "the record's sample rate " + std::to_string(replay->sample_rate()) + " Hz",
+                       std::to_string(o.rate) + " Hz");
+    }
+    source = {{"bench", "replay"}, {"file", o.replay}, {"samples", replay->samples()}};
+    backend = std::move(replay);
+  } else {
+    throw InputError("", "--bench", "virtual or replay", "'" + o.bench + "'");
+  }
+
+  rt::LoopOptions lo;
+  lo.duration = o.duration;
+  lo.realtime = o.realtime;
+  lo.priority = o.priority;
+  lo.controller = o.controller == "iff";
+  lo.gain = o.gain;
+  lo.limits = o.limits;
+  lo.limits.ramp_in = lo.limits.ramp_out = o.ramp;
+  if (!o.log.empty()) lo.log_file = std::filesystem::path(o.log);
+  lo.log_settings["command"] = std::string("rt");
+  lo.log_settings["bench"] = o.bench;
+  if (o.bench == "virtual") {
+    lo.log_settings["unit"] = static_cast<double>(o.unit);
+    lo.log_settings["seed"] = static_cast<double>(o.seed);
+  }
+  lo.log_settings["excitation"] = o.excitation;
+  lo.on_warning = [](const std::string& w) { log_line("warning: " + w); };
+  if (o.excitation == "noise") {
+    const std::vector<double> band = parse_number_list(o.band, "--band");
+    if (band.size() != 2) throw InputError("", "--band", "two frequencies LO,HI in Hz", "'" + o.band + "'");
+    dsp::NoiseOptions no;
+    no.sample_rate = backend->sample_rate();
+    const double cycles = std::max(2.0, std::round(o.duration * no.sample_rate));
+    no.samples = static_cast<Eigen::Index>(std::min(cycles, 65536.0));  // one period, played cyclically
+    no.f_low = band[0];
+    no.f_high = band[1];
+    no.rms = o.amplitude;
+    no.seed = o.seed;
+    dsp::VoltageBounds unlimited;  // the loop's safety layer limits the output, not the generator
+    unlimited.min = -1e6;
+    unlimited.max = 1e6;
+    lo.excitation = dsp::band_limited_noise(no, unlimited).u;
+    lo.log_settings["amplitude_rms"] = o.amplitude;
+  } else if (o.excitation != "none") {
+    throw InputError("", "--excitation", "none or noise", "'" + o.excitation + "'");
+  }
+  // The signals are kept in memory for the summary unless the run is long.
+  lo.keep_log = o.duration <= 120.0;
+
+  if (!o.json) {
+    log_line(fmt::format("rt: {} backend, controller {}, g = {:g}, {:g} Hz, {:g} s, {}", backend->name(), o.controller,
+                         o.gain, backend->sample_rate(), o.duration, o.realtime ? "real time" : "lockstep (as fast as possible)"));
+  }
+  io::TimeSeries log;
+  const rt::LoopReport r = rt::run_loop(*backend, lo, &log);
+
+  nlohmann::json signals = nullptr;
+  if (lo.keep_log && log.samples() > 0) {
+    const auto rms = [](const Eigen::Ref<const Eigen::VectorXd>& v) { return std::sqrt(v.squaredNorm() / static_cast<double>(v.size())); };
+    signals = {{"Va_min_V", log.channel("Va").minCoeff()},
+               {"Va_max_V", log.channel("Va").maxCoeff()},
+               {"Va_rms_V", rms(log.channel("Va"))},
+               {"de_rms_um", rms(log.channel("de")) * 1e6},
+               {"Vs_rms_V", rms(log.channel("Vs"))},
+               {"u_prime_rms_V", rms(log.channel("u_prime"))},
+               {"y_rms_V", rms(log.channel("y"))}};
+  }
+  if (o.json) {
+    print_json({{"source", source},
+                {"controller", o.controller},
+                {"gain", o.gain},
+                {"rate_Hz", r.sample_rate},
+                {"duration_s", o.duration},
+                {"realtime", r.realtime},
+                {"sched_fifo", r.sched_fifo},
+                {"memory_locked", r.memory_locked},
+                {"cycles", r.cycles},
+                {"overruns", r.overruns},
+                {"skipped_deadlines", r.skipped_deadlines},
+                {"wind_down_cycles", r.wind_down_cycles},
+                {"period_jitter_us", r.realtime ? summary(r.period_jitter_us) : nlohmann::json(nullptr)},
+                {"wake_latency_us", r.realtime ? summary(r.wake_latency_us) : nlohmann::json(nullptr)},
+                {"step_time_us", summary(r.step_time_us)},
+                {"clamped_samples", r.clamped_samples},
+                {"slew_limited_samples", r.slew_limited_samples},
+                {"safe_state_events", r.safe_state_events},
+                {"safe_state_reason", r.safe_state_reason},
+                {"safe_state_cycle", r.safe_state_cycle},
+                {"watchdog_trips", r.watchdog_trips},
+                {"nonfinite_sensor_samples", r.nonfinite_sensor_samples},
+                {"stale_sensor_samples", r.stale_sensor_samples},
+                {"va_cmd_min_V", r.va_cmd_min},
+                {"va_cmd_max_V", r.va_cmd_max},
+                {"max_va_cmd_step_V", r.max_va_cmd_step},
+                {"limits",
+                 {{"actuator", o.limits.actuator},
+                  {"va_min_V", o.limits.va_min},
+                  {"va_max_V", o.limits.va_max},
+                  {"amplifier_gain", o.limits.amplifier_gain},
+                  {"slew_rate_V_per_s", o.limits.slew_rate},
+                  {"ramp_s", o.ramp},
+                  {"watchdog_s", o.limits.watchdog_timeout},
+                  {"stale_cycles", o.limits.stale_cycles}}},
+                {"log", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
+                {"logged_samples", r.logged_samples},
+                {"dropped_log_samples", r.dropped_log_samples},
+                {"signals", signals},
+                {"warnings", r.warnings}});
+    return 0;
+  }
+  fmt::print("real-time loop: {} backend, {:g} Hz, {} ({}SCHED_FIFO, {}mlockall)\n", r.backend, r.sample_rate,
+             r.realtime ? "real time" : "lockstep", r.sched_fifo ? "" : "no ", r.memory_locked ? "" : "no ");
+  fmt::print("cycles {}   overruns {}   skipped deadlines {}\n", r.cycles, r.overruns, r.skipped_deadlines);
+  fmt::print("{:<16}{:>10}{:>10}{:>10}{:>10}   [us]\n", "", "p50", "p99", "p99.9", "max");
+  auto row = [](const char* name, const rt::TimingSummary& s) {
+    fmt::print("{:<16}{:>10.2f}{:>10.2f}{:>10.2f}{:>10.2f}\n", name, s.p50, s.p99, s.p999, s.max);
+  };
+  if (r.realtime) {
+    row("period jitter", r.period_jitter_us);
+    row("wake latency", r.wake_latency_us);
+  }
+  row("step time", r.step_time_us);
+  fmt::print("output: Va commanded {:.2f} .. {:.2f} V (limits {:g} .. {:g} V), largest step {:.3g} V\n", r.va_cmd_min,
+             r.va_cmd_max, o.limits.va_min, o.limits.va_max, r.max_va_cmd_step);
+  fmt::print("clamped samples {}   slew-limited samples {}   safe state: {}{}   watchdog trips {}\n", r.clamped_samples,
+             r.slew_limited_samples, r.safe_state_reason,
+             r.safe_state_cycle >= 0 ? fmt::format(" (cycle {})", r.safe_state_cycle) : std::string(), r.watchdog_trips);
+  if (!o.log.empty()) fmt::print("log: {} ({} samples, {} dropped)\n", o.log, r.logged_samples, r.dropped_log_samples);
+  return 0;
+}
+
+bool parse_bool(const std::string& text, const std::string& option) {
+  if (text == "true" || text == "1" || text == "yes" || text == "on") return true;
+  if (text == "false" || text == "0" || text == "no" || text == "off") return false;
+  throw InputError("", option, "true or false", "'" + text + "'");
+}
+
+}  // namespace
+
+void add_rt_commands(CLI::App& app, Action& action) {
+  auto o = std::make_shared<RtOptions>();
+  auto realtime = std::make_shared<std::string>("true");
+  CLI::App* rt = app.add_subcommand("rt", "Run the IFF loop u = u' + g K(z) Vs in real time on the virtual bench or a replayed record");
+  rt->add_option("--bench", o->bench, "I/O backend: virtual (the virtual bench in lockstep) or replay (a recorded file)")
+      ->capture_default_str();
+  rt->add_option("--controller", o->controller, "iff (eq. 2.4 discretized at the rate) or off (open loop)")->capture_default_str();
+  rt->add_option("--gain", o->gain, "IFF gain g")->required();
+  CLI::Option* rate = rt->add_option("--rate", o->rate, "loop rate, Hz (replay: the record's rate)")->capture_default_str();
+  rt->add_option("--duration", o->duration, "run length, s")->capture_default_str();
+  rt->add_option("--log", o->log, "write the signals of every cycle to this .mat (or .csv) file");
+  rt->add_option("--unit", o->unit, "virtual bench: unit of the batch (1..7)")->capture_default_str();
+  rt->add_option("--seed", o->seed, "virtual bench: unit and noise seed; excitation seed")->capture_default_str();
+  rt->add_option("--excitation", o->excitation, "u': none or noise (band-limited, periodic)")->capture_default_str();
+  rt->add_option("--amplitude", o->amplitude, "noise rms, V at the DAC")->capture_default_str();
+  rt->add_option("--band", o->band, "noise band LO,HI, Hz")->capture_default_str();
+  rt->add_option("--replay", o->replay, "replay: the recorded file (.mat or .csv with channels de and Vs)");
+  rt->add_option("--realtime", *realtime, "true: paced by absolute deadlines; false: lockstep, as fast as possible")
+      ->capture_default_str();
+  rt->add_option("--va-min", o->limits.va_min, "lowest stack voltage, V")->capture_default_str();
+  rt->add_option("--va-max", o->limits.va_max, "highest stack voltage, V")->capture_default_str();
+  rt->add_option("--slew-rate", o->limits.slew_rate, "largest stack-voltage slew rate, V/s")->capture_default_str();
+  rt->add_option("--ramp", o->ramp, "ramp in and out of the gain and output, s")->capture_default_str();
+  rt->add_option("--watchdog", o->limits.watchdog_timeout, "safe state when no cycle completes within this time, s")
+      ->capture_default_str();
+  rt->add_option("--priority", o->priority, "SCHED_FIFO priority of the loop thread (when permitted)")
+      ->check(CLI::Range(1, 99))
+      ->capture_default_str();
+  rt->add_flag("--json", o->json, "print one JSON document on stdout");
+  rt->callback([o, realtime, rate, &action] {
+    o->rate_given = rate->count() > 0;
+    action = [o, realtime] {
+      o->realtime = parse_bool(*realtime, "--realtime");
+      return run_rt(*o);
+    };
+  });
+}
+
+}  // namespace piezobench::app

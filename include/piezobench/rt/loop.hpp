@@ -1,0 +1,167 @@
+#pragma once
+// The real-time loop of the report's Figure 2.9: u = u' + g K0(z) Vs at the backend's rate, with
+// the actuator's safety limits (safety.hpp), a signal log (logger.hpp) and timing statistics
+// (timing.hpp). docs/realtime.md describes it; in short:
+//
+//  - Pacing (real-time mode): absolute deadlines t0 + k T on CLOCK_MONOTONIC, slept to with
+//    clock_nanosleep(TIMER_ABSTIME), so errors do not accumulate. The loop runs on its own thread,
+//    with SCHED_FIFO (`priority`) and mlockall(MCL_CURRENT | MCL_FUTURE) when the system permits;
+//    when it does not (a container, no CAP_SYS_NICE / CAP_IPC_LOCK) the loop still runs and a
+//    warning says so (stderr and LoopReport::warnings). A cycle that ends after the next deadline
+//    is an overrun (counted); when a whole period has been missed the loop skips to the next
+//    future deadline (counted as skipped deadlines) instead of running late cycles back to back.
+//  - Lockstep mode (realtime = false): no sleeping; cycles run back to back as fast as possible,
+//    for simulation (tests, the damped-plant study). The log never drops a record then.
+//  - Inside a cycle: read the sensors, check them, step the controller, ramp, clamp, slew-limit,
+//    write the command, push the log record. No allocation, no lock, no I/O other than the
+//    backend's (tests/rt/loop_test.cpp counts allocations around cycle()).
+//  - Ramps: over ramp_in seconds at the start and ramp_out seconds at the end of the run a factor
+//    r goes 0 -> 1 (-> 0); the controller's gain is r g (bumpless: the gain acts at the sections'
+//    input) and the command is u_safe + r (u' + y - u_safe), so the run starts and ends at the safe
+//    output without a step.
+//  - Safe state (latched): a non-finite or stale sensor sample, a non-finite controller output or
+//    the watchdog (no completed cycle within watchdog_timeout: checked every cycle from the wake-up
+//    time, and by a watchdog thread that calls Backend::on_watchdog() when the loop is stuck) sets
+//    the output to the safe value at the slew limit and resets the controller; the loop keeps
+//    running (and timing) to the end of the run with the safe output.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "piezobench/control/discrete_iff.hpp"
+#include "piezobench/io/timeseries.hpp"
+#include "piezobench/rt/backend.hpp"
+#include "piezobench/rt/logger.hpp"
+#include "piezobench/rt/safety.hpp"
+#include "piezobench/rt/timing.hpp"
+
+namespace piezobench::rt {
+
+struct LoopOptions {
+  double duration = 1.0;      // s; the run has round(duration * rate) cycles (fewer if the backend ends)
+  bool realtime = true;       // false = lockstep, as fast as possible
+  bool sched_fifo = true;     // try SCHED_FIFO for the loop thread (real-time mode)
+  int priority = 80;          // SCHED_FIFO priority, 1..99
+  bool lock_memory = true;    // try mlockall (real-time mode)
+  bool controller = true;     // false: open loop (u = u' only)
+  double gain = 0.0;          // IFF gain g
+  control::IffControllerParams controller_params;      // K0 (eq. 2.4 by default)
+  control::DiscreteIffOptions discrete;                // its sample_rate is replaced by the backend's
+  ActuatorLimits limits;
+  Eigen::VectorXd excitation;  // u' (V at the DAC), played cyclically from cycle 0; empty = 0
+  // Signal log: kept in memory when `keep_log` (Loop::log()) and/or written to `log_file`.
+  std::optional<std::filesystem::path> log_file;
+  bool keep_log = false;
+  std::size_t log_ring_capacity = 1u << 16;
+  // Rows of log storage allocated before the run (11 doubles each: 3e6 rows = 264 MB, 5 min at
+  // 10 kHz); records beyond are dropped and counted in dropped_log_samples.
+  std::size_t max_log_samples = 3'000'000;
+  std::map<std::string, io::Setting> log_settings;  // added to the log file's settings
+  // Called (on the setup path, never inside a cycle) with each warning as it arises, e.g. to print
+  // it on stderr at once; the warnings are also returned in LoopReport::warnings.
+  std::function<void(const std::string&)> on_warning;
+  // InputError naming the field (duration > 0 and finite, priority 1..99, gain finite, finite
+  // excitation, limits).
+  void validate() const;
+};
+
+struct LoopReport {
+  std::string backend;
+  double sample_rate = 0.0;         // Hz
+  bool realtime = false;
+  bool sched_fifo = false;          // SCHED_FIFO obtained
+  bool memory_locked = false;       // mlockall obtained
+  std::uint64_t cycles = 0;
+  std::uint64_t overruns = 0;       // cycles that ended after the next deadline
+  std::uint64_t skipped_deadlines = 0;
+  std::uint64_t wind_down_cycles = 0;  // extra cycles that brought the output to the safe value
+  TimingSummary period_jitter_us;   // |actual period - T| between consecutive wake-ups
+  TimingSummary wake_latency_us;    // wake-up time - deadline
+  TimingSummary step_time_us;       // execution time of a cycle: read .. log push
+  std::uint64_t clamped_samples = 0;
+  std::uint64_t slew_limited_samples = 0;
+  std::uint64_t safe_state_events = 0;
+  std::string safe_state_reason = "none";  // to_string(Fault)
+  std::int64_t safe_state_cycle = -1;      // first cycle in the safe state, -1 = never
+  std::uint64_t nonfinite_sensor_samples = 0;
+  std::uint64_t stale_sensor_samples = 0;
+  std::uint64_t watchdog_trips = 0;
+  std::uint64_t logged_samples = 0;
+  std::uint64_t dropped_log_samples = 0;
+  double va_cmd_min = 0.0, va_cmd_max = 0.0;  // V, extremes of the commanded stack voltage
+  double max_va_cmd_step = 0.0;               // V, largest |change| of it between two cycles
+  std::vector<std::string> warnings;
+};
+
+// The loop with the pacing left to the caller: start(), then cycle() until it returns false, then
+// finish(). run_loop() does this with the pacing, the threads and the real-time setup; tests call
+// cycle() directly.
+class Loop {
+ public:
+  // Validates (InputError); allocates everything the cycles need.
+  Loop(Backend& backend, const LoopOptions& options);
+  ~Loop();
+  Loop(const Loop&) = delete;
+  Loop& operator=(const Loop&) = delete;
+
+  // Starts the backend and the logger thread (allocates, may throw).
+  void start();
+  // One cycle. `deadline_ns` and `wake_ns` (CLOCK_MONOTONIC) feed the timing statistics in
+  // real-time mode; in lockstep mode pass 0 for both. Returns false, doing nothing, once the run
+  // is complete or the backend has finished. noexcept, allocation-free.
+  bool cycle(std::int64_t deadline_ns = 0, std::int64_t wake_ns = 0) noexcept;
+  // Writes the safe output, stops the backend and the logger (which writes the file) and returns
+  // the report. Rethrows a log write error (InputError).
+  LoopReport finish();
+
+  // The log (when options.keep_log), valid after finish().
+  [[nodiscard]] const io::TimeSeries& log() const;
+  [[nodiscard]] std::uint64_t cycles() const noexcept { return cycle_; }
+  [[nodiscard]] std::uint64_t total_cycles() const noexcept { return total_cycles_; }
+  [[nodiscard]] const SafetyGuard& guard() const noexcept { return guard_; }
+  [[nodiscard]] const control::DiscreteIff& controller() const noexcept { return iff_; }
+
+  // Used by run_loop(): overruns, skipped deadlines and the watchdog.
+  void add_overrun() noexcept { ++overruns_; }
+  void add_skipped(std::uint64_t n) noexcept { skipped_ += n; }
+  void watchdog_trip() noexcept;
+  [[nodiscard]] std::uint64_t heartbeat() const noexcept;
+
+ private:
+  struct Shared;
+  Backend& backend_;
+  LoopOptions options_;
+  double rate_;
+  std::uint64_t total_cycles_;
+  std::uint64_t ramp_in_cycles_, ramp_out_cycles_;
+  control::DiscreteIff iff_;
+  SafetyGuard guard_;
+  std::unique_ptr<SignalLogger> logger_;
+  std::unique_ptr<Shared> shared_;  // atomics shared with the watchdog thread
+  TimingHistogram jitter_, latency_, step_time_;
+  std::uint64_t cycle_ = 0;
+  std::uint64_t overruns_ = 0, skipped_ = 0, wind_down_ = 0;
+  std::uint64_t controller_nonfinite_seen_ = 0;
+  std::int64_t last_wake_ns_ = 0;
+  std::int64_t last_end_ns_ = 0;
+  double va_cmd_min_ = 0.0, va_cmd_max_ = 0.0, max_step_ = 0.0, last_va_cmd_ = 0.0;
+  std::int64_t period_ns_ = 0, watchdog_ns_ = 0;
+  bool started_ = false, finished_ = false;
+  io::TimeSeries log_;
+  std::vector<std::string> warnings_;
+};
+
+// The whole run: real-time setup (SCHED_FIFO, mlockall, stack prefault; warnings when refused),
+// the loop thread paced by absolute deadlines (or lockstep), the watchdog thread, the logger.
+// When `log` is given and options.keep_log, the log is moved there. Errors: InputError (options,
+// backend start, log file), NumericalError never.
+LoopReport run_loop(Backend& backend, const LoopOptions& options, io::TimeSeries* log = nullptr);
+
+}  // namespace piezobench::rt

@@ -1,0 +1,110 @@
+#pragma once
+// Safety of the real-time loop's output, configurable per actuator (DESIGN.md "Safety in the
+// real-time loop"). Every cycle the requested DAC command goes through, in this order:
+//   1. sensor check: a non-finite d_e or Vs, or more than `stale_cycles` consecutive reads without
+//      a fresh sample, trips the safe state;
+//   2. safe state (latched until the end of the run): the request is replaced by the safe output;
+//   3. clamp to the actuator's range [va_min, va_max] / amplifier_gain (counted: clamped samples);
+//   4. slew-rate limit: |u[k] - u[k-1]| <= slew_rate / amplifier_gain / sample_rate (counted).
+// Clamping before the slew limit keeps both: a slew-limited step from a value inside the range
+// towards a value inside the range stays inside it. So the stack voltage commanded never leaves
+// [va_min, va_max] and never moves faster than slew_rate, in the safe state too (the output goes
+// to the safe value at the slew limit, not in one jump). Nothing is limited silently: every
+// limited sample is counted and the loop reports the counts.
+//
+// The ramp in and out (ramp_in, ramp_out) and the watchdog (watchdog_timeout) are applied by the
+// loop (loop.hpp) with these settings.
+#include <cstdint>
+#include <string>
+
+#include "piezobench/rt/backend.hpp"
+
+namespace piezobench::rt {
+
+// Defaults: the APA300ML behind the PD200 amplifier of the report's bench.
+struct ActuatorLimits {
+  std::string actuator = "APA300ML";
+  double amplifier_gain = 20.0;   // V/V, DAC voltage -> stack voltage
+  double va_min = -20.0;          // V at the stacks (-1 V at the DAC)
+  double va_max = 150.0;          // V at the stacks (7.5 V at the DAC)
+  double va_safe = 0.0;           // V at the stacks: the output of the safe state and of the ramps' ends
+  // V/s at the stacks. 1e5 V/s drives about 1 A into the APA300ML's two stacks (9.9 uF), a typical
+  // amplifier current limit; the IFF loop at the optimal gain needs about a third of it.
+  double slew_rate = 1e5;
+  double ramp_in = 0.1;           // s, controller gain and output envelope from 0 to 1 at the start
+  double ramp_out = 0.1;          // s, and back to 0 at the end of the run
+  int stale_cycles = 3;           // consecutive stale reads tolerated (>= 0)
+  // s without a completed cycle before the watchdog trips the safe state. The default allows for a
+  // host without real-time scheduling (a container); a real target would use a few periods.
+  double watchdog_timeout = 20e-3;
+
+  // InputError (source "actuator limits") naming the field: finite values, amplifier_gain > 0,
+  // va_min < va_max, va_safe inside [va_min, va_max], slew_rate > 0, ramps >= 0, stale_cycles >= 0,
+  // watchdog_timeout > 0.
+  void validate() const;
+
+  [[nodiscard]] double u_min() const { return va_min / amplifier_gain; }    // V at the DAC
+  [[nodiscard]] double u_max() const { return va_max / amplifier_gain; }
+  [[nodiscard]] double u_safe() const { return va_safe / amplifier_gain; }
+  // Largest change of the DAC command per sample at `sample_rate` Hz.
+  [[nodiscard]] double max_step(double sample_rate) const { return slew_rate / amplifier_gain / sample_rate; }
+};
+
+// Why the loop entered its safe state.
+enum class Fault : std::uint8_t {
+  kNone,
+  kNonFiniteSensor,      // d_e or Vs was NaN or infinite
+  kStaleSensor,          // no fresh sample for more than stale_cycles reads
+  kWatchdog,             // the loop did not complete a cycle within watchdog_timeout
+  kNonFiniteController,  // the controller's output overflowed
+};
+std::string to_string(Fault fault);  // "none", "non-finite sensor", "stale sensor", "watchdog", ...
+
+// The output stage: sensor checks, safe state, clamp and slew limit, with their counters.
+// Allocates nothing after construction; all member functions but the constructor are noexcept.
+class SafetyGuard {
+ public:
+  // Validates the limits (InputError) and the rate (> 0). The previous output starts at u_safe.
+  SafetyGuard(const ActuatorLimits& limits, double sample_rate);
+
+  // Checks one acquisition: kNonFiniteSensor, kStaleSensor (after stale_cycles stale reads in a
+  // row) or kNone. Counts non-finite and stale samples. Does not trip by itself.
+  Fault check(const SensorSample& sample) noexcept;
+  // Enters the (latched) safe state for `fault` at cycle `cycle`; only the first trip is recorded
+  // as the reason, every trip while not already safe counts as an event.
+  void trip(Fault fault, std::uint64_t cycle) noexcept;
+  [[nodiscard]] bool safe_state() const noexcept { return fault_ != Fault::kNone; }
+
+  struct Output {
+    double u = 0.0;             // V at the DAC, what to write
+    bool clamped = false;       // the request was outside the range
+    bool slew_limited = false;  // the step was limited
+  };
+  // The command to write for the request `u` (V at the DAC): in the safe state u_safe; then
+  // clamped and slew-limited from the previous output. A NaN request counts as clamped and is
+  // replaced by the previous output.
+  Output limit(double u) noexcept;
+
+  [[nodiscard]] const ActuatorLimits& limits() const noexcept { return limits_; }
+  [[nodiscard]] double last_output() const noexcept { return last_u_; }
+  [[nodiscard]] Fault fault() const noexcept { return fault_; }
+  [[nodiscard]] std::uint64_t fault_cycle() const noexcept { return fault_cycle_; }
+  [[nodiscard]] std::uint64_t clamped_samples() const noexcept { return clamped_; }
+  [[nodiscard]] std::uint64_t slew_limited_samples() const noexcept { return slew_limited_; }
+  [[nodiscard]] std::uint64_t safe_state_events() const noexcept { return events_; }
+  [[nodiscard]] std::uint64_t nonfinite_samples() const noexcept { return nonfinite_; }
+  [[nodiscard]] std::uint64_t stale_samples() const noexcept { return stale_; }
+
+ private:
+  ActuatorLimits limits_;
+  double u_min_, u_max_, u_safe_, max_step_;
+  double last_u_;
+  bool have_sequence_ = false;
+  std::uint64_t last_sequence_ = 0;
+  int stale_run_ = 0;
+  Fault fault_ = Fault::kNone;
+  std::uint64_t fault_cycle_ = 0;
+  std::uint64_t clamped_ = 0, slew_limited_ = 0, events_ = 0, nonfinite_ = 0, stale_ = 0;
+};
+
+}  // namespace piezobench::rt

@@ -1,0 +1,380 @@
+#include "piezobench/rt/loop.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+#include "piezobench/core/error.hpp"
+#include "rt/util.hpp"
+
+namespace piezobench::rt {
+
+struct Loop::Shared {
+  std::atomic<std::uint64_t> heartbeat{0};  // cycles completed
+  std::atomic<bool> watchdog{false};        // set by the watchdog thread
+  std::atomic<std::uint64_t> watchdog_trips{0};
+};
+
+void LoopOptions::validate() const {
+  const std::string source = "rt loop";
+  detail::require_positive(duration, "duration", source);
+  if (duration > 1e6) throw InputError(source, "duration", "at most 1e6 s", detail::str(duration));
+  if (priority < 1 || priority > 99) throw InputError(source, "priority", "an integer in 1..99", std::to_string(priority));
+  detail::require_finite(gain, "gain", source);
+  for (Eigen::Index i = 0; i < excitation.size(); ++i) {
+    if (!std::isfinite(excitation(i))) {
+      throw InputError(source, "excitation", "finite samples", "NaN or Inf at sample " + std::to_string(i));
+    }
+  }
+  if (log_ring_capacity < 2) throw InputError(source, "log_ring_capacity", "at least 2", std::to_string(log_ring_capacity));
+  limits.validate();
+}
+
+Loop::Loop(Backend& backend, const LoopOptions& options)
+    : backend_(backend),
+      options_((options.validate(), options)),
+      rate_(backend.sample_rate()),
+      total_cycles_(0),
+      ramp_in_cycles_(0),
+      ramp_out_cycles_(0),
+      iff_(options.controller_params,
+           [&] {
+             control::DiscreteIffOptions d = options.discrete;
+             d.sample_rate = backend.sample_rate();
+             return d;
+           }(),
+           0.0),
+      guard_(options.limits, backend.sample_rate()),
+      shared_(std::make_unique<Shared>()) {
+  detail::require_positive(rate_, "sample_rate", "backend " + backend.name());
+  const double cycles = std::round(options.duration * rate_);
+  total_cycles_ = static_cast<std::uint64_t>(std::max(1.0, cycles));
+  ramp_in_cycles_ = static_cast<std::uint64_t>(std::llround(options.limits.ramp_in * rate_));
+  ramp_out_cycles_ = static_cast<std::uint64_t>(std::llround(options.limits.ramp_out * rate_));
+  period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / rate_));
+  watchdog_ns_ = static_cast<std::int64_t>(std::llround(options.limits.watchdog_timeout * 1e9));
+  if (options.keep_log || options.log_file) {
+    LoggerOptions lo;
+    lo.file = options.log_file;
+    lo.ring_capacity = options.log_ring_capacity;
+    lo.max_samples = static_cast<std::size_t>(std::min<std::uint64_t>(total_cycles_, options.max_log_samples));
+    lo.sample_rate = rate_;
+    lo.settings = options.log_settings;
+    lo.settings["backend"] = backend.name();
+    lo.settings["gain"] = options.gain;
+    lo.settings["controller"] = std::string(options.controller ? "iff" : "off");
+    lo.settings["actuator"] = options.limits.actuator;
+    lo.settings["amplifier_gain"] = options.limits.amplifier_gain;
+    lo.settings["va_min"] = options.limits.va_min;
+    lo.settings["va_max"] = options.limits.va_max;
+    lo.settings["slew_rate"] = options.limits.slew_rate;
+    lo.settings["realtime"] = options.realtime ? 1.0 : 0.0;
+    logger_ = std::make_unique<SignalLogger>(lo);
+  }
+  last_va_cmd_ = guard_.last_output() * options.limits.amplifier_gain;
+  va_cmd_min_ = va_cmd_max_ = last_va_cmd_;
+}
+
+Loop::~Loop() {
+  if (started_ && !finished_) {
+    backend_.stop();
+  }
+}
+
+void Loop::start() {
+  if (started_) return;
+  backend_.start();
+  backend_.write(guard_.last_output());  // the safe output before the first cycle
+  if (logger_) logger_->start();
+  started_ = true;
+}
+
+void Loop::watchdog_trip() noexcept {
+  if (!shared_->watchdog.exchange(true, std::memory_order_acq_rel)) {
+    shared_->watchdog_trips.fetch_add(1, std::memory_order_relaxed);
+  }
+  backend_.on_watchdog();
+}
+
+std::uint64_t Loop::heartbeat() const noexcept { return shared_->heartbeat.load(std::memory_order_acquire); }
+
+bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
+  if (!started_ || finished_) return false;
+  const double u_safe = guard_.limits().u_safe();
+  const double amp = guard_.limits().amplifier_gain;
+  if (cycle_ >= total_cycles_ || backend_.finished()) {
+    // Wind-down: bring the output to the safe value at the slew limit (the ramp out normally
+    // ends there already; not after an early end of the backend or a trip mid-slew).
+    if (guard_.last_output() == u_safe) return false;
+    const SafetyGuard::Output out = guard_.limit(u_safe);
+    backend_.write(out.u);
+    ++wind_down_;
+    shared_->heartbeat.fetch_add(1, std::memory_order_release);
+    return true;
+  }
+  const bool timed = options_.realtime && wake_ns != 0;
+  const std::int64_t start_ns = timed ? wake_ns : monotonic_ns();
+  double latency_us = 0.0;
+  bool late = false;
+  if (timed) {
+    if (cycle_ > 0) {
+      jitter_.add(std::abs(static_cast<double>(wake_ns - last_wake_ns_ - period_ns_)));
+      late = wake_ns - last_end_ns_ > watchdog_ns_;
+    }
+    latency_us = static_cast<double>(wake_ns - deadline_ns) * 1e-3;
+    latency_.add(static_cast<double>(wake_ns - deadline_ns));
+    last_wake_ns_ = wake_ns;
+  }
+
+  const SensorSample s = backend_.read();
+  Fault fault = guard_.check(s);
+  if (fault == Fault::kNone && (late || shared_->watchdog.load(std::memory_order_acquire))) {
+    fault = Fault::kWatchdog;
+    if (late && !shared_->watchdog.exchange(true, std::memory_order_acq_rel)) {
+      shared_->watchdog_trips.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+  if (fault != Fault::kNone && !guard_.safe_state()) {
+    guard_.trip(fault, cycle_);
+    iff_.reset();
+  }
+
+  // Ramp factor: 0 -> 1 over the first ramp_in cycles, 1 -> 0 over the last ramp_out cycles.
+  double r = 1.0;
+  if (ramp_in_cycles_ > 0) r = std::min(r, static_cast<double>(cycle_) / static_cast<double>(ramp_in_cycles_));
+  if (ramp_out_cycles_ > 0) {
+    r = std::min(r, static_cast<double>(total_cycles_ - 1 - cycle_) / static_cast<double>(ramp_out_cycles_));
+  }
+  const double u_prime =
+      options_.excitation.size() > 0
+          ? options_.excitation(static_cast<Eigen::Index>(cycle_ % static_cast<std::uint64_t>(options_.excitation.size())))
+          : 0.0;
+
+  double y = 0.0;
+  double request = u_safe;
+  if (!guard_.safe_state()) {
+    if (options_.controller) {
+      iff_.set_gain(r * options_.gain);
+      y = iff_.step(s.vs);
+      if (iff_.nonfinite_inputs() != controller_nonfinite_seen_) {
+        controller_nonfinite_seen_ = iff_.nonfinite_inputs();
+        guard_.trip(Fault::kNonFiniteController, cycle_);
+        iff_.reset();
+        y = 0.0;
+      }
+    }
+    if (!guard_.safe_state()) request = u_safe + r * (u_prime + y - u_safe);
+  }
+  const SafetyGuard::Output out = guard_.limit(request);
+  if (!guard_.safe_state() && options_.controller && r > 0.0 && (out.clamped || out.slew_limited)) {
+    // Anti-windup: the controller's share of what was really applied.
+    iff_.applied((out.u - u_safe) / r + u_safe - u_prime);
+  }
+  backend_.write(out.u);
+
+  const double va_cmd = out.u * amp;
+  va_cmd_min_ = std::min(va_cmd_min_, va_cmd);
+  va_cmd_max_ = std::max(va_cmd_max_, va_cmd);
+  max_step_ = std::max(max_step_, std::abs(va_cmd - last_va_cmd_));
+  last_va_cmd_ = va_cmd;
+
+  const std::int64_t end_ns = monotonic_ns();
+  step_time_.add(static_cast<double>(end_ns - start_ns));
+  if (timed && end_ns > deadline_ns + period_ns_) ++overruns_;
+  last_end_ns_ = end_ns;
+
+  if (logger_) {
+    LogRecord rec;
+    rec.t = static_cast<double>(cycle_) / rate_;
+    rec.u_prime = u_prime;
+    rec.u = out.u;
+    rec.va_cmd = va_cmd;
+    rec.va = std::isfinite(s.va) ? s.va : va_cmd;
+    const bool sensor_ok = std::isfinite(s.de) && std::isfinite(s.vs);
+    rec.de = sensor_ok ? s.de : 0.0;
+    rec.vs = sensor_ok ? s.vs : 0.0;
+    rec.y = y;
+    rec.latency_us = latency_us;
+    rec.step_us = static_cast<double>(end_ns - start_ns) * 1e-3;
+    rec.flags = (out.clamped ? kFlagClamped : 0u) | (out.slew_limited ? kFlagSlewLimited : 0u) |
+                (guard_.safe_state() ? kFlagSafeState : 0u) | (r < 1.0 ? kFlagRamping : 0u) |
+                (sensor_ok ? 0u : kFlagSensorFault);
+    if (options_.realtime) {
+      logger_->push(rec);
+    } else {
+      logger_->push_wait(rec);
+    }
+  }
+  ++cycle_;
+  shared_->heartbeat.fetch_add(1, std::memory_order_release);
+  return true;
+}
+
+LoopReport Loop::finish() {
+  LoopReport rep;
+  if (finished_) throw std::logic_error("rt::Loop::finish called twice");
+  if (started_) {
+    // Normally already at the safe output (ramp out, wind-down); make sure.
+    backend_.write(guard_.last_output());
+    backend_.stop();
+  }
+  finished_ = true;
+  rep.backend = backend_.name();
+  rep.sample_rate = rate_;
+  rep.realtime = options_.realtime;
+  rep.cycles = cycle_;
+  rep.overruns = overruns_;
+  rep.skipped_deadlines = skipped_;
+  rep.wind_down_cycles = wind_down_;
+  rep.period_jitter_us = jitter_.summary_us();
+  rep.wake_latency_us = latency_.summary_us();
+  rep.step_time_us = step_time_.summary_us();
+  rep.clamped_samples = guard_.clamped_samples();
+  rep.slew_limited_samples = guard_.slew_limited_samples();
+  rep.safe_state_events = guard_.safe_state_events();
+  rep.safe_state_reason = to_string(guard_.fault());
+  rep.safe_state_cycle = guard_.safe_state() ? static_cast<std::int64_t>(guard_.fault_cycle()) : -1;
+  rep.nonfinite_sensor_samples = guard_.nonfinite_samples();
+  rep.stale_sensor_samples = guard_.stale_samples();
+  rep.watchdog_trips = shared_->watchdog_trips.load();
+  rep.va_cmd_min = va_cmd_min_;
+  rep.va_cmd_max = va_cmd_max_;
+  rep.max_va_cmd_step = max_step_;
+  rep.warnings = warnings_;
+  if (logger_) {
+    io::TimeSeries& log = logger_->finish();  // joins the logger thread, writes the file
+    rep.logged_samples = logger_->stored();
+    rep.dropped_log_samples = logger_->dropped();
+    if (options_.keep_log) log_ = std::move(log);
+  }
+  if (rep.dropped_log_samples > 0) {
+    rep.warnings.push_back(std::to_string(rep.dropped_log_samples) + " log samples dropped (ring full or storage exhausted)");
+  }
+  return rep;
+}
+
+const io::TimeSeries& Loop::log() const {
+  if (!finished_ || !options_.keep_log) {
+    throw std::logic_error("rt::Loop::log: only after finish() and with LoopOptions::keep_log");
+  }
+  return log_;
+}
+
+namespace {
+
+// Touches a stack area so that its pages are mapped before the cycles (no page fault later).
+void prefault_stack() {
+  constexpr std::size_t kBytes = 256 * 1024;
+  unsigned char buffer[kBytes];
+  for (std::size_t i = 0; i < kBytes; i += 4096) buffer[i] = 0;
+  // Keep the writes: the compiler must assume the asm reads the buffer.
+  asm volatile("" : : "r"(buffer) : "memory");
+}
+
+std::string errno_text(int err) {
+  return std::string(err == EPERM ? "EPERM" : err == ENOMEM ? "ENOMEM" : err == EAGAIN ? "EAGAIN" : "errno " + std::to_string(err)) +
+         ", " + std::strerror(err);
+}
+
+}  // namespace
+
+LoopReport run_loop(Backend& backend, const LoopOptions& options, io::TimeSeries* log) {
+  Loop loop(backend, options);
+  std::vector<std::string> warnings;
+  auto warn = [&](const std::string& w) {
+    warnings.push_back(w);
+    if (options.on_warning) options.on_warning(w);
+  };
+  bool memory_locked = false, fifo = false;
+  loop.start();
+  if (!options.realtime) {
+    while (loop.cycle()) {
+    }
+  } else {
+    if (options.lock_memory) {
+      if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+        memory_locked = true;
+      } else {
+        const int err = errno;
+        warn("mlockall refused (" + errno_text(err) +
+             "; needs CAP_IPC_LOCK or a large enough RLIMIT_MEMLOCK): memory is not locked, page faults can add latency");
+      }
+    }
+    std::atomic<bool> done{false};
+    const std::int64_t period_ns = static_cast<std::int64_t>(std::llround(1e9 / backend.sample_rate()));
+    const bool host_clock = backend.clock_source() == ClockSource::kHostMonotonic;
+    std::thread rt_thread([&] {
+      if (options.sched_fifo) {
+        sched_param param{};
+        param.sched_priority = options.priority;
+        const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+        if (err == 0) {
+          fifo = true;
+        } else {
+          // Reported at once, before the first cycle (the main thread is waiting in join()).
+          warn("SCHED_FIFO priority " + std::to_string(options.priority) + " refused (" + errno_text(err) +
+               "; needs CAP_SYS_NICE or RLIMIT_RTPRIO): the loop runs at normal priority, expect jitter and overruns");
+        }
+      }
+      // 1 ns timer slack: without it a normal-priority thread's sleeps end up to 50 us late (the
+      // kernel ignores the slack for SCHED_FIFO threads anyway).
+      prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+      prefault_stack();
+      std::int64_t deadline = monotonic_ns() + 1'000'000;  // first cycle 1 ms from now
+      for (;;) {
+        if (host_clock) sleep_until_ns(deadline);
+        const std::int64_t wake = monotonic_ns();
+        if (!host_clock) deadline = wake;  // the backend's read() paces the loop
+        if (!loop.cycle(deadline, wake)) break;
+        deadline += period_ns;
+        const std::int64_t now = monotonic_ns();
+        if (host_clock && now > deadline + period_ns) {
+          // More than a whole period late: skip to the next future deadline.
+          const std::int64_t missed = (now - deadline) / period_ns;
+          deadline += missed * period_ns;
+          loop.add_skipped(static_cast<std::uint64_t>(missed));
+        }
+      }
+      done.store(true, std::memory_order_release);
+    });
+    // Watchdog: the loop must complete a cycle within watchdog_timeout.
+    const auto timeout_ns = static_cast<std::int64_t>(options.limits.watchdog_timeout * 1e9);
+    const auto poll = std::chrono::nanoseconds(std::max<std::int64_t>(timeout_ns / 4, 100'000));
+    std::thread watchdog([&] {
+      std::uint64_t last = loop.heartbeat();
+      std::int64_t last_change = monotonic_ns();
+      while (!done.load(std::memory_order_acquire)) {
+        std::this_thread::sleep_for(poll);
+        const std::uint64_t hb = loop.heartbeat();
+        const std::int64_t now = monotonic_ns();
+        if (hb != last) {
+          last = hb;
+          last_change = now;
+        } else if (now - last_change > timeout_ns && !done.load(std::memory_order_acquire)) {
+          loop.watchdog_trip();
+          last_change = now;
+        }
+      }
+    });
+    rt_thread.join();
+    watchdog.join();
+    if (memory_locked) munlockall();
+  }
+  LoopReport report = loop.finish();
+  report.sched_fifo = fifo;
+  report.memory_locked = memory_locked;
+  warnings.insert(warnings.end(), report.warnings.begin(), report.warnings.end());
+  report.warnings = warnings;
+  if (log != nullptr && options.keep_log) *log = loop.log();
+  return report;
+}
+
+}  // namespace piezobench::rt

@@ -1,0 +1,303 @@
+#include "piezobench/rt/loop.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "alloc_counter.hpp"
+#include "fake_backend.hpp"
+#include "piezobench/control/iff.hpp"
+#include "piezobench/lti/conversions.hpp"
+#include "piezobench/lti/discretize.hpp"
+#include "piezobench/lti/interconnect.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::rt {
+using fake::FakeBackend;
+}
+
+namespace piezobench::rt {
+namespace {
+
+constexpr double kFs = 10e3;
+
+// The report's IFF plant u -> Vs (eq. 2.3), exact ZOH discretization at 10 kHz, delayed by one
+// sample: a sensor read at the start of a cycle reflects the commands up to the previous one
+// (eq. 2.3 is biproper, and its feedthrough must not act within the cycle). The delay is a state
+// (u of the previous sample), so that lti::feedback can close the loop in the reference.
+lti::StateSpace discrete_plant() {
+  const lti::StateSpace g = lti::c2d(lti::to_state_space(control::iff_plant()), 1.0 / kFs);
+  const lti::Index n = g.states();
+  lti::Matrix a = lti::Matrix::Zero(n + 1, n + 1), b = lti::Matrix::Zero(n + 1, 1), c(1, n + 1);
+  a.topLeftCorner(n, n) = g.A;
+  a.topRightCorner(n, 1) = g.B;
+  b(n, 0) = 1.0;
+  c << g.C, g.D;
+  return lti::StateSpace(a, b, c, lti::Matrix::Zero(1, 1), g.sample_time);
+}
+
+Eigen::VectorXd noise(Eigen::Index n, double rms, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> d(0.0, rms);
+  Eigen::VectorXd v(n);
+  for (Eigen::Index i = 0; i < n; ++i) v(i) = d(rng);
+  return v;
+}
+
+LoopOptions lockstep_options(double duration) {
+  LoopOptions o;
+  o.realtime = false;
+  o.duration = duration;
+  o.keep_log = true;
+  return o;
+}
+
+std::uint64_t run_all(Loop& loop) {
+  loop.start();
+  std::uint64_t n = 0;
+  while (loop.cycle()) ++n;
+  return n;
+}
+
+// Without ramps or limits, the loop is exactly the discrete interconnection u = u' + g K(z) Vs,
+// Vs = G(z) u: the logged Vs and u equal lsim of the closed loop built with lti::feedback.
+TEST(Loop, ClosedLoopEqualsTheDiscreteInterconnection) {
+  const lti::StateSpace plant = discrete_plant();
+  FakeBackend backend(plant, kFs);
+  LoopOptions o = lockstep_options(0.3);
+  o.gain = 1.5e5;
+  o.limits.ramp_in = 0.0;
+  o.limits.ramp_out = 0.0;
+  o.excitation = noise(3000, 0.05, 11);
+  Loop loop(backend, o);
+  EXPECT_GE(run_all(loop), 3000u);  // + the wind-down cycle (no ramp out here)
+  const LoopReport rep = loop.finish();
+  EXPECT_LE(rep.wind_down_cycles, 1u);
+  EXPECT_EQ(rep.cycles, 3000u);
+  EXPECT_EQ(rep.clamped_samples, 0u);
+  EXPECT_EQ(rep.slew_limited_samples, 0u);
+  EXPECT_EQ(rep.safe_state_events, 0u);
+  EXPECT_EQ(rep.dropped_log_samples, 0u);
+  const io::TimeSeries& log = loop.log();
+  ASSERT_EQ(log.samples(), 3000);
+
+  const lti::StateSpace k = lti::scale(loop.controller().model(), o.gain);
+  const lti::StateSpace closed = lti::feedback(plant, k, lti::FeedbackSign::kPositive);
+  const Eigen::VectorXd vs_ref = lti::lsim(closed, o.excitation).y.col(0);
+  const Eigen::VectorXd u_ref = o.excitation + lti::lsim(k, vs_ref).y.col(0);
+  const double vs_scale = vs_ref.cwiseAbs().maxCoeff();
+  const double u_scale = u_ref.cwiseAbs().maxCoeff();
+  EXPECT_TRUE(test::all_near(log.channel("Vs"), vs_ref, test::Tolerance{0.0, 1e-10 * vs_scale}));
+  EXPECT_TRUE(test::all_near(log.channel("u"), u_ref, test::Tolerance{0.0, 1e-10 * u_scale}));
+  EXPECT_TRUE(test::all_near(log.channel("u_prime"), o.excitation, test::Tolerance{0.0, 0.0}));
+  // The feedback really acts: u differs from u' by much more than round-off.
+  EXPECT_GT((log.channel("u") - o.excitation).cwiseAbs().maxCoeff(), 0.1 * u_scale);
+  // Va: the fake backend measures none, so the log holds the command times 20 V/V.
+  EXPECT_TRUE(test::all_near(log.channel("Va"), 20.0 * u_ref, test::Tolerance{0.0, 1e-9 * u_scale}));
+  EXPECT_TRUE(backend.stopped);
+}
+
+// The cycle allocates nothing: controller, safety, backend, log push, a fault and the safe state,
+// with the logger thread draining the ring at the same time.
+TEST(Loop, CycleAllocatesNothing) {
+  FakeBackend backend(discrete_plant(), kFs);
+  backend.nan_at = 2500;
+  backend.writes_u.resize(4000);
+  LoopOptions o = lockstep_options(0.35);
+  o.gain = 2.8e5;
+  o.limits.ramp_in = 0.01;
+  o.limits.ramp_out = 0.01;
+  o.excitation = noise(1000, 2.0, 5);  // large: clamps and slew limits too
+  o.realtime = true;                   // the real-time path (push, timing), paced by the test
+  Loop loop(backend, o);
+  loop.start();
+  std::uint64_t n = 0;
+  {
+    test::AllocationCounter count;
+    const std::int64_t t0 = monotonic_ns();
+    while (loop.cycle(t0 + static_cast<std::int64_t>(n) * 100'000, monotonic_ns())) ++n;
+    EXPECT_EQ(count.allocations(), 0u);
+  }
+  const LoopReport rep = loop.finish();
+  EXPECT_EQ(n, 3500u + rep.wind_down_cycles);
+  EXPECT_GT(rep.clamped_samples, 0u);
+  EXPECT_GT(rep.slew_limited_samples, 0u);
+  EXPECT_EQ(rep.safe_state_reason, "non-finite sensor");
+  EXPECT_EQ(rep.step_time_us.count, 3500u);
+}
+
+// Ramps: the command starts and ends at the safe output, linearly in between (open loop, u' = 1 V).
+TEST(Loop, RampsInAndOut) {
+  FakeBackend backend(discrete_plant(), kFs);
+  LoopOptions o = lockstep_options(0.1);  // 1000 cycles
+  o.controller = false;
+  o.limits.ramp_in = 0.01;   // 100 cycles
+  o.limits.ramp_out = 0.02;  // 200 cycles
+  o.excitation = Eigen::VectorXd::Constant(1, 1.0);
+  Loop loop(backend, o);
+  run_all(loop);
+  const LoopReport rep = loop.finish();
+  const auto u = loop.log().channel("u");
+  const auto flags = loop.log().channel("flags");
+  ASSERT_EQ(u.size(), 1000);
+  EXPECT_EQ(u(0), 0.0);
+  EXPECT_DOUBLE_EQ(u(50), 0.5);
+  EXPECT_DOUBLE_EQ(u(100), 1.0);
+  EXPECT_DOUBLE_EQ(u(799), 1.0);
+  EXPECT_DOUBLE_EQ(u(899), 0.5);
+  EXPECT_EQ(u(999), 0.0);
+  EXPECT_EQ(static_cast<unsigned>(flags(50)) & kFlagRamping, kFlagRamping);
+  EXPECT_EQ(static_cast<unsigned>(flags(500)) & kFlagRamping, 0u);
+  EXPECT_EQ(rep.slew_limited_samples, 0u);  // 0.01 V per sample, far below 0.5
+  EXPECT_EQ(rep.wind_down_cycles, 0u);
+}
+
+// Pushed into saturation (a huge gain, or a large excitation), the commanded stack voltage never
+// leaves -20..150 V nor moves faster than the slew limit, and the limiting is counted.
+TEST(Loop, SaturationKeepsTheVoltageInRangeAndSlewLimited) {
+  for (const double gain : {5e7, 2.8e5}) {
+    SCOPED_TRACE("gain " + std::to_string(gain));
+    FakeBackend backend(discrete_plant(), kFs);
+    LoopOptions o = lockstep_options(0.5);
+    o.gain = gain;
+    o.excitation.resize(500);  // 20 Hz, 10 V at the DAC (200 V at the stacks): 2.5 V per sample at most
+    for (Eigen::Index k = 0; k < 500; ++k) o.excitation(k) = 10.0 * std::sin(2 * M_PI * k / 500.0);
+    o.limits.slew_rate = 2e4;  // 2 V per sample at the stacks
+    Loop loop(backend, o);
+    run_all(loop);
+    const LoopReport rep = loop.finish();
+    EXPECT_GT(rep.clamped_samples, 100u);
+    if (gain > 1e6) {
+      EXPECT_GT(rep.slew_limited_samples, 100u);  // the unstable loop oscillates
+    }
+    EXPECT_EQ(rep.safe_state_reason, "none");
+    const auto va = loop.log().channel("Va_cmd");
+    EXPECT_GE(va.minCoeff(), -20.0);
+    EXPECT_LE(va.maxCoeff(), 150.0);
+    double max_step = std::abs(va(0));
+    for (Eigen::Index k = 1; k < va.size(); ++k) max_step = std::max(max_step, std::abs(va(k) - va(k - 1)));
+    EXPECT_LE(max_step, 2.0 + 1e-9);
+    EXPECT_DOUBLE_EQ(rep.max_va_cmd_step, max_step);
+    EXPECT_DOUBLE_EQ(rep.va_cmd_min, va.minCoeff());
+    EXPECT_DOUBLE_EQ(rep.va_cmd_max, va.maxCoeff());
+    if (gain < 1e6) {  // the stable loop follows the large excitation up to both limits
+      EXPECT_NEAR(va.minCoeff(), -20.0, 1e-9);
+      EXPECT_NEAR(va.maxCoeff(), 150.0, 1e-9);
+    }
+  }
+}
+
+// A NaN sample: safe state at that cycle, output to the safe value at the slew limit, controller
+// reset, the log stays finite and flags the sample.
+TEST(Loop, NonFiniteSensorSampleEntersTheSafeState) {
+  FakeBackend backend(discrete_plant(), kFs);
+  backend.nan_at = 500;
+  LoopOptions o = lockstep_options(0.1);
+  o.gain = 1e5;
+  o.excitation = Eigen::VectorXd::Constant(1, 2.0);  // 40 V at the stacks when the fault hits
+  o.limits.ramp_in = 0.0;
+  o.limits.slew_rate = 4e4;                          // 0.2 V per sample at the DAC
+  Loop loop(backend, o);
+  run_all(loop);
+  const LoopReport rep = loop.finish();
+  EXPECT_EQ(rep.safe_state_events, 1u);
+  EXPECT_EQ(rep.safe_state_reason, "non-finite sensor");
+  EXPECT_EQ(rep.safe_state_cycle, 500);
+  EXPECT_EQ(rep.nonfinite_sensor_samples, 1u);
+  const io::TimeSeries& log = loop.log();
+  const auto u = log.channel("u");
+  const auto y = log.channel("y");
+  const auto flags = log.channel("flags");
+  const double before = u(499);
+  EXPECT_GT(before, 0.5);
+  EXPECT_NEAR(u(500), before - 0.2, 1e-12);  // slewing down, not a jump
+  for (Eigen::Index k = 500; k < u.size(); ++k) {
+    ASSERT_EQ(y(k), 0.0);  // controller off and reset
+    ASSERT_NE(static_cast<unsigned>(flags(k)) & kFlagSafeState, 0u);
+  }
+  EXPECT_EQ(u(u.size() - 1), 0.0);
+  EXPECT_NE(static_cast<unsigned>(flags(500)) & kFlagSensorFault, 0u);
+  EXPECT_EQ(log.channel("Vs")(500), 0.0);
+  EXPECT_TRUE(log.data.allFinite());
+  EXPECT_EQ(static_cast<unsigned>(flags(499)) & kFlagSafeState, 0u);
+}
+
+TEST(Loop, StaleSensorEntersTheSafeStateAfterTheToleratedReads) {
+  FakeBackend backend(discrete_plant(), kFs);
+  backend.stale_from = 300;  // reads 300.. repeat the sequence number of read 299
+  LoopOptions o = lockstep_options(0.05);
+  o.gain = 1e5;
+  o.limits.stale_cycles = 3;
+  Loop loop(backend, o);
+  run_all(loop);
+  const LoopReport rep = loop.finish();
+  EXPECT_EQ(rep.safe_state_reason, "stale sensor");
+  EXPECT_EQ(rep.safe_state_cycle, 303);  // reads 300, 301, 302 tolerated, 303 trips
+  EXPECT_EQ(rep.stale_sensor_samples, 500u - 300u);
+}
+
+// Real time: the backend stalls 120 ms in one read; the watchdog (20 ms) trips, calls the
+// backend's on_watchdog and the loop goes to its safe state.
+TEST(RunLoop, WatchdogTripsOnAStalledLoop) {
+  FakeBackend backend(discrete_plant(), kFs);
+  backend.stall_at = 100;
+  backend.stall = std::chrono::milliseconds(120);
+  LoopOptions o;
+  o.duration = 0.03;
+  o.gain = 1e5;
+  o.limits.watchdog_timeout = 0.02;
+  const LoopReport rep = run_loop(backend, o);
+  EXPECT_EQ(rep.safe_state_reason, "watchdog");
+  EXPECT_GE(rep.watchdog_trips, 1u);
+  EXPECT_GE(backend.watchdog_calls.load(), 1);
+  EXPECT_LE(rep.safe_state_cycle, 100);
+  EXPECT_GE(rep.skipped_deadlines, 1000u);  // 120 ms late: the missed deadlines are skipped
+  EXPECT_GE(rep.overruns, 1u);
+}
+
+// A real-time run reports its timing and either got SCHED_FIFO / mlockall or says why not.
+TEST(RunLoop, RealTimeRunReportsTimingAndPrivileges) {
+  FakeBackend backend(discrete_plant(), kFs);
+  LoopOptions o;
+  o.duration = 0.05;
+  o.gain = 2.8e5;
+  std::vector<std::string> printed;
+  o.on_warning = [&](const std::string& w) { printed.push_back(w); };
+  const LoopReport rep = run_loop(backend, o);
+  EXPECT_TRUE(rep.realtime);
+  EXPECT_EQ(rep.cycles, 500u);
+  EXPECT_EQ(rep.step_time_us.count, 500u);
+  EXPECT_EQ(rep.wake_latency_us.count, 500u);
+  EXPECT_EQ(rep.period_jitter_us.count, 499u);
+  EXPECT_LE(rep.step_time_us.p50, rep.step_time_us.max);
+  EXPECT_LE(rep.period_jitter_us.p99, rep.period_jitter_us.p999 + 1e-12);
+  EXPECT_LE(rep.overruns, rep.cycles);
+  auto warned = [&](const std::string& what) {
+    for (const auto& w : rep.warnings) {
+      if (test::contains(w, what)) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(rep.sched_fifo || warned("SCHED_FIFO"));
+  EXPECT_TRUE(rep.memory_locked || warned("mlockall"));
+  EXPECT_EQ(printed.size(), rep.warnings.size());
+}
+
+TEST(Loop, OptionsAreValidated) {
+  FakeBackend backend(discrete_plant(), kFs);
+  auto bad = [&](auto mutate, const std::string& field) {
+    LoopOptions o;
+    mutate(o);
+    test::input_error([&] { Loop loop(backend, o); }, field);
+  };
+  bad([](LoopOptions& o) { o.duration = 0.0; }, "duration");
+  bad([](LoopOptions& o) { o.priority = 100; }, "priority");
+  bad([](LoopOptions& o) { o.gain = std::nan(""); }, "gain");
+  bad([](LoopOptions& o) { o.excitation = Eigen::VectorXd::Constant(3, std::nan("")); }, "excitation");
+  bad([](LoopOptions& o) { o.limits.va_max = -100.0; }, "va_max");
+  bad([](LoopOptions& o) { o.discrete.prewarp = 1e6; }, "prewarp");
+}
+
+}  // namespace
+}  // namespace piezobench::rt

@@ -1,0 +1,149 @@
+#include "piezobench/rt/safety.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "test_util.hpp"
+
+namespace piezobench::rt {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+TEST(ActuatorLimits, DefaultsAreTheApa300mlBehindA20VPerVAmplifier) {
+  const ActuatorLimits l;
+  EXPECT_NO_THROW(l.validate());
+  EXPECT_DOUBLE_EQ(l.u_min(), -1.0);  // -20 V / 20
+  EXPECT_DOUBLE_EQ(l.u_max(), 7.5);   // 150 V / 20
+  EXPECT_DOUBLE_EQ(l.u_safe(), 0.0);
+  EXPECT_DOUBLE_EQ(l.max_step(10e3), 0.5);  // 1e5 V/s / 20 V/V / 10 kHz
+}
+
+TEST(ActuatorLimits, ValidateNamesTheField) {
+  auto bad = [](auto mutate, const std::string& field) {
+    ActuatorLimits l;
+    mutate(l);
+    test::input_error([&] { l.validate(); }, field);
+  };
+  bad([](ActuatorLimits& l) { l.amplifier_gain = 0.0; }, "amplifier_gain");
+  bad([](ActuatorLimits& l) { l.va_min = kNaN; }, "va_min");
+  bad([](ActuatorLimits& l) { l.va_max = -30.0; }, "va_max");
+  bad([](ActuatorLimits& l) { l.va_safe = 200.0; }, "va_safe");
+  bad([](ActuatorLimits& l) { l.slew_rate = -1.0; }, "slew_rate");
+  bad([](ActuatorLimits& l) { l.ramp_in = -0.1; }, "ramp_in");
+  bad([](ActuatorLimits& l) { l.ramp_out = kNaN; }, "ramp_out");
+  bad([](ActuatorLimits& l) { l.stale_cycles = -1; }, "stale_cycles");
+  bad([](ActuatorLimits& l) { l.watchdog_timeout = 0.0; }, "watchdog_timeout");
+  const std::string what = test::input_error([] { SafetyGuard g(ActuatorLimits{}, 0.0); }, "sample_rate");
+  EXPECT_TRUE(test::contains(what, "actuator limits")) << what;
+}
+
+TEST(SafetyGuard, ClampsToTheRangeAndCounts) {
+  ActuatorLimits l;
+  l.slew_rate = 1e12;  // slew limit out of the way
+  SafetyGuard g(l, 10e3);
+  auto o = g.limit(3.0);
+  EXPECT_EQ(o.u, 3.0);
+  EXPECT_FALSE(o.clamped);
+  o = g.limit(9.0);
+  EXPECT_EQ(o.u, 7.5);
+  EXPECT_TRUE(o.clamped);
+  o = g.limit(-4.0);
+  EXPECT_EQ(o.u, -1.0);
+  EXPECT_TRUE(o.clamped);
+  o = g.limit(kNaN);  // a NaN request keeps the previous output and counts as clamped
+  EXPECT_EQ(o.u, -1.0);
+  EXPECT_TRUE(o.clamped);
+  EXPECT_EQ(g.clamped_samples(), 3u);
+  EXPECT_EQ(g.slew_limited_samples(), 0u);
+}
+
+TEST(SafetyGuard, LimitsTheSlewRateAndCounts) {
+  SafetyGuard g(ActuatorLimits{}, 10e3);  // 0.5 V per sample at the DAC
+  auto o = g.limit(2.0);
+  EXPECT_DOUBLE_EQ(o.u, 0.5);
+  EXPECT_TRUE(o.slew_limited);
+  o = g.limit(2.0);
+  EXPECT_DOUBLE_EQ(o.u, 1.0);
+  o = g.limit(1.2);
+  EXPECT_DOUBLE_EQ(o.u, 1.2);
+  EXPECT_FALSE(o.slew_limited);
+  o = g.limit(-5.0);  // clamped to -1 then slewed down by 0.5
+  EXPECT_DOUBLE_EQ(o.u, 0.7);
+  EXPECT_TRUE(o.clamped);
+  EXPECT_TRUE(o.slew_limited);
+  EXPECT_EQ(g.slew_limited_samples(), 3u);
+  EXPECT_EQ(g.clamped_samples(), 1u);
+}
+
+// Whatever is requested, the output stays in the range and never steps more than the limit.
+TEST(SafetyGuard, OutputNeverLeavesTheRangeNorExceedsTheSlewLimit) {
+  const ActuatorLimits l;
+  SafetyGuard g(l, 10e3);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> big(0.0, 50.0);
+  double prev = g.last_output();
+  for (int k = 0; k < 100000; ++k) {
+    const double request = k % 1000 == 17 ? kNaN : big(rng);
+    if (k == 60000) g.trip(Fault::kWatchdog, 60000);
+    const double u = g.limit(request).u;
+    ASSERT_GE(u, l.u_min());
+    ASSERT_LE(u, l.u_max());
+    ASSERT_LE(std::abs(u - prev), l.max_step(10e3) * (1.0 + 1e-12));
+    prev = u;
+  }
+  EXPECT_GT(g.clamped_samples(), 50000u);
+  EXPECT_GT(g.slew_limited_samples(), 50000u);
+  EXPECT_EQ(prev, l.u_safe());  // in the safe state since sample 60000
+}
+
+TEST(SafetyGuard, SafeStateGoesToTheSafeValueAtTheSlewLimitAndLatches) {
+  ActuatorLimits l;
+  l.va_safe = 10.0;  // 0.5 V at the DAC
+  SafetyGuard g(l, 10e3);
+  EXPECT_DOUBLE_EQ(g.last_output(), 0.5);
+  for (int k = 0; k < 20; ++k) g.limit(7.5);
+  EXPECT_DOUBLE_EQ(g.last_output(), 7.5);
+  g.trip(Fault::kNonFiniteSensor, 20);
+  g.trip(Fault::kStaleSensor, 21);  // already safe: neither a new event nor a new reason
+  EXPECT_TRUE(g.safe_state());
+  EXPECT_EQ(g.fault(), Fault::kNonFiniteSensor);
+  EXPECT_EQ(g.fault_cycle(), 20u);
+  EXPECT_EQ(g.safe_state_events(), 1u);
+  // 7.5 -> 0.5 at 0.5 V per sample: 14 samples, then it stays there whatever is requested.
+  for (int k = 1; k <= 14; ++k) EXPECT_DOUBLE_EQ(g.limit(7.5).u, 7.5 - 0.5 * k);
+  EXPECT_DOUBLE_EQ(g.limit(-3.0).u, 0.5);
+  EXPECT_DOUBLE_EQ(g.limit(7.5).u, 0.5);
+  EXPECT_EQ(to_string(g.fault()), "non-finite sensor");
+}
+
+TEST(SafetyGuard, DetectsNonFiniteAndStaleSamples) {
+  ActuatorLimits l;
+  l.stale_cycles = 2;
+  SafetyGuard g(l, 10e3);
+  SensorSample s;
+  s.sequence = 1;
+  EXPECT_EQ(g.check(s), Fault::kNone);
+  s.sequence = 2;
+  EXPECT_EQ(g.check(s), Fault::kNone);
+  EXPECT_EQ(g.check(s), Fault::kNone);  // stale 1
+  EXPECT_EQ(g.check(s), Fault::kNone);  // stale 2 (tolerated)
+  EXPECT_EQ(g.check(s), Fault::kStaleSensor);  // stale 3
+  EXPECT_EQ(g.stale_samples(), 3u);
+  s.sequence = 3;  // fresh again: the run of stale reads restarts
+  EXPECT_EQ(g.check(s), Fault::kNone);
+  s.sequence = 4;
+  s.de = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(g.check(s), Fault::kNonFiniteSensor);
+  s.de = 0.0;
+  s.vs = kNaN;
+  EXPECT_EQ(g.check(s), Fault::kNonFiniteSensor);
+  EXPECT_EQ(g.nonfinite_samples(), 2u);
+  EXPECT_FALSE(g.safe_state());  // check() reports, trip() decides
+}
+
+}  // namespace
+}  // namespace piezobench::rt
