@@ -1,8 +1,11 @@
 // Welch H1 + coherence at the size: 6 million samples, 2 outputs, nfft 10,000, 50 %
-// overlap (1199 segments x 3 channels = 3597 real FFTs), against the FFTs alone.
-//   build-dsp/bench/dsp_welch_bench --benchmark_min_time=2
+// overlap (1199 segments x 3 channels = 3597 real FFTs), against the FFTs alone (FFTW_ESTIMATE
+// plans, as piezobench uses; and FFTW_MEASURE plans, with the planning time as a counter).
+// CPU times are the whole process's (all threads).
+//   build-speed/bench/dsp_welch_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <random>
 
 #include <fftw3.h>
@@ -47,15 +50,20 @@ void BM_WelchH1Coherence(benchmark::State& state) {
   }
   state.counters["segments"] = 1199;
 }
-BENCHMARK(BM_WelchH1Coherence)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_WelchH1Coherence)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
 
-// The floor: the same 3597 transforms of length nfft and nothing else, one thread.
+// The floor: the same 3597 transforms of length nfft and nothing else, one thread. Argument
+// "measure": 0 = FFTW_ESTIMATE plans (piezobench's choice), 1 = FFTW_MEASURE.
 void BM_FftsAlone(benchmark::State& state) {
   const Data& d = data();
-  // FFTW used directly (the peer): same plan flags as piezobench's (FFTW_ESTIMATE), aligned buffers.
+  // FFTW used directly (the peer), aligned buffers.
   double* in = fftw_alloc_real(kNfft);
   fftw_complex* out = fftw_alloc_complex(kNfft / 2 + 1);
-  const fftw_plan plan = fftw_plan_dft_r2c_1d(static_cast<int>(kNfft), in, out, FFTW_ESTIMATE);
+  const unsigned flags = state.range(0) != 0 ? FFTW_MEASURE : FFTW_ESTIMATE;
+  fftw_forget_wisdom();
+  const auto t0 = std::chrono::steady_clock::now();
+  const fftw_plan plan = fftw_plan_dft_r2c_1d(static_cast<int>(kNfft), in, out, flags);
+  state.counters["plan_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const Eigen::Index segments = (kSamples - kNfft) / (kNfft / 2) + 1;
   for (auto _ : state) {
     for (Eigen::Index s = 0; s < segments; ++s) {
@@ -70,7 +78,7 @@ void BM_FftsAlone(benchmark::State& state) {
   fftw_free(out);
   fftw_free(in);
 }
-BENCHMARK(BM_FftsAlone)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FftsAlone)->ArgName("measure")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -94,9 +94,16 @@ struct MatVarInfo {
 [[nodiscard]] MatVarPtr read_mat_variable(mat_t* mat, const std::filesystem::path& file, const std::string& name);
 
 // Fast path for large records: reads an uncompressed real double vector of exactly out.size()
-// elements straight into `out` (no intermediate copy). Returns false, with `out` unspecified,
-// when the variable is anything else or the read fails; the caller then uses read_mat_variable.
-[[nodiscard]] bool read_double_vector_into(mat_t* mat, const std::string& name, Eigen::Ref<Eigen::VectorXd> out);
+// elements straight into `out` (no intermediate copy), in pieces of at most `chunk` elements;
+// after each piece, `on_chunk(first, count)` (if given) may look at out[first, first + count)
+// while it is still in the cache. Returns false, with `out` unspecified, when the variable is
+// anything else or a read fails; the caller then uses read_mat_variable.
+[[nodiscard]] bool read_double_vector_into(
+    mat_t* mat, const std::string& name, Eigen::Ref<Eigen::VectorXd> out, Eigen::Index chunk = 1 << 17,
+    const std::function<void(Eigen::Index first, Eigen::Index count)>& on_chunk = {});
+// One element of such a variable (of exactly `count` elements); nullopt as above.
+[[nodiscard]] std::optional<double> read_double_element(mat_t* mat, const std::string& name, Eigen::Index count,
+                                                        Eigen::Index index);
 
 // Describes a variable for error messages: "double 3x1", "complex double 1x4", "char 1x5".
 [[nodiscard]] std::string describe(const matvar_t& var);
