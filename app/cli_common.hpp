@@ -15,10 +15,11 @@ using Action = std::function<int()>;
 // Each command module adds its subcommands to `app`; the selected one stores its work in `action`.
 void add_frf_commands(CLI::App& app, Action& action);  // frf, fit
 void add_iff_commands(CLI::App& app, Action& action);  // iff rlocus, iff study
+void add_rt_commands(CLI::App& app, Action& action);  // rt
 void add_model_commands(CLI::App& app, Action& action);  // model 2dof, model tune, piezo
 void add_superelement_commands(CLI::App& app, Action& action);  // superelement
 void add_simulate_commands(CLI::App& app, Action& action);  // simulate
-void add_rt_commands(CLI::App& app, Action& action);  // rt
+void add_run_commands(CLI::App& app, Action& action);  // run, demo
 
 // Prints exactly one JSON document on stdout (round-trip precision for doubles).
 void print_json(const nlohmann::json& document);

@@ -17,10 +17,11 @@ int main(int argc, char** argv) {
   Action action;
   piezobench::app::add_frf_commands(app, action);
   piezobench::app::add_iff_commands(app, action);
+  piezobench::app::add_rt_commands(app, action);
   piezobench::app::add_model_commands(app, action);
   piezobench::app::add_superelement_commands(app, action);
   piezobench::app::add_simulate_commands(app, action);
-  piezobench::app::add_rt_commands(app, action);
+  piezobench::app::add_run_commands(app, action);
 
   try {
     app.parse(argc, argv);

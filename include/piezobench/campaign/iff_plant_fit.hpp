@@ -1,0 +1,94 @@
+#pragma once
+// Fit of the IFF plant model of the report (eq. 2.3, section 2.6) to a measured u -> Vs FRF:
+//
+//   G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
+//
+// The report tuned g0, wz, xz, wp, xp and w_hpf by hand and added a 200 us delay to match the phase;
+// here all seven are fitted by Levenberg-Marquardt on the relative complex error
+// sum_k v_k |G(j w_k) / H_k - 1|^2 (magnitude and phase at once) with v_k ~ 1/omega_k, so that on a
+// uniform grid every decade weighs alike (else the mass line above the resonance, which holds most
+// of the points, would decide the fit), with
+// log-parameters for g0 (sign kept), wz, wp, xp, w_hpf. xz is free in sign: xz < 0 is a
+// non-minimum-phase zero pair (mirrored into the right half plane), which is what the report's data
+// show and what a minimum-phase fit cannot follow in phase. The fit is started from both signs of xz
+// and the better result is kept.
+//
+// Starting values from the data: wp at the peak of |H| in the band, wz at the dip of |H| below it,
+// damping ratios from the half-power width of the peak (xp) and 0.005 (xz), w_hpf from
+// ident::fit_high_pass on the points below hpf_fmax (when there are three), g0 as the median of
+// |H / G(g0 = 1)| below the anti-resonance, and the delay from the slope of the phase of
+// H / G(delay = 0) above 1.5 wp.
+#include <string>
+
+#include "piezobench/control/iff.hpp"
+#include "piezobench/lti/state_space.hpp"
+#include "piezobench/lti/transfer_function.hpp"
+
+namespace piezobench::campaign {
+
+struct IffPlantFitOptions {
+  double fmin_hz = 0.0;       // band used (0 = from the lowest positive frequency)
+  double fmax_hz = 1000.0;    // 0 = up to the highest
+  double hpf_fmax_hz = 5.0;   // points below this start the high-pass corner
+  double min_coherence = 0.0; // points with a known coherence below this are left out
+  bool fit_delay = true;      // false: delay fixed at 0
+  double fixed_w_hpf = 0.0;   // rad/s; > 0: the high-pass corner is not fitted but set to this
+                              // (e.g. 1 / (R C) from the measured capacitance)
+  int max_iterations = 200;
+  void validate() const;      // InputError (source "iff plant fit options")
+};
+
+struct IffPlantFit {
+  double g0 = 0.0;       // V/V, signed
+  double wz = 0.0;       // rad/s
+  double xz = 0.0;       // < 0: non-minimum-phase zero pair
+  double wp = 0.0;       // rad/s
+  double xp = 0.0;
+  double w_hpf = 0.0;    // rad/s
+  double delay = 0.0;    // s
+  double relative_rms_error = 0.0;           // rms |G/H - 1| over the points used
+  double weighted_relative_rms_error = 0.0;  // the same with the fit's per-decade weights
+  double initial_relative_rms_error = 0.0;   // weighted, at the better of the two starts
+  long points = 0;
+  int iterations = 0;
+  bool converged = false;
+
+  [[nodiscard]] bool zero_is_nonminimum_phase() const { return xz < 0.0; }
+  // G(s) as a transfer function (with the delay), also for xz < 0.
+  [[nodiscard]] lti::TransferFunction transfer_function() const;
+  // G(j omega) at every omega (rad/s).
+  [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
+};
+
+// omega: rad/s, increasing; h: u -> Vs (V/V); coherence: empty or same size. InputError (source)
+// for sizes that differ, non-finite data, fewer than 12 usable points or no resonance above an
+// anti-resonance in the band; NumericalError when Levenberg-Marquardt cannot reduce the error.
+IffPlantFit fit_iff_plant(const lti::Vector& omega, const lti::CVector& h, const lti::Vector& coherence,
+                          const IffPlantFitOptions& options = {}, const std::string& source = "");
+
+// The mass-spring-damper seen from u to d_e (report section 2.3, and the damped plants u' -> d_e of
+// section 2.6) with the measurement delay:
+//   H(s) = k wn^2 / (s^2 + 2 zeta wn s + wn^2) * exp(-s delay)
+// fitted by the same weighted Levenberg-Marquardt (log k with its sign kept, log wn, log zeta,
+// delay), started from the peak of |H| (wn), its half-power width (zeta), the median low-frequency
+// gain (k) and the phase slope above 1.5 wn (delay). The delay of d_e differs from the one of Vs
+// (the force sensor's read-out has its own filter), which is why both plants carry their own.
+struct DelayedSecondOrderFit {
+  double static_gain = 0.0;        // k, output units / input units (signed)
+  double natural_frequency = 0.0;  // wn, rad/s
+  double damping = 0.0;            // zeta
+  double delay = 0.0;              // s
+  double relative_rms_error = 0.0; // rms |H_model / H - 1| over the points used
+  long points = 0;
+  int iterations = 0;
+  [[nodiscard]] lti::Complex pole() const;  // -zeta wn + j wn sqrt(1 - zeta^2) (Im >= 0)
+  [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
+};
+
+// omega (rad/s, increasing) and h as for fit_iff_plant; options.fmin_hz/fmax_hz/min_coherence,
+// fit_delay and max_iterations apply (the high-pass options do not). InputError for bad data,
+// fewer than 8 usable points or no peak inside the band.
+DelayedSecondOrderFit fit_delayed_second_order(const lti::Vector& omega, const lti::CVector& h, const lti::Vector& coherence,
+                                               const IffPlantFitOptions& options = {}, const std::string& source = "");
+
+}  // namespace piezobench::campaign

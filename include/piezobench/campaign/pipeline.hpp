@@ -1,0 +1,49 @@
+#pragma once
+// The campaign pipeline (`piezobench run`): every unit analysed (unit_analysis.hpp) on a pool of
+// threads, then the batch: outliers and spread of the key figures, unit-to-unit similarity of the
+// FRFs, the acceptance of every unit with the reason for each rejection, the IFF study (root locus
+// of the fitted plant with the report's controller against the poles of the measured damped
+// plants, optimal gain) and the super-element comparison when the campaign gives one.
+//
+// Acceptance rules (a limit the campaign does not set is not checked; an experiment that is not
+// measured is reported as such and is no reason to reject):
+//   flatness (spec method) <= flatness_um; capacitance of the sensor and of the actuator stacks
+//   inside their ranges; stroke >= stroke_min_um; k1, k2 and the resonance stiffness inside
+//   stiffness_N_per_um; with reject_outliers, no batch outlier in capacitance or stroke (robust
+//   z-score, metrology/capacitance.hpp); every analysis that was run succeeded.
+//
+// Outputs (write_outputs): OUT/results.mat, OUT/report.html, then OUT/results.json, each written
+// atomically; a results.json left from an earlier run is removed first, so results.json exists only
+// when the run completed. Only these fixed names under OUT are written.
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "piezobench/campaign/campaign_file.hpp"
+#include "piezobench/campaign/unit_analysis.hpp"
+
+namespace piezobench::campaign {
+
+struct PipelineOptions {
+  int threads = 0;  // > 0 overrides analysis.threads
+  Log log;          // progress lines (called under a lock; may be empty)
+};
+
+struct CampaignResult {
+  nlohmann::json results;  // the results.json document (CLI.md keys)
+  nlohmann::json report;   // the report document (report/html_report.hpp)
+  int accepted = 0;
+  int rejected = 0;
+};
+
+// Analyses every unit and the batch. InputError for bad data (the first in unit order, the other
+// units stop early); a NumericalError inside an analysis is recorded, not thrown.
+CampaignResult run_campaign(const Campaign& campaign, const PipelineOptions& options = {});
+
+// Writes results.mat, report.html and results.json into `out_dir` (created if needed); returns
+// the paths written. InputError when a file cannot be written.
+std::vector<std::filesystem::path> write_outputs(const CampaignResult& result, const std::filesystem::path& out_dir);
+
+}  // namespace piezobench::campaign

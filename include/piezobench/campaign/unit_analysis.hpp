@@ -1,0 +1,97 @@
+#pragma once
+// Every analysis of the report for one unit of a campaign (report sections 1 and 2):
+//
+//   flatness      least-squares and minimum-zone (metrology/flatness.hpp); the spec's method is the
+//                 unit's flatness_um
+//   capacitance   mean of the LCR readings (or the values typed into the campaign)
+//   stroke        slow ramp (metrology/stroke.hpp)
+//   hysteresis    one result per amplitude (loop width at the offset relative to the loop's stroke)
+//   stiffness     k1, k2 at the report's reading times, creep fitted (metrology/stiffness.hpp)
+//   frf           Welch H1 u -> d_e and u -> Vs with coherence; features of both by vector fitting
+//                 (ident/features.hpp): static gain, resonance and damping, anti-resonance and
+//                 damping, the non-minimum-phase verdict (phase of the data across the zero, the
+//                 fitted zero, and the sign of xz in the IFF plant fit); the high-pass corner; the
+//                 IFF plant fit (eq. 2.3 with delay, iff_plant_fit.hpp); the stiffness from the
+//                 resonance k = m_sus w^2; the tuned 2-DoF model (apa/tuning.hpp, with the fitted
+//                 high-pass and delay as the measurement chain)
+//                 u -> d_e is also fitted as a mass-spring-damper with its own delay
+//                 (iff_plant_fit.hpp): the d_e and Vs read-outs lag differently
+//   iff           per gain g: the damped plant u' -> d_e (Welch) and its second-order fit (after
+//                 removing the delay of d_e found on the open-loop FRF)
+//   hammer        F -> v (Welch), flexible modes by peak picking and by LSCF (ident/modal.hpp)
+//
+// Data problems (a channel that is not in a file, NaN, too short a record, ...) are InputErrors
+// naming the campaign file and the key of the file entry, and stop the campaign. A method that fails
+// on valid data (NumericalError) is recorded in `failed` and the analysis is left out; the unit is
+// then not accepted (pipeline.hpp). An experiment the campaign does not list is `not_measured`.
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "piezobench/campaign/campaign_file.hpp"
+#include "piezobench/campaign/iff_plant_fit.hpp"
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/ident/features.hpp"
+#include "piezobench/io/timeseries.hpp"
+
+namespace piezobench::campaign {
+
+// A measurement file read for one experiment, its channels found by role.
+struct Record {
+  io::TimeSeries ts;
+  FileSpec spec;
+  [[nodiscard]] bool has(const std::string& role) const;
+  // The samples of a role's channel (the role must be present).
+  [[nodiscard]] Eigen::VectorXd channel(const std::string& role) const;
+  // t from the file, else k / sample_rate.
+  [[nodiscard]] Eigen::VectorXd time() const;
+};
+
+// Reads the file of `spec` with the channels its experiment needs (required roles, and optional
+// ones that the file has or that the campaign mapped explicitly). InputError (source = campaign
+// file, field = spec.key) wrapping the reader's message: missing channel, NaN, bad time vector, ...
+Record load_record(const Campaign& campaign, const FileSpec& spec, Experiment experiment);
+
+struct DampedPlant {
+  double gain = 0.0;             // controller gain g
+  std::string file;              // as given in the campaign
+  dsp::Frf frf;                  // u' -> d_e
+  DelayedSecondOrderFit fit;     // of the data in the damped-plant band, d_e's delay removed
+  double delay_removed = 0.0;    // s
+};
+
+struct UnitAnalysis {
+  int id = 0;
+  std::string name;
+  // The unit's entry of results.json without `accepted` and `reasons` (CLI.md keys, plus details):
+  // absent analyses are null.
+  nlohmann::json result;
+  // Downsampled data for the report's figures.
+  nlohmann::json plots;
+  // The numbers the batch analyses and the acceptance need (SI; nullopt = not available).
+  std::optional<double> flatness;            // m, by the spec's method
+  std::optional<double> capacitance_sensor;  // F
+  std::optional<double> capacitance_actuator;
+  std::optional<double> stroke;              // m
+  std::optional<double> k1, k2, k_resonance; // N/m
+  std::optional<double> resonance_hz, antiresonance_hz, static_gain;  // Hz, Hz, m/V
+  std::optional<dsp::Frf> frf;               // u -> [de, Vs] (outputs named "de", "Vs")
+  std::optional<IffPlantFit> iff_plant;     // u -> Vs, eq. 2.3 with delay
+  std::optional<DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
+  std::vector<DampedPlant> damped;
+  std::vector<std::string> not_measured;     // experiments the campaign does not list
+  std::vector<std::string> failed;           // "frf: vector fitting failed: ..." (NumericalError)
+};
+
+using Log = std::function<void(const std::string&)>;
+
+// All analyses of one unit (single-threaded; the pipeline runs units in parallel).
+UnitAnalysis analyze_unit(const Campaign& campaign, const UnitSpec& unit, const Log& log = {});
+
+// Welch segment length used for a record of `samples` at `fs`: the campaign's nfft, or 4 s of data
+// limited to a quarter of the record (at least 256 samples).
+long frf_segment_length(const AnalysisSettings& settings, long samples, double fs);
+
+}  // namespace piezobench::campaign

@@ -1,0 +1,208 @@
+#include "piezobench/campaign/demo.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "piezobench/bench/experiments.hpp"
+#include "piezobench/bench/truth.hpp"
+#include "piezobench/bench/virtual_bench.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/io/atomic_file.hpp"
+#include "piezobench/io/timeseries.hpp"
+
+namespace piezobench::campaign {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+void DemoOptions::validate() const {
+  if (units.empty()) throw InputError("demo", "units", "at least one unit", "none");
+  for (const int u : units) {
+    if (u < 1 || u > 7) throw InputError("demo", "units", "units of the batch, 1 to 7", std::to_string(u));
+  }
+  if (std::find(units.begin(), units.end(), iff_unit) == units.end() && !iff_gains.empty()) {
+    throw InputError("demo", "iff_unit", "one of the simulated units", std::to_string(iff_unit));
+  }
+  for (const double a : hysteresis_amplitudes) {
+    if (!(a > 0.0 && a <= 85.0)) throw InputError("demo", "hysteresis_amplitudes", "amplitudes in (0, 85] V (65 V +- A inside -20..150 V)", fmt::format("{}", a));
+  }
+  for (const double g : iff_gains) {
+    if (!(g >= 0.0)) throw InputError("demo", "iff_gains", "gains >= 0", fmt::format("{}", g));
+  }
+  if (threads < 0) throw InputError("demo", "threads", "0 (all cores) or more", std::to_string(threads));
+}
+
+namespace {
+
+struct Job {
+  int unit = 0;
+  bench::Experiment experiment = bench::Experiment::kStroke;
+  std::optional<double> amplitude, gain, duration;
+  std::string file;   // relative to DIR
+  double cost = 1.0;  // for scheduling (longest first)
+};
+
+std::string number_tag(double v) { return fmt::format("{:g}", v); }
+
+}  // namespace
+
+DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
+  options.validate();
+  const auto say = [&](const std::string& line) {
+    if (options.log) options.log(line);
+  };
+  std::error_code ec;
+  fs::create_directories(dir / "data", ec);
+  if (ec) throw InputError(dir.string(), "--out", "a folder that can be created", ec.message());
+
+  std::map<int, bench::UnitTruth> truths;
+  for (const int id : options.units) truths[id] = bench::batch_unit(id, options.seed);
+  const bench::BenchOptions bench_options;
+  const double frf_s = options.fast ? 8.0 : 20.0;
+  const double iff_s = options.fast ? 4.0 : 10.0;
+
+  std::vector<Job> jobs;
+  for (const int id : options.units) {
+    const std::string u = fmt::format("unit{}", id);
+    jobs.push_back({id, bench::Experiment::kFlatness, {}, {}, {}, "data/" + u + "_flatness.mat", 0.01});
+    jobs.push_back({id, bench::Experiment::kCapacitance, {}, {}, {}, "data/" + u + "_capacitance.mat", 0.01});
+    jobs.push_back({id, bench::Experiment::kStroke, {}, {}, {}, "data/" + u + "_stroke.mat", 3.0});
+    jobs.push_back({id, bench::Experiment::kStiffness, {}, {}, {}, "data/" + u + "_stiffness.mat", 2.0});
+    jobs.push_back({id, bench::Experiment::kFrfNoise, {}, {}, frf_s, "data/" + u + "_frf-noise.mat", frf_s / 10.0});
+    jobs.push_back({id, bench::Experiment::kHammer, {}, {}, {}, "data/" + u + "_hammer.mat", 1.0});
+    for (const double a : options.hysteresis_amplitudes) {
+      jobs.push_back({id, bench::Experiment::kHysteresis, a, {}, {}, "data/" + u + "_hysteresis_" + number_tag(a) + "V.mat", 0.5});
+    }
+    if (id == options.iff_unit) {
+      for (const double g : options.iff_gains) {
+        jobs.push_back({id, bench::Experiment::kIff, {}, g, iff_s, "data/" + u + "_iff_g" + number_tag(g) + ".mat", iff_s / 10.0});
+      }
+    }
+  }
+  std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.cost > b.cost; });
+
+  // Simulate and write in parallel.
+  std::mutex log_mutex;
+  std::map<std::string, io::TimeSeries> small;  // settings needed for the campaign (stiffness)
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> done{0};
+  std::atomic<bool> stop{false};
+  std::vector<std::exception_ptr> errors(jobs.size());
+  const auto start = std::chrono::steady_clock::now();
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= jobs.size() || stop.load()) return;
+      const Job& j = jobs[i];
+      try {
+        bench::ExperimentOptions eo;
+        eo.bench = bench_options;
+        eo.amplitude = j.amplitude;
+        eo.gain = j.gain;
+        eo.duration = j.duration;
+        const io::TimeSeries ts = bench::simulate(j.experiment, truths.at(j.unit), eo, options.seed);
+        io::write_timeseries(ts, dir / j.file);
+        const std::lock_guard<std::mutex> lock(log_mutex);
+        if (j.experiment == bench::Experiment::kStiffness) {
+          io::TimeSeries head;
+          head.settings = ts.settings;
+          small[j.file] = head;
+        }
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        say(fmt::format("simulated {:>2}/{} {} ({:.1f} s)", ++done, jobs.size(), j.file, elapsed));
+      } catch (...) {
+        errors[i] = std::current_exception();
+        stop = true;
+      }
+    }
+  };
+  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min<int>(threads, static_cast<int>(jobs.size()));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (const auto& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+
+  DemoFiles files;
+  for (const Job& j : jobs) files.data.push_back(dir / j.file);
+  std::sort(files.data.begin(), files.data.end());
+
+  // The truth.
+  json truth = {{"seed", options.seed}, {"fast", options.fast}, {"units", json::array()}};
+  for (const int id : options.units) truth["units"].push_back(bench::truth_json(truths.at(id), bench_options));
+  files.truth = dir / "data" / "truth.json";
+  io::write_text_atomically(files.truth, truth.dump(2) + "\n");
+
+  // The campaign file.
+  double added_mass = 6.4, gravity = bench_options.gravity;
+  for (const auto& [file, ts] : small) {
+    if (const auto it = ts.settings.find("added_mass_kg"); it != ts.settings.end() && std::holds_alternative<double>(it->second)) {
+      added_mass = std::get<double>(it->second);
+    }
+    if (const auto it = ts.settings.find("gravity_m_per_s2"); it != ts.settings.end() && std::holds_alternative<double>(it->second)) {
+      gravity = std::get<double>(it->second);
+    }
+  }
+  std::string toml = fmt::format(
+      "# The demo campaign written by `piezobench demo` (seed {}{}): the report's seven APA300ML on the\n"
+      "# virtual bench. docs/campaign.md documents every key.\n"
+      "title = \"APA300ML batch (virtual bench, seed {})\"\n\n"
+      "[bench]\n"
+      "amplifier_gain = {:g}          # V/V (PD200)\n"
+      "suspended_mass_kg = {:g}\n"
+      "added_mass_kg = {:g}\n"
+      "gravity_m_per_s2 = {:g}\n"
+      "hpf_resistance_ohm = {:g}\n"
+      "probe_accuracy_um = 0.5\n\n"
+      "[specs]\n"
+      "flatness_um = 25.0\n"
+      "flatness_method = \"least-squares\"\n"
+      "capacitance_sensor_uF = [4.0, 6.0]\n"
+      "capacitance_actuator_uF = [8.0, 12.0]\n"
+      "stroke_min_um = 200.0\n"
+      "stiffness_N_per_um = [1.5, 2.5]\n\n"
+      "[analysis]\n"
+      "window = \"hann-periodic\"\n"
+      "nfft = 0                       # automatic: 4 s segments\n"
+      "overlap = 0.5\n"
+      "fmin_Hz = 20.0                 # below ~10 Hz creep and hysteresis raise the small-signal gain\n"
+      "fmax_Hz = 500.0                # eq. 2.3 and the 2-DoF model hold below the anti-aliasing filter\n"
+      "iff_unit = {}\n\n",
+      options.seed, options.fast ? ", fast" : "", options.seed, bench_options.amplifier_gain, bench_options.suspended_mass, added_mass,
+      gravity, bench_options.hpf_resistance, std::find(options.units.begin(), options.units.end(), options.iff_unit) != options.units.end() && !options.iff_gains.empty() ? options.iff_unit : 0);
+  for (const int id : options.units) {
+    const std::string u = fmt::format("data/unit{}", id);
+    toml += fmt::format("[[units]]\nid = {}\nname = \"APA {}\"\n", id, id);
+    toml += fmt::format("flatness = \"{}_flatness.mat\"\ncapacitance = \"{}_capacitance.mat\"\nstroke = \"{}_stroke.mat\"\n", u, u, u);
+    toml += "hysteresis = [";
+    for (std::size_t i = 0; i < options.hysteresis_amplitudes.size(); ++i) {
+      toml += fmt::format("{}\"{}_hysteresis_{}V.mat\"", i ? ", " : "", u, number_tag(options.hysteresis_amplitudes[i]));
+    }
+    toml += "]\n";
+    toml += fmt::format("stiffness = \"{}_stiffness.mat\"\nfrf = \"{}_frf-noise.mat\"\nhammer = \"{}_hammer.mat\"\n", u, u, u);
+    if (id == options.iff_unit && !options.iff_gains.empty()) {
+      toml += "iff = [\n";
+      for (const double g : options.iff_gains) {
+        toml += fmt::format("  {{ file = \"{}_iff_g{}.mat\", gain = {:g} }},\n", u, number_tag(g), g);
+      }
+      toml += "]\n";
+    }
+    toml += "\n";
+  }
+  files.campaign = dir / "campaign.toml";
+  io::write_text_atomically(files.campaign, toml);
+  return files;
+}
+
+}  // namespace piezobench::campaign

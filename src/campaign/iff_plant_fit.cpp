@@ -1,0 +1,507 @@
+#include "piezobench/campaign/iff_plant_fit.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "piezobench/core/error.hpp"
+#include "piezobench/ident/features.hpp"
+
+namespace piezobench::campaign {
+
+using lti::Complex;
+using lti::CVector;
+using lti::Index;
+using lti::Vector;
+
+void IffPlantFitOptions::validate() const {
+  const std::string src = "iff plant fit options";
+  if (!(std::isfinite(fmin_hz) && fmin_hz >= 0.0)) throw InputError(src, "fmin_hz", "a frequency >= 0 Hz", fmt::format("{}", fmin_hz));
+  if (!(std::isfinite(fmax_hz) && fmax_hz >= 0.0) || (fmax_hz > 0.0 && fmax_hz <= fmin_hz)) {
+    throw InputError(src, "fmax_hz", "0 or a frequency above fmin_hz", fmt::format("{}", fmax_hz));
+  }
+  if (!(std::isfinite(hpf_fmax_hz) && hpf_fmax_hz > 0.0)) throw InputError(src, "hpf_fmax_hz", "a frequency > 0 Hz", fmt::format("{}", hpf_fmax_hz));
+  if (!(std::isfinite(fixed_w_hpf) && fixed_w_hpf >= 0.0)) {
+    throw InputError(src, "fixed_w_hpf", "0 (fitted) or a corner > 0 rad/s", fmt::format("{}", fixed_w_hpf));
+  }
+  if (!(min_coherence >= 0.0 && min_coherence < 1.0)) throw InputError(src, "min_coherence", "a value in [0, 1)", fmt::format("{}", min_coherence));
+  if (max_iterations < 1) throw InputError(src, "max_iterations", "at least 1", std::to_string(max_iterations));
+}
+
+namespace {
+
+Complex model(const IffPlantFit& p, double w) {
+  const Complex s(0.0, w);
+  const Complex num = 1.0 + 2.0 * p.xz * s / p.wz + s * s / (p.wz * p.wz);
+  const Complex den = 1.0 + 2.0 * p.xp * s / p.wp + s * s / (p.wp * p.wp);
+  return p.g0 * num / den * s / (p.w_hpf + s) * std::exp(-s * p.delay);
+}
+
+// Scaled parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, log w_hpf, delay / 100 us.
+constexpr double kXzScale = 0.01;
+constexpr double kDelayScale = 1e-4;
+
+// Which parameters are free: g0, wz, xz, wp, xp always; w_hpf and the delay optionally.
+struct Layout {
+  bool hpf = true;
+  bool delay = true;
+  [[nodiscard]] Index size() const { return 5 + (hpf ? 1 : 0) + (delay ? 1 : 0); }
+};
+
+Eigen::VectorXd to_x(const IffPlantFit& p, const Layout& l) {
+  Eigen::VectorXd x(l.size());
+  x(0) = std::log(std::abs(p.g0));
+  x(1) = std::log(p.wz);
+  x(2) = p.xz / kXzScale;
+  x(3) = std::log(p.wp);
+  x(4) = std::log(p.xp);
+  Index i = 5;
+  if (l.hpf) x(i++) = std::log(p.w_hpf);
+  if (l.delay) x(i++) = p.delay / kDelayScale;
+  return x;
+}
+
+IffPlantFit from_x(const Eigen::VectorXd& x, double sign, const Layout& l, double fixed_w_hpf) {
+  IffPlantFit p;
+  p.g0 = sign * std::exp(x(0));
+  p.wz = std::exp(x(1));
+  p.xz = x(2) * kXzScale;
+  p.wp = std::exp(x(3));
+  p.xp = std::exp(x(4));
+  Index i = 5;
+  p.w_hpf = l.hpf ? std::exp(x(i++)) : fixed_w_hpf;
+  p.delay = l.delay ? x(i++) * kDelayScale : 0.0;
+  return p;
+}
+
+struct LmOutcome {
+  Eigen::VectorXd x;
+  double cost = 0.0;
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Levenberg-Marquardt with Marquardt's diagonal scaling and central-difference Jacobian.
+LmOutcome levenberg_marquardt(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& residual,
+                              Eigen::VectorXd x, int max_iterations) {
+  Eigen::VectorXd r = residual(x);
+  double cost = r.squaredNorm();
+  double lambda = 1e-3;
+  LmOutcome out;
+  const Index n = x.size();
+  for (int it = 0; it < max_iterations; ++it) {
+    out.iterations = it + 1;
+    Eigen::MatrixXd j(r.size(), n);
+    for (Index i = 0; i < n; ++i) {
+      const double h = 1e-6 * std::max(1.0, std::abs(x(i)));
+      Eigen::VectorXd xp = x, xm = x;
+      xp(i) += h;
+      xm(i) -= h;
+      j.col(i) = (residual(xp) - residual(xm)) / (2.0 * h);
+    }
+    const Eigen::MatrixXd jtj = j.transpose() * j;
+    const Eigen::VectorXd g = j.transpose() * r;
+    if (g.lpNorm<Eigen::Infinity>() <= 1e-14 * (cost + 1e-300)) {
+      out.converged = true;
+      break;
+    }
+    bool improved = false;
+    for (int attempt = 0; attempt < 30 && !improved; ++attempt) {
+      Eigen::MatrixXd a = jtj;
+      a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-12);
+      const Eigen::VectorXd dx = a.ldlt().solve(-g);
+      const Eigen::VectorXd xn = x + dx;
+      const Eigen::VectorXd rn = residual(xn);
+      const double cn = rn.allFinite() ? rn.squaredNorm() : std::numeric_limits<double>::infinity();
+      if (cn < cost) {
+        const double gain = (cost - cn) / cost;
+        x = xn;
+        r = rn;
+        cost = cn;
+        lambda = std::max(lambda / 3.0, 1e-12);
+        improved = true;
+        if (gain < 1e-12 || dx.norm() < 1e-10 * (x.norm() + 1e-10)) out.converged = true;
+      } else {
+        lambda *= 4.0;
+      }
+    }
+    if (!improved) {
+      out.converged = true;  // no step lowers the cost: a minimum at the resolution of the Jacobian
+      break;
+    }
+    if (out.converged) break;
+  }
+  out.x = x;
+  out.cost = cost;
+  return out;
+}
+
+}  // namespace
+
+lti::TransferFunction IffPlantFit::transfer_function() const {
+  Vector num(4), den(4);
+  const double a2 = 1.0 / (wz * wz), a1 = 2.0 * xz / wz;
+  num << g0 * a2, g0 * a1, g0, 0.0;
+  const double b2 = 1.0 / (wp * wp), b1 = 2.0 * xp / wp;
+  // (b2 s^2 + b1 s + 1)(s + w_hpf)
+  den << b2, b2 * w_hpf + b1, b1 * w_hpf + 1.0, w_hpf;
+  return lti::TransferFunction(num / b2, den / b2, 0.0, delay);
+}
+
+CVector IffPlantFit::response(const Vector& omega) const {
+  CVector h(omega.size());
+  for (Index k = 0; k < omega.size(); ++k) h(k) = model(*this, omega(k));
+  return h;
+}
+
+IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
+                          const std::string& source) {
+  options.validate();
+  if (omega.size() != h.size()) {
+    throw InputError(source, "H", fmt::format("{} values (one per frequency)", omega.size()), std::to_string(h.size()));
+  }
+  if (coherence.size() != 0 && coherence.size() != h.size()) {
+    throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
+  }
+  std::vector<Index> use;
+  const double wmin = 2 * std::numbers::pi * options.fmin_hz;
+  const double wmax = options.fmax_hz > 0.0 ? 2 * std::numbers::pi * options.fmax_hz : std::numeric_limits<double>::infinity();
+  for (Index k = 0; k < omega.size(); ++k) {
+    if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
+      throw InputError(source, "H", "finite values", fmt::format("a non-finite value at point {}", k));
+    }
+    if (omega(k) <= 0.0 || omega(k) < wmin || omega(k) > wmax || h(k) == Complex(0.0)) continue;
+    if (coherence.size() > 0 && coherence(k) < options.min_coherence) continue;
+    use.push_back(k);
+  }
+  if (use.size() < 12) throw InputError(source, "H", "at least 12 usable points in the band", std::to_string(use.size()));
+  Vector w(static_cast<Index>(use.size()));
+  CVector d(static_cast<Index>(use.size()));
+  for (std::size_t i = 0; i < use.size(); ++i) {
+    w(static_cast<Index>(i)) = omega(use[i]);
+    d(static_cast<Index>(i)) = h(use[i]);
+  }
+  // Starting values.
+  const double w_hpf_band = 2 * std::numbers::pi * options.hpf_fmax_hz;
+  Index peak = -1;
+  for (Index k = 0; k < w.size(); ++k) {
+    if (w(k) > w_hpf_band && (peak < 0 || std::abs(d(k)) > std::abs(d(peak)))) peak = k;
+  }
+  Index dip = -1;
+  for (Index k = 0; k < peak; ++k) {
+    if (w(k) > w_hpf_band && (dip < 0 || std::abs(d(k)) < std::abs(d(dip)))) dip = k;
+  }
+  if (peak < 0 || dip < 0) {
+    throw InputError(source, "H", "a resonance above an anti-resonance inside the band", "none found");
+  }
+  IffPlantFit start;
+  start.wp = w(peak);
+  start.wz = w(dip);
+  {
+    const double half = std::abs(d(peak)) / std::sqrt(2.0);
+    Index lo = peak, hi = peak;
+    while (lo > dip && std::abs(d(lo)) > half) --lo;
+    while (hi + 1 < w.size() && std::abs(d(hi)) > half) ++hi;
+    start.xp = std::clamp((w(hi) - w(lo)) / (2.0 * w(peak)), 0.002, 0.3);
+  }
+  start.xz = 0.005;
+  Vector w_low;
+  CVector d_low;
+  {
+    std::vector<Index> low;
+    for (Index k = 0; k < w.size(); ++k) {
+      if (w(k) <= w_hpf_band) low.push_back(k);
+    }
+    w_low.resize(static_cast<Index>(low.size()));
+    d_low.resize(static_cast<Index>(low.size()));
+    for (std::size_t i = 0; i < low.size(); ++i) {
+      w_low(static_cast<Index>(i)) = w(low[i]);
+      d_low(static_cast<Index>(i)) = d(low[i]);
+    }
+  }
+  if (w_low.size() >= 3) {
+    const ident::HighPassFit hp = ident::fit_high_pass(w_low, d_low);
+    start.w_hpf = std::clamp(hp.corner, w(0) / 100.0, w_hpf_band);
+    start.g0 = hp.gain;
+  } else {
+    start.w_hpf = w(0) / 10.0;
+    start.g0 = d(0).real() >= 0.0 ? std::abs(d(0)) : -std::abs(d(0));
+  }
+  if (options.fixed_w_hpf > 0.0) start.w_hpf = options.fixed_w_hpf;
+  // g0 from the points below the anti-resonance with the model's other factors divided out (the
+  // median ratio, robust to a noisy point), then the delay from the slope of the remaining phase.
+  {
+    IffPlantFit unit_gain = start;
+    unit_gain.g0 = 1.0;
+    std::vector<double> re, mag;
+    for (Index k = 0; k < dip; ++k) {
+      const Complex g = d(k) / model(unit_gain, w(k));
+      re.push_back(g.real());
+      mag.push_back(std::abs(g));
+    }
+    if (mag.empty()) {
+      const Complex g = d(0) / model(unit_gain, w(0));
+      re.push_back(g.real());
+      mag.push_back(std::abs(g));
+    }
+    std::sort(mag.begin(), mag.end());
+    double sum_re = 0.0;
+    for (const double x : re) sum_re += x;
+    start.g0 = (sum_re >= 0.0 ? 1.0 : -1.0) * mag[mag.size() / 2];
+    if (options.fit_delay) {
+      // Slope of the unwrapped phase of H / G(delay = 0) against omega (straight line with an
+      // intercept), above 1.5 wp where the model's own phase is smooth (all points above the
+      // anti-resonance when fewer than 10 are that high).
+      std::vector<Index> use_k;
+      for (Index k = 0; k < w.size(); ++k) {
+        if (w(k) > 1.5 * start.wp) use_k.push_back(k);
+      }
+      if (use_k.size() < 10) {
+        use_k.clear();
+        for (Index k = 0; k < w.size(); ++k) {
+          if (w(k) > 1.2 * start.wz) use_k.push_back(k);
+        }
+      }
+      if (use_k.size() >= 3) {
+        std::vector<double> x, y;
+        double prev = 0.0, unwrap = 0.0;
+        for (std::size_t i = 0; i < use_k.size(); ++i) {
+          const double ph = std::arg(d(use_k[i]) / model(start, w(use_k[i])));
+          if (i == 0) {
+            unwrap = ph;
+          } else {
+            double step = ph - prev;
+            while (step > std::numbers::pi) step -= 2.0 * std::numbers::pi;
+            while (step < -std::numbers::pi) step += 2.0 * std::numbers::pi;
+            unwrap += step;
+          }
+          prev = ph;
+          x.push_back(w(use_k[i]));
+          y.push_back(unwrap);
+        }
+        double mx = 0.0, my = 0.0;
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          mx += x[i];
+          my += y[i];
+        }
+        mx /= static_cast<double>(x.size());
+        my /= static_cast<double>(x.size());
+        double sxy = 0.0, sxx = 0.0;
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          sxy += (x[i] - mx) * (y[i] - my);
+          sxx += (x[i] - mx) * (x[i] - mx);
+        }
+        if (sxx > 0.0) start.delay = std::clamp(-sxy / sxx, 0.0, 0.1);
+      }
+    }
+  }
+  const Layout layout{options.fixed_w_hpf == 0.0, options.fit_delay};
+  if (start.g0 == 0.0) start.g0 = 1.0;
+  const double sign = start.g0 > 0.0 ? 1.0 : -1.0;
+
+  // Every decade counts alike: on a uniform frequency grid the weight of a point is 1/sqrt(omega)
+  // (normalized to a mean square of 1), otherwise the mass line above the resonance, which holds
+  // most of the points, would decide the fit.
+  Vector weight(w.size());
+  for (Index k = 0; k < w.size(); ++k) weight(k) = 1.0 / std::sqrt(w(k));
+  weight /= std::sqrt(weight.squaredNorm() / static_cast<double>(w.size()));
+  const auto residual = [&](const Eigen::VectorXd& x) {
+    const IffPlantFit p = from_x(x, sign, layout, options.fixed_w_hpf);
+    Eigen::VectorXd r(2 * w.size());
+    for (Index k = 0; k < w.size(); ++k) {
+      const Complex e = (model(p, w(k)) / d(k) - 1.0) * weight(k);
+      r(2 * k) = e.real();
+      r(2 * k + 1) = e.imag();
+    }
+    return r;
+  };
+  const double n = static_cast<double>(w.size());
+  LmOutcome best;
+  best.cost = std::numeric_limits<double>::infinity();
+  double initial_cost = std::numeric_limits<double>::infinity();
+  for (const double zs : {1.0, -1.0}) {
+    IffPlantFit s0 = start;
+    s0.xz = zs * start.xz;
+    const Eigen::VectorXd x0 = to_x(s0, layout);
+    initial_cost = std::min(initial_cost, residual(x0).squaredNorm());
+    const LmOutcome o = levenberg_marquardt(residual, x0, options.max_iterations);
+    if (o.cost < best.cost) best = o;
+  }
+  if (!std::isfinite(best.cost)) {
+    throw NumericalError("IFF plant fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
+  }
+  IffPlantFit fit = from_x(best.x, sign, layout, options.fixed_w_hpf);
+  double plain = 0.0;
+  for (Index k = 0; k < w.size(); ++k) plain += std::norm(model(fit, w(k)) / d(k) - 1.0);
+  fit.relative_rms_error = std::sqrt(plain / n);
+  fit.weighted_relative_rms_error = std::sqrt(best.cost / n);
+  fit.initial_relative_rms_error = std::sqrt(initial_cost / n);
+  fit.points = w.size();
+  fit.iterations = best.iterations;
+  fit.converged = best.converged;
+  return fit;
+}
+
+namespace {
+
+Complex second_order(const DelayedSecondOrderFit& p, double w) {
+  const Complex s(0.0, w);
+  const double wn = p.natural_frequency;
+  return p.static_gain * wn * wn / (s * s + 2.0 * p.damping * wn * s + wn * wn) * std::exp(-s * p.delay);
+}
+
+// Points of the band with finite data and enough coherence.
+void select_band(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
+                 const std::string& source, Vector& w, CVector& d) {
+  if (omega.size() != h.size()) {
+    throw InputError(source, "H", fmt::format("{} values (one per frequency)", omega.size()), std::to_string(h.size()));
+  }
+  if (coherence.size() != 0 && coherence.size() != h.size()) {
+    throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
+  }
+  const double wmin = 2 * std::numbers::pi * options.fmin_hz;
+  const double wmax = options.fmax_hz > 0.0 ? 2 * std::numbers::pi * options.fmax_hz : std::numeric_limits<double>::infinity();
+  std::vector<Index> use;
+  for (Index k = 0; k < omega.size(); ++k) {
+    if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
+      throw InputError(source, "H", "finite values", fmt::format("a non-finite value at point {}", k));
+    }
+    if (omega(k) <= 0.0 || omega(k) < wmin || omega(k) > wmax || h(k) == Complex(0.0)) continue;
+    if (coherence.size() > 0 && coherence(k) < options.min_coherence) continue;
+    use.push_back(k);
+  }
+  w.resize(static_cast<Index>(use.size()));
+  d.resize(static_cast<Index>(use.size()));
+  for (std::size_t i = 0; i < use.size(); ++i) {
+    w(static_cast<Index>(i)) = omega(use[i]);
+    d(static_cast<Index>(i)) = h(use[i]);
+  }
+}
+
+}  // namespace
+
+Complex DelayedSecondOrderFit::pole() const {
+  const double z = damping;
+  if (z >= 1.0) return {-natural_frequency * (z - std::sqrt(z * z - 1.0)), 0.0};
+  return {-z * natural_frequency, natural_frequency * std::sqrt(1.0 - z * z)};
+}
+
+CVector DelayedSecondOrderFit::response(const Vector& omega) const {
+  CVector h(omega.size());
+  for (Index k = 0; k < omega.size(); ++k) h(k) = second_order(*this, omega(k));
+  return h;
+}
+
+DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVector& h, const Vector& coherence,
+                                               const IffPlantFitOptions& options, const std::string& source) {
+  options.validate();
+  Vector w;
+  CVector d;
+  select_band(omega, h, coherence, options, source, w, d);
+  if (w.size() < 8) throw InputError(source, "H", "at least 8 usable points in the band", std::to_string(w.size()));
+  Index peak = 0;
+  for (Index k = 1; k < w.size(); ++k) {
+    if (std::abs(d(k)) > std::abs(d(peak))) peak = k;
+  }
+  if (peak == 0 || peak == w.size() - 1) {
+    throw InputError(source, "H", "a resonance peak inside the band", fmt::format("the largest |H| at the band's edge ({:.4g} Hz)", w(peak) / (2 * std::numbers::pi)));
+  }
+  DelayedSecondOrderFit start;
+  start.natural_frequency = w(peak);
+  {
+    const double half = std::abs(d(peak)) / std::sqrt(2.0);
+    Index lo = peak, hi = peak;
+    while (lo > 0 && std::abs(d(lo)) > half) --lo;
+    while (hi + 1 < w.size() && std::abs(d(hi)) > half) ++hi;
+    start.damping = std::clamp((w(hi) - w(lo)) / (2.0 * w(peak)), 0.002, 0.9);
+  }
+  {
+    DelayedSecondOrderFit unit = start;
+    unit.static_gain = 1.0;
+    std::vector<double> mag;
+    double sum_re = 0.0;
+    for (Index k = 0; k < std::max<Index>(1, peak / 2); ++k) {
+      const Complex g = d(k) / second_order(unit, w(k));
+      mag.push_back(std::abs(g));
+      sum_re += g.real();
+    }
+    std::sort(mag.begin(), mag.end());
+    start.static_gain = (sum_re >= 0.0 ? 1.0 : -1.0) * mag[mag.size() / 2];
+    if (options.fit_delay) {
+      std::vector<double> x, y;
+      double prev = 0.0, unwrap = 0.0;
+      for (Index k = 0; k < w.size(); ++k) {
+        if (w(k) <= 1.5 * start.natural_frequency) continue;
+        const double ph = std::arg(d(k) / second_order(start, w(k)));
+        if (x.empty()) {
+          unwrap = ph;
+        } else {
+          double step = ph - prev;
+          while (step > std::numbers::pi) step -= 2.0 * std::numbers::pi;
+          while (step < -std::numbers::pi) step += 2.0 * std::numbers::pi;
+          unwrap += step;
+        }
+        prev = ph;
+        x.push_back(w(k));
+        y.push_back(unwrap);
+      }
+      if (x.size() >= 3) {
+        double mx = 0.0, my = 0.0, sxy = 0.0, sxx = 0.0;
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          mx += x[i] / static_cast<double>(x.size());
+          my += y[i] / static_cast<double>(x.size());
+        }
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          sxy += (x[i] - mx) * (y[i] - my);
+          sxx += (x[i] - mx) * (x[i] - mx);
+        }
+        if (sxx > 0.0) start.delay = std::clamp(-sxy / sxx, 0.0, 0.1);
+      }
+    }
+  }
+  const double sign = start.static_gain >= 0.0 ? 1.0 : -1.0;
+  Vector weight(w.size());
+  for (Index k = 0; k < w.size(); ++k) weight(k) = 1.0 / std::sqrt(w(k));
+  weight /= std::sqrt(weight.squaredNorm() / static_cast<double>(w.size()));
+  const auto unpack = [&](const Eigen::VectorXd& x) {
+    DelayedSecondOrderFit p;
+    p.static_gain = sign * std::exp(x(0));
+    p.natural_frequency = std::exp(x(1));
+    p.damping = std::exp(x(2));
+    p.delay = options.fit_delay ? x(3) * kDelayScale : 0.0;
+    return p;
+  };
+  const auto residual = [&](const Eigen::VectorXd& x) {
+    const DelayedSecondOrderFit p = unpack(x);
+    Eigen::VectorXd r(2 * w.size());
+    for (Index k = 0; k < w.size(); ++k) {
+      const Complex e = (second_order(p, w(k)) / d(k) - 1.0) * weight(k);
+      r(2 * k) = e.real();
+      r(2 * k + 1) = e.imag();
+    }
+    return r;
+  };
+  Eigen::VectorXd x0(options.fit_delay ? 4 : 3);
+  x0(0) = std::log(std::abs(start.static_gain));
+  x0(1) = std::log(start.natural_frequency);
+  x0(2) = std::log(start.damping);
+  if (options.fit_delay) x0(3) = start.delay / kDelayScale;
+  const LmOutcome o = levenberg_marquardt(residual, x0, options.max_iterations);
+  if (!std::isfinite(o.cost)) {
+    throw NumericalError("second-order fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
+  }
+  DelayedSecondOrderFit fit = unpack(o.x);
+  double plain = 0.0;
+  for (Index k = 0; k < w.size(); ++k) plain += std::norm(second_order(fit, w(k)) / d(k) - 1.0);
+  fit.relative_rms_error = std::sqrt(plain / static_cast<double>(w.size()));
+  fit.points = w.size();
+  fit.iterations = o.iterations;
+  return fit;
+}
+
+}  // namespace piezobench::campaign

@@ -1,0 +1,552 @@
+#include "piezobench/campaign/pipeline.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <numbers>
+#include <thread>
+
+#include "piezobench/campaign/report_document.hpp"
+#include "piezobench/control/iff.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/fem/structural_model.hpp"
+#include "piezobench/fem/superelement.hpp"
+#include "piezobench/io/atomic_file.hpp"
+#include "piezobench/io/json.hpp"
+#include "piezobench/io/mat_struct.hpp"
+#include "piezobench/lti/conversions.hpp"
+#include "piezobench/lti/analysis.hpp"
+#include "piezobench/lti/freqresp.hpp"
+#include "piezobench/lti/rlocus.hpp"
+#include "piezobench/metrology/capacitance.hpp"
+#include "piezobench/report/html_report.hpp"
+#include "piezobench/version.hpp"
+
+namespace piezobench::campaign {
+
+namespace fs = std::filesystem;
+using Eigen::Index;
+using Eigen::VectorXd;
+using nlohmann::json;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+namespace {
+
+// ------------------------------------------------------------------------------------ batch
+
+struct Quantity {
+  std::string name;   // results key, e.g. "capacitance_sensor_uF"
+  double scale;       // SI -> reported unit
+  std::optional<double> UnitAnalysis::*member;
+};
+
+const std::vector<Quantity>& quantities() {
+  static const std::vector<Quantity> q = {
+      {"flatness_um", 1e6, &UnitAnalysis::flatness},
+      {"capacitance_sensor_uF", 1e6, &UnitAnalysis::capacitance_sensor},
+      {"capacitance_actuator_uF", 1e6, &UnitAnalysis::capacitance_actuator},
+      {"stroke_um", 1e6, &UnitAnalysis::stroke},
+      {"k1_N_per_um", 1e-6, &UnitAnalysis::k1},
+      {"k2_N_per_um", 1e-6, &UnitAnalysis::k2},
+      {"k_resonance_N_per_um", 1e-6, &UnitAnalysis::k_resonance},
+      {"resonance_Hz", 1.0, &UnitAnalysis::resonance_hz},
+      {"antiresonance_Hz", 1.0, &UnitAnalysis::antiresonance_hz},
+      {"static_gain_um_per_V", 1e6, &UnitAnalysis::static_gain}};
+  return q;
+}
+
+// Quantities whose batch outliers reject a unit (with reject_outliers), and how a reason names them.
+const std::map<std::string, std::string>& rejecting_outliers() {
+  static const std::map<std::string, std::string> m = {{"capacitance_sensor_uF", "capacitance of the sensor stack"},
+                                                       {"capacitance_actuator_uF", "capacitance of the actuator stacks"},
+                                                       {"stroke_um", "stroke"}};
+  return m;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct BatchOutput {
+  json batch;
+  std::map<int, std::vector<std::string>> outlier_reasons;  // unit id -> reasons
+};
+
+// Interpolates |H| of one output onto the log grid `f` (NaN outside the data).
+VectorXd magnitude_on(const dsp::Frf& frf, Index output, const VectorXd& f) {
+  VectorXd out(f.size());
+  const VectorXd& g = frf.freq_hz;
+  for (Index k = 0; k < f.size(); ++k) {
+    const auto it = std::lower_bound(g.data(), g.data() + g.size(), f(k));
+    const Index j = it - g.data();
+    if (j <= 0 || j >= g.size()) {
+      out(k) = std::nan("");
+      continue;
+    }
+    const double w = (f(k) - g(j - 1)) / (g(j) - g(j - 1));
+    out(k) = std::abs((1.0 - w) * frf.H[static_cast<std::size_t>(output)](j - 1) + w * frf.H[static_cast<std::size_t>(output)](j));
+  }
+  return out;
+}
+
+BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& units) {
+  BatchOutput out;
+  json outliers = json::array();
+  json spread = json::object();
+  for (const Quantity& q : quantities()) {
+    std::vector<double> values;
+    std::vector<const UnitAnalysis*> who;
+    for (const auto& u : units) {
+      if (const auto& v = u.*(q.member)) {
+        values.push_back(*v * q.scale);
+        who.push_back(&u);
+      }
+    }
+    if (values.empty()) continue;
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    const double med = median(values);
+    spread[q.name] = {{"units", values.size()}, {"min", *lo}, {"max", *hi}, {"median", med},
+                      {"relative_spread", med != 0.0 ? (*hi - *lo) / std::abs(med) : 0.0}};
+    const metrology::OutlierAnalysis a = metrology::robust_outliers(values, c.specs.outliers, c.file.string(), q.name);
+    spread[q.name]["mad"] = a.mad;
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (!a.outlier[i]) continue;
+      outliers.push_back({{"unit", who[i]->id}, {"quantity", q.name}, {"value", values[i]}, {"median", a.median},
+                          {"robust_z", io::to_json(a.robust_z[i])}});
+      const auto it = rejecting_outliers().find(q.name);
+      if (c.specs.reject_outliers && it != rejecting_outliers().end()) {
+        out.outlier_reasons[who[i]->id].push_back(
+            fmt::format("{} {:.4g} is a batch outlier (median of the batch {:.4g}, robust z-score {:.1f}, limit {:.1f})", it->second,
+                        values[i], a.median, a.robust_z[i], c.specs.outliers.threshold));
+      }
+    }
+  }
+  // Unit-to-unit similarity of the FRFs: rms distance in dB from the batch median magnitude.
+  json similarity = json::object();
+  std::vector<const UnitAnalysis*> with_frf;
+  for (const auto& u : units) {
+    if (u.frf) with_frf.push_back(&u);
+  }
+  if (with_frf.size() >= 2) {
+    const VectorXd f = Eigen::VectorXd::LinSpaced(120, std::log10(c.analysis.fmin_hz), std::log10(c.analysis.fmax_hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
+    json per_unit = json::array();
+    double worst = 0.0;
+    for (Index o = 0; o < 2; ++o) {
+      std::vector<VectorXd> mags;
+      for (const auto* u : with_frf) mags.push_back(magnitude_on(*u->frf, o, f));
+      VectorXd med(f.size());
+      for (Index k = 0; k < f.size(); ++k) {
+        std::vector<double> v;
+        for (const auto& m : mags) {
+          if (std::isfinite(m(k)) && m(k) > 0.0) v.push_back(m(k));
+        }
+        med(k) = v.empty() ? std::nan("") : median(v);
+      }
+      for (std::size_t i = 0; i < with_frf.size(); ++i) {
+        double s = 0.0;
+        int n = 0;
+        for (Index k = 0; k < f.size(); ++k) {
+          if (std::isfinite(mags[i](k)) && std::isfinite(med(k)) && mags[i](k) > 0.0) {
+            s += std::pow(20.0 * std::log10(mags[i](k) / med(k)), 2);
+            ++n;
+          }
+        }
+        const double rms = n > 0 ? std::sqrt(s / n) : std::nan("");
+        if (o == 0) per_unit.push_back({{"unit", with_frf[i]->id}});
+        per_unit[i][o == 0 ? "de_rms_dB" : "Vs_rms_dB"] = io::to_json(rms);
+        if (std::isfinite(rms)) worst = std::max(worst, rms);
+      }
+    }
+    similarity = {{"reference", "median |H| of the batch"},
+                  {"band_Hz", {c.analysis.fmin_hz, c.analysis.fmax_hz}},
+                  {"units", per_unit},
+                  {"max_rms_dB", worst}};
+  }
+  out.batch = {{"outliers", outliers}, {"spread", spread}, {"similarity", similarity},
+               {"outlier_rule", {{"robust_z_threshold", c.specs.outliers.threshold},
+                                 {"min_relative_deviation", c.specs.outliers.min_relative_deviation},
+                                 {"rejects", c.specs.reject_outliers}}}};
+  return out;
+}
+
+// ------------------------------------------------------------------------------------ acceptance
+
+std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, const std::vector<std::string>& outlier_reasons) {
+  std::vector<std::string> reasons;
+  for (const auto& f : u.failed) reasons.push_back("analysis failed: " + f);
+  const Specs& s = c.specs;
+  if (u.flatness && s.flatness_max && *u.flatness > *s.flatness_max) {
+    reasons.push_back(fmt::format("flatness {:.2f} um above the limit {:.2f} um ({})", *u.flatness * 1e6, *s.flatness_max * 1e6,
+                                  metrology::to_string(s.flatness_method)));
+  }
+  if (u.capacitance_sensor && u.capacitance_actuator) {
+    metrology::CapacitanceSpec spec;
+    spec.sensor = s.capacitance_sensor.value_or(metrology::Range{0.0, INFINITY});
+    spec.actuator = s.capacitance_actuator.value_or(metrology::Range{0.0, INFINITY});
+    const auto check = metrology::check_capacitance(*u.capacitance_sensor, *u.capacitance_actuator, spec, c.file.string());
+    for (const auto& r : check.reasons) reasons.push_back(r);
+  }
+  if (u.stroke && s.stroke_min && *u.stroke < *s.stroke_min) {
+    reasons.push_back(fmt::format("stroke {:.1f} um below the minimum {:.1f} um", *u.stroke * 1e6, *s.stroke_min * 1e6));
+  }
+  if (s.stiffness) {
+    for (const auto& [name, v] : {std::pair{"k1", u.k1}, std::pair{"k2", u.k2}, std::pair{"from the resonance", u.k_resonance}}) {
+      if (v && !s.stiffness->contains(*v)) {
+        reasons.push_back(fmt::format("stiffness {} {:.3f} N/um outside [{:.3f}, {:.3f}] N/um", name, *v * 1e-6, s.stiffness->min * 1e-6,
+                                      s.stiffness->max * 1e-6));
+      }
+    }
+  }
+  for (const auto& r : outlier_reasons) reasons.push_back(r);
+  return reasons;
+}
+
+// ------------------------------------------------------------------------------------ IFF
+
+json pole_json(std::complex<double> p) { return io::to_json(p); }
+
+// The resonance branch of the IFF root locus on a log grid of gains, and its best damping.
+struct ResonanceLocus {
+  std::vector<double> gains;
+  std::vector<lti::CVector> poles;  // branch-matched
+  Index branch = 0;
+  double optimal_gain = 0.0;
+  double max_damping = 0.0;
+  std::complex<double> optimal_pole;
+
+  // The branch's pole at gain g: the closed-loop pole nearest to the branch's pole at the nearest
+  // grid gain.
+  [[nodiscard]] std::complex<double> pole_at(const lti::StateSpace& loop, double g) const {
+    std::size_t near = 0;
+    for (std::size_t i = 1; i < gains.size(); ++i) {
+      if (std::abs(std::log((gains[i] + 1e-300) / (g + 1e-300))) < std::abs(std::log((gains[near] + 1e-300) / (g + 1e-300)))) near = i;
+    }
+    const std::complex<double> ref = poles[near](branch);
+    const lti::CVector p = lti::closed_loop_poles(loop, g);
+    Index best = 0;
+    for (Index i = 1; i < p.size(); ++i) {
+      if (std::abs(p(i) - ref) < std::abs(p(best) - ref)) best = i;
+    }
+    return p(best);
+  }
+};
+
+double damping_of(std::complex<double> p) { return std::abs(p) > 0.0 ? -p.real() / std::abs(p) : 0.0; }
+
+ResonanceLocus resonance_locus(const lti::StateSpace& loop, std::complex<double> resonance_pole) {
+  ResonanceLocus r;
+  // Gains around the one that makes the loop gain 1 at the resonance.
+  lti::Vector w(1);
+  w(0) = std::abs(resonance_pole);
+  const double l = std::abs(lti::freqresp(loop, w).H[0](0, 0));
+  const double g_ref = l > 0.0 && std::isfinite(l) ? 1.0 / l : 1.0;
+  r.gains.push_back(0.0);
+  for (int i = 0; i <= 400; ++i) r.gains.push_back(g_ref * std::pow(10.0, -3.0 + 6.0 * i / 400.0));
+  const lti::RootLocus rl = lti::rlocus(loop, r.gains);
+  r.poles = rl.poles;
+  for (Index i = 1; i < r.poles[0].size(); ++i) {
+    if (std::abs(r.poles[0](i) - resonance_pole) < std::abs(r.poles[0](r.branch) - resonance_pole)) r.branch = i;
+  }
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < r.gains.size(); ++i) {
+    if (damping_of(r.poles[i](r.branch)) > damping_of(r.poles[best](r.branch))) best = i;
+  }
+  // Golden section on log(gain) between the neighbours of the best grid point.
+  double a = std::log(r.gains[std::max<std::size_t>(1, best - (best > 1 ? 1 : 0))]);
+  double b = std::log(r.gains[std::min(r.gains.size() - 1, best + 1)]);
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  auto damping_at = [&](double lg) { return damping_of(r.pole_at(loop, std::exp(lg))); };
+  double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
+  double f1 = damping_at(x1), f2 = damping_at(x2);
+  for (int it = 0; it < 40; ++it) {
+    if (f1 > f2) {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - phi * (b - a);
+      f1 = damping_at(x1);
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + phi * (b - a);
+      f2 = damping_at(x2);
+    }
+  }
+  r.optimal_gain = std::exp(0.5 * (a + b));
+  r.optimal_pole = r.pole_at(loop, r.optimal_gain);
+  r.max_damping = damping_of(r.optimal_pole);
+  if (damping_of(r.poles[best](r.branch)) > r.max_damping) {
+    r.optimal_gain = r.gains[best];
+    r.optimal_pole = r.poles[best](r.branch);
+    r.max_damping = damping_of(r.optimal_pole);
+  }
+  return r;
+}
+
+json iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units, json& extra) {
+  const UnitAnalysis* chosen = nullptr;
+  if (c.analysis.iff_unit != 0) {
+    for (const auto& u : units) {
+      if (u.id == c.analysis.iff_unit) chosen = &u;
+    }
+  }
+  if (!chosen) {
+    for (const auto& u : units) {
+      if (!chosen && !u.damped.empty() && u.iff_plant) chosen = &u;
+    }
+  }
+  if (!chosen) {
+    for (const auto& u : units) {
+      if (!chosen && u.iff_plant) chosen = &u;
+    }
+  }
+  json out = {{"unit", nullptr}, {"gains", json::array()}, {"damped_poles", json::array()}, {"optimal_gain", nullptr}};
+  const control::IffControllerParams& k = c.analysis.controller;
+  out["controller"] = {{"gain", k.gain}, {"hpf_Hz", k.w_hpf / kTwoPi}, {"lpf_Hz", k.w_lpf / kTwoPi}, {"robust_Hz", k.w_robust / kTwoPi},
+                       {"formula", "K(s) = gain g s/(s + w_hpf) 1/(s + w_lpf) 1/(s + w_robust) (eq. 2.4)"}};
+  if (!chosen || !chosen->iff_plant) {
+    out["note"] = "no unit with a fitted IFF plant (no FRF u -> Vs)";
+    return out;
+  }
+  out["unit"] = chosen->id;
+  const IffPlantFit& p = *chosen->iff_plant;
+  out["plant"] = {{"g0", p.g0}, {"wz_Hz", p.wz / kTwoPi}, {"xz", p.xz}, {"wp_Hz", p.wp / kTwoPi}, {"xp", p.xp},
+                  {"w_hpf_Hz", p.w_hpf / kTwoPi}, {"delay_s", p.delay}, {"source", "IFF plant fit of unit " + std::to_string(chosen->id)}};
+  const lti::StateSpace plant = lti::to_state_space(p.transfer_function());
+  const lti::StateSpace controller = lti::to_state_space(control::iff_controller(k));
+  control::IffLoopOptions lo;
+  lo.resonance = p.wp;
+  const lti::StateSpace loop = control::iff_open_loop(plant, controller, lo);
+  const std::complex<double> resonance_pole(-p.xp * p.wp, p.wp * std::sqrt(std::max(0.0, 1.0 - p.xp * p.xp)));
+  const ResonanceLocus locus = resonance_locus(loop, resonance_pole);
+  out["optimal_gain"] = locus.optimal_gain;
+  out["max_damping"] = locus.max_damping;
+  out["optimal_pole"] = pole_json(locus.optimal_pole);
+  out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)|, branch from the "
+                        "resonance pole, maximum damping refined by golden section (delay as a 6th-order Pade approximant)";
+  // The model's branches near the resonance for the plot.
+  json branches = json::array();
+  const double limit = 3.0 * p.wp;
+  const Index nb = locus.poles.empty() ? 0 : locus.poles.front().size();
+  for (Index b = 0; b < nb; ++b) {
+    json re = json::array(), im = json::array();
+    bool near_resonance = false;
+    for (std::size_t i = 0; i < locus.poles.size(); ++i) {
+      const auto z = locus.poles[i](b);
+      if (std::abs(z) > limit || z.imag() < 0.0) continue;
+      if (std::abs(z.imag()) > 0.2 * p.wp) near_resonance = true;
+      re.push_back(z.real());
+      im.push_back(z.imag());
+    }
+    if (near_resonance && re.size() > 1) branches.push_back({{"re", re}, {"im", im}, {"resonance_branch", b == locus.branch}});
+  }
+  json damped_plot = json::array();
+  json model = json::array(), distance = json::array();
+  for (const auto& d : chosen->damped) {
+    const auto pole = d.fit.pole();
+    out["gains"].push_back(d.gain);
+    out["damped_poles"].push_back(pole_json(pole));
+    damped_plot.push_back({{"gain", d.gain}, {"re", pole.real()}, {"im", pole.imag()}});
+    const std::complex<double> z = locus.pole_at(loop, d.gain);
+    model.push_back(pole_json(z));
+    distance.push_back(std::abs(pole - z) / std::abs(z));
+  }
+  if (!chosen->damped.empty()) {
+    out["model_poles"] = model;
+    out["relative_pole_distance"] = distance;
+  }
+  extra["root_locus"] = {{"branches", branches}, {"damped", damped_plot}, {"unit", chosen->id},
+                         {"open_loop_pole", {p.wp * -p.xp, p.wp * std::sqrt(std::max(0.0, 1 - p.xp * p.xp))}}};
+  return out;
+}
+
+// ------------------------------------------------------------------------------------ super element
+
+json superelement_comparison(const Campaign& c, const std::vector<UnitAnalysis>& units, json& extra) {
+  const SuperElementSpec& s = *c.superelement;
+  const std::string src = c.file.string();
+  fem::SuperElementFormat format;
+  if (s.format == "auto") {
+    format = fem::detect_format(s.k_file.path);
+  } else {
+    format = *fem::super_element_format_from_string(s.format);
+  }
+  fem::SuperElement se;
+  try {
+    se = fem::read_super_element(format, s.k_file.path, s.m_file.path, s.nodes_file.path,
+                                 s.coordinates_file ? s.coordinates_file->path : fs::path());
+  } catch (const InputError& e) {
+    throw InputError(src, "superelement", "a readable super element", e.what());
+  }
+  fem::ModelOptions mo;
+  try {
+    mo.fixed_nodes = s.fix;
+    for (const auto& m : s.masses) mo.masses.push_back(fem::PointMass::parse(m, "superelement.masses"));
+    mo.forces.push_back(fem::ForcePair::parse(s.actuator, "superelement.actuator"));
+    mo.outputs.push_back(fem::DisplacementOutput::parse(s.output, "superelement.output"));
+    mo.damping = fem::Damping::parse(s.damping, "superelement.damping");
+    mo.validate(se);
+  } catch (const InputError& e) {
+    throw e.with_source(src);
+  }
+  const fem::StructuralModel model = fem::assemble(se, mo);
+  const fem::Modes modes = fem::modes(model);
+  const VectorXd f = Eigen::VectorXd::LinSpaced(400, std::log10(c.analysis.fmin_hz), std::log10(2.0 * c.analysis.fmax_hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
+  const std::vector<Eigen::MatrixXcd> h = fem::frequency_response(model, kTwoPi * f);
+  json abs = json::array();
+  Index peak = 0;
+  for (Index k = 0; k < f.size(); ++k) {
+    const double v = std::abs(h[static_cast<std::size_t>(k)](0, 0)) * std::abs(s.ga * c.bench.amplifier_gain);
+    abs.push_back(v * 1e6);
+    if (v > abs[peak].get<double>() * 1e-6) peak = k;
+  }
+  std::vector<double> measured;
+  for (const auto& u : units) {
+    if (u.resonance_hz) measured.push_back(*u.resonance_hz);
+  }
+  json modes_hz = json::array();
+  for (Index i = 0; i < std::min<Index>(10, modes.frequencies_Hz.size()); ++i) modes_hz.push_back(modes.frequencies_Hz(i));
+  extra["superelement"] = {{"f", io::to_json(f)}, {"abs_um_per_V", abs}};
+  json out = {{"source", s.k_file.given},
+              {"dofs", se.size()},
+              {"modes_Hz", modes_hz},
+              {"resonance_Hz", f(peak)},
+              {"measured_resonance_Hz", measured.empty() ? json(nullptr) : json(median(measured))},
+              {"warnings", se.warnings}};
+  if (!measured.empty()) out["relative_difference"] = f(peak) / median(measured) - 1.0;
+  return out;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------ run
+
+CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
+  std::mutex log_mutex;
+  const Log log = [&](const std::string& line) {
+    if (!options.log) return;
+    const std::lock_guard<std::mutex> lock(log_mutex);
+    options.log(line);
+  };
+  const std::size_t n = c.units.size();
+  int threads = options.threads > 0 ? options.threads : c.analysis.threads;
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min<int>(threads, static_cast<int>(n));
+  std::vector<UnitAnalysis> units(n);
+  std::vector<std::exception_ptr> errors(n);
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= n || stop.load()) return;
+      try {
+        units[i] = analyze_unit(c, c.units[i], log);
+        log(fmt::format("{}: done ({} of the experiments not measured, {} analyses failed)", c.units[i].name,
+                        units[i].not_measured.size(), units[i].failed.size()));
+      } catch (...) {
+        errors[i] = std::current_exception();
+        stop = true;
+      }
+    }
+  };
+  log(fmt::format("analysing {} units on {} threads", n, threads));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (const auto& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+
+  log("batch: outliers, spread, similarity, acceptance, IFF");
+  CampaignResult r;
+  const BatchOutput batch = batch_analysis(c, units);
+  json unit_list = json::array();
+  for (auto& u : units) {
+    const auto it = batch.outlier_reasons.find(u.id);
+    const std::vector<std::string> reasons = acceptance(c, u, it == batch.outlier_reasons.end() ? std::vector<std::string>{} : it->second);
+    u.result["accepted"] = reasons.empty();
+    u.result["reasons"] = reasons;
+    (reasons.empty() ? r.accepted : r.rejected) += 1;
+    unit_list.push_back(u.result);
+  }
+  json extra = json::object();
+  json iff;
+  const auto t_iff = std::chrono::steady_clock::now();
+  try {
+    iff = iff_study(c, units, extra);
+    log(fmt::format("IFF: root locus and damped plants ({:.2f} s)", std::chrono::duration<double>(std::chrono::steady_clock::now() - t_iff).count()));
+  } catch (const NumericalError& e) {
+    iff = {{"gains", json::array()}, {"damped_poles", json::array()}, {"optimal_gain", nullptr}, {"failed", e.what()}};
+  }
+  json se = nullptr;
+  if (c.superelement) {
+    log("super element: " + c.superelement->k_file.given);
+    try {
+      se = superelement_comparison(c, units, extra);
+    } catch (const NumericalError& e) {
+      se = {{"failed", e.what()}};
+    }
+  }
+  const auto& a = c.analysis;
+  json specs = {{"flatness_um", c.specs.flatness_max ? json(*c.specs.flatness_max * 1e6) : json(nullptr)},
+                {"flatness_method", metrology::to_string(c.specs.flatness_method)},
+                {"capacitance_sensor_uF", c.specs.capacitance_sensor ? json({c.specs.capacitance_sensor->min * 1e6, c.specs.capacitance_sensor->max * 1e6}) : json(nullptr)},
+                {"capacitance_actuator_uF", c.specs.capacitance_actuator ? json({c.specs.capacitance_actuator->min * 1e6, c.specs.capacitance_actuator->max * 1e6}) : json(nullptr)},
+                {"stroke_min_um", c.specs.stroke_min ? json(*c.specs.stroke_min * 1e6) : json(nullptr)},
+                {"stiffness_N_per_um", c.specs.stiffness ? json({c.specs.stiffness->min * 1e-6, c.specs.stiffness->max * 1e-6}) : json(nullptr)},
+                {"reject_outliers", c.specs.reject_outliers}};
+  r.results = {{"title", c.title},
+               {"campaign", c.file.string()},
+               {"generator", std::string("piezobench ") + kVersion},
+               {"units", unit_list},
+               {"batch", batch.batch},
+               {"iff", iff},
+               {"superelement", se},
+               {"specs", specs},
+               {"summary", {{"units", n}, {"accepted", r.accepted}, {"rejected", r.rejected}}},
+               {"provenance",
+                {{"campaign", c.file.string()},
+                 {"window", dsp::to_string(a.window)},
+                 {"nfft", a.nfft == 0 ? json("auto (4 s, at most a quarter of the record)") : json(a.nfft)},
+                 {"overlap", a.overlap},
+                 {"detrend", "linear"},
+                 {"estimator", "H1"},
+                 {"band_Hz", {a.fmin_hz, a.fmax_hz}},
+                 {"fit_order", a.fit_order},
+                 {"bench", {{"amplifier_gain", c.bench.amplifier_gain}, {"suspended_mass_kg", c.bench.suspended_mass},
+                            {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},
+                            {"hpf_resistance_ohm", c.bench.hpf_resistance}, {"probe_accuracy_um", c.bench.probe_accuracy * 1e6}}},
+                 {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
+  r.report = report_document(c, units, r.results, extra);
+  return r;
+}
+
+std::vector<fs::path> write_outputs(const CampaignResult& result, const fs::path& out_dir) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec || !fs::is_directory(out_dir)) {
+    throw InputError(out_dir.string(), "--out", "a folder that can be created", ec ? ec.message() : "not a folder");
+  }
+  const fs::path json_file = out_dir / "results.json";
+  fs::remove(json_file, ec);  // results.json exists only for a completed run
+  std::vector<fs::path> written;
+  io::write_json_as_mat(result.results, out_dir / "results.mat");
+  written.push_back(out_dir / "results.mat");
+  report::write_html(result.report, out_dir / "report.html");
+  written.push_back(out_dir / "report.html");
+  io::write_text_atomically(json_file, result.results.dump(2) + "\n");
+  written.push_back(json_file);
+  return written;
+}
+
+}  // namespace piezobench::campaign

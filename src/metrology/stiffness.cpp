@@ -1,0 +1,256 @@
+#include "piezobench/metrology/stiffness.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "metrology/check.hpp"
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::metrology {
+
+using detail::num;
+using Eigen::Index;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+void StaticStiffnessOptions::validate() const {
+  const std::string src = "static stiffness options";
+  detail::require_finite_positive(added_mass, src, "added_mass", "kg");
+  detail::require_finite_positive(gravity, src, "gravity", "m/s^2");
+  detail::require_finite_positive(settle_s, src, "settle_s", "s");
+  detail::require_finite_nonnegative(t_on, src, "t_on", "s");
+  detail::require_finite_nonnegative(t_off, src, "t_off", "s");
+  if ((t_on > 0.0) != (t_off > 0.0) || (t_on > 0.0 && t_off <= t_on)) {
+    throw InputError(src, "t_off", "both event times 0 (detect) or 0 < t_on < t_off",
+                     fmt::format("t_on {} s, t_off {} s", num(t_on), num(t_off)));
+  }
+  auto window = [&](const std::array<double, 2>& w, const char* field) {
+    if (!(std::isfinite(w[0]) && std::isfinite(w[1]) && w[0] < w[1])) {
+      throw InputError(src, field, "a window [from, to) with from < to (s)", fmt::format("[{}, {}]", num(w[0]), num(w[1])));
+    }
+  };
+  window(before_s, "before_s");
+  window(loaded_s, "loaded_s");
+  window(after_s, "after_s");
+  if (before_s[1] > 0.0) throw InputError(src, "before_s", "a window before t_on (to <= 0)", num(before_s[1]));
+  if (loaded_s[1] > 0.0) throw InputError(src, "loaded_s", "a window before t_off (to <= 0)", num(loaded_s[1]));
+  if (after_s[0] < 0.0) throw InputError(src, "after_s", "a window after t_off (from >= 0)", num(after_s[0]));
+  detail::require_finite_positive(min_time_constant, src, "min_time_constant", "s");
+  if (!(std::isfinite(max_time_constant) && max_time_constant > min_time_constant)) {
+    throw InputError(src, "max_time_constant", "a time > min_time_constant", num(max_time_constant));
+  }
+}
+
+namespace {
+
+struct Fit {
+  VectorXd coef;  // d0, D_on, c_on, D_off, c_off
+  double sse = std::numeric_limits<double>::infinity();
+  Index used = 0;
+};
+
+// Model columns at time t (log creep with time constant tau).
+void basis_row(double t, double t_on, double t_off, double tau, double* row) {
+  const double on = t >= t_on ? 1.0 : 0.0;
+  const double off = t >= t_off ? 1.0 : 0.0;
+  row[0] = 1.0;
+  row[1] = on;
+  row[2] = on * std::log10(1.0 + std::max(0.0, t - t_on) / tau);
+  row[3] = off;
+  row[4] = off * std::log10(1.0 + std::max(0.0, t - t_off) / tau);
+}
+
+Fit fit_creep(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de, const std::vector<Index>& rows,
+              double t_on, double t_off, double tau, const std::string& source) {
+  MatrixXd a(static_cast<Index>(rows.size()), 5);
+  VectorXd b(static_cast<Index>(rows.size()));
+  double row[5];
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    basis_row(t(rows[i]), t_on, t_off, tau, row);
+    for (int j = 0; j < 5; ++j) a(static_cast<Index>(i), j) = row[j];
+    b(static_cast<Index>(i)) = de(rows[i]);
+  }
+  const Eigen::ColPivHouseholderQR<MatrixXd> qr(a);
+  if (qr.rank() < 5) {
+    throw NumericalError("static stiffness (" + source + ")", "the creep model is singular on this record", false);
+  }
+  Fit f;
+  f.coef = qr.solve(b);
+  f.sse = (a * f.coef - b).squaredNorm();
+  f.used = a.rows();
+  return f;
+}
+
+double window_mean(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de, double from, double to) {
+  double s = 0.0;
+  Index n = 0;
+  for (Index k = 0; k < t.size(); ++k) {
+    if (t(k) >= from && t(k) < to) {
+      s += de(k);
+      ++n;
+    }
+  }
+  return n > 0 ? s / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de,
+                                       const Eigen::Ref<const VectorXd>& mass_log, const StaticStiffnessOptions& options,
+                                       const std::string& source) {
+  options.validate();
+  detail::require_signal(t, source, "t", 10);
+  detail::require_signal(de, source, "de", 10);
+  detail::require_same_length(t.size(), de.size(), source, "de");
+  if (mass_log.size() > 0) {
+    detail::require_signal(mass_log, source, "added_mass", 10);
+    detail::require_same_length(t.size(), mass_log.size(), source, "added_mass");
+  }
+  for (Index k = 1; k < t.size(); ++k) {
+    if (!(t(k) > t(k - 1))) {
+      throw InputError(source, "t", "strictly increasing times", fmt::format("t[{}] = {} after {}", k, t(k), t(k - 1)));
+    }
+  }
+  const Index n = t.size();
+  const double dt = (t(n - 1) - t(0)) / static_cast<double>(n - 1);
+
+  StaticStiffnessResult r;
+  if (options.t_on > 0.0) {
+    r.t_on = options.t_on;
+    r.t_off = options.t_off;
+  } else if (mass_log.size() > 0) {
+    const double top = mass_log.maxCoeff();
+    if (!(top > 0.0)) throw InputError(source, "added_mass", "a log showing the mass put on (> 0 kg)", "no mass");
+    Index on = 0;
+    while (on < n && !(mass_log(on) > 0.01 * top)) ++on;
+    Index off = on;
+    while (off < n && !(mass_log(off) >= 0.99 * top)) ++off;  // fully loaded
+    while (off < n && mass_log(off) >= 0.99 * top) ++off;     // then unloading starts
+    if (on == 0 || off >= n) {
+      throw InputError(source, "added_mass", "a log with the mass put on after the start and taken off before the end",
+                       on == 0 ? "the mass on from the first sample" : "the mass never taken off");
+    }
+    r.t_on = 0.5 * (t(on - 1) + t(on));
+    r.t_off = 0.5 * (t(off - 1) + t(off));
+  } else {
+    // The two largest changes over settle_s, opposite in sign.
+    const Index w = std::max<Index>(1, static_cast<Index>(std::lround(options.settle_s / dt)));
+    if (n <= w + 1) throw InputError(source, "de", "a record longer than settle_s", fmt::format("{} samples", n));
+    Index kmin = 0, kmax = 0;
+    for (Index k = 0; k + w < n; ++k) {
+      const double g = de(k + w) - de(k);
+      if (g < de(kmin + w) - de(kmin)) kmin = k;
+      if (g > de(kmax + w) - de(kmax)) kmax = k;
+    }
+    // The mass starts moving at the event: the first sample of the window that has left the
+    // level before it (mean over the preceding w/5 samples) by 2 % of the change over the window.
+    auto start_of_motion = [&](Index k0) {
+      const Index m = std::max<Index>(1, w / 5);
+      const Index from = std::max<Index>(0, k0 - m);
+      const double level = de.segment(from, k0 - from + 1).mean();
+      const double change = de(k0 + w) - level;
+      Index k = k0 + 1;
+      while (k < k0 + w && std::abs(de(k) - level) <= 0.02 * std::abs(change)) ++k;
+      return k;
+    };
+    const Index a = start_of_motion(std::min(kmin, kmax));
+    const Index b = start_of_motion(std::max(kmin, kmax));
+    if (b - a <= w) throw InputError(source, "de", "two separate steps (mass on, mass off)", "no second step");
+    r.t_on = 0.5 * (t(a - 1) + t(a));
+    r.t_off = 0.5 * (t(b - 1) + t(b));
+  }
+  // Every window and the settling times inside the record, in order.
+  const double settle = options.settle_s;
+  auto inside = [&](double from, double to, const char* field, const char* what) {
+    if (from < t(0) || to > t(n - 1) + dt) {
+      throw InputError(source, field, fmt::format("the {} window [{}, {}) s inside the record [{}, {}] s", what, num(from), num(to), num(t(0)), num(t(n - 1))),
+                       "a window outside the record");
+    }
+  };
+  inside(r.t_on + options.before_s[0], r.t_on + options.before_s[1], "t_on", "reading-before");
+  inside(r.t_off + options.loaded_s[0], r.t_off + options.loaded_s[1], "t_off", "loaded-reading");
+  inside(r.t_off + options.after_s[0], r.t_off + options.after_s[1], "t_off", "reading-after");
+  if (r.t_off + options.loaded_s[0] < r.t_on + settle) {
+    throw InputError(source, "t_off", fmt::format("the loaded-reading window after t_on + settle_s = {} s", num(r.t_on + settle)),
+                     fmt::format("a window from {} s", num(r.t_off + options.loaded_s[0])));
+  }
+  if (t(n - 1) < r.t_off + settle + 0.5) {
+    throw InputError(source, "t_off", fmt::format("at least settle_s + 0.5 s = {} s of record after the mass is taken off", num(settle + 0.5)),
+                     fmt::format("{} s", num(t(n - 1) - r.t_off)));
+  }
+
+  std::vector<Index> rows;
+  for (Index k = 0; k < n; ++k) {
+    const double tk = t(k);
+    const bool settling = (tk >= r.t_on && tk < r.t_on + settle) || (tk >= r.t_off && tk < r.t_off + settle);
+    if (!settling) rows.push_back(k);
+  }
+  // Grid over log10(tau), then a parabola through the best point and its neighbours.
+  constexpr int kGrid = 41;
+  const double l0 = std::log10(options.min_time_constant);
+  const double l1 = std::log10(options.max_time_constant);
+  std::vector<double> sse(kGrid);
+  int best = 0;
+  for (int i = 0; i < kGrid; ++i) {
+    sse[static_cast<std::size_t>(i)] = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, l0 + (l1 - l0) * i / (kGrid - 1)), source).sse;
+    if (sse[static_cast<std::size_t>(i)] < sse[static_cast<std::size_t>(best)]) best = i;
+  }
+  const double h = (l1 - l0) / (kGrid - 1);
+  double lbest = l0 + h * best;
+  if (best > 0 && best < kGrid - 1) {
+    const double ym = sse[static_cast<std::size_t>(best - 1)];
+    const double y0 = sse[static_cast<std::size_t>(best)];
+    const double yp = sse[static_cast<std::size_t>(best + 1)];
+    const double denom = ym - 2.0 * y0 + yp;
+    if (denom > 0.0) lbest += 0.5 * h * (ym - yp) / denom;
+  }
+  Fit f = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, lbest), source);
+  const Fit at_grid = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, l0 + h * best), source);
+  if (at_grid.sse < f.sse) {
+    f = at_grid;
+    lbest = l0 + h * best;
+  }
+  r.creep_time_constant = std::pow(10.0, lbest);
+  r.deflection_on = f.coef(1);
+  r.creep_on = f.coef(2);
+  r.deflection_off = f.coef(3);
+  r.creep_off = f.coef(4);
+  r.rms_residual = std::sqrt(f.sse / static_cast<double>(f.used));
+  r.fit.resize(n);
+  double row[5];
+  for (Index k = 0; k < n; ++k) {
+    basis_row(t(k), r.t_on, r.t_off, r.creep_time_constant, row);
+    r.fit(k) = 0.0;
+    for (int j = 0; j < 5; ++j) r.fit(k) += row[j] * f.coef(j);
+  }
+  const double weight = options.added_mass * options.gravity;
+  if (r.deflection_on == 0.0 || r.deflection_off == 0.0) {
+    throw InputError(source, "de", "a deflection when the mass is put on and taken off", "none");
+  }
+  r.k_elastic_on = weight / std::abs(r.deflection_on);
+  r.k_elastic_off = weight / std::abs(r.deflection_off);
+  r.d_before = window_mean(t, de, r.t_on + options.before_s[0], r.t_on + options.before_s[1]);
+  r.d_loaded = window_mean(t, de, r.t_off + options.loaded_s[0], r.t_off + options.loaded_s[1]);
+  r.d_after = window_mean(t, de, r.t_off + options.after_s[0], r.t_off + options.after_s[1]);
+  if (!std::isfinite(r.d_before) || !std::isfinite(r.d_loaded) || !std::isfinite(r.d_after)) {
+    throw InputError(source, "t", "samples inside every reading window", "an empty window");
+  }
+  if (r.d_before == r.d_loaded || r.d_after == r.d_loaded) {
+    throw InputError(source, "de", "a deflection under the added mass", "none");
+  }
+  r.k1 = weight / std::abs(r.d_before - r.d_loaded);
+  r.k2 = weight / std::abs(r.d_after - r.d_loaded);
+  return r;
+}
+
+double stiffness_from_resonance(double mass, double resonance_rad_s, const std::string& source) {
+  detail::require_finite_positive(mass, source, "mass", "kg");
+  detail::require_finite_positive(resonance_rad_s, source, "resonance", "rad/s");
+  return mass * resonance_rad_s * resonance_rad_s;
+}
+
+}  // namespace piezobench::metrology

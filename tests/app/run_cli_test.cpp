@@ -1,0 +1,133 @@
+// `piezobench demo` and `piezobench run` end to end.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "app/run_cli.hpp"
+#include "piezobench/io/timeseries.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// One demo run shared by the tests below: units 1 (with the IFF records) and 3 (defective).
+const fs::path& demo_dir() {
+  static TempDir* dir = new TempDir();  // lives for the whole test program
+  static bool done = false;
+  if (!done) {
+    const CliRun r = run_cli("demo --fast --units 1,3 --threads 2 --out " + dir->path().string());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    done = true;
+  }
+  return dir->path();
+}
+
+TEST(RunCli, DemoWritesDataCampaignAndReport) {
+  const fs::path& d = demo_dir();
+  for (const char* f : {"campaign.toml", "data/truth.json", "data/unit1_frf-noise.mat", "data/unit3_stroke.mat",
+                        "data/unit1_iff_g30000.mat", "results.json", "results.mat", "report.html"}) {
+    EXPECT_TRUE(fs::exists(d / f)) << f;
+  }
+  const json r = json::parse(read_text(d / "results.json"));
+  ASSERT_EQ(r["units"].size(), 2u);
+  EXPECT_TRUE(r["units"][0]["accepted"].get<bool>());
+  EXPECT_FALSE(r["units"][1]["accepted"].get<bool>());
+  EXPECT_FALSE(r["iff"]["optimal_gain"].is_null());
+  // --strict turns the rejection into exit code 5; --json prints the results.
+  TempDir out;
+  const CliRun strict = run_cli("run " + (d / "campaign.toml").string() + " --strict --json --out " + out.path().string());
+  EXPECT_EQ(strict.exit_code, 5) << strict.err;
+  const json printed = json::parse(strict.out);
+  EXPECT_EQ(printed["units"].size(), 2u);
+  EXPECT_EQ(printed["outputs"].size(), 3u);
+  EXPECT_TRUE(contains(strict.err, "report written to")) << strict.err;
+}
+
+// A campaign assembled by hand from the demo's records converted to CSV with other channel names,
+// next to a .mat file, gives the same results.
+TEST(RunCli, RunOnACampaignOfCsvAndMatFiles) {
+  const fs::path& d = demo_dir();
+  TempDir dir;
+  io::ReadOptions ro;
+  ro.channels = {"u", "de", "Vs"};
+  io::TimeSeries frf = io::read_timeseries(d / "data/unit1_frf-noise.mat", ro);
+  frf.names = {"dac", "encoder", "force_sensor"};
+  frf.settings.clear();
+  io::write_timeseries(frf, dir.path() / "apa1_frf.csv");
+  io::TimeSeries stiff = io::read_timeseries(d / "data/unit1_stiffness.mat");
+  for (auto& n : stiff.names) n = n == "de" ? "laser" : n;
+  io::write_timeseries(stiff, dir.path() / "apa1_stiffness.mat");
+  fs::copy_file(d / "data/unit1_stroke.mat", dir.path() / "stroke.mat");
+  std::ofstream(dir.path() / "campaign.toml") << R"(
+title = "assembled"
+[specs]
+stroke_min_um = 200.0
+[[units]]
+id = 11
+frf = { file = "apa1_frf.csv", channels = { u = "dac", de = "encoder", Vs = "force_sensor" } }
+stiffness = { file = "apa1_stiffness.mat", channels = { de = "laser" } }
+stroke = "stroke.mat"
+capacitance_uF = { sensor = 5.10, actuator = 10.03 }
+)";
+  const fs::path out = dir.path() / "out";
+  const CliRun r = run_cli("run " + (dir.path() / "campaign.toml").string() + " --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "report: ")) << r.out;
+  const json a = json::parse(read_text(out / "results.json"));
+  const json b = json::parse(read_text(d / "results.json"));
+  const json& ua = a["units"][0];
+  const json& ub = b["units"][0];
+  EXPECT_EQ(ua["id"], 11);
+  EXPECT_TRUE(ua["accepted"].get<bool>()) << ua["reasons"].dump();
+  // The CSV keeps 17 digits: the same numbers as from the .mat files.
+  EXPECT_TRUE(near(ua["frf"]["resonance_Hz"].get<double>(), ub["frf"]["resonance_Hz"].get<double>(), 1e-9));
+  EXPECT_TRUE(near(ua["stiffness_N_per_um"]["k1"].get<double>(), ub["stiffness_N_per_um"]["k1"].get<double>(), 1e-12));
+  EXPECT_EQ(ua["frf"]["provenance"]["channels"]["de"], "encoder");
+  EXPECT_EQ(ua["not_measured"].size(), 4u);  // flatness, hysteresis, iff, hammer
+}
+
+std::string fmt_name(int i) {
+  std::string name = std::to_string(i);
+  name.insert(0, 1, 'c');
+  name.append(".toml");
+  return name;
+}
+
+// Bad campaigns: exit 3, the campaign file and the key named, no results left in --out.
+TEST(RunCli, BadInputNamesFileAndKeyAndWritesNothing) {
+  const fs::path& d = demo_dir();
+  TempDir dir;
+  const std::string stroke = (d / "data/unit1_stroke.mat").string();
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"[[units]]\nid = 1\nfrf = \"missing.mat\"\n", {"units[0].frf", "missing.mat", "does not exist"}},
+      {"[[units]]\nid = 1\nstroke = { file = \"" + stroke + "\", channels = { de = \"laser\" } }\n", {"units[0].stroke", "laser"}},
+      {"[[units]]\nid = 1\n[[units]]\nid = 1\n", {"units[1].id", "listed twice"}},
+      {"[[units]]\nid = 1\nfrequency = 3\n", {"units[0].frequency", "unknown key"}},
+  };
+  int i = 0;
+  for (const auto& [text, expected] : cases) {
+    const fs::path file = dir.path() / fmt_name(i++);
+    std::ofstream(file) << text;
+    const fs::path out = dir.path() / "out";
+    fs::create_directories(out);
+    std::ofstream(out / "results.json") << "{\"stale\": true}";
+    const CliRun r = run_cli("run " + file.string() + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 3) << text << r.err;
+    EXPECT_TRUE(contains(r.err, file.string())) << r.err;
+    for (const auto& e : expected) EXPECT_TRUE(contains(r.err, e)) << e << " in " << r.err;
+    EXPECT_FALSE(fs::exists(out / "results.json")) << text;
+    EXPECT_FALSE(fs::exists(out / "report.html")) << text;
+    EXPECT_FALSE(fs::exists(out / "results.mat")) << text;
+  }
+  // A bad command line is exit 2.
+  EXPECT_EQ(run_cli("run").exit_code, 2);
+  EXPECT_EQ(run_cli("demo --units 9 --out " + dir.path().string()).exit_code, 3);
+}
+
+}  // namespace
+}  // namespace piezobench::test

@@ -1,0 +1,157 @@
+#include "piezobench/campaign/iff_plant_fit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "piezobench/lti/freqresp.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::campaign {
+namespace {
+
+using lti::Vector;
+using test::near;
+constexpr double kTwoPi = 2.0 * M_PI;
+
+// The report's plant (section 2.6) with the zero mirrored or not and a 200 us delay.
+IffPlantFit report_plant(double xz) {
+  IffPlantFit p;
+  p.g0 = 0.64;
+  p.wz = kTwoPi * 42.7;
+  p.xz = xz;
+  p.wp = kTwoPi * 95.2;
+  p.xp = 0.02;
+  p.w_hpf = kTwoPi * 0.4;
+  p.delay = 200e-6;
+  return p;
+}
+
+// A Welch-like grid: 0.25 Hz steps up to 1 kHz.
+Vector grid() {
+  return Vector::LinSpaced(4000, 0.25, 1000.0) * kTwoPi;
+}
+
+void expect_recovered(const IffPlantFit& fit, const IffPlantFit& p, double tol) {
+  EXPECT_TRUE(near(fit.g0, p.g0, tol));
+  EXPECT_TRUE(near(fit.wz, p.wz, tol));
+  EXPECT_TRUE(near(fit.xz, p.xz, tol * 10));
+  EXPECT_TRUE(near(fit.wp, p.wp, tol));
+  EXPECT_TRUE(near(fit.xp, p.xp, tol * 10));
+  EXPECT_TRUE(near(fit.w_hpf, p.w_hpf, tol * 10));
+  EXPECT_TRUE(near(fit.delay, p.delay, tol * 10));
+}
+
+// The model's response equals the transfer function's (an independent evaluation through lti).
+TEST(IffPlantFit, ResponseMatchesTransferFunction) {
+  const IffPlantFit p = report_plant(-0.004);
+  const Vector w = Vector::LinSpaced(50, 1.0, 5000.0);
+  const lti::CVector a = p.response(w);
+  const lti::CVector b = lti::freqresp(p.transfer_function(), w);
+  EXPECT_TRUE(test::all_near(a, b, {1e-10, 0.0}));
+  EXPECT_TRUE(p.zero_is_nonminimum_phase());
+}
+
+// Noise-free data of both zero kinds: all seven parameters come back.
+TEST(IffPlantFit, RecoversTheReportPlantExactly) {
+  for (const double xz : {0.004, -0.004}) {
+    const IffPlantFit p = report_plant(xz);
+    const Vector w = grid();
+    const IffPlantFit fit = fit_iff_plant(w, p.response(w), Vector());
+    expect_recovered(fit, p, 1e-6);
+    EXPECT_EQ(fit.zero_is_nonminimum_phase(), xz < 0.0);
+    EXPECT_LT(fit.relative_rms_error, 1e-6);
+    EXPECT_EQ(fit.points, 4000);
+  }
+}
+
+// 1 % complex noise; the high-pass corner fixed (as the campaign does with 1/(R C)).
+TEST(IffPlantFit, NoisyDataWithKnownCorner) {
+  const IffPlantFit p = report_plant(-0.004);
+  const Vector w = grid();
+  lti::CVector h = p.response(w);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 0.01 / std::sqrt(2.0));
+  for (Eigen::Index k = 0; k < h.size(); ++k) h(k) *= std::complex<double>(1.0 + n(rng), n(rng));
+  IffPlantFitOptions o;
+  o.fmin_hz = 20.0;
+  o.fmax_hz = 500.0;
+  o.fixed_w_hpf = p.w_hpf;
+  const IffPlantFit fit = fit_iff_plant(w, h, Vector(), o);
+  EXPECT_DOUBLE_EQ(fit.w_hpf, p.w_hpf);
+  EXPECT_TRUE(near(fit.wz, p.wz, 1e-3));
+  EXPECT_TRUE(near(fit.wp, p.wp, 1e-3));
+  EXPECT_TRUE(near(fit.g0, p.g0, 5e-3));
+  EXPECT_TRUE(near(fit.xp, p.xp, 0.03));
+  EXPECT_TRUE(fit.zero_is_nonminimum_phase());
+  EXPECT_TRUE(near(fit.delay, p.delay, 0.05));
+  EXPECT_NEAR(fit.relative_rms_error, 0.01, 0.002);
+}
+
+// Points of low coherence are left out: garbage there changes nothing.
+TEST(IffPlantFit, CoherenceSelectsPoints) {
+  const IffPlantFit p = report_plant(0.004);
+  const Vector w = grid();
+  lti::CVector h = p.response(w);
+  Vector coh = Vector::Ones(w.size());
+  for (Eigen::Index k = 0; k < w.size(); k += 7) {
+    h(k) *= 3.0;
+    coh(k) = 0.1;
+  }
+  IffPlantFitOptions o;
+  o.min_coherence = 0.5;
+  expect_recovered(fit_iff_plant(w, h, coh, o), p, 1e-6);
+}
+
+TEST(DelayedSecondOrderFit, RecoversMassSpringDamperWithDelay) {
+  DelayedSecondOrderFit p;
+  p.static_gain = -16.8e-6;
+  p.natural_frequency = kTwoPi * 95.4;
+  p.damping = 0.006;
+  p.delay = 232e-6;
+  const Vector w = grid();
+  IffPlantFitOptions o;
+  o.fmin_hz = 20.0;
+  o.fmax_hz = 500.0;
+  const DelayedSecondOrderFit fit = fit_delayed_second_order(w, p.response(w), Vector(), o);
+  EXPECT_TRUE(near(fit.static_gain, p.static_gain, 1e-8));
+  EXPECT_TRUE(near(fit.natural_frequency, p.natural_frequency, 1e-8));
+  EXPECT_TRUE(near(fit.damping, p.damping, 1e-6));
+  EXPECT_TRUE(near(fit.delay, p.delay, 1e-6));
+  const std::complex<double> pole = fit.pole();
+  EXPECT_NEAR(pole.real(), -0.006 * kTwoPi * 95.4, 1e-6);
+  EXPECT_GT(pole.imag(), 0.0);
+  // Without the delay in the model, a delay-compensated record fits just as well.
+  lti::CVector h = p.response(w);
+  for (Eigen::Index k = 0; k < w.size(); ++k) h(k) *= std::exp(std::complex<double>(0.0, w(k) * p.delay));
+  o.fit_delay = false;
+  const DelayedSecondOrderFit nodelay = fit_delayed_second_order(w, h, Vector(), o);
+  EXPECT_DOUBLE_EQ(nodelay.delay, 0.0);
+  EXPECT_TRUE(near(nodelay.damping, p.damping, 1e-6));
+}
+
+TEST(IffPlantFit, BadInput) {
+  const Vector w = grid();
+  const lti::CVector h = report_plant(0.004).response(w);
+  const std::string src = "campaign.toml: units[0].frf";
+  EXPECT_TRUE(test::contains(test::input_error([&] { (void)fit_iff_plant(w.head(10), h, Vector(), {}, src); }, "H"), src));
+  lti::CVector bad = h;
+  bad(5) = std::complex<double>(std::nan(""), 0.0);
+  EXPECT_TRUE(test::contains(test::input_error([&] { (void)fit_iff_plant(w, bad, Vector(), {}, src); }, "H"), "point 5"));
+  test::input_error([&] { (void)fit_iff_plant(w, h, Vector::Ones(3), {}, src); }, "coherence");
+  IffPlantFitOptions narrow;
+  narrow.fmin_hz = 200.0;
+  narrow.fmax_hz = 201.0;
+  test::input_error([&] { (void)fit_iff_plant(w, h, Vector(), narrow, src); }, "H");
+  IffPlantFitOptions o;
+  o.fixed_w_hpf = -1.0;
+  test::input_error([&] { (void)fit_iff_plant(w, h, Vector(), o); }, "fixed_w_hpf");
+  // A band without a peak inside.
+  IffPlantFitOptions edge;
+  edge.fmin_hz = 300.0;
+  test::input_error([&] { (void)fit_delayed_second_order(w, h, Vector(), edge, src); }, "H");
+}
+
+}  // namespace
+}  // namespace piezobench::campaign

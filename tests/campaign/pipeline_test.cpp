@@ -1,0 +1,188 @@
+#include "piezobench/campaign/pipeline.hpp"
+
+#include <gtest/gtest.h>
+#include <matio.h>
+
+#include <fstream>
+
+#include "synthetic.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::campaign {
+namespace {
+
+namespace fs = std::filesystem;
+namespace syn = test::synthetic;
+using nlohmann::json;
+
+// Three units: 1 with FRFs and an IFF record, 2 plain, 3 with half the capacitance and a short
+// stroke (as the report's APA 3).
+struct Batch {
+  test::TempDir dir;
+  Campaign campaign;
+  Batch() {
+    io::write_timeseries(syn::frf_record(8.0), dir.path() / "frf1.mat");
+    io::write_timeseries(syn::damped_record(2 * M_PI * 90.0, 0.2, 1e5, 4.0), dir.path() / "iff1.mat");
+    io::write_timeseries(syn::stroke_record(-1.5e-6), dir.path() / "stroke1.csv");
+    io::write_timeseries(syn::stroke_record(-1.45e-6), dir.path() / "stroke2.csv");
+    io::write_timeseries(syn::stroke_record(-0.8e-6), dir.path() / "stroke3.csv");
+    io::write_timeseries(syn::stiffness_record(1.9e6), dir.path() / "stiff.mat");
+    syn::write_flatness_csv(dir.path() / "flat.csv", 2e-6);
+    const std::string stroke = "{ file = \"stroke@.csv\", channels = { Va = \"V_stack\", de = \"probe\" } }";
+    auto s = [&](int i) {
+      std::string t = stroke;
+      t.replace(t.find('@'), 1, std::to_string(i));
+      return t;
+    };
+    const std::string text = R"(
+title = "pipeline test"
+[specs]
+flatness_um = 25.0
+capacitance_sensor_uF = [4.0, 6.0]
+capacitance_actuator_uF = [8.0, 12.0]
+stroke_min_um = 200.0
+stiffness_N_per_um = [1.5, 2.5]
+[channels]
+u = "u_dac"
+de = "d_enc"
+Vs = "V_sensor"
+[[units]]
+id = 1
+capacitance_uF = { sensor = 5.0, actuator = 10.0 }
+frf = "frf1.mat"
+iff = { file = "iff1.mat", channels = { de = "de" } }
+stroke = )" + s(1) + R"(
+stiffness = { file = "stiff.mat", channels = { de = "de" } }
+flatness = { file = "flat.csv", channels = { x = "x_pos", y = "y_pos", z = "height" } }
+[[units]]
+id = 2
+capacitance_uF = { sensor = 5.05, actuator = 9.9 }
+stroke = )" + s(2) + R"(
+stiffness = { file = "stiff.mat", channels = { de = "de" } }
+[[units]]
+id = 3
+capacitance_uF = { sensor = 2.5, actuator = 5.0 }
+stroke = )" + s(3) + "\n";
+    std::ofstream(dir.path() / "campaign.toml") << text;
+    campaign = read_campaign(dir.path() / "campaign.toml");
+  }
+};
+
+const json& unit(const json& results, int id) {
+  for (const auto& u : results["units"]) {
+    if (u["id"] == id) return u;
+  }
+  throw std::runtime_error("no unit");
+}
+
+TEST(Pipeline, AcceptanceOutliersAndIff) {
+  const Batch b;
+  const CampaignResult r = run_campaign(b.campaign);
+  EXPECT_EQ(r.accepted, 2);
+  EXPECT_EQ(r.rejected, 1);
+  EXPECT_TRUE(unit(r.results, 1)["accepted"].get<bool>());
+  EXPECT_TRUE(unit(r.results, 2)["accepted"].get<bool>());
+  const json& u3 = unit(r.results, 3);
+  EXPECT_FALSE(u3["accepted"].get<bool>());
+  std::string reasons;
+  for (const auto& x : u3["reasons"]) reasons += x.get<std::string>() + "\n";
+  EXPECT_TRUE(test::contains(reasons, "capacitance of the sensor stack 2.5 uF outside")) << reasons;
+  EXPECT_TRUE(test::contains(reasons, "stroke 136.0 um below the minimum 200.0 um")) << reasons;
+  EXPECT_TRUE(test::contains(reasons, "is a batch outlier")) << reasons;
+  // Unit 3 is not measured in most experiments: that is no reason to reject.
+  EXPECT_EQ(u3["not_measured"].size(), 6u);
+  // Batch: outliers and spread.
+  bool cap_outlier = false;
+  for (const auto& o : r.results["batch"]["outliers"]) cap_outlier |= o["unit"] == 3 && o["quantity"] == "capacitance_sensor_uF";
+  EXPECT_TRUE(cap_outlier);
+  EXPECT_NEAR(r.results["batch"]["spread"]["stroke_um"]["max"].get<double>(), 255.0, 1e-9);
+  // IFF from unit 1: the measured gain, the damped pole, an optimal gain.
+  const json& iff = r.results["iff"];
+  EXPECT_EQ(iff["unit"], 1);
+  ASSERT_EQ(iff["gains"].size(), 1u);
+  EXPECT_DOUBLE_EQ(iff["gains"][0].get<double>(), 1e5);
+  EXPECT_EQ(iff["damped_poles"].size(), 1u);
+  EXPECT_GT(iff["optimal_gain"].get<double>(), 0.0);
+  EXPECT_GT(iff["max_damping"].get<double>(), 0.1);
+  // CLI.md keys on every unit.
+  for (const auto& u : r.results["units"]) {
+    for (const char* k : {"id", "flatness_um", "capacitance_uF", "stroke_um", "stiffness_N_per_um", "frf", "hpf_corner_Hz",
+                          "model_2dof", "accepted", "reasons"}) {
+      EXPECT_TRUE(u.contains(k)) << k;
+    }
+  }
+  for (const char* k : {"static_gain_um_per_V", "resonance_Hz", "resonance_damping", "antiresonance_Hz", "antiresonance_damping",
+                        "zero_is_nonminimum_phase"}) {
+    EXPECT_TRUE(unit(r.results, 1)["frf"].contains(k)) << k;
+  }
+}
+
+// The result does not depend on the number of threads.
+TEST(Pipeline, ThreadsDoNotChangeTheResult) {
+  const Batch b;
+  PipelineOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  EXPECT_EQ(run_campaign(b.campaign, one).results.dump(), run_campaign(b.campaign, two).results.dump());
+}
+
+TEST(Pipeline, OutputsWrittenWithResultsLast) {
+  const Batch b;
+  const CampaignResult r = run_campaign(b.campaign);
+  const fs::path out = b.dir.path() / "out";
+  const auto written = write_outputs(r, out);
+  ASSERT_EQ(written.size(), 3u);
+  EXPECT_EQ(written.back().filename(), "results.json");
+  EXPECT_EQ(json::parse(test::read_text(out / "results.json")), r.results);
+  EXPECT_TRUE(test::contains(test::read_text(out / "report.html"), "pipeline test"));
+  mat_t* mat = Mat_Open((out / "results.mat").c_str(), MAT_ACC_RDONLY);
+  ASSERT_NE(mat, nullptr);
+  matvar_t* units = Mat_VarRead(mat, "units");
+  ASSERT_NE(units, nullptr);
+  EXPECT_EQ(units->class_type, MAT_C_STRUCT);
+  EXPECT_EQ(units->dims[1], 3u);
+  Mat_VarFree(units);
+  Mat_Close(mat);
+  // A failing write (the output path is a file) leaves no results.json behind.
+  std::ofstream(b.dir.path() / "blocked") << "x";
+  test::input_error([&] { (void)write_outputs(r, b.dir.path() / "blocked"); });
+}
+
+// A super element (the public APA95ML Ansys export) compared with a measured FRF: its u -> d_e
+// peaks at one of its modes.
+TEST(Pipeline, SuperElementComparison) {
+  test::TempDir dir;
+  io::write_timeseries(syn::frf_record(8.0), dir.path() / "frf.mat");
+  const fs::path d = fs::path(PIEZOBENCH_SHARED_DATA_DIR) / "apa95ml-ansys";
+  std::ofstream(dir.path() / "c.toml") << "[channels]\nu = \"u_dac\"\nde = \"d_enc\"\nVs = \"V_sensor\"\n"
+                                       << "[[units]]\nid = 1\nfrf = \"frf.mat\"\n[superelement]\n"
+                                       << "k_file = \"" << (d / "piezo_amplified_K.txt").string() << "\"\n"
+                                       << "m_file = \"" << (d / "piezo_amplified_M.txt").string() << "\"\n"
+                                       << "nodes_file = \"" << (d / "piezo_amplified.txt").string() << "\"\n"
+                                       << "fix = [76429]\nactuator = \"76430:76440:x\"\noutput = \"76423:y\"\n"
+                                       << "masses = [\"76423:5.7\"]\nga_N_per_V = 23.2\n";
+  const CampaignResult r = run_campaign(read_campaign(dir.path() / "c.toml"));
+  const json& se = r.results["superelement"];
+  ASSERT_TRUE(se.is_object()) << se.dump();
+  EXPECT_EQ(se["dofs"], 108);
+  bool at_mode = false;
+  for (const auto& m : se["modes_Hz"]) at_mode |= std::abs(m.get<double>() / se["resonance_Hz"].get<double>() - 1.0) < 0.01;
+  EXPECT_TRUE(at_mode) << se.dump();
+  EXPECT_NEAR(se["measured_resonance_Hz"].get<double>(), 95.4, 0.5);
+  EXPECT_FALSE(se["warnings"].empty());  // the Ansys text's 4 digits spoil the rigid-body modes
+  // A node that is not in the element: the campaign key is named.
+  std::ofstream(dir.path() / "c2.toml") << test::read_text(dir.path() / "c.toml").replace(
+      test::read_text(dir.path() / "c.toml").find("76423:y"), 7, "99999:y");
+  test::input_error([&] { (void)run_campaign(read_campaign(dir.path() / "c2.toml")); });
+}
+
+// Bad data stops the run with the campaign key named, before anything is written.
+TEST(Pipeline, BadDataStopsTheRun) {
+  Batch b;
+  b.campaign.units[1].stroke->channels["de"] = "laser";
+  const std::string msg = test::input_error([&] { (void)run_campaign(b.campaign); }, "units[1].stroke");
+  EXPECT_TRUE(test::contains(msg, "laser")) << msg;
+}
+
+}  // namespace
+}  // namespace piezobench::campaign

@@ -1,0 +1,75 @@
+#include "piezobench/campaign/report_document.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <set>
+
+#include "piezobench/campaign/pipeline.hpp"
+#include "piezobench/report/html_report.hpp"
+#include "synthetic.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::campaign {
+namespace {
+
+namespace syn = test::synthetic;
+using nlohmann::json;
+
+TEST(ReportDocument, FiguresFollowTheReportLayout) {
+  test::TempDir dir;
+  io::write_timeseries(syn::frf_record(8.0), dir.path() / "frf.mat");
+  io::write_timeseries(syn::hysteresis_record(20.0, 0.1), dir.path() / "h.mat");
+  io::write_timeseries(syn::stiffness_record(1.9e6), dir.path() / "s.mat");
+  io::write_timeseries(syn::damped_record(2 * M_PI * 90.0, 0.2, 1e5, 4.0), dir.path() / "iff.mat");
+  std::ofstream(dir.path() / "c.toml") << R"(
+title = "report <test> & co"
+[specs]
+flatness_um = 25.0
+[channels]
+u = "u_dac"
+[[units]]
+id = 1
+frf = { file = "frf.mat", channels = { de = "d_enc", Vs = "V_sensor" } }
+hysteresis = "h.mat"
+stiffness = "s.mat"
+iff = "iff.mat"
+capacitance_uF = { sensor = 5.0, actuator = 10.0 }
+[[units]]
+id = 2
+name = "APA \"two\" </script>"
+stiffness = "s.mat"
+)";
+  const Campaign c = read_campaign(dir.path() / "c.toml");
+  const CampaignResult r = run_campaign(c);
+  const json& doc = r.report;
+  EXPECT_EQ(doc["title"], "report <test> & co");
+  EXPECT_EQ(doc["results"], r.results);
+  std::set<std::string> sections, figures;
+  for (const auto& s : doc["sections"]) {
+    sections.insert(s["id"].get<std::string>());
+    for (const auto& f : s["figures"]) {
+      EXPECT_TRUE(figures.insert(f["id"].get<std::string>()).second) << f["id"];
+      for (const auto& p : f["panels"]) {
+        for (const auto& t : p["traces"]) EXPECT_EQ(t["x"].size(), t["y"].size()) << f["id"] << " " << t["name"];
+      }
+    }
+  }
+  for (const char* s : {"frf", "quasi-static", "stiffness", "iff", "batch"}) EXPECT_EQ(sections.count(s), 1u) << s;
+  for (const char* f : {"frf-de", "frf-vs", "model-vs", "hysteresis-1", "stiffness", "root-locus", "damped-plants",
+                        "batch-capacitance", "batch-stiffness", "batch-flatness", "batch-stroke"}) {
+    EXPECT_EQ(figures.count(f), 1u) << f;
+  }
+  // The frequency responses overlay the measurement (solid) and the model (dashed) of unit 1.
+  const json& frf_de = doc["sections"][0]["figures"][0];
+  ASSERT_GE(frf_de["panels"][0]["traces"].size(), 2u);
+  EXPECT_FALSE(frf_de["panels"][0]["traces"][0]["dash"].get<bool>());
+  EXPECT_TRUE(frf_de["panels"][0]["traces"][1]["dash"].get<bool>());
+  EXPECT_EQ(frf_de["panels"].size(), 3u);  // magnitude, phase, coherence
+  // The report module accepts the document, and names are escaped.
+  const std::string html = report::render_html(doc);
+  EXPECT_FALSE(test::contains(html, "APA \"two\" </script>"));
+}
+
+}  // namespace
+}  // namespace piezobench::campaign

@@ -1,0 +1,182 @@
+#include "piezobench/campaign/unit_analysis.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "piezobench/lti/analysis.hpp"
+#include "synthetic.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::campaign {
+namespace {
+
+namespace fs = std::filesystem;
+namespace syn = test::synthetic;
+using test::near;
+
+struct Files {
+  test::TempDir dir;
+  Files() {
+    io::write_timeseries(syn::frf_record(12.0), dir.path() / "frf.mat");
+    io::write_timeseries(syn::stroke_record(-1.5e-6), dir.path() / "stroke.csv");
+    io::write_timeseries(syn::hysteresis_record(20.0, 0.1), dir.path() / "hyst20.mat");
+    io::write_timeseries(syn::hysteresis_record(4.0, 0.03), dir.path() / "hyst4.csv");
+    io::write_timeseries(syn::stiffness_record(1.9e6), dir.path() / "stiff.mat");
+    io::write_timeseries(syn::damped_record(2 * M_PI * 90.0, 0.2, 1e5, 8.0), dir.path() / "iff.mat");
+    io::write_timeseries(syn::hammer_record(), dir.path() / "hammer.mat");
+    syn::write_flatness_csv(dir.path() / "flat.csv", 2e-6);
+  }
+  Campaign campaign(const std::string& units) const {
+    const std::string text = R"(
+[specs]
+flatness_method = "minimum-zone"
+[channels]
+u = "u_dac"
+[[units]]
+id = 5
+)" + units;
+    std::ofstream(dir.path() / "campaign.toml") << text;
+    return read_campaign(dir.path() / "campaign.toml");
+  }
+};
+
+const char* kAll = R"(
+capacitance_uF = { sensor = 5.0, actuator = 10.0 }
+frf = { file = "frf.mat", channels = { de = "d_enc", Vs = "V_sensor" } }
+stroke = { file = "stroke.csv", channels = { Va = "V_stack", de = "probe" } }
+hysteresis = ["hyst4.csv", "hyst20.mat"]
+stiffness = "stiff.mat"
+iff = "iff.mat"
+hammer = "hammer.mat"
+flatness = { file = "flat.csv", channels = { x = "x_pos", y = "y_pos", z = "height" } }
+)";
+
+// Every analysis on records whose answers are known (2-DoF model of Table 3.1 on the bench).
+TEST(UnitAnalysis, EveryAnalysisOnKnownRecords) {
+  const Files f;
+  const Campaign c = f.campaign(kAll);
+  std::vector<std::string> log;
+  const UnitAnalysis u = analyze_unit(c, c.units[0], [&](const std::string& line) { log.push_back(line); });
+  EXPECT_TRUE(u.failed.empty()) << u.failed.front();
+  EXPECT_TRUE(u.not_measured.empty());
+  EXPECT_FALSE(log.empty());
+  const apa::TwoDofCharacteristics truth = apa::characterize(apa::TwoDofParams{}, syn::frf_bench());
+  // The records are the model sampled through a zero-order hold at 10 kHz: that maps the poles
+  // exactly but moves the lightly damped zero pair of u -> Vs (-0.44 +- 258 j rad/s) into the
+  // right half plane (+4.05 +- 258 j): the sampled data are non-minimum phase, damping -0.0157.
+  lti::StateSpace vs = lti::select(apa::two_dof_bench(apa::TwoDofParams{}, syn::frf_bench()), {1}, {0});
+  vs.input_delay.resize(0);
+  std::complex<double> zero;
+  for (const auto z : lti::zeros(lti::c2d(vs, 1.0 / syn::kFs))) {
+    if (z.imag() > 0.0) zero = std::log(z) * syn::kFs;
+  }
+  ASSERT_GT(zero.real(), 0.0);
+  // FRF features.
+  ASSERT_TRUE(u.resonance_hz && u.antiresonance_hz && u.static_gain);
+  EXPECT_TRUE(near(*u.resonance_hz, truth.resonance / (2 * M_PI), 1e-3));
+  EXPECT_TRUE(near(*u.antiresonance_hz, truth.antiresonance / (2 * M_PI), 2e-3));
+  EXPECT_TRUE(near(*u.static_gain, truth.static_gain_de, 1e-2));
+  const auto& frf = u.result["frf"];
+  EXPECT_EQ(frf["zero_is_nonminimum_phase"], true);
+  EXPECT_EQ(frf["nmp_evidence"]["phase_verdict"], "non-minimum-phase");
+  EXPECT_TRUE(near(frf["antiresonance_damping"].get<double>(), -zero.real() / std::abs(zero), 0.2));
+  // The Hann window over 0.33 Hz bins widens a 1.1 Hz wide peak by ~10 %.
+  EXPECT_TRUE(near(frf["resonance_damping"].get<double>(), truth.resonance_damping, 0.15));
+  EXPECT_EQ(frf["provenance"]["channels"]["de"], "d_enc");
+  EXPECT_EQ(frf["welch"]["nfft"], 30000);  // a quarter of the 12 s record (less than 4 s)
+  EXPECT_GT(frf["welch"]["averages"].get<int>(), 4);
+  // The delays: 200 us and half a sample of the zero-order hold.
+  EXPECT_TRUE(near(u.de_plant->delay, 250e-6, 0.05));
+  EXPECT_GT(u.iff_plant->delay, 200e-6);
+  EXPECT_LT(u.iff_plant->delay, 350e-6);
+  EXPECT_TRUE(near(u.result["hpf_corner_Hz"].get<double>(), 1.0 / (2 * M_PI * 80.6e3 * 5e-6), 1e-12));
+  // The tuned 2-DoF model: the stiffnesses and gains of Table 3.1.
+  const auto& m = u.result["model_2dof"];
+  const apa::TwoDofParams p;
+  for (const char* name : {"k1", "ke", "ka", "ga", "gs"}) EXPECT_TRUE(near(m[name].get<double>(), p.get(name), 0.02)) << name;
+  EXPECT_DOUBLE_EQ(m["m"].get<double>(), 5.7);
+  // Stiffness from the resonance k = m w^2.
+  EXPECT_TRUE(near(*u.k_resonance, 5.7 * std::pow(truth.resonance, 2), 2e-3));
+  // Quasi-static analyses.
+  EXPECT_TRUE(near(*u.stroke, 170.0 * 1.5e-6, 1e-6));
+  ASSERT_EQ(u.result["hysteresis"].size(), 2u);
+  EXPECT_TRUE(near(u.result["hysteresis"][0]["relative_width"].get<double>(), std::sin(0.03), 1e-3));  // sorted by amplitude
+  EXPECT_TRUE(near(u.result["hysteresis"][1]["relative_width"].get<double>(), std::sin(0.1), 1e-4));
+  EXPECT_TRUE(near(*u.k1, 1.9e6, 1e-9));
+  EXPECT_TRUE(near(*u.k2, 1.9e6, 1e-9));
+  EXPECT_TRUE(near(*u.flatness, 4e-6, 1e-6));  // minimum zone of the saddle = least squares = 2 d
+  EXPECT_DOUBLE_EQ(*u.capacitance_sensor, 5e-6);
+  // The damped plant: its pole comes back, the gain from the file's settings.
+  ASSERT_EQ(u.damped.size(), 1u);
+  EXPECT_DOUBLE_EQ(u.damped[0].gain, 1e5);
+  EXPECT_TRUE(near(u.damped[0].fit.natural_frequency, 2 * M_PI * 90.0, 2e-3));
+  EXPECT_TRUE(near(u.damped[0].fit.damping, 0.2, 0.02));
+  // Hammer: both modes by both methods (the Hann window over 1 s segments cuts some of the impacts'
+  // responses: a few tenths of a percent).
+  const auto& modes = u.result["flexible_modes"];
+  ASSERT_EQ(modes["lscf"].size(), 2u);
+  EXPECT_TRUE(near(modes["lscf"][0]["frequency_Hz"].get<double>(), 280.0, 5e-3));
+  EXPECT_TRUE(near(modes["lscf"][1]["frequency_Hz"].get<double>(), 412.0, 5e-3));
+  ASSERT_EQ(modes["peak_picking"].size(), 2u);
+  EXPECT_TRUE(near(modes["peak_picking"][0]["frequency_Hz"].get<double>(), 280.0, 5e-3));
+  EXPECT_TRUE(near(modes["peak_picking"][1]["frequency_Hz"].get<double>(), 412.0, 5e-3));
+  // Plot data for the report.
+  EXPECT_TRUE(u.plots.contains("frf") && u.plots.contains("model") && u.plots.contains("hysteresis"));
+}
+
+TEST(UnitAnalysis, ExperimentsNotListedAreNotMeasured) {
+  const Files f;
+  const Campaign c = f.campaign("stiffness = \"stiff.mat\"\n");
+  const UnitAnalysis u = analyze_unit(c, c.units[0]);
+  EXPECT_EQ(u.not_measured.size(), all_experiments().size() - 1);
+  EXPECT_TRUE(u.result["frf"].is_null());
+  EXPECT_TRUE(u.result["flatness_um"].is_null());
+  EXPECT_TRUE(u.result["stiffness_N_per_um"]["resonance"].is_null());
+  EXPECT_NEAR(u.result["stiffness_N_per_um"]["k1"].get<double>(), 1.9, 1e-9);
+}
+
+// A channel that is not in the file: the error names the campaign file, the key and the channel.
+TEST(UnitAnalysis, MissingChannelNamesCampaignKey) {
+  const Files f;
+  const Campaign c = f.campaign("stroke = { file = \"stroke.csv\", channels = { Va = \"V_stack\", de = \"laser\" } }\n");
+  const std::string msg = test::input_error([&] { (void)analyze_unit(c, c.units[0]); }, "units[0].stroke");
+  EXPECT_TRUE(test::contains(msg, "campaign.toml")) << msg;
+  EXPECT_TRUE(test::contains(msg, "laser")) << msg;
+  EXPECT_TRUE(test::contains(msg, "stroke.csv")) << msg;
+  // An optional channel mapped explicitly must be there too.
+  const Campaign c2 = f.campaign("stiffness = { file = \"stiff.mat\", channels = { added_mass = \"weight\" } }\n");
+  test::input_error([&] { (void)analyze_unit(c2, c2.units[0]); }, "units[0].stiffness");
+  // An IFF record without a gain anywhere.
+  io::TimeSeries nogain = syn::damped_record(500.0, 0.1, 1.0, 2.0);
+  nogain.settings.clear();
+  io::write_timeseries(nogain, f.dir.path() / "nogain.mat");
+  const Campaign c3 = f.campaign("iff = \"nogain.mat\"\n");
+  test::input_error([&] { (void)analyze_unit(c3, c3.units[0]); }, "units[0].iff.gain");
+}
+
+// LCR readings of one sample in a .mat file (what the bench writes) and in a CSV file.
+TEST(UnitAnalysis, CapacitanceReadingsOfOneSample) {
+  const Files f;
+  io::TimeSeries cap = syn::series({"C_sensor", "C_actuator"}, (Eigen::MatrixXd(1, 2) << 5.1e-6, 10.03e-6).finished(), 1.0, false);
+  io::write_timeseries(cap, f.dir.path() / "cap.mat");
+  io::write_timeseries(cap, f.dir.path() / "cap.csv");
+  for (const char* file : {"cap.mat", "cap.csv"}) {
+    const Campaign c = f.campaign(std::string("capacitance = \"") + file + "\"\n");
+    const UnitAnalysis u = analyze_unit(c, c.units[0]);
+    EXPECT_DOUBLE_EQ(*u.capacitance_sensor, 5.1e-6) << file;
+    EXPECT_DOUBLE_EQ(u.result["capacitance_uF"]["actuator"].get<double>(), 10.03) << file;
+  }
+}
+
+TEST(UnitAnalysis, SegmentLength) {
+  AnalysisSettings a;
+  EXPECT_EQ(frf_segment_length(a, 200000, 10e3), 40000);  // 4 s
+  EXPECT_EQ(frf_segment_length(a, 80000, 10e3), 20000);   // a quarter of the record
+  EXPECT_EQ(frf_segment_length(a, 100, 10e3), 256);
+  a.nfft = 1234;
+  EXPECT_EQ(frf_segment_length(a, 200000, 10e3), 1234);
+}
+
+}  // namespace
+}  // namespace piezobench::campaign
