@@ -1,8 +1,11 @@
 // `piezobench superelement`: imports a super element (Ansys CMS text, CalculiX MATRIXSTORAGE dumps
 // or Matrix Market), applies boundary conditions, point masses, stack force pairs and outputs, and
 // returns the modes and the frequency response (report section 4).
+// `piezobench superelement from-step`: makes one from a STEP file with gmsh, ccx and the
+// Craig-Bampton reduction (issue 8; fem/from_step.hpp, docs/from-step.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -10,8 +13,10 @@
 
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/fem/from_step.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
+#include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/lti/freqresp.hpp"
 
@@ -139,18 +144,237 @@ int run_superelement(const SuperElementCli& o) {
   return 0;
 }
 
+// ---- superelement from-step ------------------------------------------------------------------
+
+struct FromStepCli {
+  std::string step_file;
+  std::string preset = "apa95ml";
+  double mesh_size = 4.0;
+  int order = 2;
+  int modes = 30;
+  int clamped_modes = 10;
+  std::vector<std::string> regions, materials, remote_points;
+  std::string clamp;
+  bool verify = false, keep_temp = false, json = false;
+  std::string out = "superelement-from-step";
+  std::string stem;
+  std::string gmsh = "gmsh", ccx = "ccx";
+  double tolerance = 1e-3;
+};
+
+fem::FromStepOptions from_step_options(const FromStepCli& c) {
+  fem::FromStepOptions o;
+  if (c.preset == "apa95ml") {
+    o = fem::FromStepOptions::apa95ml();
+  } else if (c.preset == "none") {
+    o.materials["body"] = fem::FromStepOptions::apa95ml().materials.at("body");
+  } else {
+    throw InputError("", "--preset", "apa95ml or none", "'" + c.preset + "'");
+  }
+  if (!c.regions.empty()) {
+    o.regions.clear();
+    for (const std::string& t : c.regions) o.regions.push_back(fem::RegionSpec::parse(t, "--region"));
+    // Materials of preset regions that are gone.
+    for (auto it = o.materials.begin(); it != o.materials.end();) {
+      const bool kept = it->first == "body" || std::any_of(o.regions.begin(), o.regions.end(),
+                                                           [&](const fem::RegionSpec& r) { return r.name == it->first; });
+      it = kept ? std::next(it) : o.materials.erase(it);
+    }
+  }
+  for (const std::string& t : c.materials) {
+    const auto colon = t.find(':');
+    if (colon == std::string::npos || colon == 0) {
+      throw InputError("", "--material", "REGION:E,nu,rho (REGION: body or a --region name; SI units)", "'" + t + "'");
+    }
+    o.materials[t.substr(0, colon)] = fem::Material::parse(t.substr(colon + 1), "--material " + t.substr(0, colon));
+  }
+  if (!c.remote_points.empty()) {
+    o.remote_points.clear();
+    for (const std::string& t : c.remote_points) o.remote_points.push_back(fem::RemotePointSpec::parse(t, "--remote-point"));
+  }
+  if (!c.clamp.empty()) {
+    o.clamp = c.clamp;
+  } else if (std::none_of(o.remote_points.begin(), o.remote_points.end(),
+                          [&](const fem::RemotePointSpec& p) { return p.name == o.clamp; }) &&
+             !o.remote_points.empty()) {
+    o.clamp = o.remote_points.front().name;
+  }
+  o.mesh_size_mm = c.mesh_size;
+  o.element_order = c.order;
+  o.modes = c.modes;
+  o.clamped_modes = c.clamped_modes;
+  o.verify = c.verify;
+  o.keep_temp = c.keep_temp;
+  o.out = c.out;
+  o.stem = c.stem;
+  o.gmsh = c.gmsh;
+  o.ccx = c.ccx;
+  o.geometry_tolerance_mm = c.tolerance;
+  o.log = [](const std::string& line) { log_line("from-step: " + line); };
+  return o;
+}
+
+nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& o, const fem::FromStepResult& r) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const fem::RemotePointResult& p : r.remote_points) {
+    points.push_back({{"name", p.name},
+                      {"selector", p.selector.to_string()},
+                      {"surfaces", p.surfaces},
+                      {"node", p.node},
+                      {"rot_node", p.rot_node},
+                      {"position_m", {p.position_m.x(), p.position_m.y(), p.position_m.z()}},
+                      {"area_m2", p.area_m2},
+                      {"face_nodes", p.face_nodes}});
+  }
+  nlohmann::json materials = nlohmann::json::object();
+  for (const auto& [name, m] : o.materials) {
+    materials[name] = {{"E_Pa", m.youngs_modulus}, {"nu", m.poisson_ratio}, {"rho_kg_per_m3", m.density}};
+  }
+  nlohmann::json regions = nlohmann::json::object();
+  for (const fem::RegionSpec& reg : o.regions) {
+    regions[reg.name] = {{"box_mm", {reg.box.lo.x(), reg.box.lo.y(), reg.box.lo.z(), reg.box.hi.x(), reg.box.hi.y(), reg.box.hi.z()}}};
+  }
+  nlohmann::json seconds = nlohmann::json::object();
+  for (const auto& [step, s] : r.seconds) seconds[step] = s;
+  nlohmann::json files = nlohmann::json::array();
+  for (const auto& f : r.files) files.push_back(f.string());
+  std::string k_file, m_file, dof_file;
+  for (const auto& f : r.files) {
+    const std::string name = f.filename().string();
+    if (name.size() > 6 && name.compare(name.size() - 6, 6, "_K.mtx") == 0) k_file = f.string();
+    if (name.size() > 6 && name.compare(name.size() - 6, 6, "_M.mtx") == 0) m_file = f.string();
+    if (name.size() > 9 && name.compare(name.size() - 9, 9, "_dofs.txt") == 0) dof_file = f.string();
+  }
+  long clamp_node = -1;
+  for (const fem::RemotePointResult& p : r.remote_points) {
+    if (p.name == r.clamp) clamp_node = p.node;
+  }
+  nlohmann::json doc = {
+      {"step", c.step_file},
+      {"out", o.out.string()},
+      {"gmsh", {{"path", r.gmsh.path}, {"version", r.gmsh.version}}},
+      {"ccx", {{"path", r.ccx.path}, {"version", r.ccx.version}}},
+      {"mesh",
+       {{"size_mm", o.mesh_size_mm},
+        {"element", r.element_type},
+        {"nodes", r.mesh_nodes},
+        {"elements", r.mesh_elements},
+        {"elements_per_region", r.region_elements},
+        {"model_dofs", r.model_dofs}}},
+      {"regions", regions},
+      {"materials", materials},
+      {"remote_points", points},
+      {"reduction",
+       {{"interface_dofs", r.reduction.interface_dofs},
+        {"interior_dofs", r.reduction.interior_dofs},
+        {"modes", o.modes},
+        {"fixed_interface_Hz", io::to_json(r.reduction.fixed_interface_Hz)},
+        {"factor_nonzeros", r.reduction.factor_nonzeros},
+        {"eigensolver_restarts", r.reduction.eigensolver_iterations},
+        {"solves", r.reduction.eigensolver_operations}}},
+      {"super_element", {{"dofs", r.reduced.size()}, {"modal_dofs", r.reduced.modal_dofs()}, {"K", k_file}, {"M", m_file}, {"dof_list", dof_file}}},
+      {"usage", "piezobench superelement " + k_file + " " + m_file + " " + dof_file + " --fix " + std::to_string(clamp_node)},
+      {"clamp", r.clamp},
+      {"modes_clamped_Hz", io::to_json(r.modes_clamped_Hz)},
+      {"free_modes_Hz", io::to_json(r.free_modes_Hz)},
+      {"seconds", seconds},
+      {"files", files},
+      {"work_dir", r.work_dir.string()},
+      {"warnings", r.reduced.warnings}};
+  if (r.reference_modes_Hz) {
+    doc["reference_modes_Hz"] = io::to_json(*r.reference_modes_Hz);
+    const Index n = std::min(r.reference_modes_Hz->size(), r.modes_clamped_Hz.size());
+    Eigen::VectorXd rel(n);
+    for (Index i = 0; i < n; ++i) rel(i) = r.modes_clamped_Hz(i) / (*r.reference_modes_Hz)(i) - 1.0;
+    doc["relative_difference"] = io::to_json(rel);
+  }
+  return doc;
+}
+
+int run_from_step(const FromStepCli& c) {
+  const fem::FromStepOptions o = from_step_options(c);
+  const fem::FromStepResult r = fem::superelement_from_step(c.step_file, o);
+  nlohmann::json doc = from_step_json(c, o, r);
+  const std::filesystem::path summary = std::filesystem::path(o.out) / "from_step.json";
+  doc["files"].push_back(summary.string());
+  io::write_text_atomically(summary, doc.dump(2) + "\n");
+  log_line("from-step: done in " + fmt::format("{:.1f}", r.seconds.back().second) + " s; summary " + summary.string());
+  if (c.json) {
+    print_json(doc);
+    return 0;
+  }
+  fmt::print("super element of {}: {} DOF ({} interface, {} modal) in {}\n", c.step_file, r.reduced.size(), r.reduction.interface_dofs,
+             r.reduced.modal_dofs(), o.out.string());
+  fmt::print("mesh: {} nodes, {} {} elements, {} DOF after the rigid bodies\n", r.mesh_nodes, r.mesh_elements, r.element_type,
+             r.model_dofs);
+  for (const fem::RemotePointResult& p : r.remote_points) {
+    fmt::print("remote point {:<10} node {:>7} ({}) at ({:.6g}, {:.6g}, {:.6g}) m, {} face nodes\n", p.name, p.node,
+               p.selector.to_string(), p.position_m.x(), p.position_m.y(), p.position_m.z(), p.face_nodes);
+  }
+  fmt::print("modes with {} clamped [Hz]:", r.clamp);
+  for (Index i = 0; i < r.modes_clamped_Hz.size(); ++i) fmt::print(" {:.6g}", r.modes_clamped_Hz(i));
+  fmt::print("\n");
+  if (r.reference_modes_Hz) {
+    fmt::print("ccx on the full mesh  [Hz]:");
+    for (Index i = 0; i < r.reference_modes_Hz->size(); ++i) fmt::print(" {:.6g}", (*r.reference_modes_Hz)(i));
+    fmt::print("\n");
+  }
+  fmt::print("use it: {}\n", doc["usage"].get<std::string>());
+  for (const std::string& w : r.reduced.warnings) fmt::print("warning: {}\n", w);
+  return 0;
+}
+
+CLI::App* add_from_step_command(CLI::App& se, Action& action) {
+  auto c = std::make_shared<FromStepCli>();
+  CLI::App* fs = se.add_subcommand(
+      "from-step",
+      "Make a super element from a STEP file: gmsh meshes, ccx assembles (*FREQUENCY,SOLVER=MATRIXSTORAGE), piezobench "
+      "reduces (Craig-Bampton) and writes it (Matrix Market + DOF list, Simscape script) into --out. Defaults: APA95ML.step "
+      "(docs/from-step.md)");
+  fs->add_option("STEP_FILE", c->step_file, "the CAD geometry (STEP, mm)")->required();
+  fs->add_option("--mesh-size", c->mesh_size, "largest element size, mm")->capture_default_str();
+  fs->add_option("--order", c->order, "element order: 2 (C3D10) or 1 (C3D4)")->capture_default_str();
+  fs->add_option("--modes", c->modes, "fixed-interface modes kept")->capture_default_str();
+  fs->add_option("--preset", c->preset,
+                 "apa95ml: region stack (PZT) in a steel body, remote points top, bottom, stack_a, stack_b; none: one steel "
+                 "body, remote points from --remote-point")
+      ->capture_default_str();
+  fs->add_option("--region", c->regions,
+                 "NAME:box:x0,y0,z0,x1,y1,z1 (mm): cut this box out of the bodies as its own material region (repeatable; "
+                 "replaces the preset's regions)");
+  fs->add_option("--material", c->materials,
+                 "REGION:E,nu,rho (Pa, -, kg/m^3) for body (the rest) or a region (repeatable). Preset: body 190e9,0.3,7800 "
+                 "(steel), stack 48e9,0.31,7800 (PZT)");
+  fs->add_option("--remote-point", c->remote_points,
+                 "NAME:SELECTOR with SELECTOR x|y|z=min|max|MM (planar faces in that plane), box:x0,y0,z0,x1,y1,z1 (faces "
+                 "inside, mm) or surface:TAG[,TAG] (gmsh tags, see geometry.txt); repeatable, replaces the preset's");
+  fs->add_option("--clamp", c->clamp, "remote point clamped for modes_clamped_Hz and --verify (default: bottom, else the first)");
+  fs->add_option("--clamped-modes", c->clamped_modes, "number of clamped modes reported (and computed by ccx with --verify)")
+      ->capture_default_str();
+  fs->add_flag("--verify", c->verify, "also run ccx *FREQUENCY on the full mesh with --clamp fixed (reference_modes_Hz)");
+  fs->add_flag("--keep-temp", c->keep_temp, "keep the work folder (gmsh mesh, matrix dumps, ccx results) in --out");
+  fs->add_option("--out", c->out, "output folder")->capture_default_str();
+  fs->add_option("--stem", c->stem, "file name stem of the super element (default: the STEP file's)");
+  fs->add_option("--gmsh", c->gmsh, "gmsh executable (name in PATH or path)")->capture_default_str();
+  fs->add_option("--ccx", c->ccx, "CalculiX ccx executable (name in PATH or path)")->capture_default_str();
+  fs->add_option("--geometry-tolerance", c->tolerance, "gmsh boolean tolerance and flatness of planar faces, mm")->capture_default_str();
+  fs->add_flag("--json", c->json, "print one JSON document on stdout (progress stays on stderr)");
+  fs->callback([c, &action] { action = [c] { return run_from_step(*c); }; });
+  return fs;
+}
+
 }  // namespace
 
 void add_superelement_commands(CLI::App& app, Action& action) {
   auto o = std::make_shared<SuperElementCli>();
   CLI::App* se = app.add_subcommand(
       "superelement", "Import a super element (Ansys CMS text, CalculiX .sti/.mas/.dof, Matrix Market) and compute its "
-                      "modes and frequency response");
-  se->add_option("K_FILE", o->k_file, "stiffness: Ansys K text, CalculiX .sti or Matrix Market")->required()->check(CLI::ExistingFile);
-  se->add_option("M_FILE", o->m_file, "mass: Ansys M text, CalculiX .mas or Matrix Market")->required()->check(CLI::ExistingFile);
+                      "modes and frequency response; `superelement from-step` makes one from a STEP file");
+  // The three files are required unless the from-step subcommand is used (checked in the callback).
+  se->add_option("K_FILE", o->k_file, "stiffness: Ansys K text, CalculiX .sti or Matrix Market (required)")->check(CLI::ExistingFile);
+  se->add_option("M_FILE", o->m_file, "mass: Ansys M text, CalculiX .mas or Matrix Market (required)")->check(CLI::ExistingFile);
   se->add_option("NODES_FILE", o->nodes_file,
-                 "DOF list: Ansys master-DOF listing, CalculiX .dof or a piezobench DOF list")
-      ->required()
+                 "DOF list: Ansys master-DOF listing, CalculiX .dof or a piezobench DOF list (required)")
       ->check(CLI::ExistingFile);
   se->add_option("--nlist", o->nlist_file,
                  "node coordinates: Ansys node list (default: out_NLIST.txt beside NODES_FILE) or a CalculiX deck with *NODE")
@@ -165,7 +389,14 @@ void add_superelement_commands(CLI::App& app, Action& action) {
   se->add_option("--fmax", o->fmax, "highest frequency, Hz")->capture_default_str();
   se->add_option("--points", o->points, "number of log-spaced frequencies")->check(CLI::Range(1, 100000))->capture_default_str();
   se->add_flag("--json", o->json, "print one JSON document on stdout");
-  se->callback([o, &action] { action = [o] { return run_superelement(*o); }; });
+  CLI::App* from_step = add_from_step_command(*se, action);
+  se->callback([o, from_step, &action] {
+    if (from_step->parsed()) return;  // its own callback has set the action
+    if (o->k_file.empty()) throw CLI::RequiredError("K_FILE");
+    if (o->m_file.empty()) throw CLI::RequiredError("M_FILE");
+    if (o->nodes_file.empty()) throw CLI::RequiredError("NODES_FILE");
+    action = [o] { return run_superelement(*o); };
+  });
 }
 
 }  // namespace piezobench::app

@@ -1,0 +1,621 @@
+#include "piezobench/fem/from_step.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <set>
+#include <system_error>
+
+#include "fem/from_step_files.hpp"
+#include "fem/from_step_process.hpp"
+#include "fem/text.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/fem/matrix_io.hpp"
+#include "piezobench/fem/structural_model.hpp"
+
+namespace piezobench::fem {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* const kMinGmsh = "4.0";
+const char* const kMinCcx = "2.15";
+const char* const kWorkDir = "from_step_work";
+
+std::vector<std::string_view> split(std::string_view text, char sep) {
+  std::vector<std::string_view> out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t at = text.find(sep, start);
+    out.push_back(text.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start));
+    if (at == std::string_view::npos) return out;
+    start = at + 1;
+  }
+}
+
+std::vector<double> parse_numbers(std::string_view text, std::size_t count, const std::string& field, const std::string& form,
+                                  const std::string& whole) {
+  const auto parts = split(text, ',');
+  std::vector<double> out;
+  for (const std::string_view p : parts) {
+    const auto v = detail::parse_double(p);
+    if (!v || !std::isfinite(*v)) throw InputError("", field, form, "'" + whole + "'");
+    out.push_back(*v);
+  }
+  if (out.size() != count) throw InputError("", field, form, "'" + whole + "'");
+  return out;
+}
+
+std::string elapsed(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f s", s);
+  return buf;
+}
+
+// Removes the work folder when the run ends (also on errors) unless it is to be kept.
+class WorkFolder {
+ public:
+  WorkFolder(fs::path path, bool keep) : path_(std::move(path)), keep_(keep) {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+    fs::create_directories(path_, ec);
+    if (ec) throw InputError(path_.string(), "folder", "a folder that can be created", ec.message());
+  }
+  ~WorkFolder() {
+    if (keep_) return;
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  WorkFolder(const WorkFolder&) = delete;
+  WorkFolder& operator=(const WorkFolder&) = delete;
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+  bool keep_;
+};
+
+class Runner {
+ public:
+  explicit Runner(const FromStepOptions& o) : o_(o) {}
+
+  void log(const std::string& line) const {
+    if (o_.log) o_.log(line);
+  }
+
+  ToolInfo check_tool(const std::string& spec, const std::string& name, const std::string& flag, const std::string& min_version,
+                      const std::string& package, const fs::path& work) const {
+    const auto exe = detail::find_executable(spec);
+    if (!exe) {
+      const char* path = std::getenv("PATH");
+      const std::string found = spec.find('/') != std::string::npos
+                                    ? "'" + spec + "' is not an executable file"
+                                    : "'" + spec + "' not found in PATH (" + std::string(path != nullptr ? path : "") + ")";
+      throw InputError("--" + name, "executable",
+                       "the " + name + " program (Debian package " + package + "; or --" + name + " /path/to/" + name + ")",
+                       found);
+    }
+    const fs::path log = work / (name + "_version.log");
+    detail::ProcessResult pr;
+    try {
+      pr = detail::run_process(*exe, {flag}, work, log);
+    } catch (const std::system_error& e) {
+      throw InputError("--" + name, "executable", "a program that can be started", exe->string() + ": " + e.what());
+    }
+    const std::string text = detail::read_file(log);
+    const auto version = detail::parse_version(text);
+    if (!version || pr.signaled) {
+      throw InputError("--" + name, "version",
+                       name + " printing its version with '" + flag + "' (is " + exe->string() + " really " + name + "?)",
+                       "'" + detail::last_lines(text, "", 2) + "'");
+    }
+    if (detail::compare_versions(*version, min_version) < 0) {
+      throw InputError("--" + name, "version", name + " >= " + min_version, *version + " (" + exe->string() + ")");
+    }
+    return {exe->string(), *version};
+  }
+
+  // Runs a tool, forwarding the log lines that `keep` accepts to the progress log.
+  detail::ProcessResult run(const ToolInfo& tool, const std::string& label, const std::vector<std::string>& args, const fs::path& cwd,
+                            const fs::path& log, const std::function<bool(std::string_view)>& keep) const {
+    const auto forward = [&](std::string_view line) {
+      if (keep(line)) log_line_of(label, line);
+    };
+    try {
+      return detail::run_process(tool.path, args, cwd, log, forward);
+    } catch (const std::system_error& e) {
+      throw InputError(tool.path, "executable", "a program that can be started", e.what());
+    }
+  }
+
+  void log_line_of(const std::string& label, std::string_view line) const {
+    std::string_view t = detail::trim(line);
+    if (t.rfind("Info    : ", 0) == 0) t.remove_prefix(10);
+    if (!t.empty()) log("  " + label + ": " + std::string(t));
+  }
+
+ private:
+  const FromStepOptions& o_;
+};
+
+// gmsh's stages (not its per-curve and per-surface lines), errors and the final count.
+bool keep_gmsh_line(std::string_view line) {
+  if (line.find("Error") != std::string_view::npos) return true;
+  if (line.find('%') != std::string_view::npos) return false;
+  return line.find(": Meshing ") != std::string_view::npos || line.find(": Optimizing mesh") != std::string_view::npos ||
+         line.find(": Done meshing") != std::string_view::npos || line.find(" nodes ") != std::string_view::npos;
+}
+
+bool keep_ccx_line(std::string_view line) {
+  static const char* const keys[] = {"Determining", "Factoring", "Calculating the eigen", "Storing", "*ERROR", "Job finished"};
+  return std::any_of(std::begin(keys), std::end(keys), [&](const char* k) { return line.find(k) != std::string_view::npos; });
+}
+
+void copy_into(const fs::path& from, const fs::path& to) {
+  std::error_code ec;
+  fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
+  if (ec) throw InputError(to.string(), "file", "a writable output folder", ec.message());
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  detail::write_atomically(file, [&](std::ostream& out) { out << text; });
+}
+
+std::string sanitize_stem(const std::string& stem) {
+  std::string s;
+  for (const char c : stem) s += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-') ? c : '_';
+  return s.empty() ? "superelement" : s;
+}
+
+}  // namespace
+
+// ---- parsing --------------------------------------------------------------------------------
+
+Box3 Box3::parse(const std::string& text, const std::string& field) {
+  const auto v = parse_numbers(text, 6, field, "x0,y0,z0,x1,y1,z1 (mm)", text);
+  Box3 b;
+  b.lo = Eigen::Vector3d(std::min(v[0], v[3]), std::min(v[1], v[4]), std::min(v[2], v[5]));
+  b.hi = Eigen::Vector3d(std::max(v[0], v[3]), std::max(v[1], v[4]), std::max(v[2], v[5]));
+  if (((b.hi - b.lo).array() <= 0.0).any()) throw InputError("", field, "a box with a non-zero size along x, y and z", "'" + text + "'");
+  return b;
+}
+
+bool Box3::contains(const Box3& other, double tolerance) const {
+  return ((other.lo.array() >= lo.array() - tolerance) && (other.hi.array() <= hi.array() + tolerance)).all();
+}
+
+FaceSelector FaceSelector::parse(const std::string& text, const std::string& field) {
+  const std::string form = "x|y|z=min|max|VALUE_MM, box:x0,y0,z0,x1,y1,z1 or surface:TAG[,TAG...]";
+  FaceSelector s;
+  const std::string t = detail::lower(std::string(detail::trim(text)));
+  if (t.rfind("box:", 0) == 0) {
+    s.kind = Kind::kBox;
+    s.box = Box3::parse(t.substr(4), field);
+    return s;
+  }
+  if (t.rfind("surface:", 0) == 0) {
+    s.kind = Kind::kSurfaces;
+    for (const std::string_view p : split(std::string_view(t).substr(8), ',')) {
+      const auto tag = detail::parse_int(p);
+      if (!tag || *tag < 1) throw InputError("", field, form, "'" + text + "'");
+      s.surfaces.push_back(static_cast<int>(*tag));
+    }
+    return s;
+  }
+  if (t.size() < 3 || t[1] != '=' || (t[0] != 'x' && t[0] != 'y' && t[0] != 'z')) throw InputError("", field, form, "'" + text + "'");
+  s.kind = Kind::kPlane;
+  s.axis = t[0] - 'x';
+  const std::string at = t.substr(2);
+  if (at == "max") {
+    s.at = At::kMax;
+  } else if (at == "min") {
+    s.at = At::kMin;
+  } else {
+    const auto v = detail::parse_double(at);
+    if (!v || !std::isfinite(*v)) throw InputError("", field, form, "'" + text + "'");
+    s.at = At::kValue;
+    s.value = *v;
+  }
+  return s;
+}
+
+std::string FaceSelector::to_string() const {
+  const auto g = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    return std::string(buf);
+  };
+  switch (kind) {
+    case Kind::kPlane:
+      return std::string(1, static_cast<char>('x' + axis)) + "=" + (at == At::kMax ? "max" : at == At::kMin ? "min" : g(value));
+    case Kind::kBox:
+      return "box:" + g(box.lo.x()) + "," + g(box.lo.y()) + "," + g(box.lo.z()) + "," + g(box.hi.x()) + "," + g(box.hi.y()) + "," +
+             g(box.hi.z());
+    case Kind::kSurfaces: {
+      std::string s = "surface:";
+      for (std::size_t k = 0; k < surfaces.size(); ++k) {
+        s += (k > 0 ? "," : "");
+        s += std::to_string(surfaces[k]);
+      }
+      return s;
+    }
+  }
+  return "";
+}
+
+RemotePointSpec RemotePointSpec::parse(const std::string& text, const std::string& field) {
+  const auto colon = text.find(':');
+  const std::string form = "NAME:SELECTOR, e.g. top:y=max (NAME: letters, digits, _)";
+  if (colon == std::string::npos) throw InputError("", field, form, "'" + text + "'");
+  RemotePointSpec r;
+  r.name = std::string(detail::trim(std::string_view(text).substr(0, colon)));
+  if (!detail::is_valid_name(r.name)) throw InputError("", field, form, "'" + text + "'");
+  r.selector = FaceSelector::parse(text.substr(colon + 1), field + " " + r.name);
+  return r;
+}
+
+RegionSpec RegionSpec::parse(const std::string& text, const std::string& field) {
+  const std::string form = "NAME:box:x0,y0,z0,x1,y1,z1 (mm; NAME: letters, digits, _)";
+  const auto colon = text.find(':');
+  if (colon == std::string::npos || text.compare(colon + 1, 4, "box:") != 0) throw InputError("", field, form, "'" + text + "'");
+  RegionSpec r;
+  r.name = std::string(detail::trim(std::string_view(text).substr(0, colon)));
+  if (!detail::is_valid_name(r.name) || detail::lower(r.name) == "body") {
+    throw InputError("", field, form + "; 'body' is the rest of the model", "'" + text + "'");
+  }
+  r.box = Box3::parse(text.substr(colon + 5), field + " " + r.name);
+  return r;
+}
+
+Material Material::parse(const std::string& text, const std::string& field) {
+  const std::string form = "E,nu,rho (Pa, -, kg/m^3), e.g. 190e9,0.3,7800";
+  const auto v = parse_numbers(text, 3, field, form, text);
+  if (!(v[0] > 0.0) || !(v[1] > -1.0 && v[1] < 0.5) || !(v[2] > 0.0)) {
+    throw InputError("", field, "E > 0, -1 < nu < 0.5, rho > 0", "'" + text + "'");
+  }
+  return {v[0], v[1], v[2]};
+}
+
+FromStepOptions FromStepOptions::apa95ml() {
+  FromStepOptions o;
+  RegionSpec stack;
+  stack.name = "stack";
+  stack.box.lo = Eigen::Vector3d(-34.7793, -10.0, -11.25);
+  stack.box.hi = Eigen::Vector3d(34.7793, 10.0, 11.25);
+  o.regions = {stack};
+  o.materials["body"] = {190e9, 0.3, 7800.0};
+  o.materials["stack"] = {48e9, 0.31, 7800.0};
+  o.remote_points = {RemotePointSpec::parse("top:y=max", "default"), RemotePointSpec::parse("bottom:y=min", "default"),
+                     RemotePointSpec::parse("stack_a:x=-34.7793", "default"),
+                     RemotePointSpec::parse("stack_b:x=34.7793", "default")};
+  o.clamp = "bottom";
+  return o;
+}
+
+void FromStepOptions::validate() const {
+  const std::string src = "superelement from-step";
+  if (!(std::isfinite(mesh_size_mm) && mesh_size_mm > 0.0)) {
+    throw InputError(src, "--mesh-size", "a mesh size > 0 mm", detail::g17(mesh_size_mm));
+  }
+  if (element_order != 1 && element_order != 2) throw InputError(src, "--order", "1 (C3D4) or 2 (C3D10)", std::to_string(element_order));
+  if (modes < 0) throw InputError(src, "--modes", "a number of modes >= 0", std::to_string(modes));
+  if (clamped_modes < 1) throw InputError(src, "--clamped-modes", "at least 1", std::to_string(clamped_modes));
+  if (!(std::isfinite(geometry_tolerance_mm) && geometry_tolerance_mm > 0.0)) {
+    throw InputError(src, "--geometry-tolerance", "a tolerance > 0 mm", detail::g17(geometry_tolerance_mm));
+  }
+  if (remote_points.empty()) throw InputError(src, "--remote-point", "at least one remote point", "none");
+  std::set<std::string> names;
+  for (const RemotePointSpec& p : remote_points) {
+    if (!detail::is_valid_name(p.name)) throw InputError(src, "--remote-point", "a name of letters, digits and _", "'" + p.name + "'");
+    if (!names.insert(detail::upper(p.name)).second) throw InputError(src, "--remote-point", "distinct names", p.name + " twice");
+  }
+  if (names.count(detail::upper(clamp)) == 0) {
+    std::string list;
+    for (const RemotePointSpec& p : remote_points) {
+      list += list.empty() ? "" : ", ";
+      list += p.name;
+    }
+    throw InputError(src, "--clamp", "one of the remote points (" + list + ")", "'" + clamp + "'");
+  }
+  std::set<std::string> region_names{"BODY"};
+  for (const RegionSpec& r : regions) {
+    if (!detail::is_valid_name(r.name) || detail::upper(r.name) == "BODY") {
+      throw InputError(src, "--region", "a name of letters, digits and _ other than body", "'" + r.name + "'");
+    }
+    if (!region_names.insert(detail::upper(r.name)).second) throw InputError(src, "--region", "distinct names", r.name + " twice");
+    if (materials.count(r.name) == 0) throw InputError(src, "--material", "a material for the region " + r.name, "none");
+  }
+  if (materials.count("body") == 0) throw InputError(src, "--material", "a material for 'body' (the rest of the model)", "none");
+  for (const auto& [name, m] : materials) {
+    if (region_names.count(detail::upper(name)) == 0) {
+      throw InputError(src, "--material", "a material for 'body' or a region given with --region", "'" + name + "'");
+    }
+    if (!(m.youngs_modulus > 0.0) || !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) || !(m.density > 0.0)) {
+      throw InputError(src, "--material " + name, "E > 0, -1 < nu < 0.5, rho > 0", "out of range");
+    }
+  }
+}
+
+// ---- the chain -------------------------------------------------------------------------------
+
+FromStepResult superelement_from_step(const fs::path& step_file, const FromStepOptions& o) {
+  o.validate();
+  const auto t_start = std::chrono::steady_clock::now();
+  FromStepResult r;
+  Runner run(o);
+  const auto step_done = [&](const std::string& step, double seconds) { r.seconds.emplace_back(step, seconds); };
+
+  std::error_code ec;
+  if (!fs::is_regular_file(step_file, ec)) {
+    throw InputError(step_file.string(), "file", "an existing STEP file", fs::exists(step_file, ec) ? "not a regular file" : "no such file");
+  }
+  fs::create_directories(o.out, ec);
+  if (ec || !fs::is_directory(o.out)) throw InputError(o.out.string(), "--out", "a folder that can be created", ec.message());
+  const std::string stem = sanitize_stem(o.stem.empty() ? step_file.stem().string() : o.stem);
+  WorkFolder work(o.out / kWorkDir, o.keep_temp);
+  const fs::path& w = work.path();
+  if (o.keep_temp) r.work_dir = w;
+
+  r.gmsh = run.check_tool(o.gmsh, "gmsh", "--version", kMinGmsh, "gmsh", w);
+  r.ccx = run.check_tool(o.ccx, "ccx", "-v", kMinCcx, "calculix-ccx", w);
+  run.log("gmsh " + r.gmsh.version + " (" + r.gmsh.path + "), ccx " + r.ccx.version + " (" + r.ccx.path + ")");
+  copy_into(step_file, w / "model.step");
+
+  // 1. The geometry: volumes and faces with their bounding boxes.
+  run.log("[1/6] reading the geometry (gmsh, OpenCASCADE): " + step_file.string());
+  const std::string prelude = detail::geometry_script("model.step", o.regions, o.geometry_tolerance_mm);
+  write_text(w / "geometry.geo", prelude + detail::report_script("geometry.txt"));
+  const fs::path geometry_log = o.out / "gmsh_geometry.log";
+  const auto g_run = run.run(r.gmsh, "gmsh", {"-0", "geometry.geo", "-o", "geometry.geo_unrolled"}, w, geometry_log,
+                             [](std::string_view l) { return l.find("Error") != std::string_view::npos; });
+  step_done("gmsh geometry", g_run.seconds);
+  const std::string g_log = detail::read_file(geometry_log);
+  if (!fs::exists(w / "geometry.txt")) {
+    // gmsh writes its report even when the STEP file does not load: this is not gmsh running a .geo script.
+    throw InputError("--gmsh", "gmsh", "gmsh running the geometry script (it writes geometry.txt)",
+                     "no report from " + r.gmsh.path + " (exit code " + std::to_string(g_run.exit_code) + "; log: " +
+                         geometry_log.string() + ")");
+  }
+  if (g_run.exit_code != 0) {
+    const std::string errors = detail::last_lines(g_log, "Err", 3);
+    throw InputError(step_file.string(), "STEP", "a STEP file that gmsh loads (OpenCASCADE)",
+                     "gmsh exit code " + std::to_string(g_run.exit_code) + (errors.empty() ? "" : ": " + errors) + " (log: " +
+                         geometry_log.string() + ")");
+  }
+  const detail::GeometryReport geometry = detail::parse_geometry_report(detail::read_file(w / "geometry.txt"), (w / "geometry.txt").string());
+  if (geometry.volumes.empty()) {
+    const std::string errors = detail::last_lines(g_log, "ERR", 2);
+    throw InputError(step_file.string(), "STEP", "a STEP file with at least one solid",
+                     "no volume" + (errors.empty() ? std::string() : " (" + errors + ")"));
+  }
+  copy_into(w / "geometry.txt", o.out / "geometry.txt");
+  const auto region_volumes = detail::assign_regions(geometry, o.regions, o.geometry_tolerance_mm);
+  {
+    std::string msg = "  " + std::to_string(geometry.volumes.size()) + " volume(s), " + std::to_string(geometry.surfaces.size()) + " faces;";
+    for (const auto& [name, vols] : region_volumes) msg += " " + name + ": " + std::to_string(vols.size()) + " volume(s);";
+    run.log(msg + " " + elapsed(g_run.seconds));
+  }
+
+  // 2. Remote points: faces.
+  std::vector<std::pair<std::string, std::vector<int>>> point_surfaces;
+  std::map<int, std::string> owner;
+  for (const RemotePointSpec& p : o.remote_points) {
+    const std::vector<int> faces = detail::select_faces(p.selector, geometry, o.geometry_tolerance_mm);
+    if (faces.empty()) {
+      throw InputError("--remote-point " + p.name, "selector", "'" + p.selector.to_string() + "' to select at least one face",
+                       "no face; " + detail::describe_planar_faces(geometry, o.geometry_tolerance_mm) +
+                           " (all faces with their bounding boxes: " + (o.out / "geometry.txt").string() + ")");
+    }
+    for (const int f : faces) {
+      const auto [it, fresh] = owner.emplace(f, p.name);
+      if (!fresh) {
+        throw InputError("--remote-point " + p.name, "selector", "faces of no other remote point",
+                         "surface " + std::to_string(f) + " also selected by " + it->second);
+      }
+    }
+    point_surfaces.emplace_back(p.name, faces);
+    std::string list;
+    for (const int f : faces) {
+      list += list.empty() ? "" : ",";
+      list += std::to_string(f);
+    }
+    run.log("  remote point " + p.name + " (" + p.selector.to_string() + "): surface " + list);
+  }
+
+  // 3. The mesh.
+  const char* const element = o.element_order == 2 ? "C3D10" : "C3D4";
+  {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "[2/6] meshing (gmsh, at most %g mm, %s)", o.mesh_size_mm, element);
+    run.log(buf);
+  }
+  const std::string mesh_geo = prelude + detail::mesh_script(region_volumes, point_surfaces, o.mesh_size_mm, o.element_order);
+  write_text(w / "mesh.geo", mesh_geo);
+  write_text(o.out / "mesh.geo", mesh_geo);
+  const fs::path mesh_log = o.out / "gmsh_mesh.log";
+  const auto m_run = run.run(r.gmsh, "gmsh", {"-3", "mesh.geo", "-format", "inp", "-o", "gmsh.inp"}, w, mesh_log, keep_gmsh_line);
+  step_done("gmsh mesh", m_run.seconds);
+  if (m_run.exit_code != 0 || !fs::exists(w / "gmsh.inp")) {
+    throw NumericalError("gmsh meshing", "exit code " + std::to_string(m_run.exit_code) + ": " +
+                                             detail::last_lines(detail::read_file(mesh_log), "Error", 3) + " (log: " + mesh_log.string() + ")",
+                         true);
+  }
+  const detail::GmshMesh mesh = detail::read_gmsh_inp(w / "gmsh.inp");
+  r.element_type = mesh.volume_type;
+  long max_node = 0;
+  for (const auto& [id, p] : mesh.nodes) max_node = std::max(max_node, id);
+  std::set<long> used_nodes;
+  for (const auto& [tag, elements] : mesh.volume_elements) {
+    r.mesh_elements += static_cast<Index>(elements.size());
+    for (const auto& e : elements) used_nodes.insert(e.begin() + 1, e.end());
+  }
+  r.mesh_nodes = static_cast<Index>(used_nodes.size());
+  for (const auto& [name, vols] : region_volumes) {
+    Index n = 0;
+    for (const int v : vols) {
+      const auto it = mesh.volume_elements.find(v);
+      if (it != mesh.volume_elements.end()) n += static_cast<Index>(it->second.size());
+    }
+    r.region_elements[name] = n;
+  }
+  std::vector<detail::DeckPoint> points;
+  std::map<long, std::string> node_owner;
+  for (std::size_t k = 0; k < point_surfaces.size(); ++k) {
+    const auto& [name, faces] = point_surfaces[k];
+    const detail::FacePatch patch = detail::face_patch(mesh, faces);
+    if (patch.nodes.size() < 3 || !(patch.area > 0.0)) {
+      throw InputError("--remote-point " + name, "faces", "meshed faces with at least 3 nodes",
+                       std::to_string(patch.nodes.size()) + " nodes (log: " + mesh_log.string() + ")");
+    }
+    for (const long n : patch.nodes) {
+      const auto [it, fresh] = node_owner.emplace(n, name);
+      if (!fresh) {
+        throw InputError("--remote-point " + name, "faces", "faces that do not touch the faces of another remote point",
+                         "node " + std::to_string(n) + " shared with " + it->second + " (a *RIGID BODY node can belong to one only)");
+      }
+    }
+    detail::DeckPoint dp;
+    dp.name = name;
+    dp.ref = max_node + 1 + 2 * static_cast<long>(k);
+    dp.rot = dp.ref + 1;
+    dp.position_m = 1e-3 * patch.centroid;
+    dp.nodes = patch.nodes;
+    points.push_back(dp);
+    RemotePointResult rp;
+    rp.name = name;
+    rp.selector = o.remote_points[k].selector;
+    rp.surfaces = faces;
+    rp.node = dp.ref;
+    rp.rot_node = dp.rot;
+    rp.position_m = dp.position_m;
+    rp.area_m2 = 1e-6 * patch.area;
+    rp.face_nodes = static_cast<Index>(patch.nodes.size());
+    r.remote_points.push_back(rp);
+  }
+  detail::write_mesh_inp(w / "mesh.inp", mesh, region_volumes, points);
+  copy_into(w / "mesh.inp", o.out / "mesh.inp");
+  {
+    std::string msg = "  " + std::to_string(r.mesh_nodes) + " nodes, " + std::to_string(r.mesh_elements) + " " + r.element_type +
+                      " elements (about " + std::to_string(3 * r.mesh_nodes) + " DOF);";
+    for (const auto& [name, n] : r.region_elements) msg += " " + name + " " + std::to_string(n) + ";";
+    run.log(msg + " " + elapsed(m_run.seconds));
+    for (const RemotePointResult& rp : r.remote_points) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "  remote point %s: node %ld (rotations on node %ld) at (%.6g, %.6g, %.6g) m, %lld face nodes",
+                    rp.name.c_str(), rp.node, rp.rot_node, rp.position_m.x(), rp.position_m.y(), rp.position_m.z(),
+                    static_cast<long long>(rp.face_nodes));
+      run.log(buf);
+    }
+  }
+
+  // 4. K and M from ccx.
+  std::vector<std::string> region_names;
+  for (const auto& [name, vols] : region_volumes) region_names.push_back(name);
+  const std::string deck = detail::ccx_deck("mesh.inp", o.materials, region_names, points, nullptr, 0,
+                                            "free-free K and M of " + step_file.filename().string() + " (*FREQUENCY,SOLVER=MATRIXSTORAGE)");
+  write_text(w / "matrices.inp", deck);
+  write_text(o.out / "matrices.inp", deck);
+  run.log("[3/6] assembling K and M (ccx *FREQUENCY,SOLVER=MATRIXSTORAGE)");
+  const fs::path ccx_log = o.out / "ccx_matrices.log";
+  const auto c_run = run.run(r.ccx, "ccx", {"-i", "matrices"}, w, ccx_log, keep_ccx_line);
+  step_done("ccx matrices", c_run.seconds);
+  if (c_run.exit_code != 0 || !fs::exists(w / "matrices.sti") || !fs::exists(w / "matrices.mas") || !fs::exists(w / "matrices.dof")) {
+    throw NumericalError("ccx (*FREQUENCY,SOLVER=MATRIXSTORAGE)",
+                         "exit code " + std::to_string(c_run.exit_code) + ": " + detail::last_lines(detail::read_file(ccx_log), "ERROR", 3) +
+                             " (log: " + ccx_log.string() + ", deck: " + (o.out / "matrices.inp").string() + ")",
+                         false);
+  }
+  run.log("  " + elapsed(c_run.seconds));
+
+  // 5. Reading and reduction.
+  run.log("[4/6] reading the matrices");
+  auto t0 = std::chrono::steady_clock::now();
+  double last_report = -1.0;
+  std::string last_step;
+  const ProgressCallback progress = [&](const std::string& step, double fraction) {
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::string key = step.substr(0, step.find(" ("));
+    if (key == last_step && (fraction >= 1.0 || now - last_report < 1.0)) return;
+    last_step = key;
+    last_report = now;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "  %6.1f s  %s", now, step.c_str());
+    run.log(buf);
+  };
+  SparseModel model = read_calculix_model(w / "matrices.sti", w / "matrices.mas", w / "matrices.dof", w / "mesh.inp", progress);
+  r.model_dofs = model.size();
+  step_done("read matrices", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (!o.keep_temp) {
+    // The dumps are the largest files (hundreds of MB at 2 mm); they are read now.
+    fs::remove(w / "matrices.sti", ec);
+    fs::remove(w / "matrices.mas", ec);
+  }
+  run.log("  " + std::to_string(model.size()) + " DOF, K with " + std::to_string(model.K.nonZeros()) + " nonzeros");
+
+  run.log("[5/6] Craig-Bampton reduction: " + std::to_string(6 * points.size()) + " interface DOF, " + std::to_string(o.modes) + " modes");
+  std::vector<InterfacePoint> interface;
+  for (const detail::DeckPoint& p : points) interface.push_back({p.ref, p.rot});
+  CraigBamptonOptions cb;
+  cb.modes = o.modes;
+  t0 = std::chrono::steady_clock::now();
+  last_step.clear();
+  cb.progress = progress;
+  r.reduction = craig_bampton(model, interface, cb);
+  model = SparseModel{};  // free the large matrices
+  r.reduced = std::move(r.reduction.reduced);
+  r.reduction.reduced = SuperElement{};
+  r.reduced.source = step_file.filename().string() + " (gmsh " + r.element_type + " mesh, ccx " + r.ccx.version + ", Craig-Bampton: " +
+                     std::to_string(r.reduction.interface_dofs) + " interface DOF, " + std::to_string(o.modes) + " modes)";
+  step_done("craig-bampton", r.reduction.seconds);
+  run.log("  " + elapsed(r.reduction.seconds));
+
+  // Clamped and free modes of the reduced model.
+  const detail::DeckPoint* clamp = nullptr;
+  for (const detail::DeckPoint& p : points) {
+    if (detail::upper(p.name) == detail::upper(o.clamp)) clamp = &p;
+  }
+  r.clamp = clamp->name;
+  ModelOptions bc;
+  bc.fixed_nodes = {clamp->ref};
+  const Modes clamped = modes(assemble(r.reduced, bc));
+  r.modes_clamped_Hz = clamped.frequencies_Hz.head(std::min<Index>(o.clamped_modes, clamped.frequencies_Hz.size()));
+  const Modes free = modes(r.reduced.K, r.reduced.M);
+  r.free_modes_Hz = free.frequencies_Hz.head(std::min<Index>(6 + o.clamped_modes, free.frequencies_Hz.size()));
+
+  // 6. Outputs.
+  run.log("[6/6] writing the super element into " + o.out.string());
+  r.files = write_super_element(o.out, stem, r.reduced);
+  r.files.push_back(write_simscape(o.out, stem, r.reduced));
+  for (const char* f : {"geometry.txt", "mesh.geo", "mesh.inp", "matrices.inp", "gmsh_geometry.log", "gmsh_mesh.log", "ccx_matrices.log"}) {
+    r.files.push_back(o.out / f);
+  }
+
+  if (o.verify) {
+    const std::string ref_deck = detail::ccx_deck("mesh.inp", o.materials, region_names, points, clamp, o.clamped_modes,
+                                                  "reference: remote point " + clamp->name + " clamped, ccx *FREQUENCY on the full mesh");
+    write_text(w / "reference.inp", ref_deck);
+    write_text(o.out / "reference.inp", ref_deck);
+    run.log("[verify] ccx *FREQUENCY on the full mesh, " + clamp->name + " clamped, " + std::to_string(o.clamped_modes) + " modes");
+    const fs::path ref_log = o.out / "ccx_reference.log";
+    const auto v_run = run.run(r.ccx, "ccx", {"-i", "reference"}, w, ref_log, keep_ccx_line);
+    step_done("ccx reference", v_run.seconds);
+    if (v_run.exit_code != 0 || !fs::exists(w / "reference.dat")) {
+      throw NumericalError("ccx (*FREQUENCY, reference)",
+                           "exit code " + std::to_string(v_run.exit_code) + ": " + detail::last_lines(detail::read_file(ref_log), "ERROR", 3) +
+                               " (log: " + ref_log.string() + ")",
+                           false);
+    }
+    const std::vector<double> f = detail::read_ccx_frequencies(w / "reference.dat");
+    copy_into(w / "reference.dat", o.out / "reference.dat");
+    r.reference_modes_Hz = Eigen::Map<const Eigen::VectorXd>(f.data(), static_cast<Index>(f.size()));
+    for (const char* name : {"reference.inp", "reference.dat", "ccx_reference.log"}) r.files.push_back(o.out / name);
+    run.log("  " + elapsed(v_run.seconds));
+  }
+  step_done("total", std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count());
+  return r;
+}
+
+}  // namespace piezobench::fem
