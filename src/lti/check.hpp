@@ -35,14 +35,15 @@ void require_finite(const Eigen::DenseBase<Derived>& m, const std::string& sourc
       using std::isfinite;
       const auto v = m(i, j);
       bool finite = true;
-      std::ostringstream found;
-      found.precision(10);
       if constexpr (Eigen::NumTraits<typename Derived::Scalar>::IsComplex) {
         finite = isfinite(v.real()) && isfinite(v.imag());
       } else {
         finite = isfinite(v);
       }
       if (!finite) {
+        // Built only on failure: validating a finite matrix allocates nothing.
+        std::ostringstream found;
+        found.precision(10);
         found << v;
         const std::string name = m.cols() == 1 ? entry(field, i) : entry(field, i, j);
         throw InputError(source, name, "a finite value", found.str());

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
@@ -310,6 +311,102 @@ TEST(WelchErrors, NanIsReportedWithItsChannelAndIndex) {
     EXPECT_NE(what.find("bench.mat"), std::string::npos) << what;
     EXPECT_NE(what.find("NaN at sample 42"), std::string::npos) << what;
   }
+}
+
+// Non-finite samples are not checked in a pass of their own: the samples after the last segment
+// are checked up front and the spectral sums at the end, and only then are the channels scanned,
+// in order (input first), for the message. These records have 200,000 samples; nfft = 30000 with
+// 50 % overlap gives 12 segments covering samples [0, 195000).
+struct LongRecord {
+  static constexpr Index kN = 200000;
+  static constexpr Index kCovered = 195000;
+  VectorXd u, y1, y2;
+  WelchOptions options;
+  LongRecord() : u(kN), y1(kN), y2(kN) {
+    for (Index k = 0; k < kN; ++k) {
+      const double x = static_cast<double>(k);
+      u(k) = std::sin(0.013 * x) + 0.3 * std::cos(0.071 * x);
+      y1(k) = 0.5 * std::sin(0.013 * x + 0.2);
+      y2(k) = std::cos(0.0031 * x);
+    }
+    options.nfft = 30000;
+    options.overlap = 0.5;
+  }
+  // The InputError message of estimate_frf on (u; y1, y2), which must name `field`.
+  std::string error(const std::string& field) const {
+    return test::input_error(
+        [&] { (void)estimate_frf(channel("u", u), {channel("y1", y1), channel("y2", y2)}, 1e4, options, "rec.mat"); },
+        field);
+  }
+};
+
+TEST(WelchErrors, NonFiniteSamplesAfterTheLastSegmentAreReported) {
+  LongRecord r;
+  ASSERT_EQ((LongRecord::kN - r.options.nfft) / (r.options.nfft - r.options.noverlap()) + 1, 12);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  r.y2(LongRecord::kCovered) = nan;  // first sample no segment reaches
+  EXPECT_EQ(r.error("y2"), "rec.mat: y2: expected finite samples, found NaN at sample 195000 (0-based)");
+  r.y2(LongRecord::kCovered) = 0.0;
+  r.y1(LongRecord::kN - 1) = -std::numeric_limits<double>::infinity();  // the very last sample
+  EXPECT_EQ(r.error("y1"), "rec.mat: y1: expected finite samples, found Inf at sample 199999 (0-based)");
+  r.u(LongRecord::kN - 2) = nan;  // the input is reported first
+  EXPECT_EQ(r.error("u"), "rec.mat: u: expected finite samples, found NaN at sample 199998 (0-based)");
+  // welch_psd (no outputs) checks its tail as well.
+  VectorXd x = r.u;
+  x(LongRecord::kN - 2) = 0.0;
+  x(LongRecord::kCovered + 7) = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(test::contains(test::input_error([&] { (void)welch_psd(x, 1e4, r.options); }, "x"),
+                             "Inf at sample 195007 (0-based)"));
+}
+
+TEST(WelchErrors, NonFiniteSamplesInsideSegmentsNameTheChannelInputFirst) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (Detrend detrend : {Detrend::kNone, Detrend::kMean, Detrend::kLinear}) {
+    for (int threads : {1, 2}) {
+      SCOPED_TRACE(to_string(detrend) + ", " + std::to_string(threads) + " thread(s)");
+      LongRecord r;
+      r.options.detrend = detrend;
+      r.options.threads = threads;
+      // Each bad sample alone (only the spectral sums can reveal it): that channel and sample.
+      const auto alone = [&](VectorXd LongRecord::*channel_of, const std::string& name, Index k, double value,
+                             const std::string& found) {
+        LongRecord bad = r;
+        (bad.*channel_of)(k) = value;
+        EXPECT_EQ(bad.error(name), "rec.mat: " + name + ": expected finite samples, found " + found + " at sample " +
+                                       std::to_string(k) + " (0-based)");
+      };
+      alone(&LongRecord::y2, "y2", 1000, inf, "Inf");
+      alone(&LongRecord::y1, "y1", 150000, nan, "NaN");
+      alone(&LongRecord::u, "u", 194999, nan, "NaN");  // the last sample of the last segment
+      // Sample 0 is in one segment only, where the periodic Hann window is exactly 0.
+      alone(&LongRecord::u, "u", 0, -inf, "Inf");
+      alone(&LongRecord::y1, "y1", 0, nan, "NaN");
+      // Several bad channels: the input first, then the outputs in order, whatever the indices.
+      r.y2(1000) = inf;
+      r.y1(150000) = nan;
+      EXPECT_EQ(r.error("y1"), "rec.mat: y1: expected finite samples, found NaN at sample 150000 (0-based)");
+      r.u(194999) = nan;
+      EXPECT_EQ(r.error("u"), "rec.mat: u: expected finite samples, found NaN at sample 194999 (0-based)");
+    }
+  }
+}
+
+// Finite samples whose spectral sums overflow (|x| ~ 1e200: |X|^2 > DBL_MAX) are valid input:
+// cross_spectra does not report them as non-finite samples (welch.cpp returns the sums as they
+// are), so the densities hold +Inf, never NaN, and no InputError is thrown.
+TEST(Welch, OverflowingSumsOfFiniteSamplesAreNotReportedAsNonFiniteInput) {
+  LongRecord r;
+  const VectorXd big = r.u * 1e200;
+  ASSERT_TRUE(big.allFinite());
+  VectorXd psd;
+  EXPECT_NO_THROW(psd = welch_psd(big, 1e4, r.options));
+  ASSERT_EQ(psd.size(), r.options.nfft / 2 + 1);
+  EXPECT_FALSE(psd.array().isNaN().any());
+  EXPECT_TRUE((psd.array() == std::numeric_limits<double>::infinity()).any());
+  // The same samples scaled down by 1e-200 give finite densities (1e-400 times these).
+  const VectorXd small = welch_psd(r.u, 1e4, r.options);
+  EXPECT_TRUE(small.allFinite());
+  EXPECT_NO_THROW((void)cross_spectra(channel("u", big), {channel("y", r.y1)}, 1e4, r.options, "rec.mat"));
 }
 
 TEST(WelchErrors, ShortRecordDifferentLengthsZeroInputAndBadRate) {

@@ -7,6 +7,8 @@
 
 #include <csignal>
 #include <fstream>
+#include <limits>
+#include <tuple>
 #include <nlohmann/json.hpp>
 
 #include "io/file_util.hpp"
@@ -306,6 +308,162 @@ TEST(TimeSeriesValidation, EmptyAndNonMonotonicTime) {
   write_raw_mat(back, {{"t", t}, {"a", Eigen::VectorXd::Ones(8)}});
   const std::string msg = input_error([&] { (void)read_timeseries(back); });
   EXPECT_TRUE(contains(msg, ": t: ") && contains(msg, "strictly increasing") && contains(msg, "t[4]")) << msg;
+}
+
+// ---- large records: the reader takes .mat channels in pieces of 2^15 samples (256 kB) and checks
+// each piece as it arrives; a problem anywhere, in particular across a piece boundary, must give
+// the same message as a full scan. 200,000 samples = 6 whole pieces and a partial 7th.
+
+constexpr Eigen::Index kLarge = 200000;
+constexpr Eigen::Index kPiece = Eigen::Index{1} << 15;
+constexpr double kLargeFs = 10000.0;
+
+Eigen::VectorXd large_time() {
+  Eigen::VectorXd t(kLarge);
+  for (Eigen::Index k = 0; k < kLarge; ++k) t(k) = static_cast<double>(k) / kLargeFs;
+  return t;
+}
+
+// Distinct values at every sample, so a piece read to the wrong place cannot go unnoticed.
+Eigen::VectorXd large_channel(double phase) {
+  Eigen::VectorXd x(kLarge);
+  for (Eigen::Index k = 0; k < kLarge; ++k) x(k) = std::sin(1e-3 * static_cast<double>(k) + phase) + 1e-6 * static_cast<double>(k);
+  return x;
+}
+
+const char* version_name(bool v73) { return v73 ? "v7.3" : "v5"; }
+
+TEST(TimeSeriesLargeMat, NanLateInAChannelAndInfAtTheLastSampleNameFileChannelAndSample) {
+  TempDir dir;
+  const Eigen::VectorXd t = large_time(), a = large_channel(0.0), b = large_channel(1.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    const char* channel;  // "a" or "b"
+    Eigen::Index index;
+    double value;
+    const char* found;
+  };
+  const Case cases[] = {
+      {"b", 100000, nan, "NaN at sample 100000"},           // in the 4th piece
+      {"b", kLarge - 1, inf, "Inf at sample 199999"},       // the very last sample (partial piece)
+      {"a", kLarge - 1, -inf, "-Inf at sample 199999"},     // first channel, sign kept
+      {"a", kPiece, nan, "NaN at sample 32768"},            // first sample of the 2nd piece
+      {"b", kPiece - 1, inf, "Inf at sample 32767"},        // last sample of the 1st piece
+  };
+  for (bool v73 : {false, true}) {
+    for (const Case& c : cases) {
+      SCOPED_TRACE(std::string(version_name(v73)) + " " + c.channel + " " + c.found);
+      Eigen::VectorXd bad = std::string(c.channel) == "a" ? a : b;
+      bad(c.index) = c.value;
+      const fs::path file = dir.path() / "late.mat";
+      write_raw_mat(file, {{"t", t}, {"a", std::string(c.channel) == "a" ? bad : a}, {"b", std::string(c.channel) == "b" ? bad : b}},
+                    v73);
+      const std::string msg = input_error([&] { (void)read_timeseries(file); }, c.channel);
+      EXPECT_EQ(msg, file.string() + ": " + c.channel + ": expected finite samples, found " + c.found);
+    }
+  }
+}
+
+TEST(TimeSeriesLargeMat, TimeRepeatingOrJitteringAtAPieceBoundary) {
+  TempDir dir;
+  const Eigen::VectorXd t = large_time(), a = large_channel(0.0);
+  const double jitter = 1e-3 / kLargeFs;  // 1e-3 sample periods, 1000x the default tolerance
+  for (bool v73 : {false, true}) {
+    SCOPED_TRACE(version_name(v73));
+    const fs::path file = dir.path() / "t.mat";
+    const auto message = [&](const Eigen::VectorXd& bad_t) {
+      write_raw_mat(file, {{"t", bad_t}, {"a", a}}, v73);
+      return input_error([&] { (void)read_timeseries(file); }, "t");
+    };
+    // Repeats: the step t[k] - t[k-1] that crosses from one piece to the next, and the last one.
+    for (Eigen::Index k : {kPiece, 2 * kPiece, kLarge - 1}) {
+      Eigen::VectorXd bad = t;
+      bad(k) = bad(k - 1);
+      const std::string msg = message(bad);
+      EXPECT_TRUE(contains(msg, file.string() + ": t: expected a strictly increasing time vector") &&
+                  contains(msg, "found t[" + std::to_string(k) + "] = ") &&
+                  contains(msg, " after t[" + std::to_string(k - 1) + "] = "))
+          << k << ": " << msg;
+    }
+    // Jitter on the last sample of a piece, the first of the next, and the last sample checked
+    // for uniformity (the very last one defines dt).
+    for (const auto& [k, sign] : {std::pair{kPiece - 1, 1.0}, std::pair{kPiece, -1.0}, std::pair{3 * kPiece, 1.0},
+                                  std::pair{kLarge - 2, -1.0}}) {
+      Eigen::VectorXd bad = t;
+      bad(k) += sign * jitter;
+      const std::string msg = message(bad);
+      EXPECT_TRUE(contains(msg, file.string() + ": t: expected uniform sampling (deviation <= 1e-06 sample periods)") &&
+                  contains(msg, "found t[" + std::to_string(k) + "] = ") && contains(msg, "periods away from uniform"))
+          << k << " " << sign << ": " << msg;
+    }
+    // Below the tolerance: accepted, and the rate is the end-to-end one.
+    Eigen::VectorXd fine = t;
+    fine(kPiece) += 1e-8 / kLargeFs;
+    write_raw_mat(file, {{"t", fine}, {"a", a}}, v73);
+    const TimeSeries ts = read_timeseries(file);
+    EXPECT_EQ(ts.sample_rate, 1.0 / ((t(kLarge - 1) - t(0)) / static_cast<double>(kLarge - 1)));
+    EXPECT_EQ(ts.t, fine);
+  }
+}
+
+TEST(TimeSeriesLargeMat, NanOrInfInTimeNamesTAndTheSample) {
+  TempDir dir;
+  const Eigen::VectorXd t = large_time(), a = large_channel(0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (bool v73 : {false, true}) {
+    SCOPED_TRACE(version_name(v73));
+    const fs::path file = dir.path() / "tnan.mat";
+    for (const auto& [k, value, found] : {std::tuple{Eigen::Index{100000}, nan, "NaN at sample 100000"},
+                                          std::tuple{kPiece, inf, "Inf at sample 32768"},
+                                          std::tuple{Eigen::Index{0}, -inf, "-Inf at sample 0"},
+                                          std::tuple{kLarge - 1, nan, "NaN at sample 199999"}}) {
+      Eigen::VectorXd bad = t;
+      bad(k) = value;
+      write_raw_mat(file, {{"t", bad}, {"a", a}}, v73);
+      EXPECT_EQ(input_error([&] { (void)read_timeseries(file); }, "t"),
+                file.string() + ": t: expected finite samples, found " + found);
+    }
+  }
+}
+
+// A 1xN variable (MATLAB's row vector), as written by `x = x.'; save`.
+detail::MatVarPtr make_real_row(const std::string& name, const Eigen::VectorXd& v) {
+  size_t dims[2] = {1, static_cast<size_t>(v.size())};
+  detail::MatVarPtr var(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, const_cast<double*>(v.data()), 0));
+  if (!var) throw std::runtime_error("Mat_VarCreate failed for " + name);
+  return var;
+}
+
+TEST(TimeSeriesLargeMat, RowVectorsAreReadExactlyAcrossPieces) {
+  TempDir dir;
+  const Eigen::VectorXd t = large_time(), a = large_channel(0.0), r = large_channel(2.0);
+  for (bool v73 : {false, true}) {
+    for (bool t_row : {false, true}) {
+      SCOPED_TRACE(std::string(version_name(v73)) + (t_row ? " row t" : " column t"));
+      const fs::path file = dir.path() / "row.mat";
+      detail::write_mat_atomically(file, v73, false, [&](detail::MatWriter& w) {
+        w.write(t_row ? make_real_row("t", t) : detail::make_real_column("t", t));
+        w.write(detail::make_real_column("a", a));
+        w.write(make_real_row("r", r));
+      });
+      const TimeSeries ts = read_timeseries(file);
+      ASSERT_EQ(ts.names, (std::vector<std::string>{"a", "r"}));
+      EXPECT_EQ(ts.t, t);
+      EXPECT_EQ(ts.data.col(0), a);
+      EXPECT_EQ(ts.data.col(1), r);
+      EXPECT_EQ(ts.sample_rate, 1.0 / ((t(kLarge - 1) - t(0)) / static_cast<double>(kLarge - 1)));
+      // A NaN in a row vector is found at the same sample.
+      Eigen::VectorXd bad = r;
+      bad(3 * kPiece + 5) = std::numeric_limits<double>::quiet_NaN();
+      detail::write_mat_atomically(file, v73, false, [&](detail::MatWriter& w) {
+        w.write(t_row ? make_real_row("t", t) : detail::make_real_column("t", t));
+        w.write(detail::make_real_column("a", a));
+        w.write(make_real_row("r", bad));
+      });
+      EXPECT_EQ(input_error([&] { (void)read_timeseries(file); }, "r"),
+                file.string() + ": r: expected finite samples, found NaN at sample 98309");
+    }
+  }
 }
 
 TEST(TimeSeriesValidation, MalformedCsvFiles) {
