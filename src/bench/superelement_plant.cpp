@@ -9,22 +9,13 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "piezobench/io/toml_describe.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::bench::detail {
 namespace {
 
-std::string describe(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer:
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::table: return "a table";
-    default: return "a date or time";
-  }
-}
+using io::describe_toml;
 
 class Keys {
  public:
@@ -42,13 +33,13 @@ class Keys {
   std::string string(const char* key, bool required, const std::string& fallback = "") {
     const toml::node* n = required ? &this->required(key) : find(key);
     if (n == nullptr) return fallback;
-    if (!n->is_string()) throw InputError(source_, key, "a string", describe(*n));
+    if (!n->is_string()) throw InputError(source_, key, "a string", describe_toml(*n));
     return *n->value<std::string>();
   }
   double number(const char* key, double fallback) {
     const toml::node* n = find(key);
     if (n == nullptr) return fallback;
-    if (!n->is_number()) throw InputError(source_, key, "a number", describe(*n));
+    if (!n->is_number()) throw InputError(source_, key, "a number", describe_toml(*n));
     const double v = *n->value<double>();
     if (!std::isfinite(v)) throw InputError(source_, key, "a finite number", fmt::format("{}", v));
     return v;
@@ -56,7 +47,7 @@ class Keys {
   bool boolean(const char* key, bool fallback) {
     const toml::node* n = find(key);
     if (n == nullptr) return fallback;
-    if (!n->is_boolean()) throw InputError(source_, key, "true or false", describe(*n));
+    if (!n->is_boolean()) throw InputError(source_, key, "true or false", describe_toml(*n));
     return *n->value<bool>();
   }
   std::vector<long> nodes(const char* key) {
@@ -67,11 +58,11 @@ class Keys {
     } else if (const toml::array* a = n.as_array()) {
       for (std::size_t i = 0; i < a->size(); ++i) {
         const toml::node& e = *a->get(i);
-        if (!e.is_integer()) throw InputError(source_, fmt::format("{}[{}]", key, i), "a node number", describe(e));
+        if (!e.is_integer()) throw InputError(source_, fmt::format("{}[{}]", key, i), "a node number", describe_toml(e));
         out.push_back(static_cast<long>(*e.value<std::int64_t>()));
       }
     } else {
-      throw InputError(source_, key, "a node number or an array of node numbers", describe(n));
+      throw InputError(source_, key, "a node number or an array of node numbers", describe_toml(n));
     }
     if (out.empty()) throw InputError(source_, key, "at least one node", "an empty array");
     return out;

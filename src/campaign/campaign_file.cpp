@@ -9,6 +9,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "piezobench/io/toml_describe.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::campaign {
@@ -78,17 +79,7 @@ bool UnitSpec::has(Experiment e) const {
 
 namespace {
 
-std::string describe(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer:
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::array: return "an array of " + std::to_string(node.as_array()->size());
-    case toml::node_type::table: return "a table";
-    default: return "a date or time";
-  }
-}
+using io::describe_toml;
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -133,7 +124,7 @@ class Reader {
 
   [[nodiscard]] double number(const std::string& k, const toml::node& node) const {
     const auto v = node.value<double>();
-    if (!node.is_number() || !v) throw InputError(source_, key(k), "a number", describe(node));
+    if (!node.is_number() || !v) throw InputError(source_, key(k), "a number", describe_toml(node));
     if (!std::isfinite(*v)) throw InputError(source_, key(k), "a finite number", fmt::format("{}", *v));
     return *v;
   }
@@ -154,12 +145,12 @@ class Reader {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
     const auto v = n->value<int64_t>();
-    if (!n->is_integer() || !v) throw InputError(source_, key(k), "an integer", describe(*n));
+    if (!n->is_integer() || !v) throw InputError(source_, key(k), "an integer", describe_toml(*n));
     return static_cast<long>(*v);
   }
   [[nodiscard]] std::string string(const std::string& k, const toml::node& node) const {
     const auto v = node.value<std::string>();
-    if (!node.is_string() || !v) throw InputError(source_, key(k), "a string", describe(node));
+    if (!node.is_string() || !v) throw InputError(source_, key(k), "a string", describe_toml(node));
     return *v;
   }
   [[nodiscard]] std::optional<std::string> string(const std::string& k) const {
@@ -170,13 +161,13 @@ class Reader {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
     const auto v = n->value<bool>();
-    if (!n->is_boolean() || !v) throw InputError(source_, key(k), "true or false", describe(*n));
+    if (!n->is_boolean() || !v) throw InputError(source_, key(k), "true or false", describe_toml(*n));
     return *v;
   }
   [[nodiscard]] const toml::table* table(const std::string& k) const {
     const toml::node* n = get(k);
     if (!n) return nullptr;
-    if (!n->is_table()) throw InputError(source_, key(k), "a table", describe(*n));
+    if (!n->is_table()) throw InputError(source_, key(k), "a table", describe_toml(*n));
     return n->as_table();
   }
   // [min, max] scaled by `scale`.
@@ -184,7 +175,7 @@ class Reader {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
     const toml::array* a = n->as_array();
-    if (!a || a->size() != 2) throw InputError(source_, key(k), "[min, max]", describe(*n));
+    if (!a || a->size() != 2) throw InputError(source_, key(k), "[min, max]", describe_toml(*n));
     metrology::Range r{number(k + "[0]", (*a)[0]) * scale, number(k + "[1]", (*a)[1]) * scale};
     if (!(r.min <= r.max)) throw InputError(source_, key(k), "[min, max] with min <= max", fmt::format("[{}, {}]", r.min / scale, r.max / scale));
     return r;
@@ -194,7 +185,7 @@ class Reader {
     const toml::node* n = get(k);
     if (!n) return out;
     const toml::array* a = n->as_array();
-    if (!a) throw InputError(source_, key(k), "an array of strings", describe(*n));
+    if (!a) throw InputError(source_, key(k), "an array of strings", describe_toml(*n));
     for (std::size_t i = 0; i < a->size(); ++i) out.push_back(string(k + "[" + std::to_string(i) + "]", (*a)[i]));
     return out;
   }
@@ -279,7 +270,7 @@ FileSpec read_file_spec(const Context& ctx, const Reader& unit, const std::strin
       }
     }
   } else {
-    throw InputError(ctx.source, f.key, "a file name or a table {file = ..., channels = {...}}", describe(node));
+    throw InputError(ctx.source, f.key, "a file name or a table {file = ..., channels = {...}}", describe_toml(node));
   }
   f.path = resolve(ctx, f.given, f.key + (node.is_table() ? ".file" : ""));
   return f;
@@ -474,10 +465,10 @@ SuperElementSpec read_superelement(const Context& ctx, const Reader& r) {
   s.coordinates_file = file("coordinates_file", false);
   if (const toml::node* n = r.get("fix")) {
     const toml::array* a = n->as_array();
-    if (!a) throw InputError(ctx.source, r.key("fix"), "an array of node numbers", describe(*n));
+    if (!a) throw InputError(ctx.source, r.key("fix"), "an array of node numbers", describe_toml(*n));
     for (std::size_t i = 0; i < a->size(); ++i) {
       const auto v = (*a)[i].value<int64_t>();
-      if (!(*a)[i].is_integer() || !v) throw InputError(ctx.source, r.key("fix") + "[" + std::to_string(i) + "]", "a node number", describe((*a)[i]));
+      if (!(*a)[i].is_integer() || !v) throw InputError(ctx.source, r.key("fix") + "[" + std::to_string(i) + "]", "a node number", describe_toml((*a)[i]));
       s.fix.push_back(static_cast<long>(*v));
     }
   }
@@ -521,11 +512,11 @@ Campaign parse_campaign(const std::string& text, const fs::path& file, bool chec
   const toml::node* units = r.get("units");
   if (!units) throw InputError(source, "units", "at least one [[units]] entry", "none");
   const toml::array* list = units->as_array();
-  if (!list || list->empty()) throw InputError(source, "units", "an array of [[units]] tables", describe(*units));
+  if (!list || list->empty()) throw InputError(source, "units", "an array of [[units]] tables", describe_toml(*units));
   std::map<int, std::string> seen;
   for (std::size_t i = 0; i < list->size(); ++i) {
     const toml::table* t = (*list)[i].as_table();
-    if (!t) throw InputError(source, "units[" + std::to_string(i) + "]", "a table", describe((*list)[i]));
+    if (!t) throw InputError(source, "units[" + std::to_string(i) + "]", "a table", describe_toml((*list)[i]));
     UnitSpec u = read_unit(ctx, *t, i);
     if (const auto it = seen.find(u.id); it != seen.end()) {
       throw InputError(source, u.key + ".id", fmt::format("a unit id not listed before ({} has id {})", it->second, u.id),

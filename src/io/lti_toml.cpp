@@ -7,13 +7,13 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/toml_describe.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 
 namespace piezobench::io {
-namespace {
 
-std::string describe(const toml::node& node) {
+std::string describe_toml(const toml::node& node) {
   switch (node.type()) {
     case toml::node_type::string: return "a string";
     case toml::node_type::integer:
@@ -25,6 +25,8 @@ std::string describe(const toml::node& node) {
   }
 }
 
+namespace {
+
 class Reader {
  public:
   Reader(const toml::table& table, std::string source) : table_(table), source_(std::move(source)) {}
@@ -33,7 +35,7 @@ class Reader {
 
   [[nodiscard]] double number(const std::string& key, const toml::node& node) const {
     const auto value = node.value<double>();
-    if (!node.is_number() || !value) throw InputError(source_, key, "a number", describe(node));
+    if (!node.is_number() || !value) throw InputError(source_, key, "a number", describe_toml(node));
     if (!std::isfinite(*value)) throw InputError(source_, key, "a finite number", std::to_string(*value));
     return *value;
   }
@@ -42,7 +44,7 @@ class Reader {
 
   [[nodiscard]] const toml::array& array(const std::string& key, const toml::node& node) const {
     const toml::array* a = node.as_array();
-    if (a == nullptr) throw InputError(source_, key, "an array", describe(node));
+    if (a == nullptr) throw InputError(source_, key, "an array", describe_toml(node));
     return *a;
   }
 
@@ -62,7 +64,7 @@ class Reader {
       const std::string k = key_at(key, i);
       if (a[i].is_array()) {
         const toml::array& pair = *a[i].as_array();
-        if (pair.size() != 2) throw InputError(source_, k, "a number or a pair [re, im]", describe(a[i]));
+        if (pair.size() != 2) throw InputError(source_, k, "a number or a pair [re, im]", describe_toml(a[i]));
         v(static_cast<lti::Index>(i)) = lti::Complex(number(k + "[0]", pair[0]), number(k + "[1]", pair[1]));
       } else {
         v(static_cast<lti::Index>(i)) = number(k, a[i]);
@@ -132,7 +134,7 @@ LtiFile build(const toml::table& table, const std::string& source) {
   LtiFile out;
   if (const auto* d = table.get("description")) {
     const auto text = d->value<std::string>();
-    if (!text) throw InputError(source, "description", "a string", describe(*d));
+    if (!text) throw InputError(source, "description", "a string", describe_toml(*d));
     out.description = *text;
   }
   auto require = [&](const char* key) {

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/toml_describe.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "test_util.hpp"
 
@@ -27,6 +28,17 @@ std::string error_of(const std::string& text) {
     return e.what();
   }
   return "no error";
+}
+
+TEST(TomlDescribe, NamesEachKindOfValue) {
+  const toml::table t = toml::parse("s = 'x'\ni = 3\nf = 1.5\nb = true\na = [1, 2, 3]\nt = {}\nd = 2024-01-01\n");
+  EXPECT_EQ(describe_toml(*t.get("s")), "a string");
+  EXPECT_EQ(describe_toml(*t.get("i")), "a number");
+  EXPECT_EQ(describe_toml(*t.get("f")), "a number");
+  EXPECT_EQ(describe_toml(*t.get("b")), "a boolean");
+  EXPECT_EQ(describe_toml(*t.get("a")), "an array of 3");
+  EXPECT_EQ(describe_toml(*t.get("t")), "a table");
+  EXPECT_EQ(describe_toml(*t.get("d")), "a date or time");
 }
 
 TEST(LtiToml, TransferFunctionMatchesItsPolynomials) {
