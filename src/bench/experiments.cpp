@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 #include <span>
+#include <utility>
 
 #include "bench/flatness.hpp"
 #include "bench/random.hpp"
@@ -265,24 +266,36 @@ io::TimeSeries stiffness(const UnitTruth& unit, const ExperimentOptions& o, std:
   return ts;
 }
 
-io::TimeSeries frf_noise(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
-  const BenchOptions& b = o.bench;
-  const double duration = o.duration.value_or(20.0);
-  const double va_rms = o.amplitude.value_or(2.0);
+// Band-limited noise on u (0.1 Hz or 1/duration .. 2 kHz) of va_rms volts rms at the stacks, checked
+// against the stack voltage range, with the options that made it. Shared by frf-noise and iff.
+struct StackNoise {
+  dsp::NoiseOptions options;
+  dsp::Excitation excitation;
+};
+StackNoise stack_noise(const BenchOptions& b, double duration, double va_rms, std::uint64_t noise_seed) {
   dsp::NoiseOptions no;
   no.sample_rate = b.sample_rate;
   no.samples = static_cast<Eigen::Index>(std::llround(duration * b.sample_rate));
   no.f_low = std::max(0.1, b.sample_rate / static_cast<double>(std::max<Eigen::Index>(no.samples, 1)));
   no.f_high = std::min(2000.0, 0.4 * b.sample_rate);
   no.rms = va_rms / b.amplifier_gain;
-  no.seed = detail::derive_seed(seed, stream(Experiment::kFrfNoise, 1));
+  no.seed = noise_seed;
   if (no.samples < 2 || no.f_low >= no.f_high) {
     throw InputError(kSource, "duration", "a record long enough for the noise band (at least 2 samples)",
                      fmt::format("{:g} s", duration));
   }
-  dsp::VoltageBounds loose{-1e300, 1e300, dsp::BoundsPolicy::kReject};
-  const dsp::Excitation ex = dsp::band_limited_noise(no, loose);
+  dsp::Excitation ex = dsp::band_limited_noise(no, {-1e300, 1e300, dsp::BoundsPolicy::kReject});
   check_range(ex.u, b, fmt::format("a noise of {:g} V rms at the stacks", va_rms));
+  return {no, std::move(ex)};
+}
+
+io::TimeSeries frf_noise(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double duration = o.duration.value_or(20.0);
+  const double va_rms = o.amplitude.value_or(2.0);
+  const StackNoise noise = stack_noise(b, duration, va_rms, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 1)));
+  const dsp::NoiseOptions& no = noise.options;
+  const dsp::Excitation& ex = noise.excitation;
   VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 0)));
   io::TimeSeries ts = make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, ex.u.size(), b.sample_rate, true);
   ts.data.col(0) = ex.u;
@@ -335,19 +348,9 @@ io::TimeSeries iff(const UnitTruth& unit, const ExperimentOptions& o, std::uint6
   const double duration = o.duration.value_or(10.0);
   const double va_rms = o.amplitude.value_or(2.0);
   const double gain = o.gain.value_or(280000.0);
-  dsp::NoiseOptions no;
-  no.sample_rate = b.sample_rate;
-  no.samples = static_cast<Eigen::Index>(std::llround(duration * b.sample_rate));
-  no.f_low = std::max(0.1, b.sample_rate / static_cast<double>(std::max<Eigen::Index>(no.samples, 1)));
-  no.f_high = std::min(2000.0, 0.4 * b.sample_rate);
-  no.rms = va_rms / b.amplifier_gain;
-  no.seed = detail::derive_seed(seed, stream(Experiment::kIff, 1));
-  if (no.samples < 2 || no.f_low >= no.f_high) {
-    throw InputError(kSource, "duration", "a record long enough for the noise band (at least 2 samples)",
-                     fmt::format("{:g} s", duration));
-  }
-  const dsp::Excitation ex = dsp::band_limited_noise(no, {-1e300, 1e300, dsp::BoundsPolicy::kReject});
-  check_range(ex.u, b, fmt::format("a noise of {:g} V rms at the stacks", va_rms));
+  const StackNoise noise = stack_noise(b, duration, va_rms, detail::derive_seed(seed, stream(Experiment::kIff, 1)));
+  const dsp::NoiseOptions& no = noise.options;
+  const dsp::Excitation& ex = noise.excitation;
   VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kIff, 0)));
   control::DiscreteIffOptions co;
   co.sample_rate = b.sample_rate;
