@@ -24,7 +24,7 @@ struct SimulateOptions {
   CLI::Option* amplitude_option = nullptr;
   CLI::Option* duration_option = nullptr;
   CLI::Option* gain_option = nullptr;
-  bool no_delay = false, no_nmp_zero = false, no_hysteresis = false, no_creep = false, no_noise = false;
+  bool no_delay = false, no_nmp_zero = false, no_resistor = false, open_circuit = false, no_hysteresis = false, no_creep = false, no_noise = false;
   std::string superelement;
   bool json = false;
 };
@@ -61,6 +61,8 @@ int run_simulate(const SimulateOptions& o) {
   eo.bench.hysteresis = !o.no_hysteresis;
   eo.bench.creep = !o.no_creep;
   eo.bench.noise = !o.no_noise;
+  eo.bench.hpf_resistor = !o.no_resistor;
+  eo.bench.actuator_open_circuit = o.open_circuit;
   if (!o.superelement.empty()) eo.bench.superelement = o.superelement;
   try {
     eo.validate(experiment);
@@ -133,6 +135,9 @@ void add_simulate_commands(CLI::App& app, Action& action) {
   sim->add_flag("--no-hysteresis", o->no_hysteresis, "no hysteresis of the stacks");
   sim->add_flag("--no-creep", o->no_creep, "no creep of the stacks");
   sim->add_flag("--no-noise", o->no_noise, "no measurement noise (quantization stays)");
+  sim->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (only the ADC's input resistance)");
+  sim->add_flag("--open-circuit", o->open_circuit,
+                "actuator stacks disconnected from the amplifier (open circuit; for the stiffness test)");
   sim->add_option("--superelement", o->superelement, "TOML describing a super element to use instead of the 2-DoF model")
       ->check(CLI::ExistingFile);
   sim->add_flag("--json", o->json, "print one JSON document (file, settings, the unit's truth) on stdout");

@@ -69,6 +69,9 @@ void common_settings(io::TimeSeries& ts, Experiment e, const UnitTruth& unit, co
     ts.settings["va_max_V"] = b.va_max;
     ts.settings["suspended_mass_kg"] = b.suspended_mass;
     ts.settings["hpf_resistance_ohm"] = b.hpf_resistance;
+    ts.settings["hpf_resistor"] = b.hpf_resistor ? 1.0 : 0.0;
+    ts.settings["sensor_shunt_ohm"] = b.sensor_shunt_resistance();
+    ts.settings["actuator_circuit"] = std::string(b.actuator_open_circuit ? "open" : "short");
   }
   ts.settings["noise"] = b.noise ? 1.0 : 0.0;
 }

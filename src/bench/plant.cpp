@@ -44,6 +44,17 @@ double blocked_capacitance(const apa::TwoDofParams& p, double in_situ) {
   return in_situ * k_around / (k_around + p.gs * p.gs * in_situ);
 }
 
+double actuator_blocked_capacitance(const apa::TwoDofParams& p, double in_situ) {
+  const double cab = in_situ - p.ga * p.ga / (p.ka + p.ke * p.k1 / (p.ke + p.k1));
+  if (!(cab > 0.0)) {
+    throw InputError("unit model", "capacitance_actuator",
+                     fmt::format("an in-situ capacitance above ga^2 / (ka + ke k1 / (ke + k1)) = {:g} F (open-circuit stacks)",
+                                 in_situ - cab),
+                     fmt::format("{:g} F", in_situ));
+  }
+  return cab;
+}
+
 ContinuousPlant two_dof_plant(const apa::TwoDofParams& p, const Electrics& e) {
   p.validate("unit model");
   const double cb = blocked_capacitance(p, e.capacitance_sensor);
@@ -56,7 +67,8 @@ ContinuousPlant two_dof_plant(const apa::TwoDofParams& p, const Electrics& e) {
   }
   const double den = p.ca + p.ce;
   const double wa = e.amplifier_bandwidth;
-  const double kappa = -e.ground_resistance * e.capacitance_actuator;  // s: Vs += kappa dVa/dt
+  // s: Vs += kappa dVa/dt (the drive current; none when the stacks are disconnected)
+  const double kappa = e.actuator_open_circuit ? 0.0 : -e.ground_resistance * e.capacitance_actuator;
 
   ContinuousPlant c;
   c.A = lti::Matrix::Zero(6, 6);
@@ -73,8 +85,17 @@ ContinuousPlant two_dof_plant(const apa::TwoDofParams& p, const Electrics& e) {
   tension -= p.ce * xnd;
   const double tension_force = -p.ce * xnd_force;
 
-  c.A(0, 0) = -wa;
-  c.B(0, kInVa) = wa;
+  if (e.actuator_open_circuit) {
+    // C_ab Va' = -ga xn' - Va / R_ins: the charge stays (the insulation's leak, hours, keeps A
+    // regular), so Va follows the node.
+    const double cab = actuator_blocked_capacitance(p, e.capacitance_actuator);
+    c.A.row(0) = (-p.ga / cab) * xnd;
+    c.A(0, 0) -= 1.0 / (kStackInsulationResistance * cab);
+    c.B(0, kInForce) = (-p.ga / cab) * xnd_force;
+  } else {
+    c.A(0, 0) = -wa;
+    c.B(0, kInVa) = wa;
+  }
   c.A(1, 2) = 1.0;
   // m x'' = -k1 x - c1 x' - T + F_mass
   c.A.row(2) = -tension / p.m;

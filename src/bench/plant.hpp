@@ -40,7 +40,13 @@ struct Electrics {
   double capacitance_actuator = 0.0;  // F
   double ground_resistance = 0.0;     // Ohm; 0 = no parasitic term (minimum-phase zero)
   double adc_bandwidth = 0.0;         // rad/s, first-order anti-aliasing low-pass on Vs (> 0)
+  // The actuator stacks disconnected from the amplifier (open circuit, 2-DoF model only): their
+  // charge C_ab Va + ga xn stays 0, so the state Va is their voltage -ga xn / C_ab (no drive
+  // current, hence no parasitic term) and they are stiffer, ka + ga^2 / C_ab (report section 2.2).
+  bool actuator_open_circuit = false;
 };
+// Ohm: the stacks' insulation, the only discharge path of open-circuit stacks.
+inline constexpr double kStackInsulationResistance = 1e9;
 
 // Diagonal scales d (powers of two) such that diag(d)^-1 m diag(d) has rows and columns of similar
 // norms (Parlett-Reinsch balancing). For exponentials and discretizations of badly scaled models.
@@ -51,6 +57,9 @@ lti::Vector balancing_scales(const lti::Matrix& m);
 // docs/virtual-bench.md). The high-pass pole of the bench is then at -1 / (R in_situ) up to the
 // (corner / resonance)^2 ~ 1e-5 coupling with the mechanics.
 double blocked_capacitance(const apa::TwoDofParams& p, double in_situ);
+// The same for the actuator stacks (coupling ga, in-situ capacitance `in_situ`):
+// C_ab = in_situ - ga^2 / (ka + ke k1 / (ke + k1)). InputError when it is not positive.
+double actuator_blocked_capacitance(const apa::TwoDofParams& p, double in_situ);
 
 // The 2-DoF bench (states Va, x, x', xn, V, Vs after the anti-aliasing filter). `p.m` is the moving mass. InputError when the
 // sensor stack's short-circuit stiffness ke - gs^2 C_b is not positive.

@@ -4,8 +4,11 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
+#include <utility>
 
 #include "bench/flatness.hpp"
+#include "bench/plant.hpp"
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/lti/analysis.hpp"
 
@@ -53,7 +56,9 @@ nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
     j["model_2dof"] = nullptr;
   }
   j["capacitance_uF"] = {{"sensor", unit.capacitance_sensor * 1e6}, {"actuator", unit.capacitance_actuator * 1e6}};
-  j["hpf_corner_Hz"] = 1.0 / (two_pi * options.hpf_resistance * unit.capacitance_sensor);
+  j["hpf_corner_Hz"] = 1.0 / (two_pi * options.sensor_shunt_resistance() * unit.capacitance_sensor);
+  j["hpf_corner_with_resistor_Hz"] = 1.0 / (two_pi * options.hpf_resistance * unit.capacitance_sensor);
+  j["hpf_corner_without_resistor_Hz"] = 1.0 / (two_pi * options.adc_input_resistance * unit.capacitance_sensor);
 
   // Resonance: the lowest lightly damped complex pole pair (the 2-DoF model has one; a super
   // element's modes all have the same modal damping, and the suspended mass's is the lowest).
@@ -89,6 +94,7 @@ nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
   const lti::Matrix dc = lti::dc_gain(sys);
   const double g = options.amplifier_gain;
   double static_gain = dc(0, 0), static_vs = 0.0, k_tot = 0.0, k_static = 0.0;
+  std::optional<double> k_open;
   if (two_dof) {
     k_tot = p.total_stiffness();
     static_gain = g * p.ga * p.ke / (p.ke + p.ka) / k_tot;
@@ -98,6 +104,9 @@ nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
     const double cb = unit.capacitance_sensor * kk / (kk + p.gs * p.gs * unit.capacitance_sensor);
     const double ke_sc = p.ke - p.gs * p.gs * cb;
     k_static = p.k1 + ke_sc * p.ka / (ke_sc + p.ka);
+    // Every stack open: the sensor at ke, the actuators at ka + ga^2 / C_ab (virtual_bench.hpp).
+    const double ka_oc = p.ka + p.ga * p.ga / detail::actuator_blocked_capacitance(p, unit.capacitance_actuator);
+    k_open = p.k1 + p.ke * ka_oc / (p.ke + ka_oc);
   } else {
     // No electromechanical coupling in the super-element bench: one static stiffness, taken as
     // m_sus w^2 at the resonance (the report's eq. 2.2); no stiffness-line level of Vs is given.
@@ -113,16 +122,31 @@ nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
   ExperimentOptions eo;
   eo.bench = options;
   eo.bench.noise = false;
-  const io::TimeSeries stiff = simulate(Experiment::kStiffness, unit, eo, 0);
-  const double d_before = mean_over(stiff, "de", 2.0, 2.9);
-  const double d_loaded = mean_over(stiff, "de", 12.0, 12.9);
-  const double d_after = mean_over(stiff, "de", 14.0, 15.0);
   const double weight = options.added_mass * options.gravity;
+  // k1 and k2 of a noise-free stiffness record, N/um.
+  const auto readings = [&](const ExperimentOptions& e) {
+    const io::TimeSeries stiff = simulate(Experiment::kStiffness, unit, e, 0);
+    const double d_before = mean_over(stiff, "de", 2.0, 2.9);
+    const double d_loaded = mean_over(stiff, "de", 12.0, 12.9);
+    const double d_after = mean_over(stiff, "de", 14.0, 15.0);
+    return std::pair{weight / (d_before - d_loaded) * 1e-6, weight / (d_after - d_loaded) * 1e-6};
+  };
+  const auto [k1, k2] = readings(eo);
   j["stiffness_N_per_um"] = {{"k_tot", k_tot * 1e-6},
                              {"static", k_static * 1e-6},
                              {"resonance", options.suspended_mass * std::pow(res.natural_frequency, 2) * 1e-6},
-                             {"k1", weight / (d_before - d_loaded) * 1e-6},
-                             {"k2", weight / (d_after - d_loaded) * 1e-6}};
+                             {"k1", k1},
+                             {"k2", k2},
+                             {"k_sc", k1},
+                             {"k_oc", nullptr},
+                             {"open_circuit", k_open ? nlohmann::json(*k_open * 1e-6) : nlohmann::json(nullptr)}};
+  if (two_dof) {
+    // The same test with every stack open: the actuators disconnected, no resistor on the sensor.
+    ExperimentOptions open = eo;
+    open.bench.actuator_open_circuit = true;
+    open.bench.hpf_resistor = false;
+    j["stiffness_N_per_um"]["k_oc"] = readings(open).first;
+  }
   j["stiffness_readings"] = {{"before_s", {2.0, 2.9}}, {"loaded_s", {12.0, 12.9}}, {"after_s", {14.0, 15.0}}};
   const io::TimeSeries stroke = simulate(Experiment::kStroke, unit, eo, 0);
   const auto de = stroke.channel("de");

@@ -93,6 +93,8 @@ void BenchOptions::validate() const {
   require(std::isfinite(encoder_noise) && encoder_noise >= 0.0, s, "encoder_noise", "a noise >= 0 m rms", encoder_noise);
   require(std::isfinite(hpf_resistance) && hpf_resistance > 0.0, s, "hpf_resistance", "a resistance > 0 Ohm",
           hpf_resistance);
+  require(std::isfinite(adc_input_resistance) && adc_input_resistance > 0.0, s, "adc_input_resistance",
+          "a resistance > 0 Ohm", adc_input_resistance);
   require(adc_bits >= 2 && adc_bits <= 32, s, "adc_bits", "2 to 32 bits", adc_bits);
   require(std::isfinite(adc_range) && adc_range > 0.0, s, "adc_range", "a range > 0 V", adc_range);
   require(std::isfinite(vs_noise) && vs_noise >= 0.0, s, "vs_noise", "a noise >= 0 V rms", vs_noise);
@@ -102,6 +104,10 @@ void BenchOptions::validate() const {
           ground_resistance);
   require(std::isfinite(delay) && delay >= 0.0 && delay <= 1.0, s, "delay", "a delay in [0, 1] s", delay);
   if (superelement && superelement->empty()) throw InputError(s, "superelement", "a TOML file", "an empty path");
+  if (superelement && actuator_open_circuit) {
+    throw InputError(s, "actuator_open_circuit", "stacks driven by the amplifier with a super element (its coupling is not modelled)",
+                     "open-circuit stacks");
+  }
 }
 
 struct VirtualBench::State {
@@ -161,7 +167,9 @@ struct VirtualBench::State {
     assert(dp.Phi.rows() == 6);
     for (int j = 0; j < 6; ++j) c.two.phi[static_cast<std::size_t>(j)] = dp.Phi.col(j);
     for (int j = 0; j < 4; ++j) c.two.gamma[static_cast<std::size_t>(j)] = dp.Gamma.col(j);
-    c.two.ka = p.ka;
+    // Open-circuit stacks hold their charge, which all but stops their creep under load (charge
+    // drive is the classic cure for piezo creep): no load-creep drive then.
+    c.two.ka = electrics.actuator_open_circuit ? 0.0 : p.ka;
     return c;
   }
 
@@ -337,7 +345,8 @@ VirtualBench::VirtualBench(const UnitTruth& unit, const BenchOptions& options, s
   s.vs_noise = options.noise ? options.vs_noise : 0.0;
 
   s.electrics.amplifier_bandwidth = 2.0 * std::numbers::pi * options.amplifier_bandwidth_Hz;
-  s.electrics.hpf_resistance = options.hpf_resistance;
+  s.electrics.hpf_resistance = options.sensor_shunt_resistance();
+  s.electrics.actuator_open_circuit = options.actuator_open_circuit;
   s.electrics.capacitance_sensor = unit.capacitance_sensor;
   s.electrics.capacitance_actuator = unit.capacitance_actuator;
   s.electrics.ground_resistance = options.nonminimum_phase_zero ? options.ground_resistance : 0.0;

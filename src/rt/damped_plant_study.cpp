@@ -12,7 +12,7 @@
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/delay.hpp"
 #include "piezobench/lti/freqresp.hpp"
-#include "piezobench/ident/vector_fitting.hpp"
+#include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/lti/interconnect.hpp"
 #include "piezobench/rt/loop.hpp"
 #include "piezobench/rt/virtual_backend.hpp"
@@ -182,27 +182,13 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
     lti::Vector omega;
     lti::CVector h, raw;
     lines(options.fit_fmin, options.fit_fmax, omega, h, raw);
-    ident::VectorFittingOptions vo;
-    vo.order = options.fit_order;
-    vo.fail_if_not_converged = false;  // noisy data: the residual settles, judged below by the pole
-    const ident::VectorFittingResult vf = ident::vector_fit(omega, lti::CMatrix(h), vo);
-    double best = -1.0;
-    for (Eigen::Index k = 0; k < vf.poles.size(); ++k) {
-      const lti::Complex pk = vf.poles(k);
-      const double f = std::abs(pk) / kTwoPi;
-      if (pk.imag() <= 0.0 || f < options.resonance_fmin || f > options.resonance_fmax) continue;
-      const double peak = std::abs(vf.residues(0, k)) / std::max(std::abs(pk.real()), 1e-300);
-      if (peak > best) {
-        best = peak;
-        p.identified_pole = pk;
-      }
-    }
-    if (best < 0.0) {
-      throw NumericalError("damped-plant identification",
-                           "the vector fit at gain " + detail::str(g) + " has no complex pole between " +
-                               detail::str(options.resonance_fmin) + " and " + detail::str(options.resonance_fmax) + " Hz",
-                           true);
-    }
+    ident::DominantPoleOptions dpo;
+    dpo.fit.order = options.fit_order;
+    dpo.omega_min = kTwoPi * options.resonance_fmin;
+    dpo.omega_max = kTwoPi * options.resonance_fmax;
+    const ident::DominantPole dominant = ident::dominant_pole(omega, h, dpo);
+    p.identified_pole = dominant.pole;
+    const ident::VectorFittingResult& vf = dominant.fit;
     const lti::PoleInfo id = lti::pole_info(p.identified_pole);
     p.identified_frequency_hz = id.natural_frequency / kTwoPi;
     p.identified_damping = id.damping;

@@ -104,6 +104,32 @@ TEST(TwoDofPlant, StaticStiffnessIsTheShortCircuitedSensorsAndStiffnessLineTheOp
   EXPECT_TRUE(near(r.H[0](0, 0).real(), line, 2e-3));
 }
 
+TEST(TwoDofPlant, OpenCircuitActuatorStacksAreStifferByTheirCoupling) {
+  // Every stack open (no resistor: a shunt of 1 TOhm): between the leaks (hours) and the
+  // resonance a weight sees k1 + ke ka_oc / (ke + ka_oc), ka_oc = ka + ga^2 / C_ab (report section
+  // 2.2: k_oc about 2.3 N/um against k_sc about 1.7 with creep, 1.94 without).
+  const apa::TwoDofParams p;
+  Electrics e = report_electrics(0.16);
+  e.hpf_resistance = 1e12;
+  e.actuator_open_circuit = true;
+  const ContinuousPlant plant = two_dof_plant(p, e);
+  const double cab = actuator_blocked_capacitance(p, e.capacitance_actuator);
+  EXPECT_TRUE(near(cab, e.capacitance_actuator - p.ga * p.ga / (p.ka + p.ke * p.k1 / (p.ke + p.k1)), 1e-12));
+  const double ka_oc = p.ka + p.ga * p.ga / cab;
+  const double k_oc = p.k1 + p.ke * ka_oc / (p.ke + ka_oc);
+  EXPECT_GT(k_oc * 1e-6, 2.3);
+  EXPECT_LT(k_oc * 1e-6, 2.5);
+  const lti::StateSpace sys(plant.A, plant.B, plant.C, plant.D);
+  const lti::FrequencyResponse r = lti::freqresp(sys, lti::Vector::Constant(1, 2 * kPi * 0.5));
+  EXPECT_TRUE(near(r.H[0](kOutDe, kInMass).real(), 1.0 / k_oc, 1e-3));
+  // The stacks' voltage follows the node, Va = -ga xn / C_ab; the amplifier's command does nothing.
+  EXPECT_EQ(plant.B(0, kInVa), 0.0);
+  EXPECT_LT(std::abs(r.H[0](kOutVa, kInVa)), 1e-12);
+  // A capacitance too small for the coupling is refused by name.
+  e.capacitance_actuator = 1e-6;
+  EXPECT_TRUE(test::contains(test::input_error([&] { (void)two_dof_plant(p, e); }, "capacitance_actuator"), "open-circuit"));
+}
+
 TEST(TwoDofPlant, GroundResistanceMakesTheAntiResonanceNonMinimumPhase) {
   const apa::TwoDofParams p;
   for (const double rg : {0.0, 0.16}) {

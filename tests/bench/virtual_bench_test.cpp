@@ -322,6 +322,11 @@ TEST(VirtualBench, RefusesBadOptionsAndUnits) {
   bad([](BenchOptions& o) { o.suspended_mass = 0.0; }, "suspended_mass");
   bad([](BenchOptions& o) { o.hpf_resistance = 0.0; }, "hpf_resistance");
   bad([](BenchOptions& o) { o.superelement = ""; }, "superelement");
+  bad([](BenchOptions& o) { o.adc_input_resistance = 0.0; }, "adc_input_resistance");
+  bad([](BenchOptions& o) {
+    o.superelement = "apa.toml";
+    o.actuator_open_circuit = true;
+  }, "actuator_open_circuit");
   UnitTruth u = unit;
   u.capacitance_sensor = -1.0;
   (void)test::input_error([&] { VirtualBench b(u, BenchOptions{}, 1); }, "capacitance_sensor");

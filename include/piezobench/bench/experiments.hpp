@@ -7,7 +7,9 @@
 // Every record also carries the settings `experiment`, `unit`, `seed` (a number up to 2^53, text
 // above), `defective`, `noise`, and for bench experiments `model` ("2dof" or "superelement"),
 // `superelement` (its TOML), `delay_s` (effective), `nmp_zero`, `hysteresis`, `creep` (1 or 0),
-// `amplifier_gain_V_per_V`, `va_min_V`, `va_max_V`, `suspended_mass_kg`, `hpf_resistance_ohm`.
+// `amplifier_gain_V_per_V`, `va_min_V`, `va_max_V`, `suspended_mass_kg`, `hpf_resistance_ohm`,
+// `hpf_resistor` (1 or 0), `sensor_shunt_ohm` (what discharges the sensor stack), `actuator_circuit`
+// ("short": on the amplifier, "open": disconnected; the stiffness test measures k_sc and k_oc).
 // Row k holds the instruments at t = k / fs, read before u[k] is applied (row 0: the bench at rest).
 //
 // Channels per experiment (the contract the campaign reads; docs/virtual-bench.md shows examples):

@@ -14,7 +14,9 @@ namespace piezobench::bench {
 //   model_2dof        {m, k1, c1, ke, ce, ka, ca, ga, gs}: the unit's 2-DoF parameters (SI; m is
 //                     the suspended mass); null for a super element
 //   capacitance_uF    {sensor, actuator}: the LCR readings without error
-//   hpf_corner_Hz     1 / (2 pi R C_sensor)
+//   hpf_corner_Hz     1 / (2 pi R C_sensor), R what discharges the sensor stack on this bench;
+//                     hpf_corner_with_resistor_Hz, hpf_corner_without_resistor_Hz: with
+//                     R = hpf_resistance and R = adc_input_resistance
 //   resonance_Hz, resonance_damping         lowest lightly damped (< 0.2) pole pair of the linear bench
 //   antiresonance_Hz, antiresonance_damping lowest complex zero pair of u -> Vs (damping < 0:
 //                     non-minimum phase), zero_is_nonminimum_phase
@@ -26,7 +28,12 @@ namespace piezobench::bench {
 //   stiffness_N_per_um {k_tot: shell + stacks with the sensor open (what the resonance shows),
 //                       static: with the sensor short-circuited through R (a slow load),
 //                       resonance: m_sus (2 pi resonance_Hz)^2,
-//                       k1, k2: the readings of the `stiffness` experiment defined below}
+//                       k1, k2: the readings of the `stiffness` experiment defined below,
+//                       k_sc: k1 with the stacks short-circuited (the actuators on the amplifier,
+//                       the sensor on R: this bench's k1), k_oc: k1 of the same test with every
+//                       stack open (actuator_open_circuit, no resistor; null for a super element),
+//                       open_circuit: the static stiffness with every stack open (ka + ga^2/C_ab,
+//                       ke), null for a super element}
 //   stroke_um         max - min of the probe reading in the `stroke` experiment (-20 V -> 150 V)
 //   flatness_um       peak-to-valley of the 8 points from their least-squares plane
 //   bending_modes_Hz  {y, x}, bending_damping  (hammer test)

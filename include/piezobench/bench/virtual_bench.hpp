@@ -116,6 +116,9 @@ struct BenchOptions {
   double encoder_resolution = 2.5e-9;       // m
   double encoder_noise = 1e-9;              // m rms
   double hpf_resistance = 80.6e3;           // Ohm, across the sensor stack (C from the unit)
+  bool hpf_resistor = true;                 // the resistor is in place (report section 2.5); without
+                                            // it the stack sees the ADC's input resistance only
+  double adc_input_resistance = 10e6;       // Ohm (neglected beside the resistor when it is in place)
   int adc_bits = 16;
   double adc_range = 10.0;                  // V
   double vs_noise = 1e-3;                   // V rms
@@ -123,6 +126,12 @@ struct BenchOptions {
   // Shared return resistance between the actuator drive current and the sensor read-out: the
   // origin of the non-minimum-phase zero (see the file comment). Used when nonminimum_phase_zero.
   double ground_resistance = 0.16;          // Ohm
+  // Electrical boundary of the actuator stacks (report section 2.2). false: driven by the amplifier
+  // (a voltage source: short circuit); true: disconnected (open circuit, 2-DoF model only): their
+  // charge stays, their voltage follows their strain (Va reads it; the DAC command does nothing)
+  // and they are stiffer, ka + ga^2 / C_ab with C_ab their blocked capacitance
+  // (docs/virtual-bench.md).
+  bool actuator_open_circuit = false;
   // Effects that can be switched off (all on by default).
   double delay = 200e-6;                    // s, total measurement delay (hold included); 0 = only the hold
   bool nonminimum_phase_zero = true;        // the lightly damped NMP zero on u -> Vs
@@ -150,6 +159,8 @@ struct BenchOptions {
 
   // InputError (source "bench options") naming the field.
   void validate() const;
+  // Ohm: what discharges the sensor stack, hpf_resistance or (without the resistor) adc_input_resistance.
+  [[nodiscard]] double sensor_shunt_resistance() const { return hpf_resistor ? hpf_resistance : adc_input_resistance; }
 };
 
 // What the bench's instruments give for one sample.

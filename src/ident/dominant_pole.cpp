@@ -1,0 +1,52 @@
+#include "piezobench/ident/dominant_pole.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::ident {
+
+void DominantPoleOptions::validate() const {
+  fit.validate();
+  const bool automatic = omega_min == 0.0 && omega_max == 0.0;
+  if (!automatic && !(std::isfinite(omega_min) && std::isfinite(omega_max) && omega_min >= 0.0 && omega_max > omega_min)) {
+    throw InputError("dominant pole options", "omega_max", "a band 0 <= omega_min < omega_max (rad/s), or both 0",
+                     fmt::format("[{:g}, {:g}]", omega_min, omega_max));
+  }
+}
+
+double DominantPole::frequency_hz() const { return natural_frequency / (2.0 * std::numbers::pi); }
+
+DominantPole dominant_pole(const Vector& omega, const CVector& h, const DominantPoleOptions& options) {
+  options.validate();
+  DominantPole d;
+  d.fit = vector_fit(omega, CMatrix(h), options.fit);
+  const double lo = options.omega_max > 0.0 ? options.omega_min : omega.minCoeff();
+  const double hi = options.omega_max > 0.0 ? options.omega_max : omega.maxCoeff();
+  double best = -1.0;
+  for (Index k = 0; k < d.fit.poles.size(); ++k) {
+    const Complex p = d.fit.poles(k);
+    const double w = std::abs(p);
+    if (p.imag() <= 0.0 || w < lo || w > hi) continue;
+    const double peak = d.fit.residues.col(k).cwiseAbs().sum() / std::max(std::abs(p.real()), 1e-300);
+    if (peak > best) {
+      best = peak;
+      d.pole = p;
+    }
+  }
+  if (best < 0.0) {
+    throw NumericalError("dominant pole",
+                         fmt::format("the order-{} vector fit has no complex pole with a natural frequency in [{:.4g}, {:.4g}] Hz",
+                                     options.fit.order, lo / (2.0 * std::numbers::pi), hi / (2.0 * std::numbers::pi)),
+                         true);
+  }
+  d.peak = best;
+  d.natural_frequency = std::abs(d.pole);
+  d.damping = -d.pole.real() / d.natural_frequency;
+  return d;
+}
+
+}  // namespace piezobench::ident

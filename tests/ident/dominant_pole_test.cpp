@@ -1,0 +1,89 @@
+#include "piezobench/ident/dominant_pole.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::ident {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// A damped plant as IFF makes it: a well damped resonance (80 Hz, 25 %) that dominates, a lightly
+// damped pair with a small residue (a controller pole near a zero, 150 Hz) and a real pole (20 Hz).
+struct Plant {
+  Complex p1 = Complex(-0.25 * kTwoPi * 80.0, kTwoPi * 80.0 * std::sqrt(1.0 - 0.0625));
+  Complex p2 = Complex(-0.01 * kTwoPi * 150.0, kTwoPi * 150.0);
+  double p3 = -kTwoPi * 20.0;
+  Complex r1 = Complex(-3.0e-4, -5.0e-3), r2 = Complex(1.0e-6, 2.0e-6);
+  double r3 = 2.0e-4;
+  Complex operator()(double w) const {
+    const Complex s(0.0, w);
+    return r1 / (s - p1) + std::conj(r1) / (s - std::conj(p1)) + r2 / (s - p2) + std::conj(r2) / (s - std::conj(p2)) +
+           r3 / (s - p3);
+  }
+};
+
+Vector grid(double f0, double f1, Index n) {
+  Vector w(n);
+  for (Index k = 0; k < n; ++k) w(k) = kTwoPi * f0 * std::pow(f1 / f0, static_cast<double>(k) / static_cast<double>(n - 1));
+  return w;
+}
+
+TEST(DominantPole, FindsTheDominantPairNotTheSpuriousOne) {
+  const Plant g;
+  const Vector w = grid(2.0, 1000.0, 400);
+  CVector h(w.size());
+  for (Index k = 0; k < w.size(); ++k) h(k) = g(w(k));
+  DominantPoleOptions o;
+  o.fit.order = 5;
+  o.omega_min = kTwoPi * 20.0;
+  o.omega_max = kTwoPi * 400.0;
+  const DominantPole d = dominant_pole(w, h, o);
+  EXPECT_LT(std::abs(d.pole - g.p1) / std::abs(g.p1), 1e-6);
+  EXPECT_NEAR(d.damping, 0.25, 1e-6);
+  EXPECT_NEAR(d.frequency_hz(), 80.0, 1e-4);
+  EXPECT_LT(d.fit.relative_rms_error, 1e-6);
+}
+
+TEST(DominantPole, WithinOnePercentOnNoisyData) {
+  const Plant g;
+  const Vector w = grid(2.0, 1000.0, 600);
+  CVector h(w.size());
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 0.01);
+  for (Index k = 0; k < w.size(); ++k) h(k) = g(w(k)) * Complex(1.0 + n(rng), n(rng));
+  DominantPoleOptions o;
+  o.omega_min = kTwoPi * 20.0;
+  o.omega_max = kTwoPi * 400.0;
+  const DominantPole d = dominant_pole(w, h, o);
+  EXPECT_LT(std::abs(d.pole - g.p1) / std::abs(g.p1), 0.01);
+}
+
+TEST(DominantPole, NoPairInTheBandIsANumericalError) {
+  const Plant g;
+  const Vector w = grid(2.0, 1000.0, 200);
+  CVector h(w.size());
+  for (Index k = 0; k < w.size(); ++k) h(k) = g(w(k));
+  DominantPoleOptions o;
+  o.fit.order = 5;
+  o.omega_min = kTwoPi * 300.0;
+  o.omega_max = kTwoPi * 400.0;
+  EXPECT_THROW(dominant_pole(w, h, o), NumericalError);
+}
+
+TEST(DominantPole, BadBandIsAnInputError) {
+  DominantPoleOptions o;
+  o.omega_min = 10.0;
+  o.omega_max = 5.0;
+  EXPECT_THROW(o.validate(), InputError);
+  o.omega_max = std::nan("");
+  EXPECT_THROW(o.validate(), InputError);
+}
+
+}  // namespace
+}  // namespace piezobench::ident
