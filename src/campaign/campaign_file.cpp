@@ -23,7 +23,9 @@ std::string to_string(Experiment e) {
     case Experiment::kStroke: return "stroke";
     case Experiment::kHysteresis: return "hysteresis";
     case Experiment::kStiffness: return "stiffness";
+    case Experiment::kStiffnessOpen: return "stiffness_open_circuit";
     case Experiment::kFrf: return "frf";
+    case Experiment::kFrfNoResistor: return "frf_without_resistor";
     case Experiment::kIff: return "iff";
     case Experiment::kHammer: return "hammer";
   }
@@ -32,8 +34,9 @@ std::string to_string(Experiment e) {
 
 const std::vector<Experiment>& all_experiments() {
   static const std::vector<Experiment> all = {Experiment::kFlatness, Experiment::kCapacitance, Experiment::kStroke,
-                                              Experiment::kHysteresis, Experiment::kStiffness, Experiment::kFrf,
-                                              Experiment::kIff, Experiment::kHammer};
+                                              Experiment::kHysteresis, Experiment::kStiffness, Experiment::kStiffnessOpen,
+                                              Experiment::kFrf, Experiment::kFrfNoResistor, Experiment::kIff,
+                                              Experiment::kHammer};
   return all;
 }
 
@@ -41,8 +44,9 @@ Experiment experiment_from_string(const std::string& name, const std::string& so
   for (const Experiment e : all_experiments()) {
     if (to_string(e) == name) return e;
   }
-  throw InputError(source, "experiment", "one of flatness, capacitance, stroke, hysteresis, stiffness, frf, iff, hammer",
-                   "'" + name + "'");
+  std::string names;
+  for (const Experiment e : all_experiments()) names += (names.empty() ? "" : ", ") + to_string(e);
+  throw InputError(source, "experiment", "one of " + names, "'" + name + "'");
 }
 
 const std::vector<std::string>& required_roles(Experiment e) {
@@ -50,6 +54,7 @@ const std::vector<std::string>& required_roles(Experiment e) {
       {Experiment::kFlatness, {"x", "y", "z"}},         {Experiment::kCapacitance, {"C_sensor", "C_actuator"}},
       {Experiment::kStroke, {"Va", "de"}},              {Experiment::kHysteresis, {"Va", "de"}},
       {Experiment::kStiffness, {"de"}},                 {Experiment::kFrf, {"u", "de", "Vs"}},
+      {Experiment::kStiffnessOpen, {"de"}},             {Experiment::kFrfNoResistor, {"u", "Vs"}},
       {Experiment::kIff, {"u_prime", "de"}},            {Experiment::kHammer, {"F", "v"}}};
   return roles.at(e);
 }
@@ -59,7 +64,7 @@ const std::vector<std::string>& optional_roles(Experiment e) {
   static const std::vector<std::string> interface = {"interface"};
   static const std::vector<std::string> mass = {"added_mass"};
   if (e == Experiment::kFlatness) return interface;
-  if (e == Experiment::kStiffness) return mass;
+  if (e == Experiment::kStiffness || e == Experiment::kStiffnessOpen) return mass;
   return none;
 }
 
@@ -70,7 +75,9 @@ bool UnitSpec::has(Experiment e) const {
     case Experiment::kStroke: return stroke.has_value();
     case Experiment::kHysteresis: return !hysteresis.empty();
     case Experiment::kStiffness: return stiffness.has_value();
+    case Experiment::kStiffnessOpen: return stiffness_open.has_value();
     case Experiment::kFrf: return frf.has_value();
+    case Experiment::kFrfNoResistor: return frf_no_resistor.has_value();
     case Experiment::kIff: return !iff.empty();
     case Experiment::kHammer: return hammer.has_value();
   }
@@ -318,7 +325,9 @@ UnitSpec read_unit(const Context& ctx, const toml::table& t, std::size_t index) 
       case Experiment::kCapacitance: u.capacitance = f; break;
       case Experiment::kStroke: u.stroke = f; break;
       case Experiment::kStiffness: u.stiffness = f; break;
+      case Experiment::kStiffnessOpen: u.stiffness_open = f; break;
       case Experiment::kFrf: u.frf = f; break;
+      case Experiment::kFrfNoResistor: u.frf_no_resistor = f; break;
       case Experiment::kHammer: u.hammer = f; break;
       default: break;
     }

@@ -48,6 +48,8 @@ struct Job {
   std::optional<double> amplitude, gain, duration;
   std::string file;   // relative to DIR
   double cost = 1.0;  // for scheduling (longest first)
+  bool open_circuit = false;  // every stack open: the actuators disconnected, no resistor (k_oc)
+  bool no_resistor = false;   // no resistor across the sensor stack (report section 2.5)
 };
 
 std::string number_tag(double v) { return fmt::format("{:g}", v); }
@@ -76,12 +78,15 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
     jobs.push_back({id, bench::Experiment::kCapacitance, {}, {}, {}, "data/" + u + "_capacitance.mat", 0.01});
     jobs.push_back({id, bench::Experiment::kStroke, {}, {}, {}, "data/" + u + "_stroke.mat", 3.0});
     jobs.push_back({id, bench::Experiment::kStiffness, {}, {}, {}, "data/" + u + "_stiffness.mat", 2.0});
+    jobs.push_back({id, bench::Experiment::kStiffness, {}, {}, {}, "data/" + u + "_stiffness-open.mat", 2.0, true, true});
     jobs.push_back({id, bench::Experiment::kFrfNoise, {}, {}, frf_s, "data/" + u + "_frf-noise.mat", frf_s / 10.0});
     jobs.push_back({id, bench::Experiment::kHammer, {}, {}, {}, "data/" + u + "_hammer.mat", 1.0});
     for (const double a : options.hysteresis_amplitudes) {
       jobs.push_back({id, bench::Experiment::kHysteresis, a, {}, {}, "data/" + u + "_hysteresis_" + number_tag(a) + "V.mat", 0.5});
     }
     if (id == options.iff_unit) {
+      // Figure 2.7 on the IFF unit: u -> Vs without the resistor.
+      jobs.push_back({id, bench::Experiment::kFrfNoise, {}, {}, frf_s, "data/" + u + "_frf-noise-no-resistor.mat", frf_s / 10.0, false, true});
       for (const double g : options.iff_gains) {
         jobs.push_back({id, bench::Experiment::kIff, {}, g, iff_s, "data/" + u + "_iff_g" + number_tag(g) + ".mat", iff_s / 10.0});
       }
@@ -105,6 +110,8 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
       try {
         bench::ExperimentOptions eo;
         eo.bench = bench_options;
+        eo.bench.actuator_open_circuit = j.open_circuit;
+        eo.bench.hpf_resistor = !(j.no_resistor || j.open_circuit);
         eo.amplitude = j.amplitude;
         eo.gain = j.gain;
         eo.duration = j.duration;
@@ -190,7 +197,9 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
       toml += fmt::format("{}\"{}_hysteresis_{}V.mat\"", i ? ", " : "", u, number_tag(options.hysteresis_amplitudes[i]));
     }
     toml += "]\n";
-    toml += fmt::format("stiffness = \"{}_stiffness.mat\"\nfrf = \"{}_frf-noise.mat\"\nhammer = \"{}_hammer.mat\"\n", u, u, u);
+    toml += fmt::format("stiffness = \"{}_stiffness.mat\"\nstiffness_open_circuit = \"{}_stiffness-open.mat\"\n", u, u);
+    toml += fmt::format("frf = \"{}_frf-noise.mat\"\nhammer = \"{}_hammer.mat\"\n", u, u);
+    if (id == options.iff_unit) toml += fmt::format("frf_without_resistor = \"{}_frf-noise-no-resistor.mat\"\n", u);
     if (id == options.iff_unit && !options.iff_gains.empty()) {
       toml += "iff = [\n";
       for (const double g : options.iff_gains) {

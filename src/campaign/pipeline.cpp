@@ -212,6 +212,10 @@ std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, co
 
 json pole_json(std::complex<double> p) { return io::to_json(p); }
 
+// Relative distance between an identified damped pole and the model's at the same gain above which
+// the report warns that the model does not describe the closed loop.
+constexpr double kPoleDistanceTolerance = 0.05;
+
 // The resonance branch of the IFF root locus on a log grid of gains, and its best damping.
 struct ResonanceLocus {
   std::vector<double> gains;
@@ -332,38 +336,67 @@ json iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units, json& 
   out["optimal_pole"] = pole_json(locus.optimal_pole);
   out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)|, branch from the "
                         "resonance pole, maximum damping refined by golden section (delay as a 6th-order Pade approximant)";
-  // The model's branches near the resonance for the plot.
-  json branches = json::array();
+  // The root locus for the plot (report Figure 2.10b): every branch, with its gains for the hover
+  // labels, the open-loop poles and zeros, inside a window of 3 wp around the origin (the
+  // controller's 2 kHz pole and the Pade approximant's poles lie far outside).
   const double limit = 3.0 * p.wp;
+  const auto inside = [&](std::complex<double> z) { return std::abs(z) <= limit && z.imag() >= 0.0; };
+  const auto gain_label = [](double g) { return fmt::format("g = {:.3g}", g); };
+  json branches = json::array();
   const Index nb = locus.poles.empty() ? 0 : locus.poles.front().size();
   for (Index b = 0; b < nb; ++b) {
-    json re = json::array(), im = json::array();
-    bool near_resonance = false;
+    json re = json::array(), im = json::array(), text = json::array();
     for (std::size_t i = 0; i < locus.poles.size(); ++i) {
       const auto z = locus.poles[i](b);
-      if (std::abs(z) > limit || z.imag() < 0.0) continue;
-      if (std::abs(z.imag()) > 0.2 * p.wp) near_resonance = true;
+      if (!inside(z)) continue;
+      re.push_back(z.real());
+      im.push_back(z.imag());
+      text.push_back(gain_label(locus.gains[i]));
+    }
+    if (re.size() > 1) branches.push_back({{"re", re}, {"im", im}, {"text", text}, {"resonance_branch", b == locus.branch}});
+  }
+  const auto points = [&](const lti::CVector& v) {
+    json re = json::array(), im = json::array();
+    for (const auto z : v) {
+      if (!inside(z)) continue;
       re.push_back(z.real());
       im.push_back(z.imag());
     }
-    if (near_resonance && re.size() > 1) branches.push_back({{"re", re}, {"im", im}, {"resonance_branch", b == locus.branch}});
-  }
+    return json{{"re", re}, {"im", im}};
+  };
   json damped_plot = json::array();
-  json model = json::array(), distance = json::array();
+  json model = json::array(), distance = json::array(), model_plot = json::array();
+  double worst = 0.0;
   for (const auto& d : chosen->damped) {
-    const auto pole = d.fit.pole();
+    const auto pole = d.identified->pole;
     out["gains"].push_back(d.gain);
     out["damped_poles"].push_back(pole_json(pole));
     damped_plot.push_back({{"gain", d.gain}, {"re", pole.real()}, {"im", pole.imag()}});
     const std::complex<double> z = locus.pole_at(loop, d.gain);
     model.push_back(pole_json(z));
+    model_plot.push_back({{"gain", d.gain}, {"re", z.real()}, {"im", z.imag()}});
     distance.push_back(std::abs(pole - z) / std::abs(z));
+    worst = std::max(worst, std::abs(pole - z) / std::abs(z));
   }
   if (!chosen->damped.empty()) {
     out["model_poles"] = model;
     out["relative_pole_distance"] = distance;
+    out["max_relative_pole_distance"] = worst;
+    out["pole_distance_tolerance"] = kPoleDistanceTolerance;
+    if (worst > kPoleDistanceTolerance) {
+      out["warning"] = fmt::format("the identified damped poles are up to {:.0f} % off the model's root locus (more than {:.0f} %): "
+                                   "the IFF plant model (eq. 2.3) does not describe the closed loop at those gains",
+                                   100.0 * worst, 100.0 * kPoleDistanceTolerance);
+    }
   }
-  extra["root_locus"] = {{"branches", branches}, {"damped", damped_plot}, {"unit", chosen->id},
+  extra["root_locus"] = {{"branches", branches},
+                         {"open_loop_poles", points(lti::poles(loop))},
+                         {"open_loop_zeros", points(lti::zeros(loop))},
+                         {"damped", damped_plot},
+                         {"model_at_gains", model_plot},
+                         {"optimum", {{"gain", locus.optimal_gain}, {"re", locus.optimal_pole.real()}, {"im", locus.optimal_pole.imag()},
+                                      {"damping", locus.max_damping}}},
+                         {"unit", chosen->id},
                          {"open_loop_pole", {p.wp * -p.xp, p.wp * std::sqrt(std::max(0.0, 1 - p.xp * p.xp))}}};
   return out;
 }

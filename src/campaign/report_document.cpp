@@ -2,6 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <optional>
+#include <tuple>
+
 #include "piezobench/version.hpp"
 
 namespace piezobench::campaign {
@@ -17,6 +24,11 @@ json trace(const std::string& name, const json& x, const json& y, const std::str
   return t;
 }
 
+json with_text(json t, json text) {
+  t["text"] = std::move(text);
+  return t;
+}
+
 json panel(const std::string& y_label, bool y_log, json traces) {
   return {{"y_label", y_label}, {"y_log", y_log}, {"traces", std::move(traces)}};
 }
@@ -28,199 +40,533 @@ json figure(const std::string& id, const std::string& title, const std::string& 
   return f;
 }
 
+json table(const std::string& title, const std::vector<std::string>& columns, json rows, const std::string& text = "") {
+  json t = {{"title", title}, {"columns", columns}, {"rows", std::move(rows)}};
+  if (!text.empty()) t["text"] = text;
+  return t;
+}
+
 bool has(const json& j, const char* key) { return j.is_object() && j.contains(key) && !j[key].is_null(); }
 
-// FRF figure of one output ("de" or "Vs"), all units, with the model named by `model_key`.
+// j[a][b]... or null.
+json at(const json& j, std::initializer_list<const char*> path) {
+  const json* v = &j;
+  for (const char* k : path) {
+    if (!has(*v, k)) return nullptr;
+    v = &(*v)[k];
+  }
+  return *v;
+}
+json scaled(const json& v, double s) { return v.is_number() ? json(v.get<double>() * s) : json(nullptr); }
+
+// A model's phase drawn on the measurement's branch: each model point is moved by the multiple of
+// 360 degrees that brings it nearest to the measured phase at the nearest frequency (phases are
+// defined modulo 360 degrees; unwrapped separately, a model and its measurement can sit one turn
+// apart). Where that multiple changes (a model zero on the other side of the axis than the
+// measured one), a gap is left rather than a vertical line.
+std::pair<json, json> on_branch(const json& f_model, const json& ph_model, const json& f_ref, const json& ph_ref) {
+  json x = json::array(), y = json::array();
+  std::size_t j = 0;
+  double last_shift = 0.0;
+  bool first = true;
+  for (std::size_t i = 0; i < f_model.size(); ++i) {
+    if (!f_model[i].is_number() || !ph_model[i].is_number()) continue;
+    const double f = f_model[i].get<double>(), ph = ph_model[i].get<double>();
+    while (j + 1 < f_ref.size() && f_ref[j + 1].is_number() && std::abs(f_ref[j + 1].get<double>() - f) <= std::abs(f_ref[j].get<double>() - f)) ++j;
+    double shift = last_shift;
+    if (j < ph_ref.size() && ph_ref[j].is_number()) shift = 360.0 * std::round((ph_ref[j].get<double>() - ph) / 360.0);
+    if (!first && shift != last_shift) {
+      x.push_back(f);
+      y.push_back(nullptr);
+    }
+    x.push_back(f);
+    y.push_back(ph + shift);
+    last_shift = shift;
+    first = false;
+  }
+  return {x, y};
+}
+
+// Magnitude and phase (and coherence) of one output, all units, the measurement solid and a model
+// dashed, the model's phase on the measurement's branch.
 json frf_figure(const std::vector<UnitAnalysis>& units, const std::string& out, const std::string& id, const std::string& title,
-                const std::string& unit_label, const std::string& model_abs, const std::string& model_phase,
-                const std::string& model_name, bool model_in_frf) {
+                const std::string& unit_label, const std::string& model_key, const std::string& model_abs,
+                const std::string& model_phase, const std::string& model_name, bool coherence, const std::string& text) {
   json mag = json::array(), phase = json::array(), coh = json::array();
   for (const auto& u : units) {
     if (!has(u.plots, "frf")) continue;
     const json& p = u.plots["frf"];
     mag.push_back(trace(u.name, p["f"], p[out + "_abs"], u.name));
     phase.push_back(trace(u.name, p["f"], p[out + "_phase"], u.name));
-    coh.push_back(trace(u.name, p["f"], p[out + "_coh"], u.name));
-    const json& m = model_in_frf ? p : (has(u.plots, "model") ? u.plots["model"] : json());
-    if (has(m, model_abs.c_str())) {
+    if (coherence) coh.push_back(trace(u.name, p["f"], p[out + "_coh"], u.name));
+    const json m = model_key.empty() ? p : at(u.plots, {model_key.c_str()});
+    if (has(m, model_abs.c_str()) && has(m, model_phase.c_str())) {
       mag.push_back(trace(u.name + " " + model_name, m["f"], m[model_abs], u.name, true));
-      phase.push_back(trace(u.name + " " + model_name, m["f"], m[model_phase], u.name, true));
+      const auto [x, y] = on_branch(m["f"], m[model_phase], p["f"], p[out + "_phase"]);
+      phase.push_back(trace(u.name + " " + model_name, x, y, u.name, true));
     }
   }
-  return figure(id, title, "Frequency [Hz]", true,
-                json::array({panel("|H| [" + unit_label + "]", true, mag), panel("Phase [deg]", false, phase),
-                             panel("Coherence", false, coh)}),
-                "Solid: measured (Welch H1); dashed: " + model_name + ".");
+  json panels = json::array({panel("|H| [" + unit_label + "]", true, mag), panel("Phase [deg]", false, phase)});
+  if (coherence) panels.push_back(panel("Coherence", false, coh));
+  return figure(id, title, "Frequency [Hz]", true, panels, text);
 }
+
+std::string amplitude_label(double a) { return fmt::format("{:.3g} V", a); }
 
 }  // namespace
 
 json report_document(const Campaign& c, const std::vector<UnitAnalysis>& units, const json& results, const json& extra) {
   json sections = json::array();
-  // Frequency responses.
-  {
+  const auto any = [&](const char* key) {
+    return std::any_of(units.begin(), units.end(), [&](const UnitAnalysis& u) { return has(u.plots, key); });
+  };
+  const json& result_units = results["units"];
+  const auto result_of = [&](const UnitAnalysis& u) -> json {
+    for (const auto& r : result_units) {
+      if (r.contains("id") && r["id"] == u.id) return r;
+    }
+    return json::object();
+  };
+
+  // ---- Section 2.3: frequency responses (Figure 2.5), 2.4: the NMP zero (Figure 2.6).
+  if (any("frf")) {
     json figs = json::array();
-    if (std::any_of(units.begin(), units.end(), [](const UnitAnalysis& u) { return has(u.plots, "frf"); })) {
-      figs.push_back(frf_figure(units, "de", "frf-de", "u -> d_e", "um/V", "de_abs", "de_phase", "tuned 2-DoF model", false));
-      figs.push_back(frf_figure(units, "Vs", "frf-vs", "u -> Vs", "V/V", "iff_fit_abs", "iff_fit_phase", "IFF plant fit (eq. 2.3)", true));
-      json model = json::array();
-      for (const auto& u : units) {
-        if (has(u.plots, "model")) {
-          model.push_back(trace(u.name + " model", u.plots["model"]["f"], u.plots["model"]["Vs_abs"], u.name, true));
-          model.push_back(trace(u.name, u.plots["frf"]["f"], u.plots["frf"]["Vs_abs"], u.name));
+    figs.push_back(frf_figure(units, "de", "frf-de", "Fig. 2.5a: u -> d_e", "um/V", "model", "de_abs", "de_phase", "2-DoF model", true,
+                              "Solid: measured (Welch H1); dashed: the tuned 2-DoF model (section 3). The model's phase is drawn "
+                              "on the measurement's branch (modulo 360 deg)."));
+    figs.push_back(frf_figure(units, "Vs", "frf-vs", "Fig. 2.5b: u -> Vs", "V/V", "", "iff_fit_abs", "iff_fit_phase", "IFF plant fit", true,
+                              "Solid: measured; dashed: the IFF plant fit (eq. 2.3 with delay). The phase falls by 180 deg at the "
+                              "anti-resonance: a non-minimum-phase zero."));
+    json rows = json::array();
+    for (const auto& u : units) {
+      const json r = result_of(u);
+      if (!has(r, "frf")) continue;
+      const json& f = r["frf"];
+      const json verdict = at(f, {"zero_is_nonminimum_phase"});
+      rows.push_back({u.name, at(f, {"static_gain_um_per_V"}), at(f, {"resonance_Hz"}), at(f, {"resonance_damping"}),
+                      at(f, {"antiresonance_Hz"}), at(f, {"antiresonance_damping"}),
+                      verdict.is_boolean() ? json(verdict.get<bool>() ? "non-minimum phase" : "minimum phase") : json(nullptr),
+                      at(f, {"nmp_evidence", "phase_change_deg"}), at(f, {"shell_stiffness_N_per_um"}), at(r, {"hpf_corner_Hz"})});
+    }
+    json tables = json::array({table("FRF features per unit",
+                                     {"unit", "static gain [um/V]", "resonance [Hz]", "damping", "anti-resonance [Hz]", "zero damping",
+                                      "zero", "phase change at the zero [deg]", "k_shell [N/um]", "HPF corner [Hz]"},
+                                     rows, "Zero damping < 0: the zero is in the right half plane.")});
+    sections.push_back({{"id", "frf"}, {"title", "Frequency responses (report 2.3)"},
+                        {"text", "FRFs from the DAC voltage u to the encoder d_e and to the force-sensor voltage Vs, all units "
+                                 "overlaid, with the coherence."},
+                        {"tables", tables}, {"figures", figs}});
+  }
+  if (any("nmp")) {
+    json coh = json::array(), phase = json::array(), mag = json::array();
+    json rows = json::array();
+    for (const auto& u : units) {
+      if (!has(u.plots, "nmp")) continue;
+      const json& z = u.plots["nmp"];
+      mag.push_back(trace(u.name, z["f"], z["abs"], u.name, false, "lines+markers"));
+      coh.push_back(trace(u.name, z["f"], z["coh"], u.name, false, "lines+markers"));
+      phase.push_back(trace(u.name, z["f"], z["phase"], u.name, false, "lines+markers"));
+      const json r = result_of(u);
+      rows.push_back({u.name, at(r, {"frf", "antiresonance_Hz"}), at(r, {"frf", "antiresonance_damping"}),
+                      at(r, {"frf", "nmp_evidence", "phase_change_deg"}), at(r, {"frf", "nmp_evidence", "phase_verdict"}),
+                      at(r, {"frf", "nmp_evidence", "verdict_from"})});
+    }
+    sections.push_back(
+        {{"id", "nmp"}, {"title", "The non-minimum-phase zero (report 2.4)"},
+         {"text", "u -> Vs around the anti-resonance, every frequency line. A minimum-phase zero pair raises the phase by 180 deg, "
+                  "a non-minimum-phase one lowers it by 180 deg; the coherence says whether the data there can be trusted."},
+         {"tables", json::array({table("Verdict per unit",
+                                       {"unit", "anti-resonance [Hz]", "zero damping", "phase change [deg]", "verdict of the phase",
+                                        "verdict from"},
+                                       rows)})},
+         {"figures", json::array({figure("nmp-zoom", "Fig. 2.6: u -> Vs at the anti-resonance", "Frequency [Hz]", false,
+                                         json::array({panel("|H| [V/V]", true, mag), panel("Coherence", false, coh),
+                                                      panel("Phase [deg]", false, phase)}))})}});
+  }
+
+  // ---- Section 2.5: the resistor (Figure 2.7).
+  {
+    json mag = json::array(), phase = json::array(), rows = json::array();
+    for (const auto& u : units) {
+      if (!has(u.plots, "resistor")) continue;
+      for (const char* which : {"with", "without"}) {
+        const json p = at(u.plots, {"resistor", which});
+        if (p.is_null()) continue;
+        const std::string name = u.name + (std::string(which) == "with" ? ", with R" : ", without R");
+        mag.push_back(trace(name, p["f"], p["abs"], name));
+        phase.push_back(trace(name, p["f"], p["phase"], name));
+      }
+      const json r = at(result_of(u), {"hpf_resistor"});
+      const auto corner = [&](const char* which) -> json {
+        const json w = at(r, {which});
+        if (w.is_null()) return nullptr;
+        if (has(w, "corner_Hz")) return w["corner_Hz"];
+        return has(w, "below_Hz") ? json(fmt::format("below {:.2g} (not observable)", w["below_Hz"].get<double>())) : json(nullptr);
+      };
+      rows.push_back({u.name, corner("with_resistor"), corner("without_resistor"), at(r, {"without_resistor", "fitted_corner_Hz"}),
+                      at(r, {"without_resistor", "lowest_line_Hz"}), at(result_of(u), {"hpf", "R_C_Hz"})});
+    }
+    if (!mag.empty()) {
+      sections.push_back(
+          {{"id", "resistor"}, {"title", "The resistor across the force sensor (report 2.5)"},
+           {"text", fmt::format("u -> Vs at low frequency with and without the {:.3g} kOhm resistor in parallel with the sensor "
+                                "stack: with it, a high-pass at 1/(2 pi R C).", c.bench.hpf_resistance * 1e-3)},
+           {"tables", json::array({table("High-pass corner per unit",
+                                         {"unit", "with R [Hz]", "without R [Hz]", "fitted without R [Hz]", "lowest line [Hz]",
+                                          "1/(2 pi R C_sensor) [Hz]"},
+                                         rows,
+                                         "First-order high-pass fitted below the campaign's hpf_fmax_Hz. A corner below a third "
+                                         "of the record's lowest line is reported as not observable.")})},
+           {"figures", json::array({figure("resistor", "Fig. 2.7: u -> Vs with and without the resistor", "Frequency [Hz]", true,
+                                           json::array({panel("|H| [V/V]", true, mag), panel("Phase [deg]", false, phase)}))})}});
+    }
+  }
+
+  // ---- Section 2.6: IFF (Figures 2.8, 2.10).
+  {
+    json figs = json::array(), tables = json::array(), warnings = json::array();
+    // Figure 2.8: the IFF plant of the IFF unit against its fit.
+    const UnitAnalysis* iff_unit = nullptr;
+    const json iff = at(results, {"iff"});
+    for (const auto& u : units) {
+      if (!iff_unit && has(u.plots, "frf") && has(u.plots["frf"], "iff_fit_abs") && (!has(iff, "unit") || iff["unit"] == u.id)) iff_unit = &u;
+    }
+    if (iff_unit) {
+      const json& p = iff_unit->plots["frf"];
+      const auto [x, y] = on_branch(p["f"], p["iff_fit_phase"], p["f"], p["Vs_phase"]);
+      figs.push_back(figure("iff-plant", fmt::format("Fig. 2.8: IFF plant of {} and its fit (eq. 2.3)", iff_unit->name), "Frequency [Hz]", true,
+                            json::array({panel("|H| [V/V]", true,
+                                               json::array({trace("measured", p["f"], p["Vs_abs"], "measured"),
+                                                            trace("fit (eq. 2.3 with delay)", p["f"], p["iff_fit_abs"], "fit", true)})),
+                                         panel("Phase [deg]", false,
+                                               json::array({trace("measured", p["f"], p["Vs_phase"], "measured"),
+                                                            trace("fit (eq. 2.3 with delay)", x, y, "fit", true)})),
+                                         panel("Coherence", false, json::array({trace("measured", p["f"], p["Vs_coh"], "measured")}))}),
+                            "u -> Vs of the unit whose IFF data make the batch's IFF result, against the fitted plant model."));
+    }
+    json prow = json::array();
+    for (const auto& u : units) {
+      const json f = at(result_of(u), {"frf", "iff_plant_fit"});
+      if (f.is_null()) continue;
+      prow.push_back({u.name, f["g0"], f["wz_Hz"], f["xz"], f["wp_Hz"], f["xp"], f["w_hpf_Hz"], scaled(f["delay_s"], 1e6),
+                      f["relative_rms_error"]});
+    }
+    if (!prow.empty()) {
+      tables.push_back(table("IFF plant (eq. 2.3) per unit",
+                             {"unit", "g0", "w_z [Hz]", "xi_z", "w_p [Hz]", "xi_p", "w_HPF [Hz]", "delay [us]", "relative rms error"}, prow,
+                             "The report's hand-tuned values: g0 0.64, w_z 42.7 Hz, xi_z 0.4 %, w_p 95.2 Hz, xi_p 2 %, "
+                             "w_HPF 0.4 Hz, 200 us."));
+    }
+    if (extra.contains("root_locus")) {
+      const json& rl = extra["root_locus"];
+      const auto gain_text = [](const json& list) {
+        json re = json::array(), im = json::array(), text = json::array();
+        for (const auto& d : list) {
+          re.push_back(d["re"]);
+          im.push_back(d["im"]);
+          text.push_back(fmt::format("g = {:.3g}", d["gain"].get<double>()));
+        }
+        return std::tuple{re, im, text};
+      };
+      json traces = json::array();
+      for (const auto& b : rl["branches"]) {
+        traces.push_back(with_text(trace("root locus of the model", b["re"], b["im"], "root locus of the model"), b["text"]));
+      }
+      if (has(rl, "open_loop_poles")) {
+        traces.push_back(trace("open-loop poles", rl["open_loop_poles"]["re"], rl["open_loop_poles"]["im"], "", false, "markers"));
+      }
+      if (has(rl, "open_loop_zeros")) {
+        traces.push_back(trace("open-loop zeros", rl["open_loop_zeros"]["re"], rl["open_loop_zeros"]["im"], "", true, "markers"));
+      }
+      if (has(rl, "model_at_gains")) {
+        const auto [re, im, text] = gain_text(rl["model_at_gains"]);
+        traces.push_back(with_text(trace("model at the measured gains", re, im, "", true, "markers"), text));
+      }
+      {
+        const auto [re, im, text] = gain_text(rl["damped"]);
+        if (!re.empty()) traces.push_back(with_text(trace("identified damped poles", re, im, "", false, "markers"), text));
+      }
+      if (has(rl, "optimum")) {
+        const json& o = rl["optimum"];
+        traces.push_back(with_text(trace("optimum", json::array({o["re"]}), json::array({o["im"]}), "", false, "markers"),
+                                   json::array({fmt::format("g = {:.3g}, damping {:.2f}", o["gain"].get<double>(), o["damping"].get<double>())})));
+      }
+      figs.push_back(figure("root-locus", fmt::format("Fig. 2.10b: root locus, APA {}", rl["unit"].get<int>()), "Re [rad/s]", false,
+                            json::array({panel("Im [rad/s]", false, traces)}),
+                            "Closed-loop poles of 1 - g K(s) G(s) = 0 for the fitted plant G (eq. 2.3 with delay) and the report's "
+                            "controller K (eq. 2.4), every branch inside 3 w_p; open circles: the model's poles at the measured gains; "
+                            "filled: the poles identified on the measured damped plants (dominant pair of a vector fit). Hover for "
+                            "the gains."));
+    }
+    json mag = json::array(), phase = json::array();
+    for (const auto& u : units) {
+      if (!has(u.plots, "damped")) continue;
+      for (const auto& d : u.plots["damped"]) {
+        const std::string name = fmt::format("{} g = {:.3g}", u.name, d["gain"].get<double>());
+        mag.push_back(trace(name, d["f"], d["abs"], name));
+        mag.push_back(trace(name + " fit", d["f"], d["fit_abs"], name, true));
+        if (has(d, "phase")) {
+          phase.push_back(trace(name, d["f"], d["phase"], name));
+          const auto [x, y] = on_branch(d["f"], d["fit_phase"], d["f"], d["phase"]);
+          phase.push_back(trace(name + " fit", x, y, name, true));
         }
       }
-      if (!model.empty()) {
-        figs.push_back(figure("model-vs", "Tuned 2-DoF model against the measurement, u -> Vs", "Frequency [Hz]", true,
-                              json::array({panel("|H| [V/V]", true, model)})));
-      }
     }
-    if (!figs.empty()) {
-      sections.push_back({{"id", "frf"}, {"title", "Frequency responses"},
-                          {"text", "FRFs from the DAC voltage u to the encoder d_e and to the force-sensor voltage Vs "
-                                   "(report section 2.3), all units overlaid, with the coherence."},
+    if (!mag.empty()) {
+      figs.push_back(figure("damped-plants", "Fig. 2.10a: damped plants u' -> d_e", "Frequency [Hz]", true,
+                            json::array({panel("|H| [um/V]", true, mag), panel("Phase [deg]", false, phase)}),
+                            "Solid: measured; dashed: the vector fits whose dominant pole is the identified damped pole."));
+    }
+    if (has(iff, "gains") && !iff["gains"].empty()) {
+      json rows = json::array();
+      const json distance = at(iff, {"relative_pole_distance"});
+      for (std::size_t i = 0; i < iff["gains"].size(); ++i) {
+        const auto info = [](const json& p) -> std::pair<json, json> {
+          if (!p.is_array() || p.size() != 2 || !p[0].is_number()) return {nullptr, nullptr};
+          const double re = p[0].get<double>(), im = p[1].get<double>(), w = std::hypot(re, im);
+          return {w / (2.0 * std::numbers::pi), -re / w};
+        };
+        const auto [fi, zi] = info(iff["damped_poles"][i]);
+        const auto [fm, zm] = has(iff, "model_poles") ? info(iff["model_poles"][i]) : std::pair<json, json>{nullptr, nullptr};
+        rows.push_back({iff["gains"][i], fi, zi, fm, zm, distance.is_array() ? distance[i] : json(nullptr)});
+      }
+      tables.push_back(table("Damped poles against the model's root locus",
+                             {"gain g", "identified [Hz]", "identified damping", "model [Hz]", "model damping", "relative distance"},
+                             rows,
+                             fmt::format("Optimal gain of the model {}, maximum damping {}.",
+                                         has(iff, "optimal_gain") ? fmt::format("{:.3g}", iff["optimal_gain"].get<double>()) : "-",
+                                         has(iff, "max_damping") ? fmt::format("{:.2f}", iff["max_damping"].get<double>()) : "-")));
+    }
+    if (has(iff, "warning")) warnings.push_back(iff["warning"]);
+    if (!figs.empty() || !tables.empty()) {
+      sections.push_back({{"id", "iff"}, {"title", "Integral Force Feedback (report 2.6)"}, {"warnings", warnings}, {"tables", tables},
                           {"figures", figs}});
     }
   }
-  // Hysteresis, stroke, stiffness.
-  {
+
+  // ---- Section 3: the 2-DoF model (Figure 3.4).
+  if (any("model")) {
     json figs = json::array();
+    figs.push_back(frf_figure(units, "de", "model-de", "Fig. 3.4a: 2-DoF model against the measurement, u -> d_e", "um/V", "model", "de_abs",
+                              "de_phase", "2-DoF model", false, "Solid: measured; dashed: the tuned 2-DoF model."));
+    figs.push_back(frf_figure(units, "Vs", "model-vs", "Fig. 3.4b: 2-DoF model against the measurement, u -> Vs", "V/V", "model", "Vs_abs",
+                              "Vs_phase", "2-DoF model", false,
+                              "Solid: measured; dashed: the tuned 2-DoF model. Its zero is minimum phase: where the measured phase "
+                              "falls through the anti-resonance, the model's (drawn on the measurement's branch) jumps by one turn."));
+    json rows = json::array();
+    for (const auto& u : units) {
+      const json r = result_of(u);
+      const json m = at(r, {"model_2dof"});
+      if (m.is_null()) continue;
+      rows.push_back({u.name, m["m"], scaled(m["k1"], 1e-6), m["c1"], scaled(m["ke"], 1e-6), m["ce"], scaled(m["ka"], 1e-6), m["ca"], m["ga"],
+                      scaled(m["gs"], 1e-6), at(r, {"model_2dof_fit", "relative_error_de"}), at(r, {"model_2dof_fit", "relative_error_Vs"})});
+    }
+    sections.push_back({{"id", "model"}, {"title", "Two degrees-of-freedom model (report 3)"},
+                        {"tables", json::array({table("2-DoF parameters per unit (Table 3.1)",
+                                                      {"unit", "m [kg]", "k1 [N/um]", "c1 [Ns/m]", "ke [N/um]", "ce [Ns/m]", "ka [N/um]",
+                                                       "ca [Ns/m]", "ga [N/V]", "gs [V/um]", "error d_e", "error Vs"},
+                                                      rows, "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46.")})},
+                        {"figures", figs}});
+  }
+
+  // ---- Section 2.1 and 1.3: hysteresis and stroke (Figures 2.3, 1.4b).
+  {
+    json figs = json::array(), rows = json::array();
+    bool absolute = false;
+    std::vector<double> amplitudes;
+    for (const auto& u : units) {
+      for (const auto& h : at(result_of(u), {"hysteresis"})) {
+        const double a = std::round(h["amplitude_V"].get<double>() * 10.0) / 10.0;
+        if (std::find(amplitudes.begin(), amplitudes.end(), a) == amplitudes.end()) amplitudes.push_back(a);
+      }
+    }
+    std::sort(amplitudes.begin(), amplitudes.end());
     for (const auto& u : units) {
       if (!has(u.plots, "hysteresis") || u.plots["hysteresis"].empty()) continue;
-      json traces = json::array();
+      json loops = json::array(), normalized = json::array();
       for (const auto& loop : u.plots["hysteresis"]) {
-        traces.push_back(trace(fmt::format("{:g} V", loop["amplitude_V"].get<double>()), loop["Va"], loop["de_um"]));
+        const std::string name = amplitude_label(loop["amplitude_V"].get<double>());
+        loops.push_back(trace(name, loop["Va"], loop["de_um"], name));
+        // (Va - middle) / half range against (d_e - middle) / half range: every loop fills [-1, 1].
+        const auto norm = [](const json& v) {
+          double lo = INFINITY, hi = -INFINITY;
+          for (const auto& x : v) {
+            if (x.is_number()) lo = std::min(lo, x.get<double>()), hi = std::max(hi, x.get<double>());
+          }
+          json out = json::array();
+          for (const auto& x : v) out.push_back(x.is_number() && hi > lo ? json((2.0 * x.get<double>() - lo - hi) / (hi - lo)) : json(nullptr));
+          return out;
+        };
+        normalized.push_back(trace(name, norm(loop["Va"]), norm(loop["de_um"]), name));
       }
-      figs.push_back(figure(fmt::format("hysteresis-{}", u.id), u.name + ": hysteresis loops", "Va [V]", false,
-                            json::array({panel("d_e [um]", false, traces)})));
+      if (!absolute) {
+        figs.push_back(figure("hysteresis", fmt::format("Fig. 2.3: {}, d_e against Va for each amplitude", u.name), "Va [V]", false,
+                              json::array({panel("d_e [um]", false, loops)})));
+        absolute = true;
+      }
+      figs.push_back(figure(fmt::format("hysteresis-{}", u.id), u.name + ": hysteresis loops, normalized", "(Va - mid) / half range", false,
+                            json::array({panel("(d_e - mid) / half range", false, normalized)}),
+                            "Each loop scaled to fill [-1, 1] on both axes, so the small ones can be told apart: the wider the "
+                            "loop, the larger the hysteresis relative to the stroke."));
+      json row = json::array({u.name});
+      const json list = at(result_of(u), {"hysteresis"});
+      for (const double a : amplitudes) {
+        json cell = nullptr;
+        for (const auto& h : list) {
+          if (std::abs(h["amplitude_V"].get<double>() - a) < 0.05) cell = fmt::format("{:.3g} ({:.1f} %)", h["width_um"].get<double>(), 100.0 * h["relative_width"].get<double>());
+        }
+        row.push_back(cell);
+      }
+      rows.push_back(row);
     }
     json stroke = json::array();
     for (const auto& u : units) {
       if (has(u.plots, "stroke")) stroke.push_back(trace(u.name, u.plots["stroke"]["Va"], u.plots["stroke"]["de_um"], u.name));
     }
     if (!stroke.empty()) {
-      figs.push_back(figure("stroke", "Stroke: displacement against the stack voltage (slow ramp)", "Va [V]", false,
+      figs.push_back(figure("stroke", "Fig. 1.4b: stroke, displacement against the stack voltage (slow ramp)", "Va [V]", false,
                             json::array({panel("d_e [um]", false, stroke)})));
     }
-    if (!figs.empty()) sections.push_back({{"id", "quasi-static"}, {"title", "Stroke and hysteresis"}, {"figures", figs}});
+    json tables = json::array();
+    if (!rows.empty()) {
+      std::vector<std::string> columns = {"unit"};
+      for (const double a : amplitudes) columns.push_back(fmt::format("width at {:.3g} V [um] (of the stroke)", a));
+      tables.push_back(table("Hysteresis: loop width at the offset per amplitude", columns, rows));
+    }
+    if (!figs.empty()) sections.push_back({{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}});
   }
+
+  // ---- Section 2.2: stiffness (Figure 2.4), short and open circuit.
   {
-    json traces = json::array();
+    json traces = json::array(), rows = json::array();
     for (const auto& u : units) {
-      if (!has(u.plots, "stiffness")) continue;
-      traces.push_back(trace(u.name, u.plots["stiffness"]["t"], u.plots["stiffness"]["de_um"], u.name));
-      traces.push_back(trace(u.name + " creep fit", u.plots["stiffness"]["t"], u.plots["stiffness"]["fit_um"], u.name, true));
-    }
-    if (!traces.empty()) {
-      sections.push_back({{"id", "stiffness"},
-                          {"title", "Static stiffness"},
-                          {"text", fmt::format("Added mass {:g} kg put on and taken off (report section 2.2); dashed: the fitted "
-                                               "logarithmic creep model.", c.bench.added_mass)},
-                          {"figures", json::array({figure("stiffness", "d_e during the added-mass test", "Time [s]", false,
-                                                          json::array({panel("d_e [um]", false, traces)}))})}});
-    }
-  }
-  // IFF.
-  {
-    json figs = json::array();
-    if (extra.contains("root_locus")) {
-      const json& rl = extra["root_locus"];
-      json traces = json::array();
-      for (const auto& b : rl["branches"]) traces.push_back(trace("root locus (fitted plant, eq. 2.4)", b["re"], b["im"], "model"));
-      json re = json::array(), im = json::array();
-      for (const auto& d : rl["damped"]) {
-        re.push_back(d["re"]);
-        im.push_back(d["im"]);
+      for (const char* key : {"stiffness", "stiffness_open"}) {
+        if (!has(u.plots, key)) continue;
+        const std::string name = u.name + (std::string(key) == "stiffness" ? "" : ", stacks open");
+        traces.push_back(trace(name, u.plots[key]["t"], u.plots[key]["de_um"], name));
+        traces.push_back(trace(name + " creep fit", u.plots[key]["t"], u.plots[key]["fit_um"], name, true));
       }
-      if (!re.empty()) traces.push_back(trace("damped plants (2nd-order fits)", re, im, "", false, "markers"));
-      traces.push_back(trace("open-loop resonance", json::array({rl["open_loop_pole"][0]}), json::array({rl["open_loop_pole"][1]}), "", false, "markers"));
-      figs.push_back(figure("root-locus", fmt::format("Root locus, APA {}", rl["unit"].get<int>()), "Re [rad/s]", false,
-                            json::array({panel("Im [rad/s]", false, traces)}),
-                            "Closed-loop poles of 1 - g K(s) G(s) = 0 for the fitted plant G (eq. 2.3 with delay) and the "
-                            "report's controller K (eq. 2.4), against the poles of the second-order fits of the measured damped plants."));
-    }
-    json damped = json::array();
-    for (const auto& u : units) {
-      if (!has(u.plots, "damped")) continue;
-      for (const auto& d : u.plots["damped"]) {
-        const std::string name = fmt::format("{} g = {:g}", u.name, d["gain"].get<double>());
-        damped.push_back(trace(name, d["f"], d["abs"], name));
-        damped.push_back(trace(name + " fit", d["f"], d["fit_abs"], name, true));
+      const json k = at(result_of(u), {"stiffness_N_per_um"});
+      if (!k.is_null()) {
+        rows.push_back({u.name, at(k, {"k1"}), at(k, {"k2"}), at(k, {"k_sc"}), at(k, {"k_oc"}), at(k, {"resonance"}),
+                        at(result_of(u), {"stiffness_static", "creep_um_per_decade", "on"})});
       }
     }
-    if (!damped.empty()) {
-      figs.push_back(figure("damped-plants", "Damped plants u' -> d_e", "Frequency [Hz]", true,
-                            json::array({panel("|H| [um/V]", true, damped)}), "Solid: measured; dashed: second-order fits."));
+    if (!traces.empty() || !rows.empty()) {
+      json figs = json::array();
+      if (!traces.empty()) {
+        figs.push_back(figure("stiffness", "Fig. 2.4: d_e during the added-mass test", "Time [s]", false,
+                              json::array({panel("d_e [um]", false, traces)})));
+      }
+      sections.push_back(
+          {{"id", "stiffness"},
+           {"title", "Static stiffness (report 2.2)"},
+           {"text", fmt::format("Added mass {:g} kg put on and taken off; dashed: the fitted logarithmic creep model. k_sc: the stacks "
+                                "short-circuited (actuators on the amplifier, sensor on the resistor), which is k1; k_oc: the same test "
+                                "with every stack open (report: about 2.3 and 1.7 N/um).",
+                                c.bench.added_mass)},
+           {"tables", json::array({table("Stiffness per unit [N/um]",
+                                         {"unit", "k1", "k2", "k_sc", "k_oc", "from the resonance", "creep under load [um/decade]"}, rows)})},
+           {"figures", figs}});
     }
-    if (!figs.empty()) sections.push_back({{"id", "iff"}, {"title", "Integral Force Feedback"}, {"figures", figs}});
   }
-  // Flexible modes.
+
+  // ---- Section 1.4: flexible modes (Figure 1.7).
   {
     json traces = json::array();
     for (const auto& u : units) {
       if (has(u.plots, "hammer")) traces.push_back(trace(u.name, u.plots["hammer"]["f"], u.plots["hammer"]["abs"], u.name));
     }
     if (!traces.empty()) {
-      sections.push_back({{"id", "modes"}, {"title", "Flexible modes (hammer test)"},
-                          {"figures", json::array({figure("hammer", "Force -> vibrometer velocity", "Frequency [Hz]", true,
+      sections.push_back({{"id", "modes"}, {"title", "Flexible modes, hammer test (report 1.4)"},
+                          {"figures", json::array({figure("hammer", "Fig. 1.7: force -> vibrometer velocity", "Frequency [Hz]", true,
                                                           json::array({panel("|H| [m/s/N]", true, traces)}))})}});
     }
   }
-  // Batch comparison.
+
+  // ---- Batch comparison: bars with both limits of every spec.
   {
     json names = json::array();
     for (const auto& u : units) names.push_back(u.name);
-    auto bars = [&](const std::string& name, const std::function<json(const json&)>& get) {
+    auto bars = [&](const std::string& name, std::initializer_list<const char*> path) {
       json y = json::array();
-      for (const auto& r : results["units"]) y.push_back(get(r));
+      for (const auto& r : result_units) y.push_back(at(r, path));
       return trace(name, names, y, "", false, "bars");
-    };
-    auto at = [](const json& r, const char* a, const char* b = nullptr) -> json {
-      if (!has(r, a)) return nullptr;
-      if (!b) return r[a];
-      return has(r[a], b) ? r[a][b] : json(nullptr);
     };
     auto limit = [&](const std::string& name, double v) {
       json y = json::array();
       for (std::size_t i = 0; i < names.size(); ++i) y.push_back(v);
-      return trace(name, names, y, "", true, "lines");
+      return trace(fmt::format("{} {:.3g}", name, v), names, y, "", true, "lines");
+    };
+    auto range = [&](json& t, const std::string& what, const std::optional<metrology::Range>& r, double scale) {
+      if (!r) return;
+      t.push_back(limit(what + " minimum", r->min * scale));
+      if (std::isfinite(r->max)) t.push_back(limit(what + " maximum", r->max * scale));
     };
     json figs = json::array();
     {
-      json t = json::array({bars("sensor stack", [&](const json& r) { return at(r, "capacitance_uF", "sensor"); }),
-                            bars("actuator stacks", [&](const json& r) { return at(r, "capacitance_uF", "actuator"); })});
-      if (c.specs.capacitance_sensor) t.push_back(limit("sensor minimum", c.specs.capacitance_sensor->min * 1e6));
-      if (c.specs.capacitance_actuator) t.push_back(limit("actuator minimum", c.specs.capacitance_actuator->min * 1e6));
-      figs.push_back(figure("batch-capacitance", "Capacitance", "", false, json::array({panel("C [uF]", false, t)})));
+      json t = json::array({bars("sensor stack", {"capacitance_uF", "sensor"}), bars("actuator stacks", {"capacitance_uF", "actuator"})});
+      range(t, "sensor", c.specs.capacitance_sensor, 1e6);
+      range(t, "actuator", c.specs.capacitance_actuator, 1e6);
+      figs.push_back(figure("batch-capacitance", "Capacitance (Table 1.2)", "", false, json::array({panel("C [uF]", false, t)})));
     }
     {
-      json t = json::array({bars("k1", [&](const json& r) { return at(r, "stiffness_N_per_um", "k1"); }),
-                            bars("k2", [&](const json& r) { return at(r, "stiffness_N_per_um", "k2"); }),
-                            bars("from the resonance", [&](const json& r) { return at(r, "stiffness_N_per_um", "resonance"); })});
-      figs.push_back(figure("batch-stiffness", "Stiffness", "", false, json::array({panel("k [N/um]", false, t)})));
+      json t = json::array({bars("k1", {"stiffness_N_per_um", "k1"}), bars("k2", {"stiffness_N_per_um", "k2"}),
+                            bars("k_oc", {"stiffness_N_per_um", "k_oc"}), bars("from the resonance", {"stiffness_N_per_um", "resonance"})});
+      range(t, "stiffness", c.specs.stiffness, 1e-6);
+      figs.push_back(figure("batch-stiffness", "Stiffness (Table 2.1)", "", false, json::array({panel("k [N/um]", false, t)})));
     }
     {
-      json t = json::array({bars("flatness", [&](const json& r) { return at(r, "flatness_um"); })});
-      if (c.specs.flatness_max) t.push_back(limit("flatness limit", *c.specs.flatness_max * 1e6));
-      figs.push_back(figure("batch-flatness", "Flatness (" + metrology::to_string(c.specs.flatness_method) + ")", "", false,
+      json t = json::array({bars("flatness", {"flatness_um"})});
+      if (c.specs.flatness_max) t.push_back(limit("flatness maximum", *c.specs.flatness_max * 1e6));
+      figs.push_back(figure("batch-flatness", "Flatness (Table 1.1, " + metrology::to_string(c.specs.flatness_method) + ")", "", false,
                             json::array({panel("flatness [um]", false, t)})));
     }
     {
-      json t = json::array({bars("stroke", [&](const json& r) { return at(r, "stroke_um"); })});
-      if (c.specs.stroke_min) t.push_back(limit("minimum stroke", *c.specs.stroke_min * 1e6));
-      figs.push_back(figure("batch-stroke", "Stroke", "", false, json::array({panel("stroke [um]", false, t)})));
+      json t = json::array({bars("stroke", {"stroke_um"})});
+      if (c.specs.stroke_min) t.push_back(limit("stroke minimum", *c.specs.stroke_min * 1e6));
+      figs.push_back(figure("batch-stroke", "Stroke (Figure 1.4)", "", false, json::array({panel("stroke [um]", false, t)}),
+                            "The specification gives a minimum stroke only."));
     }
-    sections.push_back({{"id", "batch"}, {"title", "Batch comparison"}, {"figures", figs}});
+    sections.push_back({{"id", "batch"}, {"title", "Batch comparison"},
+                        {"text", "Dashed lines: the specification's limits (both where it has two)."},
+                        {"figures", figs}});
   }
-  if (extra.contains("superelement")) {
-    json traces = json::array();
-    for (const auto& u : units) {
-      if (has(u.plots, "frf")) traces.push_back(trace(u.name, u.plots["frf"]["f"], u.plots["frf"]["de_abs"], u.name));
+
+  // ---- Section 4: the super element (Figure 4.2).
+  {
+    json figs = json::array();
+    std::string text;
+    if (extra.contains("superelement")) {
+      const json& se = extra["superelement"];
+      json mag = json::array(), phase = json::array();
+      for (const auto& u : units) {
+        if (!has(u.plots, "frf")) continue;
+        mag.push_back(trace(u.name, u.plots["frf"]["f"], u.plots["frf"]["de_abs"], u.name));
+        phase.push_back(trace(u.name, u.plots["frf"]["f"], u.plots["frf"]["de_phase"], u.name));
+      }
+      mag.push_back(trace("super element", se["f"], se["abs_um_per_V"], "super element", true));
+      json panels = json::array({panel("|H| [um/V]", true, mag)});
+      if (has(se, "phase_deg")) {
+        const UnitAnalysis* ref = nullptr;
+        for (const auto& u : units) {
+          if (!ref && has(u.plots, "frf")) ref = &u;
+        }
+        if (ref) {
+          const auto [x, y] = on_branch(se["f"], se["phase_deg"], ref->plots["frf"]["f"], ref->plots["frf"]["de_phase"]);
+          phase.push_back(trace("super element", x, y, "super element", true));
+        } else {
+          phase.push_back(trace("super element", se["f"], se["phase_deg"], "super element", true));
+        }
+        panels.push_back(panel("Phase [deg]", false, phase));
+      }
+      figs.push_back(figure("superelement", "Fig. 4.2: u -> d_e, super element against the measurements", "Frequency [Hz]", true, panels));
+      text = "The super element's u -> d_e (report section 4) against the measured FRFs.";
+    } else {
+      text = "Not part of this campaign: no super element was given. A [superelement] table in the campaign file (docs/campaign.md) "
+             "adds the finite-element model's u -> d_e against the measured FRFs here (report Figure 4.2).";
     }
-    traces.push_back(trace("super element", extra["superelement"]["f"], extra["superelement"]["abs_um_per_V"], "", true));
-    sections.push_back({{"id", "superelement"}, {"title", "Super element"},
-                        {"figures", json::array({figure("superelement", "u -> d_e: super element against the measurements",
-                                                        "Frequency [Hz]", true, json::array({panel("|H| [um/V]", true, traces)}))})}});
+    sections.push_back({{"id", "superelement"}, {"title", "Super element (report 4)"}, {"text", text}, {"figures", figs}});
   }
   return {{"title", c.title},
           {"subtitle", fmt::format("{} — piezobench {}", c.file.filename().string(), kVersion)},

@@ -11,6 +11,7 @@
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/welch.hpp"
+#include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/modal.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/metrology/capacitance.hpp"
@@ -361,7 +362,9 @@ void hysteresis(const Campaign& c, const std::vector<Record>& records, UnitAnaly
   u.plots["hysteresis"] = loops;
 }
 
-void stiffness(const Campaign& c, const Record& r, UnitAnalysis& u) {
+// The added-mass test (report section 2.2). `open`: every stack open (k_oc), else the stacks on
+// the amplifier and the resistor (k1, k2; k_sc = k1). The same readings and creep fit either way.
+void stiffness(const Campaign& c, const Record& r, UnitAnalysis& u, bool open) {
   const VectorXd t = r.time();
   const VectorXd de = r.channel("de");
   const VectorXd mass = r.has("added_mass") ? r.channel("added_mass") : VectorXd();
@@ -369,9 +372,13 @@ void stiffness(const Campaign& c, const Record& r, UnitAnalysis& u) {
   o.added_mass = c.bench.added_mass;
   o.gravity = c.bench.gravity;
   const metrology::StaticStiffnessResult s = metrology::static_stiffness(t, de, mass, o, c.file.string() + ": " + r.spec.key);
-  u.k1 = s.k1;
-  u.k2 = s.k2;
-  u.result["stiffness_static"] = {{"k1_N_per_um", s.k1 * 1e-6},
+  if (open) {
+    u.k_oc = s.k1;
+  } else {
+    u.k1 = s.k1;
+    u.k2 = s.k2;
+  }
+  u.result[open ? "stiffness_open_circuit" : "stiffness_static"] = {{"k1_N_per_um", s.k1 * 1e-6},
                                   {"k2_N_per_um", s.k2 * 1e-6},
                                   {"t_on_s", s.t_on},
                                   {"t_off_s", s.t_off},
@@ -385,7 +392,7 @@ void stiffness(const Campaign& c, const Record& r, UnitAnalysis& u) {
                                   {"gravity_m_per_s2", o.gravity},
                                   {"mass_log", r.has("added_mass")},
                                   {"provenance", provenance(r, {"de", "added_mass"})}};
-  u.plots["stiffness"] = {{"t", thin(t)}, {"de_um", thin(de * 1e6)}, {"fit_um", thin(s.fit * 1e6)}};
+  u.plots[open ? "stiffness_open" : "stiffness"] = {{"t", thin(t)}, {"de_um", thin(de * 1e6)}, {"fit_um", thin(s.fit * 1e6)}};
 }
 
 // Chooses the feature nearest in frequency to `target` (rad/s).
@@ -668,6 +675,22 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     }
     p["de_phase"] = unwrapped_degrees(hde);
     p["Vs_phase"] = unwrapped_degrees(hvs);
+    // Every line around the anti-resonance (report Figure 2.6: coherence and phase there).
+    if (anti_w) {
+      const double fz = *anti_w / kTwoPi;
+      json z = {{"f", json::array()}, {"abs", json::array()}, {"coh", json::array()}};
+      std::vector<std::complex<double>> hz;
+      for (Index k = 0; k < f.size(); ++k) {
+        if (f(k) < 0.7 * fz || f(k) > 1.4 * fz) continue;
+        z["f"].push_back(f(k));
+        z["abs"].push_back(std::abs(frf.H[1](k)));
+        z["coh"].push_back(frf.coherence[1](k));
+        hz.push_back(frf.H[1](k));
+      }
+      z["phase"] = unwrapped_degrees(hz);
+      z["antiresonance_Hz"] = fz;
+      u.plots["nmp"] = z;
+    }
     if (u.iff_plant) {
       VectorXd w(static_cast<Index>(idx.size()));
       for (std::size_t i = 0; i < idx.size(); ++i) w(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
@@ -682,6 +705,59 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     }
     u.plots["frf"] = p;
   }
+}
+
+// The low-frequency u -> Vs with and without the resistor across the sensor stack (report section
+// 2.5, Figure 2.7): Welch with segments of half the record (the lowest lines matter here), a
+// first-order high-pass fitted below hpf_fmax_hz (ident::fit_high_pass). A corner below a third of
+// the lowest line (where it would change |H| there by less than 5 %) is not observable in the
+// record: it is reported as an upper bound, not as a number.
+json low_frequency_vs(const Campaign& c, const Record& r, const std::string& name, UnitAnalysis& u) {
+  const AnalysisSettings& a = c.analysis;
+  long nfft = static_cast<long>(r.ts.samples()) / 2;
+  nfft -= nfft % 2;
+  const dsp::Frf frf = welch(r, "u", {"Vs"}, a, std::max(256L, nfft));
+  const double lowest = frf.freq_hz.size() > 1 ? frf.freq_hz(1) : 0.0;
+  json out = {{"provenance", provenance(r, {"u", "Vs"})}, {"welch", welch_provenance(frf)}, {"lowest_line_Hz", lowest},
+              {"band_Hz", {lowest, a.hpf_fmax_hz}}, {"corner_Hz", nullptr}, {"observable", false}};
+  const Band low = band(frf, 0, 0.0, a.hpf_fmax_hz);
+  if (low.omega.size() >= 3) {
+    const ident::HighPassFit h = ident::fit_high_pass(low.omega, low.h);
+    const bool observable = h.corner_hz() >= lowest / 3.0;
+    out["observable"] = observable;
+    out["fitted_corner_Hz"] = h.corner_hz();
+    out["relative_rms_error"] = h.relative_rms_error;
+    out["points"] = low.omega.size();
+    if (observable) {
+      out["corner_Hz"] = h.corner_hz();
+    } else {
+      out["below_Hz"] = lowest / 3.0;
+      out["note"] = fmt::format("not observable in this record: the fitted corner ({:.2g} Hz) is below a third of the lowest line "
+                                "({:.3g} Hz)", h.corner_hz(), lowest);
+    }
+  }
+  // For Figure 2.7: up to 20 Hz.
+  const std::vector<Index> idx = log_indices(frf.freq_hz, lowest, std::min(20.0, frf.freq_hz(frf.freq_hz.size() - 1)), 200);
+  json p = {{"f", json::array()}, {"abs", json::array()}, {"coh", json::array()}};
+  std::vector<std::complex<double>> h;
+  for (const Index k : idx) {
+    p["f"].push_back(frf.freq_hz(k));
+    p["abs"].push_back(std::abs(frf.H[0](k)));
+    p["coh"].push_back(frf.coherence[0](k));
+    h.push_back(frf.H[0](k));
+  }
+  p["phase"] = unwrapped_degrees(h);
+  if (!u.plots.contains("resistor")) u.plots["resistor"] = json::object();
+  u.plots["resistor"][name] = p;
+  return out;
+}
+
+void resistor(const Campaign& c, const Record* with, const Record& without, UnitAnalysis& u) {
+  json out = json::object();
+  out["with_resistor"] = with ? low_frequency_vs(c, *with, "with", u) : json(nullptr);
+  out["without_resistor"] = low_frequency_vs(c, without, "without", u);
+  out["method"] = "first-order high-pass g s/(s + wc) fitted to u -> Vs below hpf_fmax_Hz (Welch, segments of half the record)";
+  u.result["hpf_resistor"] = out;
 }
 
 void iff(const Campaign& c, const std::vector<Record>& records, UnitAnalysis& u) {
@@ -708,23 +784,42 @@ void iff(const Campaign& c, const std::vector<Record>& records, UnitAnalysis& u)
     d.delay_removed = delay;
     Band b = band(d.frf, 0, a.damped_fmin_hz, a.damped_fmax_hz);
     for (Index k = 0; k < b.omega.size(); ++k) b.h(k) *= std::exp(std::complex<double>(0.0, b.omega(k) * delay));
-    IffPlantFitOptions so;
-    so.fit_delay = false;
     json entry = {{"gain", gain}, {"provenance", provenance(r, {"u_prime", "de"})}, {"welch", welch_provenance(d.frf)},
                   {"delay_removed_s", delay}};
     try {
-      d.fit = fit_delayed_second_order(b.omega, b.h, b.coherence, so, c.file.string() + ": " + r.spec.key);
-      entry["fit"] = {{"frequency_Hz", d.fit.natural_frequency / kTwoPi},
-                      {"damping", d.fit.damping},
-                      {"static_gain_um_per_V", d.fit.static_gain * 1e6},
-                      {"pole", io::to_json(d.fit.pole())},
-                      {"relative_rms_error", d.fit.relative_rms_error},
-                      {"method", "weighted Levenberg-Marquardt, k wn^2/(s^2 + 2 zeta wn s + wn^2), delay of d_e removed"}};
-      u.damped.push_back(d);
+      // The damped pole: the dominant pair of a vector fit (ident/dominant_pole.hpp, the method of
+      // `iff study`), not the report's second-order fit, which misplaces it by up to 50 % once the
+      // controller's poles have moved into the band.
+      ident::DominantPoleOptions po;
+      po.fit.order = a.fit_order;
+      po.omega_min = kTwoPi * a.damped_fmin_hz;
+      po.omega_max = kTwoPi * a.damped_fmax_hz;
+      d.identified = ident::dominant_pole(b.omega, b.h, po);
+      entry["fit"] = {{"frequency_Hz", d.identified->frequency_hz()},
+                      {"damping", d.identified->damping},
+                      {"pole", io::to_json(d.identified->pole)},
+                      {"order", po.fit.order},
+                      {"relative_rms_error", d.identified->fit.relative_rms_error},
+                      {"band_Hz", {a.damped_fmin_hz, a.damped_fmax_hz}},
+                      {"method", "vector fitting, the dominant pole pair (largest |r|/|Re p|) in the band; delay of d_e removed"}};
     } catch (const NumericalError& e) {
       record_failure(u, fmt::format("damped plant g = {}", gain), e);
       entry["fit"] = nullptr;
     }
+    // The report's second-order fit, for comparison only.
+    try {
+      IffPlantFitOptions so;
+      so.fit_delay = false;
+      d.second_order = fit_delayed_second_order(b.omega, b.h, b.coherence, so, c.file.string() + ": " + r.spec.key);
+      entry["second_order_fit"] = {{"frequency_Hz", d.second_order->natural_frequency / kTwoPi},
+                                   {"damping", d.second_order->damping},
+                                   {"pole", io::to_json(d.second_order->pole())},
+                                   {"relative_rms_error", d.second_order->relative_rms_error},
+                                   {"method", "the report's: k wn^2/(s^2 + 2 zeta wn s + wn^2), weighted Levenberg-Marquardt"}};
+    } catch (const NumericalError& e) {
+      entry["second_order_fit"] = nullptr;
+    }
+    if (d.identified) u.damped.push_back(d);
     list.push_back(entry);
   }
   std::sort(u.damped.begin(), u.damped.end(), [](const DampedPlant& x, const DampedPlant& y) { return x.gain < y.gain; });
@@ -733,13 +828,22 @@ void iff(const Campaign& c, const std::vector<Record>& records, UnitAnalysis& u)
     const VectorXd& f = d.frf.freq_hz;
     const std::vector<Index> idx = log_indices(f, std::max(f(1), 0.5 * a.damped_fmin_hz), std::min(f(f.size() - 1), 2.0 * a.damped_fmax_hz), 300);
     json p = {{"gain", d.gain}, {"f", json::array()}, {"abs", json::array()}, {"fit_abs", json::array()}};
-    for (const Index i : idx) {
-      lti::Vector om(1);
-      om(0) = kTwoPi * f(i);
-      p["f"].push_back(f(i));
-      p["abs"].push_back(std::abs(d.frf.H[0](i)) * 1e6);
-      p["fit_abs"].push_back(std::abs(d.fit.response(om)(0)) * 1e6);
+    VectorXd om(static_cast<Index>(idx.size()));
+    for (std::size_t i = 0; i < idx.size(); ++i) om(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
+    // The fit (delay removed) with the delay put back, to sit on the measurement.
+    const Eigen::MatrixXcd fit = d.identified->fit.evaluate(om);
+    std::vector<std::complex<double>> hm, hf;
+    for (std::size_t i = 0; i < idx.size(); ++i) {
+      const auto k = static_cast<Index>(i);
+      const std::complex<double> g = fit(k, 0) * std::exp(std::complex<double>(0.0, -om(k) * d.delay_removed));
+      p["f"].push_back(f(idx[i]));
+      p["abs"].push_back(std::abs(d.frf.H[0](idx[i])) * 1e6);
+      p["fit_abs"].push_back(std::abs(g) * 1e6);
+      hm.push_back(d.frf.H[0](idx[i]));
+      hf.push_back(g);
     }
+    p["phase"] = unwrapped_degrees(hm);
+    p["fit_phase"] = unwrapped_degrees(hf);
     plots.push_back(p);
   }
   u.plots["damped"] = plots;
@@ -825,17 +929,39 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   if (spec.stiffness) {
     say("static stiffness", *spec.stiffness);
     try {
-      stiffness(c, load_record(c, *spec.stiffness, Experiment::kStiffness), u);
+      stiffness(c, load_record(c, *spec.stiffness, Experiment::kStiffness), u, false);
     } catch (const NumericalError& e) {
       record_failure(u, "static stiffness", e);
     }
   }
+  if (spec.stiffness_open) {
+    say("static stiffness, stacks open", *spec.stiffness_open);
+    try {
+      stiffness(c, load_record(c, *spec.stiffness_open, Experiment::kStiffnessOpen), u, true);
+    } catch (const NumericalError& e) {
+      record_failure(u, "static stiffness, stacks open", e);
+    }
+  }
+  std::optional<Record> frf_record;
   if (spec.frf) {
     say("FRFs u -> d_e, Vs", *spec.frf);
-    frf(c, load_record(c, *spec.frf, Experiment::kFrf), u);
+    frf_record = load_record(c, *spec.frf, Experiment::kFrf);
+    frf(c, *frf_record, u);
   }
-  if (u.k1 || u.k_resonance) {
-    u.result["stiffness_N_per_um"] = {{"k1", opt(u.k1, 1e-6)}, {"k2", opt(u.k2, 1e-6)}, {"resonance", opt(u.k_resonance, 1e-6)}};
+  if (spec.frf_no_resistor) {
+    say("u -> Vs without the resistor", *spec.frf_no_resistor);
+    try {
+      resistor(c, frf_record ? &*frf_record : nullptr, load_record(c, *spec.frf_no_resistor, Experiment::kFrfNoResistor), u);
+    } catch (const NumericalError& e) {
+      record_failure(u, "high-pass corner with and without the resistor", e);
+    }
+  }
+  frf_record.reset();
+  if (u.k1 || u.k_resonance || u.k_oc) {
+    // k_sc: the stacks short-circuited (on the amplifier, the sensor on R) = k1; k_oc: every stack
+    // open, read the same way (report section 2.2).
+    u.result["stiffness_N_per_um"] = {{"k1", opt(u.k1, 1e-6)},    {"k2", opt(u.k2, 1e-6)},   {"resonance", opt(u.k_resonance, 1e-6)},
+                                      {"k_sc", opt(u.k1, 1e-6)}, {"k_oc", opt(u.k_oc, 1e-6)}};
   }
   if (!spec.iff.empty()) {
     std::vector<Record> records;

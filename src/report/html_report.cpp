@@ -1,5 +1,6 @@
 #include "piezobench/report/html_report.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -125,8 +126,16 @@ struct Figure {
   json client;  // what report.js draws: the figure with defaults filled in, gaps as null
 };
 
+struct Table {
+  std::string title, text;
+  std::vector<std::string> columns;
+  const json* rows = nullptr;  // validated: lists of numbers, strings, booleans or null
+};
+
 struct Section {
   std::string id, title, text;
+  std::vector<std::string> warnings;
+  std::vector<Table> tables;
   std::vector<Figure> figures;
 };
 
@@ -267,7 +276,7 @@ bool all_strings(const json& values) {
 }
 
 json read_trace(const json& t, const std::string& at, std::optional<bool>& category_x) {
-  require_object(t, at, {"name", "x", "y", "mode", "dash", "group"});
+  require_object(t, at, {"name", "x", "y", "mode", "dash", "group", "text"});
   json out = json::object();
   out["name"] = required_string(t, "name", at);
   const json& x = required_array(t, "x", at);
@@ -296,6 +305,17 @@ json read_trace(const json& t, const std::string& at, std::optional<bool>& categ
   out["mode"] = mode;
   out["dash"] = optional_bool(t, "dash", at);
   if (auto group = optional_string(t, "group", at)) out["group"] = *group;
+  if (const auto text = t.find("text"); text != t.end() && !text->is_null()) {
+    const std::string field = child(at, "text");
+    if (!text->is_array()) fail(field, "a list of strings (hover labels, one per point)", describe(*text));
+    if (text->size() != x.size()) {
+      fail(field, std::to_string(x.size()) + " labels (as many as x)", std::to_string(text->size()) + " labels");
+    }
+    for (std::size_t i = 0; i < text->size(); ++i) {
+      if (!(*text)[i].is_string() && !(*text)[i].is_null()) fail(element(field, i), "a string or null", describe((*text)[i]));
+    }
+    out["text"] = *text;
+  }
   return out;
 }
 
@@ -340,6 +360,32 @@ Figure read_figure(const json& f, const std::string& at) {
   return figure;
 }
 
+Table read_table(const json& t, const std::string& at) {
+  require_object(t, at, {"title", "text", "columns", "rows"});
+  Table table;
+  table.title = required_string(t, "title", at);
+  table.text = optional_string(t, "text", at).value_or("");
+  const json& columns = required_array(t, "columns", at);
+  if (columns.empty()) fail(child(at, "columns"), "at least one column", "an empty list");
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (!columns[i].is_string()) fail(element(child(at, "columns"), i), "a string", describe(columns[i]));
+    table.columns.push_back(columns[i].get<std::string>());
+  }
+  const json& rows = required_array(t, "rows", at);
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const std::string rat = element(child(at, "rows"), r);
+    if (!rows[r].is_array()) fail(rat, "a list of cells", describe(rows[r]));
+    if (rows[r].size() != columns.size()) {
+      fail(rat, std::to_string(columns.size()) + " cells (one per column)", std::to_string(rows[r].size()) + " cells");
+    }
+    for (std::size_t c = 0; c < rows[r].size(); ++c) {
+      if (rows[r][c].is_structured()) fail(element(rat, c), "a number, a string, true, false or null", describe(rows[r][c]));
+    }
+  }
+  table.rows = &rows;
+  return table;
+}
+
 Document read_document(const json& document) {
   const std::string root = "document";
   if (!document.is_object()) throw InputError(kSource, root, "a JSON object", describe(document));
@@ -378,10 +424,21 @@ Document read_document(const json& document) {
   for (std::size_t s = 0; s < sections->size(); ++s) {
     const std::string at = element("sections", s);
     const json& sj = (*sections)[s];
-    require_object(sj, at, {"id", "title", "text", "figures"});
+    require_object(sj, at, {"id", "title", "text", "warnings", "tables", "figures"});
     Section section;
     section.title = required_string(sj, "title", at);
     section.text = optional_string(sj, "text", at).value_or("");
+    if (const auto w = sj.find("warnings"); w != sj.end() && !w->is_null()) {
+      if (!w->is_array()) fail(child(at, "warnings"), "a list of strings", describe(*w));
+      for (std::size_t i = 0; i < w->size(); ++i) {
+        if (!(*w)[i].is_string()) fail(element(child(at, "warnings"), i), "a string", describe((*w)[i]));
+        section.warnings.push_back((*w)[i].get<std::string>());
+      }
+    }
+    if (const auto tables = sj.find("tables"); tables != sj.end() && !tables->is_null()) {
+      if (!tables->is_array()) fail(child(at, "tables"), "a list", describe(*tables));
+      for (std::size_t i = 0; i < tables->size(); ++i) section.tables.push_back(read_table((*tables)[i], element(child(at, "tables"), i)));
+    }
     if (auto id = optional_string(sj, "id", at)) {
       if (!is_id(*id)) fail(child(at, "id"), "1 to 64 characters among a-z, 0-9 and -", describe(sj.at("id")));
       section.id = *id;
@@ -518,6 +575,61 @@ std::string script_safe(const std::string& json_text) {
   return out;
 }
 
+// Plain text as paragraphs: a blank line starts a new one.
+void paragraphs(std::string& out, const std::string& text, const char* attributes) {
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    auto end = text.find("\n\n", begin);
+    if (end == std::string::npos) end = text.size();
+    const auto first = text.find_first_not_of(" \t\r\n", begin);
+    if (first != std::string::npos && first < end) {
+      out +=
+          std::string("<p") + attributes + ">" + escape(std::string_view(text).substr(begin, end - begin)) + "</p>\n";
+    }
+    begin = end + 2;
+  }
+}
+
+// A number for people: `significant` digits, positional between 0.001 and 1e6 (249000, 1.70,
+// 0.00558), scientific outside (1.2e-05).
+std::string readable(double value, int significant = 3) {
+  if (!std::isfinite(value)) return number(value, significant);
+  if (value == 0.0) return "0";
+  // The exponent of the value once rounded (9.9996 -> 10.0, not 10.00).
+  const double magnitude = std::abs(std::stod(number(value, significant)));
+  if (magnitude < 1e-3 || magnitude >= 1e6) return number(value, significant);
+  const int exponent = static_cast<int>(std::floor(std::log10(magnitude)));
+  const int decimals = std::max(0, significant - 1 - exponent);
+  const double scale = std::pow(10.0, exponent - significant + 1);
+  const double rounded = decimals > 0 ? value : std::round(value / scale) * scale;
+  std::array<char, 64> buf{};
+  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), rounded, std::chars_format::fixed, decimals);
+  return {buf.data(), r.ptr};
+}
+
+std::string table_cell(const json& v) {
+  if (v.is_null()) return "<td class=\"nm\" title=\"not available\">&ndash;</td>";
+  if (v.is_boolean()) return std::string("<td>") + (v.get<bool>() ? "yes" : "no") + "</td>";
+  if (v.is_number_integer() || v.is_number_unsigned()) return "<td class=\"num\">" + v.dump() + "</td>";
+  if (v.is_number()) return "<td class=\"num\">" + readable(v.get<double>()) + "</td>";
+  if (is_nonfinite_word(v)) return "<td class=\"nm\">" + escape(v.get<std::string>()) + "</td>";
+  return "<td>" + escape(v.get<std::string>()) + "</td>";
+}
+
+void table_html(std::string& out, const Table& t) {
+  out += "<div class=\"pb-table\"><h3>" + escape(t.title) + "</h3>\n";
+  paragraphs(out, t.text, " class=\"caption\"");
+  out += "<div class=\"table-wrap\"><table class=\"params\"><thead><tr>";
+  for (const auto& c : t.columns) out += "<th>" + escape(c) + "</th>";
+  out += "</tr></thead><tbody>\n";
+  for (const json& row : *t.rows) {
+    out += "<tr>";
+    for (const json& v : row) out += table_cell(v);
+    out += "</tr>\n";
+  }
+  out += "</tbody></table></div></div>\n";
+}
+
 std::string cell_html(const Cell& cell) {
   switch (cell.kind) {
     case Cell::Kind::kNumber:
@@ -559,68 +671,101 @@ void acceptance_table(std::string& out, const Document& doc) {
       "results.json has them in full.</p>\n</section>\n";
 }
 
-// A value of results.batch: scalars inline, lists of scalars joined, objects as nested tables.
+// results.batch, compactly: scalars (and lists of scalars) as "key value" lines, an object whose
+// values are all flat objects (e.g. the spread per quantity) and a list of flat objects (e.g. the
+// outliers) as one table each with a row per entry, deeper objects as titled blocks. Numbers to 3
+// significant digits.
+bool is_scalar_list(const json& v) {
+  if (!v.is_array()) return false;
+  for (const json& x : v) {
+    if (x.is_structured()) return false;
+  }
+  return true;
+}
+bool is_flat_object(const json& v) {
+  if (!v.is_object() || v.empty()) return false;
+  for (const auto& item : v.items()) {
+    if (item.value().is_structured() && !is_scalar_list(item.value())) return false;
+  }
+  return true;
+}
+std::string scalar_text(const json& v) {
+  if (v.is_null()) return "&ndash;";
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+  if (v.is_number_integer() || v.is_number_unsigned()) return v.dump();
+  if (v.is_number()) return readable(v.get<double>());
+  if (v.is_string()) return escape(v.get<std::string>());
+  if (v.is_array()) {
+    if (v.empty()) return "none";
+    std::string s;
+    for (const json& x : v) s += (s.empty() ? "" : ", ") + scalar_text(x);
+    return s;
+  }
+  return "&hellip;";
+}
+std::string pretty_key(const std::string& key) {
+  std::string s = key;
+  for (char& c : s) c = c == '_' ? ' ' : c;
+  return escape(s);
+}
+// Rows (name, flat object) as one table, columns the union of their keys in first-seen order.
+void rows_table(std::string& out, const std::vector<std::pair<std::string, const json*>>& rows, const std::string& first) {
+  std::vector<std::string> keys;
+  for (const auto& [name, obj] : rows) {
+    for (const auto& item : obj->items()) {
+      if (std::find(keys.begin(), keys.end(), item.key()) == keys.end()) keys.push_back(item.key());
+    }
+  }
+  out += "<div class=\"table-wrap\"><table class=\"params\"><thead><tr>";
+  if (!first.empty()) out += "<th>" + escape(first) + "</th>";
+  for (const auto& k : keys) out += "<th>" + pretty_key(k) + "</th>";
+  out += "</tr></thead><tbody>";
+  for (const auto& [name, obj] : rows) {
+    out += "<tr>";
+    if (!first.empty()) out += "<th scope=\"row\">" + pretty_key(name) + "</th>";
+    for (const auto& k : keys) {
+      const auto it = obj->find(k);
+      out += it == obj->end() ? "<td class=\"nm\">&ndash;</td>" : "<td class=\"num\">" + scalar_text(*it) + "</td>";
+    }
+    out += "</tr>";
+  }
+  out += "</tbody></table></div>";
+}
 void batch_value(std::string& out, const json& value, int depth) {
-  if (depth > 6) {
-    out += "&hellip;";
+  if (depth > 4 || !value.is_object()) {
+    out += "<p>" + scalar_text(value) + "</p>";
     return;
   }
-  switch (value.type()) {
-    case json::value_t::null:
-      out += "&ndash;";
-      break;
-    case json::value_t::boolean:
-      out += value.get<bool>() ? "yes" : "no";
-      break;
-    case json::value_t::number_integer:
-    case json::value_t::number_unsigned:
-      out += value.dump();
-      break;
-    case json::value_t::number_float:
-      out += number(value.get<double>(), 6);
-      break;
-    case json::value_t::string:
-      out += escape(value.get<std::string>());
-      break;
-    case json::value_t::array: {
-      bool scalars = true;
-      for (const json& v : value) scalars = scalars && !v.is_structured();
-      if (value.empty()) {
-        out += "none";
-      } else if (scalars) {
-        bool first = true;
-        for (const json& v : value) {
-          if (!first) out += ", ";
-          first = false;
-          batch_value(out, v, depth + 1);
-        }
-      } else {
-        out += "<ol>";
-        for (const json& v : value) {
-          out += "<li>";
-          batch_value(out, v, depth + 1);
-          out += "</li>";
-        }
-        out += "</ol>";
+  std::string line;
+  for (const auto& item : value.items()) {
+    const json& v = item.value();
+    if (!v.is_structured() || is_scalar_list(v)) line += "<span class=\"kv\"><b>" + pretty_key(item.key()) + "</b> " + scalar_text(v) + "</span> ";
+  }
+  if (!line.empty()) out += "<p class=\"kvs\">" + line + "</p>";
+  for (const auto& item : value.items()) {
+    const json& v = item.value();
+    if (!v.is_structured() || is_scalar_list(v)) continue;
+    out += "<h4>" + pretty_key(item.key()) + "</h4>";
+    std::vector<std::pair<std::string, const json*>> rows;
+    bool tabular = !v.empty();
+    if (v.is_object()) {
+      for (const auto& e : v.items()) {
+        tabular = tabular && is_flat_object(e.value());
+        rows.emplace_back(e.key(), &e.value());
       }
-      break;
+    } else {
+      for (const json& e : v) {
+        tabular = tabular && is_flat_object(e);
+        rows.emplace_back("", &e);
+      }
     }
-    case json::value_t::object: {
-      if (value.empty()) {
-        out += "none";
-        break;
-      }
-      out += "<table class=\"batch\">";
-      for (const auto& item : value.items()) {
-        out += "<tr><td class=\"key\">" + escape(item.key()) + "</td><td>";
-        batch_value(out, item.value(), depth + 1);
-        out += "</td></tr>";
-      }
-      out += "</table>";
-      break;
+    if (tabular) {
+      rows_table(out, rows, v.is_object() ? "quantity" : "");
+    } else if (v.is_array()) {
+      out += v.empty() ? "<p>none</p>" : "<p>" + std::to_string(v.size()) + " entries (results.json)</p>";
+    } else {
+      batch_value(out, v, depth + 1);
     }
-    default:
-      out += "&ndash;";
   }
 }
 
@@ -639,11 +784,7 @@ void batch_summary(std::string& out, const Document& doc) {
     out += escape(u.id);
   }
   out += "</dd>";
-  if (doc.iff_optimal_gain != nullptr) {
-    out += "<dt>IFF optimal gain</dt><dd>";
-    batch_value(out, *doc.iff_optimal_gain, 0);
-    out += "</dd>";
-  }
+  if (doc.iff_optimal_gain != nullptr) out += "<dt>IFF optimal gain</dt><dd>" + scalar_text(*doc.iff_optimal_gain) + "</dd>";
   out += "</dl>\n";
   if (doc.batch != nullptr) {
     out += "<div class=\"table-wrap\">";
@@ -651,21 +792,6 @@ void batch_summary(std::string& out, const Document& doc) {
     out += "</div>\n";
   }
   out += "</section>\n";
-}
-
-// Plain text as paragraphs: a blank line starts a new one.
-void paragraphs(std::string& out, const std::string& text, const char* attributes) {
-  std::size_t begin = 0;
-  while (begin < text.size()) {
-    auto end = text.find("\n\n", begin);
-    if (end == std::string::npos) end = text.size();
-    const auto first = text.find_first_not_of(" \t\r\n", begin);
-    if (first != std::string::npos && first < end) {
-      out +=
-          std::string("<p") + attributes + ">" + escape(std::string_view(text).substr(begin, end - begin)) + "</p>\n";
-    }
-    begin = end + 2;
-  }
 }
 
 void contents(std::string& out, const Document& doc) {
@@ -719,6 +845,8 @@ std::string render_html(const nlohmann::json& document) {
     out += "<section class=\"report-section\" id=\"sec-" + escape(s.id) + "\"><h2>" +
            std::to_string(number_of_section++) + ". " + escape(s.title) + "</h2>\n";
     paragraphs(out, s.text, "");
+    for (const auto& w : s.warnings) out += "<p class=\"warning\" role=\"alert\">" + escape(w) + "</p>\n";
+    for (const Table& t : s.tables) table_html(out, t);
     if (!s.figures.empty()) {
       out +=
           "<p class=\"hint\">Drag to zoom, double-click to reset, click a legend entry to hide or show a "

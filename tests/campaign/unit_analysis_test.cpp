@@ -47,6 +47,8 @@ frf = { file = "frf.mat", channels = { de = "d_enc", Vs = "V_sensor" } }
 stroke = { file = "stroke.csv", channels = { Va = "V_stack", de = "probe" } }
 hysteresis = ["hyst4.csv", "hyst20.mat"]
 stiffness = "stiff.mat"
+stiffness_open_circuit = "stiff.mat"
+frf_without_resistor = { file = "frf.mat", channels = { Vs = "V_sensor" } }
 iff = "iff.mat"
 hammer = "hammer.mat"
 flatness = { file = "flat.csv", channels = { x = "x_pos", y = "y_pos", z = "height" } }
@@ -110,8 +112,17 @@ TEST(UnitAnalysis, EveryAnalysisOnKnownRecords) {
   // The damped plant: its pole comes back, the gain from the file's settings.
   ASSERT_EQ(u.damped.size(), 1u);
   EXPECT_DOUBLE_EQ(u.damped[0].gain, 1e5);
-  EXPECT_TRUE(near(u.damped[0].fit.natural_frequency, 2 * M_PI * 90.0, 2e-3));
-  EXPECT_TRUE(near(u.damped[0].fit.damping, 0.2, 0.02));
+  ASSERT_TRUE(u.damped[0].identified.has_value());
+  EXPECT_TRUE(near(u.damped[0].identified->natural_frequency, 2 * M_PI * 90.0, 2e-3));
+  EXPECT_TRUE(near(u.damped[0].identified->damping, 0.2, 0.02));
+  // The same stiffness record read as the open-circuit test gives the same k (k_oc = k1 here), and
+  // the same FRF read as the record without the resistor the same corner.
+  ASSERT_TRUE(u.k_oc.has_value());
+  EXPECT_DOUBLE_EQ(*u.k_oc, *u.k1);
+  EXPECT_DOUBLE_EQ(u.result["stiffness_N_per_um"]["k_oc"].get<double>(), u.result["stiffness_N_per_um"]["k_sc"].get<double>());
+  const nlohmann::json& hr = u.result["hpf_resistor"];
+  EXPECT_EQ(hr["with_resistor"]["fitted_corner_Hz"], hr["without_resistor"]["fitted_corner_Hz"]);
+  EXPECT_TRUE(u.plots["resistor"].contains("with") && u.plots["resistor"].contains("without"));
   // Hammer: both modes by both methods (the Hann window over 1 s segments cuts some of the impacts'
   // responses: a few tenths of a percent).
   const auto& modes = u.result["flexible_modes"];

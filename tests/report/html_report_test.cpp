@@ -77,8 +77,8 @@ TEST(HtmlReport, RendersEveryFigureTheTableAndTheContents) {
   EXPECT_EQ(count(html, "<tr class=\"rejected\">"), 1u);
   // Batch summary: counts, the rejected unit, results.batch and the IFF gain.
   EXPECT_TRUE(contains(html, "<dt>Rejected</dt><dd>1: APA 3</dd>"));
-  EXPECT_TRUE(contains(html, "<dt>IFF optimal gain</dt><dd>102.5</dd>"));
-  EXPECT_TRUE(contains(html, "<td class=\"key\">resonance_Hz</td><td>1.2</td>"));
+  EXPECT_TRUE(contains(html, "<dt>IFF optimal gain</dt><dd>103</dd>"));
+  EXPECT_TRUE(contains(html, "<span class=\"kv\"><b>resonance Hz</b> 1.20</span>"));
   // The library is inlined verbatim, once, and nothing is loaded from elsewhere.
   EXPECT_EQ(count(html, std::string(detail::plotting_library().substr(0, 4096))), 1u);
   EXPECT_TRUE(contains(html, std::string(detail::plotting_library().substr(detail::plotting_library().size() - 4096))));
@@ -149,7 +149,7 @@ TEST(HtmlReport, EscapesEveryStringOfTheDocument) {
   EXPECT_TRUE(contains(html, "<th scope=\"row\">" + escaped + "</th>"));
   EXPECT_TRUE(contains(html, "<li>" + escaped + "</li>"));
   EXPECT_TRUE(contains(html, "<td class=\"num\">" + escaped + "</td>"));
-  EXPECT_TRUE(contains(html, "<td class=\"key\">" + escaped + "</td>"));
+  EXPECT_TRUE(contains(html, "<b>" + escaped + "</b>"));
   EXPECT_TRUE(contains(html, "<h3>" + escaped + "</h3>"));
   EXPECT_GE(count(html, escaped), 10u);
 
@@ -191,6 +191,54 @@ TEST(HtmlReport, TextBecomesEscapedParagraphs) {
                        "<p>Second one,\non two lines.</p>\n<p class=\"hint\">"));
   EXPECT_TRUE(contains(html, "<p class=\"caption\">A caption &amp; more</p>"));
   EXPECT_TRUE(contains(html, "<p>u -&gt; d_e for every unit &amp; the fitted model &lt;dashed&gt;.</p>"));
+}
+
+TEST(HtmlReport, TablesWarningsHoverLabelsAndACompactBatch) {
+  json doc = sample::document();
+  doc["sections"][1]["warnings"] = {"poles 12 % off the <model>"};
+  doc["sections"][1]["tables"] = {{{"title", "Damped poles"},
+                                   {"text", "per gain"},
+                                   {"columns", {"gain", "f [Hz]", "ok", "note"}},
+                                   {"rows", {{30000, 95.78576, true, nullptr}, {240000.0, 0.000123456, false, "a & b"}, {9.9996, -0.5, 1e7, "x"}}}}};
+  doc["sections"][1]["figures"][0]["panels"][0]["traces"][0]["text"] = json::array();
+  for (std::size_t i = 0; i < doc["sections"][1]["figures"][0]["panels"][0]["traces"][0]["x"].size(); ++i) {
+    doc["sections"][1]["figures"][0]["panels"][0]["traces"][0]["text"].push_back(i == 0 ? json(nullptr) : json("g = <" + std::to_string(i) + ">"));
+  }
+  // results.batch as the pipeline writes it: flat objects per quantity, a list of flat objects.
+  doc["results"]["batch"] = {{"outlier_rule", {{"robust_z_threshold", 3.5}, {"rejects", true}}},
+                             {"spread", {{"resonance_Hz", {{"median", 95.31927}, {"min", 94.978}, {"units", 7}}},
+                                         {"k1_N_per_um", {{"median", 1.697019948}, {"min", 1.6749}, {"units", 7}}}}},
+                             {"outliers", {{{"unit", 3}, {"quantity", "stroke_um"}, {"value", 158.3063121909871}}}}};
+  const std::string html = render_html(doc);
+  EXPECT_TRUE(contains(html, "<p class=\"warning\" role=\"alert\">poles 12 % off the &lt;model&gt;</p>"));
+  EXPECT_TRUE(contains(html, "<h3>Damped poles</h3>"));
+  // Numbers to 3 significant digits, positional in [0.001, 1e6); booleans and null readable.
+  EXPECT_TRUE(contains(html, "<tr><td class=\"num\">30000</td><td class=\"num\">95.8</td><td>yes</td><td class=\"nm\""));
+  EXPECT_TRUE(contains(html, "<td class=\"num\">240000</td><td class=\"num\">0.000123</td><td>no</td><td>a &amp; b</td>"));
+  EXPECT_TRUE(contains(html, "<td class=\"num\">10.0</td><td class=\"num\">-0.500</td><td class=\"num\">1e+07</td>"));
+  // The batch: scalars on a line, one table per group with a row per quantity or entry, no dump.
+  EXPECT_TRUE(contains(html, "<b>robust z threshold</b> 3.50</span>"));
+  EXPECT_TRUE(contains(html, "<th>quantity</th><th>median</th><th>min</th><th>units</th>"));
+  EXPECT_TRUE(contains(html, "<th scope=\"row\">resonance Hz</th><td class=\"num\">95.3</td><td class=\"num\">95.0</td><td class=\"num\">7</td>"));
+  EXPECT_TRUE(contains(html, "<td class=\"num\">stroke_um</td><td class=\"num\">3</td><td class=\"num\">158</td>"));
+  // Hover labels reach the data, escaped there like every string.
+  const json data = json::parse(embedded_data(html));
+  const json& t = data["figures"][2]["panels"][0]["traces"][0];
+  EXPECT_TRUE(t["text"][0].is_null());
+  EXPECT_EQ(t["text"][1], "g = <1>");
+  // Bad tables and labels name their field.
+  json bad = doc;
+  bad["sections"][1]["tables"][0]["rows"][1].erase(0);
+  (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].tables[0].rows[1]");
+  bad = doc;
+  bad["sections"][1]["tables"][0]["rows"][0][1] = json::array();
+  (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].tables[0].rows[0][1]");
+  bad = doc;
+  bad["sections"][1]["figures"][0]["panels"][0]["traces"][0]["text"].erase(0);
+  (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].figures[0].panels[0].traces[0].text");
+  bad = doc;
+  bad["sections"][1]["warnings"] = "one";
+  (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].warnings");
 }
 
 struct BadDocument {

@@ -19,11 +19,70 @@ const zlib = require('node:zlib');
 
 const WIDTH = 1280;
 const HEIGHT = 900;
-const TIMEOUT_MS = 30000;
+const TIMEOUT_MS = Number(process.env.PIEZOBENCH_RENDER_TIMEOUT_MS || 90000);
 
 function usage() {
-  console.error('usage: node render_check.js REPORT.html SCREENSHOT.png');
+  console.error('usage: node render_check.js REPORT.html SCREENSHOT.png [--figures LIST.md]');
   process.exit(2);
+}
+
+// ---- checks on the embedded document, before any browser ----------------------------------------
+function embeddedDocument(html) {
+  const m = html.match(/<script type="application\/json" id="pb-data">([\s\S]*?)<\/script>/);
+  if (!m) throw new Error('no <script id="pb-data"> in the report');
+  return JSON.parse(m[1]);
+}
+
+// Figure ids a list promises (docs/report.md: table rows "| 2.5a | `frf-de` | ...").
+function promisedFigures(markdown) {
+  const ids = [];
+  for (const line of markdown.split('\n')) {
+    const m = line.match(/^\|\s*[0-9]+\.[0-9]+[a-z]?\s*\|\s*`([a-z0-9-]+)`/);
+    if (m) ids.push(m[1]);
+  }
+  return ids;
+}
+
+function nearestIndex(xs, x) {
+  let best = -1;
+  for (let i = 0; i < xs.length; ++i) {
+    if (xs[i] === null) continue;
+    if (best < 0 || Math.abs(Math.log(xs[i] / x)) < Math.abs(Math.log(xs[best] / x))) best = i;
+  }
+  return best;
+}
+
+// In every figure with a magnitude panel first and a "Phase" panel, each group's model (dashed)
+// and measurement (solid): wherever their magnitudes agree within 25 %, their phases must be within
+// 180 degrees (the same branch). Returns the failures.
+function phaseBranchFailures(data) {
+  const failures = [];
+  let compared = 0;
+  for (const fig of data.figures) {
+    if (fig.x_category || fig.panels.length < 2) continue;
+    const phasePanel = fig.panels.find((p) => /^Phase/.test(p.y_label));
+    if (!phasePanel) continue;
+    const magPanel = fig.panels[0];
+    const groups = new Set(phasePanel.traces.filter((t) => t.group !== undefined).map((t) => t.group));
+    for (const g of groups) {
+      const pick = (panel, dash) => panel.traces.find((t) => t.group === g && Boolean(t.dash) === dash);
+      const [mMag, dMag, mPh, dPh] = [pick(magPanel, false), pick(magPanel, true), pick(phasePanel, false), pick(phasePanel, true)];
+      if (!mMag || !dMag || !mPh || !dPh) continue;
+      let worst = 0, worstX = 0;
+      for (let i = 0; i < dPh.x.length; ++i) {
+        const x = dPh.x[i], y = dPh.y[i];
+        if (x === null || y === null || !(x > 0)) continue;
+        const a = nearestIndex(dMag.x, x), b = nearestIndex(mMag.x, x), c = nearestIndex(mPh.x, x);
+        if (a < 0 || b < 0 || c < 0 || dMag.y[a] === null || mMag.y[b] === null || mPh.y[c] === null) continue;
+        if (Math.abs(Math.log(dMag.y[a] / mMag.y[b])) > Math.log(1.25)) continue;
+        ++compared;
+        const d = Math.abs(y - mPh.y[c]);
+        if (d > worst) { worst = d; worstX = x; }
+      }
+      if (worst > 180) failures.push(`figure ${fig.id}: ${g}: model and measured phase ${worst.toFixed(0)} deg apart at ${worstX.toPrecision(4)} where their magnitudes agree`);
+    }
+  }
+  return { failures, compared };
 }
 
 // ---- PNG decoding (8-bit RGB/RGBA, not interlaced: what Chromium writes) -------------------------
@@ -137,8 +196,13 @@ function trace(what) { if (process.env.PIEZOBENCH_RENDER_CHECK_VERBOSE) console.
 function sleep(ms) { return new Promise((resolve) => setTimeout(resolve, ms)); }
 
 async function main() {
-  const [reportArg, screenshotArg] = process.argv.slice(2);
+  const [reportArg, screenshotArg, ...rest] = process.argv.slice(2);
   if (!reportArg || !screenshotArg) usage();
+  let figuresList = null;
+  if (rest.length > 0) {
+    if (rest[0] !== '--figures' || rest.length !== 2) usage();
+    figuresList = rest[1];
+  }
   const report = path.resolve(reportArg);
   const screenshot = path.resolve(screenshotArg);
   const chromium = process.env.PIEZOBENCH_CHROMIUM || '/usr/bin/chromium';
@@ -148,6 +212,16 @@ async function main() {
     throw new Error(`${chromium} not found: install Debian's chromium package (scripts/setup.sh does)`);
   }
   fs.rmSync(screenshot, { force: true });
+  const embedded = embeddedDocument(fs.readFileSync(report, 'utf8'));
+  const phase = phaseBranchFailures(embedded);
+  failures.push(...phase.failures);
+  let promised = [];
+  if (figuresList) {
+    promised = promisedFigures(fs.readFileSync(figuresList, 'utf8'));
+    if (promised.length === 0) failures.push(`${figuresList} lists no figure ("| 2.5a | \`id\` | ..." rows)`);
+    const ids = new Set(embedded.figures.map((f) => f.id));
+    for (const id of promised) if (!ids.has(id)) failures.push(`figure ${id}, listed in ${figuresList}, is not in the report`);
+  }
 
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'piezobench-chromium-'));
   const args = [
@@ -277,6 +351,23 @@ async function main() {
     });
     fs.writeFileSync(screenshot, Buffer.from(shot.data, 'base64'));
     trace('screenshot');
+    // One screenshot per section too (SCREENSHOT-<id>.png), to look at each part at full size.
+    const sections = await evaluate(`Array.from(document.querySelectorAll('main > section')).map((s) => {
+      const r = s.getBoundingClientRect();
+      return { id: s.id, top: r.top + window.scrollY, height: r.height };
+    })`);
+    const stem = screenshot.replace(/\.png$/, '');
+    for (const sec of sections) {
+      await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: Math.ceil(Math.min(sec.height, 8000)), deviceScaleFactor: 1, mobile: false });
+      await evaluate(`window.scrollTo(0, ${Math.floor(sec.top)})`);
+      await sleep(150);
+      const part = await page('Page.captureScreenshot', { format: 'png' });
+      fs.writeFileSync(`${stem}-${sec.id}.png`, Buffer.from(part.data, 'base64'));
+    }
+    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height, deviceScaleFactor: 1, mobile: false });
+    await evaluate('window.scrollTo(0, 0)');
+    await sleep(150);
+    trace('section screenshots');
 
     // Interaction with a real mouse, on the first figure with several panels and a group:
     // hovering a point shows its label; clicking the group's legend entry hides the group's
@@ -293,7 +384,16 @@ async function main() {
       const box = gd.getBoundingClientRect();
       const legend = Array.from(gd.querySelectorAll('g.legend g.traces'))
         .find((g) => g.textContent === trace.name).querySelector('rect.legendtoggle').getBoundingClientRect();
+      // Traces of the same panel with a point within 4 px of the target: any of them may own the label.
+      const px = (tr, i) => [xa.l2p(xa.d2l(tr.x[i])), ya.l2p(ya.d2l(tr.y[i]))];
+      const [tx, ty] = px(trace, k);
+      const near = gd.data.filter((tr) => tr.yaxis === trace.yaxis && tr.x.some((x, i) => {
+        if (x === null || tr.y[i] === null) return false;
+        const [x2, y2] = px(tr, i);
+        return Math.hypot(x2 - tx, y2 - ty) <= 4;
+      })).map((tr) => tr.hovertemplate.split('<br>')[0]);
       return {
+        near,
         id: fig.id, group: trace.legendgroup, name: fig.panels[0].traces.find((x) => x.group).name,
         members: gd.data.filter((tr) => tr.legendgroup === trace.legendgroup).length,
         panels: new Set(gd.data.filter((tr) => tr.legendgroup === trace.legendgroup).map((tr) => tr.yaxis)).size,
@@ -310,7 +410,9 @@ async function main() {
       await mouse('mouseMoved', target.point);
       await sleep(300);
       const hover = await evaluate(`Array.from(document.querySelectorAll('#fig-${target.id} .hoverlayer .hovertext')).map((h) => h.textContent).join(' | ')`);
-      if (!hover.includes(target.name)) failures.push(`hover on ${target.id}: label "${hover}" does not name "${target.name}"`);
+      if (!hover.includes(target.name) && !target.near.some((n) => n && hover.includes(n))) {
+        failures.push(`hover on ${target.id}: label "${hover}" names neither "${target.name}" nor a trace drawn at that point`);
+      }
       await mouse('mouseMoved', { x: 2, y: 2 });
       const hidden = (state) => `document.getElementById('fig-${target.id}')._fullData
         .filter((tr) => tr.legendgroup === ${JSON.stringify(target.group)}).map((tr) => tr.visible === ${state})`;
@@ -352,7 +454,9 @@ async function main() {
       console.log(`render_check: ${check.figures.length} of ${check.figures.length} figures drawn (${traces} traces) ` +
         `in ${renderMs} ms, no console error; hover label and legend toggle of ${target.group.slice(6)} across ` +
         `${target.panels} panels of ${target.id} work; screenshot ${png.width} x ${png.height} px, ` +
-        `${(100 * ink.inkFraction).toFixed(1)} % ink, ${ink.colours}${ink.colours >= 5000 ? '+' : ''} colours: ${screenshot}`);
+        `${(100 * ink.inkFraction).toFixed(1)} % ink, ${ink.colours}${ink.colours >= 5000 ? '+' : ''} colours: ${screenshot}; ` +
+        `model and measured phase on one branch at ${phase.compared} points` +
+        (figuresList ? `; the ${promised.length} figures of ${path.basename(figuresList)} present` : ''));
     }
   } finally {
     clearTimeout(timer);

@@ -25,8 +25,12 @@
 namespace piezobench::campaign {
 
 // The experiments a unit can have (keys of a [[units]] entry).
-enum class Experiment { kFlatness, kCapacitance, kStroke, kHysteresis, kStiffness, kFrf, kIff, kHammer };
-// "flatness", "capacitance", "stroke", "hysteresis", "stiffness", "frf", "iff", "hammer".
+// kStiffnessOpen: the stiffness test with every stack open (actuators disconnected from the
+// amplifier, no resistor on the sensor: k_oc, report section 2.2); kFrfNoResistor: u -> Vs without
+// the resistor across the sensor stack (report section 2.5, Figure 2.7).
+enum class Experiment { kFlatness, kCapacitance, kStroke, kHysteresis, kStiffness, kStiffnessOpen, kFrf, kFrfNoResistor, kIff, kHammer };
+// "flatness", "capacitance", "stroke", "hysteresis", "stiffness", "stiffness_open_circuit", "frf",
+// "frf_without_resistor", "iff", "hammer".
 std::string to_string(Experiment e);
 Experiment experiment_from_string(const std::string& name, const std::string& source = "");  // InputError
 const std::vector<Experiment>& all_experiments();
@@ -34,7 +38,8 @@ const std::vector<Experiment>& all_experiments();
 // Channel roles each experiment reads, required ones first; the defaults are the virtual bench's
 // channel names (bench/experiments.hpp), which are also the role names:
 //   flatness x, y, z [interface]; capacitance C_sensor, C_actuator; stroke Va, de;
-//   hysteresis Va, de; stiffness de [added_mass]; frf u, de, Vs; iff u_prime, de; hammer F, v.
+//   hysteresis Va, de; stiffness and stiffness_open_circuit de [added_mass]; frf u, de, Vs;
+//   frf_without_resistor u, Vs; iff u_prime, de; hammer F, v.
 // Optional roles are used when their channel is in the file (or when mapped explicitly, in which
 // case the channel must be there).
 const std::vector<std::string>& required_roles(Experiment e);
@@ -55,7 +60,7 @@ struct UnitSpec {
   int id = 0;
   std::string name;     // "APA 1" unless given
   std::string key;      // "units[0]"
-  std::optional<FileSpec> flatness, capacitance, stroke, stiffness, frf, hammer;
+  std::optional<FileSpec> flatness, capacitance, stroke, stiffness, stiffness_open, frf, frf_no_resistor, hammer;
   std::vector<FileSpec> hysteresis, iff;
   // LCR readings typed into the campaign instead of a file (F): capacitance_uF = {sensor, actuator}.
   std::optional<double> capacitance_sensor, capacitance_actuator;

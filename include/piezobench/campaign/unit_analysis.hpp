@@ -16,8 +16,11 @@
 //                 high-pass and delay as the measurement chain)
 //                 u -> d_e is also fitted as a mass-spring-damper with its own delay
 //                 (iff_plant_fit.hpp): the d_e and Vs read-outs lag differently
-//   iff           per gain g: the damped plant u' -> d_e (Welch) and its second-order fit (after
-//                 removing the delay of d_e found on the open-loop FRF)
+//   stiffness_open_circuit  the same with every stack open: k_oc (k_sc = k1)
+//   frf_without_resistor    u -> Vs without the resistor: the high-pass corner with and without it
+//   iff           per gain g: the damped plant u' -> d_e (Welch) and its pole, the dominant pair of
+//                 a vector fit (after removing the delay of d_e found on the open-loop FRF); the
+//                 report's second-order fit for comparison
 //   hammer        F -> v (Welch), flexible modes by peak picking and by LSCF (ident/modal.hpp)
 //
 // Data problems (a channel that is not in a file, NaN, too short a record, ...) are InputErrors
@@ -33,6 +36,7 @@
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/iff_plant_fit.hpp"
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/io/timeseries.hpp"
 
@@ -58,7 +62,11 @@ struct DampedPlant {
   double gain = 0.0;             // controller gain g
   std::string file;              // as given in the campaign
   dsp::Frf frf;                  // u' -> d_e
-  DelayedSecondOrderFit fit;     // of the data in the damped-plant band, d_e's delay removed
+  // The damped pole: the dominant pair of a vector fit in the damped-plant band, d_e's delay
+  // removed (ident/dominant_pole.hpp, as `iff study`).
+  std::optional<ident::DominantPole> identified;
+  // The report's second-order fit of the same data, for comparison (nullopt when it failed).
+  std::optional<DelayedSecondOrderFit> second_order;
   double delay_removed = 0.0;    // s
 };
 
@@ -76,6 +84,7 @@ struct UnitAnalysis {
   std::optional<double> capacitance_actuator;
   std::optional<double> stroke;              // m
   std::optional<double> k1, k2, k_resonance; // N/m
+  std::optional<double> k_oc;                // N/m, k1 of the test with every stack open
   std::optional<double> resonance_hz, antiresonance_hz, static_gain;  // Hz, Hz, m/V
   std::optional<dsp::Frf> frf;               // u -> [de, Vs] (outputs named "de", "Vs")
   std::optional<IffPlantFit> iff_plant;     // u -> Vs, eq. 2.3 with delay

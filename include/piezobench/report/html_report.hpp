@@ -35,15 +35,21 @@
 //     category axis (unit names for batch comparisons); every trace of that figure then has one
 //     and "x_log" must be false.
 //   - "mode" may also be "bars" (a bar per x, bars of one x side by side).
-//   - Additions: section "id" ([a-z0-9-], unique, default "section-N"), figure "text" (a caption).
+//   - Additions: section "id" ([a-z0-9-], unique, default "section-N"), figure "text" (a caption),
+//     section "warnings" (a list of strings, shown highlighted above everything else of the
+//     section), section "tables" (before the figures): [{ "title", "text" (optional caption),
+//     "columns": [strings], "rows": [[cell, ...], ...] }] with one cell per column, each a number
+//     (shown to 3 significant digits), a string, true/false or null ("–"); trace "text": one hover
+//     label per point (string or null), shown with the point's x and y.
 //   - A trace's colour is its group's (its name's when it has no group), the same in every figure.
 //   - results.units: a list of objects with "id" (string or number, unique), "accepted" (bool) and
 //     "reasons" (a list of strings, at least one for a rejected unit). The key figures of the table
 //     are read where CLI.md puts them (flatness_um, capacitance_uF.{sensor,actuator}, stroke_um,
 //     stiffness_N_per_um.{k1,k2,resonance}, frf.{resonance_Hz,antiresonance_Hz,
 //     static_gain_um_per_V}, hpf_corner_Hz); a missing or null one reads "not measured". Other
-//     keys of results are ignored, except results.batch (shown in the batch summary: its numbers,
-//     strings, lists and nested objects) and results.iff.optimal_gain.
+//     keys of results are ignored, except results.batch (shown compactly in the batch summary:
+//     its scalars as "key value" lines, an object of flat objects or a list of flat objects as one
+//     table, numbers to 3 significant digits) and results.iff.optimal_gain.
 //   Every string is escaped: a unit name or a reason cannot inject HTML or script.
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>

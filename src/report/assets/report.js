@@ -82,8 +82,9 @@
           showlegend: !shown.has(key),
           x: t.x, y: t.y,
           xaxis: 'x', yaxis: axisName('y', i),
-          hovertemplate: text(t.name) + '<br>' + '%{x}, %{y}<extra></extra>',
+          hovertemplate: text(t.name) + '<br>' + (t.text ? '%{text}<br>' : '') + '%{x}, %{y}<extra></extra>',
         };
+        if (t.text) trace.text = t.text.map(function (s) { return s === null ? '' : text(s); });
         shown.add(key);
         if (t.mode === 'bars') {
           trace.type = 'bar';
