@@ -190,6 +190,12 @@ TEST(CampaignFile, DocumentedExampleParses) {
   EXPECT_EQ(c.units[0].frf->channels.at("Vs"), "V_force_sensor");
   EXPECT_EQ(c.units[0].frf->channels.at("de"), "d_e");
   EXPECT_EQ(c.units[0].hammer->channels.at("F"), "force");
+  // The open-circuit stiffness test and u -> Vs without the resistor (report 2.2, 2.5).
+  ASSERT_TRUE(c.units[0].stiffness_open && c.units[0].frf_no_resistor);
+  EXPECT_EQ(c.units[0].frf_no_resistor->channels.at("Vs"), "V_force_sensor");
+  EXPECT_EQ(c.units[0].stiffness_open->given, "apa1/added_mass_open.mat");
+  EXPECT_TRUE(c.units[0].has(Experiment::kStiffnessOpen));
+  EXPECT_FALSE(c.units[1].has(Experiment::kFrfNoResistor));
   EXPECT_EQ(c.analysis.iff_unit, 1);
   ASSERT_TRUE(c.superelement);
   EXPECT_EQ(c.superelement->actuator, "3:4:z");
