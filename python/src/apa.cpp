@@ -1,0 +1,197 @@
+// piezobench.apa: include/piezobench/apa/{two_dof,tuning,piezo}.hpp
+#include "common.hpp"
+#include "piezobench/apa/piezo.hpp"
+#include "piezobench/apa/tuning.hpp"
+#include "piezobench/apa/two_dof.hpp"
+#include "piezobench/dsp/frf.hpp"
+
+namespace piezobench::python {
+namespace {
+
+using namespace piezobench::apa;
+
+const Options<TwoDofParams>& params_options() {
+  static const Options<TwoDofParams> t = [] {
+    Options<TwoDofParams> o("TwoDofParams");
+    o.add("m", &TwoDofParams::m, "kg, mass carried by the APA")
+        .add("k1", &TwoDofParams::k1, "N/m, shell stiffness")
+        .add("c1", &TwoDofParams::c1, "N s/m, shell damping")
+        .add("ke", &TwoDofParams::ke, "N/m, sensor stack stiffness")
+        .add("ce", &TwoDofParams::ce, "N s/m, sensor stack damping")
+        .add("ka", &TwoDofParams::ka, "N/m, actuator stacks stiffness (the two in series)")
+        .add("ca", &TwoDofParams::ca, "N s/m, actuator stacks damping")
+        .add("ga", &TwoDofParams::ga, "N/V, actuator sensitivity f = ga Va (negative in the report)")
+        .add("gs", &TwoDofParams::gs, "V/m, sensor sensitivity Vs = gs e");
+    return o;
+  }();
+  return t;
+}
+
+const Options<TwoDofBench>& bench_options() {
+  static const Options<TwoDofBench> t = [] {
+    Options<TwoDofBench> o("TwoDofBench");
+    o.add("amplifier_gain", &TwoDofBench::amplifier_gain, "V/V, Va = G u")
+        .add("suspended_mass", &TwoDofBench::suspended_mass, "kg; > 0 replaces m, 0 = m")
+        .add("added_mass", &TwoDofBench::added_mass, "kg, added on top")
+        .add("hpf_resistance", &TwoDofBench::hpf_resistance, "Ohm, resistor across the sensor stack (0 = no high-pass)")
+        .add("hpf_capacitance", &TwoDofBench::hpf_capacitance, "F, sensor stack capacitance for the high-pass")
+        .add("delay", &TwoDofBench::delay, "s, pure delay on u");
+    return o;
+  }();
+  return t;
+}
+
+const Options<PiezoConstants>& piezo_options() {
+  static const Options<PiezoConstants> t = [] {
+    Options<PiezoConstants> o("PiezoConstants");
+    o.add("d33", &PiezoConstants::d33, "m/V, piezoelectric charge constant")
+        .add("eps_t", &PiezoConstants::eps_t, "F/m, permittivity at constant stress")
+        .add("s_d", &PiezoConstants::s_d, "m^2/N, compliance at constant electric displacement")
+        .add("c_e", &PiezoConstants::c_e, "N/m^2, Young's modulus at constant field")
+        .add("length", &PiezoConstants::length, "m, stack length")
+        .add("area", &PiezoConstants::area, "m^2, stack cross-section")
+        .add("layers", &PiezoConstants::layers, "number of layers (an integer >= 1)");
+    return o;
+  }();
+  return t;
+}
+
+const Options<TuningOptions>& tuning_options() {
+  static const Options<TuningOptions> t = [] {
+    Options<TuningOptions> o("TuningOptions");
+    o.add("mass", &TuningOptions::mass, "kg, the known moving mass")
+        .add_nested("bench", &TuningOptions::bench, bench_options(),
+                    "measurement chain removed before fitting (apa.two_dof_bench keywords; masses 0)")
+        .add("fmin_hz", &TuningOptions::fmin_hz, "Hz, band used; 0 = from the lowest point")
+        .add("fmax_hz", &TuningOptions::fmax_hz, "Hz; 0 = to the highest point")
+        .add("min_coherence", &TuningOptions::min_coherence, "points below this coherence are left out")
+        .add("stack_stiffness_ratio", &TuningOptions::stack_stiffness_ratio, "ke / ka imposed in the refinement; 0 = free")
+        .add("stack_damping_ratio", &TuningOptions::stack_damping_ratio, "ce / ca imposed in the refinement; 0 = free")
+        .add("refine", &TuningOptions::refine, "False: stop after the report's procedure")
+        .add("max_iterations", &TuningOptions::max_iterations, "Levenberg-Marquardt steps")
+        .add("de_output", &TuningOptions::de_output, "name of the u -> d_e output in the FRF")
+        .add("vs_output", &TuningOptions::vs_output, "name of the u -> Vs output in the FRF");
+    return o;
+  }();
+  return t;
+}
+
+// Parameters and bench from one set of keywords (both tables), leftovers refused.
+std::pair<TwoDofParams, TwoDofBench> model_kwargs(const py::kwargs& kw, const std::string& source) {
+  py::dict d = kwargs_dict(kw);
+  auto p = params_options().take(d, source);
+  auto b = bench_options().take(d, source);
+  reject_leftovers(d, source, params_options().names() + ", " + bench_options().names());
+  return {p, b};
+}
+
+const std::string& model_doc() {
+  static const std::string s = "\nKeywords (TwoDofParams, Table 3.1):\n" + params_options().doc() +
+                               "Keywords (TwoDofBench):\n" + bench_options().doc();
+  return s;
+}
+
+}  // namespace
+
+void bind_apa(py::module_& m) {
+  using py::arg;
+
+  m.def(
+      "two_dof_actuator",
+      [](const py::kwargs& kw) { return two_dof_actuator(params_options().from_kwargs(kwargs_dict(kw), "apa.two_dof_actuator")); },
+      ("The 2-DoF actuator alone (report section 3): input Va (V), outputs [d_e (m), Vs (V)], states\n"
+       "[x, x', xn]. Returns an lti.StateSpace.\n\nKeywords (TwoDofParams, Table 3.1):\n" + params_options().doc())
+          .c_str());
+  m.def(
+      "two_dof_bench",
+      [](const py::kwargs& kw) {
+        auto [p, b] = model_kwargs(kw, "apa.two_dof_bench");
+        return two_dof_bench(p, b);
+      },
+      ("The actuator on the bench: input u (V at the DAC), outputs [d_e (m), Vs (V)] with the amplifier,\n"
+       "the moving mass, the high-pass on Vs and the delay (input_delay). Returns an lti.StateSpace." + model_doc())
+          .c_str());
+  m.def(
+      "two_dof_response",
+      [](py::handle omega, const py::kwargs& kw) {
+        auto [p, b] = model_kwargs(kw, "apa.two_dof_response");
+        auto w = to_vector(omega, "apa.two_dof_response", "omega");
+        return to_numpy(two_dof_response(p, b, w));
+      },
+      arg("omega"),
+      ("Closed-form response of two_dof_bench at j omega (rad/s): (len(omega), 2) complex, columns d_e (m/V)\n"
+       "and Vs (V/V)." + model_doc()).c_str());
+  m.def(
+      "characterize",
+      [](const py::kwargs& kw) {
+        auto [p, b] = model_kwargs(kw, "apa.characterize");
+        auto c = characterize(p, b);
+        py::dict d;
+        d["poles"] = to_numpy(std::move(c.poles));
+        d["zeros_vs"] = to_numpy(std::move(c.zeros_vs));
+        d["static_gain_de"] = c.static_gain_de;
+        d["static_gain_vs"] = c.static_gain_vs;
+        d["static_gain_vs_actuator"] = c.static_gain_vs_actuator;
+        d["resonance"] = c.resonance;
+        d["resonance_damping"] = c.resonance_damping;
+        d["antiresonance"] = c.antiresonance;
+        d["antiresonance_damping"] = c.antiresonance_damping;
+        return result("TwoDofCharacteristics", d);
+      },
+      ("Poles, zeros of u -> Vs (rad/s), static gains (m/V, V/V), resonance and anti-resonance (rad/s)\n"
+       "with damping: what `piezobench model 2dof` reports." + model_doc()).c_str());
+  m.def(
+      "default_params", [] { return params_options().to_dict(TwoDofParams{}); },
+      "The 9 parameters of Table 3.1 (SI) as a dict: the defaults of every TwoDofParams keyword.");
+  m.def(
+      "piezo_sensitivities",
+      [](const py::kwargs& kw) {
+        auto s = piezo_sensitivities(piezo_options().from_kwargs(kwargs_dict(kw), "apa.piezo_sensitivities"));
+        py::dict d;
+        d["ka"] = s.ka;
+        d["ga"] = s.ga;
+        d["gs"] = s.gs;
+        return result("PiezoSensitivities", d);
+      },
+      ("Eq. 4.1: ka = cE A / L (N/m), ga = d33 n ka (N/V), gs = d33 / (eps_T sD n) (V/m).\n"
+       "Defaults: Table 4.1 (ga = 26.11 N/V, gs = 5.06e6 V/m, ka = 2.4e8 N/m).\n\nKeywords (PiezoConstants):\n" +
+       piezo_options().doc())
+          .c_str());
+  m.def(
+      "tune_two_dof",
+      [](py::handle frf, const py::kwargs& kw) {
+        const std::string src = "apa.tune_two_dof";
+        const auto& f = frf_arg(frf, src, "frf");
+        auto o = tuning_options().from_kwargs(kwargs_dict(kw), src);
+        auto r = without_gil([&] { return tune_two_dof(f, o); });
+        py::dict feat;
+        feat["resonance"] = r.features.resonance;
+        feat["resonance_damping"] = r.features.resonance_damping;
+        feat["antiresonance"] = r.features.antiresonance;
+        feat["antiresonance_damping"] = r.features.antiresonance_damping;
+        feat["static_gain_de"] = r.features.static_gain_de;
+        feat["static_gain_vs"] = r.features.static_gain_vs;
+        py::dict d;
+        d["params"] = params_options().to_dict(r.params);
+        d["initial"] = params_options().to_dict(r.initial);
+        d["features"] = result("TuningFeatures", feat);
+        d["fit_error_de"] = r.fit_error_de;
+        d["fit_error_vs"] = r.fit_error_vs;
+        d["initial_fit_error_de"] = r.initial_fit_error_de;
+        d["initial_fit_error_vs"] = r.initial_fit_error_vs;
+        d["points"] = r.points;
+        d["iterations"] = r.iterations;
+        d["status"] = to_string(r.status);
+        d["message"] = r.message;
+        d["brief_report"] = r.brief_report();
+        return result("TwoDofTuning", d);
+      },
+      arg("frf"),
+      ("Tunes the 2-DoF model to a measured FRF u -> [d_e, Vs] (report section 3): the report's procedure,\n"
+       "then Levenberg-Marquardt on the relative complex error. Returns a Result: params and initial\n"
+       "(dicts of the 9 parameters, SI), features (rad/s), fit errors (rms relative), points, iterations,\n"
+       "status, message.\n\nKeywords (TuningOptions):\n" + tuning_options().doc())
+          .c_str());
+}
+
+}  // namespace piezobench::python

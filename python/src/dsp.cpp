@@ -1,0 +1,394 @@
+// piezobench.dsp: include/piezobench/dsp/*.hpp
+#include "common.hpp"
+#include "piezobench/dsp/excitation.hpp"
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/welch.hpp"
+#include "piezobench/dsp/window.hpp"
+
+namespace piezobench::python {
+namespace {
+
+using namespace piezobench::dsp;
+using Eigen::Index;
+
+const Options<WelchOptions>& welch_options() {
+  static const Options<WelchOptions> t = [] {
+    Options<WelchOptions> o("WelchOptions");
+    o.add_enum("window", &WelchOptions::window, &dsp::to_string, &window_type_from_string,
+               "\"hann-periodic\" (scipy's \"hann\"), \"hann-symmetric\", \"hamming-periodic\", ..., \"rectangular\"")
+        .add("nfft", &WelchOptions::nfft, "segment length = FFT length, samples (>= 2)")
+        .add("overlap", &WelchOptions::overlap,
+             "fraction of nfft shared by consecutive segments, in [0, 1) (scipy noverlap = floor(overlap*nfft))")
+        .add_enum("detrend", &WelchOptions::detrend, &dsp::to_string, &detrend_from_string,
+                  "\"none\", \"mean\" (scipy \"constant\", its default) or \"linear\"")
+        .add_enum("estimator", &WelchOptions::estimator, &dsp::to_string, &frf_estimator_from_string,
+                  "\"H1\" (Suy/Suu) or \"H2\" (Syy/Syu), for frf()")
+        .add("threads", &WelchOptions::threads, "worker threads; 0 = all cores");
+    return o;
+  }();
+  return t;
+}
+
+const Options<VoltageBounds>& bounds_options() {
+  static const Options<VoltageBounds> t = [] {
+    Options<VoltageBounds> o("VoltageBounds");
+    o.add("min", &VoltageBounds::min, "V, lowest sample")
+        .add("max", &VoltageBounds::max, "V, highest sample")
+        .add_enum("policy", &VoltageBounds::policy, &dsp::to_string, &bounds_policy_from_string,
+                  "\"scale\" the varying part, \"clip\" samples, or \"reject\" (InputError)");
+    return o;
+  }();
+  return t;
+}
+
+const Options<NoiseOptions>& noise_options() {
+  static const Options<NoiseOptions> t = [] {
+    Options<NoiseOptions> o("NoiseOptions");
+    o.add("sample_rate", &NoiseOptions::sample_rate, "Hz")
+        .add("samples", &NoiseOptions::samples, "length (>= 2)")
+        .add("f_low", &NoiseOptions::f_low, "Hz, lowest excited line (>= 0)")
+        .add("f_high", &NoiseOptions::f_high, "Hz, highest excited line (<= sample_rate / 2)")
+        .add("rms", &NoiseOptions::rms, "V, rms of the varying part before scaling")
+        .add("offset", &NoiseOptions::offset, "V")
+        .add("seed", &NoiseOptions::seed, "random seed (mt19937_64)");
+    return o;
+  }();
+  return t;
+}
+
+const Options<MultisineOptions>& multisine_options() {
+  static const Options<MultisineOptions> t = [] {
+    Options<MultisineOptions> o("MultisineOptions");
+    o.add("sample_rate", &MultisineOptions::sample_rate, "Hz")
+        .add("period_samples", &MultisineOptions::period_samples, "N, samples per period (>= 2)")
+        .add("periods", &MultisineOptions::periods, "periods generated (>= 1)")
+        .add("lines_hz", &MultisineOptions::lines_hz, "Hz, each a multiple k sample_rate / N, 1 <= k < N/2")
+        .add("amplitudes", &MultisineOptions::amplitudes, "relative amplitude per line; empty = equal")
+        .add("rms", &MultisineOptions::rms, "V, rms of the varying part before scaling")
+        .add("offset", &MultisineOptions::offset, "V")
+        .add_enum("phases", &MultisineOptions::phases, &dsp::to_string, &multisine_phases_from_string,
+                  "\"schroeder\" (low crest factor) or \"random\"")
+        .add("seed", &MultisineOptions::seed, "random phases' seed");
+    return o;
+  }();
+  return t;
+}
+
+const Options<SweepOptions>& sweep_options() {
+  static const Options<SweepOptions> t = [] {
+    Options<SweepOptions> o("SweepOptions");
+    o.add("sample_rate", &SweepOptions::sample_rate, "Hz")
+        .add("duration", &SweepOptions::duration, "s")
+        .add("f_start", &SweepOptions::f_start, "Hz")
+        .add("f_end", &SweepOptions::f_end, "Hz")
+        .add("amplitude", &SweepOptions::amplitude, "V")
+        .add("offset", &SweepOptions::offset, "V")
+        .add("ramp_time", &SweepOptions::ramp_time, "s, raised-cosine taper at each end")
+        .add_enum("type", &SweepOptions::type, &dsp::to_string, &sweep_type_from_string, "\"linear\" or \"log\"");
+    return o;
+  }();
+  return t;
+}
+
+const Options<OffsetSineOptions>& offset_sine_options() {
+  static const Options<OffsetSineOptions> t = [] {
+    Options<OffsetSineOptions> o("OffsetSineOptions");
+    o.add("sample_rate", &OffsetSineOptions::sample_rate, "Hz")
+        .add("rest", &OffsetSineOptions::rest, "V, level before and after")
+        .add("offset", &OffsetSineOptions::offset, "V")
+        .add("amplitude", &OffsetSineOptions::amplitude, "V")
+        .add("frequency", &OffsetSineOptions::frequency, "Hz")
+        .add("cycles", &OffsetSineOptions::cycles, "periods at full amplitude")
+        .add("ramp_time", &OffsetSineOptions::ramp_time, "s, raised-cosine ramp in and out");
+    return o;
+  }();
+  return t;
+}
+
+const Options<StepOptions>& step_options() {
+  static const Options<StepOptions> t = [] {
+    Options<StepOptions> o("StepOptions");
+    o.add("sample_rate", &StepOptions::sample_rate, "Hz")
+        .add("rest", &StepOptions::rest, "V")
+        .add("levels", &StepOptions::levels, "V, the staircase's levels (at least one)")
+        .add("hold_time", &StepOptions::hold_time, "s")
+        .add("ramp_time", &StepOptions::ramp_time, "s (0: a jump)");
+    return o;
+  }();
+  return t;
+}
+
+// The outputs of a Welch call: one 1-D array, a sequence of 1-D arrays, or a 2-D array of shape
+// (outputs, samples) (time on the last axis, as scipy's default axis=-1).
+struct Outputs {
+  std::vector<DoubleArray> arrays;
+  std::vector<std::string> names;
+  bool single = false;
+};
+
+Outputs outputs_arg(py::handle y, const std::string& source, py::handle names) {
+  Outputs out;
+  py::array probe = py::array::ensure(y);
+  if (probe && probe.ndim() == 1) {
+    out.arrays.push_back(vector_arg(y, source, "y", false));
+    out.single = true;
+  } else if (probe && probe.ndim() == 2 && !py::isinstance<py::list>(y) && !py::isinstance<py::tuple>(y)) {
+    DoubleArray all(DoubleArray::ensure(y));
+    for (py::ssize_t i = 0; i < all.shape(0); ++i) {
+      out.arrays.push_back(vector_arg(all[py::int_(i)], source, "y[" + std::to_string(i) + "]", false));
+    }
+  } else if (py::isinstance<py::sequence>(y) && !py::isinstance<py::str>(y)) {
+    py::ssize_t i = 0;
+    for (auto item : y) out.arrays.push_back(vector_arg(item, source, "y[" + std::to_string(i++) + "]", false));
+  } else {
+    PyErr_Clear();
+    throw InputError(source, "y", "a 1-D array, a list of them or a 2-D array (outputs, samples)", short_repr(y));
+  }
+  if (names.is_none()) {
+    for (std::size_t i = 0; i < out.arrays.size(); ++i) out.names.push_back(out.single ? "y" : "y" + std::to_string(i));
+  } else {
+    for (auto n : names) out.names.push_back(string_arg(n, source, "outputs"));
+    if (out.names.size() != out.arrays.size()) {
+      throw InputError(source, "outputs", std::to_string(out.arrays.size()) + " names", std::to_string(out.names.size()));
+    }
+  }
+  return out;
+}
+
+// Runs the estimate over the arrays in place (no copy of the samples), without the GIL.
+FrfEstimate estimate(const DoubleArray& u, const Outputs& y, double fs, const WelchOptions& options,
+                     const std::string& input_name, const std::string& source) {
+  std::vector<Channel> outs;
+  for (std::size_t i = 0; i < y.arrays.size(); ++i) outs.push_back(Channel{y.names[i], span(y.arrays[i])});
+  Channel in{input_name, span(u)};
+  return without_gil([&] { return estimate_frf(in, outs, fs, options, source); });
+}
+
+py::array stack(const std::vector<Eigen::VectorXcd>& v, bool single) {
+  if (single) return to_numpy(v.front());
+  const Index n = v.empty() ? 0 : v.front().size();
+  py::array_t<Complex> out({static_cast<Index>(v.size()), n});
+  auto a = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (Index k = 0; k < n; ++k) a(static_cast<Index>(i), k) = v[i](k);
+  return out;
+}
+py::array stack(const std::vector<Eigen::VectorXd>& v, bool single) {
+  if (single) return to_numpy(v.front());
+  const Index n = v.empty() ? 0 : v.front().size();
+  py::array_t<double> out({static_cast<Index>(v.size()), n});
+  auto a = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (Index k = 0; k < n; ++k) a(static_cast<Index>(i), k) = v[i](k);
+  return out;
+}
+
+py::dict provenance_dict(const FrfProvenance& p) {
+  py::dict d;
+  d["source"] = p.source;
+  d["estimator"] = p.estimator;
+  d["window"] = p.window;
+  d["nfft"] = p.nfft;
+  d["overlap"] = p.overlap;
+  d["detrend"] = p.detrend;
+  d["averages"] = p.averages;
+  d["sample_rate"] = p.sample_rate;
+  return d;
+}
+
+py::object excitation(Excitation&& e) {
+  py::dict d;
+  const double fs = e.sample_rate;
+  const Index n = e.u.size();
+  d["u"] = to_numpy(std::move(e.u));
+  d["t"] = to_numpy(Eigen::VectorXd(Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1)) / fs));
+  d["sample_rate"] = fs;
+  d["kind"] = e.kind;
+  d["scaled"] = e.scaled;
+  d["scale"] = e.scale;
+  d["clipped"] = e.clipped;
+  d["lines_hz"] = to_numpy(std::move(e.lines_hz));
+  d["seed"] = e.seed;
+  return result("Excitation", d);
+}
+
+template <class O>
+void def_excitation(py::module_& m, const char* name, const Options<O>& table, Excitation (*f)(const O&, const VoltageBounds&),
+                    const std::string& doc) {
+  const std::string source = std::string("dsp.") + name;
+  m.def(
+      name,
+      [&table, f, source](py::handle bounds, const py::kwargs& kw) {
+        auto o = table.from_kwargs(kwargs_dict(kw), source);
+        VoltageBounds b;
+        if (!bounds.is_none()) {
+          if (!py::isinstance<py::dict>(bounds)) throw InputError(source, "bounds", "a dict (min, max, policy)", short_repr(bounds));
+          b = bounds_options().from_kwargs(py::reinterpret_borrow<py::dict>(bounds), source);
+        }
+        return excitation(without_gil([&] { return f(o, b); }));
+      },
+      py::arg("bounds") = py::none(),
+      (doc + "\nReturns a Result: u (V), t (s), sample_rate (Hz), kind, scaled, scale, clipped, lines_hz, seed.\n\n"
+             "bounds: dict of\n" + bounds_options().doc("    ") + "\nKeywords:\n" + table.doc())
+          .c_str());
+}
+
+}  // namespace
+
+const Frf& frf_arg(py::handle obj, const std::string& source, const std::string& field) {
+  if (!py::isinstance<Frf>(obj)) throw InputError(source, field, "a dsp.Frf (dsp.frf(...).frf, io.read_frf, dsp.Frf(...))", short_repr(obj));
+  return obj.cast<const Frf&>();
+}
+
+void bind_dsp(py::module_& m) {
+  using py::arg;
+
+  py::class_<Frf>(m, "Frf", R"(A frequency response: one input, named outputs, a common grid (dsp/frf.hpp).
+
+H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says how it was estimated.)")
+      .def(py::init([](py::handle freq_hz, py::handle H, py::handle outputs, const std::string& input,
+                       py::handle coherence) {
+             const std::string src = "dsp.Frf";
+             Frf f;
+             f.freq_hz = to_vector(freq_hz, src, "freq_hz");
+             f.input = input;
+             auto h = to_complex_matrix(H, src, "H");
+             // H: (points,) for one output, or (outputs, points).
+             if (h.cols() == 1 && h.rows() == f.freq_hz.size()) h.transposeInPlace();
+             for (Index i = 0; i < h.rows(); ++i) f.H.push_back(h.row(i).transpose());
+             if (outputs.is_none()) {
+               for (Index i = 0; i < h.rows(); ++i) f.outputs.push_back(h.rows() == 1 ? "y" : "y" + std::to_string(i));
+             } else {
+               for (auto n : outputs) f.outputs.push_back(string_arg(n, src, "outputs"));
+             }
+             if (!coherence.is_none()) {
+               auto c = to_matrix(coherence, src, "coherence", true);
+               if (c.cols() == 1 && c.rows() == f.freq_hz.size()) c.transposeInPlace();
+               for (Index i = 0; i < c.rows(); ++i) f.coherence.push_back(c.row(i).transpose());
+             }
+             f.validate(src);
+             return f;
+           }),
+           arg("freq_hz"), arg("H"), arg("outputs") = py::none(), arg("input") = "u", arg("coherence") = py::none(),
+           "freq_hz (Hz, increasing); H: 1-D for one output or (outputs, points); outputs: names; coherence "
+           "like H (None = unknown).")
+      .def_property_readonly("freq_hz", [](py::object self) { return view(self.cast<const Frf&>().freq_hz, self); }, "Hz")
+      .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(2.0 * M_PI * f.freq_hz)); }, "rad/s")
+      .def_readonly("input", &Frf::input)
+      .def_readonly("outputs", &Frf::outputs)
+      .def_property_readonly("H", [](const Frf& f) { return stack(f.H, f.H.size() == 1); },
+                             "1-D complex array for one output, else (outputs, points)")
+      .def_property_readonly("coherence", [](const Frf& f) -> py::object {
+        if (f.coherence.empty()) return py::none();
+        return stack(f.coherence, f.coherence.size() == 1);
+      }, "like H (None when unknown)")
+      .def_property_readonly("provenance", [](const Frf& f) { return provenance_dict(f.provenance); })
+      .def("response", [](const Frf& f, const std::string& name) { return to_numpy(f.H[static_cast<std::size_t>(f.output_index(name))]); },
+           arg("output"), "H of the named output (InputError listing the names when unknown).")
+      .def("__repr__", [](const Frf& f) {
+        std::string outs;
+        for (const auto& o : f.outputs) outs += (outs.empty() ? "" : ", ") + o;
+        return "Frf(input=" + f.input + ", outputs=[" + outs + "], points=" + std::to_string(f.freq_hz.size()) + ")";
+      });
+
+  m.def("window", [](const std::string& type, Index length) { return to_numpy(make_window(window_type_from_string(type), length)); },
+        arg("type"), arg("length"), "The window of `length` samples, sample for sample scipy.signal.get_window's.");
+
+  const std::string keywords = "\nKeywords (WelchOptions):\n" + welch_options().doc();
+  m.def(
+      "welch",
+      [](py::handle x, double fs, const py::kwargs& kw) {
+        auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.welch");
+        auto a = vector_arg(x, "dsp.welch", "x", false);
+        Channel in{"x", span(a)};
+        auto s = without_gil([&] { return cross_spectra(in, {}, fs, o, "dsp.welch"); });
+        return py::make_tuple(to_numpy(std::move(s.freq_hz)), to_numpy(std::move(s.Suu)));
+      },
+      arg("x"), arg("fs"),
+      ("(f, Pxx): one-sided power spectral density of x, [x]^2/Hz, at f (Hz), as scipy.signal.welch with\n"
+       "the same window, nperseg = nfft, noverlap = floor(overlap * nfft) and detrend." + keywords).c_str());
+  m.def(
+      "csd",
+      [](py::handle x, py::handle y, double fs, const py::kwargs& kw) {
+        auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.csd");
+        auto a = vector_arg(x, "dsp.csd", "x", false);
+        auto ys = outputs_arg(y, "dsp.csd", py::none());
+        std::vector<Channel> outs;
+        for (std::size_t i = 0; i < ys.arrays.size(); ++i) outs.push_back(Channel{ys.names[i], span(ys.arrays[i])});
+        Channel in{"x", span(a)};
+        auto s = without_gil([&] { return cross_spectra(in, outs, fs, o, "dsp.csd"); });
+        return py::make_tuple(to_numpy(std::move(s.freq_hz)), stack(s.Suy, ys.single));
+      },
+      arg("x"), arg("y"), arg("fs"),
+      ("(f, Pxy): cross spectral density conj(X) Y, [x][y]/Hz, as scipy.signal.csd(x, y). y may hold\n"
+       "several outputs (list or (outputs, samples)): then Pxy is (outputs, points)." + keywords).c_str());
+  m.def(
+      "frf",
+      [](py::handle u, py::handle y, double fs, py::handle names, const std::string& input, const py::kwargs& kw) {
+        auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.frf");
+        auto a = vector_arg(u, "dsp.frf", "u", false);
+        auto ys = outputs_arg(y, "dsp.frf", names);
+        auto e = estimate(a, ys, fs, o, input, "dsp.frf");
+        py::dict d;
+        const bool single = ys.single;
+        d["freq_hz"] = to_numpy(e.spectra.freq_hz);
+        d["H"] = stack(e.frf.H, single);
+        d["coherence"] = stack(e.frf.coherence, single);
+        d["Suu"] = to_numpy(std::move(e.spectra.Suu));
+        d["Syy"] = stack(e.spectra.Syy, single);
+        d["Suy"] = stack(e.spectra.Suy, single);
+        d["averages"] = e.spectra.averages;
+        d["frf"] = py::cast(std::move(e.frf));
+        return result("FrfEstimate", d);
+      },
+      arg("u"), arg("y"), arg("fs"), arg("outputs") = py::none(), arg("input") = "u",
+      ("H1 (or H2) and coherence of every output in one pass over the data (the samples are read in\n"
+       "place, without copies, and the GIL is released). u: input (1-D), y: one output (1-D), a list,\n"
+       "or (outputs, samples); fs: Hz; outputs: names. Returns a Result: freq_hz, H, coherence,\n"
+       "Suu, Syy, Suy (1-D for one output, else (outputs, points)), averages, and frf (a dsp.Frf)." + keywords)
+          .c_str());
+  m.def(
+      "h1",
+      [](py::handle u, py::handle y, double fs, const py::kwargs& kw) {
+        auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.h1");
+        o.estimator = FrfEstimator::kH1;
+        auto a = vector_arg(u, "dsp.h1", "u", false);
+        auto ys = outputs_arg(y, "dsp.h1", py::none());
+        auto e = estimate(a, ys, fs, o, "u", "dsp.h1");
+        return py::make_tuple(to_numpy(std::move(e.frf.freq_hz)), stack(e.frf.H, ys.single));
+      },
+      arg("u"), arg("y"), arg("fs"), ("(f, H1): H1 = Suy / Suu (scipy: csd(u, y) / welch(u))." + keywords).c_str());
+  m.def(
+      "h2",
+      [](py::handle u, py::handle y, double fs, const py::kwargs& kw) {
+        auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.h2");
+        o.estimator = FrfEstimator::kH2;
+        auto a = vector_arg(u, "dsp.h2", "u", false);
+        auto ys = outputs_arg(y, "dsp.h2", py::none());
+        auto e = estimate(a, ys, fs, o, "u", "dsp.h2");
+        return py::make_tuple(to_numpy(std::move(e.frf.freq_hz)), stack(e.frf.H, ys.single));
+      },
+      arg("u"), arg("y"), arg("fs"), ("(f, H2): H2 = Syy / Syu (scipy: welch(y) / conj(csd(u, y)))." + keywords).c_str());
+  m.def(
+      "coherence",
+      [](py::handle u, py::handle y, double fs, const py::kwargs& kw) {
+        auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.coherence");
+        auto a = vector_arg(u, "dsp.coherence", "u", false);
+        auto ys = outputs_arg(y, "dsp.coherence", py::none());
+        auto e = estimate(a, ys, fs, o, "u", "dsp.coherence");
+        return py::make_tuple(to_numpy(std::move(e.frf.freq_hz)), stack(e.frf.coherence, ys.single));
+      },
+      arg("u"), arg("y"), arg("fs"),
+      ("(f, Cuy): magnitude-squared coherence |Suy|^2 / (Suu Syy), as scipy.signal.coherence." + keywords).c_str());
+
+  def_excitation(m, "band_limited_noise", noise_options(), &band_limited_noise,
+                 "Gaussian noise, white on the DFT lines inside [f_low, f_high] (periodic over `samples`).");
+  def_excitation(m, "multisine", multisine_options(), &multisine,
+                 "Sum of cosines on exact DFT lines (Schroeder or random phases), repeated `periods` times.");
+  def_excitation(m, "sine_sweep", sweep_options(), &sine_sweep, "Linear or logarithmic sine sweep with end tapers.");
+  def_excitation(m, "offset_sine", offset_sine_options(), &offset_sine,
+                 "Quasi-static offset sine (hysteresis, stroke tests), ramped in and out from `rest`.");
+  def_excitation(m, "steps", step_options(), &steps, "Staircase of held levels with linear ramps.");
+}
+
+}  // namespace piezobench::python

@@ -1,0 +1,299 @@
+// piezobench.ident: include/piezobench/ident/{vector_fitting,features,modal}.hpp
+#include "common.hpp"
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/ident/features.hpp"
+#include "piezobench/ident/modal.hpp"
+#include "piezobench/ident/vector_fitting.hpp"
+
+namespace piezobench::python {
+namespace {
+
+using namespace piezobench::ident;
+
+const Options<VectorFittingOptions>& vf_options() {
+  static const Options<VectorFittingOptions> t = [] {
+    Options<VectorFittingOptions> o("VectorFittingOptions");
+    o.add("order", &VectorFittingOptions::order, "number of poles N (a complex pair counts two)")
+        .add_enum("asymptote", &VectorFittingOptions::asymptote, &ident::to_string, &asymptote_from_string,
+                  "\"none\", \"d\" or \"de\" (d + s e)")
+        .add("relaxed", &VectorFittingOptions::relaxed, "relaxed non-triviality constraint (Gustavsen 2006)")
+        .add("enforce_stable_poles", &VectorFittingOptions::enforce_stable_poles, "mirror unstable poles")
+        .add("max_iterations", &VectorFittingOptions::max_iterations, "pole relocations")
+        .add("pole_tolerance", &VectorFittingOptions::pole_tolerance, "relative pole change that ends the relocations")
+        .add("significance_floor", &VectorFittingOptions::significance_floor, "poles below this peak share are not compared")
+        .add("residual_tolerance", &VectorFittingOptions::residual_tolerance, "relative change of the rms error that ends them")
+        .add("fail_if_not_converged", &VectorFittingOptions::fail_if_not_converged,
+             "True: NumericalError (retry_may_help) when the poles do not settle")
+        .add("starting_poles", &VectorFittingOptions::starting_poles, "rad/s; empty = automatic")
+        .add_enum("starting_spacing", &VectorFittingOptions::starting_spacing, &ident::to_string,
+                  &pole_spacing_from_string, "\"log\" or \"lin\"")
+        .add("starting_damping", &VectorFittingOptions::starting_damping, "damping of the automatic starting poles")
+        .add_enum("weighting", &VectorFittingOptions::weighting, &ident::to_string, &weighting_from_string,
+                  "\"unit\", \"inverse-magnitude\" or \"inverse-sqrt-magnitude\"")
+        .add("frequency_scale", &VectorFittingOptions::frequency_scale, "rad/s; 0 = the highest omega");
+    return o;
+  }();
+  return t;
+}
+
+const Options<FrfFeatureOptions>& feature_options() {
+  static const Options<FrfFeatureOptions> t = [] {
+    Options<FrfFeatureOptions> o("FrfFeatureOptions");
+    o.add_nested("fit", &FrfFeatureOptions::fit, vf_options(), "the rational model (ident.vector_fit keywords)")
+        .add("max_damping", &FrfFeatureOptions::max_damping, "lightly damped below this damping ratio")
+        .add("min_significance", &FrfFeatureOptions::min_significance, "modal peak / fitted response for a resonance")
+        .add("cancellation_tolerance", &FrfFeatureOptions::cancellation_tolerance, "a zero and a pole this close cancel")
+        .add("phase_band", &FrfFeatureOptions::phase_band, "relative half-width of the band of the phase verdict")
+        .add("phase_threshold_deg", &FrfFeatureOptions::phase_threshold_deg, "deg, |phase change| that gives a verdict")
+        .add("high_pass_ratio", &FrfFeatureOptions::high_pass_ratio, "DC gain / |H(lowest)| below which there is a high-pass");
+    return o;
+  }();
+  return t;
+}
+
+const Options<SecondOrderFitOptions>& second_order_options() {
+  static const Options<SecondOrderFitOptions> t = [] {
+    Options<SecondOrderFitOptions> o("SecondOrderFitOptions");
+    o.add_enum("method", &SecondOrderFitOptions::method, &ident::to_string, &second_order_method_from_string,
+               "\"nls\" (Levy then Levenberg-Marquardt) or \"vector-fitting\"")
+        .add("max_iterations", &SecondOrderFitOptions::max_iterations, "Levenberg-Marquardt steps");
+    return o;
+  }();
+  return t;
+}
+
+const Options<PeakPickingOptions>& peak_options() {
+  static const Options<PeakPickingOptions> t = [] {
+    Options<PeakPickingOptions> o("PeakPickingOptions");
+    o.add("min_omega", &PeakPickingOptions::min_omega, "rad/s; 0 = from the first point")
+        .add("max_omega", &PeakPickingOptions::max_omega, "rad/s; 0 = to the last point")
+        .add("min_prominence", &PeakPickingOptions::min_prominence, "peak / the higher separating minimum")
+        .add("max_modes", &PeakPickingOptions::max_modes, "keep the most prominent; 0 = all");
+    return o;
+  }();
+  return t;
+}
+
+const Options<LscfOptions>& lscf_options() {
+  static const Options<LscfOptions> t = [] {
+    Options<LscfOptions> o("LscfOptions");
+    o.add("min_omega", &LscfOptions::min_omega, "rad/s; 0 = from the first point")
+        .add("max_omega", &LscfOptions::max_omega, "rad/s; 0 = to the last point")
+        .add("min_order", &LscfOptions::min_order, "lowest denominator order")
+        .add("max_order", &LscfOptions::max_order, "highest denominator order")
+        .add("frequency_tolerance", &LscfOptions::frequency_tolerance, "stabilization: relative frequency change")
+        .add("damping_tolerance", &LscfOptions::damping_tolerance, "stabilization: relative damping change")
+        .add("min_stable_orders", &LscfOptions::min_stable_orders, "consecutive stable orders for a mode")
+        .add("max_damping", &LscfOptions::max_damping, "physical poles: 0 < zeta < max_damping");
+    return o;
+  }();
+  return t;
+}
+
+py::object vf_result(const VectorFittingResult& r) {
+  py::dict d;
+  d["poles"] = to_numpy(r.poles);
+  d["residues"] = to_numpy(r.residues);
+  d["d"] = to_numpy(r.d);
+  d["e"] = to_numpy(r.e);
+  d["model"] = py::cast(r.model);
+  d["rms_error"] = r.rms_error;
+  d["relative_rms_error"] = r.relative_rms_error;
+  d["iterations"] = r.iterations;
+  d["converged"] = r.converged;
+  d["convergence"] = to_string(r.convergence);
+  d["last_pole_change"] = r.last_pole_change;
+  d["frequency_scale"] = r.frequency_scale;
+  d["brief_report"] = r.brief_report();
+  d["evaluate"] = py::cpp_function(
+      [r](py::handle omega) { return to_numpy(r.evaluate(to_vector(omega, "VectorFittingResult.evaluate", "omega"))); },
+      py::arg("omega"), "The fitted model at j omega (rad/s): (len(omega), outputs) complex.");
+  return result("VectorFittingResult", d);
+}
+
+py::dict modal(const ModalFeature& f) {
+  py::dict d;
+  d["root"] = f.root;
+  d["natural_frequency"] = f.natural_frequency;
+  d["frequency_hz"] = f.frequency_hz();
+  d["damping"] = f.damping;
+  return d;
+}
+
+py::object features_result(const FrfFeatures& f) {
+  py::list res, anti;
+  for (const auto& r : f.resonances) res.append(result("Resonance", modal(r)));
+  for (const auto& a : f.antiresonances) {
+    py::dict d = modal(a);
+    d["nonminimum_phase_model"] = a.nonminimum_phase_model;
+    d["phase_verdict"] = to_string(a.phase_verdict);
+    d["phase_change_deg"] = a.phase_change_deg;
+    d["phase_points"] = a.phase_points;
+    anti.append(result("AntiResonance", d));
+  }
+  py::dict d;
+  d["static_gain"] = f.static_gain;
+  d["static_gain_source"] = to_string(f.static_gain_source);
+  d["plateau_frequency"] = f.plateau_frequency;
+  d["resonances"] = res;
+  d["antiresonances"] = anti;
+  d["fit"] = vf_result(f.fit);
+  return result("FrfFeatures", d);
+}
+
+py::object mode_result(const Mode& md) {
+  py::dict d;
+  d["pole"] = md.pole;
+  d["natural_frequency"] = md.natural_frequency;
+  d["frequency_hz"] = md.frequency_hz();
+  d["damping"] = md.damping;
+  d["stable_orders"] = md.stable_orders;
+  return result("Mode", d);
+}
+
+// omega and the response(s): h is (points,) or (points, outputs).
+std::pair<Vector, CMatrix> data_args(py::handle omega, py::handle h, const std::string& source) {
+  return {to_vector(omega, source, "omega"), to_complex_matrix(h, source, "h")};
+}
+
+}  // namespace
+
+void bind_ident(py::module_& m) {
+  using py::arg;
+
+  m.def(
+      "vector_fit",
+      [](py::handle omega_or_frf, py::handle data, py::handle weights, const py::kwargs& kw) {
+        const std::string src = "ident.vector_fit";
+        auto o = vf_options().from_kwargs(kwargs_dict(kw), src);
+        if (py::isinstance<dsp::Frf>(omega_or_frf)) {
+          const auto& f = frf_arg(omega_or_frf, src, "frf");
+          return vf_result(without_gil([&] { return vector_fit(f, o); }));
+        }
+        auto [w, h] = data_args(omega_or_frf, data, src);
+        Matrix wt = weights.is_none() ? Matrix() : to_matrix(weights, src, "weights", true);
+        return vf_result(without_gil([&] { return vector_fit(w, h, wt, o); }));
+      },
+      arg("omega"), arg("data") = py::none(), arg("weights") = py::none(),
+      ("Vector fitting (Gustavsen & Semlyen 1999, relaxed 2006, fast QR): common poles fitted to\n"
+       "data (points,) or (points, outputs) at s = j omega (rad/s); or vector_fit(frf) for every\n"
+       "output of a dsp.Frf. Returns a Result: poles, residues, d, e, model (lti.StateSpace), rms_error,\n"
+       "relative_rms_error, iterations, converged, convergence, evaluate(omega).\n\nKeywords:\n" +
+       vf_options().doc())
+          .c_str());
+  m.def(
+      "frf_features",
+      [](py::handle omega_or_frf, py::handle h_or_output, const py::kwargs& kw) {
+        const std::string src = "ident.frf_features";
+        auto o = feature_options().from_kwargs(kwargs_dict(kw), src);
+        if (py::isinstance<dsp::Frf>(omega_or_frf)) {
+          const auto& f = frf_arg(omega_or_frf, src, "frf");
+          auto name = string_arg(h_or_output, src, "output");
+          return features_result(without_gil([&] { return frf_features(f, name, o); }));
+        }
+        auto w = to_vector(omega_or_frf, src, "omega");
+        auto h = to_complex_vector(h_or_output, src, "h");
+        return features_result(without_gil([&] { return frf_features(w, h, o); }));
+      },
+      arg("omega"), arg("h"),
+      ("Static gain, resonances and anti-resonances (rad/s, damping) of one response, with the\n"
+       "non-minimum-phase verdicts (fitted zero and measured phase; report section 2.3). Call with\n"
+       "(omega, h) or (frf, output_name). Returns a Result: static_gain, static_gain_source,\n"
+       "plateau_frequency, resonances, antiresonances (phase_verdict, nonminimum_phase_model), fit.\n\n"
+       "Keywords:\n" + feature_options().doc())
+          .c_str());
+  m.def(
+      "fit_high_pass",
+      [](py::handle omega, py::handle h, double max_omega) {
+        auto w = to_vector(omega, "ident.fit_high_pass", "omega");
+        auto hv = to_complex_vector(h, "ident.fit_high_pass", "h");
+        auto r = fit_high_pass(w, hv, max_omega);
+        py::dict d;
+        d["corner"] = r.corner;
+        d["corner_hz"] = r.corner_hz();
+        d["gain"] = r.gain;
+        d["relative_rms_error"] = r.relative_rms_error;
+        return result("HighPassFit", d);
+      },
+      arg("omega"), arg("h"), arg("max_omega") = 0.0,
+      "First-order high-pass g s / (s + corner) fitted to the points with omega <= max_omega (rad/s; 0 = all):\n"
+      "Result(corner (rad/s), corner_hz, gain, relative_rms_error).");
+  m.def(
+      "fit_second_order",
+      [](py::handle omega, py::handle h, const py::kwargs& kw) {
+        const std::string src = "ident.fit_second_order";
+        auto o = second_order_options().from_kwargs(kwargs_dict(kw), src);
+        auto w = to_vector(omega, src, "omega");
+        auto hv = to_complex_vector(h, src, "h");
+        auto r = without_gil([&] { return fit_second_order(w, hv, o); });
+        py::dict d;
+        d["static_gain"] = r.static_gain;
+        d["natural_frequency"] = r.natural_frequency;
+        d["frequency_hz"] = r.frequency_hz();
+        d["damping"] = r.damping;
+        d["poles"] = to_numpy(std::move(r.poles));
+        d["feedthrough"] = r.feedthrough;
+        d["relative_rms_error"] = r.relative_rms_error;
+        d["iterations"] = r.iterations;
+        return result("SecondOrderFit", d);
+      },
+      arg("omega"), arg("h"),
+      ("k wn^2 / (s^2 + 2 zeta wn s + wn^2) fitted to h at j omega (rad/s): Result(static_gain,\n"
+       "natural_frequency (rad/s), frequency_hz, damping, poles, feedthrough, relative_rms_error, iterations).\n\n"
+       "Keywords:\n" + second_order_options().doc())
+          .c_str());
+  m.def(
+      "peak_picking",
+      [](py::handle omega, py::handle h, const py::kwargs& kw) {
+        const std::string src = "ident.peak_picking";
+        auto o = peak_options().from_kwargs(kwargs_dict(kw), src);
+        auto [w, hm] = data_args(omega, h, src);
+        auto modes = peak_picking(w, hm, o);
+        py::list out;
+        for (const auto& md : modes) out.append(mode_result(md));
+        return out;
+      },
+      arg("omega"), arg("h"),
+      ("Modes from the peaks of sum |H|^2 (h: (points,) or (points, outputs)), damping from the half-power\n"
+       "bandwidth: a list of Result(pole, natural_frequency (rad/s), frequency_hz, damping).\n\nKeywords:\n" +
+       peak_options().doc())
+          .c_str());
+  m.def(
+      "lscf",
+      [](py::handle omega, py::handle h, const py::kwargs& kw) {
+        const std::string src = "ident.lscf";
+        auto o = lscf_options().from_kwargs(kwargs_dict(kw), src);
+        auto [w, hm] = data_args(omega, h, src);
+        auto r = without_gil([&] { return lscf(w, hm, o); });
+        py::list modes;
+        for (const auto& md : r.modes) modes.append(mode_result(md));
+        const auto n = static_cast<Index>(r.diagram.size());
+        Eigen::VectorXd order(n), wn(n), zeta(n), stable(n);
+        Eigen::VectorXcd pole(n);
+        for (Index i = 0; i < n; ++i) {
+          const auto& p = r.diagram[static_cast<std::size_t>(i)];
+          order(i) = static_cast<double>(p.order);
+          pole(i) = p.pole;
+          wn(i) = p.natural_frequency;
+          zeta(i) = p.damping;
+          stable(i) = p.stable ? 1.0 : 0.0;
+        }
+        py::dict diag;
+        diag["order"] = to_numpy(std::move(order));
+        diag["pole"] = to_numpy(std::move(pole));
+        diag["natural_frequency"] = to_numpy(std::move(wn));
+        diag["damping"] = to_numpy(std::move(zeta));
+        diag["stable"] = to_numpy(std::move(stable));
+        py::dict d;
+        d["modes"] = modes;
+        d["diagram"] = result("StabilizationDiagram", diag);
+        return result("LscfResult", d);
+      },
+      arg("omega"), arg("h"),
+      ("Least-squares complex-frequency estimator (PolyMAX-like, single reference) over a range of\n"
+       "orders with a stabilization diagram: Result(modes, diagram (order, pole, natural_frequency,\n"
+       "damping, stable as arrays)).\n\nKeywords:\n" + lscf_options().doc())
+          .c_str());
+}
+
+}  // namespace piezobench::python
