@@ -135,7 +135,12 @@ class Options {
     Field f{name, "str", doc, {}, {}};
     std::string key = name;
     f.set = [member, from, key](T& t, py::handle value, const std::string& source) {
-      t.*member = from(convert<std::string>(value, source, key));
+      const std::string text = convert<std::string>(value, source, key);
+      try {
+        t.*member = from(text);
+      } catch (const InputError& e) {  // the library names its own field: name the keyword
+        throw InputError(source, key, "a known name (" + std::string(e.what()) + ")", "\"" + text + "\"");
+      }
     };
     f.get = [member, to](const T& t) { return py::object(py::str(to(t.*member))); };
     fields_.push_back(std::move(f));

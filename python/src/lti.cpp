@@ -199,7 +199,7 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
       R"(H(j omega) at every omega (rad/s), delays exact. SISO: a 1-D complex array; MIMO state space:
 shape (len(omega), outputs, inputs). Discrete systems use z = exp(j omega Ts). State spaces go
 through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of factors.)");
-  m.def("logspace", &lti::logspace, arg("lo_exponent"), arg("hi_exponent"), arg("n"),
+  m.def("logspace", [](double lo, double hi, Index n) { return to_numpy(lti::logspace(lo, hi, n)); }, arg("lo_exponent"), arg("hi_exponent"), arg("n"),
         "n points from 10**lo to 10**hi, logarithmically spaced (as MATLAB's logspace).");
   m.def("poles", [](py::handle sys) { return to_numpy(lti::poles(state_space_arg(sys, "lti.poles", "sys"))); },
         arg("sys"), "Eigenvalues of A (rad/s or z-plane), by increasing magnitude, conjugates adjacent.");
