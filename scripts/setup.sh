@@ -39,6 +39,8 @@ packages=(
   # External programs piezobench drives (`superelement from-step`) and the independent checks of
   # the test suite (scipy reads the virtual bench's files).
   gmsh calculix-ccx python3-scipy
+  # The Python module (python/, pybind11) and its pytest suite, for Debian's python3.
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
   # The report's plotting library comes from npm (src/report/js); its test runs headless Chromium.
   nodejs chromium
 )
@@ -70,12 +72,15 @@ fi
 
 if [ "$sanitize" -eq 1 ]; then
   build_dir="$root/build-sanitize"
+  # No Python module there: python3 would need the sanitizer runtime preloaded to load it.
   # -O1 -g1: line tables for the sanitizers' stack traces at about half the compile time of -O2 -g.
   config=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
-          -DPIEZOBENCH_SANITIZE=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF)
+          -DPIEZOBENCH_SANITIZE=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
 else
   build_dir="$root/build"
-  config=(-DCMAKE_BUILD_TYPE=Release)
+  # The Python module is built for Debian's interpreter (where apt puts numpy, scipy and pytest),
+  # not for another python3 that may come first on PATH.
+  config=(-DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3)
 fi
 jobs="$(nproc 2>/dev/null || echo 2)"
 
