@@ -113,7 +113,7 @@ void bind_apa(py::module_& m) {
           .c_str());
   m.def(
       "two_dof_response",
-      [](py::handle omega, const py::kwargs& kw) {
+      [](py::object omega, const py::kwargs& kw) {
         auto [p, b] = model_kwargs(kw, "apa.two_dof_response");
         auto w = to_vector(omega, "apa.two_dof_response", "omega");
         return to_numpy(two_dof_response(p, b, w));
@@ -159,7 +159,7 @@ void bind_apa(py::module_& m) {
           .c_str());
   m.def(
       "tune_two_dof",
-      [](py::handle frf, const py::kwargs& kw) {
+      [](py::object frf, const py::kwargs& kw) {
         const std::string src = "apa.tune_two_dof";
         const auto& f = frf_arg(frf, src, "frf");
         auto o = tuning_options().from_kwargs(kwargs_dict(kw), src);

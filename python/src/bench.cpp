@@ -148,7 +148,7 @@ hysteresis, creep, the NMP zero, DAC/amplifier/encoder/ADC, noise and delay, sam
           arg("u"), "One sample with DAC command u (V): returns (d_e (m), Vs (V), Va (V)).")
       .def(
           "run",
-          [](VirtualBench& b, py::handle u) {
+          [](VirtualBench& b, py::object u) {
             auto a = vector_arg(u, "bench.VirtualBench.run", "u", false);
             std::vector<BenchSample> out(static_cast<std::size_t>(a.size()));
             {

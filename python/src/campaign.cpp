@@ -58,7 +58,7 @@ void bind_campaign(py::module_& m) {
 
   m.def(
       "run",
-      [](const std::string& file, int threads, py::handle out_dir, bool progress) {
+      [](const std::string& file, int threads, py::object out_dir, bool progress) {
         auto c = read_campaign(file);
         PipelineOptions o;
         o.threads = threads;

@@ -96,7 +96,7 @@ void bind_control(py::module_& m) {
           .c_str());
   m.def(
       "iff_open_loop",
-      [](py::handle plant, py::handle controller, const py::kwargs& kw) {
+      [](py::object plant, py::object controller, const py::kwargs& kw) {
         auto o = loop_options().from_kwargs(kwargs_dict(kw), "control.iff_open_loop");
         return iff_open_loop(state_space_arg(plant, "control.iff_open_loop", "plant"),
                              state_space_arg(controller, "control.iff_open_loop", "controller"), o);
@@ -105,7 +105,7 @@ void bind_control(py::module_& m) {
       ("L = -K0 G as a SISO state space (delays as Pade approximants).\n\nKeywords:\n" + loop_options().doc()).c_str());
   m.def(
       "iff_root_locus",
-      [](py::handle plant, py::handle controller, py::handle gains, const py::kwargs& kw) {
+      [](py::object plant, py::object controller, py::object gains, const py::kwargs& kw) {
         const std::string src = "control.iff_root_locus";
         auto o = loop_options().from_kwargs(kwargs_dict(kw), src);
         auto g = state_space_arg(plant, src, "plant");
@@ -136,7 +136,7 @@ void bind_control(py::module_& m) {
   py::class_<DiscreteIff>(m, "DiscreteIff", R"(The report's IFF controller as it runs on the real-time target
 (control/discrete_iff.hpp): Tustin with pre-warping, second-order sections, bumpless gain changes,
 anti-windup. y[k] = g K0(z) Vs[k]; a non-finite input resets the states and gives 0.)")
-      .def(py::init([](double gain, py::handle controller, const py::kwargs& kw) {
+      .def(py::init([](double gain, py::object controller, const py::kwargs& kw) {
              const std::string src = "control.DiscreteIff";
              auto o = discrete_options().from_kwargs(kwargs_dict(kw), src);
              IffControllerParams p;
@@ -153,7 +153,7 @@ anti-windup. y[k] = g K0(z) Vs[k]; a non-finite input resets the states and give
       .def("step", &DiscreteIff::step, arg("vs"), "One sample: returns g K0 Vs (V).")
       .def(
           "run",
-          [](DiscreteIff& c, py::handle vs) {
+          [](DiscreteIff& c, py::object vs) {
             auto a = vector_arg(vs, "control.DiscreteIff.run", "vs", false);
             Eigen::VectorXd y(a.size());
             {

@@ -218,7 +218,7 @@ void def_excitation(py::module_& m, const char* name, const Options<O>& table, E
   const std::string source = std::string("dsp.") + name;
   m.def(
       name,
-      [&table, f, source](py::handle bounds, const py::kwargs& kw) {
+      [&table, f, source](py::object bounds, const py::kwargs& kw) {
         auto o = table.from_kwargs(kwargs_dict(kw), source);
         VoltageBounds b;
         if (!bounds.is_none()) {
@@ -246,8 +246,8 @@ void bind_dsp(py::module_& m) {
   py::class_<Frf>(m, "Frf", R"(A frequency response: one input, named outputs, a common grid (dsp/frf.hpp).
 
 H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says how it was estimated.)")
-      .def(py::init([](py::handle freq_hz, py::handle H, py::handle outputs, const std::string& input,
-                       py::handle coherence) {
+      .def(py::init([](py::object freq_hz, py::object H, py::object outputs, const std::string& input,
+                       py::object coherence) {
              const std::string src = "dsp.Frf";
              Frf f;
              f.freq_hz = to_vector(freq_hz, src, "freq_hz");
@@ -297,7 +297,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
   const std::string keywords = "\nKeywords (WelchOptions):\n" + welch_options().doc();
   m.def(
       "welch",
-      [](py::handle x, double fs, const py::kwargs& kw) {
+      [](py::object x, double fs, const py::kwargs& kw) {
         auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.welch");
         auto a = vector_arg(x, "dsp.welch", "x", false);
         Channel in{"x", span(a)};
@@ -309,7 +309,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
        "the same window, nperseg = nfft, noverlap = floor(overlap * nfft) and detrend." + keywords).c_str());
   m.def(
       "csd",
-      [](py::handle x, py::handle y, double fs, const py::kwargs& kw) {
+      [](py::object x, py::object y, double fs, const py::kwargs& kw) {
         auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.csd");
         auto a = vector_arg(x, "dsp.csd", "x", false);
         auto ys = outputs_arg(y, "dsp.csd", py::none());
@@ -324,7 +324,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
        "several outputs (list or (outputs, samples)): then Pxy is (outputs, points)." + keywords).c_str());
   m.def(
       "frf",
-      [](py::handle u, py::handle y, double fs, py::handle names, const std::string& input, const py::kwargs& kw) {
+      [](py::object u, py::object y, double fs, py::object names, const std::string& input, const py::kwargs& kw) {
         auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.frf");
         auto a = vector_arg(u, "dsp.frf", "u", false);
         auto ys = outputs_arg(y, "dsp.frf", names);
@@ -349,7 +349,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
           .c_str());
   m.def(
       "h1",
-      [](py::handle u, py::handle y, double fs, const py::kwargs& kw) {
+      [](py::object u, py::object y, double fs, const py::kwargs& kw) {
         auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.h1");
         o.estimator = FrfEstimator::kH1;
         auto a = vector_arg(u, "dsp.h1", "u", false);
@@ -360,7 +360,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
       arg("u"), arg("y"), arg("fs"), ("(f, H1): H1 = Suy / Suu (scipy: csd(u, y) / welch(u))." + keywords).c_str());
   m.def(
       "h2",
-      [](py::handle u, py::handle y, double fs, const py::kwargs& kw) {
+      [](py::object u, py::object y, double fs, const py::kwargs& kw) {
         auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.h2");
         o.estimator = FrfEstimator::kH2;
         auto a = vector_arg(u, "dsp.h2", "u", false);
@@ -371,7 +371,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
       arg("u"), arg("y"), arg("fs"), ("(f, H2): H2 = Syy / Syu (scipy: welch(y) / conj(csd(u, y)))." + keywords).c_str());
   m.def(
       "coherence",
-      [](py::handle u, py::handle y, double fs, const py::kwargs& kw) {
+      [](py::object u, py::object y, double fs, const py::kwargs& kw) {
         auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.coherence");
         auto a = vector_arg(u, "dsp.coherence", "u", false);
         auto ys = outputs_arg(y, "dsp.coherence", py::none());

@@ -139,7 +139,7 @@ coordinates (m), the source files and warnings.)")
       });
 
   py::class_<SparseModel>(m, "SparseModel", "A large sparse FE model (fem/matrix_io.hpp): K (N/m), M (kg), nodal DOF labels.")
-      .def(py::init([](py::handle K, py::handle M, py::handle dofs, py::handle coordinates) {
+      .def(py::init([](py::object K, py::object M, py::object dofs, py::object coordinates) {
              const std::string src = "fem.SparseModel";
              SparseModel s;
              s.K = sparse_arg(K, src, "K");
@@ -177,7 +177,7 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
            "x = [q; q'] first-order form as an lti.StateSpace.")
       .def(
           "frequency_response",
-          [](const StructuralModel& s, py::handle omega) {
+          [](const StructuralModel& s, py::object omega) {
             auto w = to_vector(omega, "fem.StructuralModel.frequency_response", "omega");
             auto h = without_gil([&] { return frequency_response(s, w); });
             const py::ssize_t n = w.size(), p = s.T.rows(), q = s.F.cols();
@@ -220,7 +220,7 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
       "A large model from CalculiX MATRIXSTORAGE dumps, as a fem.SparseModel (for craig_bampton).");
   m.def(
       "modes",
-      [](py::handle K, py::handle M) {
+      [](py::object K, py::object M) {
         auto r = fem::modes(to_matrix(K, "fem.modes", "K"), to_matrix(M, "fem.modes", "M"));
         py::dict d;
         d["frequencies_hz"] = to_numpy(std::move(r.frequencies_Hz));
@@ -265,7 +265,7 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
       arg("se"), arg("relative_threshold") = 1e-3, "Are the six free-free rigid-body modes at ~0 Hz?");
   m.def(
       "craig_bampton",
-      [](const SparseModel& model, py::handle interface, const py::kwargs& kw) {
+      [](const SparseModel& model, py::object interface, const py::kwargs& kw) {
         const std::string src = "fem.craig_bampton";
         auto o = cb_options().from_kwargs(kwargs_dict(kw), src);
         std::vector<InterfacePoint> points;

@@ -106,7 +106,7 @@ py::object vf_result(const VectorFittingResult& r) {
   d["frequency_scale"] = r.frequency_scale;
   d["brief_report"] = r.brief_report();
   d["evaluate"] = py::cpp_function(
-      [r](py::handle omega) { return to_numpy(r.evaluate(to_vector(omega, "VectorFittingResult.evaluate", "omega"))); },
+      [r](py::object omega) { return to_numpy(r.evaluate(to_vector(omega, "VectorFittingResult.evaluate", "omega"))); },
       py::arg("omega"), "The fitted model at j omega (rad/s): (len(omega), outputs) complex.");
   return result("VectorFittingResult", d);
 }
@@ -163,7 +163,7 @@ void bind_ident(py::module_& m) {
 
   m.def(
       "vector_fit",
-      [](py::handle omega_or_frf, py::handle data, py::handle weights, const py::kwargs& kw) {
+      [](py::object omega_or_frf, py::object data, py::object weights, const py::kwargs& kw) {
         const std::string src = "ident.vector_fit";
         auto o = vf_options().from_kwargs(kwargs_dict(kw), src);
         if (py::isinstance<dsp::Frf>(omega_or_frf)) {
@@ -183,7 +183,7 @@ void bind_ident(py::module_& m) {
           .c_str());
   m.def(
       "frf_features",
-      [](py::handle omega_or_frf, py::handle h_or_output, const py::kwargs& kw) {
+      [](py::object omega_or_frf, py::object h_or_output, const py::kwargs& kw) {
         const std::string src = "ident.frf_features";
         auto o = feature_options().from_kwargs(kwargs_dict(kw), src);
         if (py::isinstance<dsp::Frf>(omega_or_frf)) {
@@ -204,7 +204,7 @@ void bind_ident(py::module_& m) {
           .c_str());
   m.def(
       "fit_high_pass",
-      [](py::handle omega, py::handle h, double max_omega) {
+      [](py::object omega, py::object h, double max_omega) {
         auto w = to_vector(omega, "ident.fit_high_pass", "omega");
         auto hv = to_complex_vector(h, "ident.fit_high_pass", "h");
         auto r = fit_high_pass(w, hv, max_omega);
@@ -220,7 +220,7 @@ void bind_ident(py::module_& m) {
       "Result(corner (rad/s), corner_hz, gain, relative_rms_error).");
   m.def(
       "fit_second_order",
-      [](py::handle omega, py::handle h, const py::kwargs& kw) {
+      [](py::object omega, py::object h, const py::kwargs& kw) {
         const std::string src = "ident.fit_second_order";
         auto o = second_order_options().from_kwargs(kwargs_dict(kw), src);
         auto w = to_vector(omega, src, "omega");
@@ -244,7 +244,7 @@ void bind_ident(py::module_& m) {
           .c_str());
   m.def(
       "peak_picking",
-      [](py::handle omega, py::handle h, const py::kwargs& kw) {
+      [](py::object omega, py::object h, const py::kwargs& kw) {
         const std::string src = "ident.peak_picking";
         auto o = peak_options().from_kwargs(kwargs_dict(kw), src);
         auto [w, hm] = data_args(omega, h, src);
@@ -260,7 +260,7 @@ void bind_ident(py::module_& m) {
           .c_str());
   m.def(
       "lscf",
-      [](py::handle omega, py::handle h, const py::kwargs& kw) {
+      [](py::object omega, py::object h, const py::kwargs& kw) {
         const std::string src = "ident.lscf";
         auto o = lscf_options().from_kwargs(kwargs_dict(kw), src);
         auto [w, hm] = data_args(omega, h, src);

@@ -63,7 +63,7 @@ void bind_io(py::module_& m) {
   py::class_<TimeSeries>(m, "TimeSeries", R"(A sampled measurement record (io/timeseries.hpp): named channels of
 equal length (SI units), the sample rate (Hz), the time vector t (s) when known, units and settings.
 data is samples x channels; channel(name) / ts[name] give one channel without a copy.)")
-      .def(py::init([](py::dict channels, double sample_rate, py::handle t, py::handle units, py::handle settings) {
+      .def(py::init([](py::dict channels, double sample_rate, py::object t, py::object units, py::object settings) {
              const std::string src = "io.TimeSeries";
              TimeSeries ts;
              ts.sample_rate = sample_rate;
@@ -165,7 +165,7 @@ data is samples x channels; channel(name) / ts[name] give one channel without a 
       "Reads an FRF (.csv, .mat, .uff/.unv 58 ASCII or binary) as a dsp.Frf, validated.");
   m.def(
       "write_frf",
-      [](py::handle frf, const std::string& file, const py::kwargs& kw) {
+      [](py::object frf, const std::string& file, const py::kwargs& kw) {
         const auto& f = frf_arg(frf, "io.write_frf", "frf");
         auto o = frf_write_options().from_kwargs(kwargs_dict(kw), "io.write_frf");
         without_gil([&] { write_frf(f, file, o); return 0; });

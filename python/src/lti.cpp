@@ -100,8 +100,8 @@ continuous (sample_time == 0): dx/dt = A x + B u(t - input_delay),  y = C x + D 
 discrete   (sample_time  > 0): x[k+1] = A x[k] + B u[k],            y[k] = C x[k] + D u[k]
 Delays (s) are exact in frequency responses; lti.pade() turns them into states. SI units;
 poles in rad/s (continuous) or the z-plane (discrete).)")
-      .def(py::init([](py::handle a, py::handle b, py::handle c, py::handle d, double ts, py::handle in_delay,
-                       py::handle out_delay) {
+      .def(py::init([](py::object a, py::object b, py::object c, py::object d, double ts, py::object in_delay,
+                       py::object out_delay) {
              const std::string src = "lti.StateSpace";
              StateSpace s(to_matrix(a, src, "A"), to_matrix(b, src, "B", true), to_matrix(c, src, "C"),
                           d.is_none() ? Eigen::MatrixXd() : to_matrix(d, src, "D"), ts);
@@ -129,7 +129,7 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
 
   py::class_<TransferFunction>(m, "TransferFunction", R"(SISO transfer function num(s)/den(s) exp(-s delay)
 (lti/transfer_function.hpp). Coefficients in descending powers of s (z when discrete), as MATLAB's tf.)")
-      .def(py::init([](py::handle num, py::handle den, double ts, double delay) {
+      .def(py::init([](py::object num, py::object den, double ts, double delay) {
              return TransferFunction(to_vector(num, "lti.TransferFunction", "num"),
                                      to_vector(den, "lti.TransferFunction", "den"), ts, delay);
            }),
@@ -145,7 +145,7 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
 
   py::class_<Zpk>(m, "Zpk", R"(SISO zeros, poles and gain: gain prod(s - zeros) / prod(s - poles) exp(-s delay)
 (lti/transfer_function.hpp). Complex values in conjugate pairs; rad/s (continuous) or z-plane.)")
-      .def(py::init([](py::handle z, py::handle p, double k, double ts, double delay) {
+      .def(py::init([](py::object z, py::object p, double k, double ts, double delay) {
              return Zpk(to_complex_vector(z, "lti.Zpk", "zeros"), to_complex_vector(p, "lti.Zpk", "poles"), k, ts, delay);
            }),
            arg("zeros"), arg("poles"), arg("gain"), arg("sample_time") = 0.0, arg("delay") = 0.0)
@@ -159,11 +159,11 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
                ", gain=" + std::to_string(z.gain) + ")";
       });
 
-  m.def("ss", [](py::handle sys) { return state_space_arg(sys, "lti.ss", "sys"); }, arg("sys"),
+  m.def("ss", [](py::object sys) { return state_space_arg(sys, "lti.ss", "sys"); }, arg("sys"),
         "The state space of a StateSpace, TransferFunction or Zpk (cascade of real sections from the zpk form).");
   m.def(
       "tf",
-      [](py::handle sys, Index output, Index input) -> TransferFunction {
+      [](py::object sys, Index output, Index input) -> TransferFunction {
         if (py::isinstance<Zpk>(sys)) return to_transfer_function(sys.cast<Zpk>());
         if (py::isinstance<TransferFunction>(sys)) return sys.cast<TransferFunction>();
         return to_transfer_function(state_space_arg(sys, "lti.tf", "sys"), output, input);
@@ -171,7 +171,7 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
       arg("sys"), arg("output") = 0, arg("input") = 0, "Transfer function of one channel (output, input) of sys.");
   m.def(
       "zpk",
-      [](py::handle sys, Index output, Index input) -> Zpk {
+      [](py::object sys, Index output, Index input) -> Zpk {
         if (py::isinstance<TransferFunction>(sys)) return to_zpk(sys.cast<TransferFunction>());
         if (py::isinstance<Zpk>(sys)) return sys.cast<Zpk>();
         return to_zpk(state_space_arg(sys, "lti.zpk", "sys"), output, input);
@@ -181,7 +181,7 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
 
   m.def(
       "freqresp",
-      [](py::handle sys, py::handle omega, int threads) -> py::array {
+      [](py::object sys, py::object omega, int threads) -> py::array {
         auto w = to_vector(omega, "lti.freqresp", "omega");
         if (py::isinstance<Zpk>(sys)) {
           auto z = sys.cast<Zpk>();
@@ -201,15 +201,15 @@ shape (len(omega), outputs, inputs). Discrete systems use z = exp(j omega Ts). S
 through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of factors.)");
   m.def("logspace", [](double lo, double hi, Index n) { return to_numpy(lti::logspace(lo, hi, n)); }, arg("lo_exponent"), arg("hi_exponent"), arg("n"),
         "n points from 10**lo to 10**hi, logarithmically spaced (as MATLAB's logspace).");
-  m.def("poles", [](py::handle sys) { return to_numpy(lti::poles(state_space_arg(sys, "lti.poles", "sys"))); },
+  m.def("poles", [](py::object sys) { return to_numpy(lti::poles(state_space_arg(sys, "lti.poles", "sys"))); },
         arg("sys"), "Eigenvalues of A (rad/s or z-plane), by increasing magnitude, conjugates adjacent.");
-  m.def("zeros", [](py::handle sys) { return to_numpy(lti::zeros(state_space_arg(sys, "lti.zeros", "sys"))); },
+  m.def("zeros", [](py::object sys) { return to_numpy(lti::zeros(state_space_arg(sys, "lti.zeros", "sys"))); },
         arg("sys"), "Transmission zeros (system pencil, Emami-Naeini & Van Dooren), sorted as poles().");
-  m.def("dc_gain", [](py::handle sys) { return to_numpy(lti::dc_gain(state_space_arg(sys, "lti.dc_gain", "sys"))); },
+  m.def("dc_gain", [](py::object sys) { return to_numpy(lti::dc_gain(state_space_arg(sys, "lti.dc_gain", "sys"))); },
         arg("sys"), "H(0) (continuous) or H(1) (discrete), outputs x inputs; +-inf for an uncancelled integrator.");
   m.def(
       "damp",
-      [](py::handle sys) {
+      [](py::object sys) {
         auto s = state_space_arg(sys, "lti.damp", "sys");
         auto info = lti::damp(s);
         Eigen::VectorXcd p(static_cast<Index>(info.size()));
@@ -229,7 +229,7 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
 
   m.def(
       "c2d",
-      [](py::handle sys, double ts, const py::kwargs& kw) -> py::object {
+      [](py::object sys, double ts, const py::kwargs& kw) -> py::object {
         auto o = discretize_options().from_kwargs(kwargs_dict(kw), "lti.c2d");
         if (py::isinstance<TransferFunction>(sys)) return py::cast(lti::c2d(sys.cast<TransferFunction>(), ts, o));
         return py::cast(lti::c2d(state_space_arg(sys, "lti.c2d", "sys"), ts, o));
@@ -241,7 +241,7 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
           .c_str());
   m.def(
       "lsim",
-      [](py::handle sys_arg, py::handle u, py::handle x0) {
+      [](py::object sys_arg, py::object u, py::object x0) {
         auto sys = state_space_arg(sys_arg, "lti.lsim", "sys");
         auto um = to_matrix(u, "lti.lsim", "u", true);
         Eigen::VectorXd x = x0.is_none() ? Eigen::VectorXd() : to_vector(x0, "lti.lsim", "x0");
@@ -252,32 +252,32 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
       "Returns a Result with t (s), y (samples x outputs), x (samples x states).");
   m.def(
       "step",
-      [](py::handle sys, double ts, Index samples, Index input) {
+      [](py::object sys, double ts, Index samples, Index input) {
         return time_response(lti::step(state_space_arg(sys, "lti.step", "sys"), ts, samples, input));
       },
       arg("sys"), arg("sample_time"), arg("samples"), arg("input") = 0,
       "Unit-step response (continuous systems discretized by ZOH at sample_time): Result(t, y, x).");
   m.def(
       "impulse",
-      [](py::handle sys, double ts, Index samples, Index input) {
+      [](py::object sys, double ts, Index samples, Index input) {
         return time_response(lti::impulse(state_space_arg(sys, "lti.impulse", "sys"), ts, samples, input));
       },
       arg("sys"), arg("sample_time"), arg("samples"), arg("input") = 0,
       "Unit-impulse response (area-1 pulse over the first sample for continuous systems): Result(t, y, x).");
-  m.def("expm", [](py::handle a) { return to_numpy(lti::expm(to_matrix(a, "lti.expm", "a"))); }, arg("a"),
+  m.def("expm", [](py::object a) { return to_numpy(lti::expm(to_matrix(a, "lti.expm", "a"))); }, arg("a"),
         "Matrix exponential (scaling and squaring, [13/13] Pade; Higham 2005).");
   m.def("pade", [](double delay, int order) { return lti::pade(delay, order); }, arg("delay"), arg("order"),
         "[order/order] Pade approximant of exp(-s delay) (delay in s), as MATLAB's pade(T, N).");
 
-  m.def("series", [](py::handle a, py::handle b) {
+  m.def("series", [](py::object a, py::object b) {
     return lti::series(state_space_arg(a, "lti.series", "first"), state_space_arg(b, "lti.series", "second"));
   }, arg("first"), arg("second"), "y = second(first(u)).");
-  m.def("parallel", [](py::handle a, py::handle b) {
+  m.def("parallel", [](py::object a, py::object b) {
     return lti::parallel(state_space_arg(a, "lti.parallel", "a"), state_space_arg(b, "lti.parallel", "b"));
   }, arg("a"), arg("b"), "y = a(u) + b(u).");
   m.def(
       "feedback",
-      [](py::handle f, py::handle b, int sign) {
+      [](py::object f, py::object b, int sign) {
         if (sign != 1 && sign != -1) throw InputError("lti.feedback", "sign", "-1 or +1", std::to_string(sign));
         return lti::feedback(state_space_arg(f, "lti.feedback", "forward"), state_space_arg(b, "lti.feedback", "back"),
                              sign < 0 ? FeedbackSign::kNegative : FeedbackSign::kPositive);
@@ -287,13 +287,13 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
 
   m.def(
       "closed_loop_poles",
-      [](py::handle sys, double gain) {
+      [](py::object sys, double gain) {
         return to_numpy(lti::closed_loop_poles(state_space_arg(sys, "lti.closed_loop_poles", "open_loop"), gain));
       },
       arg("open_loop"), arg("gain"), "Poles of 1 + k L(s) = 0 (negative feedback u = -k y, MATLAB's rlocus).");
   m.def(
       "rlocus",
-      [](py::handle sys, py::handle gains, const py::kwargs& kw) {
+      [](py::object sys, py::object gains, const py::kwargs& kw) {
         auto s = state_space_arg(sys, "lti.rlocus", "open_loop");
         auto o = rlocus_options().from_kwargs(kwargs_dict(kw), "lti.rlocus");
         if (gains.is_none()) return root_locus(without_gil([&] { return lti::rlocus_auto(s, o); }));
@@ -308,7 +308,7 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
           .c_str());
   m.def(
       "max_damping_on_branch",
-      [](py::handle sys, Complex start, const py::kwargs& kw) {
+      [](py::object sys, Complex start, const py::kwargs& kw) {
         auto s = state_space_arg(sys, "lti.max_damping_on_branch", "open_loop");
         auto o = rlocus_options().from_kwargs(kwargs_dict(kw), "lti.max_damping_on_branch");
         auto b = without_gil([&] { return lti::max_damping_on_branch(s, start, o); });
