@@ -64,24 +64,41 @@ void basis_row(double t, double t_on, double t_off, double tau, double* row) {
   row[4] = off * std::log10(1.0 + std::max(0.0, t - t_off) / tau);
 }
 
+// Least squares of the creep model over `rows` through its 5 x 5 normal equations, accumulated
+// row by row: no n x 5 matrix per time constant (the grid below fits 43 of them on records of a
+// few hundred thousand samples). The columns are of order 1, so the normal equations lose nothing
+// that matters here; the residual is summed directly when `exact_sse` (else b'b - b'A x, ample for
+// comparing time constants).
 Fit fit_creep(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de, const std::vector<Index>& rows,
-              double t_on, double t_off, double tau, const std::string& source) {
-  MatrixXd a(static_cast<Index>(rows.size()), 5);
-  VectorXd b(static_cast<Index>(rows.size()));
-  double row[5];
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    basis_row(t(rows[i]), t_on, t_off, tau, row);
-    for (int j = 0; j < 5; ++j) a(static_cast<Index>(i), j) = row[j];
-    b(static_cast<Index>(i)) = de(rows[i]);
+              double t_on, double t_off, double tau, const std::string& source, bool exact_sse = false) {
+  Eigen::Matrix<double, 5, 5> ata = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> atb = Eigen::Matrix<double, 5, 1>::Zero();
+  double btb = 0.0;
+  Eigen::Matrix<double, 5, 1> row;
+  for (const Index k : rows) {
+    basis_row(t(k), t_on, t_off, tau, row.data());
+    ata.selfadjointView<Eigen::Lower>().rankUpdate(row);
+    atb += row * de(k);
+    btb += de(k) * de(k);
   }
-  const Eigen::ColPivHouseholderQR<MatrixXd> qr(a);
+  ata = ata.selfadjointView<Eigen::Lower>();
+  const Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 5, 5>> qr(ata);
   if (qr.rank() < 5) {
     throw NumericalError("static stiffness (" + source + ")", "the creep model is singular on this record", false);
   }
   Fit f;
-  f.coef = qr.solve(b);
-  f.sse = (a * f.coef - b).squaredNorm();
-  f.used = a.rows();
+  f.coef = qr.solve(atb);
+  f.used = static_cast<Index>(rows.size());
+  if (exact_sse) {
+    f.sse = 0.0;
+    for (const Index k : rows) {
+      basis_row(t(k), t_on, t_off, tau, row.data());
+      const double r = row.dot(f.coef) - de(k);
+      f.sse += r * r;
+    }
+  } else {
+    f.sse = std::max(0.0, btb - atb.dot(f.coef));
+  }
   return f;
 }
 
@@ -208,8 +225,8 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
     const double denom = ym - 2.0 * y0 + yp;
     if (denom > 0.0) lbest += 0.5 * h * (ym - yp) / denom;
   }
-  Fit f = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, lbest), source);
-  const Fit at_grid = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, l0 + h * best), source);
+  Fit f = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, lbest), source, true);
+  const Fit at_grid = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, l0 + h * best), source, true);
   if (at_grid.sse < f.sse) {
     f = at_grid;
     lbest = l0 + h * best;
