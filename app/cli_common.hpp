@@ -19,6 +19,7 @@ void add_rt_commands(CLI::App& app, Action& action);  // rt
 void add_model_commands(CLI::App& app, Action& action);  // model 2dof, model tune, piezo
 void add_superelement_commands(CLI::App& app, Action& action);  // superelement
 void add_simulate_commands(CLI::App& app, Action& action);  // simulate
+void add_measure_commands(CLI::App& app, Action& action);  // measure, bench serve
 void add_run_commands(CLI::App& app, Action& action);  // run, demo
 
 // Prints exactly one JSON document on stdout (round-trip precision for doubles).

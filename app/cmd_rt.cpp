@@ -7,10 +7,12 @@
 #include <numbers>
 
 #include "cli_common.hpp"
+#include "measure_common.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/io/json.hpp"
+#include "piezobench/rt/bench_file.hpp"
 #include "piezobench/rt/loop.hpp"
 #include "piezobench/rt/replay_backend.hpp"
 #include "piezobench/rt/virtual_backend.hpp"
@@ -36,6 +38,8 @@ struct RtOptions {
   rt::ActuatorLimits limits;
   double ramp = 0.1;
   int priority = 80;
+  bool fifo = false;          // with a bench file: SCHED_FIFO and mlockall only when asked
+  bool limits_given = false;
   bool json = false;
 };
 
@@ -56,7 +60,28 @@ int run_rt(const RtOptions& o) {
   o.limits.validate();
   std::unique_ptr<rt::Backend> backend;
   nlohmann::json source;
-  if (o.bench == "virtual") {
+  rt::ActuatorLimits limits = o.limits;
+  limits.ramp_in = limits.ramp_out = o.ramp;
+  const bool bench_file = o.bench.size() > 5 && o.bench.substr(o.bench.size() - 5) == ".toml";
+  if (bench_file) {
+    // A bench file: its backend, rate and limits (a hardware backend never starts without them).
+    if (!o.replay.empty()) throw InputError("", "--replay", "only with --bench replay", "'" + o.replay + "'");
+    const rt::BenchDescription desc = rt::read_bench_file(o.bench);
+    if (o.limits_given) {
+      throw InputError("", "--va-min/--va-max/--slew-rate/--watchdog/--ramp",
+                       "no limit options with a bench file (its [limits] apply)", "limit options");
+    }
+    if (o.rate_given && std::abs(o.rate - desc.sample_rate) > 1e-9 * desc.sample_rate) {
+      throw InputError(o.bench, "--rate", fmt::format("the bench file's rate {:g} Hz", desc.sample_rate), fmt::format("{:g} Hz", o.rate));
+    }
+    limits = desc.limits;
+    if (desc.backend == "comedi" && !o.realtime) {
+      throw InputError("", "--realtime", "true with a card (its I/O is paced by the loop)", "false");
+    }
+    backend = make_backend(desc);
+    source = {{"bench", desc.backend}, {"bench_file", o.bench}};
+    if (!desc.hardware()) source.update({{"unit", desc.unit}, {"seed", desc.seed}});
+  } else if (o.bench == "virtual") {
     if (!o.replay.empty()) throw InputError("", "--replay", "only with --bench replay", "'" + o.replay + "'");
     bench::BenchOptions bo;
     bo.sample_rate = o.rate;
@@ -75,17 +100,18 @@ int run_rt(const RtOptions& o) {
     source = {{"bench", "replay"}, {"file", o.replay}, {"samples", replay->samples()}};
     backend = std::move(replay);
   } else {
-    throw InputError("", "--bench", "virtual or replay", "'" + o.bench + "'");
+    throw InputError("", "--bench", "virtual, replay or a bench file (.toml)", "'" + o.bench + "'");
   }
 
   rt::LoopOptions lo;
   lo.duration = o.duration;
   lo.realtime = o.realtime;
   lo.priority = o.priority;
+  if (bench_file && !o.fifo) lo.sched_fifo = lo.lock_memory = false;  // --fifo asks for them
   lo.controller = o.controller == "iff";
   lo.gain = o.gain;
-  lo.limits = o.limits;
-  lo.limits.ramp_in = lo.limits.ramp_out = o.ramp;
+  lo.limits = limits;
+  lo.stop = stop_on_sigint();  // Ctrl-C: the output ramps to the safe value, the log is written
   if (!o.log.empty()) lo.log_file = std::filesystem::path(o.log);
   lo.log_settings["command"] = std::string("rt");
   lo.log_settings["bench"] = o.bench;
@@ -161,16 +187,24 @@ int run_rt(const RtOptions& o) {
                 {"stale_sensor_samples", r.stale_sensor_samples},
                 {"va_cmd_min_V", r.va_cmd_min},
                 {"va_cmd_max_V", r.va_cmd_max},
+                {"io",
+                 {{"exchanges", r.io.exchanges},
+                  {"replies", r.io.replies},
+                  {"lost", r.io.lost},
+                  {"late", r.io.late},
+                  {"stale_inputs", r.io.timeouts},
+                  {"errors", r.io.errors},
+                  {"round_trip_us", summary(r.io.round_trip_us)}}},
                 {"max_va_cmd_step_V", r.max_va_cmd_step},
                 {"limits",
-                 {{"actuator", o.limits.actuator},
-                  {"va_min_V", o.limits.va_min},
-                  {"va_max_V", o.limits.va_max},
-                  {"amplifier_gain", o.limits.amplifier_gain},
-                  {"slew_rate_V_per_s", o.limits.slew_rate},
-                  {"ramp_s", o.ramp},
-                  {"watchdog_s", o.limits.watchdog_timeout},
-                  {"stale_cycles", o.limits.stale_cycles}}},
+                 {{"actuator", limits.actuator},
+                  {"va_min_V", limits.va_min},
+                  {"va_max_V", limits.va_max},
+                  {"amplifier_gain", limits.amplifier_gain},
+                  {"slew_rate_V_per_s", limits.slew_rate},
+                  {"ramp_s", limits.ramp_in},
+                  {"watchdog_s", limits.watchdog_timeout},
+                  {"stale_cycles", limits.stale_cycles}}},
                 {"log", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
                 {"logged_samples", r.logged_samples},
                 {"dropped_log_samples", r.dropped_log_samples},
@@ -191,10 +225,15 @@ int run_rt(const RtOptions& o) {
   }
   row("step time", r.step_time_us);
   fmt::print("output: Va commanded {:.2f} .. {:.2f} V (limits {:g} .. {:g} V), largest step {:.3g} V\n", r.va_cmd_min,
-             r.va_cmd_max, o.limits.va_min, o.limits.va_max, r.max_va_cmd_step);
+             r.va_cmd_max, limits.va_min, limits.va_max, r.max_va_cmd_step);
   fmt::print("clamped samples {}   slew-limited samples {}   safe state: {}{}   watchdog trips {}\n", r.clamped_samples,
              r.slew_limited_samples, r.safe_state_reason,
              r.safe_state_cycle >= 0 ? fmt::format(" (cycle {})", r.safe_state_cycle) : std::string(), r.watchdog_trips);
+  if (r.io.exchanges > 0) {
+    fmt::print("I/O: {} exchanges, {} lost, {} late, {} stale inputs, {} errors; round trip p50 {:.1f} us, p99 {:.1f} us\n",
+               r.io.exchanges, r.io.lost, r.io.late, r.io.timeouts, r.io.errors, r.io.round_trip_us.p50,
+               r.io.round_trip_us.p99);
+  }
   if (!o.log.empty()) fmt::print("log: {} ({} samples, {} dropped)\n", o.log, r.logged_samples, r.dropped_log_samples);
   return 0;
 }
@@ -211,7 +250,9 @@ void add_rt_commands(CLI::App& app, Action& action) {
   auto o = std::make_shared<RtOptions>();
   auto realtime = std::make_shared<std::string>("true");
   CLI::App* rt = app.add_subcommand("rt", "Run the IFF loop u = u' + g K(z) Vs in real time on the virtual bench or a replayed record");
-  rt->add_option("--bench", o->bench, "I/O backend: virtual (the virtual bench in lockstep) or replay (a recorded file)")
+  rt->add_option("--bench", o->bench,
+                 "I/O backend: virtual (the virtual bench in lockstep), replay (a recorded file) or a bench file "
+                 "BENCH.toml (udp, comedi: its rate and limits; docs/hardware.md)")
       ->capture_default_str();
   rt->add_option("--controller", o->controller, "iff (eq. 2.4 discretized at the rate) or off (open loop)")->capture_default_str();
   rt->add_option("--gain", o->gain, "IFF gain g")->required();
@@ -226,18 +267,23 @@ void add_rt_commands(CLI::App& app, Action& action) {
   rt->add_option("--replay", o->replay, "replay: the recorded file (.mat or .csv with channels de and Vs)");
   rt->add_option("--realtime", *realtime, "true: paced by absolute deadlines; false: lockstep, as fast as possible")
       ->capture_default_str();
-  rt->add_option("--va-min", o->limits.va_min, "lowest stack voltage, V")->capture_default_str();
-  rt->add_option("--va-max", o->limits.va_max, "highest stack voltage, V")->capture_default_str();
-  rt->add_option("--slew-rate", o->limits.slew_rate, "largest stack-voltage slew rate, V/s")->capture_default_str();
-  rt->add_option("--ramp", o->ramp, "ramp in and out of the gain and output, s")->capture_default_str();
-  rt->add_option("--watchdog", o->limits.watchdog_timeout, "safe state when no cycle completes within this time, s")
-      ->capture_default_str();
+  auto limit_options = std::make_shared<std::vector<CLI::Option*>>();
+  limit_options->push_back(rt->add_option("--va-min", o->limits.va_min, "lowest stack voltage, V")->capture_default_str());
+  limit_options->push_back(rt->add_option("--va-max", o->limits.va_max, "highest stack voltage, V")->capture_default_str());
+  limit_options->push_back(
+      rt->add_option("--slew-rate", o->limits.slew_rate, "largest stack-voltage slew rate, V/s")->capture_default_str());
+  limit_options->push_back(rt->add_option("--ramp", o->ramp, "ramp in and out of the gain and output, s")->capture_default_str());
+  limit_options->push_back(rt->add_option("--watchdog", o->limits.watchdog_timeout,
+                                          "safe state when no cycle completes within this time, s")
+                               ->capture_default_str());
+  rt->add_flag("--fifo", o->fifo, "with a bench file: ask for SCHED_FIFO and mlockall (a message when not permitted)");
   rt->add_option("--priority", o->priority, "SCHED_FIFO priority of the loop thread (when permitted)")
       ->check(CLI::Range(1, 99))
       ->capture_default_str();
   rt->add_flag("--json", o->json, "print one JSON document on stdout");
-  rt->callback([o, realtime, rate, &action] {
+  rt->callback([o, realtime, rate, limit_options, &action] {
     o->rate_given = rate->count() > 0;
+    for (const CLI::Option* opt : *limit_options) o->limits_given = o->limits_given || opt->count() > 0;
     action = [o, realtime] {
       o->realtime = parse_bool(*realtime, "--realtime");
       return run_rt(*o);

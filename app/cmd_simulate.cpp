@@ -1,16 +1,9 @@
 // `piezobench simulate`: one experiment of the report on the virtual bench, written as the
 // measurement file a real bench would give (bench/experiments.hpp, docs/virtual-bench.md).
-#include <fmt/format.h>
-
-#include <cmath>
 #include <memory>
-#include <variant>
 
 #include "cli_common.hpp"
-#include "piezobench/bench/experiments.hpp"
-#include "piezobench/bench/truth.hpp"
-#include "piezobench/core/error.hpp"
-#include "piezobench/io/timeseries.hpp"
+#include "measure_common.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -29,89 +22,26 @@ struct SimulateOptions {
   bool json = false;
 };
 
-nlohmann::json settings_json(const io::TimeSeries& ts) {
-  nlohmann::json s = nlohmann::json::object();
-  for (const auto& [key, value] : ts.settings) {
-    if (const double* d = std::get_if<double>(&value)) {
-      s[key] = *d;
-    } else {
-      s[key] = std::get<std::string>(value);
-    }
-  }
-  return s;
-}
-
-// "experiment options: amplitude: expected ..., found ..." -> "--amplitude: expected ..., found ...":
-// the message names the command-line option the user typed.
-InputError as_option_error(const InputError& e) {
-  const std::string prefix = "experiment options: ";
-  const std::string what = e.what();
-  if (what.rfind(prefix, 0) != 0) return e;
-  return InputError("--" + what.substr(prefix.size()));
-}
-
+// simulate is measure on the virtual bench, with the bench's options from the command line.
 int run_simulate(const SimulateOptions& o) {
-  const bench::Experiment experiment = bench::experiment_from_string(o.experiment);
-  bench::ExperimentOptions eo;
-  if (o.amplitude_option->count() > 0) eo.amplitude = o.amplitude;
-  if (o.duration_option->count() > 0) eo.duration = o.duration;
-  if (o.gain_option->count() > 0) eo.gain = o.gain;
-  if (o.no_delay) eo.bench.delay = 0.0;
-  eo.bench.nonminimum_phase_zero = !o.no_nmp_zero;
-  eo.bench.hysteresis = !o.no_hysteresis;
-  eo.bench.creep = !o.no_creep;
-  eo.bench.noise = !o.no_noise;
-  eo.bench.hpf_resistor = !o.no_resistor;
-  eo.bench.actuator_open_circuit = o.open_circuit;
-  if (!o.superelement.empty()) eo.bench.superelement = o.superelement;
-  try {
-    eo.validate(experiment);
-  } catch (const InputError& e) {
-    throw as_option_error(e);
-  }
-  bench::UnitTruth unit;
-  try {
-    unit = bench::batch_unit(o.unit, o.seed);
-  } catch (const InputError& e) {
-    throw InputError("--" + std::string(e.what()));  // "--unit: expected a unit of the batch, 1 to 7, ..."
-  }
-  const std::string out = o.out.empty() ? fmt::format("{}-unit{}.mat", o.experiment, o.unit) : o.out;
-
-  // Progress for the long runs, every quarter.
-  int quarter = 0;
-  const bench::Progress progress = [&quarter](double fraction) {
-    if (fraction >= 0.25 * (quarter + 1) && fraction < 1.0) {
-      quarter = static_cast<int>(fraction / 0.25);
-      log_line(fmt::format("simulating: {:.0f} %", 100.0 * fraction));
-    }
-  };
-  const bool long_run = eo.duration.value_or(0.0) >= 50.0;
-  io::TimeSeries ts;
-  try {
-    ts = bench::simulate(experiment, unit, eo, o.seed, long_run ? progress : bench::Progress{});
-  } catch (const InputError& e) {
-    throw as_option_error(e);
-  }
-  io::write_timeseries(ts, out);
-  if (!o.json) {
-    fmt::print("wrote {}: {} on unit {}{} ({} samples at {:g} Hz; channels {}{})\n", out, o.experiment, o.unit,
-               unit.defective ? " (defective)" : "", ts.samples(), ts.sample_rate, ts.t.size() > 0 ? "t, " : "",
-               fmt::join(ts.names, ", "));
-    return 0;
-  }
-  nlohmann::json units = nlohmann::json::object();
-  for (std::size_t i = 0; i < ts.names.size(); ++i) units[ts.names[i]] = i < ts.units.size() ? ts.units[i] : "";
-  print_json({{"file", out},
-              {"experiment", o.experiment},
-              {"unit", o.unit},
-              {"seed", o.seed},
-              {"samples", ts.samples()},
-              {"sample_rate_Hz", ts.sample_rate},
-              {"channels", ts.names},
-              {"units", units},
-              {"settings", settings_json(ts)},
-              {"truth", bench::truth_json(unit, eo.bench)}});
-  return 0;
+  MeasureRequest r;
+  r.experiment = o.experiment;
+  if (o.amplitude_option->count() > 0) r.options.amplitude = o.amplitude;
+  if (o.duration_option->count() > 0) r.options.duration = o.duration;
+  if (o.gain_option->count() > 0) r.options.gain = o.gain;
+  if (o.no_delay) r.options.bench.delay = 0.0;
+  r.options.bench.nonminimum_phase_zero = !o.no_nmp_zero;
+  r.options.bench.hysteresis = !o.no_hysteresis;
+  r.options.bench.creep = !o.no_creep;
+  r.options.bench.noise = !o.no_noise;
+  r.options.bench.hpf_resistor = !o.no_resistor;
+  r.options.bench.actuator_open_circuit = o.open_circuit;
+  if (!o.superelement.empty()) r.options.bench.superelement = o.superelement;
+  r.unit = o.unit;
+  r.seed = o.seed;
+  r.out = o.out;
+  r.json = o.json;
+  return run_measurement(r);
 }
 
 }  // namespace

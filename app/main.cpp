@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   piezobench::app::add_model_commands(app, action);
   piezobench::app::add_superelement_commands(app, action);
   piezobench::app::add_simulate_commands(app, action);
+  piezobench::app::add_measure_commands(app, action);
   piezobench::app::add_run_commands(app, action);
 
   try {

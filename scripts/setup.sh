@@ -33,6 +33,8 @@ packages=(
   libeigen3-dev libfftw3-dev libmatio-dev libsuitesparse-dev libspectra-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # Data-acquisition cards through Comedi (the `measure` command's comedi backend).
+  libcomedi-dev
   # An optimized BLAS under CHOLMOD (Debian's alternatives select it): the Craig-Bampton reduction
   # of a 150,000-DOF model takes 31 s of CPU with it and 83 s with the reference BLAS.
   libopenblas0-serial

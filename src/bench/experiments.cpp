@@ -45,9 +45,9 @@ bool uses_duration(Experiment e) {
   return e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
 }
 
-// The settings every record carries.
+// The settings every record carries; `runner` adds where it was made (bench experiments).
 void common_settings(io::TimeSeries& ts, Experiment e, const UnitTruth& unit, const BenchOptions& b, std::uint64_t seed,
-                     const VirtualBench* bench) {
+                     const BenchRunner* runner) {
   ts.settings["experiment"] = to_string(e);
   ts.settings["unit"] = static_cast<double>(unit.id);
   // Seeds up to 2^53 are numbers; larger ones would lose digits as doubles, so they are text.
@@ -57,13 +57,7 @@ void common_settings(io::TimeSeries& ts, Experiment e, const UnitTruth& unit, co
     ts.settings["seed"] = std::to_string(seed);
   }
   ts.settings["defective"] = unit.defective ? 1.0 : 0.0;
-  if (bench != nullptr) {
-    ts.settings["model"] = bench->model_name();
-    if (b.superelement) ts.settings["superelement"] = b.superelement->string();
-    ts.settings["delay_s"] = bench->effective_delay();
-    ts.settings["nmp_zero"] = b.nonminimum_phase_zero ? 1.0 : 0.0;
-    ts.settings["hysteresis"] = b.hysteresis ? 1.0 : 0.0;
-    ts.settings["creep"] = b.creep ? 1.0 : 0.0;
+  if (runner != nullptr) {
     ts.settings["amplifier_gain_V_per_V"] = b.amplifier_gain;
     ts.settings["va_min_V"] = b.va_min;
     ts.settings["va_max_V"] = b.va_max;
@@ -74,6 +68,7 @@ void common_settings(io::TimeSeries& ts, Experiment e, const UnitTruth& unit, co
     ts.settings["actuator_circuit"] = std::string(b.actuator_open_circuit ? "open" : "short");
   }
   ts.settings["noise"] = b.noise ? 1.0 : 0.0;
+  if (runner != nullptr) runner->describe(ts);
 }
 
 io::TimeSeries make_record(const std::vector<std::string>& names, const std::vector<std::string>& units, Eigen::Index rows,
@@ -103,31 +98,6 @@ struct Progressor {
   }
 };
 
-// Runs the bench over the DAC commands u and writes the instruments into the columns of ts
-// (-1: not recorded). Row k holds the instruments at t = k Ts, read before u[k] is applied (row 0:
-// the bench at rest).
-void run_open_loop(VirtualBench& bench, const Eigen::VectorXd& u, io::TimeSeries& ts, Eigen::Index col_de,
-                   Eigen::Index col_vs, Eigen::Index col_va, const Progressor& progress) {
-  const Eigen::Index n = u.size();
-  constexpr Eigen::Index kBlock = 4096;
-  std::vector<BenchSample> block(static_cast<std::size_t>(kBlock));
-  BenchSample m = bench.step(0.0);
-  const auto record = [&](Eigen::Index k, const BenchSample& s) {
-    if (col_de >= 0) ts.data(k, col_de) = s.de;
-    if (col_vs >= 0) ts.data(k, col_vs) = s.vs;
-    if (col_va >= 0) ts.data(k, col_va) = s.va;
-  };
-  if (n > 0) record(0, m);
-  for (Eigen::Index k = 0; k + 1 < n; k += kBlock) {
-    const Eigen::Index count = std::min(kBlock, n - 1 - k);
-    bench.run(std::span<const double>(u.data() + k, static_cast<std::size_t>(count)),
-              std::span<BenchSample>(block.data(), static_cast<std::size_t>(count)));
-    for (Eigen::Index i = 0; i < count; ++i) record(k + 1 + i, block[static_cast<std::size_t>(i)]);
-    progress(k);
-  }
-  progress.done();
-}
-
 // Refuses an excitation whose stack voltage G u leaves [va_min, va_max], naming the limit.
 void check_range(const Eigen::VectorXd& u, const BenchOptions& b, const std::string& what) {
   const double lo = b.amplifier_gain * u.minCoeff();
@@ -145,9 +115,9 @@ std::uint64_t stream(Experiment e, std::uint64_t which) { return 1000 * (static_
 
 // ---------------------------------------------------------------------------------------------
 
-io::TimeSeries stroke(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+io::TimeSeries stroke(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                      const Progress& progress) {
   const BenchOptions& b = o.bench;
-  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kStroke, 0)));
   const double fs = b.sample_rate;
   const double ramp_s = 10.0;  // s for va_min -> va_max
   const double rate = (b.va_max - b.va_min) / ramp_s;
@@ -173,10 +143,8 @@ io::TimeSeries stroke(const UnitTruth& unit, const ExperimentOptions& o, std::ui
     }
     u(k) = va / b.amplifier_gain;
   }
-  io::TimeSeries raw;  // de, Vs, Va at the bench's rate
-  raw.data.resize(n, 3);
-  run_open_loop(bench, u, raw, 0, 1, 2, {progress, n});
-  const Eigen::MatrixXd& y = raw.data;
+  Eigen::MatrixXd y;  // u, Va, de, Vs at the bench's rate
+  runner.open_loop(u, detail::derive_seed(seed, stream(Experiment::kStroke, 0)), y, progress);
   // The displacement probe (Millimar 1318): first-order bandwidth, noise; recorded at 1 kHz.
   const double probe_bw = 2.0;      // Hz
   const double probe_noise = 10e-9;  // m rms
@@ -187,22 +155,31 @@ io::TimeSeries stroke(const UnitTruth& unit, const ExperimentOptions& o, std::ui
   io::TimeSeries ts = make_record({"u", "Va", "de"}, {"V", "V", "m"}, rows, fs / static_cast<double>(decimation), true);
   double probe = 0.0;
   for (Eigen::Index k = 0; k < n; ++k) {
-    probe += a * (y(k, 0) - probe);
+    probe += a * (y(k, 2) - probe);
     if (k % decimation == 0) {
       const Eigen::Index r = k / decimation;
-      ts.data(r, 0) = u(k);
-      ts.data(r, 1) = y(k, 2);
+      ts.data(r, 0) = y(k, 0);
+      ts.data(r, 1) = y(k, 1);
       ts.data(r, 2) = probe + (b.noise ? probe_noise * rng.normal() : 0.0);
     }
   }
-  common_settings(ts, Experiment::kStroke, unit, b, seed, &bench);
+  common_settings(ts, Experiment::kStroke, unit, b, seed, &runner);
   ts.settings["ramp_s"] = ramp_s;
   ts.settings["probe_bandwidth_Hz"] = probe_bw;
   ts.settings["probe_noise_m"] = probe_noise;
   return ts;
 }
 
-io::TimeSeries hysteresis(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+// A record of the open-loop channels u, Va, de (and Vs when `with_vs`) from the runner's columns.
+io::TimeSeries open_loop_record(const Eigen::MatrixXd& y, double fs, bool with_vs) {
+  io::TimeSeries ts = with_vs ? make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, y.rows(), fs, true)
+                              : make_record({"u", "Va", "de"}, {"V", "V", "m"}, y.rows(), fs, true);
+  ts.data = with_vs ? y : Eigen::MatrixXd(y.leftCols(3));
+  return ts;
+}
+
+io::TimeSeries hysteresis(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                          const Progress& progress) {
   const BenchOptions& b = o.bench;
   const double amplitude = o.amplitude.value_or(20.0);
   const double offset = 0.5 * (b.va_min + b.va_max);  // 65 V for -20..150 V
@@ -212,7 +189,6 @@ io::TimeSeries hysteresis(const UnitTruth& unit, const ExperimentOptions& o, std
                                  std::min(offset - b.va_min, b.va_max - offset), offset, b.va_min, b.va_max),
                      fmt::format("{:g} V", amplitude));
   }
-  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kHysteresis, 0)));
   dsp::OffsetSineOptions s;
   s.sample_rate = b.sample_rate;
   s.rest = 0.0;
@@ -223,10 +199,10 @@ io::TimeSeries hysteresis(const UnitTruth& unit, const ExperimentOptions& o, std
   s.ramp_time = 1.0;
   dsp::VoltageBounds bounds{b.va_min / b.amplifier_gain - 1e-9, b.va_max / b.amplifier_gain + 1e-9, dsp::BoundsPolicy::kReject};
   const dsp::Excitation ex = dsp::offset_sine(s, bounds);
-  io::TimeSeries ts = make_record({"u", "Va", "de"}, {"V", "V", "m"}, ex.u.size(), b.sample_rate, true);
-  ts.data.col(0) = ex.u;
-  run_open_loop(bench, ex.u, ts, /*col_de=*/2, /*col_vs=*/-1, /*col_va=*/1, {progress, ex.u.size()});
-  common_settings(ts, Experiment::kHysteresis, unit, b, seed, &bench);
+  Eigen::MatrixXd y;
+  runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kHysteresis, 0)), y, progress);
+  io::TimeSeries ts = open_loop_record(y, b.sample_rate, false);
+  common_settings(ts, Experiment::kHysteresis, unit, b, seed, &runner);
   ts.settings["amplitude_V"] = amplitude;
   ts.settings["offset_V"] = offset;
   ts.settings["frequency_Hz"] = s.frequency;
@@ -235,34 +211,25 @@ io::TimeSeries hysteresis(const UnitTruth& unit, const ExperimentOptions& o, std
   return ts;
 }
 
-io::TimeSeries stiffness(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+io::TimeSeries stiffness(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                         const Progress& progress) {
   const BenchOptions& b = o.bench;
   if (!(b.added_mass > 0.0)) throw InputError(kSource, "bench.added_mass", "a mass > 0 kg for the stiffness test", "0");
-  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kStiffness, 0)));
   const double fs = b.sample_rate;
   const double duration = 20.0, t_on = 3.0, t_off = 13.0, ramp = 0.5;
   const auto n = static_cast<Eigen::Index>(std::llround(duration * fs));
+  const std::vector<OperatorStep> steps = {
+      {t_on, fmt::format("put the {:g} kg mass on the suspended mass", b.added_mass), b.added_mass, ramp},
+      {t_off, fmt::format("take the {:g} kg mass off", b.added_mass), 0.0, ramp}};
+  Eigen::MatrixXd y;
+  const std::vector<double> done =
+      runner.hold(n, steps, detail::derive_seed(seed, stream(Experiment::kStiffness, 0)), y, progress);
   io::TimeSeries ts = make_record({"de", "added_mass"}, {"m", "kg"}, n, fs, true);
-  const auto raised = [](double x) { return 0.5 - 0.5 * std::cos(std::numbers::pi * std::clamp(x, 0.0, 1.0)); };
-  const Progressor p{progress, n};
-  BenchSample m = bench.step(0.0);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) / fs;
-    double fraction = 0.0;
-    if (t >= t_on && t < t_off + ramp) fraction = t < t_off ? raised((t - t_on) / ramp) : 1.0 - raised((t - t_off) / ramp);
-    // The mass rides on the granite from the moment it touches it until it is lifted off.
-    bench.set_added_mass(t >= t_on && t < t_off + ramp ? b.added_mass : 0.0);
-    bench.set_load_fraction(fraction);
-    ts.data(k, 0) = m.de;
-    ts.data(k, 1) = fraction * b.added_mass;
-    m = bench.step(0.0);
-    p(k);
-  }
-  p.done();
-  common_settings(ts, Experiment::kStiffness, unit, b, seed, &bench);
+  ts.data = y;
+  common_settings(ts, Experiment::kStiffness, unit, b, seed, &runner);
   ts.settings["added_mass_kg"] = b.added_mass;
-  ts.settings["t_on_s"] = t_on;
-  ts.settings["t_off_s"] = t_off;
+  ts.settings["t_on_s"] = done.at(0);
+  ts.settings["t_off_s"] = done.at(1);
   ts.settings["ramp_s"] = ramp;
   ts.settings["gravity_m_per_s2"] = b.gravity;
   ts.settings["duration_s"] = duration;
@@ -292,18 +259,18 @@ StackNoise stack_noise(const BenchOptions& b, double duration, double va_rms, st
   return {no, std::move(ex)};
 }
 
-io::TimeSeries frf_noise(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+io::TimeSeries frf_noise(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                         const Progress& progress) {
   const BenchOptions& b = o.bench;
   const double duration = o.duration.value_or(20.0);
   const double va_rms = o.amplitude.value_or(2.0);
   const StackNoise noise = stack_noise(b, duration, va_rms, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 1)));
   const dsp::NoiseOptions& no = noise.options;
   const dsp::Excitation& ex = noise.excitation;
-  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 0)));
-  io::TimeSeries ts = make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, ex.u.size(), b.sample_rate, true);
-  ts.data.col(0) = ex.u;
-  run_open_loop(bench, ex.u, ts, /*col_de=*/2, /*col_vs=*/3, /*col_va=*/1, {progress, ex.u.size()});
-  common_settings(ts, Experiment::kFrfNoise, unit, b, seed, &bench);
+  Eigen::MatrixXd y;
+  runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 0)), y, progress);
+  io::TimeSeries ts = open_loop_record(y, b.sample_rate, true);
+  common_settings(ts, Experiment::kFrfNoise, unit, b, seed, &runner);
   ts.settings["duration_s"] = duration;
   ts.settings["rms_V"] = no.rms;
   ts.settings["va_rms_V"] = va_rms;
@@ -312,7 +279,8 @@ io::TimeSeries frf_noise(const UnitTruth& unit, const ExperimentOptions& o, std:
   return ts;
 }
 
-io::TimeSeries frf_sweep(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+io::TimeSeries frf_sweep(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                         const Progress& progress) {
   const BenchOptions& b = o.bench;
   const double duration = o.duration.value_or(20.0);
   const double va_amplitude = o.amplitude.value_or(1.0);
@@ -332,11 +300,10 @@ io::TimeSeries frf_sweep(const UnitTruth& unit, const ExperimentOptions& o, std:
   so.type = dsp::SweepType::kLogarithmic;
   const dsp::Excitation ex = dsp::sine_sweep(so, {-1e300, 1e300, dsp::BoundsPolicy::kReject});
   check_range(ex.u, b, fmt::format("a sweep of {:g} V amplitude at the stacks", va_amplitude));
-  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kFrfSweep, 0)));
-  io::TimeSeries ts = make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, ex.u.size(), b.sample_rate, true);
-  ts.data.col(0) = ex.u;
-  run_open_loop(bench, ex.u, ts, /*col_de=*/2, /*col_vs=*/3, /*col_va=*/1, {progress, ex.u.size()});
-  common_settings(ts, Experiment::kFrfSweep, unit, b, seed, &bench);
+  Eigen::MatrixXd y;
+  runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kFrfSweep, 0)), y, progress);
+  io::TimeSeries ts = open_loop_record(y, b.sample_rate, true);
+  common_settings(ts, Experiment::kFrfSweep, unit, b, seed, &runner);
   ts.settings["duration_s"] = duration;
   ts.settings["f0_Hz"] = so.f_start;
   ts.settings["f1_Hz"] = so.f_end;
@@ -346,7 +313,8 @@ io::TimeSeries frf_sweep(const UnitTruth& unit, const ExperimentOptions& o, std:
   return ts;
 }
 
-io::TimeSeries iff(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
+io::TimeSeries iff(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                   const Progress& progress) {
   const BenchOptions& b = o.bench;
   const double duration = o.duration.value_or(10.0);
   const double va_rms = o.amplitude.value_or(2.0);
@@ -354,35 +322,13 @@ io::TimeSeries iff(const UnitTruth& unit, const ExperimentOptions& o, std::uint6
   const StackNoise noise = stack_noise(b, duration, va_rms, detail::derive_seed(seed, stream(Experiment::kIff, 1)));
   const dsp::NoiseOptions& no = noise.options;
   const dsp::Excitation& ex = noise.excitation;
-  VirtualBench bench(unit, b, detail::derive_seed(seed, stream(Experiment::kIff, 0)));
-  control::DiscreteIffOptions co;
-  co.sample_rate = b.sample_rate;
-  control::DiscreteIff controller(control::IffControllerParams{}, co, gain);
-  // The real-time target's safety clamp: u stays inside the stack range seen at the DAC.
-  const double u_min = b.va_min / b.amplifier_gain, u_max = b.va_max / b.amplifier_gain;
   const Eigen::Index n = ex.u.size();
+  Eigen::MatrixXd y;
+  const std::uint64_t clamped = runner.iff(ex.u, gain, detail::derive_seed(seed, stream(Experiment::kIff, 0)), y, progress);
   io::TimeSeries ts = make_record({"u_prime", "u", "Va", "de", "Vs"}, {"V", "V", "V", "m", "V"}, n, b.sample_rate, true);
-  const Progressor p{progress, n};
-  BenchSample m = bench.step(0.0);
-  Eigen::Index clamped = 0;
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double y = controller.step(m.vs);
-    double u = ex.u(k) + y;
-    if (u < u_min || u > u_max) {
-      u = std::clamp(u, u_min, u_max);
-      controller.applied(u - ex.u(k));
-      ++clamped;
-    }
-    ts.data(k, 0) = ex.u(k);
-    ts.data(k, 1) = u;
-    ts.data(k, 2) = m.va;
-    ts.data(k, 3) = m.de;
-    ts.data(k, 4) = m.vs;
-    m = bench.step(u);
-    p(k);
-  }
-  p.done();
-  common_settings(ts, Experiment::kIff, unit, b, seed, &bench);
+  ts.data.col(0) = ex.u;
+  ts.data.rightCols(4) = y;
+  common_settings(ts, Experiment::kIff, unit, b, seed, &runner);
   ts.settings["gain"] = gain;
   ts.settings["duration_s"] = duration;
   ts.settings["rms_V"] = no.rms;
@@ -483,6 +429,149 @@ io::TimeSeries capacitance(const UnitTruth& unit, const ExperimentOptions& o, st
 
 }  // namespace
 
+VirtualRunner::VirtualRunner(const UnitTruth& unit, const BenchOptions& options) : unit_(unit), options_(options) {}
+VirtualRunner::~VirtualRunner() = default;
+
+VirtualBench& VirtualRunner::bench(std::uint64_t seed) {
+  bench_ = std::make_unique<VirtualBench>(unit_, options_, seed);
+  return *bench_;
+}
+
+void VirtualRunner::open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) {
+  VirtualBench& b = bench(seed);
+  const Eigen::Index n = u.size();
+  out.resize(n, 4);
+  out.col(0) = u;
+  const Progressor p{progress, n};
+  constexpr Eigen::Index kBlock = 4096;
+  std::vector<BenchSample> block(static_cast<std::size_t>(kBlock));
+  const auto record = [&](Eigen::Index k, const BenchSample& s) {
+    out(k, 1) = s.va;
+    out(k, 2) = s.de;
+    out(k, 3) = s.vs;
+  };
+  const BenchSample rest = b.step(0.0);
+  if (n > 0) record(0, rest);
+  for (Eigen::Index k = 0; k + 1 < n; k += kBlock) {
+    const Eigen::Index count = std::min(kBlock, n - 1 - k);
+    b.run(std::span<const double>(u.data() + k, static_cast<std::size_t>(count)),
+          std::span<BenchSample>(block.data(), static_cast<std::size_t>(count)));
+    for (Eigen::Index i = 0; i < count; ++i) record(k + 1 + i, block[static_cast<std::size_t>(i)]);
+    p(k);
+  }
+  p.done();
+}
+
+std::uint64_t VirtualRunner::iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
+                                 const Progress& progress) {
+  VirtualBench& b = bench(seed);
+  control::DiscreteIffOptions co;
+  co.sample_rate = options_.sample_rate;
+  control::DiscreteIff controller(control::IffControllerParams{}, co, gain);
+  // The real-time target's safety clamp: u stays inside the stack range seen at the DAC.
+  const double u_min = options_.va_min / options_.amplifier_gain, u_max = options_.va_max / options_.amplifier_gain;
+  const Eigen::Index n = u_prime.size();
+  out.resize(n, 4);
+  const Progressor p{progress, n};
+  BenchSample m = b.step(0.0);
+  std::uint64_t clamped = 0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double y = controller.step(m.vs);
+    double u = u_prime(k) + y;
+    if (u < u_min || u > u_max) {
+      u = std::clamp(u, u_min, u_max);
+      controller.applied(u - u_prime(k));
+      ++clamped;
+    }
+    out(k, 0) = u;
+    out(k, 1) = m.va;
+    out(k, 2) = m.de;
+    out(k, 3) = m.vs;
+    m = b.step(u);
+    p(k);
+  }
+  p.done();
+  return clamped;
+}
+
+std::vector<double> VirtualRunner::hold(Eigen::Index n, const std::vector<OperatorStep>& steps, std::uint64_t seed,
+                                        Eigen::MatrixXd& out, const Progress& progress) {
+  VirtualBench& b = bench(seed);
+  const double fs = options_.sample_rate;
+  out.resize(n, 2);
+  // The virtual operator lowers (lifts) the weight with a raised cosine over each step's ramp; the
+  // mass rides on the bench from the moment it touches it until it is lifted off.
+  const auto raised = [](double x) { return 0.5 - 0.5 * std::cos(std::numbers::pi * std::clamp(x, 0.0, 1.0)); };
+  const Progressor p{progress, n};
+  BenchSample m = b.step(0.0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / fs;
+    double mass = 0.0, fraction = 0.0, before = 0.0;
+    for (const OperatorStep& s : steps) {
+      if (t < s.t) break;
+      const double x = s.ramp > 0.0 ? (t - s.t) / s.ramp : 1.0;
+      if (s.added_mass > 0.0) {
+        mass = s.added_mass;
+        fraction = raised(x);
+      } else {
+        mass = x < 1.0 ? before : 0.0;
+        fraction = x < 1.0 ? 1.0 - raised(x) : 0.0;
+      }
+      before = s.added_mass;
+    }
+    b.set_added_mass(mass);
+    b.set_load_fraction(fraction);
+    out(k, 0) = m.de;
+    out(k, 1) = fraction * mass;
+    m = b.step(0.0);
+    p(k);
+  }
+  p.done();
+  std::vector<double> done;
+  for (const OperatorStep& s : steps) done.push_back(s.t);
+  return done;
+}
+
+void VirtualRunner::describe(io::TimeSeries& ts) const {
+  if (!bench_) return;
+  ts.settings["model"] = bench_->model_name();
+  if (options_.superelement) ts.settings["superelement"] = options_.superelement->string();
+  ts.settings["delay_s"] = bench_->effective_delay();
+  ts.settings["nmp_zero"] = options_.nonminimum_phase_zero ? 1.0 : 0.0;
+  ts.settings["hysteresis"] = options_.hysteresis ? 1.0 : 0.0;
+  ts.settings["creep"] = options_.creep ? 1.0 : 0.0;
+}
+
+bool runs_on_bench(Experiment e) {
+  return e == Experiment::kStroke || e == Experiment::kHysteresis || e == Experiment::kStiffness ||
+         e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
+}
+
+io::TimeSeries run_experiment(Experiment experiment, BenchRunner& runner, const UnitTruth& unit,
+                              const ExperimentOptions& options, std::uint64_t seed, const Progress& progress) {
+  options.validate(experiment);
+  std::vector<std::string> setup;
+  if (options.bench.actuator_open_circuit) setup.emplace_back("disconnect the amplifier from the actuator stacks (open circuit)");
+  if (!options.bench.hpf_resistor) {
+    setup.push_back(fmt::format("take the {:g} kOhm resistor off the sensor stack", options.bench.hpf_resistance / 1e3));
+  }
+  if (!setup.empty() && runs_on_bench(experiment)) runner.prepare(setup);
+  io::TimeSeries ts;
+  switch (experiment) {
+    case Experiment::kStroke: ts = stroke(runner, unit, options, seed, progress); break;
+    case Experiment::kHysteresis: ts = hysteresis(runner, unit, options, seed, progress); break;
+    case Experiment::kStiffness: ts = stiffness(runner, unit, options, seed, progress); break;
+    case Experiment::kFrfNoise: ts = frf_noise(runner, unit, options, seed, progress); break;
+    case Experiment::kFrfSweep: ts = frf_sweep(runner, unit, options, seed, progress); break;
+    case Experiment::kIff: ts = iff(runner, unit, options, seed, progress); break;
+    default:
+      throw InputError("", "experiment", "an experiment that runs on the bench (stroke, hysteresis, stiffness, frf-noise, "
+                       "frf-sweep, iff)", "'" + to_string(experiment) + "'");
+  }
+  ts.validate();
+  return ts;
+}
+
 std::string to_string(Experiment e) {
   for (const Named& n : kNames) {
     if (n.e == e) return n.name;
@@ -536,17 +625,16 @@ io::TimeSeries simulate(Experiment experiment, const UnitTruth& unit, const Expe
                         const Progress& progress) {
   options.validate(experiment);
   unit.validate();
+  if (runs_on_bench(experiment)) {
+    VirtualRunner runner(unit, options.bench);
+    return run_experiment(experiment, runner, unit, options, seed, progress);
+  }
   io::TimeSeries ts;
   switch (experiment) {
-    case Experiment::kStroke: ts = stroke(unit, options, seed, progress); break;
-    case Experiment::kHysteresis: ts = hysteresis(unit, options, seed, progress); break;
-    case Experiment::kStiffness: ts = stiffness(unit, options, seed, progress); break;
-    case Experiment::kFrfNoise: ts = frf_noise(unit, options, seed, progress); break;
-    case Experiment::kFrfSweep: ts = frf_sweep(unit, options, seed, progress); break;
-    case Experiment::kIff: ts = iff(unit, options, seed, progress); break;
     case Experiment::kHammer: ts = hammer(unit, options, seed, progress); break;
     case Experiment::kFlatness: ts = flatness(unit, options, seed); break;
     case Experiment::kCapacitance: ts = capacitance(unit, options, seed); break;
+    default: break;
   }
   ts.validate();
   return ts;

@@ -110,6 +110,8 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
   if (!started_ || finished_) return false;
   const double u_safe = guard_.limits().u_safe();
   const double amp = guard_.limits().amplifier_gain;
+  // A stop request ends the run once the safe state has brought the output to the safe value.
+  if (stopping_ && guard_.last_output() == u_safe) total_cycles_ = std::min(total_cycles_, cycle_);
   if (cycle_ >= total_cycles_ || backend_.finished()) {
     // Wind-down: bring the output to the safe value at the slew limit (the ramp out normally
     // ends there already; not after an early end of the backend or a trip mid-slew).
@@ -141,6 +143,10 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
     if (late && !shared_->watchdog.exchange(true, std::memory_order_acq_rel)) {
       shared_->watchdog_trips.fetch_add(1, std::memory_order_relaxed);
     }
+  }
+  if (options_.stop != nullptr && options_.stop->load(std::memory_order_relaxed)) {
+    stopping_ = true;
+    if (fault == Fault::kNone) fault = Fault::kInterrupted;
   }
   if (fault != Fault::kNone && !guard_.safe_state()) {
     guard_.trip(fault, cycle_);
@@ -245,6 +251,8 @@ LoopReport Loop::finish() {
   rep.nonfinite_sensor_samples = guard_.nonfinite_samples();
   rep.stale_sensor_samples = guard_.stale_samples();
   rep.watchdog_trips = shared_->watchdog_trips.load();
+  rep.interrupted = stopping_;
+  rep.io = backend_.io_stats();
   rep.va_cmd_min = va_cmd_min_;
   rep.va_cmd_max = va_cmd_max_;
   rep.max_va_cmd_step = max_step_;

@@ -24,6 +24,8 @@ std::string to_string(Fault fault) {
       return "watchdog";
     case Fault::kNonFiniteController:
       return "non-finite controller output";
+    case Fault::kInterrupted:
+      return "interrupted";
   }
   return "unknown";
 }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <random>
 
@@ -221,6 +222,36 @@ TEST(Loop, NonFiniteSensorSampleEntersTheSafeState) {
   EXPECT_EQ(log.channel("Vs")(500), 0.0);
   EXPECT_TRUE(log.data.allFinite());
   EXPECT_EQ(static_cast<unsigned>(flags(499)) & kFlagSafeState, 0u);
+}
+
+TEST(Loop, AStopRequestRampsToTheSafeOutputAndEndsTheRun) {
+  FakeBackend backend(discrete_plant(), kFs);
+  std::atomic<bool> stop{false};
+  LoopOptions o = lockstep_options(0.1);
+  o.controller = false;
+  o.excitation = Eigen::VectorXd::Constant(1, 2.0);  // 40 V at the stacks when Ctrl-C comes
+  o.limits.ramp_in = 0.0;
+  o.limits.ramp_out = 0.0;
+  o.limits.slew_rate = 4e4;                          // 0.2 V per sample at the DAC: 10 cycles
+  o.stop = &stop;
+  Loop loop(backend, o);
+  loop.start();
+  for (int k = 0; k < 300; ++k) ASSERT_TRUE(loop.cycle());
+  stop = true;  // what the SIGINT handler does
+  int more = 0;
+  while (loop.cycle()) ++more;
+  const LoopReport rep = loop.finish();
+  EXPECT_TRUE(rep.interrupted);
+  EXPECT_EQ(rep.safe_state_reason, "interrupted");
+  EXPECT_EQ(rep.safe_state_cycle, 300);
+  // 2 V at 0.2 V per cycle (one more for the round-off of ten steps), then the run ends.
+  EXPECT_GE(more, 10);
+  EXPECT_LE(more, 11);
+  const io::TimeSeries& log = loop.log();
+  ASSERT_EQ(log.samples(), 300 + more);  // every cycle up to the end, the ramp included
+  EXPECT_NEAR(log.channel("u")(299), 2.0, 1e-12);
+  EXPECT_NEAR(log.channel("u")(300), 1.8, 1e-12);
+  EXPECT_EQ(log.channel("u")(299 + more), 0.0);
 }
 
 TEST(Loop, StaleSensorEntersTheSafeStateAfterTheToleratedReads) {

@@ -45,6 +45,7 @@
 //                                 +-accuracy_relative. Settings: frequency_Hz, accuracy_relative.
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -78,6 +79,71 @@ struct ExperimentOptions {
 
 // Progress in [0, 1], called from the simulating thread now and then (may be empty).
 using Progress = std::function<void(double)>;
+
+// Where the bench experiments (stroke, hysteresis, stiffness, frf-noise, frf-sweep, iff) run: each
+// experiment is defined once, as commands for these primitives and the record made of what they
+// measure; VirtualRunner runs them on the virtual bench, rt::BackendRunner on any rt backend (a
+// DAQ card, a remote I/O target: `piezobench measure`). Every primitive fills `out` with one row per
+// sample at the bench's rate, row k holding the instruments at t = k / fs read before the k-th
+// command is applied (row 0: the bench at rest). `seed` seeds the virtual bench's noise (ignored
+// by real hardware).
+struct OperatorStep {
+  double t = 0.0;           // s from the start of the record: when the operator is asked
+  std::string prompt;       // what the operator is asked to do ("put the 6.4 kg mass on ...")
+  double added_mass = 0.0;  // kg on the bench once the step is done (0: taken off)
+  double ramp = 0.0;        // s the virtual operator takes to lower or lift the weight
+};
+
+class BenchRunner {
+ public:
+  virtual ~BenchRunner() = default;
+  // Open loop with the DAC commands u (V): out is n x 4, columns u (applied), Va, de, Vs.
+  virtual void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) = 0;
+  // IFF closed loop u = u' + g K0 Vs (report's controller, control::DiscreteIff), u clamped to the
+  // stack range: out is n x 4, columns u, Va, de, Vs. Returns the number of clamped samples.
+  virtual std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
+                            const Progress& progress) = 0;
+  // u = 0 for n samples while the operator carries out `steps` (in order): out is n x 2, columns
+  // de, added_mass (kg carried, the operator's log). Returns when each step took effect (s).
+  virtual std::vector<double> hold(Eigen::Index n, const std::vector<OperatorStep>& steps, std::uint64_t seed,
+                                   Eigen::MatrixXd& out, const Progress& progress) = 0;
+  // Adds the settings that say where the record was made (bench model, delay; backend, device).
+  virtual void describe(io::TimeSeries& record) const = 0;
+  // Operator steps before the record starts, with nothing moving (disconnect the amplifier for the
+  // open-circuit test, take the resistor off the sensor stack): a real bench asks and waits for the
+  // confirmation; the virtual bench has them in its options already (default: nothing to do).
+  virtual void prepare(const std::vector<std::string>& steps) { (void)steps; }
+};
+
+// The virtual bench of `unit` with `options` (a fresh bench, seeded per primitive, for each call).
+class VirtualRunner final : public BenchRunner {
+ public:
+  VirtualRunner(const UnitTruth& unit, const BenchOptions& options);
+  ~VirtualRunner() override;
+  void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) override;
+  std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
+                    const Progress& progress) override;
+  std::vector<double> hold(Eigen::Index n, const std::vector<OperatorStep>& steps, std::uint64_t seed, Eigen::MatrixXd& out,
+                           const Progress& progress) override;
+  void describe(io::TimeSeries& record) const override;
+
+ private:
+  VirtualBench& bench(std::uint64_t seed);
+  UnitTruth unit_;
+  BenchOptions options_;
+  std::unique_ptr<VirtualBench> bench_;
+};
+
+// True for the experiments that run on the bench (a BenchRunner): stroke, hysteresis, stiffness,
+// frf-noise, frf-sweep, iff.
+bool runs_on_bench(Experiment experiment);
+
+// Runs one bench experiment (runs_on_bench) through `runner` and returns its record: the same
+// channels, units and settings whatever the runner. options.bench gives the rates, the amplifier
+// gain and the stack range; `unit` and `seed` are recorded. InputError for bad options or an
+// experiment that does not run on a bench.
+io::TimeSeries run_experiment(Experiment experiment, BenchRunner& runner, const UnitTruth& unit,
+                              const ExperimentOptions& options, std::uint64_t seed, const Progress& progress = {});
 
 // Runs one experiment on `unit` and returns its record. The same (experiment, unit, options, seed)
 // gives the same record. InputError for bad options.

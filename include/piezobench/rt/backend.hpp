@@ -13,6 +13,8 @@
 #include <limits>
 #include <string>
 
+#include "piezobench/rt/timing.hpp"
+
 namespace piezobench::rt {
 
 // One acquisition.
@@ -38,6 +40,18 @@ enum class ClockSource {
   kBackendSampleClock,
 };
 std::string to_string(ClockSource source);  // "host-monotonic", "backend-sample-clock"
+
+// The I/O health of a backend that talks to a device over a link (udp, comedi): what the loop's
+// report and `piezobench measure --json` show next to the safety counts.
+struct IoStats {
+  std::uint64_t exchanges = 0;   // I/O transactions started (datagrams sent, instruction lists run)
+  std::uint64_t replies = 0;     // answered in time
+  std::uint64_t late = 0;        // answered after the cycle had given up on them (stale input)
+  std::uint64_t lost = 0;        // never answered (counted when the backend stops)
+  std::uint64_t timeouts = 0;    // reads that returned no fresh sample in time (stale inputs)
+  std::uint64_t errors = 0;      // device errors (each one also trips the safe state)
+  TimingSummary round_trip_us;   // request -> reply (udp) or instruction list (comedi) time
+};
 
 class Backend {
  public:
@@ -69,6 +83,8 @@ class Backend {
   // Must be thread-safe and async-signal-safe in spirit (no allocation, no lock). Default: nothing
   // (the simulated backends have no output that can go on moving while the loop is stalled).
   virtual void on_watchdog() noexcept {}
+  // I/O health since start() (valid after stop()); zeros for the backends without a link.
+  [[nodiscard]] virtual IoStats io_stats() const { return {}; }
 };
 
 }  // namespace piezobench::rt

@@ -24,6 +24,7 @@
 //    time, and by a watchdog thread that calls Backend::on_watchdog() when the loop is stuck) sets
 //    the output to the safe value at the slew limit and resets the controller; the loop keeps
 //    running (and timing) to the end of the run with the safe output.
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -64,6 +65,11 @@ struct LoopOptions {
   // 10 kHz); records beyond are dropped and counted in dropped_log_samples.
   std::size_t max_log_samples = 3'000'000;
   std::map<std::string, io::Setting> log_settings;  // added to the log file's settings
+  // Stop request (Ctrl-C; set from a signal handler): the loop enters its safe state (reason
+  // "interrupted"), brings the output to the safe value at the slew limit (at most
+  // max(|va_max|, |va_min|) / slew_rate + one period: 1.5 ms for the APA300ML) and ends the run
+  // there; the log holds every cycle up to that moment. Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
   // Called (on the setup path, never inside a cycle) with each warning as it arises, e.g. to print
   // it on stderr at once; the warnings are also returned in LoopReport::warnings.
   std::function<void(const std::string&)> on_warning;
@@ -93,6 +99,8 @@ struct LoopReport {
   std::uint64_t nonfinite_sensor_samples = 0;
   std::uint64_t stale_sensor_samples = 0;
   std::uint64_t watchdog_trips = 0;
+  bool interrupted = false;                // the run was ended by LoopOptions::stop
+  IoStats io;                              // the backend's I/O health (Backend::io_stats)
   std::uint64_t logged_samples = 0;
   std::uint64_t dropped_log_samples = 0;
   double va_cmd_min = 0.0, va_cmd_max = 0.0;  // V, extremes of the commanded stack voltage
@@ -153,7 +161,7 @@ class Loop {
   std::int64_t last_end_ns_ = 0;
   double va_cmd_min_ = 0.0, va_cmd_max_ = 0.0, max_step_ = 0.0, last_va_cmd_ = 0.0;
   std::int64_t period_ns_ = 0, watchdog_ns_ = 0;
-  bool started_ = false, finished_ = false;
+  bool started_ = false, finished_ = false, stopping_ = false;
   io::TimeSeries log_;
   std::vector<std::string> warnings_;
 };

@@ -57,6 +57,7 @@ enum class Fault : std::uint8_t {
   kStaleSensor,          // no fresh sample for more than stale_cycles reads
   kWatchdog,             // the loop did not complete a cycle within watchdog_timeout
   kNonFiniteController,  // the controller's output overflowed
+  kInterrupted,          // a stop was requested (Ctrl-C)
 };
 std::string to_string(Fault fault);  // "none", "non-finite sensor", "stale sensor", "watchdog", ...
 

@@ -1,0 +1,318 @@
+// `piezobench measure`: one experiment of the report on the bench a bench file describes (the
+// virtual bench, a Comedi card, a UDP I/O target), written as the same measurement file `simulate`
+// writes; `piezobench bench serve`: the virtual bench behind the UDP protocol (docs/hardware.md).
+#include <fmt/format.h>
+
+#include <csignal>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <variant>
+
+#include "cli_common.hpp"
+#include "measure_common.hpp"
+#include "piezobench/bench/truth.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/io/timeseries.hpp"
+#include "piezobench/rt/comedi_backend.hpp"
+#include "piezobench/rt/measure.hpp"
+#include "piezobench/rt/udp.hpp"
+#include "piezobench/rt/virtual_backend.hpp"
+
+namespace piezobench::app {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_sigint(int) { g_stop.store(true); }
+
+nlohmann::json settings_json(const io::TimeSeries& ts) {
+  nlohmann::json s = nlohmann::json::object();
+  for (const auto& [key, value] : ts.settings) {
+    if (const double* d = std::get_if<double>(&value)) {
+      s[key] = *d;
+    } else {
+      s[key] = std::get<std::string>(value);
+    }
+  }
+  return s;
+}
+
+// "experiment options: amplitude: expected ..., found ..." -> "--amplitude: expected ..., found ...":
+// the message names the command-line option the user typed.
+InputError as_option_error(const InputError& e) {
+  const std::string prefix = "experiment options: ";
+  const std::string what = e.what();
+  if (what.rfind(prefix, 0) != 0) return e;
+  return InputError("--" + what.substr(prefix.size()));
+}
+
+nlohmann::json timing_json(const rt::TimingSummary& s) { return {{"p50", s.p50}, {"p99", s.p99}, {"max", s.max}, {"count", s.count}}; }
+
+}  // namespace
+
+const std::atomic<bool>* stop_on_sigint() {
+  g_stop.store(false);
+  std::signal(SIGINT, on_sigint);
+  std::signal(SIGTERM, on_sigint);
+  return &g_stop;
+}
+
+std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& b) {
+  if (b.backend == "udp") return std::make_unique<rt::UdpBackend>(b.udp_address, b.sample_rate, b.udp_timeout);
+  if (b.backend == "comedi") return std::make_unique<rt::ComediBackend>(b);
+  return std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(b.unit, b.seed), rt::bench_options(b), b.seed);
+}
+
+int run_measurement(const MeasureRequest& r) {
+  const bench::Experiment experiment = bench::experiment_from_string(r.experiment);
+  bench::ExperimentOptions eo = r.options;
+  try {
+    eo.validate(experiment);
+  } catch (const InputError& e) {
+    throw as_option_error(e);
+  }
+  const bool hardware = r.bench && r.bench->hardware();
+  bench::UnitTruth unit;
+  if (hardware) {
+    if (r.unit < 1) throw InputError("", "--unit", "the number of the unit under test (>= 1)", std::to_string(r.unit));
+    unit.id = r.unit;  // a real unit: only its number is known
+  } else {
+    try {
+      unit = bench::batch_unit(r.unit, r.seed);
+    } catch (const InputError& e) {
+      throw InputError("--" + std::string(e.what()));  // "--unit: expected a unit of the batch, 1 to 7, ..."
+    }
+  }
+  const std::string out = r.out.empty() ? fmt::format("{}-unit{}.mat", r.experiment, r.unit) : r.out;
+
+  // Progress for the long simulations, every quarter.
+  int quarter = 0;
+  const bench::Progress progress = [&quarter](double fraction) {
+    if (fraction >= 0.25 * (quarter + 1) && fraction < 1.0) {
+      quarter = static_cast<int>(fraction / 0.25);
+      log_line(fmt::format("simulating: {:.0f} %", 100.0 * fraction));
+    }
+  };
+  io::TimeSeries ts;
+  std::unique_ptr<rt::Backend> backend;
+  std::unique_ptr<rt::BackendRunner> runner;
+  if (!hardware) {
+    const bool long_run = eo.duration.value_or(0.0) >= 50.0;
+    try {
+      ts = bench::simulate(experiment, unit, eo, r.seed, long_run ? progress : bench::Progress{});
+    } catch (const InputError& e) {
+      throw as_option_error(e);
+    }
+  } else {
+    if (!bench::runs_on_bench(experiment)) {
+      throw InputError("", "experiment",
+                       "an experiment that runs on the bench's I/O (stroke, hysteresis, stiffness, frf-noise, frf-sweep, "
+                       "iff); record " + r.experiment + " with its own instruments and give the file to `piezobench run`",
+                       "'" + r.experiment + "'");
+    }
+    backend = make_backend(*r.bench);
+    rt::MeasureOptions mo;
+    mo.bench = *r.bench;
+    mo.realtime_priority = r.realtime;
+    mo.stop = stop_on_sigint();
+    if (!r.log.empty()) mo.raw_log = r.log;
+    mo.on_warning = [](const std::string& w) { log_line("warning: " + w); };
+    runner = std::make_unique<rt::BackendRunner>(*backend, mo);
+    log_line(fmt::format("measure: {} on unit {} through the {} backend ({}), {:g} Hz", r.experiment, r.unit,
+                         backend->name(), r.bench->source, r.bench->sample_rate));
+    try {
+      ts = bench::run_experiment(experiment, *runner, unit, eo, r.seed);
+    } catch (const InputError& e) {
+      throw as_option_error(e);
+    }
+  }
+  io::write_timeseries(ts, out);
+  if (!r.json) {
+    fmt::print("wrote {}: {} on unit {}{} ({} samples at {:g} Hz; channels {}{})\n", out, r.experiment, r.unit,
+               unit.defective ? " (defective)" : "", ts.samples(), ts.sample_rate, ts.t.size() > 0 ? "t, " : "",
+               fmt::join(ts.names, ", "));
+    if (runner) {
+      const rt::IoStats io = runner->report().io();
+      fmt::print("I/O: {} exchanges, {} lost, {} late, {} stale inputs, {} errors; round trip p50 {:.1f} us, p99 {:.1f} us\n",
+                 io.exchanges, io.lost, io.late, io.timeouts, io.errors, io.round_trip_us.p50, io.round_trip_us.p99);
+    }
+    return 0;
+  }
+  nlohmann::json units = nlohmann::json::object();
+  for (std::size_t i = 0; i < ts.names.size(); ++i) units[ts.names[i]] = i < ts.units.size() ? ts.units[i] : "";
+  nlohmann::json doc = {{"file", out},
+                        {"experiment", r.experiment},
+                        {"unit", r.unit},
+                        {"seed", r.seed},
+                        {"samples", ts.samples()},
+                        {"sample_rate_Hz", ts.sample_rate},
+                        {"channels", ts.names},
+                        {"units", units},
+                        {"settings", settings_json(ts)}};
+  if (!hardware) {
+    doc["truth"] = bench::truth_json(unit, eo.bench);
+  } else {
+    const rt::MeasureReport& rep = runner->report();
+    const rt::IoStats io = rep.io();
+    doc["backend"] = backend->name();
+    doc["bench_file"] = r.bench->source;
+    doc["cycles"] = rep.cycles();
+    doc["io"] = {{"exchanges", io.exchanges}, {"replies", io.replies}, {"lost", io.lost},       {"late", io.late},
+                 {"stale_inputs", io.timeouts}, {"errors", io.errors}, {"round_trip_us", timing_json(io.round_trip_us)}};
+    nlohmann::json runs = nlohmann::json::array();
+    for (const rt::LoopReport& lr : rep.runs) {
+      runs.push_back({{"cycles", lr.cycles},
+                      {"overruns", lr.overruns},
+                      {"skipped_deadlines", lr.skipped_deadlines},
+                      {"clamped_samples", lr.clamped_samples},
+                      {"slew_limited_samples", lr.slew_limited_samples},
+                      {"stale_sensor_samples", lr.stale_sensor_samples},
+                      {"safe_state_reason", lr.safe_state_reason},
+                      {"sched_fifo", lr.sched_fifo},
+                      {"memory_locked", lr.memory_locked},
+                      {"step_time_us", timing_json(lr.step_time_us)},
+                      {"warnings", lr.warnings}});
+    }
+    doc["runs"] = runs;
+    nlohmann::json steps = nlohmann::json::array();
+    for (const rt::OperatorConfirmation& c : rep.operator_steps) {
+      steps.push_back({{"prompt", c.prompt}, {"asked_s", c.asked_s}, {"confirmed_s", c.confirmed_s}});
+    }
+    doc["operator_steps"] = steps;
+  }
+  print_json(doc);
+  return 0;
+}
+
+namespace {
+
+struct MeasureCli {
+  std::string experiment, bench, out, log;
+  int unit = 1;
+  std::uint64_t seed = 1;
+  double amplitude = 0.0, duration = 0.0, gain = 0.0;
+  CLI::Option *amplitude_option = nullptr, *duration_option = nullptr, *gain_option = nullptr, *seed_option = nullptr,
+              *unit_option = nullptr;
+  bool realtime = false, json = false, open_circuit = false, no_resistor = false;
+};
+
+int run_measure(const MeasureCli& o) {
+  MeasureRequest r;
+  r.experiment = o.experiment;
+  const rt::BenchDescription desc = rt::read_bench_file(o.bench);
+  r.options.bench = rt::bench_options(desc);
+  if (o.amplitude_option->count() > 0) r.options.amplitude = o.amplitude;
+  if (o.duration_option->count() > 0) r.options.duration = o.duration;
+  if (o.gain_option->count() > 0) r.options.gain = o.gain;
+  r.options.bench.actuator_open_circuit = o.open_circuit;
+  r.options.bench.hpf_resistor = !o.no_resistor;
+  r.unit = o.unit_option->count() > 0 || desc.hardware() ? o.unit : desc.unit;
+  r.seed = o.seed_option->count() > 0 || desc.hardware() ? o.seed : desc.seed;
+  r.out = o.out;
+  r.json = o.json;
+  r.realtime = o.realtime;
+  r.log = o.log;
+  if (desc.hardware()) {
+    r.bench = desc;
+  } else if (o.realtime || !o.log.empty()) {
+    throw InputError(o.bench, "bench.backend", "a hardware backend (udp or comedi) for --realtime and --log",
+                     "virtual (simulated, not paced)");
+  }
+  return run_measurement(r);
+}
+
+struct ServeCli {
+  std::string udp = "127.0.0.1:5600";
+  int unit = 1;
+  std::uint64_t seed = 1;
+  double rate = 10e3;
+  int sessions = 0;
+  double idle_timeout = 60.0;
+  std::uint64_t drop_every = 0;
+  bool json = false;
+};
+
+int run_serve(const ServeCli& o) {
+  bench::BenchOptions bo;
+  bo.sample_rate = o.rate;
+  bench::UnitTruth unit;
+  try {
+    unit = bench::batch_unit(o.unit, o.seed);
+  } catch (const InputError& e) {
+    throw InputError("--" + std::string(e.what()));
+  }
+  if (!(std::isfinite(o.idle_timeout) && o.idle_timeout > 0.0)) {
+    throw InputError("", "--idle-timeout", "a time > 0 s", fmt::format("{:g}", o.idle_timeout));
+  }
+  rt::UdpServerOptions so;
+  so.address = o.udp;
+  so.sessions = o.sessions;
+  so.idle_timeout = o.idle_timeout;
+  so.drop_every = o.drop_every;
+  so.stop = stop_on_sigint();
+  so.on_listening = [&](const std::string& address) {
+    // First line on stdout, flushed: a script (or a test) reads the port from it.
+    fmt::print("listening on {}\n", address);
+    std::fflush(stdout);
+    log_line(fmt::format("bench serve: virtual bench, unit {}, seed {}, {:g} Hz on udp {}", o.unit, o.seed, o.rate, address));
+  };
+  const rt::UdpServerReport rep = rt::serve_udp(unit, bo, o.seed, so);
+  if (o.json) {
+    print_json({{"sessions", rep.sessions},
+                {"requests", rep.requests},
+                {"replies", rep.replies},
+                {"dropped", rep.dropped},
+                {"rejected", rep.rejected},
+                {"target_safe", rep.target_safe}});
+  } else {
+    fmt::print("served {} sessions: {} io requests, {} replies ({} dropped on purpose), {} datagrams rejected\n",
+               rep.sessions, rep.requests, rep.replies, rep.dropped, rep.rejected);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_measure_commands(CLI::App& app, Action& action) {
+  auto o = std::make_shared<MeasureCli>();
+  CLI::App* m = app.add_subcommand("measure", "One experiment of the report on the bench a bench file describes, written as a measurement file");
+  m->add_option("experiment", o->experiment, "stroke, hysteresis, stiffness, frf-noise, frf-sweep or iff (virtual bench: also "
+                                             "hammer, flatness, capacitance)")
+      ->required();
+  m->add_option("--bench", o->bench, "bench file (TOML): backend, channels, amplifier, limits (docs/hardware.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  o->unit_option = m->add_option("--unit", o->unit, "number of the unit under test (virtual bench: 1..7 of the batch)");
+  o->seed_option = m->add_option("--seed", o->seed, "virtual bench: seed of the batch and of the noise; excitation seed");
+  m->add_option("--out", o->out, "output file, .mat (default) or .csv (default: EXPERIMENT-unitN.mat)");
+  o->amplitude_option = m->add_option("--amplitude", o->amplitude, "V at the stacks, as for simulate");
+  o->duration_option = m->add_option("--duration", o->duration, "s: frf-noise (20), frf-sweep (20), iff (10)");
+  o->gain_option = m->add_option("--gain", o->gain, "IFF gain g (280000)");
+  m->add_flag("--open-circuit", o->open_circuit,
+              "actuator stacks disconnected from the amplifier (stiffness k_oc; a real bench asks the operator first)");
+  m->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (a real bench asks the operator first)");
+  m->add_flag("--realtime", o->realtime, "SCHED_FIFO priority and locked memory for the loop (a message when not permitted)");
+  m->add_option("--log", o->log, "also write the loop's raw log (every cycle, with safety flags) to this file");
+  m->add_flag("--json", o->json, "print one JSON document (file, settings, I/O counts) on stdout");
+  m->callback([o, &action] { action = [o] { return run_measure(*o); }; });
+
+  auto s = std::make_shared<ServeCli>();
+  CLI::App* bench = app.add_subcommand("bench", "The bench as a remote I/O target");
+  bench->require_subcommand(1);
+  CLI::App* serve = bench->add_subcommand("serve", "Expose the virtual bench through the UDP I/O protocol (docs/hardware.md)");
+  serve->add_option("--udp", s->udp, "HOST:PORT to listen on (port 0: any free port; the first line says which)")
+      ->capture_default_str();
+  serve->add_option("--unit", s->unit, "unit of the batch, 1..7")->capture_default_str();
+  serve->add_option("--seed", s->seed, "seed of the batch and of the noise")->capture_default_str();
+  serve->add_option("--rate", s->rate, "sample rate, Hz (clients must use the same)")->capture_default_str();
+  serve->add_option("--sessions", s->sessions, "exit after this many client sessions (0: serve until Ctrl-C)")
+      ->capture_default_str();
+  serve->add_option("--idle-timeout", s->idle_timeout, "exit after this long without a datagram, s")->capture_default_str();
+  serve->add_option("--drop-every", s->drop_every, "testing: leave every N-th io request unanswered (0: none)")
+      ->capture_default_str();
+  serve->add_flag("--json", s->json, "print the session counts as JSON at the end");
+  serve->callback([s, &action] { action = [s] { return run_serve(*s); }; });
+}
+
+}  // namespace piezobench::app

@@ -1,0 +1,40 @@
+#pragma once
+// What `simulate`, `measure`, `rt` and `bench serve` share: one experiment run and reported
+// (simulate is measure on the virtual bench), the backend a bench file names, Ctrl-C.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "piezobench/bench/experiments.hpp"
+#include "piezobench/rt/backend.hpp"
+#include "piezobench/rt/bench_file.hpp"
+
+namespace piezobench::app {
+
+struct MeasureRequest {
+  std::string experiment;
+  bench::ExperimentOptions options;  // options.bench: the virtual bench's (virtual) or from the bench file
+  int unit = 1;
+  std::uint64_t seed = 1;
+  std::string out;                   // default EXPERIMENT-unitN.mat
+  bool json = false;
+  // Hardware (or remote) bench: the experiment runs through rt::BackendRunner; none: the virtual
+  // bench (bench::simulate).
+  std::optional<rt::BenchDescription> bench;
+  bool realtime = false;             // SCHED_FIFO and mlockall
+  std::string log;                   // raw loop log
+};
+// Runs the experiment, writes the record, prints the summary (or the JSON document).
+int run_measurement(const MeasureRequest& request);
+
+// The backend a bench file names (virtual: the batch unit of its [virtual] table). InputError when
+// the device cannot be used.
+std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& bench);
+
+// Ctrl-C (SIGINT) sets the returned flag instead of killing the process, until the process ends:
+// the loop brings the output to the safe value and the log is written.
+const std::atomic<bool>* stop_on_sigint();
+
+}  // namespace piezobench::app

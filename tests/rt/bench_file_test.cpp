@@ -1,0 +1,128 @@
+// The bench file: the examples of docs/examples read, and the refusals before anything moves.
+#include "piezobench/rt/bench_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "piezobench/core/error.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::rt {
+namespace {
+
+const std::string kComedi = R"(
+[bench]
+name = "report bench"
+backend = "comedi"
+sample_rate_Hz = 10000
+[amplifier]
+gain_V_per_V = 20
+[limits]
+va_min_V = -20
+va_max_V = 150
+slew_rate_V_per_s = 1e5
+[encoder]
+resolution_m = 2.5e-9
+[comedi]
+device = "/dev/comedi0"
+calibration = "auto"
+[signals.u]
+subdevice = 1
+channel = 0
+range = [-10, 10]
+scale = 1.0
+unit = "V"
+[signals.d_e]
+subdevice = 2
+channel = 0
+kind = "counter"
+unit = "m"
+[signals.Vs]
+subdevice = 0
+channel = 2
+range = [-10, 10]
+scale = 1.0
+unit = "V"
+)";
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_bench_description(text, "bench.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(BenchFile, ReadsTheComediBench) {
+  const BenchDescription d = parse_bench_description(kComedi, "bench.toml");
+  EXPECT_EQ(d.backend, "comedi");
+  EXPECT_DOUBLE_EQ(d.limits.u_min(), -1.0);
+  EXPECT_DOUBLE_EQ(d.limits.u_max(), 7.5);
+  EXPECT_EQ(d.de.kind, "counter");
+  EXPECT_DOUBLE_EQ(d.de.scale, 2.5e-9);  // a counter's scale defaults to the encoder's resolution
+  EXPECT_EQ(d.vs.channel, 2);
+  EXPECT_FALSE(d.va.has_value());
+}
+
+TEST(BenchFile, RefusesARangeThatCannotExpressTheLimits) {
+  // 150 V / 20 V/V = 7.5 V at the DAC: a 0..5 V output cannot reach it (nor -1 V).
+  const std::string e = error_of(replace(kComedi, "range = [-10, 10]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]",
+                                         "range = [0, 5]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]"));
+  EXPECT_TRUE(test::contains(e, "signals.u.range")) << e;
+  EXPECT_TRUE(test::contains(e, "-1 .. 7.5 V at the DAC")) << e;
+}
+
+TEST(BenchFile, RefusesAMissingChannel) {
+  const std::string text = kComedi.substr(0, kComedi.find("[signals.Vs]"));
+  const std::string e = error_of(text);
+  EXPECT_TRUE(test::contains(e, "signals.Vs")) << e;
+  EXPECT_TRUE(test::contains(e, "missing channel")) << e;
+  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "subdevice = 0\nchannel = 2", "subdevice = 0")), "signals.Vs.channel"));
+}
+
+TEST(BenchFile, RefusesAWrongSignFromUToVa) {
+  std::string e = error_of(replace(kComedi, "range = [-10, 10]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]",
+                                   "range = [-10, 10]\nscale = -1.0\nunit = \"V\"\n[signals.d_e]"));
+  EXPECT_TRUE(test::contains(e, "signals.u.scale")) << e;
+  e = error_of(replace(kComedi, "gain_V_per_V = 20", "gain_V_per_V = -20"));
+  EXPECT_TRUE(test::contains(e, "amplifier.gain_V_per_V")) << e;
+}
+
+TEST(BenchFile, AHardwareBenchNeedsItsLimits) {
+  std::string e = error_of(replace(kComedi, "va_max_V = 150\n", ""));
+  EXPECT_TRUE(test::contains(e, "limits.va_max_V")) << e;
+  e = error_of(replace(kComedi, "slew_rate_V_per_s = 1e5\n", ""));
+  EXPECT_TRUE(test::contains(e, "limits.slew_rate_V_per_s")) << e;
+  const std::string udp = "[bench]\nbackend = \"udp\"\nsample_rate_Hz = 10000\n[udp]\naddress = \"127.0.0.1:5600\"\n";
+  e = error_of(udp);
+  EXPECT_TRUE(test::contains(e, "amplifier.gain_V_per_V")) << e;
+  // The virtual bench has the report's limits by default.
+  const BenchDescription v = parse_bench_description("[bench]\nbackend = \"virtual\"\nsample_rate_Hz = 10000\n", "v.toml");
+  EXPECT_DOUBLE_EQ(v.limits.va_max, 150.0);
+}
+
+TEST(BenchFile, NamesUnknownKeysAndBadValues) {
+  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "[encoder]", "[encoder]\nresolution = 1")), "encoder.resolution"));
+  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "backend = \"comedi\"", "backend = \"nidaq\"")), "bench.backend"));
+  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "unit = \"m\"", "unit = \"mm\"")), "signals.d_e.unit"));
+  EXPECT_TRUE(test::contains(error_of("[bench\n"), "bench.toml"));
+}
+
+TEST(BenchFile, TheDocumentedExamplesRead) {
+  for (const char* name : {"bench-virtual.toml", "bench-udp.toml", "bench-comedi.toml"}) {
+    const auto path = std::filesystem::path(PIEZOBENCH_SOURCE_DIR) / "docs" / "examples" / name;
+    EXPECT_NO_THROW(read_bench_file(path)) << path;
+  }
+}
+
+}  // namespace
+}  // namespace piezobench::rt

@@ -1,0 +1,160 @@
+// The bench experiments through rt::BackendRunner: on the virtual bench's backend they give the
+// records bench::simulate gives (so the path a card takes is the simulator's), the operator's
+// steps are prompted and confirmed, a safety trip refuses the record.
+#include "piezobench/rt/measure.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "bench/random.hpp"
+#include "piezobench/bench/virtual_bench.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/rt/virtual_backend.hpp"
+#include "test_util.hpp"
+
+namespace piezobench::rt {
+namespace {
+
+BenchDescription virtual_bench(double ramp) {
+  return parse_bench_description("[bench]\nbackend = \"virtual\"\nsample_rate_Hz = 10000\n[limits]\nramp_s = " +
+                                     std::to_string(ramp) + "\n",
+                                 "virtual.toml");
+}
+
+// The noise seed experiments.cpp gives the bench of experiment e (its `stream`).
+std::uint64_t bench_seed(bench::Experiment e, std::uint64_t seed) {
+  return bench::detail::derive_seed(seed, 1000 * (static_cast<std::uint64_t>(e) + 1));
+}
+
+TEST(BackendRunner, OnTheVirtualBenchItWritesTheSimulatedRecord) {
+  const bench::UnitTruth unit = bench::batch_unit(2, 5);
+  for (const bench::Experiment e : {bench::Experiment::kFrfNoise, bench::Experiment::kIff, bench::Experiment::kHysteresis}) {
+    bench::ExperimentOptions eo;
+    if (e != bench::Experiment::kHysteresis) eo.duration = 0.5;
+    const io::TimeSeries simulated = bench::simulate(e, unit, eo, 5);
+    VirtualBenchBackend backend(unit, eo.bench, bench_seed(e, 5));
+    MeasureOptions mo;
+    mo.bench = virtual_bench(0.0);  // the experiments' commands as they are: no ramps
+    mo.lockstep = true;
+    BackendRunner runner(backend, mo);
+    const io::TimeSeries measured = bench::run_experiment(e, runner, unit, eo, 5);
+    ASSERT_EQ(measured.names, simulated.names);
+    ASSERT_EQ(measured.units, simulated.units);
+    ASSERT_EQ(measured.samples(), simulated.samples());
+    const double diff = (measured.data - simulated.data).cwiseAbs().maxCoeff();
+    EXPECT_LE(diff, 1e-9 * simulated.data.cwiseAbs().maxCoeff()) << bench::to_string(e);
+    // The same settings, plus where it was made.
+    for (const auto& [key, value] : simulated.settings) {
+      if (key == "defective" || key == "noise" || key == "suspended_mass_kg" || key == "hpf_resistance_ohm" ||
+          key == "model" || key == "delay_s" || key == "nmp_zero" || key == "hysteresis" || key == "creep") {
+        continue;  // what only the simulator knows
+      }
+      ASSERT_TRUE(measured.settings.count(key)) << key;
+      EXPECT_EQ(measured.settings.at(key), value) << key;
+    }
+    EXPECT_EQ(std::get<std::string>(measured.settings.at("backend")), "virtual");
+    EXPECT_EQ(runner.report().runs.size(), 1u);
+  }
+}
+
+TEST(BackendRunner, PromptsTheOperatorAndRecordsTheConfirmations) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  ASSERT_EQ(write(fds[1], "\n\n", 2), 2);  // the operator presses Enter at each prompt
+  close(fds[1]);
+  VirtualBenchBackend backend(bench::batch_unit(1, 1), bench::BenchOptions{}, 1);
+  std::ostringstream prompts;
+  MeasureOptions mo;
+  mo.bench = virtual_bench(0.01);
+  mo.operator_fd = fds[0];
+  mo.operator_out = &prompts;
+  BackendRunner runner(backend, mo);
+  const std::vector<bench::OperatorStep> steps = {{0.1, "put the 6.4 kg mass on", 6.4, 0.0}, {0.3, "take it off", 0.0, 0.0}};
+  Eigen::MatrixXd out;
+  const std::vector<double> done = runner.hold(6000, steps, 0, out, {});
+  close(fds[0]);
+  ASSERT_EQ(done.size(), 2u);
+  // Confirmed as soon as asked (the answers were waiting), give or take a loaded machine.
+  EXPECT_GE(done[0], 0.1);
+  EXPECT_LT(done[0], 0.25);
+  EXPECT_GE(done[1], 0.3);
+  EXPECT_LT(done[1], 0.45);
+  EXPECT_TRUE(test::contains(prompts.str(), "put the 6.4 kg mass on; press Enter")) << prompts.str();
+  EXPECT_TRUE(test::contains(prompts.str(), "confirmed")) << prompts.str();
+  const auto row = [&](double t) { return static_cast<Eigen::Index>(std::llround(t * 1e4)); };
+  EXPECT_EQ(out(row(done[0]) - 1, 1), 0.0);
+  EXPECT_EQ(out(row(done[0]) + 1, 1), 6.4);
+  EXPECT_EQ(out(row(done[1]) + 1, 1), 0.0);
+  ASSERT_EQ(runner.report().operator_steps.size(), 2u);
+  EXPECT_EQ(runner.report().operator_steps[1].prompt, "take it off");
+}
+
+TEST(BackendRunner, AsksForTheSetUpBeforeAnythingMoves) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  ASSERT_EQ(write(fds[1], "\n", 1), 1);  // one confirmation, then the end of the input
+  close(fds[1]);
+  VirtualBenchBackend backend(bench::batch_unit(1, 1), bench::BenchOptions{}, 1);
+  std::ostringstream prompts;
+  MeasureOptions mo;
+  mo.bench = virtual_bench(0.01);
+  mo.operator_fd = fds[0];
+  mo.operator_out = &prompts;
+  BackendRunner runner(backend, mo);
+  runner.prepare({"disconnect the amplifier from the actuator stacks (open circuit)"});
+  EXPECT_TRUE(test::contains(prompts.str(), "before the record (nothing moves): disconnect the amplifier")) << prompts.str();
+  ASSERT_EQ(runner.report().operator_steps.size(), 1u);
+  EXPECT_TRUE(runner.report().runs.empty());  // nothing ran
+  EXPECT_THROW(runner.prepare({"take the 80.6 kOhm resistor off the sensor stack"}), InputError);
+  close(fds[0]);
+}
+
+TEST(BackendRunner, AnUnconfirmedStepRefusesTheRecord) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  ASSERT_EQ(write(fds[1], "\n", 1), 1);  // only the first step is confirmed, then end of input
+  close(fds[1]);
+  VirtualBenchBackend backend(bench::batch_unit(1, 1), bench::BenchOptions{}, 1);
+  std::ostringstream prompts;
+  MeasureOptions mo;
+  mo.bench = virtual_bench(0.01);
+  mo.operator_fd = fds[0];
+  mo.operator_out = &prompts;
+  BackendRunner runner(backend, mo);
+  Eigen::MatrixXd out;
+  try {
+    runner.hold(2000, {{0.05, "put the mass on", 6.4, 0.0}, {0.1, "take it off", 0.0, 0.0}}, 0, out, {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(test::contains(e.what(), "take it off")) << e.what();
+  }
+  close(fds[0]);
+}
+
+TEST(BackendRunner, ASafetyTripRefusesTheRecordAndKeepsTheLog) {
+  VirtualBenchBackend backend(bench::batch_unit(1, 1), bench::BenchOptions{}, 1);
+  std::atomic<bool> stop{true};  // Ctrl-C before the run
+  test::TempDir dir;
+  MeasureOptions mo;
+  mo.bench = virtual_bench(0.0);
+  mo.lockstep = true;
+  mo.stop = &stop;
+  mo.raw_log = dir.path() / "raw.mat";
+  BackendRunner runner(backend, mo);
+  Eigen::MatrixXd out;
+  try {
+    runner.open_loop(Eigen::VectorXd::Constant(100, 1.0), 0, out, {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(test::contains(e.what(), "interrupted")) << e.what();
+    EXPECT_TRUE(test::contains(e.what(), "raw.mat")) << e.what();
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "raw.mat"));
+  EXPECT_TRUE(runner.report().runs.at(0).interrupted);
+}
+
+}  // namespace
+}  // namespace piezobench::rt
