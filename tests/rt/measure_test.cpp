@@ -48,7 +48,7 @@ TEST(BackendRunner, OnTheVirtualBenchItWritesTheSimulatedRecord) {
     EXPECT_LE(diff, 1e-9 * simulated.data.cwiseAbs().maxCoeff()) << bench::to_string(e);
     // The same settings, plus where it was made.
     for (const auto& [key, value] : simulated.settings) {
-      if (key == "defective" || key == "noise" || key == "suspended_mass_kg" || key == "hpf_resistance_ohm" ||
+      if (key == "defective" || key == "noise" || key == "suspended_mass_kg" || key == "hpf_resistance_ohm" || key == "sensor_shunt_ohm" ||
           key == "model" || key == "delay_s" || key == "nmp_zero" || key == "hysteresis" || key == "creep") {
         continue;  // what only the simulator knows
       }
