@@ -35,6 +35,9 @@ io = _core.io
 bench = _core.bench
 campaign = _core.campaign
 
+# Super elements are files too: io.read_super_element is fem.read_super_element.
+io.read_super_element = fem.read_super_element
+
 for _name in ("lti", "dsp", "ident", "control", "apa", "fem", "io", "bench", "campaign"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_core, _name)
 

@@ -7,6 +7,9 @@
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/demo.hpp"
 #include "piezobench/campaign/pipeline.hpp"
+#if __has_include("piezobench/campaign/results_json.hpp")
+#include "piezobench/campaign/results_json.hpp"
+#endif
 
 namespace piezobench::python {
 
@@ -51,6 +54,17 @@ namespace {
 
 using namespace piezobench::campaign;
 
+// The results.json document of a run (CLI.md keys), whether the pipeline keeps it as JSON or as
+// typed results with one serializer (campaign/results_json.hpp).
+template <class R>
+nlohmann::json results_document(const R& r) {
+  if constexpr (requires { r.results.dump(); }) {
+    return r.results;
+  } else {
+    return results_json(r);
+  }
+}
+
 }  // namespace
 
 void bind_campaign(py::module_& m) {
@@ -69,7 +83,7 @@ void bind_campaign(py::module_& m) {
         py::dict d;
         d["accepted"] = r.accepted;
         d["rejected"] = r.rejected;
-        d["results"] = from_json(r.results, "CampaignResults", true);
+        d["results"] = from_json(results_document(r), "CampaignResults", true);
         if (!out_dir.is_none()) {
           const std::string dir = py::str(out_dir);
           auto paths = without_gil([&] { return write_outputs(r, dir); });
