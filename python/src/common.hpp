@@ -30,6 +30,7 @@
 namespace piezobench::lti {
 struct StateSpace;
 struct RootLocusOptions;
+struct RootLocus;
 }
 namespace piezobench::dsp {
 struct Frf;
@@ -312,6 +313,8 @@ lti::StateSpace state_space_arg(py::handle obj, const std::string& source, const
 template <class T>
 class Options;
 const Options<lti::RootLocusOptions>& root_locus_options();
+// Result(gains, poles): poles[i] are the closed-loop poles at gains[i] (lti.cpp).
+py::object root_locus_result(const lti::RootLocus& r);
 // An argument that must be a dsp.Frf.
 const dsp::Frf& frf_arg(py::handle obj, const std::string& source, const std::string& field);
 

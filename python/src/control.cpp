@@ -60,16 +60,6 @@ const Options<DiscreteIffOptions>& discrete_options() {
   return t;
 }
 
-py::object locus_result(const lti::RootLocus& r) {
-  const Index n = r.poles.empty() ? 0 : r.poles[0].size();
-  Eigen::MatrixXcd p(static_cast<Index>(r.poles.size()), n);
-  for (std::size_t i = 0; i < r.poles.size(); ++i) p.row(static_cast<Index>(i)) = r.poles[i].transpose();
-  py::dict d;
-  d["gains"] = to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(r.gains.data(), static_cast<Index>(r.gains.size()))));
-  d["poles"] = to_numpy(std::move(p));
-  return result("RootLocus", d);
-}
-
 }  // namespace
 
 void bind_control(py::module_& m) {
@@ -121,7 +111,7 @@ void bind_control(py::module_& m) {
         opt["damping"] = r.optimum.damping;
         opt["pole"] = r.optimum.pole;
         py::dict d;
-        d["locus"] = locus_result(r.locus);
+        d["locus"] = root_locus_result(r.locus);
         d["resonance_pole"] = r.resonance_pole;
         d["optimum"] = result("BranchOptimum", opt);
         d["resonance_branch"] = r.resonance_branch;

@@ -66,7 +66,15 @@ py::object time_response(TimeResponse&& r) {
   return result("TimeResponse", d);
 }
 
-py::object root_locus(RootLocus&& r) {
+std::string ss_repr(const StateSpace& s) {
+  return "StateSpace(states=" + std::to_string(s.states()) + ", inputs=" + std::to_string(s.inputs()) +
+         ", outputs=" + std::to_string(s.outputs()) + ", sample_time=" + std::to_string(s.sample_time) +
+         (s.has_delay() ? ", delayed" : "") + ")";
+}
+
+}  // namespace
+
+py::object root_locus_result(const RootLocus& r) {
   py::dict d;
   const Index n = r.poles.empty() ? 0 : r.poles[0].size();
   Eigen::MatrixXcd p(static_cast<Index>(r.poles.size()), n);
@@ -75,14 +83,6 @@ py::object root_locus(RootLocus&& r) {
   d["poles"] = to_numpy(std::move(p));
   return result("RootLocus", d);
 }
-
-std::string ss_repr(const StateSpace& s) {
-  return "StateSpace(states=" + std::to_string(s.states()) + ", inputs=" + std::to_string(s.inputs()) +
-         ", outputs=" + std::to_string(s.outputs()) + ", sample_time=" + std::to_string(s.sample_time) +
-         (s.has_delay() ? ", delayed" : "") + ")";
-}
-
-}  // namespace
 
 StateSpace state_space_arg(py::handle obj, const std::string& source, const std::string& field) {
   if (py::isinstance<StateSpace>(obj)) return obj.cast<StateSpace>();
@@ -296,10 +296,10 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
       [](py::object sys, py::object gains, const py::kwargs& kw) {
         auto s = state_space_arg(sys, "lti.rlocus", "open_loop");
         auto o = rlocus_options().from_kwargs(kwargs_dict(kw), "lti.rlocus");
-        if (gains.is_none()) return root_locus(without_gil([&] { return lti::rlocus_auto(s, o); }));
+        if (gains.is_none()) return root_locus_result(without_gil([&] { return lti::rlocus_auto(s, o); }));
         auto g = vector_arg(gains, "lti.rlocus", "gains");
         std::vector<double> gv(g.data(), g.data() + g.size());
-        return root_locus(without_gil([&] { return lti::rlocus(s, gv); }));
+        return root_locus_result(without_gil([&] { return lti::rlocus(s, gv); }));
       },
       arg("open_loop"), arg("gains") = py::none(),
       ("Root locus of the SISO loop L under u = -k y: Result(gains, poles) with poles[i] the closed-loop\n"
