@@ -12,6 +12,7 @@
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/demo.hpp"
 #include "piezobench/campaign/pipeline.hpp"
+#include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::app {
@@ -61,7 +62,7 @@ int run_pipeline(const fs::path& campaign_file, const fs::path& out, bool strict
   const double elapsed = seconds_since(t0);
   const fs::path report = out / "report.html";
   if (json) {
-    nlohmann::json doc = r.results;
+    nlohmann::json doc = campaign::results_json(r);
     doc["outputs"] = nlohmann::json::array();
     for (const auto& p : written) doc["outputs"].push_back(p.string());
     doc["pipeline_seconds"] = elapsed;
@@ -69,13 +70,12 @@ int run_pipeline(const fs::path& campaign_file, const fs::path& out, bool strict
     print_json(doc);
   } else {
     fmt::print("{} units: {} accepted, {} rejected ({:.1f} s)\n", r.accepted + r.rejected, r.accepted, r.rejected, elapsed);
-    for (const auto& u : r.results["units"]) {
-      fmt::print("  {:<8} {}\n", u["name"].get<std::string>(), u["accepted"].get<bool>() ? "accepted" : "REJECTED");
-      for (const auto& reason : u["reasons"]) fmt::print("           - {}\n", reason.get<std::string>());
+    for (const auto& u : r.units) {
+      fmt::print("  {:<8} {}\n", u.name, u.accepted ? "accepted" : "REJECTED");
+      for (const auto& reason : u.reasons) fmt::print("           - {}\n", reason);
     }
-    if (r.results["iff"].contains("optimal_gain") && !r.results["iff"]["optimal_gain"].is_null()) {
-      fmt::print("IFF: optimal gain {:.4g} (APA {}), maximum damping {:.3f}\n", r.results["iff"]["optimal_gain"].get<double>(),
-                 r.results["iff"]["unit"].get<int>(), r.results["iff"].value("max_damping", 0.0));
+    if (r.iff.optimal_gain && r.iff.unit) {
+      fmt::print("IFF: optimal gain {:.4g} (APA {}), maximum damping {:.3f}\n", *r.iff.optimal_gain, *r.iff.unit, r.iff.max_damping.value_or(0.0));
     }
     fmt::print("report: {}\n", fs::absolute(report).string());
     fmt::print("results: {}, {}\n", (out / "results.json").string(), (out / "results.mat").string());

@@ -12,12 +12,13 @@
 #include <thread>
 
 #include "piezobench/campaign/report_document.hpp"
+#include "piezobench/campaign/results_json.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
 #include "piezobench/io/atomic_file.hpp"
-#include "piezobench/io/json.hpp"
 #include "piezobench/io/mat_struct.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/analysis.hpp"
@@ -25,7 +26,6 @@
 #include "piezobench/lti/rlocus.hpp"
 #include "piezobench/metrology/capacitance.hpp"
 #include "piezobench/report/html_report.hpp"
-#include "piezobench/version.hpp"
 
 namespace piezobench::campaign {
 
@@ -33,7 +33,6 @@ namespace fs = std::filesystem;
 using Eigen::Index;
 using Eigen::VectorXd;
 using nlohmann::json;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 namespace {
 
@@ -54,8 +53,8 @@ const std::vector<Quantity>& quantities() {
       {"k1_N_per_um", 1e-6, &UnitAnalysis::k1},
       {"k2_N_per_um", 1e-6, &UnitAnalysis::k2},
       {"k_resonance_N_per_um", 1e-6, &UnitAnalysis::k_resonance},
-      {"resonance_Hz", 1.0, &UnitAnalysis::resonance_hz},
-      {"antiresonance_Hz", 1.0, &UnitAnalysis::antiresonance_hz},
+      {"resonance_Hz", 1.0, &UnitAnalysis::resonance_Hz},
+      {"antiresonance_Hz", 1.0, &UnitAnalysis::antiresonance_Hz},
       {"static_gain_um_per_V", 1e6, &UnitAnalysis::static_gain}};
   return q;
 }
@@ -75,7 +74,7 @@ double median(std::vector<double> v) {
 }
 
 struct BatchOutput {
-  json batch;
+  BatchAnalysis batch;
   std::map<int, std::vector<std::string>> outlier_reasons;  // unit id -> reasons
 };
 
@@ -98,8 +97,6 @@ VectorXd magnitude_on(const dsp::Frf& frf, Index output, const VectorXd& f) {
 
 BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& units) {
   BatchOutput out;
-  json outliers = json::array();
-  json spread = json::object();
   for (const Quantity& q : quantities()) {
     std::vector<double> values;
     std::vector<const UnitAnalysis*> who;
@@ -112,14 +109,12 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
     if (values.empty()) continue;
     const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
     const double med = median(values);
-    spread[q.name] = {{"units", values.size()}, {"min", *lo}, {"max", *hi}, {"median", med},
-                      {"relative_spread", med != 0.0 ? (*hi - *lo) / std::abs(med) : 0.0}};
     const metrology::OutlierAnalysis a = metrology::robust_outliers(values, c.specs.outliers, c.file.string(), q.name);
-    spread[q.name]["mad"] = a.mad;
+    out.batch.spread.push_back({q.name, static_cast<long>(values.size()), *lo, *hi, med,
+                                med != 0.0 ? (*hi - *lo) / std::abs(med) : 0.0, a.mad});
     for (std::size_t i = 0; i < values.size(); ++i) {
       if (!a.outlier[i]) continue;
-      outliers.push_back({{"unit", who[i]->id}, {"quantity", q.name}, {"value", values[i]}, {"median", a.median},
-                          {"robust_z", io::to_json(a.robust_z[i])}});
+      out.batch.outliers.push_back({who[i]->id, q.name, values[i], a.median, a.robust_z[i]});
       const auto it = rejecting_outliers().find(q.name);
       if (c.specs.reject_outliers && it != rejecting_outliers().end()) {
         out.outlier_reasons[who[i]->id].push_back(
@@ -129,14 +124,16 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
     }
   }
   // Unit-to-unit similarity of the FRFs: rms distance in dB from the batch median magnitude.
-  json similarity = json::object();
   std::vector<const UnitAnalysis*> with_frf;
   for (const auto& u : units) {
     if (u.frf) with_frf.push_back(&u);
   }
   if (with_frf.size() >= 2) {
     const VectorXd f = Eigen::VectorXd::LinSpaced(120, std::log10(c.analysis.fmin_hz), std::log10(c.analysis.fmax_hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
-    json per_unit = json::array();
+    FrfSimilarity sim;
+    sim.fmin_Hz = c.analysis.fmin_hz;
+    sim.fmax_Hz = c.analysis.fmax_hz;
+    sim.units.resize(with_frf.size());
     double worst = 0.0;
     for (Index o = 0; o < 2; ++o) {
       std::vector<VectorXd> mags;
@@ -159,20 +156,16 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
           }
         }
         const double rms = n > 0 ? std::sqrt(s / n) : std::nan("");
-        if (o == 0) per_unit.push_back({{"unit", with_frf[i]->id}});
-        per_unit[i][o == 0 ? "de_rms_dB" : "Vs_rms_dB"] = io::to_json(rms);
+        sim.units[i].unit = with_frf[i]->id;
+        (o == 0 ? sim.units[i].de_rms_dB : sim.units[i].vs_rms_dB) = rms;
         if (std::isfinite(rms)) worst = std::max(worst, rms);
       }
     }
-    similarity = {{"reference", "median |H| of the batch"},
-                  {"band_Hz", {c.analysis.fmin_hz, c.analysis.fmax_hz}},
-                  {"units", per_unit},
-                  {"max_rms_dB", worst}};
+    sim.max_rms_dB = worst;
+    out.batch.similarity = std::move(sim);
   }
-  out.batch = {{"outliers", outliers}, {"spread", spread}, {"similarity", similarity},
-               {"outlier_rule", {{"robust_z_threshold", c.specs.outliers.threshold},
-                                 {"min_relative_deviation", c.specs.outliers.min_relative_deviation},
-                                 {"rejects", c.specs.reject_outliers}}}};
+  out.batch.rule = c.specs.outliers;
+  out.batch.rejects = c.specs.reject_outliers;
   return out;
 }
 
@@ -209,8 +202,6 @@ std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, co
 }
 
 // ------------------------------------------------------------------------------------ IFF
-
-json pole_json(std::complex<double> p) { return io::to_json(p); }
 
 // Relative distance between an identified damped pole and the model's at the same gain above which
 // the report warns that the model does not describe the closed loop.
@@ -295,7 +286,7 @@ ResonanceLocus resonance_locus(const lti::StateSpace& loop, std::complex<double>
   return r;
 }
 
-json iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units, json& extra) {
+IffStudy iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units) {
   const UnitAnalysis* chosen = nullptr;
   if (c.analysis.iff_unit != 0) {
     for (const auto& u : units) {
@@ -304,7 +295,8 @@ json iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units, json& 
   }
   if (!chosen) {
     for (const auto& u : units) {
-      if (!chosen && !u.damped.empty() && u.iff_plant) chosen = &u;
+      const bool identified = std::any_of(u.damped.begin(), u.damped.end(), [](const DampedPlant& d) { return d.identified.has_value(); });
+      if (!chosen && identified && u.iff_plant) chosen = &u;
     }
   }
   if (!chosen) {
@@ -312,98 +304,76 @@ json iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units, json& 
       if (!chosen && u.iff_plant) chosen = &u;
     }
   }
-  json out = {{"unit", nullptr}, {"gains", json::array()}, {"damped_poles", json::array()}, {"optimal_gain", nullptr}};
-  const control::IffControllerParams& k = c.analysis.controller;
-  out["controller"] = {{"gain", k.gain}, {"hpf_Hz", k.w_hpf / kTwoPi}, {"lpf_Hz", k.w_lpf / kTwoPi}, {"robust_Hz", k.w_robust / kTwoPi},
-                       {"formula", "K(s) = gain g s/(s + w_hpf) 1/(s + w_lpf) 1/(s + w_robust) (eq. 2.4)"}};
+  IffStudy out;
+  out.controller = c.analysis.controller;
   if (!chosen || !chosen->iff_plant) {
-    out["note"] = "no unit with a fitted IFF plant (no FRF u -> Vs)";
+    out.note = "no unit with a fitted IFF plant (no FRF u -> Vs)";
     return out;
   }
-  out["unit"] = chosen->id;
+  out.unit = chosen->id;
+  out.plant = *chosen->iff_plant;
   const IffPlantFit& p = *chosen->iff_plant;
-  out["plant"] = {{"g0", p.g0}, {"wz_Hz", p.wz / kTwoPi}, {"xz", p.xz}, {"wp_Hz", p.wp / kTwoPi}, {"xp", p.xp},
-                  {"w_hpf_Hz", p.w_hpf / kTwoPi}, {"delay_s", p.delay}, {"source", "IFF plant fit of unit " + std::to_string(chosen->id)}};
   const lti::StateSpace plant = lti::to_state_space(p.transfer_function());
-  const lti::StateSpace controller = lti::to_state_space(control::iff_controller(k));
+  const lti::StateSpace controller = lti::to_state_space(control::iff_controller(out.controller));
   control::IffLoopOptions lo;
   lo.resonance = p.wp;
   const lti::StateSpace loop = control::iff_open_loop(plant, controller, lo);
   const std::complex<double> resonance_pole(-p.xp * p.wp, p.wp * std::sqrt(std::max(0.0, 1.0 - p.xp * p.xp)));
   const ResonanceLocus locus = resonance_locus(loop, resonance_pole);
-  out["optimal_gain"] = locus.optimal_gain;
-  out["max_damping"] = locus.max_damping;
-  out["optimal_pole"] = pole_json(locus.optimal_pole);
-  out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)|, branch from the "
-                        "resonance pole, maximum damping refined by golden section (delay as a 6th-order Pade approximant)";
+  out.optimal_gain = locus.optimal_gain;
+  out.max_damping = locus.max_damping;
+  out.optimal_pole = locus.optimal_pole;
   // The root locus for the plot (report Figure 2.10b): every branch, with its gains for the hover
   // labels, the open-loop poles and zeros, inside a window of 3 wp around the origin (the
   // controller's 2 kHz pole and the Pade approximant's poles lie far outside).
   const double limit = 3.0 * p.wp;
   const auto inside = [&](std::complex<double> z) { return std::abs(z) <= limit && z.imag() >= 0.0; };
-  const auto gain_label = [](double g) { return fmt::format("g = {:.3g}", g); };
-  json branches = json::array();
   const Index nb = locus.poles.empty() ? 0 : locus.poles.front().size();
   for (Index b = 0; b < nb; ++b) {
-    json re = json::array(), im = json::array(), text = json::array();
+    IffStudy::Branch branch;
     for (std::size_t i = 0; i < locus.poles.size(); ++i) {
       const auto z = locus.poles[i](b);
       if (!inside(z)) continue;
-      re.push_back(z.real());
-      im.push_back(z.imag());
-      text.push_back(gain_label(locus.gains[i]));
+      branch.re_im.x.push_back(z.real());
+      branch.re_im.y.push_back(z.imag());
+      branch.gains.push_back(locus.gains[i]);
     }
-    if (re.size() > 1) branches.push_back({{"re", re}, {"im", im}, {"text", text}, {"resonance_branch", b == locus.branch}});
+    branch.resonance_branch = b == locus.branch;
+    if (branch.re_im.x.size() > 1) out.branches.push_back(std::move(branch));
   }
   const auto points = [&](const lti::CVector& v) {
-    json re = json::array(), im = json::array();
+    Curve c;
     for (const auto z : v) {
       if (!inside(z)) continue;
-      re.push_back(z.real());
-      im.push_back(z.imag());
+      c.x.push_back(z.real());
+      c.y.push_back(z.imag());
     }
-    return json{{"re", re}, {"im", im}};
+    return c;
   };
-  json damped_plot = json::array();
-  json model = json::array(), distance = json::array(), model_plot = json::array();
-  double worst = 0.0;
+  out.open_loop_poles = points(lti::poles(loop));
+  out.open_loop_zeros = points(lti::zeros(loop));
+  out.pole_distance_tolerance = kPoleDistanceTolerance;
   for (const auto& d : chosen->damped) {
+    if (!d.identified) continue;
     const auto pole = d.identified->pole;
-    out["gains"].push_back(d.gain);
-    out["damped_poles"].push_back(pole_json(pole));
-    damped_plot.push_back({{"gain", d.gain}, {"re", pole.real()}, {"im", pole.imag()}});
+    out.gains.push_back(d.gain);
+    out.damped_poles.push_back(pole);
     const std::complex<double> z = locus.pole_at(loop, d.gain);
-    model.push_back(pole_json(z));
-    model_plot.push_back({{"gain", d.gain}, {"re", z.real()}, {"im", z.imag()}});
-    distance.push_back(std::abs(pole - z) / std::abs(z));
-    worst = std::max(worst, std::abs(pole - z) / std::abs(z));
+    out.model_poles.push_back(z);
+    out.relative_pole_distance.push_back(std::abs(pole - z) / std::abs(z));
+    out.max_relative_pole_distance = std::max(out.max_relative_pole_distance, out.relative_pole_distance.back());
   }
-  if (!chosen->damped.empty()) {
-    out["model_poles"] = model;
-    out["relative_pole_distance"] = distance;
-    out["max_relative_pole_distance"] = worst;
-    out["pole_distance_tolerance"] = kPoleDistanceTolerance;
-    if (worst > kPoleDistanceTolerance) {
-      out["warning"] = fmt::format("the identified damped poles are up to {:.0f} % off the model's root locus (more than {:.0f} %): "
-                                   "the IFF plant model (eq. 2.3) does not describe the closed loop at those gains",
-                                   100.0 * worst, 100.0 * kPoleDistanceTolerance);
-    }
+  if (out.max_relative_pole_distance > kPoleDistanceTolerance) {
+    out.warning = fmt::format("the identified damped poles are up to {:.0f} % off the model's root locus (more than {:.0f} %): "
+                              "the IFF plant model (eq. 2.3) does not describe the closed loop at those gains",
+                              100.0 * out.max_relative_pole_distance, 100.0 * kPoleDistanceTolerance);
   }
-  extra["root_locus"] = {{"branches", branches},
-                         {"open_loop_poles", points(lti::poles(loop))},
-                         {"open_loop_zeros", points(lti::zeros(loop))},
-                         {"damped", damped_plot},
-                         {"model_at_gains", model_plot},
-                         {"optimum", {{"gain", locus.optimal_gain}, {"re", locus.optimal_pole.real()}, {"im", locus.optimal_pole.imag()},
-                                      {"damping", locus.max_damping}}},
-                         {"unit", chosen->id},
-                         {"open_loop_pole", {p.wp * -p.xp, p.wp * std::sqrt(std::max(0.0, 1 - p.xp * p.xp))}}};
   return out;
 }
 
 // ------------------------------------------------------------------------------------ super element
 
-json superelement_comparison(const Campaign& c, const std::vector<UnitAnalysis>& units, json& extra) {
+SuperElementComparison superelement_comparison(const Campaign& c, const std::vector<UnitAnalysis>& units) {
   const SuperElementSpec& s = *c.superelement;
   const std::string src = c.file.string();
   fem::SuperElementFormat format;
@@ -434,27 +404,24 @@ json superelement_comparison(const Campaign& c, const std::vector<UnitAnalysis>&
   const fem::Modes modes = fem::modes(model);
   const VectorXd f = Eigen::VectorXd::LinSpaced(400, std::log10(c.analysis.fmin_hz), std::log10(2.0 * c.analysis.fmax_hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
   const std::vector<Eigen::MatrixXcd> h = fem::frequency_response(model, kTwoPi * f);
-  json abs = json::array();
+  SuperElementComparison out;
   Index peak = 0;
   for (Index k = 0; k < f.size(); ++k) {
     const double v = std::abs(h[static_cast<std::size_t>(k)](0, 0)) * std::abs(s.ga * c.bench.amplifier_gain);
-    abs.push_back(v * 1e6);
-    if (v > abs[peak].get<double>() * 1e-6) peak = k;
+    out.magnitude.x.push_back(f(k));
+    out.magnitude.y.push_back(v);
+    if (v > out.magnitude.y[static_cast<std::size_t>(peak)]) peak = k;
   }
   std::vector<double> measured;
   for (const auto& u : units) {
-    if (u.resonance_hz) measured.push_back(*u.resonance_hz);
+    if (u.resonance_Hz) measured.push_back(*u.resonance_Hz);
   }
-  json modes_hz = json::array();
-  for (Index i = 0; i < std::min<Index>(10, modes.frequencies_Hz.size()); ++i) modes_hz.push_back(modes.frequencies_Hz(i));
-  extra["superelement"] = {{"f", io::to_json(f)}, {"abs_um_per_V", abs}};
-  json out = {{"source", s.k_file.given},
-              {"dofs", se.size()},
-              {"modes_Hz", modes_hz},
-              {"resonance_Hz", f(peak)},
-              {"measured_resonance_Hz", measured.empty() ? json(nullptr) : json(median(measured))},
-              {"warnings", se.warnings}};
-  if (!measured.empty()) out["relative_difference"] = f(peak) / median(measured) - 1.0;
+  for (Index i = 0; i < std::min<Index>(10, modes.frequencies_Hz.size()); ++i) out.modes_Hz.push_back(modes.frequencies_Hz(i));
+  out.source = s.k_file.given;
+  out.dofs = static_cast<long>(se.size());
+  out.resonance_Hz = f(peak);
+  if (!measured.empty()) out.measured_resonance_Hz = median(measured);
+  out.warnings = se.warnings;
   return out;
 }
 
@@ -502,65 +469,34 @@ CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
 
   log("batch: outliers, spread, similarity, acceptance, IFF");
   CampaignResult r;
-  const BatchOutput batch = batch_analysis(c, units);
-  json unit_list = json::array();
+  r.campaign = c;
+  BatchOutput batch = batch_analysis(c, units);
   for (auto& u : units) {
     const auto it = batch.outlier_reasons.find(u.id);
-    const std::vector<std::string> reasons = acceptance(c, u, it == batch.outlier_reasons.end() ? std::vector<std::string>{} : it->second);
-    u.result["accepted"] = reasons.empty();
-    u.result["reasons"] = reasons;
-    (reasons.empty() ? r.accepted : r.rejected) += 1;
-    unit_list.push_back(u.result);
+    u.reasons = acceptance(c, u, it == batch.outlier_reasons.end() ? std::vector<std::string>{} : it->second);
+    u.accepted = u.reasons.empty();
+    (u.accepted ? r.accepted : r.rejected) += 1;
   }
-  json extra = json::object();
-  json iff;
   const auto t_iff = std::chrono::steady_clock::now();
   try {
-    iff = iff_study(c, units, extra);
+    r.iff = iff_study(c, units);
     log(fmt::format("IFF: root locus and damped plants ({:.2f} s)", std::chrono::duration<double>(std::chrono::steady_clock::now() - t_iff).count()));
   } catch (const NumericalError& e) {
-    iff = {{"gains", json::array()}, {"damped_poles", json::array()}, {"optimal_gain", nullptr}, {"failed", e.what()}};
+    r.iff = IffStudy{};
+    r.iff.controller = c.analysis.controller;
+    r.iff.failed = e.what();
   }
-  json se = nullptr;
   if (c.superelement) {
     log("super element: " + c.superelement->k_file.given);
     try {
-      se = superelement_comparison(c, units, extra);
+      r.superelement = superelement_comparison(c, units);
     } catch (const NumericalError& e) {
-      se = {{"failed", e.what()}};
+      r.superelement = SuperElementComparison{};
+      r.superelement->failed = e.what();
     }
   }
-  const auto& a = c.analysis;
-  json specs = {{"flatness_um", c.specs.flatness_max ? json(*c.specs.flatness_max * 1e6) : json(nullptr)},
-                {"flatness_method", metrology::to_string(c.specs.flatness_method)},
-                {"capacitance_sensor_uF", c.specs.capacitance_sensor ? json({c.specs.capacitance_sensor->min * 1e6, c.specs.capacitance_sensor->max * 1e6}) : json(nullptr)},
-                {"capacitance_actuator_uF", c.specs.capacitance_actuator ? json({c.specs.capacitance_actuator->min * 1e6, c.specs.capacitance_actuator->max * 1e6}) : json(nullptr)},
-                {"stroke_min_um", c.specs.stroke_min ? json(*c.specs.stroke_min * 1e6) : json(nullptr)},
-                {"stiffness_N_per_um", c.specs.stiffness ? json({c.specs.stiffness->min * 1e-6, c.specs.stiffness->max * 1e-6}) : json(nullptr)},
-                {"reject_outliers", c.specs.reject_outliers}};
-  r.results = {{"title", c.title},
-               {"campaign", c.file.string()},
-               {"generator", std::string("piezobench ") + kVersion},
-               {"units", unit_list},
-               {"batch", batch.batch},
-               {"iff", iff},
-               {"superelement", se},
-               {"specs", specs},
-               {"summary", {{"units", n}, {"accepted", r.accepted}, {"rejected", r.rejected}}},
-               {"provenance",
-                {{"campaign", c.file.string()},
-                 {"window", dsp::to_string(a.window)},
-                 {"nfft", a.nfft == 0 ? json("auto (4 s, at most a quarter of the record)") : json(a.nfft)},
-                 {"overlap", a.overlap},
-                 {"detrend", "linear"},
-                 {"estimator", "H1"},
-                 {"band_Hz", {a.fmin_hz, a.fmax_hz}},
-                 {"fit_order", a.fit_order},
-                 {"bench", {{"amplifier_gain", c.bench.amplifier_gain}, {"suspended_mass_kg", c.bench.suspended_mass},
-                            {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},
-                            {"hpf_resistance_ohm", c.bench.hpf_resistance}, {"probe_accuracy_um", c.bench.probe_accuracy * 1e6}}},
-                 {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
-  r.report = report_document(c, units, r.results, extra);
+  r.batch = std::move(batch.batch);
+  r.units = std::move(units);
   return r;
 }
 
@@ -573,11 +509,12 @@ std::vector<fs::path> write_outputs(const CampaignResult& result, const fs::path
   const fs::path json_file = out_dir / "results.json";
   fs::remove(json_file, ec);  // results.json exists only for a completed run
   std::vector<fs::path> written;
-  io::write_json_as_mat(result.results, out_dir / "results.mat");
+  const json results = results_json(result);
+  io::write_json_as_mat(results, out_dir / "results.mat");
   written.push_back(out_dir / "results.mat");
-  report::write_html(result.report, out_dir / "report.html");
+  report::write_html(report_document(result), out_dir / "report.html");
   written.push_back(out_dir / "report.html");
-  io::write_text_atomically(json_file, result.results.dump(2) + "\n");
+  io::write_text_atomically(json_file, results.dump(2) + "\n");
   written.push_back(json_file);
   return written;
 }

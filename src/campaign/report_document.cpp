@@ -9,13 +9,235 @@
 #include <optional>
 #include <tuple>
 
+#include "piezobench/apa/two_dof.hpp"
+#include "piezobench/campaign/results_json.hpp"
+#include "piezobench/core/units.hpp"
+#include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
 
 namespace piezobench::campaign {
 
+using Eigen::Index;
+using Eigen::VectorXd;
 using nlohmann::json;
 
 namespace {
+
+// ------------------------------------------------------------------------------------ curves
+// The figures' data, made from the typed results: thinned records and log-spaced FRF lines.
+
+// Samples as a JSON list (non-finite values as null), each times `scale`.
+json values(const std::vector<double>& x, double scale = 1.0) {
+  json out = json::array();
+  for (const double v : x) out.push_back(std::isfinite(v) ? json(v * scale) : json(nullptr));
+  return out;
+}
+
+// Phases in degrees, unwrapped along the list (no 360 deg jumps between neighbours).
+json unwrapped_degrees(const std::vector<std::complex<double>>& h) {
+  json out = json::array();
+  double prev = 0.0, offset = 0.0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    const double p = std::arg(h[i]) * 180.0 / std::numbers::pi;
+    if (i > 0) {
+      while (p + offset - prev > 180.0) offset -= 360.0;
+      while (p + offset - prev < -180.0) offset += 360.0;
+    }
+    prev = p + offset;
+    out.push_back(prev);
+  }
+  return out;
+}
+
+// Indices of a frequency grid thinned to ~`points` log-spaced values inside [fmin, fmax].
+std::vector<Index> log_indices(const VectorXd& f, double fmin, double fmax, int points = 400) {
+  std::vector<Index> idx;
+  double next = fmin;
+  const double ratio = std::pow(fmax / fmin, 1.0 / points);
+  for (Index k = 0; k < f.size(); ++k) {
+    if (f(k) < fmin || f(k) > fmax) continue;
+    if (f(k) >= next) {
+      idx.push_back(k);
+      next = f(k) * ratio;
+    }
+  }
+  return idx;
+}
+
+// |H|, coherence and unwrapped phase of one output at the indices `idx` (|H| times `scale`).
+json frf_lines(const dsp::Frf& frf, Index output, const std::vector<Index>& idx, double scale) {
+  const auto o = static_cast<std::size_t>(output);
+  json p = {{"f", json::array()}, {"abs", json::array()}, {"coh", json::array()}};
+  std::vector<std::complex<double>> h;
+  for (const Index k : idx) {
+    p["f"].push_back(frf.freq_hz(k));
+    p["abs"].push_back(std::abs(frf.H[o](k)) * scale);
+    p["coh"].push_back(frf.coherence[o].size() > 0 ? json(frf.coherence[o](k)) : json(nullptr));
+    h.push_back(frf.H[o](k));
+  }
+  p["phase"] = unwrapped_degrees(h);
+  return p;
+}
+
+json stiffness_curves(const StiffnessAnalysis& s) {
+  return {{"t", values(s.de.x)}, {"de_um", values(s.de.y, 1e6)}, {"fit_um", values(s.fit.y, 1e6)}};
+}
+
+// The curves of one unit's analyses, under the keys the figures read.
+json unit_plots(const Campaign& c, const UnitAnalysis& u) {
+  json plots = json::object();
+  if (u.flatness_analysis) plots["flatness_deviation_um"] = values(u.flatness_analysis->deviation, 1e6);
+  if (u.stroke_analysis) {
+    plots["stroke"] = {{"Va", values(u.stroke_analysis->de_vs_va.x)}, {"de_um", values(u.stroke_analysis->de_vs_va.y, 1e6)}};
+  }
+  if (!u.hysteresis.empty()) {
+    json loops = json::array();
+    for (const auto& h : u.hysteresis) {
+      loops.push_back({{"amplitude_V", h.result.amplitude}, {"Va", values(h.loop.x)}, {"de_um", values(h.loop.y, 1e6)}});
+    }
+    plots["hysteresis"] = loops;
+  }
+  if (u.stiffness_analysis) plots["stiffness"] = stiffness_curves(*u.stiffness_analysis);
+  if (u.stiffness_open_analysis) plots["stiffness_open"] = stiffness_curves(*u.stiffness_open_analysis);
+  if (u.frf) {
+    const dsp::Frf& frf = *u.frf;
+    const VectorXd& f = frf.freq_hz;
+    const std::vector<Index> idx = log_indices(f, std::max(0.5, f(1)), std::min(2.0 * c.analysis.fmax_hz, f(f.size() - 1)));
+    VectorXd w(static_cast<Index>(idx.size()));
+    for (std::size_t i = 0; i < idx.size(); ++i) w(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
+    if (u.model_2dof) {
+      apa::TwoDofBench b = u.model_2dof->bench;
+      const lti::CMatrix hm = apa::two_dof_response(u.model_2dof->tuning.params, b, w);
+      json m = {{"f", json::array()}, {"de_abs", json::array()}, {"Vs_abs", json::array()}};
+      std::vector<std::complex<double>> mde, mvs;
+      for (Index k = 0; k < w.size(); ++k) {
+        m["f"].push_back(w(k) / kTwoPi);
+        m["de_abs"].push_back(std::abs(hm(k, 0)) * 1e6);
+        m["Vs_abs"].push_back(std::abs(hm(k, 1)));
+        mde.push_back(hm(k, 0));
+        mvs.push_back(hm(k, 1));
+      }
+      m["de_phase"] = unwrapped_degrees(mde);
+      m["Vs_phase"] = unwrapped_degrees(mvs);
+      plots["model"] = m;
+    }
+    const json de = frf_lines(frf, 0, idx, 1e6), vs = frf_lines(frf, 1, idx, 1.0);
+    json p = {{"f", de["f"]}, {"de_abs", de["abs"]}, {"de_coh", de["coh"]}, {"de_phase", de["phase"]},
+              {"Vs_abs", vs["abs"]}, {"Vs_coh", vs["coh"]}, {"Vs_phase", vs["phase"]}};
+    if (u.iff_plant) {
+      const Eigen::VectorXcd g = u.iff_plant->response(w);
+      p["iff_fit_abs"] = json::array();
+      std::vector<std::complex<double>> hg;
+      for (Index k = 0; k < g.size(); ++k) {
+        p["iff_fit_abs"].push_back(std::abs(g(k)));
+        hg.push_back(g(k));
+      }
+      p["iff_fit_phase"] = unwrapped_degrees(hg);
+    }
+    plots["frf"] = p;
+    // Every line around the anti-resonance (report Figure 2.6: coherence and phase there).
+    if (u.antiresonance_Hz) {
+      const double fz = *u.antiresonance_Hz;
+      std::vector<Index> near;
+      for (Index k = 0; k < f.size(); ++k) {
+        if (f(k) >= 0.7 * fz && f(k) <= 1.4 * fz) near.push_back(k);
+      }
+      json z = frf_lines(frf, 1, near, 1.0);
+      z["antiresonance_Hz"] = fz;
+      plots["nmp"] = z;
+    }
+  }
+  if (u.resistor) {
+    // Figure 2.7: up to 20 Hz.
+    const auto lines = [](const LowFrequencyVs& v) {
+      const VectorXd& f = v.frf.freq_hz;
+      return frf_lines(v.frf, 0, log_indices(f, v.lowest_line_Hz, std::min(20.0, f(f.size() - 1)), 200), 1.0);
+    };
+    json r = json::object();
+    if (u.resistor->with_resistor) r["with"] = lines(*u.resistor->with_resistor);
+    r["without"] = lines(u.resistor->without_resistor);
+    plots["resistor"] = r;
+  }
+  json damped = json::array();
+  for (const DampedPlant& d : u.damped) {
+    if (!d.identified) continue;
+    const VectorXd& f = d.frf.freq_hz;
+    const std::vector<Index> idx =
+        log_indices(f, std::max(f(1), 0.5 * c.analysis.damped_fmin_hz), std::min(f(f.size() - 1), 2.0 * c.analysis.damped_fmax_hz), 300);
+    VectorXd om(static_cast<Index>(idx.size()));
+    for (std::size_t i = 0; i < idx.size(); ++i) om(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
+    // The fit (delay removed) with the delay put back, to sit on the measurement.
+    const Eigen::MatrixXcd fit = d.identified->fit.evaluate(om);
+    json p = {{"gain", d.gain}, {"f", json::array()}, {"abs", json::array()}, {"fit_abs", json::array()}};
+    std::vector<std::complex<double>> hm, hf;
+    for (std::size_t i = 0; i < idx.size(); ++i) {
+      const auto k = static_cast<Index>(i);
+      const std::complex<double> g = fit(k, 0) * std::exp(std::complex<double>(0.0, -om(k) * d.delay_removed));
+      p["f"].push_back(f(idx[i]));
+      p["abs"].push_back(std::abs(d.frf.H[0](idx[i])) * 1e6);
+      p["fit_abs"].push_back(std::abs(g) * 1e6);
+      hm.push_back(d.frf.H[0](idx[i]));
+      hf.push_back(g);
+    }
+    p["phase"] = unwrapped_degrees(hm);
+    p["fit_phase"] = unwrapped_degrees(hf);
+    damped.push_back(p);
+  }
+  if (!u.damped.empty()) plots["damped"] = damped;
+  if (u.flexible_modes) {
+    const dsp::Frf& frf = u.flexible_modes->frf;
+    json x = json::array(), y = json::array();
+    for (const Index k : log_indices(frf.freq_hz, std::max(1.0, frf.freq_hz(1)), frf.freq_hz(frf.freq_hz.size() - 1), 500)) {
+      x.push_back(frf.freq_hz(k));
+      y.push_back(std::abs(frf.H[0](k)));
+    }
+    plots["hammer"] = {{"f", x}, {"abs", y}};
+  }
+  return plots;
+}
+
+// The batch-level curves: the root locus of the IFF study, the super element's u -> d_e.
+json extra_plots(const CampaignResult& r) {
+  json extra = json::object();
+  const IffStudy& s = r.iff;
+  if (s.plant && !s.failed) {
+    const IffPlantFit& p = *s.plant;
+    const auto gain_label = [](double g) { return fmt::format("g = {:.3g}", g); };
+    json branches = json::array();
+    for (const auto& b : s.branches) {
+      json text = json::array();
+      for (const double g : b.gains) text.push_back(gain_label(g));
+      branches.push_back({{"re", values(b.re_im.x)}, {"im", values(b.re_im.y)}, {"text", text}, {"resonance_branch", b.resonance_branch}});
+    }
+    json damped = json::array(), model = json::array();
+    for (std::size_t i = 0; i < s.gains.size(); ++i) {
+      damped.push_back({{"gain", s.gains[i]}, {"re", s.damped_poles[i].real()}, {"im", s.damped_poles[i].imag()}});
+      model.push_back({{"gain", s.gains[i]}, {"re", s.model_poles[i].real()}, {"im", s.model_poles[i].imag()}});
+    }
+    extra["root_locus"] = {{"branches", branches},
+                           {"open_loop_poles", {{"re", values(s.open_loop_poles.x)}, {"im", values(s.open_loop_poles.y)}}},
+                           {"open_loop_zeros", {{"re", values(s.open_loop_zeros.x)}, {"im", values(s.open_loop_zeros.y)}}},
+                           {"damped", damped},
+                           {"model_at_gains", model},
+                           {"optimum", {{"gain", s.optimal_gain.value_or(0.0)}, {"re", s.optimal_pole.real()}, {"im", s.optimal_pole.imag()},
+                                        {"damping", s.max_damping.value_or(0.0)}}},
+                           {"unit", *s.unit},
+                           {"open_loop_pole", {p.wp * -p.xp, p.wp * std::sqrt(std::max(0.0, 1 - p.xp * p.xp))}}};
+  }
+  if (r.superelement && !r.superelement->failed) {
+    extra["superelement"] = {{"f", values(r.superelement->magnitude.x)}, {"abs_um_per_V", values(r.superelement->magnitude.y, 1e6)}};
+  }
+  return extra;
+}
+
+// What the figures read of a unit.
+struct UnitPlots {
+  int id = 0;
+  std::string name;
+  json plots;
+};
+
+// ------------------------------------------------------------------------------------ layout
 
 json trace(const std::string& name, const json& x, const json& y, const std::string& group = "", bool dash = false,
            const std::string& mode = "lines") {
@@ -89,7 +311,7 @@ std::pair<json, json> on_branch(const json& f_model, const json& ph_model, const
 
 // Magnitude and phase (and coherence) of one output, all units, the measurement solid and a model
 // dashed, the model's phase on the measurement's branch.
-json frf_figure(const std::vector<UnitAnalysis>& units, const std::string& out, const std::string& id, const std::string& title,
+json frf_figure(const std::vector<UnitPlots>& units, const std::string& out, const std::string& id, const std::string& title,
                 const std::string& unit_label, const std::string& model_key, const std::string& model_abs,
                 const std::string& model_phase, const std::string& model_name, bool coherence, const std::string& text) {
   json mag = json::array(), phase = json::array(), coh = json::array();
@@ -113,15 +335,14 @@ json frf_figure(const std::vector<UnitAnalysis>& units, const std::string& out, 
 
 std::string amplitude_label(double a) { return fmt::format("{:.3g} V", a); }
 
-}  // namespace
-
-json report_document(const Campaign& c, const std::vector<UnitAnalysis>& units, const json& results, const json& extra) {
+// The document from the results.json document, the units' curves and the batch curves.
+json document(const Campaign& c, const std::vector<UnitPlots>& units, const json& results, const json& extra) {
   json sections = json::array();
   const auto any = [&](const char* key) {
-    return std::any_of(units.begin(), units.end(), [&](const UnitAnalysis& u) { return has(u.plots, key); });
+    return std::any_of(units.begin(), units.end(), [&](const UnitPlots& u) { return has(u.plots, key); });
   };
   const json& result_units = results["units"];
-  const auto result_of = [&](const UnitAnalysis& u) -> json {
+  const auto result_of = [&](const UnitPlots& u) -> json {
     for (const auto& r : result_units) {
       if (r.contains("id") && r["id"] == u.id) return r;
     }
@@ -226,7 +447,7 @@ json report_document(const Campaign& c, const std::vector<UnitAnalysis>& units, 
   {
     json figs = json::array(), tables = json::array(), warnings = json::array();
     // Figure 2.8: the IFF plant of the IFF unit against its fit.
-    const UnitAnalysis* iff_unit = nullptr;
+    const UnitPlots* iff_unit = nullptr;
     const json iff = at(results, {"iff"});
     for (const auto& u : units) {
       if (!iff_unit && has(u.plots, "frf") && has(u.plots["frf"], "iff_fit_abs") && (!has(iff, "unit") || iff["unit"] == u.id)) iff_unit = &u;
@@ -548,7 +769,7 @@ json report_document(const Campaign& c, const std::vector<UnitAnalysis>& units, 
       mag.push_back(trace("super element", se["f"], se["abs_um_per_V"], "super element", true));
       json panels = json::array({panel("|H| [um/V]", true, mag)});
       if (has(se, "phase_deg")) {
-        const UnitAnalysis* ref = nullptr;
+        const UnitPlots* ref = nullptr;
         for (const auto& u : units) {
           if (!ref && has(u.plots, "frf")) ref = &u;
         }
@@ -572,6 +793,14 @@ json report_document(const Campaign& c, const std::vector<UnitAnalysis>& units, 
           {"subtitle", fmt::format("{} — piezobench {}", c.file.filename().string(), kVersion)},
           {"results", results},
           {"sections", sections}};
+}
+
+}  // namespace
+
+json report_document(const CampaignResult& result) {
+  std::vector<UnitPlots> units;
+  for (const auto& u : result.units) units.push_back({u.id, u.name, unit_plots(result.campaign, u)});
+  return document(result.campaign, units, results_json(result), extra_plots(result));
 }
 
 }  // namespace piezobench::campaign

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "piezobench/campaign/pipeline.hpp"
+#include "piezobench/campaign/results_json.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::campaign {
@@ -26,9 +27,10 @@ TEST(Demo, ResultsAgreeWithTheBenchTruth) {
   EXPECT_EQ(files.data.size(), 2u * 11u + 5u);
   const json truth = json::parse(test::read_text(files.truth));
   const CampaignResult r = run_campaign(read_campaign(files.campaign));
-  ASSERT_EQ(r.results["units"].size(), 2u);
+  const json results = results_json(r);
+  ASSERT_EQ(results["units"].size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
-    const json& u = r.results["units"][i];
+    const json& u = results["units"][i];
     const json& t = truth["units"][i];
     ASSERT_EQ(u["id"], t["id"]);
     SCOPED_TRACE("unit " + std::to_string(u["id"].get<int>()));
@@ -58,11 +60,11 @@ TEST(Demo, ResultsAgreeWithTheBenchTruth) {
   }
   // Unit 3 rejected for its capacitance and its stroke.
   std::string reasons;
-  for (const auto& x : r.results["units"][1]["reasons"]) reasons += x.get<std::string>() + "\n";
+  for (const auto& x : results["units"][1]["reasons"]) reasons += x.get<std::string>() + "\n";
   EXPECT_TRUE(test::contains(reasons, "capacitance")) << reasons;
   EXPECT_TRUE(test::contains(reasons, "stroke")) << reasons;
   // The IFF study of unit 1.
-  const json& iff = r.results["iff"];
+  const json& iff = results["iff"];
   EXPECT_EQ(iff["unit"], 1);
   EXPECT_EQ(iff["gains"].size(), 4u);
   EXPECT_GT(iff["optimal_gain"].get<double>(), 1e5);

@@ -4,6 +4,7 @@
 
 #include <fstream>
 
+#include "piezobench/campaign/results_json.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "synthetic.hpp"
 #include "test_util.hpp"
@@ -75,36 +76,42 @@ TEST(UnitAnalysis, EveryAnalysisOnKnownRecords) {
   }
   ASSERT_GT(zero.real(), 0.0);
   // FRF features.
-  ASSERT_TRUE(u.resonance_hz && u.antiresonance_hz && u.static_gain);
-  EXPECT_TRUE(near(*u.resonance_hz, truth.resonance / (2 * M_PI), 1e-3));
-  EXPECT_TRUE(near(*u.antiresonance_hz, truth.antiresonance / (2 * M_PI), 2e-3));
+  ASSERT_TRUE(u.resonance_Hz && u.antiresonance_Hz && u.static_gain);
+  EXPECT_TRUE(near(*u.resonance_Hz, truth.resonance / (2 * M_PI), 1e-3));
+  EXPECT_TRUE(near(*u.antiresonance_Hz, truth.antiresonance / (2 * M_PI), 2e-3));
   EXPECT_TRUE(near(*u.static_gain, truth.static_gain_de, 1e-2));
-  const auto& frf = u.result["frf"];
-  EXPECT_EQ(frf["zero_is_nonminimum_phase"], true);
-  EXPECT_EQ(frf["nmp_evidence"]["phase_verdict"], "non-minimum-phase");
-  EXPECT_TRUE(near(frf["antiresonance_damping"].get<double>(), -zero.real() / std::abs(zero), 0.2));
+  ASSERT_TRUE(u.frf_analysis);
+  const FrfAnalysis& frf = *u.frf_analysis;
+  EXPECT_EQ(frf.zero_is_nonminimum_phase, true);
+  ASSERT_TRUE(frf.nmp.zero);
+  EXPECT_EQ(frf.nmp.zero->phase_verdict, ident::PhaseVerdict::kNonMinimumPhase);
+  EXPECT_TRUE(near(*frf.antiresonance_damping, -zero.real() / std::abs(zero), 0.2));
   // The Hann window over 0.33 Hz bins widens a 1.1 Hz wide peak by ~10 %.
-  EXPECT_TRUE(near(frf["resonance_damping"].get<double>(), truth.resonance_damping, 0.15));
-  EXPECT_EQ(frf["provenance"]["channels"]["de"], "d_enc");
-  EXPECT_EQ(frf["welch"]["nfft"], 30000);  // a quarter of the 12 s record (less than 4 s)
-  EXPECT_GT(frf["welch"]["averages"].get<int>(), 4);
+  EXPECT_TRUE(near(*frf.resonance_damping, truth.resonance_damping, 0.15));
+  const auto de_channel = std::find_if(frf.provenance.channels.begin(), frf.provenance.channels.end(),
+                                       [](const auto& rc) { return rc.first == "de"; });
+  ASSERT_NE(de_channel, frf.provenance.channels.end());
+  EXPECT_EQ(de_channel->second, "d_enc");
+  EXPECT_EQ(frf.welch.nfft, 30000);  // a quarter of the 12 s record (less than 4 s)
+  EXPECT_GT(frf.welch.averages, 4);
   // The delays: 200 us and half a sample of the zero-order hold.
   EXPECT_TRUE(near(u.de_plant->delay, 250e-6, 0.05));
   EXPECT_GT(u.iff_plant->delay, 200e-6);
   EXPECT_LT(u.iff_plant->delay, 350e-6);
-  EXPECT_TRUE(near(u.result["hpf_corner_Hz"].get<double>(), 1.0 / (2 * M_PI * 80.6e3 * 5e-6), 1e-12));
+  EXPECT_TRUE(near(*frf.hpf.corner_Hz, 1.0 / (2 * M_PI * 80.6e3 * 5e-6), 1e-12));
   // The tuned 2-DoF model: the stiffnesses and gains of Table 3.1.
-  const auto& m = u.result["model_2dof"];
+  ASSERT_TRUE(u.model_2dof);
+  const apa::TwoDofParams& m = u.model_2dof->tuning.params;
   const apa::TwoDofParams p;
-  for (const char* name : {"k1", "ke", "ka", "ga", "gs"}) EXPECT_TRUE(near(m[name].get<double>(), p.get(name), 0.02)) << name;
-  EXPECT_DOUBLE_EQ(m["m"].get<double>(), 5.7);
+  for (const char* name : {"k1", "ke", "ka", "ga", "gs"}) EXPECT_TRUE(near(m.get(name), p.get(name), 0.02)) << name;
+  EXPECT_DOUBLE_EQ(m.get("m"), 5.7);
   // Stiffness from the resonance k = m w^2.
   EXPECT_TRUE(near(*u.k_resonance, 5.7 * std::pow(truth.resonance, 2), 2e-3));
   // Quasi-static analyses.
   EXPECT_TRUE(near(*u.stroke, 170.0 * 1.5e-6, 1e-6));
-  ASSERT_EQ(u.result["hysteresis"].size(), 2u);
-  EXPECT_TRUE(near(u.result["hysteresis"][0]["relative_width"].get<double>(), std::sin(0.03), 1e-3));  // sorted by amplitude
-  EXPECT_TRUE(near(u.result["hysteresis"][1]["relative_width"].get<double>(), std::sin(0.1), 1e-4));
+  ASSERT_EQ(u.hysteresis.size(), 2u);
+  EXPECT_TRUE(near(u.hysteresis[0].result.relative_width, std::sin(0.03), 1e-3));  // sorted by amplitude
+  EXPECT_TRUE(near(u.hysteresis[1].result.relative_width, std::sin(0.1), 1e-4));
   EXPECT_TRUE(near(*u.k1, 1.9e6, 1e-9));
   EXPECT_TRUE(near(*u.k2, 1.9e6, 1e-9));
   EXPECT_TRUE(near(*u.flatness, 4e-6, 1e-6));  // minimum zone of the saddle = least squares = 2 d
@@ -119,21 +126,23 @@ TEST(UnitAnalysis, EveryAnalysisOnKnownRecords) {
   // the same FRF read as the record without the resistor the same corner.
   ASSERT_TRUE(u.k_oc.has_value());
   EXPECT_DOUBLE_EQ(*u.k_oc, *u.k1);
-  EXPECT_DOUBLE_EQ(u.result["stiffness_N_per_um"]["k_oc"].get<double>(), u.result["stiffness_N_per_um"]["k_sc"].get<double>());
-  const nlohmann::json& hr = u.result["hpf_resistor"];
-  EXPECT_EQ(hr["with_resistor"]["fitted_corner_Hz"], hr["without_resistor"]["fitted_corner_Hz"]);
-  EXPECT_TRUE(u.plots["resistor"].contains("with") && u.plots["resistor"].contains("without"));
+  const nlohmann::json stiff = unit_json(u)["stiffness_N_per_um"];
+  EXPECT_DOUBLE_EQ(stiff["k_oc"].get<double>(), stiff["k_sc"].get<double>());
+  ASSERT_TRUE(u.resistor && u.resistor->with_resistor);
+  EXPECT_EQ(u.resistor->with_resistor->fitted_corner_Hz, u.resistor->without_resistor.fitted_corner_Hz);
   // Hammer: both modes by both methods (the Hann window over 1 s segments cuts some of the impacts'
   // responses: a few tenths of a percent).
-  const auto& modes = u.result["flexible_modes"];
-  ASSERT_EQ(modes["lscf"].size(), 2u);
-  EXPECT_TRUE(near(modes["lscf"][0]["frequency_Hz"].get<double>(), 280.0, 5e-3));
-  EXPECT_TRUE(near(modes["lscf"][1]["frequency_Hz"].get<double>(), 412.0, 5e-3));
-  ASSERT_EQ(modes["peak_picking"].size(), 2u);
-  EXPECT_TRUE(near(modes["peak_picking"][0]["frequency_Hz"].get<double>(), 280.0, 5e-3));
-  EXPECT_TRUE(near(modes["peak_picking"][1]["frequency_Hz"].get<double>(), 412.0, 5e-3));
+  ASSERT_TRUE(u.flexible_modes);
+  const FlexibleModes& modes = *u.flexible_modes;
+  ASSERT_EQ(modes.lscf.size(), 2u);
+  EXPECT_TRUE(near(modes.lscf[0].frequency_Hz, 280.0, 5e-3));
+  EXPECT_TRUE(near(modes.lscf[1].frequency_Hz, 412.0, 5e-3));
+  ASSERT_EQ(modes.peak_picking.size(), 2u);
+  EXPECT_TRUE(near(modes.peak_picking[0].frequency_Hz, 280.0, 5e-3));
+  EXPECT_TRUE(near(modes.peak_picking[1].frequency_Hz, 412.0, 5e-3));
   // Plot data for the report.
-  EXPECT_TRUE(u.plots.contains("frf") && u.plots.contains("model") && u.plots.contains("hysteresis"));
+  EXPECT_FALSE(u.hysteresis[0].loop.x.empty());
+  EXPECT_EQ(u.hysteresis[0].loop.x.size(), u.hysteresis[0].loop.y.size());
 }
 
 TEST(UnitAnalysis, ExperimentsNotListedAreNotMeasured) {
@@ -141,10 +150,16 @@ TEST(UnitAnalysis, ExperimentsNotListedAreNotMeasured) {
   const Campaign c = f.campaign("stiffness = \"stiff.mat\"\n");
   const UnitAnalysis u = analyze_unit(c, c.units[0]);
   EXPECT_EQ(u.not_measured.size(), all_experiments().size() - 1);
-  EXPECT_TRUE(u.result["frf"].is_null());
-  EXPECT_TRUE(u.result["flatness_um"].is_null());
-  EXPECT_TRUE(u.result["stiffness_N_per_um"]["resonance"].is_null());
-  EXPECT_NEAR(u.result["stiffness_N_per_um"]["k1"].get<double>(), 1.9, 1e-9);
+  EXPECT_FALSE(u.frf_analysis);
+  EXPECT_FALSE(u.flatness);
+  EXPECT_FALSE(u.k_resonance);
+  EXPECT_NEAR(*u.k1, 1.9e6, 1e-3);
+  // results.json: absent analyses are null.
+  const nlohmann::json r = unit_json(u);
+  EXPECT_TRUE(r["frf"].is_null());
+  EXPECT_TRUE(r["flatness_um"].is_null());
+  EXPECT_TRUE(r["stiffness_N_per_um"]["resonance"].is_null());
+  EXPECT_NEAR(r["stiffness_N_per_um"]["k1"].get<double>(), 1.9, 1e-9);
 }
 
 // A channel that is not in the file: the error names the campaign file, the key and the channel.
@@ -176,7 +191,8 @@ TEST(UnitAnalysis, CapacitanceReadingsOfOneSample) {
     const Campaign c = f.campaign(std::string("capacitance = \"") + file + "\"\n");
     const UnitAnalysis u = analyze_unit(c, c.units[0]);
     EXPECT_DOUBLE_EQ(*u.capacitance_sensor, 5.1e-6) << file;
-    EXPECT_DOUBLE_EQ(u.result["capacitance_uF"]["actuator"].get<double>(), 10.03) << file;
+    EXPECT_DOUBLE_EQ(u.capacitance_analysis->actuator, 10.03e-6) << file;
+    EXPECT_DOUBLE_EQ(unit_json(u)["capacitance_uF"]["actuator"].get<double>(), 10.03) << file;
   }
 }
 

@@ -17,11 +17,11 @@
 // when the run completed. Only these fixed names under OUT are written.
 #include <filesystem>
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "piezobench/campaign/campaign_file.hpp"
+#include "piezobench/campaign/results.hpp"
 #include "piezobench/campaign/unit_analysis.hpp"
 
 namespace piezobench::campaign {
@@ -31,18 +31,12 @@ struct PipelineOptions {
   Log log;          // progress lines (called under a lock; may be empty)
 };
 
-struct CampaignResult {
-  nlohmann::json results;  // the results.json document (CLI.md keys)
-  nlohmann::json report;   // the report document (report/html_report.hpp)
-  int accepted = 0;
-  int rejected = 0;
-};
-
 // Analyses every unit and the batch. InputError for bad data (the first in unit order, the other
 // units stop early); a NumericalError inside an analysis is recorded, not thrown.
 CampaignResult run_campaign(const Campaign& campaign, const PipelineOptions& options = {});
 
-// Writes results.mat, report.html and results.json into `out_dir` (created if needed); returns
+// Writes results.mat, report.html and results.json (results_json.hpp, report_document.hpp) into
+// `out_dir` (created if needed); returns
 // the paths written. InputError when a file cannot be written.
 std::vector<std::filesystem::path> write_outputs(const CampaignResult& result, const std::filesystem::path& out_dir);
 

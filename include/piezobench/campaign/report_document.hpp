@@ -14,15 +14,12 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "piezobench/campaign/campaign_file.hpp"
-#include "piezobench/campaign/unit_analysis.hpp"
+#include "piezobench/campaign/results.hpp"
 
 namespace piezobench::campaign {
 
-// `extra` holds the batch-level plot data the pipeline computed: "root_locus" {branches:
-// [{re, im}], damped: [{gain, re, im}], model_at_gains: [...]}, "superelement" {f, abs} (either may be
-// absent).
-nlohmann::json report_document(const Campaign& campaign, const std::vector<UnitAnalysis>& units,
-                                const nlohmann::json& results, const nlohmann::json& extra);
+// The report document of a campaign's typed results; its `results` entry is results.json
+// (results_json.hpp).
+nlohmann::json report_document(const CampaignResult& result);
 
 }  // namespace piezobench::campaign

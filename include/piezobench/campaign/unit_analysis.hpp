@@ -28,15 +28,14 @@
 // on valid data (NumericalError) is recorded in `failed` and the analysis is left out; the unit is
 // then not accepted (pipeline.hpp). An experiment the campaign does not list is `not_measured`.
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/iff_plant_fit.hpp"
+#include "piezobench/campaign/results.hpp"
 #include "piezobench/dsp/frf.hpp"
-#include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/io/timeseries.hpp"
 
@@ -58,45 +57,9 @@ struct Record {
 // file, field = spec.key) wrapping the reader's message: missing channel, NaN, bad time vector, ...
 Record load_record(const Campaign& campaign, const FileSpec& spec, Experiment experiment);
 
-struct DampedPlant {
-  double gain = 0.0;             // controller gain g
-  std::string file;              // as given in the campaign
-  dsp::Frf frf;                  // u' -> d_e
-  // The damped pole: the dominant pair of a vector fit in the damped-plant band, d_e's delay
-  // removed (ident/dominant_pole.hpp, as `iff study`).
-  std::optional<ident::DominantPole> identified;
-  // The report's second-order fit of the same data, for comparison (nullopt when it failed).
-  std::optional<DelayedSecondOrderFit> second_order;
-  double delay_removed = 0.0;    // s
-};
-
-struct UnitAnalysis {
-  int id = 0;
-  std::string name;
-  // The unit's entry of results.json without `accepted` and `reasons` (CLI.md keys, plus details):
-  // absent analyses are null.
-  nlohmann::json result;
-  // Downsampled data for the report's figures.
-  nlohmann::json plots;
-  // The numbers the batch analyses and the acceptance need (SI; nullopt = not available).
-  std::optional<double> flatness;            // m, by the spec's method
-  std::optional<double> capacitance_sensor;  // F
-  std::optional<double> capacitance_actuator;
-  std::optional<double> stroke;              // m
-  std::optional<double> k1, k2, k_resonance; // N/m
-  std::optional<double> k_oc;                // N/m, k1 of the test with every stack open
-  std::optional<double> resonance_hz, antiresonance_hz, static_gain;  // Hz, Hz, m/V
-  std::optional<dsp::Frf> frf;               // u -> [de, Vs] (outputs named "de", "Vs")
-  std::optional<IffPlantFit> iff_plant;     // u -> Vs, eq. 2.3 with delay
-  std::optional<DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
-  std::vector<DampedPlant> damped;
-  std::vector<std::string> not_measured;     // experiments the campaign does not list
-  std::vector<std::string> failed;           // "frf: vector fitting failed: ..." (NumericalError)
-};
-
 using Log = std::function<void(const std::string&)>;
 
-// All analyses of one unit (single-threaded; the pipeline runs units in parallel).
+// All analyses of one unit (results.hpp; the acceptance is left to the pipeline) (single-threaded; the pipeline runs units in parallel).
 UnitAnalysis analyze_unit(const Campaign& campaign, const UnitSpec& unit, const Log& log = {});
 
 // Welch segment length used for a record of `samples` at `fs`: the campaign's nfft, or 4 s of data

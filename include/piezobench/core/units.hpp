@@ -1,0 +1,9 @@
+#pragma once
+// Constants shared by every module.
+#include <numbers>
+
+namespace piezobench {
+
+inline constexpr double kTwoPi = 2.0 * std::numbers::pi;  // rad per cycle: omega [rad/s] = kTwoPi f [Hz]
+
+}  // namespace piezobench

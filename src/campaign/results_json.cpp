@@ -1,0 +1,398 @@
+#include "piezobench/campaign/results_json.hpp"
+
+#include <fmt/format.h>
+
+#include "piezobench/core/units.hpp"
+#include "piezobench/io/json.hpp"
+#include "piezobench/version.hpp"
+
+namespace piezobench::campaign {
+
+using nlohmann::json;
+
+namespace {
+
+json num(double v) { return io::to_json(v); }
+json opt(const std::optional<double>& v, double scale = 1.0) { return v ? num(*v * scale) : json(nullptr); }
+
+json provenance(const RecordProvenance& p) {
+  json ch = json::object();
+  for (const auto& [role, name] : p.channels) ch[role] = name;
+  json out = {{"file", p.file}, {"key", p.key}, {"channels", ch}, {"samples", p.samples}, {"sample_rate_Hz", p.sample_rate_Hz}};
+  if (!p.input.empty()) {
+    out["input"] = p.input;
+    out["outputs"] = p.outputs;
+  }
+  return out;
+}
+
+json welch(const dsp::FrfProvenance& p) {
+  return {{"estimator", p.estimator}, {"window", p.window}, {"nfft", p.nfft}, {"overlap", p.overlap},
+          {"detrend", p.detrend},     {"averages", p.averages}, {"resolution_Hz", p.sample_rate / static_cast<double>(p.nfft)}};
+}
+
+json flatness(const FlatnessAnalysis& f) {
+  json per_interface = json::array();
+  for (const auto& i : f.per_interface) per_interface.push_back({{"interface", i.id}, {"least_squares_um", i.least_squares * 1e6}});
+  return {{"method", metrology::to_string(f.method)},
+          {"least_squares_um", f.least_squares * 1e6},
+          {"minimum_zone_um", opt(f.minimum_zone, 1e6)},
+          {"points", f.points},
+          {"per_interface", per_interface},
+          {"probe_accuracy_um", f.probe_accuracy * 1e6},
+          {"provenance", provenance(f.provenance)}};
+}
+
+json stroke(const StrokeAnalysis& s) {
+  return {{"va_min_V", s.result.va_min},
+          {"va_max_V", s.result.va_max},
+          {"sensitivity_um_per_V", s.result.sensitivity * 1e6},
+          {"loop_width_um", s.result.loop_width * 1e6},
+          {"provenance", provenance(s.provenance)}};
+}
+
+json hysteresis(const std::vector<HysteresisLoop>& loops) {
+  json list = json::array();
+  for (const auto& l : loops) {
+    const auto& h = l.result;
+    list.push_back({{"amplitude_V", h.amplitude},
+                    {"offset_V", h.offset},
+                    {"width_um", h.width * 1e6},
+                    {"loop_stroke_um", h.loop_stroke * 1e6},
+                    {"relative_width", h.relative_width},
+                    {"periods", h.periods},
+                    {"provenance", provenance(l.provenance)}});
+  }
+  return list;
+}
+
+json stiffness(const StiffnessAnalysis& a) {
+  const auto& s = a.result;
+  const auto& o = a.options;
+  return {{"k1_N_per_um", s.k1 * 1e-6},
+          {"k2_N_per_um", s.k2 * 1e-6},
+          {"t_on_s", s.t_on},
+          {"t_off_s", s.t_off},
+          {"readings_um", {{"before", s.d_before * 1e6}, {"loaded", s.d_loaded * 1e6}, {"after", s.d_after * 1e6}}},
+          {"reading_windows_s",
+           {{"before", {o.before_s[0], o.before_s[1]}}, {"loaded", {o.loaded_s[0], o.loaded_s[1]}}, {"after", {o.after_s[0], o.after_s[1]}}}},
+          {"elastic_N_per_um", {{"on", s.k_elastic_on * 1e-6}, {"off", s.k_elastic_off * 1e-6}}},
+          {"creep_um_per_decade", {{"on", s.creep_on * 1e6}, {"off", s.creep_off * 1e6}}},
+          {"creep_time_constant_s", s.creep_time_constant},
+          {"fit_rms_um", s.rms_residual * 1e6},
+          {"added_mass_kg", o.added_mass},
+          {"gravity_m_per_s2", o.gravity},
+          {"mass_log", a.mass_log},
+          {"provenance", provenance(a.provenance)}};
+}
+
+json vector_fit(const VectorFitSummary& v) {
+  return {{"order", v.order}, {"relative_rms_error", v.relative_rms_error}, {"converged", v.converged}};
+}
+
+json hpf(const HighPassCorner& h) {
+  json out = json::object();
+  if (h.first_order_fit_Hz) {
+    out["first_order_fit_Hz"] = *h.first_order_fit_Hz;
+    out["first_order_fit_points"] = h.first_order_fit_points;
+  }
+  if (h.r_c_Hz) out["R_C_Hz"] = *h.r_c_Hz;
+  if (h.iff_plant_fit_Hz) {
+    out["iff_plant_fit_Hz"] = *h.iff_plant_fit_Hz;
+  } else if (h.iff_plant_fit_error) {
+    out["iff_plant_fit_Hz"] = nullptr;
+    out["iff_plant_fit_error"] = *h.iff_plant_fit_error;
+  }
+  out["method"] = h.method;
+  return out;
+}
+
+json frf(const FrfAnalysis& f) {
+  json out = {{"provenance", provenance(f.provenance)}, {"welch", welch(f.welch)}};
+  if (f.fit_de) out["fit_de"] = vector_fit(*f.fit_de);
+  if (f.fit_vs) out["fit_Vs"] = vector_fit(*f.fit_vs);
+  if (f.static_gain_vs) out["static_gain_Vs_V_per_V"] = *f.static_gain_vs;
+  if (f.static_gain_vector_fit) out["static_gain_vector_fit_um_per_V"] = *f.static_gain_vector_fit * 1e6;
+  out["static_gain_um_per_V"] = opt(f.static_gain, 1e6);
+  if (!f.static_gain_source.empty()) out["static_gain_source"] = f.static_gain_source;
+  if (f.de_plant) {
+    const auto& p = *f.de_plant;
+    out["de_plant_fit"] = {{"static_gain_um_per_V", p.static_gain * 1e6},
+                           {"resonance_Hz", p.natural_frequency / kTwoPi},
+                           {"damping", p.damping},
+                           {"delay_s", p.delay},
+                           {"relative_rms_error", p.relative_rms_error},
+                           {"points", p.points}};
+  }
+  if (f.iff_plant) {
+    const auto& p = *f.iff_plant;
+    out["iff_plant_fit"] = {{"g0", p.g0},
+                            {"wz_Hz", p.wz / kTwoPi},
+                            {"xz", p.xz},
+                            {"wp_Hz", p.wp / kTwoPi},
+                            {"xp", p.xp},
+                            {"w_hpf_Hz", p.w_hpf / kTwoPi},
+                            {"w_hpf_from", f.iff_plant_w_hpf_measured ? "R C_sensor" : "fit"},
+                            {"delay_s", p.delay},
+                            {"band_Hz", {f.iff_plant_fmin_Hz, f.iff_plant_fmax_Hz}},
+                            {"relative_rms_error", p.relative_rms_error},
+                            {"points", p.points},
+                            {"iterations", p.iterations}};
+  }
+  json nmp = json::object();
+  if (f.nmp.zero) {
+    const auto& z = *f.nmp.zero;
+    nmp = {{"phase_verdict", ident::to_string(z.phase_verdict)},
+           {"phase_change_deg", z.phase_change_deg},
+           {"fitted_zero", io::to_json(z.fitted_zero)},
+           {"fitted_zero_nonminimum_phase", z.fitted_zero_nonminimum_phase}};
+  }
+  if (f.nmp.iff_plant_fit_xz) nmp["iff_plant_fit_xz"] = *f.nmp.iff_plant_fit_xz;
+  nmp["verdict_from"] = f.nmp.verdict_from;
+  out["nmp_evidence"] = nmp;
+  if (f.antiresonance_vector_fit_Hz) {
+    out["antiresonance_vector_fit_Hz"] = *f.antiresonance_vector_fit_Hz;
+    out["antiresonance_vector_fit_damping"] = *f.antiresonance_vector_fit_damping;
+  }
+  if (f.resonance_vector_fit_Hz) {
+    out["resonance_vector_fit_Hz"] = *f.resonance_vector_fit_Hz;
+    out["resonance_vector_fit_damping"] = *f.resonance_vector_fit_damping;
+  }
+  out["resonance_Hz"] = opt(f.resonance_Hz);
+  out["resonance_damping"] = opt(f.resonance_damping);
+  out["antiresonance_Hz"] = opt(f.antiresonance_Hz);
+  out["antiresonance_damping"] = opt(f.antiresonance_damping);
+  out["zero_is_nonminimum_phase"] = f.zero_is_nonminimum_phase ? json(*f.zero_is_nonminimum_phase) : json(nullptr);
+  out["shell_stiffness_N_per_um"] = opt(f.shell_stiffness, 1e-6);
+  return out;
+}
+
+void model_2dof(const Model2DofFit& m, json& unit) {
+  const apa::TwoDofTuning& t = m.tuning;
+  json params = json::object();
+  for (const auto& name : apa::TwoDofParams::names()) params[name] = t.params.get(name);
+  unit["model_2dof"] = params;
+  unit["model_2dof_fit"] = {{"status", apa::to_string(t.status)},
+                            {"iterations", t.iterations},
+                            {"relative_error_de", t.fit_error_de},
+                            {"relative_error_Vs", t.fit_error_vs},
+                            {"points", t.points},
+                            {"delay_s", m.bench.delay},
+                            {"band_Hz", {m.fmin_Hz, m.fmax_Hz}},
+                            {"units", "SI: kg, N/m, N s/m, N/V, V/m"}};
+}
+
+json damped_plants(const std::vector<DampedPlant>& plants) {
+  json list = json::array();
+  for (const DampedPlant& d : plants) {
+    json entry = {{"gain", d.gain}, {"provenance", provenance(d.provenance)}, {"welch", welch(d.frf.provenance)},
+                  {"delay_removed_s", d.delay_removed}, {"fit", nullptr}, {"second_order_fit", nullptr}};
+    if (d.identified) {
+      entry["fit"] = {{"frequency_Hz", d.identified->frequency_hz()},
+                      {"damping", d.identified->damping},
+                      {"pole", io::to_json(d.identified->pole)},
+                      {"order", d.identified_order},
+                      {"relative_rms_error", d.identified->fit.relative_rms_error},
+                      {"band_Hz", {d.fmin_Hz, d.fmax_Hz}},
+                      {"method", "vector fitting, the dominant pole pair (largest |r|/|Re p|) in the band; delay of d_e removed"}};
+    }
+    if (d.second_order) {
+      entry["second_order_fit"] = {{"frequency_Hz", d.second_order->natural_frequency / kTwoPi},
+                                   {"damping", d.second_order->damping},
+                                   {"pole", io::to_json(d.second_order->pole())},
+                                   {"relative_rms_error", d.second_order->relative_rms_error},
+                                   {"method", "the report's: k wn^2/(s^2 + 2 zeta wn s + wn^2), weighted Levenberg-Marquardt"}};
+    }
+    list.push_back(entry);
+  }
+  return list;
+}
+
+json low_frequency_vs(const LowFrequencyVs& v) {
+  json out = {{"provenance", provenance(v.provenance)}, {"welch", welch(v.frf.provenance)}, {"lowest_line_Hz", v.lowest_line_Hz},
+              {"band_Hz", {v.lowest_line_Hz, v.fmax_Hz}}, {"corner_Hz", nullptr}, {"observable", false}};
+  if (v.fitted_corner_Hz) {
+    out["observable"] = v.observable;
+    out["fitted_corner_Hz"] = *v.fitted_corner_Hz;
+    out["relative_rms_error"] = v.relative_rms_error;
+    out["points"] = v.points;
+    if (v.observable) {
+      out["corner_Hz"] = *v.fitted_corner_Hz;
+    } else {
+      out["below_Hz"] = v.lowest_line_Hz / 3.0;
+      out["note"] = fmt::format("not observable in this record: the fitted corner ({:.2g} Hz) is below a third of the lowest line "
+                                "({:.3g} Hz)", *v.fitted_corner_Hz, v.lowest_line_Hz);
+    }
+  }
+  return out;
+}
+
+json resistor(const ResistorComparison& r) {
+  return {{"with_resistor", r.with_resistor ? low_frequency_vs(*r.with_resistor) : json(nullptr)},
+          {"without_resistor", low_frequency_vs(r.without_resistor)},
+          {"method", "first-order high-pass g s/(s + wc) fitted to u -> Vs below hpf_fmax_Hz (Welch, segments of half the record)"}};
+}
+
+json flexible_modes(const FlexibleModes& m) {
+  json peaks = json::array(), modes = json::array();
+  for (const auto& p : m.peak_picking) peaks.push_back({{"frequency_Hz", p.frequency_Hz}, {"damping", p.damping}});
+  for (const auto& p : m.lscf) modes.push_back({{"frequency_Hz", p.frequency_Hz}, {"damping", p.damping}, {"stable_orders", p.stable_orders}});
+  return {{"provenance", provenance(m.provenance)}, {"welch", welch(m.welch)}, {"peak_picking", peaks}, {"lscf", modes}};
+}
+
+json batch(const BatchAnalysis& b) {
+  json outliers = json::array();
+  for (const auto& o : b.outliers) {
+    outliers.push_back({{"unit", o.unit}, {"quantity", o.quantity}, {"value", o.value}, {"median", o.median}, {"robust_z", num(o.robust_z)}});
+  }
+  json spread = json::object();
+  for (const auto& s : b.spread) {
+    spread[s.quantity] = {{"units", s.units}, {"min", s.min}, {"max", s.max}, {"median", s.median},
+                          {"relative_spread", s.relative_spread}, {"mad", s.mad}};
+  }
+  json similarity = json::object();
+  if (b.similarity) {
+    const FrfSimilarity& s = *b.similarity;
+    json per_unit = json::array();
+    for (const auto& u : s.units) per_unit.push_back({{"unit", u.unit}, {"de_rms_dB", num(u.de_rms_dB)}, {"Vs_rms_dB", num(u.vs_rms_dB)}});
+    similarity = {{"reference", "median |H| of the batch"}, {"band_Hz", {s.fmin_Hz, s.fmax_Hz}}, {"units", per_unit}, {"max_rms_dB", s.max_rms_dB}};
+  }
+  return {{"outliers", outliers}, {"spread", spread}, {"similarity", similarity},
+          {"outlier_rule", {{"robust_z_threshold", b.rule.threshold}, {"min_relative_deviation", b.rule.min_relative_deviation},
+                            {"rejects", b.rejects}}}};
+}
+
+json iff(const IffStudy& s) {
+  if (s.failed) return {{"gains", json::array()}, {"damped_poles", json::array()}, {"optimal_gain", nullptr}, {"failed", *s.failed}};
+  const control::IffControllerParams& k = s.controller;
+  json out = {{"unit", s.unit ? json(*s.unit) : json(nullptr)}, {"gains", s.gains}, {"damped_poles", json::array()}, {"optimal_gain", opt(s.optimal_gain)}};
+  out["controller"] = {{"gain", k.gain}, {"hpf_Hz", k.w_hpf / kTwoPi}, {"lpf_Hz", k.w_lpf / kTwoPi}, {"robust_Hz", k.w_robust / kTwoPi},
+                       {"formula", "K(s) = gain g s/(s + w_hpf) 1/(s + w_lpf) 1/(s + w_robust) (eq. 2.4)"}};
+  if (!s.plant) {
+    out["note"] = s.note;
+    return out;
+  }
+  const IffPlantFit& p = *s.plant;
+  out["plant"] = {{"g0", p.g0}, {"wz_Hz", p.wz / kTwoPi}, {"xz", p.xz}, {"wp_Hz", p.wp / kTwoPi}, {"xp", p.xp},
+                  {"w_hpf_Hz", p.w_hpf / kTwoPi}, {"delay_s", p.delay}, {"source", "IFF plant fit of unit " + std::to_string(*s.unit)}};
+  out["max_damping"] = opt(s.max_damping);
+  out["optimal_pole"] = io::to_json(s.optimal_pole);
+  out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)|, branch from the "
+                        "resonance pole, maximum damping refined by golden section (delay as a 6th-order Pade approximant)";
+  for (const auto& pole : s.damped_poles) out["damped_poles"].push_back(io::to_json(pole));
+  if (!s.damped_poles.empty()) {
+    json model = json::array();
+    for (const auto& pole : s.model_poles) model.push_back(io::to_json(pole));
+    out["model_poles"] = model;
+    out["relative_pole_distance"] = s.relative_pole_distance;
+    out["max_relative_pole_distance"] = s.max_relative_pole_distance;
+    out["pole_distance_tolerance"] = s.pole_distance_tolerance;
+    if (s.warning) out["warning"] = *s.warning;
+  }
+  return out;
+}
+
+json superelement(const SuperElementComparison& s) {
+  if (s.failed) return {{"failed", *s.failed}};
+  json out = {{"source", s.source},
+              {"dofs", s.dofs},
+              {"modes_Hz", s.modes_Hz},
+              {"resonance_Hz", s.resonance_Hz},
+              {"measured_resonance_Hz", opt(s.measured_resonance_Hz)},
+              {"warnings", s.warnings}};
+  if (s.measured_resonance_Hz) out["relative_difference"] = s.resonance_Hz / *s.measured_resonance_Hz - 1.0;
+  return out;
+}
+
+json range(const std::optional<metrology::Range>& r, double scale) {
+  return r ? json({r->min * scale, r->max * scale}) : json(nullptr);
+}
+
+}  // namespace
+
+json unit_json(const UnitAnalysis& u) {
+  json r = {{"id", u.id},
+            {"name", u.name},
+            {"flatness_um", nullptr},
+            {"capacitance_uF", nullptr},
+            {"stroke_um", nullptr},
+            {"stiffness_N_per_um", nullptr},
+            {"frf", nullptr},
+            {"hpf_corner_Hz", nullptr},
+            {"model_2dof", nullptr}};
+  if (u.flatness_analysis) {
+    r["flatness_um"] = u.flatness_analysis->flatness * 1e6;
+    r["flatness"] = flatness(*u.flatness_analysis);
+  }
+  if (u.capacitance_analysis) {
+    const auto& c = *u.capacitance_analysis;
+    r["capacitance_uF"] = {{"sensor", c.sensor * 1e6}, {"actuator", c.actuator * 1e6}};
+    r["capacitance_provenance"] = c.provenance ? provenance(*c.provenance) : json({{"key", c.key}});
+  }
+  if (u.stroke_analysis) {
+    r["stroke_um"] = u.stroke_analysis->result.stroke * 1e6;
+    r["stroke"] = stroke(*u.stroke_analysis);
+  }
+  if (!u.hysteresis.empty()) r["hysteresis"] = hysteresis(u.hysteresis);
+  if (u.stiffness_analysis) r["stiffness_static"] = stiffness(*u.stiffness_analysis);
+  if (u.stiffness_open_analysis) r["stiffness_open_circuit"] = stiffness(*u.stiffness_open_analysis);
+  if (u.frf_analysis) {
+    r["frf"] = frf(*u.frf_analysis);
+    r["hpf"] = hpf(u.frf_analysis->hpf);
+    if (u.frf_analysis->hpf.corner_Hz) r["hpf_corner_Hz"] = *u.frf_analysis->hpf.corner_Hz;
+  }
+  if (u.model_2dof) model_2dof(*u.model_2dof, r);
+  if (u.resistor) r["hpf_resistor"] = resistor(*u.resistor);
+  if (u.k1 || u.k_resonance || u.k_oc) {
+    // k_sc: the stacks short-circuited (on the amplifier, the sensor on R) = k1; k_oc: every stack
+    // open, read the same way (report section 2.2).
+    r["stiffness_N_per_um"] = {{"k1", opt(u.k1, 1e-6)}, {"k2", opt(u.k2, 1e-6)}, {"resonance", opt(u.k_resonance, 1e-6)},
+                               {"k_sc", opt(u.k1, 1e-6)}, {"k_oc", opt(u.k_oc, 1e-6)}};
+  }
+  if (!u.damped.empty()) r["iff_damped_plants"] = damped_plants(u.damped);
+  if (u.flexible_modes) r["flexible_modes"] = flexible_modes(*u.flexible_modes);
+  r["not_measured"] = u.not_measured;
+  r["failed"] = u.failed;
+  r["accepted"] = u.accepted;
+  r["reasons"] = u.reasons;
+  return r;
+}
+
+json results_json(const CampaignResult& r) {
+  const Campaign& c = r.campaign;
+  json units = json::array();
+  for (const auto& u : r.units) units.push_back(unit_json(u));
+  const auto& a = c.analysis;
+  const Specs& sp = c.specs;
+  json specs = {{"flatness_um", sp.flatness_max ? json(*sp.flatness_max * 1e6) : json(nullptr)},
+                {"flatness_method", metrology::to_string(sp.flatness_method)},
+                {"capacitance_sensor_uF", range(sp.capacitance_sensor, 1e6)},
+                {"capacitance_actuator_uF", range(sp.capacitance_actuator, 1e6)},
+                {"stroke_min_um", sp.stroke_min ? json(*sp.stroke_min * 1e6) : json(nullptr)},
+                {"stiffness_N_per_um", range(sp.stiffness, 1e-6)},
+                {"reject_outliers", sp.reject_outliers}};
+  return {{"title", c.title},
+          {"campaign", c.file.string()},
+          {"generator", std::string("piezobench ") + kVersion},
+          {"units", units},
+          {"batch", batch(r.batch)},
+          {"iff", iff(r.iff)},
+          {"superelement", r.superelement ? superelement(*r.superelement) : json(nullptr)},
+          {"specs", specs},
+          {"summary", {{"units", r.units.size()}, {"accepted", r.accepted}, {"rejected", r.rejected}}},
+          {"provenance",
+           {{"campaign", c.file.string()},
+            {"window", dsp::to_string(a.window)},
+            {"nfft", a.nfft == 0 ? json("auto (4 s, at most a quarter of the record)") : json(a.nfft)},
+            {"overlap", a.overlap},
+            {"detrend", "linear"},
+            {"estimator", "H1"},
+            {"band_Hz", {a.fmin_hz, a.fmax_hz}},
+            {"fit_order", a.fit_order},
+            {"bench", {{"amplifier_gain", c.bench.amplifier_gain}, {"suspended_mass_kg", c.bench.suspended_mass},
+                       {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},
+                       {"hpf_resistance_ohm", c.bench.hpf_resistance}, {"probe_accuracy_um", c.bench.probe_accuracy * 1e6}}},
+            {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
+}
+
+}  // namespace piezobench::campaign
