@@ -28,10 +28,39 @@ function(piezobench_add_module)
   add_library(${target} STATIC ${ARG_SOURCES})
   add_library(piezobench::${ARG_NAME} ALIAS ${target})
   target_include_directories(${target}
-    PUBLIC "${PROJECT_SOURCE_DIR}/include" "${PROJECT_BINARY_DIR}/generated"
+    PUBLIC "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>" "$<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>"
+           "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>"
     PRIVATE "${PROJECT_SOURCE_DIR}/src")
-  target_link_libraries(${target} PUBLIC piezobench::options ${ARG_DEPS})
-  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  # The warnings and sanitizer flags are for this build only; an installed module asks for C++20.
+  target_link_libraries(${target} PUBLIC "$<BUILD_INTERFACE:piezobench::options>" ${ARG_DEPS})
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON EXPORT_NAME ${ARG_NAME})
+  set_property(GLOBAL APPEND PROPERTY PIEZOBENCH_MODULES ${target})
+  install(TARGETS ${target} EXPORT piezobenchTargets ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}")
+endfunction()
+
+# piezobench_install_package()
+# After every module is declared: piezobench::piezobench (all modules), the headers, the version
+# header, and the CMake package (find_package(piezobench) in lib/cmake/piezobench).
+function(piezobench_install_package)
+  get_property(modules GLOBAL PROPERTY PIEZOBENCH_MODULES)
+  add_library(piezobench_library INTERFACE)
+  add_library(piezobench::piezobench ALIAS piezobench_library)
+  target_link_libraries(piezobench_library INTERFACE ${modules})
+  set_target_properties(piezobench_library PROPERTIES EXPORT_NAME piezobench)
+  install(TARGETS piezobench_library EXPORT piezobenchTargets)
+  install(DIRECTORY "${PROJECT_SOURCE_DIR}/include/" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
+  install(FILES "${PROJECT_BINARY_DIR}/generated/piezobench/version.hpp" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/piezobench")
+  set(config_dir "${CMAKE_INSTALL_LIBDIR}/cmake/piezobench")
+  install(EXPORT piezobenchTargets NAMESPACE piezobench:: DESTINATION "${config_dir}")
+  include(CMakePackageConfigHelpers)
+  configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/piezobenchConfig.cmake.in"
+    "${PROJECT_BINARY_DIR}/piezobenchConfig.cmake" INSTALL_DESTINATION "${config_dir}")
+  write_basic_package_version_file("${PROJECT_BINARY_DIR}/piezobenchConfigVersion.cmake" COMPATIBILITY SameMinorVersion)
+  install(FILES "${PROJECT_BINARY_DIR}/piezobenchConfig.cmake" "${PROJECT_BINARY_DIR}/piezobenchConfigVersion.cmake"
+                "${PROJECT_SOURCE_DIR}/cmake/FindFFTW3.cmake" "${PROJECT_SOURCE_DIR}/cmake/FindMatio.cmake"
+                "${PROJECT_SOURCE_DIR}/cmake/FindCHOLMOD.cmake"
+          DESTINATION "${config_dir}")
 endfunction()
 
 # piezobench_add_test(NAME <name> SOURCES <files...> DEPS <targets...>)
@@ -44,7 +73,7 @@ function(piezobench_add_test)
   target_compile_definitions(${ARG_NAME} PRIVATE
     PIEZOBENCH_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     PIEZOBENCH_FIXTURE_DIR="${PROJECT_SOURCE_DIR}/tests/fixtures"
-    PIEZOBENCH_SHARED_DATA_DIR="${PROJECT_SOURCE_DIR}/../shared/data"
+    PIEZOBENCH_SHARED_DATA_DIR="${PIEZOBENCH_SHARED_DATA_DIR}"
     PIEZOBENCH_BINARY="$<TARGET_FILE:piezobench>")
   gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
 endfunction()

@@ -1,0 +1,16 @@
+#pragma once
+// Every module of piezobench (one umbrella header per module: piezobench/<module>.hpp).
+#include "piezobench/apa.hpp"
+#include "piezobench/bench.hpp"
+#include "piezobench/campaign.hpp"
+#include "piezobench/control.hpp"
+#include "piezobench/core.hpp"
+#include "piezobench/dsp.hpp"
+#include "piezobench/fem.hpp"
+#include "piezobench/ident.hpp"
+#include "piezobench/io.hpp"
+#include "piezobench/lti.hpp"
+#include "piezobench/metrology.hpp"
+#include "piezobench/report.hpp"
+#include "piezobench/rt.hpp"
+#include "piezobench/version.hpp"

@@ -1,0 +1,6 @@
+#pragma once
+// The bench module: the virtual test bench (the report's experiments simulated on a batch of units
+// with noise, its truth file).
+#include "piezobench/bench/experiments.hpp"
+#include "piezobench/bench/truth.hpp"
+#include "piezobench/bench/virtual_bench.hpp"

@@ -1,0 +1,4 @@
+#pragma once
+// The control module: the IFF controller of eq. 2.4, its loop and root locus, the discrete controller.
+#include "piezobench/control/discrete_iff.hpp"
+#include "piezobench/control/iff.hpp"

@@ -1,0 +1,7 @@
+#pragma once
+// The dsp module: windows, detrending, excitations, Welch spectra and FRF estimates.
+#include "piezobench/dsp/detrend.hpp"
+#include "piezobench/dsp/excitation.hpp"
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/welch.hpp"
+#include "piezobench/dsp/window.hpp"

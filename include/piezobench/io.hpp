@@ -1,0 +1,10 @@
+#pragma once
+// The io module: time series and FRF files (.mat, CSV, UFF), JSON encodings, TOML models, atomic
+// writes.
+#include "piezobench/io/atomic_file.hpp"
+#include "piezobench/io/frf_file.hpp"
+#include "piezobench/io/json.hpp"
+#include "piezobench/io/lti_toml.hpp"
+#include "piezobench/io/mat_struct.hpp"
+#include "piezobench/io/timeseries.hpp"
+#include "piezobench/io/toml_describe.hpp"

@@ -1,0 +1,3 @@
+#pragma once
+// The report module: the self-contained HTML report.
+#include "piezobench/report/html_report.hpp"
