@@ -23,6 +23,18 @@
 
 #include "piezobench/core/error.hpp"
 
+// Tests that need the external data (the Ansys APA95ML export in ../shared/data next to the
+// repository; CMake option PIEZOBENCH_SHARED_DATA_DIR) call this first: without the data the test
+// is skipped with a message naming the missing path. `relative` is inside that folder.
+#define PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA(relative)                                                     \
+  do {                                                                                                   \
+    const std::filesystem::path pb_needed_ = std::filesystem::path(PIEZOBENCH_SHARED_DATA_DIR) / (relative); \
+    if (!std::filesystem::exists(pb_needed_)) {                                                          \
+      GTEST_SKIP() << "external data not found: " << pb_needed_.string()                                 \
+                   << " (the Ansys APA95ML export; set the CMake option PIEZOBENCH_SHARED_DATA_DIR)";    \
+    }                                                                                                    \
+  } while (0)
+
 namespace piezobench::test {
 
 // Double round-off accumulated through O(n) operations on well-conditioned data.

@@ -31,6 +31,7 @@ long node_of(const nlohmann::json& doc, const std::string& name) {
 }
 
 TEST(FromStepCli, CoarseChainWritesASuperElementThatTheImporterReads) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
   test::TempDir dir;
   const fs::path out = dir.path() / "apa";
   const test::CliRun r = run("superelement from-step " + kStep + " --mesh-size 8 --order 1 --modes 10 --verify --json --out " +
@@ -83,6 +84,7 @@ TEST(FromStepCli, CoarseChainWritesASuperElementThatTheImporterReads) {
 }
 
 TEST(FromStepCli, TextOutputHelpAndUsage) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
   const test::CliRun h = run("superelement from-step --help");
   EXPECT_EQ(h.exit_code, 0);
   for (const char* option : {"--mesh-size", "--modes", "--material", "--remote-point", "--verify", "--keep-temp", "--out"}) {
@@ -102,6 +104,7 @@ TEST(FromStepCli, TextOutputHelpAndUsage) {
 }
 
 TEST(FromStepCli, BadInputExitsWithThreeAndSaysWhat) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
   test::TempDir dir;
   const std::string bad_step = test::write_text_file(dir, "bad.step", "ISO-10303-21;\nnot a STEP file\n");
   const std::string out = " --out " + (dir.path() / "out").string() + " --mesh-size 8 --order 1";

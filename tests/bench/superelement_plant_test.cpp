@@ -46,6 +46,7 @@ Electrics electrics() {
 }
 
 TEST(SuperElementSpec, ReadsTheKeysAndResolvesRelativePaths) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   std::ofstream(dir.path() / "K.txt") << "x";
   std::ofstream(dir.path() / "M.txt") << "x";
@@ -70,6 +71,7 @@ TEST(SuperElementSpec, ReadsTheKeysAndResolvesRelativePaths) {
 }
 
 TEST(SuperElementSpec, RefusesBadDescriptionsNamingTheKey) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   const auto refused = [&](const std::string& text, const std::string& field, bool with_files = true) {
     const std::string file = write_toml(dir, text, with_files);
@@ -97,6 +99,7 @@ TEST(SuperElementSpec, RefusesBadDescriptionsNamingTheKey) {
 // The reduced plant (modes below max_mode_Hz + static correction, modal damping) against the full
 // constrained model with the same modal damping (fem::frequency_response on every DOF).
 TEST(SuperElementPlant, MatchesTheFullStructuralModel) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   const SuperElementMechanics mech = load_superelement(write_toml(dir, kNodes + "ga = 20.0\ngs = 0.2e6\n"));
   SuperElementPlantInfo info;
@@ -131,6 +134,7 @@ TEST(SuperElementPlant, MatchesTheFullStructuralModel) {
 }
 
 TEST(SuperElementPlant, VoltageDrivesTheActuatorPairThroughGaAndTheAmplifier) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   const SuperElementMechanics mech = load_superelement(write_toml(dir, kNodes + "ga = 20.0\ngs = 0.2e6\n"));
   const ContinuousPlant plant = superelement_plant(mech, 5.7, 0.5, electrics());
@@ -144,6 +148,7 @@ TEST(SuperElementPlant, VoltageDrivesTheActuatorPairThroughGaAndTheAmplifier) {
 }
 
 TEST(SuperElementPlant, GuidedMassRemovesTheLateralModes) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   const SuperElementMechanics guided = load_superelement(write_toml(dir, kNodes));
   const fem::Modes g = fem::modes(bench_structure(guided, 5.7));

@@ -88,6 +88,7 @@ TEST(Truth, DefectiveUnitThree) {
 }
 
 TEST(Truth, SuperElementBench) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   const std::string data = std::string(PIEZOBENCH_SHARED_DATA_DIR) + "/apa95ml-ansys/";
   const auto toml = dir.path() / "apa95ml.toml";

@@ -81,6 +81,7 @@ TEST(VirtualBench, StepAndRunAllocateNothing) {
 }
 
 TEST(VirtualBench, SuperElementBenchStepsWithoutAllocating) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   BenchOptions o;
   o.superelement = apa95ml_toml(dir);

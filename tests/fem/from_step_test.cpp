@@ -291,6 +291,7 @@ TEST(FromStep, ReadsTheEigenvalueTableOfCcx) {
 // ---- error paths of the chain ------------------------------------------------------------------
 
 TEST(FromStep, MissingOrWrongToolsAreInputErrors) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
   test::TempDir dir;
   FromStepOptions o = quiet_apa95ml(dir.path() / "out");
   {
@@ -322,6 +323,7 @@ TEST(FromStep, AStepThatDoesNotLoadIsAnInputError) {
 }
 
 TEST(FromStep, SelectorsAndRegionsThatSelectNothingAreInputErrors) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
   test::TempDir dir;
   FromStepOptions o = quiet_apa95ml(dir.path() / "out");
   o.remote_points.push_back(RemotePointSpec::parse("nothing:z=100", "--remote-point"));
@@ -386,6 +388,7 @@ double mesh_mass(const fs::path& mesh_inp, const std::map<std::string, double>& 
 }
 
 TEST(FromStep, Apa95mlAt4mmMatchesCalculixOnTheFullMesh) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
   test::TempDir dir;
   FromStepOptions o = quiet_apa95ml(dir.path() / "out");
   o.mesh_size_mm = 4.0;

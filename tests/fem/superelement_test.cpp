@@ -68,6 +68,7 @@ TEST(SuperElement, EnumsRoundTrip) {
 }
 
 TEST(SuperElement, ReadsTheAnsysApa95mlFilesExactly) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const SuperElement se = read_ansys_super_element(kK, kM, kMasters);
   ASSERT_EQ(se.size(), 108);
   EXPECT_EQ(se.nodal_dofs(), 78);
@@ -92,6 +93,7 @@ TEST(SuperElement, ReadsTheAnsysApa95mlFilesExactly) {
 }
 
 TEST(SuperElement, WarnsThatFourDigitsSpoilTheRigidBodyModes) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const SuperElement se = read_ansys_super_element(kK, kM, kMasters);
   ASSERT_EQ(se.warnings.size(), 1U);
   EXPECT_NE(se.warnings[0].find("rigid-body modes"), std::string::npos) << se.warnings[0];
@@ -122,6 +124,7 @@ TEST(SuperElement, WarnsThatFourDigitsSpoilTheRigidBodyModes) {
 }
 
 TEST(SuperElement, ExactRigidBodyModesDoNotWarn) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   // Two nodes joined by an axial spring along x (6 DOF each, rotations carried by small
   // inertias and stiff torsion/bending between the nodes): a free-free element with an exact
   // null space of rigid motions -> performed, free-free, not spoiled.
@@ -247,6 +250,7 @@ TEST_F(BadAnsysFiles, ListingLongerThanTheMatrices) {
 }
 
 TEST_F(BadAnsysFiles, NodeWithoutCoordinates) {
+  PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   write_all();
   const fs::path nlist = dir.path() / "nlist.txt";
   std::string text = test::read_text(kAnsysDir / "out_NLIST.txt");
