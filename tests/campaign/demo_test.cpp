@@ -75,12 +75,12 @@ TEST(Demo, ResultsAgreeWithTheBenchTruth) {
   for (const auto& d : iff["relative_pole_distance"]) EXPECT_LT(d.get<double>(), 0.05);
   EXPECT_FALSE(iff.contains("warning"));
   // k_oc > k_sc on every unit.
-  for (const auto& u : r.results["units"]) {
+  for (const auto& u : results["units"]) {
     EXPECT_GT(u["stiffness_N_per_um"]["k_oc"].get<double>(), u["stiffness_N_per_um"]["k_sc"].get<double>());
   }
   // The resistor (report section 2.5, Figure 2.7) on unit 1: the corner with it near 1/(2 pi R C),
   // without it not observable in the record (the truth's 0.003 Hz is far below its lowest line).
-  const json& hr = r.results["units"][0]["hpf_resistor"];
+  const json& hr = results["units"][0]["hpf_resistor"];
   EXPECT_TRUE(near(hr["with_resistor"]["corner_Hz"].get<double>(), truth["units"][0]["hpf_corner_with_resistor_Hz"].get<double>(), 0.1));
   EXPECT_FALSE(hr["without_resistor"]["observable"].get<bool>());
   EXPECT_TRUE(hr["without_resistor"]["corner_Hz"].is_null());
