@@ -30,7 +30,7 @@ cd "$root"
 # Build tools and every library piezobench links, all from Debian's archive.
 packages=(
   g++ cmake ninja-build pkg-config
-  libeigen3-dev libfftw3-dev libmatio-dev libsuitesparse-dev libspectra-dev
+  libeigen3-dev libfftw3-dev libmatio-dev libhdf5-dev zlib1g-dev libsuitesparse-dev libspectra-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # Data-acquisition cards through Comedi (the `measure` command's comedi backend).

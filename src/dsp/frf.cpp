@@ -1,6 +1,7 @@
 #include "piezobench/dsp/frf.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "piezobench/core/error.hpp"
@@ -19,10 +20,21 @@ Index Frf::output_index(const std::string& name) const {
                    "\"" + name + "\"");
 }
 
+namespace {
+std::string format_value(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+}  // namespace
+
 void Frf::validate(const std::string& source) const {
   const std::string src = source.empty() ? provenance.source : source;
   const Index n = freq_hz.size();
   if (n < 1) throw InputError(src, "freq_hz", "at least one frequency", "none");
+  if (std::isfinite(freq_hz(0)) && freq_hz(0) < 0.0) {
+    throw InputError(src, "freq_hz", "frequencies >= 0 Hz (one-sided FRF)", format_value(freq_hz(0)) + " Hz at index 0");
+  }
   for (Index k = 0; k < n; ++k) {
     if (!std::isfinite(freq_hz(k))) {
       throw InputError(src, "freq_hz", "finite frequencies", "non-finite value at index " + std::to_string(k));
@@ -64,6 +76,11 @@ void Frf::validate(const std::string& source) const {
         if (!std::isfinite(coherence[i](k))) {
           throw InputError(src, outputs[i] + " coherence", "finite values",
                            "non-finite value at " + std::to_string(freq_hz(k)) + " Hz (index " + std::to_string(k) + ")");
+        }
+        // Magnitude-squared coherence lies in [0, 1]; the tolerance admits round-off only.
+        if (coherence[i](k) < 0.0 || coherence[i](k) > 1.0 + 1e-9) {
+          throw InputError(src, outputs[i] + " coherence", "values in [0, 1]",
+                           format_value(coherence[i](k)) + " at " + format_value(freq_hz(k)) + " Hz (index " + std::to_string(k) + ")");
         }
       }
     }

@@ -317,14 +317,16 @@ Frf frf_from_spectra(const CrossSpectra& spectra, FrfEstimator estimator, const 
   for (std::size_t o = 0; o < spectra.Suy.size(); ++o) {
     const auto& suy = spectra.Suy[o];
     const auto& syy = spectra.Syy[o];
+    // A silent output (all samples equal, or zero after detrending) has no FRF: its coherence
+    // would be 0/0 at every frequency.
+    if (!(syy.array() > 0.0).any()) {
+      throw InputError(source, spectra.outputs[o], "an output with non-zero power (a varying signal)",
+                       "zero power at every frequency (a constant channel: check the channel name and its wiring)");
+    }
     Eigen::VectorXcd h(suy.size());
     if (estimator == FrfEstimator::kH1) {
       for (Index k = 0; k < h.size(); ++k) h(k) = spectra.Suu(k) != 0.0 ? suy(k) / spectra.Suu(k) : Complex(nan, nan);
     } else {
-      if (!(syy.array() > 0.0).any()) {
-        throw InputError(source, spectra.outputs[o], "an output with non-zero power (H2 divides by it)",
-                         "zero power at every frequency");
-      }
       // H2 = Syy / Syu, Syu = conj(Suy): for y = H u both equal H.
       for (Index k = 0; k < h.size(); ++k) h(k) = suy(k) != 0.0 ? syy(k) / std::conj(suy(k)) : Complex(nan, nan);
     }

@@ -273,199 +273,9 @@ void MatVarFreer::operator()(matvar_t* var) const {
   if (var != nullptr) Mat_VarFree(var);
 }
 
-namespace {
 std::string with_matio_reason(const std::string& text) {
   const std::string reason = take_matio_message();
   return reason.empty() ? text : text + " (matio: " + reason + ")";
-}
-
-// The first bytes decide whether matio may look at the file at all: a v5/v7 file has a 128-byte
-// header with the version 0x0100 and an endian indicator "IM"/"MI" at bytes 126..127; a v7.3 file
-// is an HDF5 file with the same 128-byte MATLAB header in its user block (or a bare HDF5 file).
-// Anything else (a CSV renamed .mat, a truncated header) is rejected here with a clear message.
-void check_mat_header(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "file", "a readable file", "cannot open it");
-  char header[128] = {};
-  in.read(header, sizeof header);
-  const std::streamsize got = in.gcount();
-  static const char kHdf5[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
-  if (got >= 8 && std::memcmp(header, kHdf5, 8) == 0) return;
-  if (got < 128) {
-    throw InputError(file.string(), "file", "a MAT file (128-byte header)",
-                     std::to_string(got) + " bytes in total");
-  }
-  const bool little = header[126] == 'I' && header[127] == 'M';
-  const bool big = header[126] == 'M' && header[127] == 'I';
-  if (!little && !big) {
-    throw InputError(file.string(), "file", "a MAT file (v5, v7 or v7.3)",
-                     "no MATLAB header (bytes 126-127 are " + quote(std::string_view(header + 126, 2)) + ")");
-  }
-  // Version 0x0200 is v7.3: an HDF5 file (at byte 512) that HDF5 itself checks.
-  const auto version = static_cast<unsigned>(
-      little ? (static_cast<unsigned char>(header[124]) | (static_cast<unsigned char>(header[125]) << 8))
-             : ((static_cast<unsigned char>(header[124]) << 8) | static_cast<unsigned char>(header[125])));
-  if (version == 0x0200) return;
-  // matio stops at the first variable it cannot read and reports the ones before it as if the
-  // file ended there, so a truncated file would silently lose channels. Walking the top-level
-  // data element tags (type, byte count) against the file size catches that up front.
-  in.seekg(0, std::ios::end);
-  const auto size = static_cast<unsigned long long>(in.tellg());
-  const bool swap = (little != (std::endian::native == std::endian::little));
-  const auto u32 = [&](const unsigned char* p) {
-    std::uint32_t v;
-    std::memcpy(&v, p, 4);
-    return swap ? ((v >> 24) | ((v >> 8) & 0xff00u) | ((v << 8) & 0xff0000u) | (v << 24)) : v;
-  };
-  unsigned long long pos = 128;
-  int index = 0;
-  while (pos < size) {
-    ++index;
-    if (pos + 8 > size) {
-      throw InputError(file.string(), "file", "complete variables",
-                       "a truncated file (variable " + std::to_string(index) + " at byte " + std::to_string(pos) + " has no complete tag)");
-    }
-    unsigned char tag[8];
-    in.clear();
-    in.seekg(static_cast<std::streamoff>(pos));
-    in.read(reinterpret_cast<char*>(tag), 8);
-    const std::uint32_t type = u32(tag);
-    if ((type >> 16) != 0) {  // small data element: type and size share the first 4 bytes
-      pos += 8;
-      continue;
-    }
-    const unsigned long long nbytes = u32(tag + 4);
-    unsigned long long next = pos + 8 + nbytes;
-    if (type != 15) next = (next + 7) / 8 * 8;  // miCOMPRESSED elements are not padded
-    if (pos + 8 + nbytes > size) {
-      throw InputError(file.string(), "file", "complete variables",
-                       "a truncated file (variable " + std::to_string(index) + " at byte " + std::to_string(pos) + " declares " +
-                           std::to_string(nbytes) + " bytes, " + std::to_string(size - pos - 8) + " are left)");
-    }
-    pos = next;
-  }
-}
-}  // namespace
-
-MatFilePtr open_mat_for_reading(const fs::path& file) {
-  install_matio_logger();
-  std::error_code ec;
-  if (!fs::exists(file, ec)) throw InputError(file.string(), "file", "an existing file", "no such file");
-  if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "a regular file", "a directory");
-  check_mat_header(file);
-  (void)take_matio_message();
-  MatFilePtr mat(Mat_Open(file.c_str(), MAT_ACC_RDONLY));
-  if (!mat) {
-    throw InputError(file.string(), "file", "a MAT file (v5, v7 or v7.3)", with_matio_reason("matio cannot open it"));
-  }
-  return mat;
-}
-
-std::vector<MatVarInfo> list_mat_variables(mat_t* mat, const fs::path& file) {
-  std::vector<MatVarInfo> out;
-  if (Mat_Rewind(mat) != 0) throw InputError(file.string(), "file", "a readable MAT file", with_matio_reason("cannot rewind"));
-  // A corrupt file can make matio loop on garbage; a real file never holds this many variables.
-  constexpr size_t kMaxVariables = 1u << 20;
-  for (;;) {
-    MatVarPtr var(Mat_VarReadNextInfo(mat));
-    if (!var) break;
-    MatVarInfo info;
-    info.name = var->name != nullptr ? var->name : "";
-    info.class_type = var->class_type;
-    info.is_complex = var->isComplex != 0;
-    if (var->dims != nullptr) info.dims.assign(var->dims, var->dims + std::max(var->rank, 0));
-    out.push_back(std::move(info));
-    if (out.size() > kMaxVariables) {
-      throw InputError(file.string(), "file", "a well-formed MAT file", "more than 2^20 variables (corrupt?)");
-    }
-  }
-  const std::string reason = take_matio_message();
-  if (out.empty() && !reason.empty()) {
-    throw InputError(file.string(), "file", "a well-formed MAT file", "matio: " + reason);
-  }
-  return out;
-}
-
-MatVarPtr read_mat_variable(mat_t* mat, const fs::path& file, const std::string& name) {
-  (void)take_matio_message();
-  MatVarPtr var(Mat_VarRead(mat, name.c_str()));
-  if (!var) {
-    throw InputError(file.string(), name, "a readable variable", with_matio_reason("matio cannot read it (missing or corrupt)"));
-  }
-  // matio may return the header of a variable whose data it could not read (truncated file).
-  if (var->class_type != MAT_C_STRUCT && var->class_type != MAT_C_CELL && var->class_type != MAT_C_EMPTY &&
-      element_count(*var) > 0 && var->data == nullptr) {
-    throw InputError(file.string(), name, "a complete variable", with_matio_reason("its data cannot be read (truncated file?)"));
-  }
-  return var;
-}
-
-namespace {
-// The header of a real, uncompressed double vector of exactly `count` elements, or null.
-MatVarPtr plain_double_vector_info(mat_t* mat, const std::string& name, Eigen::Index count) {
-  if (count == 0 || count > std::numeric_limits<int>::max()) return nullptr;
-  MatVarPtr info(Mat_VarReadInfo(mat, name.c_str()));
-  if (!info || info->class_type != MAT_C_DOUBLE || info->isComplex != 0 || info->isLogical != 0 ||
-      info->compression != MAT_COMPRESSION_NONE || static_cast<Eigen::Index>(element_count(*info)) != count ||
-      std::count_if(info->dims, info->dims + info->rank, [](size_t d) { return d != 1; }) > 1) {
-    (void)take_matio_message();
-    return nullptr;
-  }
-  return info;
-}
-
-// Reads elements [first, first + count) of a vector variable (header `info`) into out.
-// v5: Mat_VarReadDataLinear, an fread into `out`. v7.3: Mat_VarReadData with a hyperslab along the
-// vector's dimension, because matio implements Mat_VarReadDataLinear there with an HDF5 point
-// selection (one coordinate per element): 1 s instead of 0.05 s for 6 million samples. (The other
-// way round does not work either: matio 1.5.23 reads zeros for a v5 row vector through
-// Mat_VarReadData at a nonzero start.)
-bool read_vector_part(mat_t* mat, matvar_t* info, Eigen::Index first, Eigen::Index count, double* out) {
-  if (Mat_GetVersion(mat) != MAT_FT_MAT73) {
-    return Mat_VarReadDataLinear(mat, info, out, static_cast<int>(first), 1, static_cast<int>(count)) == 0;
-  }
-  const int rank = info->rank;
-  if (rank < 1 || info->dims == nullptr) return false;
-  const auto dims = static_cast<size_t>(rank);
-  std::vector<int> start(dims, 0), stride(dims, 1), edge(dims, 1);
-  int along = 0;
-  for (int d = 0; d < rank; ++d) {
-    if (info->dims[d] != 1) along = d;
-  }
-  start[static_cast<size_t>(along)] = static_cast<int>(first);
-  edge[static_cast<size_t>(along)] = static_cast<int>(count);
-  return Mat_VarReadData(mat, info, out, start.data(), stride.data(), edge.data()) == 0;
-}
-}  // namespace
-
-bool read_double_vector_into(mat_t* mat, const std::string& name, Eigen::Ref<Eigen::VectorXd> out, Eigen::Index chunk,
-                             const std::function<void(Eigen::Index, Eigen::Index)>& on_chunk) {
-  if (out.innerStride() != 1) return false;
-  const MatVarPtr info = plain_double_vector_info(mat, name, out.size());
-  if (!info) return false;
-  const Eigen::Index n = out.size();
-  const Eigen::Index step = chunk > 0 ? chunk : n;
-  for (Eigen::Index first = 0; first < n; first += step) {
-    const Eigen::Index count = std::min(step, n - first);
-    if (!read_vector_part(mat, info.get(), first, count, out.data() + first)) {
-      (void)take_matio_message();
-      return false;
-    }
-    if (on_chunk) on_chunk(first, count);
-  }
-  (void)take_matio_message();
-  return true;
-}
-
-std::optional<double> read_double_element(mat_t* mat, const std::string& name, Eigen::Index count, Eigen::Index index) {
-  if (index < 0 || index >= count) return std::nullopt;
-  const MatVarPtr info = plain_double_vector_info(mat, name, count);
-  if (!info) return std::nullopt;
-  double value = 0.0;
-  const bool ok = read_vector_part(mat, info.get(), index, 1, &value);
-  (void)take_matio_message();
-  if (!ok) return std::nullopt;
-  return value;
 }
 
 namespace {
@@ -569,6 +379,10 @@ void copy_real_vector(const matvar_t& var, const std::string& source, const std:
   }
   if (n > 0) {
     if (var.data == nullptr) throw InputError(source, f, "a complete variable", "no data (truncated file?)");
+    if (var.data_size <= 0 || var.nbytes / static_cast<size_t>(var.data_size) < n) {
+      throw InputError(source, f, std::to_string(n) + " samples of data (declared " + describe(var) + ")",
+                       std::to_string(var.nbytes) + " bytes");
+    }
     to_doubles(var.class_type, var.data, n, out.data());
   }
 }
@@ -607,6 +421,12 @@ std::string to_text(const matvar_t& var, const std::string& source, const std::s
     throw InputError(source, f, "a char row", describe(var));
   }
   const size_t n = element_count(var);
+  // The data must hold what the dimensions declare (a corrupt header claims more than is there).
+  const size_t unit = var.data_size > 0 ? static_cast<size_t>(var.data_size) : 1;
+  if (var.nbytes / unit < n) {
+    throw InputError(source, f, std::to_string(n) + " characters (declared " + describe(var) + ")",
+                     std::to_string(var.nbytes) + " bytes of data");
+  }
   std::string out;
   out.reserve(n);
   switch (var.data_type) {
@@ -694,7 +514,7 @@ namespace {
 std::vector<std::string> create_and_fill(const fs::path& temp, const fs::path& file, bool v73, bool compress,
                                          const std::function<void(MatWriter&)>& fill) {
   (void)take_matio_message();
-  MatFilePtr mat(Mat_CreateVer(temp.c_str(), nullptr, v73 ? MAT_FT_MAT73 : MAT_FT_MAT5));
+  MatioPtr mat(Mat_CreateVer(temp.c_str(), nullptr, v73 ? MAT_FT_MAT73 : MAT_FT_MAT5));
   if (!mat) {
     throw InputError(file.string(), "output file", "a MAT file matio can create", with_matio_reason("Mat_CreateVer failed"));
   }
@@ -789,7 +609,7 @@ void write_mat_atomically(const fs::path& file, bool v73, bool compress, const s
   // matio does not report every failed fwrite (disk full, file size limit); reading the variables
   // back is cheap next to writing them and proves the file complete before it gets its name.
   {
-    MatFilePtr check(Mat_Open(out.temp_path().c_str(), MAT_ACC_RDONLY));
+    MatioPtr check(Mat_Open(out.temp_path().c_str(), MAT_ACC_RDONLY));
     if (!check) throw InputError(file.string(), "output file", "a complete write", with_matio_reason("the written file does not open"));
     for (const std::string& name : written) {
       MatVarPtr var(Mat_VarRead(check.get(), name.c_str()));

@@ -71,7 +71,7 @@ struct MatCloser {
 struct MatVarFreer {
   void operator()(matvar_t* var) const;
 };
-using MatFilePtr = std::unique_ptr<mat_t, MatCloser>;
+using MatioPtr = std::unique_ptr<mat_t, MatCloser>;  // a MAT file being written through matio
 using MatVarPtr = std::unique_ptr<matvar_t, MatVarFreer>;
 
 // Routes matio's messages away from stderr into a per-thread buffer (called by the functions
@@ -79,8 +79,42 @@ using MatVarPtr = std::unique_ptr<matvar_t, MatVarFreer>;
 void install_matio_logger();
 // The last message matio logged on this thread ("" if none); clears it.
 [[nodiscard]] std::string take_matio_message();
+// "text (matio: <last message>)", or text when matio said nothing.
+[[nodiscard]] std::string with_matio_reason(const std::string& text);
 
-// Opens an existing MAT file for reading; InputError (field "file") if missing or not a MAT file.
+// ---- reading MAT files (mat_reader.cpp) -----------------------------------------------------
+//
+// Resource bounds (docs/formats.md, "Hostile files"): before anything is allocated for a
+// variable, the size its header declares is checked against the bytes the file holds for it.
+//  v5/v7  every data element must hold the bytes its dimensions need (at least 1 byte per element:
+//         MATLAB may store doubles as smaller integers), so a variable takes at most 8 times its
+//         bytes in the file (16 for complex); a compressed variable may declare at most
+//         kMaxInflation times its compressed size (zlib's own limit is 1032) and its inflated
+//         stream is checked the same way. Read by matio after these checks.
+//  v7.3   read through HDF5 directly (matio 1.5 misreads class strings written by h5py and
+//         hdf5storage, and reads flagged-empty datasets as dimensions): an uncompressed dataset
+//         must have the bytes its dimensions need allocated in the file; a filtered (deflated)
+//         one may declare at most kMaxInflation times its stored bytes. Every HDF5 return value is
+//         checked; a failed read is an InputError, never data.
+inline constexpr double kMaxInflation = 1100.0;
+
+// An open MAT file (v5/v7 through matio, v7.3 through HDF5).
+class MatInput {
+ public:
+  virtual ~MatInput() = default;
+  [[nodiscard]] virtual bool v73() const = 0;
+  [[nodiscard]] const std::filesystem::path& file() const { return file_; }
+
+ protected:
+  explicit MatInput(std::filesystem::path file) : file_(std::move(file)) {}
+
+ private:
+  std::filesystem::path file_;
+};
+using MatFilePtr = std::unique_ptr<MatInput>;
+
+// Opens an existing MAT file for reading; InputError (field "file") if missing, not a MAT file,
+// or when a variable declares more data than the file holds for it (see above).
 [[nodiscard]] MatFilePtr open_mat_for_reading(const std::filesystem::path& file);
 // Names and classes of the variables, in file order (info only, no data read).
 struct MatVarInfo {
@@ -88,21 +122,23 @@ struct MatVarInfo {
   matio_classes class_type = MAT_C_EMPTY;
   bool is_complex = false;
   std::vector<size_t> dims;
+  std::string unit;  // v7.3: the dataset's string attribute `units` (h5py users write one), else ""
 };
-[[nodiscard]] std::vector<MatVarInfo> list_mat_variables(mat_t* mat, const std::filesystem::path& file);
-// Reads a variable with its data; InputError (field = name) when absent or unreadable.
-[[nodiscard]] MatVarPtr read_mat_variable(mat_t* mat, const std::filesystem::path& file, const std::string& name);
+[[nodiscard]] std::vector<MatVarInfo> list_mat_variables(MatInput* mat, const std::filesystem::path& file);
+// Reads a variable with its data; InputError (field = name) when absent or unreadable. Classes
+// piezobench never reads the data of (sparse, object, function) come back as their header only.
+[[nodiscard]] MatVarPtr read_mat_variable(MatInput* mat, const std::filesystem::path& file, const std::string& name);
 
-// Fast path for large records: reads an uncompressed real double vector of exactly out.size()
+// Fast path for large records: reads a real double vector of exactly out.size()
 // elements straight into `out` (no intermediate copy), in pieces of at most `chunk` elements;
 // after each piece, `on_chunk(first, count)` (if given) may look at out[first, first + count)
 // while it is still in the cache. Returns false, with `out` unspecified, when the variable is
-// anything else or a read fails; the caller then uses read_mat_variable.
+// anything else; the caller then uses read_mat_variable. A read error is an InputError.
 [[nodiscard]] bool read_double_vector_into(
-    mat_t* mat, const std::string& name, Eigen::Ref<Eigen::VectorXd> out, Eigen::Index chunk = 1 << 17,
+    MatInput* mat, const std::string& name, Eigen::Ref<Eigen::VectorXd> out, Eigen::Index chunk = 1 << 17,
     const std::function<void(Eigen::Index first, Eigen::Index count)>& on_chunk = {});
 // One element of such a variable (of exactly `count` elements); nullopt as above.
-[[nodiscard]] std::optional<double> read_double_element(mat_t* mat, const std::string& name, Eigen::Index count,
+[[nodiscard]] std::optional<double> read_double_element(MatInput* mat, const std::string& name, Eigen::Index count,
                                                         Eigen::Index index);
 
 // Describes a variable for error messages: "double 3x1", "complex double 1x4", "char 1x5".

@@ -1,6 +1,7 @@
 #include "piezobench/io/lti_toml.hpp"
 
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
@@ -34,7 +35,10 @@ class Reader {
   [[nodiscard]] bool has(const char* key) const { return table_.contains(key); }
 
   [[nodiscard]] double number(const std::string& key, const toml::node& node) const {
-    const auto value = node.value<double>();
+    // An integer is taken as the nearest double: toml++ converts only the exactly representable
+    // ones, so 9223372036854775807 would otherwise be "a number" refused as "a number".
+    const std::optional<double> value =
+        node.is_integer() ? std::optional<double>(static_cast<double>(node.as_integer()->get())) : node.value<double>();
     if (!node.is_number() || !value) throw InputError(source_, key, "a number", describe_toml(node));
     if (!std::isfinite(*value)) throw InputError(source_, key, "a finite number", std::to_string(*value));
     return *value;

@@ -359,7 +359,7 @@ std::vector<std::string> struct_channels(const matvar_t& var) {
   return out;
 }
 
-detail::MatVarPtr read_group(mat_t* mat, const fs::path& file, const std::string& group) {
+detail::MatVarPtr read_group(detail::MatInput* mat, const fs::path& file, const std::string& group) {
   detail::MatVarPtr var = detail::read_mat_variable(mat, file, group);
   if (var->class_type != MAT_C_STRUCT || detail::element_count(*var) != 1) {
     throw InputError(file.string(), group, "a 1x1 struct holding the channels", detail::describe(*var));
@@ -367,7 +367,7 @@ detail::MatVarPtr read_group(mat_t* mat, const fs::path& file, const std::string
   return var;
 }
 
-MatLayout mat_layout(mat_t* mat, const fs::path& file, const ReadOptions& options,
+MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOptions& options,
                      const std::vector<detail::MatVarInfo>& vars) {
   MatLayout layout;
   if (!options.group.empty()) {

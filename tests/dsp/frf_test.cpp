@@ -73,6 +73,19 @@ TEST(Frf, ValidateRejectsEachKindOfInconsistency) {
   f = two_outputs();
   f.coherence.pop_back();
   expect_field(f, "coherence");
+  // Issue 21: a coherence outside [0, 1] and negative frequencies were accepted from FRF files.
+  f = two_outputs();
+  f.coherence[1](3) = 1.5;
+  expect_field(f, "V_s coherence");
+  f = two_outputs();
+  f.coherence[0](1) = -0.01;
+  expect_field(f, "d_e coherence");
+  f = two_outputs();
+  f.coherence[0](1) = 1.0 + 1e-12;  // round-off of |Suy|^2 / (Suu Syy) on a noiseless record
+  EXPECT_NO_THROW(f.validate());
+  f = two_outputs();
+  f.freq_hz(0) = -1.0;
+  expect_field(f, "freq_hz");
 }
 
 }  // namespace

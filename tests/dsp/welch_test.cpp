@@ -429,6 +429,9 @@ TEST(WelchErrors, ShortRecordDifferentLengthsZeroInputAndBadRate) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "dac");
   }
+  // A silent output is an error for H1 too (its coherence would be 0/0, printed "nan", exit 0).
+  test::expect_input_error([&] { (void)estimate_frf(channel("u", u), {channel("y", zero)}, 1e3, o, "rec.mat"); },
+                           {"rec.mat", "y", "zero power at every frequency", "constant channel"});
   o.estimator = FrfEstimator::kH2;
   EXPECT_THROW((void)estimate_frf(channel("u", u), {channel("y", zero)}, 1e3, o), InputError);
   EXPECT_THROW((void)estimate_frf(channel("u", u), {channel("y", u)}, 0.0, o), InputError);

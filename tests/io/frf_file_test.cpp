@@ -134,6 +134,10 @@ TEST(FrfCsv, MalformedFilesNameFileAndColumn) {
       {"freq_Hz,re_a,im_a\n1,2,nan\n", "im_a (line 2)"},
       {"freq_Hz,re_a,im_a\n2,2,3\n1,2,3\n", "increasing"},
       {"freq_Hz,re_a,im_a,coh_a,re_b,im_b\n1,2,3,1,2,3\n", "coh_NAME columns for every output"},
+      // Issue 21: coherence outside [0, 1] and negative frequencies were accepted.
+      {"freq_Hz,re_a,im_a,coh_a\n1,2,3,0.5\n2,2,3,1.7\n", "a coherence"},
+      {"freq_Hz,re_a,im_a,coh_a\n1,2,3,-0.2\n", "values in [0, 1]"},
+      {"freq_Hz,re_a,im_a\n-5,2,3\n1,2,3\n", "frequencies >= 0 Hz"},
   };
   for (const auto& [text, expected] : cases) {
     const fs::path file = dir.path() / "bad.csv";

@@ -50,6 +50,13 @@ TEST(LtiToml, TransferFunctionMatchesItsPolynomials) {
   EXPECT_TRUE(test::near(response_at(f, 1.7), expected, {test::kRoundoff, 0.0}));
 }
 
+TEST(LtiToml, LargeIntegersAreTakenAsTheNearestDouble) {
+  // toml++ converts only exactly representable integers; 2^63 - 1 was refused as "expected a
+  // number, found a number".
+  const LtiFile f = parse_lti_toml("num = [9223372036854775807]\nden = [1, 9223372036854775807]\n", "big.toml");
+  EXPECT_TRUE(test::near(response_at(f, 0.0), lti::Complex(1.0, 0.0), {test::kRoundoff, 0.0}));
+}
+
 TEST(LtiToml, ZpkAcceptsRealAndComplexEntries) {
   const LtiFile f = parse_lti_toml("zeros = [-1.0]\npoles = [[-1.0, 2.0], [-1.0, -2.0], -5]\ngain = 3.0\n", "z.toml");
   EXPECT_EQ(f.form, LtiForm::kZpk);

@@ -21,16 +21,17 @@ struct FrfProvenance {
 };
 
 struct Frf {
-  Eigen::VectorXd freq_hz;                 // Hz, strictly increasing
+  Eigen::VectorXd freq_hz;                 // Hz, >= 0, strictly increasing
   std::string input;                       // input channel name
   std::vector<std::string> outputs;        // output channel names
   std::vector<Eigen::VectorXcd> H;         // H[i](k): output i / input at freq_hz(k)
-  std::vector<Eigen::VectorXd> coherence;  // same layout as H; empty vector = unknown
+  std::vector<Eigen::VectorXd> coherence;  // same layout as H, in [0, 1]; empty vector = unknown
   FrfProvenance provenance;
 
   // Index of the named output; throws InputError (field "output", expected one of the names).
   [[nodiscard]] Eigen::Index output_index(const std::string& name) const;
-  // Throws InputError for inconsistent sizes, non-finite values or a non-increasing grid.
+  // Throws InputError for inconsistent sizes, non-finite values, a non-increasing grid, a negative
+  // frequency or a coherence outside [0, 1] (1e-9 of round-off admitted).
   void validate(const std::string& source = "") const;
 };
 
