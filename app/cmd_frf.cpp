@@ -31,6 +31,8 @@ struct FrfOptions {
   std::string estimator = "H1";
   std::string out;
   bool json = false;
+  std::string delimiter = "auto";  // CSV input only
+  std::string decimal = "auto";
 };
 
 // The CLI's short window names ("hann", "hamming", "flattop") are the periodic windows that Welch
@@ -74,6 +76,8 @@ int run_frf(const FrfOptions& o) {
   read.fs = o.fs;
   read.channels = split_list(o.outputs, "--output");
   read.channels.insert(read.channels.begin(), o.input);
+  read.delimiter = io::csv_delimiter_from_string(o.delimiter);
+  read.decimal = io::csv_decimal_from_string(o.decimal);
   if (!o.json) log_line("reading " + o.file);
   const io::TimeSeries ts = io::read_timeseries(o.file, read);
 
@@ -90,7 +94,15 @@ int run_frf(const FrfOptions& o) {
     if (!o.json) log_line("wrote " + o.out);
   }
   if (o.json) {
-    print_json(frf_json(estimate.frf));
+    // Units of the SI samples the reader returned ("" where the file gave none): H is output / input.
+    nlohmann::json document = frf_json(estimate.frf);
+    nlohmann::json units = nlohmann::json::object();
+    for (const std::string& name : estimate.frf.outputs) {
+      const std::string num = ts.unit(name), den = ts.unit(o.input);
+      units[name] = (num.empty() ? "1" : num) + "/" + (den.empty() ? "1" : den);
+    }
+    document["H_units"] = units;
+    print_json(document);
     return 0;
   }
   const dsp::Frf& frf = estimate.frf;
@@ -225,6 +237,12 @@ void add_frf_commands(CLI::App& app, Action& action) {
   frf->add_option("--estimator", f->estimator, "H1 (noise on the output) or H2 (noise on the input)")->capture_default_str();
   frf->add_option("--out", f->out, "write the FRF: .csv, .mat or .uff (Universal File Format 58)");
   frf->add_flag("--json", f->json, "print one JSON document on stdout");
+  frf->add_option("--delimiter", f->delimiter, "CSV input: auto (detected), ',', ';', tab or space")
+      ->check(CLI::IsMember({"auto", ",", ";", "tab", "space"}))
+      ->capture_default_str();
+  frf->add_option("--decimal", f->decimal, "CSV input: auto (detected), '.' or ','")
+      ->check(CLI::IsMember({"auto", ".", ","}))
+      ->capture_default_str();
   frf->callback([f, &action] { action = [f] { return run_frf(*f); }; });
 
   auto v = std::make_shared<FitOptions>();

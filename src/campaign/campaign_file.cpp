@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/units.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::campaign {
@@ -255,7 +256,7 @@ FileSpec read_file_spec(const Context& ctx, const Reader& unit, const std::strin
     f.given = *node.value<std::string>();
   } else if (const toml::table* t = node.as_table()) {
     const Reader r(*t, ctx.source, f.key);
-    std::vector<std::string> known = {"file", "channels", "sample_rate_Hz"};
+    std::vector<std::string> known = {"file", "channels", "units", "sample_rate_Hz"};
     if (e == Experiment::kIff) known.push_back("gain");
     r.only(known);
     const auto file = r.string("file");
@@ -267,6 +268,12 @@ FileSpec read_file_spec(const Context& ctx, const Reader& unit, const std::strin
         if (std::find(f.explicit_roles.begin(), f.explicit_roles.end(), role) == f.explicit_roles.end()) {
           f.explicit_roles.push_back(role);
         }
+      }
+    }
+    // Units of channels the file does not label, checked against the one unit table.
+    if (const toml::table* u = r.table("units")) {
+      for (const auto& [role, symbol] : read_channels(r, *u, "units", roles)) {
+        f.units[role] = io::unit_from_string(symbol, ctx.source, r.key("units." + role)).symbol;
       }
     }
     r.positive("sample_rate_Hz", f.sample_rate);

@@ -171,6 +171,38 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
 
 // ------------------------------------------------------------------------------------ acceptance
 
+// Values no actuator on a bench has (an APA's stroke is tens to hundreds of um, its stiffness 0.1
+// to 100 N/um, its stacks' capacitance nF to tens of uF): a value outside these wide limits is a
+// unit error in a record, never a measurement (issue 12: `d_e [um]` read as metres was accepted).
+std::vector<std::string> implausible(const Campaign& c, const UnitAnalysis& u) {
+  const UnitSpec* spec = nullptr;
+  for (const UnitSpec& s : c.units) {
+    if (s.id == u.id) spec = &s;
+  }
+  // "column 'probe' of 'stroke3.csv'" for a role of a file entry.
+  const auto column = [&](const std::optional<FileSpec> UnitSpec::*entry, const char* role) {
+    if (spec == nullptr || !(spec->*entry)) return fmt::format("column {}", role);
+    const FileSpec& f = *(spec->*entry);
+    const auto it = f.channels.find(role);
+    return fmt::format("column '{}' of '{}'", it != f.channels.end() ? it->second : role, f.given);
+  };
+  std::vector<std::string> out;
+  const auto check = [&](const std::optional<double>& v, double lo, double hi, double scale, const char* unit, const std::string& what,
+                         const std::string& where) {
+    if (v && !(*v >= lo && *v <= hi)) {
+      out.push_back(fmt::format("implausible: {} {:.4g} {} cannot be a measurement (plausible {:g} to {:g} {}): check the units of {}", what,
+                                *v * scale, unit, lo * scale, hi * scale, unit, where));
+    }
+  };
+  check(u.stroke, 1e-9, 5e-3, 1e6, "um", "stroke", column(&UnitSpec::stroke, "de"));
+  check(u.k1, 1e3, 1e10, 1e-6, "N/um", "stiffness k1", column(&UnitSpec::stiffness, "de"));
+  check(u.k2, 1e3, 1e10, 1e-6, "N/um", "stiffness k2", column(&UnitSpec::stiffness, "de"));
+  check(u.k_resonance, 1e3, 1e10, 1e-6, "N/um", "stiffness from the resonance", column(&UnitSpec::frf, "de"));
+  check(u.capacitance_sensor, 1e-12, 1e-2, 1e6, "uF", "sensor capacitance", column(&UnitSpec::capacitance, "C_sensor"));
+  check(u.capacitance_actuator, 1e-12, 1e-2, 1e6, "uF", "actuator capacitance", column(&UnitSpec::capacitance, "C_actuator"));
+  return out;
+}
+
 std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, const std::vector<std::string>& outlier_reasons) {
   std::vector<std::string> reasons;
   for (const auto& f : u.failed) reasons.push_back("analysis failed: " + f);
@@ -198,6 +230,7 @@ std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, co
     }
   }
   for (const auto& r : outlier_reasons) reasons.push_back(r);
+  for (const auto& r : implausible(c, u)) reasons.push_back(r);
   return reasons;
 }
 

@@ -86,6 +86,7 @@ Record load_record(const Campaign& campaign, const FileSpec& spec, Experiment ex
   // Point lists and LCR readings have no time base: one "sample" per point or reading.
   const bool readings = experiment == Experiment::kCapacitance || experiment == Experiment::kFlatness;
   if (readings && read.fs == 0.0) read.fs = 1.0;
+  for (const auto& [role, unit] : spec.units) read.units[spec.channels.at(role)] = unit;
   for (const auto& role : required_roles(experiment)) read.channels.push_back(spec.channels.at(role));
   std::vector<std::string> optional;
   for (const auto& role : optional_roles(experiment)) {

@@ -13,8 +13,10 @@
 #include <set>
 #include <sstream>
 
+#include "io/csv_table.hpp"
 #include "io/file_util.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/units.hpp"
 
 namespace piezobench::io {
 namespace fs = std::filesystem;
@@ -83,9 +85,9 @@ void write_frf(const dsp::Frf& frf, const fs::path& file, const FrfWriteOptions&
   }
 }
 
-dsp::Frf read_frf(const fs::path& file) {
+dsp::Frf read_frf(const fs::path& file, const FrfReadOptions& options) {
   switch (frf_format_from_path(file)) {
-    case FrfFormat::kCsv: return read_frf_csv(file);
+    case FrfFormat::kCsv: return read_frf_csv(file, options);
     case FrfFormat::kMat: return read_frf_mat(file);
     case FrfFormat::kUff58: return read_frf_uff58(file);
   }
@@ -122,42 +124,31 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file) {
   });
 }
 
-dsp::Frf read_frf_csv(const fs::path& file) {
-  const std::string source = file.string();
-  const std::string content = detail::read_file(file);
-  if (content.find('\0') != std::string::npos) throw InputError(source, "file", "a text (CSV) file", "binary data");
-  std::vector<std::pair<size_t, std::string_view>> lines;  // (line number, text) of non-comment lines
-  {
-    size_t pos = 0, line_no = 0;
-    const std::string_view text(content);
-    while (pos < text.size()) {
-      size_t end = text.find('\n', pos);
-      if (end == std::string_view::npos) end = text.size();
-      std::string_view line = text.substr(pos, end - pos);
-      pos = end + 1;
-      ++line_no;
-      const std::string_view t = detail::trim(line);
-      if (t.empty() || t.front() == '#') continue;
-      lines.emplace_back(line_no, line);
-    }
-  }
-  if (lines.empty()) throw InputError(source, "header", "a header row (freq_Hz,re_NAME,im_NAME,...)", "an empty file");
+dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) {
+  const detail::CsvTable table(file, {options.delimiter, options.decimal});
+  const std::string& source = table.source();
+  const auto& columns = table.columns();
 
-  // Header: which output and which part each column holds.
-  enum class Part { kRe, kIm, kCoh };
-  struct Column {
-    size_t output;
-    Part part;
-  };
-  const std::vector<std::string_view> cells = detail::split(lines.front().second, ',');
-  if (detail::to_lower(std::string(detail::trim(cells[0]))) != "freq_hz") {
-    throw InputError(source, "header column 1", "freq_Hz", quote(detail::trim(cells[0])));
+  // Header: the frequency column, then which output and which part each other column holds.
+  const std::string first = detail::to_lower(columns[0].name);
+  double freq_factor = 1.0;
+  if (first == "freq_hz" && columns[0].unit.empty()) {
+    freq_factor = 1.0;
+  } else if ((first == "freq" || first == "f" || first == "frequency") && !columns[0].unit.empty()) {
+    const Unit u = unit_from_string(columns[0].unit, source, "header column 1");
+    if (u.quantity != Quantity::kFrequency) throw InputError(source, "header column 1", "a frequency in Hz or kHz", "unit " + quote(columns[0].unit));
+    freq_factor = u.to_si;
+  } else {
+    throw InputError(source, "header column 1", "freq_Hz (or freq [Hz], freq [kHz])", quote(columns[0].name));
   }
+  enum class Part { kRe, kIm, kCoh };
   dsp::Frf frf;
-  std::vector<Column> columns;
+  std::vector<int> target(columns.size(), -1);
   std::map<std::string, std::array<int, 3>> seen;  // output -> column index of re, im, coh
-  for (size_t c = 1; c < cells.size(); ++c) {
-    const std::string cell(detail::trim(cells[c]));
+  target[0] = 0;
+  for (size_t c = 1; c < columns.size(); ++c) {
+    const std::string& cell = columns[c].name;
+    const std::string where = "header column " + std::to_string(c + 1);
     Part part;
     std::string name;
     if (cell.rfind("re_", 0) == 0) {
@@ -170,16 +161,18 @@ dsp::Frf read_frf_csv(const fs::path& file) {
       part = Part::kCoh;
       name = cell.substr(4);
     } else {
-      throw InputError(source, "header column " + std::to_string(c + 1), "re_NAME, im_NAME or coh_NAME", quote(cell));
+      throw InputError(source, where, "re_NAME, im_NAME or coh_NAME", quote(cell));
     }
-    if (name.empty()) throw InputError(source, "header column " + std::to_string(c + 1), "a channel name after the prefix", quote(cell));
+    if (name.empty()) throw InputError(source, where, "a channel name after the prefix", quote(cell));
+    if (!columns[c].unit.empty()) {
+      throw InputError(source, where, "no unit (an FRF file holds the response in the units of its measurement)",
+                       "unit " + quote(columns[c].unit));
+    }
     auto [it, inserted] = seen.try_emplace(name, std::array<int, 3>{-1, -1, -1});
     if (inserted) frf.outputs.push_back(name);
     int& slot = it->second[static_cast<size_t>(part)];
-    if (slot >= 0) throw InputError(source, "header column " + std::to_string(c + 1), "each column once", quote(cell) + " twice");
+    if (slot >= 0) throw InputError(source, where, "each column once", quote(cell) + " twice");
     slot = static_cast<int>(c);
-    const size_t output = static_cast<size_t>(std::find(frf.outputs.begin(), frf.outputs.end(), name) - frf.outputs.begin());
-    columns.push_back({output, part});
   }
   if (frf.outputs.empty()) throw InputError(source, "header", "at least one output (re_NAME,im_NAME)", "only freq_Hz");
   size_t with_coh = 0;
@@ -193,40 +186,21 @@ dsp::Frf read_frf_csv(const fs::path& file) {
     throw InputError(source, "header", "coh_NAME columns for every output or for none",
                      std::to_string(with_coh) + " of " + std::to_string(frf.outputs.size()));
   }
-
-  const auto n = static_cast<Index>(lines.size() - 1);
-  if (n == 0) throw InputError(source, "data", "at least one data row after the header", "none");
-  frf.freq_hz.resize(n);
-  Eigen::MatrixXd re(n, static_cast<Index>(frf.outputs.size())), im = re, coh = re;
-  for (Index k = 0; k < n; ++k) {
-    const auto& [line_no, line] = lines[static_cast<size_t>(k) + 1];
-    const std::vector<std::string_view> fields = detail::split(line, ',');
-    if (fields.size() != cells.size()) {
-      throw InputError(source, "line " + std::to_string(line_no), std::to_string(cells.size()) + " comma-separated fields",
-                       std::to_string(fields.size()));
-    }
-    for (size_t c = 0; c < fields.size(); ++c) {
-      const std::optional<double> v = detail::parse_double(fields[c]);
-      const std::string column = std::string(detail::trim(cells[c]));
-      if (!v || !std::isfinite(*v)) {
-        throw InputError(source, column + " (line " + std::to_string(line_no) + ")", "a finite number",
-                         detail::trim(fields[c]).empty() ? std::string("an empty cell") : quote(detail::trim(fields[c])));
-      }
-      if (c == 0) {
-        frf.freq_hz(k) = *v;
-        continue;
-      }
-      const Column& col = columns[c - 1];
-      const auto o = static_cast<Index>(col.output);
-      (col.part == Part::kRe ? re : col.part == Part::kIm ? im : coh)(k, o) = *v;
-    }
-  }
+  // Table columns: freq, then re, im (and coh) per output in output order.
+  const int per_output = with_coh != 0 ? 3 : 2;
   for (size_t i = 0; i < frf.outputs.size(); ++i) {
-    Eigen::VectorXcd h(n);
-    h.real() = re.col(static_cast<Index>(i));
-    h.imag() = im.col(static_cast<Index>(i));
+    const auto& slots = seen[frf.outputs[i]];
+    for (int p = 0; p < per_output; ++p) target[static_cast<size_t>(slots[static_cast<size_t>(p)])] = 1 + static_cast<int>(i) * per_output + p;
+  }
+  const Eigen::MatrixXd data = table.read(target, 1 + static_cast<Index>(frf.outputs.size()) * per_output);
+  frf.freq_hz = data.col(0) * freq_factor;
+  for (size_t i = 0; i < frf.outputs.size(); ++i) {
+    const Index base = 1 + static_cast<Index>(i) * per_output;
+    Eigen::VectorXcd h(data.rows());
+    h.real() = data.col(base);
+    h.imag() = data.col(base + 1);
     frf.H.push_back(std::move(h));
-    if (with_coh != 0) frf.coherence.emplace_back(coh.col(static_cast<Index>(i)));
+    if (with_coh != 0) frf.coherence.emplace_back(data.col(base + 2));
   }
   frf.provenance.source = source;
   frf.validate(source);
@@ -525,6 +499,7 @@ struct Dataset58 {
   double abscissa_min = 0.0, abscissa_inc = 0.0;
   int abscissa_spec = 0;
   std::string ord_label, denom_label;
+  std::string abscissa_unit, ord_unit, denom_unit;  // records 8-10 units labels ("" = NONE)
   Eigen::VectorXd x;
   Eigen::VectorXcd y;
 };
@@ -673,12 +648,19 @@ class UffReader {
     if (d.even && !(d.abscissa_inc > 0.0)) {
       throw InputError(source_, field(d, "record 7 (abscissa increment)"), "> 0 for even spacing", format_short(d.abscissa_inc));
     }
+    const auto units_label = [](std::string_view record) {
+      std::string u(detail::trim(column(record, 47, 20)));
+      return u == "NONE" ? std::string() : u;
+    };
     const std::string_view r8 = require_line(d, "record 8");
     d.abscissa_spec = static_cast<int>(int_field(d, r8, 0, 10, "record 8 (abscissa data type)"));
+    d.abscissa_unit = units_label(r8);
     const std::string_view r9 = require_line(d, "record 9");
     d.ord_label = std::string(detail::trim(column(r9, 26, 20)));
+    d.ord_unit = units_label(r9);
     const std::string_view r10 = require_line(d, "record 10");
     d.denom_label = std::string(detail::trim(column(r10, 26, 20)));
+    d.denom_unit = units_label(r10);
     (void)require_line(d, "record 11");
 
     if (binary) {
@@ -690,7 +672,26 @@ class UffReader {
       d.x.resize(static_cast<Index>(d.n));
       for (Index k = 0; k < d.x.size(); ++k) d.x(k) = d.abscissa_min + static_cast<double>(k) * d.abscissa_inc;
     }
+    to_si(d);
     return d;
+  }
+
+  // Units labels of records 8-10, honoured or refused: the abscissa in Hz (kHz converted), an
+  // FRF's ordinate as numerator / denominator in SI (e.g. um / V scales by 1e-6). An unlabelled
+  // ("NONE") axis is taken as SI. Coherence (function type 6) is dimensionless.
+  void to_si(Dataset58& d) const {
+    if (!d.abscissa_unit.empty()) {
+      const Unit u = unit_from_string(d.abscissa_unit, source_, field(d, "record 8 (abscissa units)"));
+      if (u.quantity != Quantity::kFrequency) {
+        throw InputError(source_, field(d, "record 8 (abscissa units)"), "a frequency unit (Hz, kHz)", "unit " + quote(d.abscissa_unit));
+      }
+      d.x *= u.to_si;
+    }
+    if (d.func_type != kFuncFrf) return;
+    double factor = 1.0;
+    if (!d.ord_unit.empty()) factor *= unit_from_string(d.ord_unit, source_, field(d, "record 9 (ordinate units)")).to_si;
+    if (!d.denom_unit.empty()) factor /= unit_from_string(d.denom_unit, source_, field(d, "record 10 (denominator units)")).to_si;
+    if (factor != 1.0) d.y *= factor;
   }
 
   bool is_complex(const Dataset58& d) const { return d.ord_type == kOrdComplexSingle || d.ord_type == kOrdComplexDouble; }

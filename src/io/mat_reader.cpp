@@ -503,7 +503,10 @@ std::string read_string_attribute(hid_t obj, const char* name, const std::string
   std::string out;
   if (variable > 0) {
     const H5Id mem(H5Tcopy(H5T_C_S1), H5Tclose);
-    if (!mem.valid() || H5Tset_size(mem.get(), H5T_VARIABLE) < 0) throw InputError(source, field, "HDF5 string type", "failure");
+    // Same character set as the file's (h5py writes UTF-8): HDF5 converts no other way.
+    if (!mem.valid() || H5Tset_size(mem.get(), H5T_VARIABLE) < 0 || H5Tset_cset(mem.get(), H5Tget_cset(type.get())) < 0) {
+      throw InputError(source, field, "a readable " + std::string(name) + " attribute", "an unreadable string type");
+    }
     char* value = nullptr;
     if (H5Aread(attr.get(), mem.get(), &value) < 0 || value == nullptr) {
       throw InputError(source, field, "a readable " + std::string(name) + " attribute", "HDF5 read failed");

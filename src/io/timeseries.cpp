@@ -14,8 +14,10 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "io/csv_table.hpp"
 #include "io/file_util.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/units.hpp"
 
 namespace piezobench::io {
 namespace fs = std::filesystem;
@@ -172,6 +174,96 @@ double resolve_sample_rate(const std::string& source, const Eigen::VectorXd& t, 
   throw InputError(source, "fs", "a time vector t (2 samples or more) or a sample rate (--fs)", "neither");
 }
 
+bool is_time_name(const std::string& name) {
+  const std::string l = detail::to_lower(name);
+  return l == "t" || l == "time";
+}
+
+bool is_rate_name(const std::string& name) {
+  const std::string l = detail::to_lower(name);
+  return l == "fs" || l == "sample_rate" || l == "sample_rate_hz" || l == "samplerate" || l == "sampling_rate";
+}
+
+std::vector<std::string> struct_field_names(const matvar_t& var) {
+  std::vector<std::string> out;
+  const unsigned nfields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
+  char* const* names = Mat_VarGetStructFieldnames(&var);
+  for (unsigned i = 0; i < nfields && names != nullptr; ++i) {
+    if (names[i] != nullptr) out.emplace_back(names[i]);
+  }
+  return out;
+}
+
+// A sample rate written as text: "fs: 10000", "Fs = 10 kHz", "sample_rate_Hz: 10000",
+// "sample rate [Hz]: 1000" (keys in any case; Hz unless a frequency unit follows). nullopt when the
+// text is not about the sample rate; InputError (source, field) when its value is not a rate.
+std::optional<double> rate_from_text(const std::string& text, const std::string& source, const std::string& field) {
+  const size_t sep = text.find_first_of(":=");
+  if (sep == std::string::npos) return std::nullopt;
+  std::string key(detail::trim(std::string_view(text).substr(0, sep)));
+  std::string unit;
+  if (const size_t open = key.find_first_of("[("); open != std::string::npos) {
+    const size_t close = key.find_first_of("])", open);
+    unit = std::string(detail::trim(std::string_view(key).substr(open + 1, close == std::string::npos ? std::string::npos : close - open - 1)));
+    key = std::string(detail::trim(std::string_view(key).substr(0, open)));
+  }
+  std::string lower = detail::to_lower(key);
+  std::replace(lower.begin(), lower.end(), ' ', '_');
+  if (lower.size() > 3 && lower.compare(lower.size() - 3, 3, "_hz") == 0) {
+    lower.resize(lower.size() - 3);
+    if (unit.empty()) unit = "Hz";
+  }
+  if (lower != "fs" && lower != "sample_rate" && lower != "samplerate" && lower != "sampling_rate" &&
+      lower != "sampling_frequency") {
+    return std::nullopt;
+  }
+  std::string_view value = detail::trim(std::string_view(text).substr(sep + 1));
+  if (const size_t blank = value.find_first_of(" \t"); blank != std::string_view::npos) {
+    if (!unit.empty()) throw InputError(source, field, "one unit for the sample rate", quote(text));
+    unit = std::string(detail::trim(value.substr(blank)));
+    value = value.substr(0, blank);
+  }
+  const std::optional<double> v = detail::parse_double(value);
+  if (!v || !(std::isfinite(*v) && *v > 0.0)) throw InputError(source, field, "a positive sample rate", quote(value));
+  if (unit.empty()) return *v;
+  const Unit u = unit_from_string(unit, source, field);
+  if (u.quantity != Quantity::kFrequency) throw InputError(source, field, "a sample rate in Hz or kHz", "unit " + quote(unit));
+  return *v * u.to_si;
+}
+
+// Factor from a time column's unit to seconds ("" = seconds).
+double time_unit_factor(const std::string& unit, const std::string& source, const std::string& field) {
+  if (unit.empty()) return 1.0;
+  const Unit u = unit_from_string(unit, source, field);
+  if (u.quantity != Quantity::kTime) {
+    throw InputError(source, field, "a time unit (us, ms, s, min) for the time vector", "unit " + quote(unit));
+  }
+  return u.to_si;
+}
+
+// Samples in SI units: each channel's unit (from the file, else ReadOptions::units) is converted
+// with the unit table and replaced by its SI symbol; a unit the table does not know is an
+// InputError naming the channel and the units known. Units stay "" where nothing says one.
+void convert_to_si(TimeSeries& ts, const ReadOptions& options) {
+  if (ts.units.empty()) ts.units.assign(ts.names.size(), "");
+  for (size_t j = 0; j < ts.names.size(); ++j) {
+    std::string& unit = ts.units[j];
+    const auto given = options.units.find(ts.names[j]);
+    if (given != options.units.end()) {
+      if (!unit.empty() && unit != given->second) {
+        throw InputError(ts.source, "channel " + ts.names[j], "the unit given for it (" + given->second + ")",
+                         "unit " + quote(unit) + " in the file");
+      }
+      unit = given->second;
+    }
+    if (unit.empty()) continue;
+    const Unit u = unit_from_string(unit, ts.source, "channel " + ts.names[j]);
+    if (u.to_si != 1.0) ts.data.col(static_cast<Eigen::Index>(j)) *= u.to_si;
+    unit = u.si_symbol;
+  }
+  if (std::all_of(ts.units.begin(), ts.units.end(), [](const std::string& u) { return u.empty(); })) ts.units.clear();
+}
+
 std::vector<std::string> available_names(const std::vector<std::string>& names) {
   std::vector<std::string> sorted = names;
   std::sort(sorted.begin(), sorted.end());
@@ -296,6 +388,8 @@ void ReadOptions::validate() const {
     if (c.empty()) throw InputError("ReadOptions", "channels", "non-empty names", "an empty name");
     if (!seen.insert(c).second) throw InputError("ReadOptions", "channels", "distinct names", quote(c) + " twice");
   }
+  detail::CsvDialect{delimiter, decimal}.validate();
+  for (const auto& [channel, unit] : units) (void)unit_from_string(unit, "ReadOptions", "units." + channel);
 }
 
 std::string to_string(MatVersion v) {
@@ -347,7 +441,7 @@ std::vector<std::string> struct_channels(const matvar_t& var) {
   const unsigned nfields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
   char* const* names = Mat_VarGetStructFieldnames(&var);
   for (unsigned i = 0; i < nfields && names != nullptr; ++i) {
-    if (names[i] == nullptr || std::string(names[i]) == kTime) continue;
+    if (names[i] == nullptr || is_time_name(names[i])) continue;
     matvar_t* field = Mat_VarGetStructFieldByIndex(const_cast<matvar_t*>(&var), i, 0);
     if (field == nullptr) continue;
     detail::MatVarInfo info;
@@ -385,7 +479,7 @@ MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOpti
   }
   std::vector<std::string> structs;
   for (const auto& v : vars) {
-    if (v.name == kTime || v.name == kFs) continue;
+    if (is_time_name(v.name) || is_rate_name(v.name)) continue;
     if (is_numeric_vector(v)) layout.channels.push_back(v.name);
     if (v.class_type == MAT_C_STRUCT && v.name != kUnits && v.name != kSettings) structs.push_back(v.name);
   }
@@ -502,10 +596,23 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
   // time_samples_ok); anything else through matio's copy and the full checks.
   Eigen::Index t_length = -1;
   bool t_prechecked = false;
-  matvar_t* t_in_group = field_of(kTime);
-  const auto t_info = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return v.name == kTime; });
+  // `t` or `time` in any case (MATLAB scripts write `time`, `Time`).
+  std::string t_name;
+  matvar_t* t_in_group = nullptr;
+  if (layout.group_var) {
+    for (const std::string& f : struct_field_names(*layout.group_var)) {
+      if (is_time_name(f)) {
+        t_name = f;
+        t_in_group = field_of(f);
+        break;
+      }
+    }
+  }
+  const auto t_info = t_in_group != nullptr ? vars.end()
+                                            : std::find_if(vars.begin(), vars.end(), [](const auto& v) { return is_time_name(v.name); });
+  if (t_info != vars.end()) t_name = t_info->name;
   if (t_in_group != nullptr) {
-    ts.t = detail::to_real_vector(*t_in_group, source, layout.group + ".t");
+    ts.t = detail::to_real_vector(*t_in_group, source, layout.group + "." + t_name);
     t_length = ts.t.size();
   } else if (t_info != vars.end()) {
     size_t count = 1;
@@ -513,7 +620,7 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
     const auto n = static_cast<Eigen::Index>(count);
     const std::optional<double> t_last =
         n >= 2 && n == lengths.front() && is_numeric_vector(*t_info) && t_info->class_type == MAT_C_DOUBLE
-            ? detail::read_double_element(mat.get(), kTime, n, n - 1)
+            ? detail::read_double_element(mat.get(), t_name, n, n - 1)
             : std::nullopt;
     bool read = false;
     if (t_last) {
@@ -525,23 +632,43 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
         if (first == 0) dt = (*t_last - ts.t(0)) / static_cast<double>(n - 1);  // as sample_rate_from_time
         ok = ok && time_samples_ok(ts.t.data(), n, first, piece, dt, options.time_tolerance);
       };
-      read = detail::read_double_vector_into(mat.get(), kTime, ts.t, kReadChunk, check);
+      read = detail::read_double_vector_into(mat.get(), t_name, ts.t, kReadChunk, check);
       t_prechecked = read && ok && ts.t(n - 1) == *t_last;
     }
     if (!read) {
-      detail::MatVarPtr tv = detail::read_mat_variable(mat.get(), file, kTime);
-      ts.t = detail::to_real_vector(*tv, source, kTime);
+      detail::MatVarPtr tv = detail::read_mat_variable(mat.get(), file, t_name);
+      ts.t = detail::to_real_vector(*tv, source, t_name);
     }
     t_length = ts.t.size();
   }
   check_lengths(source, names, lengths, t_length);
 
+  // The sample rate as a scalar `fs`, `Fs`, `sample_rate` or `sample_rate_Hz` (any case).
   std::optional<double> fs_file;
-  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kFs; })) {
-    detail::MatVarPtr fv = detail::read_mat_variable(mat.get(), file, kFs);
-    const Eigen::VectorXd f = detail::to_real_vector(*fv, source, kFs);
-    if (f.size() != 1) throw InputError(source, kFs, "a scalar sample rate in Hz", detail::describe(*fv));
+  const auto fs_info = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return is_rate_name(v.name); });
+  if (fs_info != vars.end()) {
+    detail::MatVarPtr fv = detail::read_mat_variable(mat.get(), file, fs_info->name);
+    const Eigen::VectorXd f = detail::to_real_vector(*fv, source, fs_info->name);
+    if (f.size() != 1) throw InputError(source, fs_info->name, "a scalar sample rate in Hz", detail::describe(*fv));
     fs_file = f(0);
+  }
+
+  // Units: the `units` struct of the file (one char field per channel, and the time vector's).
+  std::map<std::string, Setting> file_units;
+  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kUnits; })) {
+    detail::MatVarPtr uv = detail::read_mat_variable(mat.get(), file, kUnits);
+    if (uv->class_type == MAT_C_STRUCT) file_units = read_struct_settings(*uv, source, kUnits);
+  }
+  // A field of `units`, else (v7.3) the dataset's own `units` attribute.
+  const auto unit_of = [&](const std::string& name) {
+    const auto it = file_units.find(name);
+    if (it != file_units.end() && std::holds_alternative<std::string>(it->second)) return std::get<std::string>(it->second);
+    const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; });
+    return layout.group.empty() && info != vars.end() ? info->unit : std::string();
+  };
+  if (ts.t.size() > 0) {
+    const double factor = time_unit_factor(unit_of(t_name), source, std::string(kUnits) + "." + t_name);
+    if (factor != 1.0) ts.t *= factor;
   }
 
   ts.names = names;
@@ -567,18 +694,9 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
     if (!finite) check_finite(source, field, ts.data.col(col));
   }
   ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_file, options.time_tolerance, t_prechecked);
-
-  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kUnits; })) {
-    detail::MatVarPtr uv = detail::read_mat_variable(mat.get(), file, kUnits);
-    if (uv->class_type == MAT_C_STRUCT) {
-      const auto units = read_struct_settings(*uv, source, kUnits);
-      ts.units.assign(names.size(), "");
-      for (size_t j = 0; j < names.size(); ++j) {
-        const auto it = units.find(names[j]);
-        if (it != units.end() && std::holds_alternative<std::string>(it->second)) ts.units[j] = std::get<std::string>(it->second);
-      }
-    }
-  }
+  ts.units.assign(names.size(), "");
+  for (size_t j = 0; j < names.size(); ++j) ts.units[j] = unit_of(names[j]);
+  convert_to_si(ts, options);
   if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kSettings; })) {
     detail::MatVarPtr sv = detail::read_mat_variable(mat.get(), file, kSettings);
     if (sv->class_type == MAT_C_STRUCT) ts.settings = read_struct_settings(*sv, source, kSettings);
@@ -588,179 +706,57 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
   return ts;
 }
 
-namespace {
-
-struct HeaderCell {
-  std::string name;
-  std::string unit;
-};
-
-std::string unquote(std::string_view s) {
-  s = detail::trim(s);
-  if (s.size() >= 2 && s.front() == '"' && s.back() == '"') s = detail::trim(s.substr(1, s.size() - 2));
-  return std::string(s);
-}
-
-HeaderCell parse_header_cell(std::string_view cell, const std::string& source, size_t line_no, size_t column) {
-  std::string text = unquote(cell);
-  HeaderCell out;
-  const size_t open = text.find('[');
-  if (open != std::string::npos) {
-    const size_t close = text.find(']', open);
-    if (close == std::string::npos || detail::trim(std::string_view(text).substr(close + 1)).size() != 0) {
-      throw InputError(source, "header (line " + std::to_string(line_no) + ", column " + std::to_string(column + 1) + ")",
-                       "NAME or NAME [UNIT]", quote(text));
-    }
-    out.unit = std::string(detail::trim(std::string_view(text).substr(open + 1, close - open - 1)));
-    out.name = std::string(detail::trim(std::string_view(text).substr(0, open)));
-  } else {
-    out.name = text;
-  }
-  if (out.name.empty()) {
-    throw InputError(source, "header (line " + std::to_string(line_no) + ", column " + std::to_string(column + 1) + ")",
-                     "a channel name", quote(text));
-  }
-  return out;
-}
-
-bool is_comment_or_blank(std::string_view line) {
-  const std::string_view t = detail::trim(line);
-  return t.empty() || t.front() == '#';
-}
-
-}  // namespace
-
 TimeSeries read_timeseries_csv(const fs::path& file, const ReadOptions& options) {
   options.validate();
-  const std::string source = file.string();
-  const std::string content = detail::read_file(file);
-  if (content.find('\0') != std::string::npos) {
-    throw InputError(source, "file", "a text (CSV) file", "binary data (a NUL byte at offset " +
-                                                              std::to_string(content.find('\0')) + ")");
-  }
-  const std::string_view text(content);
+  const detail::CsvTable table(file, {options.delimiter, options.decimal});
+  const std::string& source = table.source();
 
-  size_t pos = 0;
-  size_t line_no = 0;
-  auto next_line = [&](std::string_view& line) {
-    if (pos >= text.size()) return false;
-    size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    line = text.substr(pos, end - pos);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    pos = end + 1;
-    ++line_no;
-    return true;
-  };
-
-  std::string_view line;
-  bool have_header = false;
   std::optional<double> fs_comment;
-  while (next_line(line)) {
-    if (!is_comment_or_blank(line)) {
-      have_header = true;
-      break;
-    }
-    // "# sample_rate_Hz: 10000", written by write_timeseries_csv when there is no time column.
-    const std::string_view body = detail::trim(line);
-    constexpr std::string_view kRateKey = "sample_rate_Hz:";
-    if (body.size() > 1) {
-      const std::string_view rest = detail::trim(body.substr(1));
-      if (rest.substr(0, kRateKey.size()) == kRateKey) {
-        fs_comment = detail::parse_double(rest.substr(kRateKey.size()));
-        if (!fs_comment) {
-          throw InputError(source, "sample_rate_Hz (line " + std::to_string(line_no) + ")", "a number in Hz",
-                           quote(rest.substr(kRateKey.size())));
-        }
-      }
+  for (const auto& [line_no, comment] : table.comments()) {
+    if (const std::optional<double> f = rate_from_text(comment, source, "comment (line " + std::to_string(line_no) + ")")) {
+      fs_comment = f;
     }
   }
-  if (!have_header) throw InputError(source, "header", "a header row (channel names)", "no line other than comments");
 
-  const std::vector<std::string_view> cells = detail::split(line, ',');
-  std::vector<HeaderCell> header;
-  header.reserve(cells.size());
-  for (size_t c = 0; c < cells.size(); ++c) header.push_back(parse_header_cell(cells[c], source, line_no, c));
-  std::set<std::string> seen;
+  const auto& columns = table.columns();
   std::vector<std::string> available;
   int time_column = -1;
-  for (size_t c = 0; c < header.size(); ++c) {
-    if (!seen.insert(header[c].name).second) {
-      throw InputError(source, "header", "distinct column names", quote(header[c].name) + " twice");
-    }
-    if (header[c].name == kTime) {
+  for (size_t c = 0; c < columns.size(); ++c) {
+    if (time_column < 0 && is_time_name(columns[c].name)) {
       time_column = static_cast<int>(c);
-      if (!header[c].unit.empty() && header[c].unit != "s") {
-        throw InputError(source, "t", "time in seconds (unit [s])", "unit " + quote(header[c].unit));
-      }
     } else {
-      available.push_back(header[c].name);
+      available.push_back(columns[c].name);
     }
   }
   const std::vector<std::string> names = select_channels(source, options, available);
-  // For each CSV column, the TimeSeries column it fills (-1: not read, -2: the time vector).
-  std::vector<int> target(header.size(), -1);
+  // For each CSV column, the column of the table it fills (-1: not read); the time vector last.
+  std::vector<int> target(columns.size(), -1);
+  std::vector<std::string> units(names.size());
   for (size_t j = 0; j < names.size(); ++j) {
-    for (size_t c = 0; c < header.size(); ++c) {
-      if (header[c].name == names[j]) target[c] = static_cast<int>(j);
-    }
-  }
-  if (time_column >= 0) target[static_cast<size_t>(time_column)] = -2;
-
-  // Upper bound of the number of rows, so the matrix is allocated once.
-  const auto max_rows = static_cast<Eigen::Index>(std::count(text.begin() + static_cast<std::ptrdiff_t>(pos), text.end(), '\n') + 1);
-  Eigen::MatrixXd data(max_rows, static_cast<Eigen::Index>(names.size()));
-  Eigen::VectorXd t(time_column >= 0 ? max_rows : 0);
-  Eigen::Index rows = 0;
-  const size_t ncols = header.size();
-  while (next_line(line)) {
-    if (is_comment_or_blank(line)) continue;
-    size_t start = 0;
-    for (size_t c = 0; c < ncols; ++c) {
-      const size_t comma = c + 1 < ncols ? line.find(',', start) : std::string_view::npos;
-      if (c + 1 < ncols && comma == std::string_view::npos) {
-        throw InputError(source, "line " + std::to_string(line_no), std::to_string(ncols) + " comma-separated fields",
-                         std::to_string(c + 1));
-      }
-      const std::string_view cell = line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
-      if (c + 1 == ncols && cell.find(',') != std::string_view::npos) {
-        throw InputError(source, "line " + std::to_string(line_no), std::to_string(ncols) + " comma-separated fields",
-                         std::to_string(ncols + static_cast<size_t>(std::count(cell.begin(), cell.end(), ','))));
-      }
-      start = comma + 1;
-      if (target[c] == -1) continue;
-      const std::optional<double> v = detail::parse_double(cell);
-      const std::string& name = header[c].name;
-      if (!v) {
-        throw InputError(source, name + " (line " + std::to_string(line_no) + ")", "a number",
-                         detail::trim(cell).empty() ? std::string("an empty cell") : quote(detail::trim(cell)));
-      }
-      if (!std::isfinite(*v)) {
-        throw InputError(source, name, "finite samples",
-                         quote(detail::trim(cell)) + " at sample " + std::to_string(rows) + " (line " + std::to_string(line_no) + ")");
-      }
-      if (target[c] == -2) {
-        t(rows) = *v;
-      } else {
-        data(rows, target[c]) = *v;
+    for (size_t c = 0; c < columns.size(); ++c) {
+      if (static_cast<int>(c) != time_column && columns[c].name == names[j]) {
+        target[c] = static_cast<int>(j);
+        units[j] = columns[c].unit;
       }
     }
-    ++rows;
   }
-  if (rows == 0) throw InputError(source, "data", "at least one data row after the header", "none");
+  const auto nread = static_cast<Eigen::Index>(names.size() + (time_column >= 0 ? 1 : 0));
+  if (time_column >= 0) target[static_cast<size_t>(time_column)] = static_cast<int>(names.size());
+  Eigen::MatrixXd data = table.read(target, nread);
 
   TimeSeries ts;
   ts.source = source;
   ts.names = names;
-  ts.data = data.topRows(rows);
-  if (time_column >= 0) ts.t = t.head(rows);
-  ts.units.assign(names.size(), "");
-  for (size_t j = 0; j < names.size(); ++j) {
-    for (const HeaderCell& h : header) {
-      if (h.name == names[j]) ts.units[j] = h.unit;
-    }
+  if (time_column >= 0) {
+    const detail::CsvColumn& tc = columns[static_cast<size_t>(time_column)];
+    ts.t = data.col(nread - 1);
+    ts.t *= time_unit_factor(tc.unit, source, "column " + tc.name);
+    ts.data = data.leftCols(nread - 1);
+  } else {
+    ts.data = std::move(data);
   }
-  if (std::all_of(ts.units.begin(), ts.units.end(), [](const std::string& u) { return u.empty(); })) ts.units.clear();
+  ts.units = std::move(units);
+  convert_to_si(ts, options);
   ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_comment, options.time_tolerance);
   ts.validate();
   return ts;

@@ -128,5 +128,44 @@ TEST(FitCli, TooHighAnOrderIsAClearError) {
   EXPECT_TRUE(r.out.empty());
 }
 
+// Issue 12: files as labs have them (scripts/fixtures/make_io_lab_fixtures.py: DAQ CSV in ms, um
+// and mV with tabs and decimal commas, ';' CSV in mm, blank-separated CSV, v7.3 from MATLAB's
+// layout, h5py and hdf5storage): `frf` gives scipy's H1 in SI units.
+TEST(FrfCli, LabFilesGiveScipysH1InSi) {
+  const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("io/lab/expected.json")));
+  const std::pair<const char*, double> files[] = {
+      {"daq_tab_decimal_comma.csv", 1e-5}, {"semicolon_mm.csv", 1e-5}, {"blanks_us.csv", 1e-5},  // 10 digits
+      {"v73_matlab.mat", 1e-9},           {"v73_h5py.mat", 1e-9},     {"v73_hdf5storage.mat", 1e-9}};
+  for (const auto& [name, tol] : files) {
+    SCOPED_TRACE(name);
+    const std::string file = test::fixture_path(std::string("io/lab/") + name).string();
+    const test::CliRun r =
+        run_cli("frf " + file + " --input u --output d_e,Vs --nfft 512 --overlap 0.5 --window hann --detrend none --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto got = nlohmann::json::parse(r.out);
+    ASSERT_EQ(got["freq_Hz"].size(), ref["freq_Hz"].size());
+    for (const char* out : {"d_e", "Vs"}) {
+      const auto& g = got["outputs"][out];
+      const auto& e = ref["outputs"][out];
+      // Relative to the largest |H|: bins of tiny response carry the rounding of the files' 10 digits.
+      double scale = 0.0;
+      for (const auto& h : e["H"]) scale = std::max(scale, std::abs(pair(h)));
+      for (std::size_t k = 0; k < e["H"].size(); ++k) {
+        ASSERT_TRUE(test::near(pair(g["H"][k]), pair(e["H"][k]), {tol, tol * scale})) << out << " bin " << k;
+      }
+    }
+  }
+  const test::CliRun r = run_cli("frf " + test::fixture_path("io/lab/daq_tab_decimal_comma.csv").string() +
+                                 " --input u --output d_e,Vs --nfft 512 --json --delimiter tab --decimal ,");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["H_units"]["d_e"], "m/V");
+  // A wrong forced dialect is an input error that names it; an unknown spelling a usage error.
+  const test::CliRun bad = run_cli("frf " + test::fixture_path("io/lab/semicolon_mm.csv").string() +
+                                   " --input u --output d_e --fs 2000 --delimiter tab");
+  EXPECT_EQ(bad.exit_code, 3);
+  EXPECT_TRUE(test::contains(bad.err, "tab-separated")) << bad.err;
+  EXPECT_EQ(run_cli("frf " + test::fixture_path("io/lab/semicolon_mm.csv").string() + " --input u --output d_e --delimiter pipe").exit_code, 2);
+}
+
 }  // namespace
 }  // namespace piezobench

@@ -124,6 +124,18 @@ TEST(CampaignFile, DefaultsAndTypedCapacitance) {
   EXPECT_FALSE(c.units[0].has(Experiment::kFrf));
 }
 
+TEST(CampaignFile, ChannelUnitsOfAFileEntry) {
+  // Issue 12: the unit of a channel whose file says none, from the one unit table.
+  const Folder f;
+  const Campaign c = f.parse(
+      "[[units]]\nid = 1\nstroke = { file = \"data/a_stroke.csv\", channels = { de = \"laser\" }, units = { de = \"um\", Va = \"V\" } }\n");
+  EXPECT_EQ(c.units[0].stroke->units.at("de"), "um");
+  EXPECT_EQ(c.units[0].stroke->units.at("Va"), "V");
+  const std::string msg = f.error("[[units]]\nid = 1\nstroke = { file = \"data/a_stroke.csv\", units = { de = \"microns\" } }\n",
+                                  "units[0].stroke.units.de");
+  EXPECT_TRUE(contains(msg, "'microns'") && contains(msg, "nm, um, mm")) << msg;
+}
+
 TEST(CampaignFile, UnknownKeysNameFileAndKey) {
   const Folder f;
   const std::string top = f.error("titel = \"x\"\n[[units]]\nid = 1\n", "titel");

@@ -119,6 +119,22 @@ TEST(Pipeline, AcceptanceOutliersAndIff) {
   }
 }
 
+// Issue 12: a record whose numbers are in um under a label that says metres gave a stroke of
+// 136,000,000 um, accepted. It is rejected as implausible, naming the column and the file.
+TEST(Pipeline, ImplausibleValuesAreRejectedNamingTheColumn) {
+  const Batch b;
+  io::TimeSeries um = syn::stroke_record(-0.8);  // probe in um, written as if in metres
+  io::write_timeseries(um, b.dir.path() / "stroke3.csv");
+  const CampaignResult r = run_campaign(b.campaign);
+  const json& u3 = unit(r.results, 3);
+  EXPECT_FALSE(u3["accepted"].get<bool>());
+  std::string reasons;
+  for (const auto& x : u3["reasons"]) reasons += x.get<std::string>() + "\n";
+  EXPECT_TRUE(test::contains(reasons, "implausible: stroke 1.36e+08 um cannot be a measurement")) << reasons;
+  EXPECT_TRUE(test::contains(reasons, "check the units of column 'probe' of 'stroke3.csv'")) << reasons;
+  EXPECT_TRUE(unit(r.results, 1)["accepted"].get<bool>());
+}
+
 // The result does not depend on the number of threads.
 TEST(Pipeline, ThreadsDoNotChangeTheResult) {
   const Batch b;

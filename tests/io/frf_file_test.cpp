@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <bit>
 #include <cstdint>
 #include <cstring>
@@ -234,6 +236,62 @@ TEST(FrfUff, EvenGridRoundTripToPrintedPrecision) {
   EXPECT_EQ(lines[9].substr(0, 10), "        18");                      // abscissa: frequency
   EXPECT_EQ(lines[13].size(), 80u);  // 4E20.12: two complex values per line
   expect_uff_round_trip(read_frf(file), frf);
+}
+
+TEST(FrfUff, UnitsLabelsAreHonouredOrRefused) {
+  TempDir dir;
+  const dsp::Frf frf = sample_frf(even_grid());
+  const fs::path file = dir.path() / "frf.uff";
+  write_frf(frf, file);
+  std::vector<std::string> lines = lines_of(test::read_text(file));
+  // Every abscissa in kHz (record 8), the first FRF's ordinate in um (record 9; denominator NONE = V).
+  ASSERT_EQ(lines[9].substr(47, 2), "Hz");
+  const auto relabel = [&](size_t i, const std::string& unit) { lines[i] = lines[i].substr(0, 47) + unit; };
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (lines[i].size() > 47 && lines[i].substr(0, 10) == "        18" && lines[i].substr(47, 2) == "Hz") relabel(i, "kHz");
+  }
+  relabel(10, "um");
+  const auto write_lines = [&] {
+    std::string text;
+    for (const auto& l : lines) text += l + "\n";
+    write_bytes(file, text);
+  };
+  write_lines();
+  const dsp::Frf back = read_frf(file);
+  EXPECT_TRUE(test::near(back.freq_hz(1), 1e3 * frf.freq_hz(1), {1e-5, 0.0}));
+  EXPECT_TRUE(test::near(back.H[0](7), 1e-6 * frf.H[0](7), {1e-11, 0.0}));
+  EXPECT_TRUE(test::near(back.H[1](7), frf.H[1](7), {1e-11, 0.0}));  // the second dataset is unlabelled
+  relabel(10, "furlong");
+  write_lines();
+  test::expect_input_error([&] { (void)read_frf(file); }, {"frf.uff", "record 9 (ordinate units)", "'furlong'", "known unit"});
+  relabel(10, "NONE");
+  relabel(9, "s");  // a time abscissa
+  write_lines();
+  test::expect_input_error([&] { (void)read_frf(file); }, {"record 8 (abscissa units)", "a frequency unit"});
+}
+
+TEST(FrfCsv, LabDialectsAndScipysWelchFile) {
+  TempDir dir;
+  const fs::path file = dir.path() / "semi.csv";
+  write_bytes(file, "freq [kHz];re_a;im_a\n0,5;1,5;-2\n1;3;4\n");
+  const dsp::Frf frf = read_frf(file);
+  EXPECT_EQ(frf.freq_hz(0), 500.0);
+  EXPECT_EQ(frf.H[0](0), std::complex<double>(1.5, -2.0));
+  write_bytes(file, "freq_Hz;re_a;im_a\n1;2;3\n2;3\n");
+  test::expect_input_error([&] { (void)read_frf(file); }, {"semi.csv", "line 3", "';'-separated (detected)"});
+  // scipy's Welch H1 and coherence, 17 digits (scripts/fixtures/make_io_lab_fixtures.py).
+  const dsp::Frf w = read_frf(test::fixture_path("io/lab/welch_frf.csv"));
+  const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("io/lab/expected.json")));
+  ASSERT_EQ(w.outputs, (std::vector<std::string>{"d_e", "Vs"}));
+  ASSERT_EQ(static_cast<size_t>(w.freq_hz.size()), ref["freq_Hz"].size());
+  for (size_t i = 0; i < 2; ++i) {
+    const auto& e = ref["outputs"][w.outputs[i]];
+    for (size_t k = 0; k < e["H"].size(); ++k) {
+      const std::complex<double> want(e["H"][k][0].get<double>(), e["H"][k][1].get<double>());
+      ASSERT_EQ(w.H[i](static_cast<Index>(k)), want) << w.outputs[i] << " bin " << k;
+      ASSERT_EQ(w.coherence[i](static_cast<Index>(k)), e["coherence"][k].get<double>());
+    }
+  }
 }
 
 TEST(FrfUff, UnevenGridRoundTripToPrintedPrecision) {

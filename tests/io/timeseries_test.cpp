@@ -157,9 +157,10 @@ TEST(TimeSeriesCsv, CommentsUnitsAndExplicitRate) {
   options.fs = 500.0;
   const TimeSeries ts = read_timeseries_csv(file, options);
   EXPECT_EQ(ts.names, (std::vector<std::string>{"u", "de", "Vs"}));
-  EXPECT_EQ(ts.units, (std::vector<std::string>{"", "um", "V"}));
+  // de [um] is converted to metres (issue 12: it was read as metres, a factor 1e6 off).
+  EXPECT_EQ(ts.units, (std::vector<std::string>{"", "m", "V"}));
   Eigen::MatrixXd expected(3, 3);
-  expected << 1, 2, 3, 4, 0.5, 6, 7, -8, 9;
+  expected << 1, 2e-6, 3, 4, 0.5e-6, 6, 7, -8e-6, 9;
   EXPECT_TRUE(all_near(ts.data, expected, kExact));
   EXPECT_EQ(ts.sample_rate, 500.0);
   // Without t and without fs there is no rate.
@@ -294,7 +295,7 @@ TEST(TimeSeriesValidation, NanAndInfNameChannelAndSample) {
   const fs::path csv = dir.path() / "inf.csv";
   write_text(csv, "t,a,b\n0,1,2\n0.1,1,inf\n");
   const std::string msg2 = input_error([&] { (void)read_timeseries(csv); });
-  EXPECT_TRUE(contains(msg2, csv.string()) && contains(msg2, "b") && contains(msg2, "sample 1 (line 3)")) << msg2;
+  EXPECT_TRUE(contains(msg2, csv.string()) && contains(msg2, "b (line 3)") && contains(msg2, "'inf' at sample 1")) << msg2;
 }
 
 TEST(TimeSeriesValidation, EmptyAndNonMonotonicTime) {
@@ -477,7 +478,8 @@ TEST(TimeSeriesValidation, MalformedCsvFiles) {
       {"a,b\n1,x2\n", "b (line 2)"},
       {"a,b\n1,\n", "empty cell"},
       {"a,a\n1,2\n", "twice"},
-      {"t [ms],a\n0,1\n1,2\n", "unit 'ms'"},
+      {"t [V],a\n0,1\n1,2\n", "a time unit (us, ms, s, min)"},
+      {"t,a [furlong]\n0,1\n1,2\n", "channel a: expected a known unit (nm, um"},
       {"a,b [V\n1,2\n", "NAME [UNIT]"},
       {std::string("a,b\n1,2\0\n", 10), "binary"},
   };
@@ -586,6 +588,81 @@ TEST(TimeSeriesOptions, ValidateNamesTheField) {
   EXPECT_EQ(mat_version_from_string("-v7.3"), MatVersion::kV73);
   EXPECT_EQ(mat_version_from_string(to_string(MatVersion::kV5)), MatVersion::kV5);
   EXPECT_THROW((void)mat_version_from_string("v4"), InputError);
+}
+
+// ---- files as labs have them (scripts/fixtures/make_io_lab_fixtures.py) -----------------------
+
+nlohmann::json lab_expected() { return nlohmann::json::parse(test::read_text(test::fixture_path("io/lab/expected.json"))); }
+
+// Every lab file holds the same record; read in SI it must give the same samples and rate.
+void expect_lab_record(const fs::path& file, double rel_tol, const ReadOptions& base = {}) {
+  SCOPED_TRACE(file.filename().string());
+  const nlohmann::json ref = lab_expected();
+  ReadOptions o = base;
+  o.channels = {"u", "d_e", "Vs"};
+  const TimeSeries ts = read_timeseries(file, o);
+  ASSERT_EQ(ts.samples(), ref["samples"].get<Eigen::Index>());
+  EXPECT_TRUE(test::near(ts.sample_rate, ref["fs"].get<double>(), {1e-9, 0.0}));
+  for (Eigen::Index k = 0; k < 3; ++k) {
+    for (size_t j = 0; j < 3; ++j) {
+      const double want = ref["first"][ts.names[j]][static_cast<size_t>(k)].get<double>();
+      EXPECT_TRUE(test::near(ts.data(k, static_cast<Eigen::Index>(j)), want, {rel_tol, 0.0})) << ts.names[j] << "[" << k << "]";
+    }
+  }
+}
+
+TEST(TimeSeriesLabFiles, CsvDialectsAndUnitsAreReadInSi) {
+  // 10 significant digits in the files.
+  expect_lab_record(test::fixture_path("io/lab/daq_tab_decimal_comma.csv"), 1e-9);
+  expect_lab_record(test::fixture_path("io/lab/semicolon_mm.csv"), 1e-9);
+  expect_lab_record(test::fixture_path("io/lab/blanks_us.csv"), 1e-9);
+  const TimeSeries ts = read_timeseries(test::fixture_path("io/lab/daq_tab_decimal_comma.csv"));
+  EXPECT_EQ(ts.names, (std::vector<std::string>{"u", "d_e", "Vs"}));
+  EXPECT_EQ(ts.units, (std::vector<std::string>{"V", "m", "V"}));
+  EXPECT_TRUE(test::near(ts.t(1), 0.5e-3, {1e-12, 0.0}));  // Time [ms]
+}
+
+TEST(TimeSeriesLabFiles, MatV73FromMatlabH5pyAndHdf5storage) {
+  expect_lab_record(test::fixture_path("io/lab/v73_matlab.mat"), 1e-15);
+  expect_lab_record(test::fixture_path("io/lab/v73_h5py.mat"), 1e-15);         // d_e in um (attribute), Fs
+  expect_lab_record(test::fixture_path("io/lab/v73_hdf5storage.mat"), 1e-15);  // NULLPAD classes, deflated
+  const TimeSeries h = read_timeseries(test::fixture_path("io/lab/v73_hdf5storage.mat"));
+  EXPECT_EQ(h.names, (std::vector<std::string>{"Vs", "d_e", "u"}));  // HDF5 lists fields by name
+  EXPECT_EQ(h.unit("d_e"), "m");
+}
+
+TEST(TimeSeriesLabFiles, ForcedDialectAndUnitsGivenByTheCaller) {
+  ReadOptions o;
+  o.delimiter = '\t';
+  o.decimal = ',';
+  expect_lab_record(test::fixture_path("io/lab/daq_tab_decimal_comma.csv"), 1e-9, o);
+  // A file that says nothing about units, and the caller (a campaign file) who knows them.
+  TempDir dir;
+  const fs::path file = dir.path() / "raw.csv";
+  write_text(file, "t,d_e,F\n0,1,2\n0.001,3,4\n");
+  ReadOptions u;
+  u.units = {{"d_e", "mm"}, {"F", "kN"}};
+  const TimeSeries ts = read_timeseries(file, u);
+  EXPECT_EQ(ts.data(1, 0), 3e-3);
+  EXPECT_EQ(ts.data(1, 1), 4e3);
+  EXPECT_EQ(ts.units, (std::vector<std::string>{"m", "N"}));
+  // The file and the caller disagree: refused, not guessed.
+  write_text(file, "t,d_e [um]\n0,1\n0.001,3\n");
+  ReadOptions mm;
+  mm.units = {{"d_e", "mm"}};
+  test::expect_input_error([&] { (void)read_timeseries(file, mm); }, {"raw.csv", "channel d_e", "(mm)", "'um' in the file"});
+}
+
+TEST(TimeSeriesLabFiles, SampleRateSpellings) {
+  TempDir dir;
+  const fs::path file = dir.path() / "rate.csv";
+  for (const char* comment : {"# fs: 250", "# Fs = 250 Hz", "# sample_rate: 0.25 kHz", "# sample rate [Hz]: 250",
+                              "# sample_rate_Hz: 250"}) {
+    write_text(file, std::string(comment) + "\nx\n1\n2\n");
+    EXPECT_EQ(read_timeseries(file).sample_rate, 250.0) << comment;
+  }
+  write_text(file, "# fs: fast\nx\n1\n2\n");
+  test::expect_input_error([&] { (void)read_timeseries(file); }, {"rate.csv", "comment (line 1)", "a positive sample rate"});
 }
 
 }  // namespace

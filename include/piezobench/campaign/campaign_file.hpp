@@ -54,6 +54,7 @@ struct FileSpec {
   std::vector<std::string> explicit_roles;      // roles mapped by the campaign (must exist)
   double sample_rate = 0.0;                     // Hz; 0 = from the file (t or fs)
   double gain = 0.0;                            // iff: controller gain g (0 = from the file's settings)
+  std::map<std::string, std::string> units;     // role -> unit of a channel whose file gives none
 };
 
 struct UnitSpec {

@@ -6,7 +6,9 @@
 // Layouts
 //  CSV   header `freq_Hz,re_NAME,im_NAME,coh_NAME` repeated per output (CLI.md), values %.17g, so
 //        a round trip is exact. On read, coh_ columns are optional, lines starting with '#' and
-//        blank lines are ignored; the input name is not stored (read back as "").
+//        blank lines are ignored, the first column may also be `freq [Hz]` or `freq [kHz]`, and
+//        the dialect (delimiter, decimal comma) is detected as for time series; the input name is
+//        not stored (read back as "").
 //  .mat  `freq_Hz` (column, Hz), per output `H_<name>` (complex column) and `coh_<name>` (when the
 //        coherence is known), `input` and `outputs` (char rows; outputs comma-separated, keeps the
 //        order) and `provenance` (struct). Exact round trip. Names must be MATLAB identifiers.
@@ -58,10 +60,17 @@ void write_frf_csv(const dsp::Frf& frf, const std::filesystem::path& file);
 void write_frf_mat(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
 void write_frf_uff58(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
 
+struct FrfReadOptions {
+  // CSV only: the delimiter (0 = detect; ',', ';', '\t' or ' ' for runs of blanks) and the decimal
+  // separator (0 = detect; '.' or ','), as for time series (timeseries.hpp).
+  char delimiter = 0;
+  char decimal = 0;
+};
+
 // Reads an FRF in the format of the file's extension. provenance.source is the time-series file
 // recorded in a .mat FRF, else the FRF file itself.
-[[nodiscard]] dsp::Frf read_frf(const std::filesystem::path& file);
-[[nodiscard]] dsp::Frf read_frf_csv(const std::filesystem::path& file);
+[[nodiscard]] dsp::Frf read_frf(const std::filesystem::path& file, const FrfReadOptions& options = {});
+[[nodiscard]] dsp::Frf read_frf_csv(const std::filesystem::path& file, const FrfReadOptions& options = {});
 [[nodiscard]] dsp::Frf read_frf_mat(const std::filesystem::path& file);
 [[nodiscard]] dsp::Frf read_frf_uff58(const std::filesystem::path& file);
 

@@ -10,18 +10,29 @@
 // directory and renames it over the target only when complete, so a failed write leaves no file
 // (and an existing target untouched).
 //
+// Units: every reader converts the samples to SI with the unit table of io/units.hpp (a CSV
+// header's `[unit]` or `(unit)`, the .mat `units` struct, ReadOptions::units for files that say
+// nothing) and records the SI symbol in TimeSeries::units; a unit the table does not know is an
+// InputError naming the channel and listing the known ones. A channel without any unit is kept as
+// it is (SI assumed).
+//
 // File layouts
 //  .mat  one real double vector per channel (row or column; single and integer classes are
-//        converted to double), optionally `t` (s). Written files also hold `fs` (Hz, scalar),
+//        converted to double), optionally a time vector `t` or `time` (any case; in seconds, or in
+//        the time unit its `units` field gives) and the sample rate as a scalar `fs`, `Fs`,
+//        `sample_rate` or `sample_rate_Hz` (any case, Hz). Written files also hold `fs` (Hz, scalar),
 //        `channels` (char row, the names comma-separated in order: v7.3 lists variables by name),
 //        `units` (struct: one char field per channel that has a unit) and `settings` (struct: one
 //        field per setting, a char row or a real scalar). Channels may instead be the fields of a
 //        1x1 struct variable (ReadOptions::group), as in `data.u`, `data.de`.
-//  .csv  comma-separated; blank lines and lines starting with '#' are ignored; the first other
-//        line is the header. A header cell is a channel name optionally followed by its unit in
-//        square brackets, e.g. `de [m]`. A column named `t` is the time vector (s). A comment
-//        `# sample_rate_Hz: 10000` before the header gives the rate of a file without `t` (the
-//        writer adds it then).
+//  .csv  the dialects labs write: delimiter ',', ';', tab or runs of blanks, decimal point or
+//        comma, all detected from the header and the first data row unless ReadOptions forces
+//        them; a UTF-8 byte order mark, blank lines and lines starting with '#' are ignored; the
+//        first other line is the header. A header cell is a channel name optionally followed by
+//        its unit in square brackets or parentheses, e.g. `de [um]`, `Vs (mV)`. A column named `t`
+//        or `time` (any case) is the time vector, in any time unit (`Time [ms]`). A comment before
+//        the header such as `# sample_rate_Hz: 10000`, `# fs = 10 kHz` or `# Fs: 2000` gives the
+//        rate of a file without a time column (the writer adds the first form then).
 #include <Eigen/Dense>
 #include <filesystem>
 #include <map>
@@ -38,7 +49,7 @@ struct TimeSeries {
   Eigen::MatrixXd data;              // samples x channels; column j is channel names[j] (SI units)
   double sample_rate = 0.0;          // Hz, > 0
   Eigen::VectorXd t;                 // s, same length as data.rows(); empty when the file has none
-  std::vector<std::string> units;    // per channel ("" = unknown); empty or names.size() entries
+  std::vector<std::string> units;    // per channel, SI symbol ("" = unknown); empty or names.size() entries
   std::map<std::string, Setting> settings;  // how the record was made (experiment, seed, ...)
   std::string source;                // file it was read from ("" when built in memory)
 
@@ -68,10 +79,22 @@ struct ReadOptions {
   // Largest accepted deviation of t[k] from t[0] + k / fs, as a fraction of the sample period.
   // Also the largest accepted relative difference between an explicit fs and the one from `t`.
   double time_tolerance = 1e-6;
+  // CSV only: the delimiter (0 = detect; ',', ';', '\t' or ' ' for runs of blanks) and the decimal
+  // separator (0 = detect; '.' or ',').
+  char delimiter = 0;
+  char decimal = 0;
+  // Units of channels whose file gives none (e.g. from a campaign file): channel -> unit symbol.
+  // A file that gives another unit for such a channel is an InputError.
+  std::map<std::string, std::string> units;
 
   // Throws InputError (source "ReadOptions") naming the bad field.
   void validate() const;
 };
+
+// Spellings of ReadOptions::delimiter / decimal for command lines: "auto" (0), ",", ";", "tab",
+// "space" (blanks); "auto", ".", ",". InputError (field --delimiter / --decimal) otherwise.
+[[nodiscard]] char csv_delimiter_from_string(const std::string& s);
+[[nodiscard]] char csv_decimal_from_string(const std::string& s);
 
 enum class MatVersion { kV5, kV73 };
 [[nodiscard]] std::string to_string(MatVersion v);        // "v5", "v7.3"

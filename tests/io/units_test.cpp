@@ -1,0 +1,54 @@
+// The unit table: every listed unit converts to SI by its factor, aliases of micro, unknown units
+// are refused with the list of known ones.
+#include "piezobench/io/units.hpp"
+
+#include <gtest/gtest.h>
+
+#include "test_util.hpp"
+
+namespace piezobench::io {
+namespace {
+
+double factor(const char* symbol) { return find_unit(symbol).value().to_si; }
+
+TEST(Units, FactorsToSi) {
+  EXPECT_EQ(factor("nm"), 1e-9);
+  EXPECT_EQ(factor("um"), 1e-6);
+  EXPECT_EQ(factor("mm"), 1e-3);
+  EXPECT_EQ(factor("m"), 1.0);
+  EXPECT_EQ(factor("us"), 1e-6);
+  EXPECT_EQ(factor("ms"), 1e-3);
+  EXPECT_EQ(factor("min"), 60.0);
+  EXPECT_EQ(factor("uV"), 1e-6);
+  EXPECT_EQ(factor("mV"), 1e-3);
+  EXPECT_EQ(factor("kV"), 1e3);
+  EXPECT_EQ(factor("mN"), 1e-3);
+  EXPECT_EQ(factor("kN"), 1e3);
+  EXPECT_EQ(factor("kHz"), 1e3);
+  EXPECT_EQ(factor("nF"), 1e-9);
+  EXPECT_EQ(factor("uF"), 1e-6);
+  EXPECT_EQ(factor("F"), 1.0);
+  EXPECT_EQ(find_unit("um")->si_symbol, "m");
+  EXPECT_EQ(find_unit("ms")->quantity, Quantity::kTime);
+  EXPECT_EQ(find_unit("mV")->si_symbol, "V");
+  EXPECT_EQ(find_unit("kN")->si_symbol, "N");
+  EXPECT_EQ(find_unit("uF")->si_symbol, "F");
+  EXPECT_EQ(find_unit("-")->quantity, Quantity::kDimensionless);
+}
+
+TEST(Units, MicroIsWrittenThreeWaysAndCaseMatters) {
+  EXPECT_EQ(factor("\xC2\xB5m"), 1e-6);  // micro sign
+  EXPECT_EQ(factor("\xCE\xBCm"), 1e-6);  // Greek mu
+  EXPECT_EQ(factor(" um "), 1e-6);
+  EXPECT_FALSE(find_unit("MV").has_value());  // megavolt is not millivolt
+  EXPECT_FALSE(find_unit("M").has_value());
+}
+
+TEST(Units, UnknownUnitNamesSourceFieldAndTheKnownUnits) {
+  test::expect_input_error([] { (void)unit_from_string("furlong", "rec.csv", "column d_e"); },
+                           {"rec.csv", "column d_e", "'furlong'", "nm, um, mm", "kHz", "uF"});
+  EXPECT_EQ(known_units().find("\xC2\xB5"), std::string::npos);  // aliases are not listed
+}
+
+}  // namespace
+}  // namespace piezobench::io
