@@ -180,7 +180,9 @@ class V5Checker {
 
     const Tag dims_tag = read_tag(path + " (dimensions)");
     const unsigned long long rank = dims_tag.bytes / 4;
-    if (rank < 1 || rank > 32) fail(path + " (dimensions)", "1 to 32 dimensions", std::to_string(rank));
+    if (dims_tag.bytes % 4 != 0 || rank < 1 || rank > 32) {
+      fail(path + " (dimensions)", "1 to 32 dimensions of 4 bytes", bytes_text(dims_tag.bytes));
+    }
     std::array<unsigned char, 128> dim_bytes{};
     read_payload(dims_tag, dim_bytes.data(), path + " (dimensions)");
     unsigned long long count = 1;
@@ -684,7 +686,9 @@ MatVarPtr read_h5_struct(const Mat73Input& in, const H5Var& v, const std::string
   MatVarPtr var = checked_create(MatVarPtr(Mat_VarCreateStruct2(name.c_str(), 2, dims, cnames.data())), source, field);
   for (const auto& n : names) {
     MatVarPtr f = read_h5_var(in, v.obj.get(), n, field + "." + n, depth + 1);
-    if (Mat_VarSetStructFieldByName(var.get(), n.c_str(), 0, f.get()) == nullptr) (void)f.release();
+    // The struct owns the new field from here; it returns the one it replaces (none: names are unique).
+    MatVarPtr replaced(Mat_VarSetStructFieldByName(var.get(), n.c_str(), 0, f.get()));
+    (void)f.release();
   }
   return var;
 }
