@@ -125,14 +125,14 @@ TEST(Pipeline, ImplausibleValuesAreRejectedNamingTheColumn) {
   const Batch b;
   io::TimeSeries um = syn::stroke_record(-0.8);  // probe in um, written as if in metres
   io::write_timeseries(um, b.dir.path() / "stroke3.csv");
-  const CampaignResult r = run_campaign(b.campaign);
-  const json& u3 = unit(r.results, 3);
+  const json results = results_json(run_campaign(b.campaign));
+  const json& u3 = unit(results, 3);
   EXPECT_FALSE(u3["accepted"].get<bool>());
   std::string reasons;
   for (const auto& x : u3["reasons"]) reasons += x.get<std::string>() + "\n";
   EXPECT_TRUE(test::contains(reasons, "implausible: stroke 1.36e+08 um cannot be a measurement")) << reasons;
   EXPECT_TRUE(test::contains(reasons, "check the units of column 'probe' of 'stroke3.csv'")) << reasons;
-  EXPECT_TRUE(unit(r.results, 1)["accepted"].get<bool>());
+  EXPECT_TRUE(unit(results, 1)["accepted"].get<bool>());
 }
 
 // The result does not depend on the number of threads.
