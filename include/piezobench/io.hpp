@@ -8,3 +8,4 @@
 #include "piezobench/io/mat_struct.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/units.hpp"
