@@ -204,6 +204,7 @@ int run_rt(const RtOptions& o) {
                   {"slew_rate_V_per_s", limits.slew_rate},
                   {"ramp_s", limits.ramp_in},
                   {"watchdog_s", limits.watchdog_timeout},
+                  {"saturation_time_s", limits.saturation_time},
                   {"stale_cycles", limits.stale_cycles}}},
                 {"log", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
                 {"logged_samples", r.logged_samples},
@@ -234,6 +235,10 @@ int run_rt(const RtOptions& o) {
                r.io.exchanges, r.io.lost, r.io.late, r.io.timeouts, r.io.errors, r.io.round_trip_us.p50,
                r.io.round_trip_us.p99);
   }
+  if (r.safe_state_reason == rt::to_string(rt::Fault::kSaturation)) {
+    fmt::print("the output was saturated for {:g} s (--saturation-time): the loop went to its safe state\n",
+               limits.saturation_time);
+  }
   if (!o.log.empty()) fmt::print("log: {} ({} samples, {} dropped)\n", o.log, r.logged_samples, r.dropped_log_samples);
   return 0;
 }
@@ -256,7 +261,9 @@ void add_rt_commands(CLI::App& app, Action& action) {
       ->capture_default_str();
   rt->add_option("--controller", o->controller, "iff (eq. 2.4 discretized at the rate) or off (open loop)")->capture_default_str();
   rt->add_option("--gain", o->gain, "IFF gain g")->required();
-  CLI::Option* rate = rt->add_option("--rate", o->rate, "loop rate, Hz (replay: the record's rate)")->capture_default_str();
+  CLI::Option* rate = rt->add_option("--rate", o->rate, "loop rate, Hz (replay: the record's rate), at most 1e6")
+                          ->check(CLI::Range(0.0, rt::kMaxSampleRate))
+                          ->capture_default_str();
   rt->add_option("--duration", o->duration, "run length, s")->capture_default_str();
   rt->add_option("--log", o->log, "write the signals of every cycle to this .mat (or .csv) file");
   rt->add_option("--unit", o->unit, "virtual bench: unit of the batch (1..7)")->capture_default_str();
@@ -275,6 +282,9 @@ void add_rt_commands(CLI::App& app, Action& action) {
   limit_options->push_back(rt->add_option("--ramp", o->ramp, "ramp in and out of the gain and output, s")->capture_default_str());
   limit_options->push_back(rt->add_option("--watchdog", o->limits.watchdog_timeout,
                                           "safe state when no cycle completes within this time, s")
+                               ->capture_default_str());
+  limit_options->push_back(rt->add_option("--saturation-time", o->limits.saturation_time,
+                                          "safe state when the output has been saturated (clamped) this long, net, s")
                                ->capture_default_str());
   rt->add_flag("--fifo", o->fifo, "with a bench file: ask for SCHED_FIFO and mlockall (a message when not permitted)");
   rt->add_option("--priority", o->priority, "SCHED_FIFO priority of the loop thread (when permitted)")

@@ -14,6 +14,7 @@
 #include "piezobench/campaign/pipeline.hpp"
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/output_dir.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -49,9 +50,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 int run_pipeline(const fs::path& campaign_file, const fs::path& out, bool strict, bool json, int threads,
                  nlohmann::json extra = nlohmann::json::object()) {
   const auto t0 = std::chrono::steady_clock::now();
-  // results.json exists only for a completed run: an earlier one's goes first.
-  std::error_code ec;
-  fs::remove(out / "results.json", ec);
+  // An earlier run's result set goes first: a run that fails leaves none, never a mix.
+  campaign::remove_outputs(out);
   log_line("reading " + campaign_file.string());
   const campaign::Campaign c = campaign::read_campaign(campaign_file);
   campaign::PipelineOptions po;
@@ -86,11 +86,13 @@ int run_pipeline(const fs::path& campaign_file, const fs::path& out, bool strict
 
 int run_run(const RunOptions& o) {
   if (o.threads < 0) throw InputError("", "--threads", "0 (all cores) or more", std::to_string(o.threads));
+  const io::OutputLock lock(o.out);  // a second run on the same --out is refused (exit 3)
   return run_pipeline(o.campaign, o.out, o.strict, o.json, o.threads);
 }
 
 int run_demo(const DemoCli& o) {
   if (o.threads < 0) throw InputError("", "--threads", "0 (all cores) or more", std::to_string(o.threads));
+  const io::OutputLock lock(o.out);
   const auto t0 = std::chrono::steady_clock::now();
   campaign::DemoOptions d;
   d.seed = o.seed;

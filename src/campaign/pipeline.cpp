@@ -20,6 +20,7 @@
 #include "piezobench/fem/superelement.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/mat_struct.hpp"
+#include "piezobench/io/output_dir.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/freqresp.hpp"
@@ -533,23 +534,26 @@ CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
   return r;
 }
 
+void remove_outputs(const fs::path& out_dir) {
+  std::error_code ec;
+  for (const char* name : {"results.json", "results.mat", "report.html"}) fs::remove(out_dir / name, ec);
+}
+
 std::vector<fs::path> write_outputs(const CampaignResult& result, const fs::path& out_dir) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec || !fs::is_directory(out_dir)) {
     throw InputError(out_dir.string(), "--out", "a folder that can be created", ec ? ec.message() : "not a folder");
   }
-  const fs::path json_file = out_dir / "results.json";
-  fs::remove(json_file, ec);  // results.json exists only for a completed run
-  std::vector<fs::path> written;
+  // All three are written into a staging folder first: a failure (disk full) leaves out_dir as it
+  // was. results.json goes before the renames and comes back last, so it marks a complete set.
   const json results = results_json(result);
-  io::write_json_as_mat(results, out_dir / "results.mat");
-  written.push_back(out_dir / "results.mat");
-  report::write_html(report_document(result), out_dir / "report.html");
-  written.push_back(out_dir / "report.html");
-  io::write_text_atomically(json_file, results.dump(2) + "\n");
-  written.push_back(json_file);
-  return written;
+  io::StagedOutputs staged(out_dir);
+  io::write_json_as_mat(results, staged.stage("results.mat"));
+  report::write_html(report_document(result), staged.stage("report.html"));
+  io::write_text_atomically(staged.stage("results.json"), results.dump(2) + "\n");
+  fs::remove(out_dir / "results.json", ec);
+  return staged.commit();
 }
 
 }  // namespace piezobench::campaign

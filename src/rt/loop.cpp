@@ -55,6 +55,9 @@ Loop::Loop(Backend& backend, const LoopOptions& options)
       guard_(options.limits, backend.sample_rate()),
       shared_(std::make_unique<Shared>()) {
   detail::require_positive(rate_, "sample_rate", "backend " + backend.name());
+  if (rate_ > kMaxSampleRate) {
+    throw InputError("backend " + backend.name(), "sample_rate", "at most " + detail::str(kMaxSampleRate) + " Hz", detail::str(rate_) + " Hz");
+  }
   const double cycles = std::round(options.duration * rate_);
   total_cycles_ = static_cast<std::uint64_t>(std::max(1.0, cycles));
   ramp_in_cycles_ = static_cast<std::uint64_t>(std::llround(options.limits.ramp_in * rate_));
@@ -180,6 +183,10 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
     if (!guard_.safe_state()) request = u_safe + r * (u_prime + y - u_safe);
   }
   const SafetyGuard::Output out = guard_.limit(request);
+  if (!guard_.safe_state() && guard_.saturated_too_long()) {
+    guard_.trip(Fault::kSaturation, cycle_);  // from the next cycle on
+    iff_.reset();
+  }
   if (!guard_.safe_state() && options_.controller && r > 0.0 && (out.clamped || out.slew_limited)) {
     // Anti-windup: the controller's share of what was really applied.
     iff_.applied((out.u - u_safe) / r + u_safe - u_prime);

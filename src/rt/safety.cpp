@@ -26,6 +26,8 @@ std::string to_string(Fault fault) {
       return "non-finite controller output";
     case Fault::kInterrupted:
       return "interrupted";
+    case Fault::kSaturation:
+      return "output saturated";
   }
   return "unknown";
 }
@@ -46,6 +48,7 @@ void ActuatorLimits::validate() const {
   detail::require_nonnegative(ramp_out, "ramp_out", kSource);
   if (stale_cycles < 0) throw InputError(kSource, "stale_cycles", "an integer >= 0", std::to_string(stale_cycles));
   detail::require_positive(watchdog_timeout, "watchdog_timeout", kSource);
+  detail::require_positive(saturation_time, "saturation_time", kSource);
 }
 
 SafetyGuard::SafetyGuard(const ActuatorLimits& limits, double sample_rate) : limits_(limits) {
@@ -56,6 +59,9 @@ SafetyGuard::SafetyGuard(const ActuatorLimits& limits, double sample_rate) : lim
   u_safe_ = limits.u_safe();
   max_step_ = limits.max_step(sample_rate);
   last_u_ = u_safe_;
+  // At least one sample; a time longer than 2^62 samples is as good as never.
+  const double cycles = std::ceil(limits.saturation_time * sample_rate);
+  saturation_cycles_ = cycles < 0x1p62 ? std::max<std::uint64_t>(1, static_cast<std::uint64_t>(cycles)) : (1ULL << 62);
 }
 
 Fault SafetyGuard::check(const SensorSample& sample) noexcept {
@@ -100,6 +106,13 @@ SafetyGuard::Output SafetyGuard::limit(double u) noexcept {
     out.slew_limited = true;
   }
   if (out.clamped) ++clamped_;
+  if (!safe_state()) {
+    if (out.clamped) {
+      ++saturation_level_;
+    } else if (saturation_level_ > 0) {
+      --saturation_level_;
+    }
+  }
   if (out.slew_limited) ++slew_limited_;
   last_u_ = u;
   out.u = u;

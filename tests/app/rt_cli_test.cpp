@@ -77,6 +77,28 @@ TEST(RtCli, SaturatedLoopKeepsTheVoltageInRangeAndSlewLimited) {
   EXPECT_LE(j["max_va_cmd_step_V"].get<double>(), 5.0 + 1e-9);
 }
 
+// Issue 21.8: `rt --gain 1e12` pinned Va to the limits without ever going safe. Now the loop goes
+// to its safe state after --saturation-time (0.1 s by default) and the report says why.
+TEST(RtCli, OutputSaturatedTooLongGoesToTheSafeState) {
+  const test::CliRun r = run_cli("rt --bench virtual --gain 1e12 --excitation noise --duration 0.5 --realtime false --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["safe_state_reason"], "output saturated");
+  EXPECT_GE(j["safe_state_cycle"].get<int>(), 999);  // at least 0.1 s of saturation at 10 kHz
+  EXPECT_EQ(j["limits"]["saturation_time_s"].get<double>(), 0.1);
+  const test::CliRun text = run_cli("rt --bench virtual --gain 1e12 --duration 0.3 --realtime false --saturation-time 0.05");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_TRUE(test::contains(text.out, "safe state: output saturated")) << text.out;
+  EXPECT_TRUE(test::contains(text.out, "saturated for 0.05 s")) << text.out;
+}
+
+// Issue 21.5: `rt --rate 1e12` reached 2.4 GB; the rate is capped (exit 2 for the command line).
+TEST(RtCli, RateAboveTheCapIsACommandLineError) {
+  const test::CliRun r = run_cli("rt --bench virtual --gain 1 --rate 1e12 --duration 1 --realtime false");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "--rate")) << r.err;
+}
+
 TEST(RtCli, ReplaysARecordedFile) {
   test::TempDir dir;
   io::TimeSeries rec;

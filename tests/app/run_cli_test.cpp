@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/run_cli.hpp"
+#include "piezobench/io/output_dir.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "test_util.hpp"
 
@@ -89,6 +90,18 @@ capacitance_uF = { sensor = 5.10, actuator = 10.03 }
   EXPECT_TRUE(near(ua["stiffness_N_per_um"]["k1"].get<double>(), ub["stiffness_N_per_um"]["k1"].get<double>(), 1e-12));
   EXPECT_EQ(ua["frf"]["provenance"]["channels"]["de"], "encoder");
   EXPECT_EQ(ua["not_measured"].size(), 6u);  // flatness, hysteresis, stiffness_open_circuit, frf_without_resistor, iff, hammer
+}
+
+// A second run on a --out another run holds is refused with exit 3 and leaves the folder alone.
+TEST(RunCli, BusyOutFolderIsRefused) {
+  const fs::path& d = demo_dir();
+  TempDir dir;
+  const fs::path out = dir.path() / "busy";
+  const io::OutputLock held(out);
+  const CliRun r = run_cli("run " + (d / "campaign.toml").string() + " --out " + out.string());
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_TRUE(contains(r.err, "locked by another run")) << r.err;
+  EXPECT_FALSE(fs::exists(out / "results.json"));
 }
 
 std::string fmt_name(int i) {

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 #include <matio.h>
 
+#include <sys/resource.h>
+
+#include <csignal>
 #include <fstream>
 
 #include "piezobench/campaign/results_json.hpp"
@@ -165,6 +168,35 @@ TEST(Pipeline, OutputsWrittenWithResultsLast) {
   // A failing write (the output path is a file) leaves no results.json behind.
   std::ofstream(b.dir.path() / "blocked") << "x";
   test::input_error([&] { (void)write_outputs(r, b.dir.path() / "blocked"); });
+}
+
+// A full disk (RLIMIT_FSIZE: write() fails with EFBIG past 4 KiB) while the outputs are written
+// leaves the earlier complete set as it was and no staged file behind.
+TEST(Pipeline, FailedWriteLeavesTheEarlierSetUntouched) {
+  const Batch b;
+  const CampaignResult r = run_campaign(b.campaign);
+  const fs::path out = b.dir.path() / "full";
+  fs::create_directories(out);
+  for (const char* name : {"results.json", "results.mat", "report.html"}) std::ofstream(out / name) << "old";
+  rlimit old_limit{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit small = old_limit;
+  small.rlim_cur = 4096;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string what;
+  try {
+    (void)write_outputs(r, out);
+  } catch (const InputError& e) {
+    what = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_FALSE(what.empty()) << "no InputError";
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(out)) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left.size(), 3u);
+  for (const char* name : {"results.json", "results.mat", "report.html"}) EXPECT_EQ(test::read_text(out / name), "old") << name;
 }
 
 // A super element (the public APA95ML Ansys export) compared with a measured FRF: its u -> d_e

@@ -165,6 +165,7 @@ TEST(Loop, SaturationKeepsTheVoltageInRangeAndSlewLimited) {
     o.excitation.resize(500);  // 20 Hz, 10 V at the DAC (200 V at the stacks): 2.5 V per sample at most
     for (Eigen::Index k = 0; k < 500; ++k) o.excitation(k) = 10.0 * std::sin(2 * M_PI * k / 500.0);
     o.limits.slew_rate = 2e4;  // 2 V per sample at the stacks
+    o.limits.saturation_time = 10.0;  // the saturation policy is tested below
     Loop loop(backend, o);
     run_all(loop);
     const LoopReport rep = loop.finish();
@@ -187,6 +188,27 @@ TEST(Loop, SaturationKeepsTheVoltageInRangeAndSlewLimited) {
       EXPECT_NEAR(va.maxCoeff(), 150.0, 1e-9);
     }
   }
+}
+
+// An output pinned to the upper limit (open loop, u' = 10 V at the DAC, above 7.5 V) goes to the
+// safe state after saturation_time (100 samples at 10 kHz) and the report says why.
+TEST(Loop, OutputSaturatedForTheSaturationTimeEntersTheSafeState) {
+  FakeBackend backend(discrete_plant(), kFs);
+  LoopOptions o = lockstep_options(0.1);
+  o.controller = false;
+  o.limits.ramp_in = 0.0;
+  o.limits.slew_rate = 1e12;
+  o.limits.saturation_time = 0.01;
+  o.excitation = Eigen::VectorXd::Constant(1, 10.0);
+  Loop loop(backend, o);
+  run_all(loop);
+  const LoopReport rep = loop.finish();
+  EXPECT_EQ(rep.safe_state_reason, "output saturated");
+  EXPECT_EQ(rep.safe_state_cycle, 99);  // the 100th clamped sample
+  EXPECT_EQ(rep.clamped_samples, 100u);
+  const auto u = loop.log().channel("u");
+  EXPECT_EQ(u(99), 7.5);
+  EXPECT_EQ(u(100), 0.0);
 }
 
 // A NaN sample: safe state at that cycle, output to the safe value at the slew limit, controller

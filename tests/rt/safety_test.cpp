@@ -37,8 +37,29 @@ TEST(ActuatorLimits, ValidateNamesTheField) {
   bad([](ActuatorLimits& l) { l.ramp_out = kNaN; }, "ramp_out");
   bad([](ActuatorLimits& l) { l.stale_cycles = -1; }, "stale_cycles");
   bad([](ActuatorLimits& l) { l.watchdog_timeout = 0.0; }, "watchdog_timeout");
+  bad([](ActuatorLimits& l) { l.saturation_time = kNaN; }, "saturation_time");
   const std::string what = test::input_error([] { SafetyGuard g(ActuatorLimits{}, 0.0); }, "sample_rate");
   EXPECT_TRUE(test::contains(what, "actuator limits")) << what;
+}
+
+// The saturation level: +1 per clamped sample, -1 per sample inside the range; saturation_time =
+// 1 ms at 10 kHz is 10 samples.
+TEST(SafetyGuard, SaturationLevelReachesTheTimeOnlyWhenMostSamplesAreClamped) {
+  ActuatorLimits l;
+  l.slew_rate = 1e12;
+  l.saturation_time = 1e-3;
+  SafetyGuard g(l, 10e3);
+  for (int k = 0; k < 1000; ++k) {  // every other sample clamped: the level stays at 0 or 1
+    (void)g.limit(k % 2 == 0 ? 100.0 : 1.0);
+    ASSERT_FALSE(g.saturated_too_long()) << k;
+  }
+  int samples = 0;
+  for (int k = 0; !g.saturated_too_long(); ++k, ++samples) (void)g.limit(k % 3 == 2 ? 1.0 : 100.0);
+  // Two clamped, one inside: net +1 per 3 samples, from level 0 (the last sample above was inside)
+  // to 10: 9 triples then two clamped samples.
+  EXPECT_EQ(samples, 29);
+  g.trip(Fault::kSaturation, 29);
+  EXPECT_EQ(to_string(g.fault()), "output saturated");
 }
 
 TEST(SafetyGuard, ClampsToTheRangeAndCounts) {

@@ -12,9 +12,10 @@
 //   stiffness_N_per_um; with reject_outliers, no batch outlier in capacitance or stroke (robust
 //   z-score, metrology/capacitance.hpp); every analysis that was run succeeded.
 //
-// Outputs (write_outputs): OUT/results.mat, OUT/report.html, then OUT/results.json, each written
-// atomically; a results.json left from an earlier run is removed first, so results.json exists only
-// when the run completed. Only these fixed names under OUT are written.
+// Outputs (write_outputs): OUT/results.mat, OUT/report.html and OUT/results.json, staged in a hidden
+// folder inside OUT and renamed into place only when all three are written, results.json last, so
+// results.json exists only when the run completed and a failed write leaves OUT as it was. Only these
+// fixed names (and the staging folder and the .piezobench.lock of `run`) under OUT are written.
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -38,6 +39,11 @@ CampaignResult run_campaign(const Campaign& campaign, const PipelineOptions& opt
 // Writes results.mat, report.html and results.json (results_json.hpp, report_document.hpp) into
 // `out_dir` (created if needed); returns
 // the paths written. InputError when a file cannot be written.
+// All or nothing: the files are staged in a hidden folder inside out_dir and renamed into place
+// only when all three are written (io/output_dir.hpp).
 std::vector<std::filesystem::path> write_outputs(const CampaignResult& result, const std::filesystem::path& out_dir);
+
+// Removes the result set of an earlier run from out_dir (a run that then fails leaves none).
+void remove_outputs(const std::filesystem::path& out_dir);
 
 }  // namespace piezobench::campaign

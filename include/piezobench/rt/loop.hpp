@@ -19,7 +19,8 @@
 //    r goes 0 -> 1 (-> 0); the controller's gain is r g (bumpless: the gain acts at the sections'
 //    input) and the command is u_safe + r (u' + y - u_safe), so the run starts and ends at the safe
 //    output without a step.
-//  - Safe state (latched): a non-finite or stale sensor sample, a non-finite controller output or
+//  - Safe state (latched): a non-finite or stale sensor sample, a non-finite controller output, an
+//    output saturated for limits.saturation_time (safety.hpp, policy 5) or
 //    the watchdog (no completed cycle within watchdog_timeout: checked every cycle from the wake-up
 //    time, and by a watchdog thread that calls Backend::on_watchdog() when the loop is stuck) sets
 //    the output to the safe value at the slew limit and resets the controller; the loop keeps
@@ -44,6 +45,10 @@
 #include "piezobench/rt/timing.hpp"
 
 namespace piezobench::rt {
+
+// Highest loop rate accepted (Hz): far above what a host loop can pace (10 kHz is the report's),
+// and it bounds the per-second work and log of a run (docs/cli.md, resource bounds).
+inline constexpr double kMaxSampleRate = 1e6;
 
 struct LoopOptions {
   double duration = 1.0;      // s; the run has round(duration * rate) cycles (fewer if the backend ends)

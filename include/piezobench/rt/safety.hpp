@@ -5,7 +5,12 @@
 //      a fresh sample, trips the safe state;
 //   2. safe state (latched until the end of the run): the request is replaced by the safe output;
 //   3. clamp to the actuator's range [va_min, va_max] / amplifier_gain (counted: clamped samples);
-//   4. slew-rate limit: |u[k] - u[k-1]| <= slew_rate / amplifier_gain / sample_rate (counted).
+//   4. slew-rate limit: |u[k] - u[k-1]| <= slew_rate / amplifier_gain / sample_rate (counted);
+//   5. saturation policy: a saturation level goes up by one sample period for every clamped
+//      sample and down by one for every sample inside the range (never below 0); when it reaches
+//      saturation_time the loop trips the safe state (Fault::kSaturation). So an output pinned to
+//      the limits for saturation_time, or clamped on more than half of the samples for a while
+//      (an unstable loop banging between the limits), goes safe; occasional clamping does not.
 // Clamping before the slew limit keeps both: a slew-limited step from a value inside the range
 // towards a value inside the range stays inside it. So the stack voltage commanded never leaves
 // [va_min, va_max] and never moves faster than slew_rate, in the safe state too (the output goes
@@ -37,10 +42,12 @@ struct ActuatorLimits {
   // s without a completed cycle before the watchdog trips the safe state. The default allows for a
   // host without real-time scheduling (a container); a real target would use a few periods.
   double watchdog_timeout = 20e-3;
+  // s of (net) saturated output before the safe state (policy 5 above).
+  double saturation_time = 0.1;
 
   // InputError (source "actuator limits") naming the field: finite values, amplifier_gain > 0,
   // va_min < va_max, va_safe inside [va_min, va_max], slew_rate > 0, ramps >= 0, stale_cycles >= 0,
-  // watchdog_timeout > 0.
+  // watchdog_timeout > 0, saturation_time > 0.
   void validate() const;
 
   [[nodiscard]] double u_min() const { return va_min / amplifier_gain; }    // V at the DAC
@@ -58,6 +65,7 @@ enum class Fault : std::uint8_t {
   kWatchdog,             // the loop did not complete a cycle within watchdog_timeout
   kNonFiniteController,  // the controller's output overflowed
   kInterrupted,          // a stop was requested (Ctrl-C)
+  kSaturation,           // the output was saturated for saturation_time (policy 5)
 };
 std::string to_string(Fault fault);  // "none", "non-finite sensor", "stale sensor", "watchdog", ...
 
@@ -83,8 +91,10 @@ class SafetyGuard {
   };
   // The command to write for the request `u` (V at the DAC): in the safe state u_safe; then
   // clamped and slew-limited from the previous output. A NaN request counts as clamped and is
-  // replaced by the previous output.
+  // replaced by the previous output. Updates the saturation level (not in the safe state).
   Output limit(double u) noexcept;
+  // True once the saturation level has reached saturation_time: the caller trips kSaturation.
+  [[nodiscard]] bool saturated_too_long() const noexcept { return saturation_level_ >= saturation_cycles_; }
 
   [[nodiscard]] const ActuatorLimits& limits() const noexcept { return limits_; }
   [[nodiscard]] double last_output() const noexcept { return last_u_; }
@@ -103,6 +113,7 @@ class SafetyGuard {
   bool have_sequence_ = false;
   std::uint64_t last_sequence_ = 0;
   int stale_run_ = 0;
+  std::uint64_t saturation_level_ = 0, saturation_cycles_ = 1;
   Fault fault_ = Fault::kNone;
   std::uint64_t fault_cycle_ = 0;
   std::uint64_t clamped_ = 0, slew_limited_ = 0, events_ = 0, nonfinite_ = 0, stale_ = 0;
