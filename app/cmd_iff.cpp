@@ -25,6 +25,8 @@ struct RlocusOptions {
   double delay = 0.0;
   int pade_order = 6;
   double resonance_hz = 0.0;
+  int max_order = lti::RootLocusOptions{}.max_order;
+  double max_work = lti::RootLocusOptions{}.max_work;
   bool json = false;
 };
 
@@ -83,6 +85,14 @@ int run_rlocus(const RlocusOptions& o) {
 
   control::IffLoopOptions options;
   options.pade_order = o.pade_order;
+  options.locus.max_order = o.max_order;
+  options.locus.max_work = o.max_work;
+  const lti::Index order = plant.system.states() + controller.system.states();
+  if (order > o.max_order) {
+    throw InputError(o.plant_file.empty() ? o.controller_file : o.plant_file, "order",
+                     "a loop (plant and controller) of at most " + std::to_string(o.max_order) + " states (--max-order)",
+                     std::to_string(order) + " states");
+  }
   if (o.resonance_hz > 0.0) options.resonance = 2 * std::numbers::pi * o.resonance_hz;
   if (!o.json) log_line("computing the root locus" + std::string(gains.empty() ? " on an automatic gain grid" : ""));
   const control::IffRootLocus r = control::iff_root_locus(plant.system, controller.system, gains, options);
@@ -229,6 +239,13 @@ void add_iff_commands(CLI::App& app, Action& action) {
       ->capture_default_str();
   rl->add_option("--resonance-hz", o->resonance_hz,
                  "frequency of the resonance whose damping is optimized (default: the plant's least damped pole)");
+  rl->add_option("--max-order", o->max_order, "largest loop order (plant + controller states) accepted")
+      ->check(CLI::Range(1, 5000))
+      ->capture_default_str();
+  rl->add_option("--max-work", o->max_work,
+                 "work budget of the automatic gain grid: eigenvalue problems x order^3 (exit 4 when exceeded)")
+      ->check(CLI::Range(1e3, 1e15))
+      ->capture_default_str();
   rl->add_flag("--json", o->json, "print one JSON document on stdout");
   rl->callback([o, &action] { action = [o] { return run_rlocus(*o); }; });
 

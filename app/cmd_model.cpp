@@ -8,12 +8,12 @@
 #include <memory>
 #include <numbers>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "cli_common.hpp"
 #include "piezobench/apa/piezo.hpp"
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/apa/two_dof.hpp"
+#include "piezobench/apa/two_dof_file.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
@@ -24,33 +24,6 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr const char* kCommandLine = "command line";
-
-// ------------------------------------------------------------------------------ params TOML
-// Keys m, k1, c1, ke, ce, ka, ca, ga, gs (SI); each a number; unknown keys rejected by name.
-apa::TwoDofParams read_params_toml(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "a readable file", "none (cannot open it)");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  toml::table table;
-  try {
-    table = toml::parse(ss.str(), path);
-  } catch (const toml::parse_error& e) {
-    throw InputError(path, fmt::format("line {}, column {}", e.source().begin.line, e.source().begin.column),
-                     "valid TOML", std::string(e.description()));
-  }
-  std::map<std::string, double> values;
-  for (const auto& [key, node] : table) {
-    const std::string name(key.str());
-    const auto value = node.value<double>();
-    // Unknown keys first, so that a misspelt key is reported as such whatever its value.
-    apa::TwoDofParams probe;
-    probe.set(name, 0.0, path);
-    if (!node.is_number() || !value) throw InputError(path, name, "a number (SI units)", "a non-number");
-    values[name] = *value;
-  }
-  return apa::two_dof_params_from_map(values, path);
-}
 
 nlohmann::json params_json(const apa::TwoDofParams& p) {
   nlohmann::json j = nlohmann::json::object();
@@ -79,7 +52,7 @@ int run_two_dof(const TwoDofCommand& o) {
   if (!(std::isfinite(o.fmax) && o.fmax > o.fmin)) {
     throw InputError("", "--fmax", fmt::format("a frequency above --fmin = {} Hz", o.fmin), fmt::format("{}", o.fmax));
   }
-  const apa::TwoDofParams p = o.params_file.empty() ? apa::TwoDofParams{} : read_params_toml(o.params_file);
+  const apa::TwoDofParams p = o.params_file.empty() ? apa::TwoDofParams{} : apa::read_two_dof_params(o.params_file);
   o.bench.validate(kCommandLine);
   const apa::TwoDofCharacteristics c = apa::characterize(p, o.bench);
   const lti::Vector f = lti::logspace(std::log10(o.fmin), std::log10(o.fmax), o.points);

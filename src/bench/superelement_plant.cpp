@@ -9,7 +9,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-#include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/toml_table.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::bench::detail {
@@ -39,8 +39,9 @@ class Keys {
   double number(const char* key, double fallback) {
     const toml::node* n = find(key);
     if (n == nullptr) return fallback;
-    if (!n->is_number()) throw InputError(source_, key, "a number", describe_toml(*n));
-    const double v = *n->value<double>();
+    const auto number = io::toml_number(*n);
+    if (!number) throw InputError(source_, key, "a number", describe_toml(*n));
+    const double v = *number;
     if (!std::isfinite(v)) throw InputError(source_, key, "a finite number", fmt::format("{}", v));
     return v;
   }
@@ -89,16 +90,7 @@ class Keys {
 
 SuperElementSpec read_superelement_spec(const std::filesystem::path& file) {
   const std::string source = file.string();
-  std::ifstream in(file);
-  if (!in) throw InputError(source, "file", "a readable super-element description (TOML)", "a file that cannot be opened");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  toml::table table;
-  try {
-    table = toml::parse(ss.str(), source);
-  } catch (const toml::parse_error& e) {
-    throw InputError(source, fmt::format("line {}", e.source().begin.line), "valid TOML", std::string(e.description()));
-  }
+  const toml::table table = io::read_toml_file(file);
   Keys keys(table, source);
   SuperElementSpec s;
   s.file = file;

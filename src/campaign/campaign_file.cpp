@@ -9,7 +9,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-#include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/toml_table.hpp"
 #include "piezobench/io/units.hpp"
 #include "piezobench/core/error.hpp"
 
@@ -131,8 +131,8 @@ class Reader {
   }
 
   [[nodiscard]] double number(const std::string& k, const toml::node& node) const {
-    const auto v = node.value<double>();
-    if (!node.is_number() || !v) throw InputError(source_, key(k), "a number", describe_toml(node));
+    const auto v = io::toml_number(node);
+    if (!v) throw InputError(source_, key(k), "a number", describe_toml(node));
     if (!std::isfinite(*v)) throw InputError(source_, key(k), "a finite number", fmt::format("{}", *v));
     return *v;
   }
@@ -507,13 +507,7 @@ SuperElementSpec read_superelement(const Context& ctx, const Reader& r) {
 
 Campaign parse_campaign(const std::string& text, const fs::path& file, bool check_files) {
   const std::string source = file.string();
-  toml::table root;
-  try {
-    root = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    throw InputError(source, "TOML", "valid TOML",
-                     fmt::format("{} at line {}, column {}", e.description(), e.source().begin.line, e.source().begin.column));
-  }
+  const toml::table root = io::parse_toml(text, source);
   Campaign c;
   c.file = file;
   c.folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
@@ -549,11 +543,7 @@ Campaign parse_campaign(const std::string& text, const fs::path& file, bool chec
 }
 
 Campaign read_campaign(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "file", "a readable campaign file", "it cannot be opened");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_campaign(ss.str(), file, true);
+  return parse_campaign(io::read_toml_text(file), file, true);
 }
 
 }  // namespace piezobench::campaign

@@ -234,7 +234,9 @@ SparseMatrix read_matrix_market(const std::filesystem::path& file) {
       cols = *c;
       nnz = *z;
       if (symmetric && rows != cols) throw InputError(source, at_line(line), "a square symmetric matrix", quote(t));
-      triplets.reserve(static_cast<std::size_t>(std::min<long long>(nnz, 100000000)));
+      // Never more than the file can hold ("i j v\n" is at least 6 bytes): a declared count alone
+      // does not allocate.
+      triplets.reserve(static_cast<std::size_t>(std::min<long long>(nnz, static_cast<long long>(text.size() / 6 + 1))));
       have_size = true;
       return true;
     }

@@ -19,6 +19,9 @@ namespace piezobench::fem::detail {
 
 // The whole file; InputError(file, "file", ...) when it cannot be read.
 inline std::string read_file(const std::filesystem::path& file) {
+  std::error_code status_ec;
+  const auto status = std::filesystem::status(file, status_ec);
+  if (std::filesystem::is_directory(status)) throw InputError(file.string(), "file", "a readable file", "a directory");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string(), "file", "a readable file", "it cannot be opened");
   std::string text;

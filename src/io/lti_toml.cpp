@@ -8,23 +8,11 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
-#include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/toml_table.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 
 namespace piezobench::io {
-
-std::string describe_toml(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer:
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::array: return "an array of " + std::to_string(node.as_array()->size());
-    case toml::node_type::table: return "a table";
-    default: return "a date or time";
-  }
-}
 
 namespace {
 
@@ -35,11 +23,8 @@ class Reader {
   [[nodiscard]] bool has(const char* key) const { return table_.contains(key); }
 
   [[nodiscard]] double number(const std::string& key, const toml::node& node) const {
-    // An integer is taken as the nearest double: toml++ converts only the exactly representable
-    // ones, so 9223372036854775807 would otherwise be "a number" refused as "a number".
-    const std::optional<double> value =
-        node.is_integer() ? std::optional<double>(static_cast<double>(node.as_integer()->get())) : node.value<double>();
-    if (!node.is_number() || !value) throw InputError(source_, key, "a number", describe_toml(node));
+    const auto value = toml_number(node);
+    if (!value) throw InputError(source_, key, "a number", describe_toml(node));
     if (!std::isfinite(*value)) throw InputError(source_, key, "a finite number", std::to_string(*value));
     return *value;
   }
@@ -49,6 +34,12 @@ class Reader {
   [[nodiscard]] const toml::array& array(const std::string& key, const toml::node& node) const {
     const toml::array* a = node.as_array();
     if (a == nullptr) throw InputError(source_, key, "an array", describe_toml(node));
+    // Bounds the order before any n x n matrix is built (a 100,000-coefficient denominator ran out
+    // of memory in the conversion to a state space).
+    if (a->size() > kMaxLtiOrder + 1) {
+      throw InputError(source_, key, "at most " + std::to_string(kMaxLtiOrder + 1) + " entries (systems of order <= " +
+                       std::to_string(kMaxLtiOrder) + ")", std::to_string(a->size()) + " entries");
+    }
     return *a;
   }
 
@@ -193,23 +184,11 @@ std::string to_string(LtiForm form) {
 }
 
 LtiFile parse_lti_toml(const std::string& text, const std::string& source) {
-  toml::table table;
-  try {
-    table = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream where;
-    where << "line " << e.source().begin.line << ", column " << e.source().begin.column;
-    throw InputError(source, where.str(), "valid TOML", std::string(e.description()));
-  }
-  return build(table, source);
+  return build(parse_toml(text, source), source);
 }
 
 LtiFile read_lti_toml(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "", "a readable file", "none (cannot open it)");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_lti_toml(ss.str(), path.string());
+  return build(read_toml_file(path), path.string());
 }
 
 }  // namespace piezobench::io

@@ -1,5 +1,6 @@
 #include "lti/balance.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace piezobench::lti::detail {
@@ -10,6 +11,7 @@ namespace {
 Vector balance_block(Matrix& m, Index n) {
   constexpr double kRadix = 2.0;
   constexpr double kFactor = 0.95;
+  constexpr int kMaxSteps = 1100;
   Vector d = Vector::Ones(n);
   bool converged = false;
   for (int sweep = 0; sweep < 100 && !converged; ++sweep) {
@@ -23,19 +25,25 @@ Vector balance_block(Matrix& m, Index n) {
       for (Index j = 0; j < m.cols(); ++j) {
         if (j != i) r += std::abs(m(i, j));
       }
-      if (c == 0.0 || r == 0.0) continue;
+      // A non-finite norm (an overflowed entry) would keep the loops below scaling forever: such a
+      // row is left as it is (the caller's finiteness checks report it).
+      if (c == 0.0 || r == 0.0 || !std::isfinite(c) || !std::isfinite(r)) continue;
       double g = r / kRadix;
       double f = 1.0;
       const double s = c + r;
-      while (c < g) {
+      // Each loop moves the exponent of f by one; 2 * 1100 steps cover the whole double range.
+      for (int k = 0; k < kMaxSteps && c < g; ++k) {
         f *= kRadix;
         c *= kRadix * kRadix;
       }
       g = r * kRadix;
-      while (c >= g) {
+      for (int k = 0; k < kMaxSteps && c >= g; ++k) {
         f /= kRadix;
         c /= kRadix * kRadix;
       }
+      // Apply only a scaling that keeps every entry finite and every scale representable.
+      const double grown = std::max(m.col(i).cwiseAbs().maxCoeff() * f, m.row(i).cwiseAbs().maxCoeff() / f);
+      if (!std::isfinite(grown) || !std::isfinite(d(i) * f) || d(i) * f == 0.0) continue;
       if ((c + r) / f < kFactor * s) {
         converged = false;
         d(i) *= f;

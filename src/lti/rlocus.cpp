@@ -228,6 +228,8 @@ void RootLocusOptions::validate() const {
     throw InputError("rlocus", "settle_fraction", "a fraction in (0, 1)", detail::str(settle_fraction));
   }
   if (max_points < 2) throw InputError("rlocus", "max_points", "a count >= 2", std::to_string(max_points));
+  if (max_order < 1) throw InputError("rlocus", "max_order", "a count >= 1", std::to_string(max_order));
+  if (!std::isfinite(max_work) || max_work <= 0.0) throw InputError("rlocus", "max_work", "a finite budget > 0", detail::str(max_work));
 }
 
 CVector closed_loop_poles(const StateSpace& open_loop, double gain) {
@@ -257,6 +259,15 @@ RootLocus rlocus(const StateSpace& open_loop, const std::vector<double>& gains) 
 RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& options) {
   check_loop(open_loop, "rlocus_auto");
   options.validate();
+  const Index n = open_loop.states();
+  if (n > options.max_order) {
+    throw InputError("rlocus", "loop order", "at most max_order = " + std::to_string(options.max_order) + " states",
+                     std::to_string(n) + " states");
+  }
+  // Eigenvalue problems this grid may solve (rejected steps included).
+  const double n3 = std::max(1.0, static_cast<double>(n) * static_cast<double>(n) * static_cast<double>(n));
+  const double max_evaluations = std::max(16.0, std::floor(options.max_work / n3));
+  double evaluations = 1.0;
   RootLocus rl;
   const bool automatic = options.gain_max == 0.0;
   CVector current = poles_at(open_loop, options.gain_min);
@@ -288,6 +299,12 @@ RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& optio
     if (automatic && k > 0.0 && settled(current, sc, options.settle_fraction)) break;
     double next = k == 0.0 ? k_first : k * ratio;
     next = std::min(next, last);
+    if (++evaluations > max_evaluations) {
+      throw NumericalError("rlocus", "the adaptive gain grid needed more than " + detail::str(max_evaluations) +
+                           " eigenvalue problems of order " + std::to_string(n) + " (max_work = " + detail::str(options.max_work) +
+                           "); it reached gain " + detail::str(k),
+                           /*retry_may_help=*/true);
+    }
     const CVector candidate = match_to(current, poles_at(open_loop, next));
     const double move = relative_move(current, candidate, sc.smallest);
     if (move > options.max_relative_step) {

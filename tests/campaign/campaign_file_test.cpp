@@ -180,8 +180,14 @@ TEST(CampaignFile, BadValues) {
           "units[0].capacitance_uF");
   f.error("[[units]]\nid = 1\ncapacitance_uF = { sensor = 1.0 }\n", "units[0].capacitance_uF.actuator");
   // TOML syntax: the line is named.
-  const std::string syntax = f.error("[[units]]\nid = = 1\n", "TOML");
+  const std::string syntax = test::input_error([&] { (void)f.parse("[[units]]\nid = = 1\n"); });
   EXPECT_TRUE(contains(syntax, "line 2")) << syntax;
+  EXPECT_TRUE(contains(syntax, "valid TOML")) << syntax;
+  // A header deeper than the TOML limits (issue 21.2: it overflowed the stack in toml++).
+  std::string deep = "[a";
+  for (int i = 0; i < 100000; ++i) deep += ".a";
+  const std::string limit = test::input_error([&] { (void)f.parse(deep + "]\n"); }, "line 1");
+  EXPECT_TRUE(contains(limit, "more than 64 parts")) << limit;
 }
 
 TEST(CampaignFile, ReadFromDisk) {

@@ -185,6 +185,26 @@ class BadAnsysFiles : public ::testing::Test {
   SuperElement read() { return read_ansys_super_element(kf(), mf(), lf()); }
 };
 
+// Issue 21.5: the 26-byte file '[15000,15000]: 1.0' allocated the 15000 x 15000 matrix (1.77 GB)
+// before finding the entries missing; the count is now checked first. Issue 21.6: a directory
+// where a file is expected (out_NLIST.txt beside the listing) is an InputError, not exit 1.
+TEST(SuperElementHostile, DeclaredSizeWithoutEntriesAndDirectories) {
+  test::TempDir dir;
+  const fs::path k = dir.path() / "K.txt", m = dir.path() / "M.txt", l = dir.path() / "masters.txt";
+  test::write_text(k, "MAT_K:\n[15000,15000]: 1.0\n");
+  test::write_text(m, "MAT_M:\n[15000,15000]: 1.0\n");
+  test::write_text(l, "1 UX\n2 UX\n");
+  test::expect_input_error([&] { (void)read_ansys_super_element(k, m, l); },
+                           {k.string(), "225000000 entries of a full 15000 x 15000 matrix", "first missing: [1,1]"});
+  test::write_text(k, "MAT_K:\n[1,1]: 1.0 [1,2]: 0.5 [1,2]: 0.5\n");
+  test::expect_input_error([&] { (void)read_ansys_super_element(k, m, l); }, {k.string(), "[1,2]", "a repeated entry"});
+  test::write_text(k, "MAT_K:\n[1,1]: 2.0 [1,2]: -1.0\n[2,1]: -1.0 [2,2]: 2.0\n");
+  test::write_text(m, "MAT_M:\n[1,1]: 1.0 [1,2]: 0.0\n[2,1]: 0.0 [2,2]: 1.0\n");
+  fs::create_directories(dir.path() / "out_NLIST.txt");
+  test::expect_input_error([&] { (void)read_ansys_super_element(k, m, l); }, {"out_NLIST.txt", "a directory"});
+  test::expect_input_error([&] { (void)read_ansys_super_element(dir.path(), m, l); }, {dir.path().string(), "a directory"});
+}
+
 TEST_F(BadAnsysFiles, CopiesReadFine) {
   write_all();
   const SuperElement se = read();

@@ -221,6 +221,28 @@ TEST(RlocusTest, IffLoopMaximumDampingMatchesDenseScan) {
   EXPECT_GT(opt.pole.imag(), 0.0);  // still the upper branch of the 95.2 Hz pair
 }
 
+// Issue 21.7: the work of the automatic grid is bounded: a loop above max_order states is refused
+// at once, and a budget too small for the grid is a NumericalError saying so.
+TEST(RlocusTest, WorkIsBoundedByOrderAndBudget) {
+  const StateSpace l = double_integrator_with_lead();  // 3 states
+  RootLocusOptions o;
+  o.max_order = 2;
+  const std::string e = test::input_error([&] { (void)rlocus_auto(l, o); }, "loop order");
+  EXPECT_TRUE(test::contains(e, "3 states")) << e;
+  o.max_order = 200;
+  o.max_work = 27.0 * 20;  // 20 eigenvalue problems of order 3
+  try {
+    (void)rlocus_auto(l, o);
+    ADD_FAILURE() << "no NumericalError";
+  } catch (const NumericalError& err) {
+    EXPECT_TRUE(err.retry_may_help());
+    EXPECT_TRUE(test::contains(err.what(), "more than 20 eigenvalue problems of order 3")) << err.what();
+  }
+  EXPECT_GT(rlocus_auto(l).gains.size(), 20u);  // the default budget is far above what it needs
+  o.max_work = 0.0;
+  test::input_error([&] { (void)rlocus_auto(l, o); }, "max_work");
+}
+
 TEST(RlocusTest, BadInput) {
   const StateSpace l = double_integrator_with_lead();
   // Not SISO.

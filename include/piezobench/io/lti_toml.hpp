@@ -11,13 +11,18 @@
 //                       sample_time = 1e-4  (s; absent or 0 = continuous)
 //                       description = "any text"
 // Unknown keys, missing keys, a mix of forms, wrong types or shapes and non-finite values are
-// InputErrors naming the file and the key (and the line for TOML syntax errors).
+// InputErrors naming the file and the key (and the line for TOML syntax errors). The text goes
+// through io/toml_table.hpp (size and nesting limits); an array holds at most kMaxLtiOrder + 1
+// entries, so a file never describes a system of more than kMaxLtiOrder states.
+#include <cstddef>
 #include <filesystem>
 #include <string>
 
 #include "piezobench/lti/state_space.hpp"
 
 namespace piezobench::io {
+
+inline constexpr std::size_t kMaxLtiOrder = 1000;
 
 enum class LtiForm { kTransferFunction, kZpk, kStateSpace };
 std::string to_string(LtiForm form);  // "tf", "zpk", "ss"

@@ -33,6 +33,12 @@ struct RootLocusOptions {
   double max_relative_step = 0.02;
   double settle_fraction = 1e-3;
   int max_points = 20000;
+  // Bounds on the work (docs/cli.md, resource bounds): a loop of more than max_order states is an
+  // InputError; the adaptive grid solves at most max_work / n^3 eigenvalue problems of the loop's
+  // order n (rejected steps included) and throws NumericalError (retry may help: a larger budget,
+  // or fewer points) when they do not suffice.
+  int max_order = 200;
+  double max_work = 5e8;
   void validate() const;  // InputError naming the field
 };
 
