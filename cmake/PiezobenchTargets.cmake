@@ -19,6 +19,19 @@ if(PIEZOBENCH_SANITIZE)
   target_link_options(piezobench_options INTERFACE ${_pb_sanitize})
 endif()
 
+if(PIEZOBENCH_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "PIEZOBENCH_FUZZ needs clang (libFuzzer): configure with -DCMAKE_CXX_COMPILER=clang++-14")
+  endif()
+  # The libraries are instrumented for coverage (fuzzer-no-link) and checked by ASan and UBSan,
+  # with the same UBSan exclusions as PIEZOBENCH_SANITIZE; the targets link libFuzzer (fuzz/).
+  set(PIEZOBENCH_FUZZ_SANITIZE -fsanitize=address,undefined -fno-sanitize=alignment,null,vptr,object-size
+      -fno-sanitize-recover=all)
+  target_compile_options(piezobench_options INTERFACE -fsanitize=fuzzer-no-link ${PIEZOBENCH_FUZZ_SANITIZE}
+                         -fno-omit-frame-pointer)
+  target_link_options(piezobench_options INTERFACE ${PIEZOBENCH_FUZZ_SANITIZE})
+endif()
+
 # piezobench_add_module(NAME <name> SOURCES <files...> [DEPS <targets...>])
 # Declares the library piezobench_<name> with the alias piezobench::<name>. Its public headers live
 # in include/piezobench/<name>/; its sources and private headers in src/<name>/.

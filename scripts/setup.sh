@@ -4,6 +4,10 @@
 #   scripts/setup.sh demo [--sanitize]   install what is missing, build, run the main job
 #   scripts/setup.sh test [--sanitize]   install what is missing, build, run the whole test suite
 #   scripts/setup.sh build [--sanitize]  install what is missing and build
+#   scripts/setup.sh fuzz                install what is missing, build the readers' libFuzzer
+#                                        targets with clang in build-fuzz/, replay the regression
+#                                        corpus and fuzz for PIEZOBENCH_FUZZ_SECONDS (default 180)
+#                                        in all (docs/fuzzing.md)
 #
 # Installing is idempotent: packages already present are left alone, and nothing is installed
 # (not even an `apt-get update`) when everything is there. --sanitize builds in build-sanitize/
@@ -20,8 +24,8 @@ for arg in "$@"; do
   esac
 done
 case "$job" in
-  demo|test|build) ;;
-  *) echo "usage: scripts/setup.sh demo|test|build [--sanitize]" >&2; exit 2 ;;
+  demo|test|build|fuzz) ;;
+  *) echo "usage: scripts/setup.sh demo|test|build|fuzz [--sanitize]" >&2; exit 2 ;;
 esac
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -43,6 +47,9 @@ packages=(
   gmsh calculix-ccx python3-scipy
   # The Python module (python/, pybind11) and its pytest suite, for Debian's python3.
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
+  # The fuzz job (docs/fuzzing.md): clang with libFuzzer and the sanitizer runtimes, and the
+  # symbolizer of their stack traces.
+  clang-14 libclang-rt-14-dev llvm-14
   # The report's plotting library comes from npm (src/report/js); its test runs headless Chromium.
   nodejs chromium
 )
@@ -70,6 +77,17 @@ if [ ! -f "$report_js/node_modules/.package-lock.json" ] || \
    [ "$report_js/package-lock.json" -nt "$report_js/node_modules/.package-lock.json" ]; then
   echo "setup.sh: installing the report's plotting library with npm ci" >&2
   npm ci --prefix "$report_js" --no-audit --no-fund --loglevel=error >/dev/null
+fi
+
+if [ "$job" = fuzz ]; then
+  # Only the reader libraries and the fuzz targets, with clang; Debian's matio, HDF5, ... linked.
+  build_dir="$root/build-fuzz"
+  cmake -S "$root" -B "$build_dir" -G Ninja -DPIEZOBENCH_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 \
+    -DPIEZOBENCH_BUILD_PYTHON=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" >/dev/null
+  cmake --build "$build_dir" -j "$(nproc 2>/dev/null || echo 2)" --target fuzzers
+  bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" regression
+  bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" fuzz "${PIEZOBENCH_FUZZ_SECONDS:-180}"
+  exit 0
 fi
 
 if [ "$sanitize" -eq 1 ]; then

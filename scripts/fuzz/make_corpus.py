@@ -1,0 +1,175 @@
+#!/usr/bin/env python3
+"""Writes the fuzzing seeds (fuzz/seeds/READER/) and the regression corpus of hostile files
+(fuzz/regression/READER/) that CI replays every time (docs/fuzzing.md).
+
+Seeds are small valid inputs in the layouts the readers accept; the fuzz runner adds the fixture
+files of tests/fixtures (scipy .mat files, CalculiX dumps). The regression corpus holds the
+reproducers of issue 21 and files like them; every one must end in exit 2, 3 or 4 (or 0 for a file
+named valid_*; any of 0, 2, 3, 4 for heavy_*) within 20 s and 1 GB, never a signal, a sanitizer report or exit 1.
+
+Multi-file readers (Ansys text, CalculiX, Matrix Market) take one input whose parts are separated
+by lines "@@@@" (fuzz/readers_fuzz.cpp): K, M, DOF list (and for CalculiX the .inp).
+Run from the repository root: python3 scripts/fuzz/make_corpus.py
+"""
+import os
+import shutil
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(__file__), "..", ".."))
+SEP = "\n@@@@\n"
+
+
+def write(kind, reader, name, text):
+    d = os.path.join(ROOT, "fuzz", kind, reader)
+    os.makedirs(d, exist_ok=True)
+    mode = "wb" if isinstance(text, bytes) else "w"
+    with open(os.path.join(d, name), mode) as f:
+        f.write(text)
+
+
+def clean(kind):
+    shutil.rmtree(os.path.join(ROOT, "fuzz", kind), ignore_errors=True)
+
+
+def seeds():
+    clean("seeds")
+    # LTI TOML: the three forms of docs/formats.md.
+    write("seeds", "lti_toml", "tf.toml", "num = [0.64, 0.0]\nden = [1.0, 2.5]\ndelay = 200e-6\n")
+    write("seeds", "lti_toml", "zpk.toml", "zeros = [0.0, [-1.0, 2.0], [-1.0, -2.0]]\n"
+          "poles = [-12.5, [-10.0, 3000.0], [-10.0, -3000.0], -12566.4]\ngain = -10.0\n")
+    write("seeds", "lti_toml", "ss.toml", "A = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\n"
+          "D = [[0.0]]\nsample_time = 1e-4\ndescription = \"any text\"\n")
+    # 2-DoF parameters (SI).
+    write("seeds", "two_dof_toml", "params.toml", "m = 5.7\nk1 = 0.4e6\nc1 = 20.0\nke = 4.3e6\nce = 10.0\n"
+          "ka = 2.5e6\nca = 10.0\nga = 23.2\ngs = -0.5e6\n")
+    # Campaign (docs/campaign.md); the reader is fuzzed without checking that the files exist.
+    write("seeds", "campaign_toml", "campaign.toml", """title = "seed"
+[bench]
+amplifier_gain = 20.0
+suspended_mass_kg = 5.7
+[specs]
+stroke_min_um = 200.0
+flatness_um = 5.0
+stiffness_N_per_um = [1.5, 2.5]
+[analysis]
+window = "hann"
+nfft = 4096
+overlap = 0.5
+fmin_Hz = 10.0
+fmax_Hz = 1000.0
+[channels]
+u = "u_dac"
+de = "d_enc"
+Vs = "V_sensor"
+[[units]]
+id = 1
+frf = { file = "apa1_frf.csv", channels = { u = "dac", de = "encoder", Vs = "force_sensor" } }
+stroke = "stroke.mat"
+capacitance_uF = { sensor = 5.10, actuator = 10.03 }
+iff = [{ file = "iff1.mat", gain = 30000.0 }]
+[[units]]
+id = 2
+stiffness = "k.mat"
+[superelement]
+k_file = "K.txt"
+m_file = "M.txt"
+nodes_file = "nodes.txt"
+fix = [1]
+actuator = "2:3:x"
+output = "2:y"
+masses = ["2:5.7"]
+ga_N_per_V = 23.2
+""")
+    # Time series CSV (LabVIEW-style: a time column, units in brackets) and with a rate comment.
+    rows = "\n".join(f"{k * 1e-4:.4f},{0.1 * ((k * 7) % 5 - 2):.3f},{1e-6 * k:.3e},{0.01 * (k % 3):.3f}" for k in range(16))
+    write("seeds", "csv_timeseries", "labview.csv", "t [s],u [V],de [m],Vs [V]\n" + rows + "\n")
+    write("seeds", "csv_timeseries", "rate.csv", "# sample_rate_Hz: 10000\nu,de,Vs\n" +
+          "\n".join(f"{0.1 * (k % 4)},{1e-6 * k},{0.02 * (k % 2)}" for k in range(16)) + "\n")
+    # FRF CSV (docs/cli.md).
+    write("seeds", "csv_frf", "frf.csv", "freq_Hz,re_de,im_de,coh_de,re_Vs,im_Vs,coh_Vs\n" +
+          "\n".join(f"{f},{1e-6 / (1 + f / 100)},{-1e-7 * f / 100},0.99,{0.5},{0.01 * f},0.98" for f in range(10, 200, 10)) + "\n")
+    # UFF58 (ASCII, complex real/imag pairs, even abscissa): one function.
+    n = 8
+    lines = ["    -1", "    58", "u -> de", "NONE", "NONE", "NONE", "NONE",
+             "    4         1    1         0       de         1   3       u          1   3",
+             f"         5{n:10d}         1  1.00000E+01  1.00000E+01  0.00000E+00",
+             "        18    0    0    0                 Frequency                   Hz",
+             "         8    0    0    0                  Response                    m",
+             "        13    0    0    0                  Input                       V",
+             "         0    0    0    0                     NONE                  NONE"]
+    vals = []
+    for k in range(n):
+        vals += [1e-6 / (1 + k), -1e-7 * k]
+    for i in range(0, len(vals), 6):
+        lines.append("".join(f"{v:13.5E}" for v in vals[i:i + 6]))
+    lines.append("    -1")
+    write("seeds", "uff58", "frf.uff", "\n".join(lines) + "\n")
+    # Ansys CMS text: a 2-node bar (UX of nodes 1 and 2) plus one modal coordinate.
+    k = "MAT_K:\n[1,1]: 2.0E+06 [1,2]: -1.0E+06 [1,3]: 0.0\n[2,1]: -1.0E+06 [2,2]: 2.0E+06 [2,3]: 0.0\n" \
+        "[3,1]: 0.0 [3,2]: 0.0 [3,3]: 4.0E+06\n"
+    m = "MAT_M:\n[1,1]: 1.0 [1,2]: 0.0 [1,3]: 0.0\n[2,1]: 0.0 [2,2]: 1.0 [2,3]: 0.0\n[3,1]: 0.0 [3,2]: 0.0 [3,3]: 1.0\n"
+    listing = "    1  UX\n    2  UX\n\n    NODE     X      Y      Z\n    1   0.0  0.0  0.0\n    2   0.01  0.0  0.0\n"
+    write("seeds", "ansys_text", "bar.txt", k + SEP[1:] + m + SEP[1:] + listing)
+    # Matrix Market K, M and a piezobench DOF list.
+    kmm = "%%MatrixMarket matrix coordinate real symmetric\n2 2 3\n1 1 2.0e6\n2 1 -1.0e6\n2 2 2.0e6\n"
+    mmm = "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n2 2 1.0\n"
+    dofs = "1 UX 0.0 0.0 0.0\n2 UX 0.01 0.0 0.0\n"
+    write("seeds", "matrix_market", "bar.txt", kmm + SEP[1:] + mmm + SEP[1:] + dofs)
+    # CalculiX dumps: .sti, .mas, .dof, .inp with the node coordinates.
+    sti = "1 1 2.0e6\n1 2 -1.0e6\n2 2 2.0e6\n"
+    mas = "1 1 1.0\n2 2 1.0\n"
+    dof = "1.1\n2.1\n"
+    inp = "*NODE\n1, 0.0, 0.0, 0.0\n2, 0.01, 0.0, 0.0\n"
+    write("seeds", "calculix", "bar.txt", sti + SEP[1:] + mas + SEP[1:] + dof + SEP[1:] + inp)
+
+
+def regression():
+    clean("regression")
+    # 21.2: a table header / dotted key of 100,000 parts recursed 30,000 frames deep in toml++;
+    # 20,000 parts keep the files small and are as far past the limit (64).
+    deep = ".a" * 20000
+    for reader in ("lti_toml", "two_dof_toml", "campaign_toml"):
+        write("regression", reader, "deep_header.toml", "[a" + deep + "]\nx = 1\n")
+        write("regression", reader, "deep_dotted_key.toml", "a" + deep + " = 1\n")
+        write("regression", reader, "deep_inline_key.toml", "t = { a" + deep[:2000] + " = 1 }\n")
+        write("regression", reader, "deep_arrays.toml", "v = " + "[" * 5000 + "]" * 5000 + "\n")
+    # 21.3: C = -2.5e308 overflows; the balancing looped forever.
+    write("regression", "lti_toml", "balance_overflow.toml", "num = [1e308, 0.0]\nden = [1.0, 2.5]\n")
+    write("regression", "lti_toml", "balance_overflow_ss.toml",
+          "A = [[0.0, 1e308], [-1e308, -1.0]]\nB = [[0.0], [1e308]]\nC = [[1e308, 1e-308]]\n")
+    # 21.8: an integer beyond double precision ("expected a number, found a number").
+    write("regression", "lti_toml", "int64_max.toml", "num = [9223372036854775807]\nden = [1.0, 2.5]\n")
+    write("regression", "two_dof_toml", "int64_max.toml", "m = 9223372036854775807\nk1 = -9223372036854775808\n")
+    write("regression", "campaign_toml", "int64_id.toml", "[[units]]\nid = 9223372036854775807\nstroke = \"s.mat\"\n")
+    # 21.5: a 100,000-coefficient denominator ran out of memory in the state-space conversion;
+    # 20,000 are as far past the cap (1,001).
+    write("regression", "lti_toml", "den_20000.toml", "num = [1]\nden = [1" + ",1" * 20000 + "]\n")
+    # 21.7: a 1,000-pole zpk (over 150 s in the root locus); a 30th-order transfer function.
+    poles = ", ".join(f"[{-1.0 - (k // 2) % 7}, {100.0 * (k // 2 + 1) * (1 if k % 2 == 0 else -1)}]" for k in range(1000))
+    write("regression", "lti_toml", "zpk_1000_poles.toml", f"zeros = [0.0]\npoles = [{poles}]\ngain = 1.0\n")
+    den = ", ".join(f"{1.0 + 0.1 * k}" for k in range(31))
+    write("regression", "lti_toml", "heavy_tf_order30.toml", f"num = [1.0, 0.0]\nden = [{den}]\n")
+    # 21.5: a 26-byte Ansys file declaring a 15000 x 15000 matrix (1.77 GB before exit 3).
+    master = "    1  UX\n    2  UX\n"
+    write("regression", "ansys_text", "declared_15000.txt",
+          "MAT_K:\n[15000,15000]: 1.0\n" + SEP[1:] + "MAT_M:\n[15000,15000]: 1.0\n" + SEP[1:] + master)
+    write("regression", "ansys_text", "declared_100000.txt",
+          "MAT_K:\n[1,1]: 1.0\n[100000,100000]: 1.0\n" + SEP[1:] + "MAT_M:\n[1,1]: 1.0\n" + SEP[1:] + master)
+    write("regression", "ansys_text", "overflow_index.txt",
+          "MAT_K:\n[9223372036854775807,1]: 1.0\n" + SEP[1:] + "MAT_M:\n[1,1]: 1.0\n" + SEP[1:] + master)
+    # Matrix Market: a size line declaring 10^7 x 10^7 with 10^8 entries, two given.
+    write("regression", "matrix_market", "declared_nnz.txt",
+          "%%MatrixMarket matrix coordinate real symmetric\n10000000 10000000 100000000\n1 1 1.0\n2 2 1.0\n" + SEP[1:] +
+          "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n2 2 1.0\n" + SEP[1:] + "1 UX\n2 UX\n")
+    write("regression", "matrix_market", "dense_too_large.txt",
+          "%%MatrixMarket matrix coordinate real symmetric\n9000000 9000000 1\n1 1 1.0\n" + SEP[1:] +
+          "%%MatrixMarket matrix coordinate real symmetric\n9000000 9000000 1\n1 1 1.0\n" + SEP[1:] + "1 UX\n")
+    # CalculiX: a .dof that is fine, K entries outside it, an *INCLUDE of a directory (21.6).
+    write("regression", "calculix", "include_directory.txt",
+          "1 1 1.0\n" + SEP[1:] + "1 1 1.0\n" + SEP[1:] + "1.1\n" + SEP[1:] + "*INCLUDE, INPUT=.\n")
+    write("regression", "calculix", "index_overflow.txt",
+          "1 99999999999999999999 1.0\n" + SEP[1:] + "1 1 1.0\n" + SEP[1:] + "1.1\n" + SEP[1:] + "*NODE\n1, 0, 0, 0\n")
+
+
+if __name__ == "__main__":
+    seeds()
+    regression()
