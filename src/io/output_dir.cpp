@@ -80,6 +80,9 @@ std::vector<fs::path> StagedOutputs::commit() {
     }
     out.push_back(target);
   }
+  std::error_code ec;
+  fs::remove(staging_, ec);  // empty now
+  staging_.clear();
   return out;
 }
 
