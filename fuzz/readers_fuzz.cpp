@@ -1,5 +1,5 @@
-// libFuzzer targets, one per reader, selected at compile time by PIEZOBENCH_FUZZ_READER
-// (fuzz/CMakeLists.txt builds this file once per reader). docs/fuzzing.md.
+// libFuzzer targets, one per reader (docs/fuzzing.md). This file is compiled once and linked into
+// every fuzz_READER executable (fuzz/CMakeLists.txt); the executable's name selects the reader.
 //
 // Every input must end in a piezobench::Error (InputError or NumericalError: exit 3 or 4 on the
 // command line) or in a successful read. Anything else is a bug the fuzzer reports: a crash, a
@@ -7,6 +7,7 @@
 // "internal error"), which is turned into an abort here.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -20,21 +21,12 @@
 
 #include "piezobench/core/error.hpp"
 
-#if PIEZOBENCH_FUZZ_READER_IO
+#include "piezobench/apa/two_dof_file.hpp"
+#include "piezobench/campaign/campaign_file.hpp"
+#include "piezobench/fem/superelement.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
-#endif
-#if PIEZOBENCH_FUZZ_READER_CAMPAIGN
-#include "piezobench/campaign/campaign_file.hpp"
-#endif
-#if PIEZOBENCH_FUZZ_READER_APA
-#include "piezobench/apa/two_dof_file.hpp"
-#endif
-#if PIEZOBENCH_FUZZ_READER_FEM
-#include "piezobench/fem/matrix_io.hpp"
-#include "piezobench/fem/superelement.hpp"
-#endif
 
 namespace {
 
@@ -77,23 +69,21 @@ std::vector<std::string_view> split_parts(std::string_view data, std::size_t par
   return out;
 }
 
+std::string& reader() {
+  static std::string name;
+  return name;
+}
+
 void read(std::string_view data) {
-  const std::string reader = PIEZOBENCH_FUZZ_READER;
-#if PIEZOBENCH_FUZZ_READER_IO
+  const std::string& reader = ::reader();
   if (reader == "mat_timeseries") (void)piezobench::io::read_timeseries(write_input("input.mat", data));
   if (reader == "csv_timeseries") (void)piezobench::io::read_timeseries(write_input("input.csv", data));
   if (reader == "mat_frf") (void)piezobench::io::read_frf(write_input("input.mat", data));
   if (reader == "csv_frf") (void)piezobench::io::read_frf(write_input("input.csv", data));
   if (reader == "uff58") (void)piezobench::io::read_frf(write_input("input.uff", data));
   if (reader == "lti_toml") (void)piezobench::io::parse_lti_toml(std::string(data), "input.toml");
-#endif
-#if PIEZOBENCH_FUZZ_READER_CAMPAIGN
   if (reader == "campaign_toml") (void)piezobench::campaign::parse_campaign(std::string(data), work_dir() / "campaign.toml", false);
-#endif
-#if PIEZOBENCH_FUZZ_READER_APA
   if (reader == "two_dof_toml") (void)piezobench::apa::parse_two_dof_params(std::string(data), "input.toml");
-#endif
-#if PIEZOBENCH_FUZZ_READER_FEM
   if (reader == "ansys_text") {
     // K, M, master DOF listing (with or without its node list).
     const auto p = split_parts(data, 3);
@@ -112,10 +102,24 @@ void read(std::string_view data) {
     (void)piezobench::fem::read_matrix_market_super_element(write_input("k.mtx", p[0]), write_input("m.mtx", p[1]),
                                                            write_input("dofs.txt", p[2]));
   }
-#endif
 }
 
 }  // namespace
+
+// The reader is the executable's name without "fuzz_" (fuzz_lti_toml -> lti_toml).
+extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
+  const std::string name = fs::path((*argv)[0]).filename().string();
+  const std::vector<std::string> known = {"mat_timeseries", "csv_timeseries", "mat_frf",       "csv_frf",
+                                          "uff58",          "lti_toml",       "campaign_toml", "two_dof_toml",
+                                          "ansys_text",     "calculix",       "matrix_market"};
+  reader() = name.rfind("fuzz_", 0) == 0 ? name.substr(5) : name;
+  if (std::find(known.begin(), known.end(), reader()) == known.end()) {
+    std::fprintf(stderr, "piezobench fuzz: unknown reader '%s' (the executable must be named fuzz_READER)\n", reader().c_str());
+    std::exit(2);
+  }
+  (void)argc;
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {

@@ -55,10 +55,10 @@ TEST(SafetyGuard, SaturationLevelReachesTheTimeOnlyWhenMostSamplesAreClamped) {
   }
   int samples = 0;
   for (int k = 0; !g.saturated_too_long(); ++k, ++samples) (void)g.limit(k % 3 == 2 ? 1.0 : 100.0);
-  // Two clamped, one inside: net +1 per 3 samples, from level 0 (the last sample above was inside)
-  // to 10: 9 triples then two clamped samples.
-  EXPECT_EQ(samples, 29);
-  g.trip(Fault::kSaturation, 29);
+  // Two clamped, one inside: net +1 per 3 samples, from level 0 (the last sample above was inside):
+  // after 8 triples the level is 8, the next two clamped samples bring it to 10.
+  EXPECT_EQ(samples, 26);
+  g.trip(Fault::kSaturation, 26);
   EXPECT_EQ(to_string(g.fault()), "output saturated");
 }
 
