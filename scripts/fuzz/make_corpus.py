@@ -141,7 +141,7 @@ def regression():
     write("regression", "two_dof_toml", "int64_max.toml", "m = 9223372036854775807\nk1 = -9223372036854775808\n")
     write("regression", "campaign_toml", "int64_id.toml", "[[units]]\nid = 9223372036854775807\nstroke = \"s.mat\"\n")
     # 21.5: a 100,000-coefficient denominator ran out of memory in the state-space conversion;
-    # 20,000 are as far past the cap (1,001).
+    # 20,000 are as far past the cap (201).
     write("regression", "lti_toml", "den_20000.toml", "num = [1]\nden = [1" + ",1" * 20000 + "]\n")
     # 21.7: a 1,000-pole zpk (over 150 s in the root locus); a 30th-order transfer function.
     poles = ", ".join(f"[{-1.0 - (k // 2) % 7}, {100.0 * (k // 2 + 1) * (1 if k % 2 == 0 else -1)}]" for k in range(1000))

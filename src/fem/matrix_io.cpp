@@ -260,6 +260,12 @@ SparseMatrix read_matrix_market(const std::filesystem::path& file) {
     throw InputError(source, "entries", std::to_string(nnz) + " entries (as the size line says)",
                      std::to_string(triplets.size()) + " (truncated file?)");
   }
+  // The sparse matrix costs memory per row and column: its size is bounded by the entries the file
+  // holds (a stiffness or mass matrix has at least its diagonal), not only by the size line.
+  if (rows > 8 * nnz + 8 || cols > 8 * nnz + 8) {
+    throw InputError(source, "size", "at most 8 rows and columns per entry (" + std::to_string(8 * nnz + 8) + " for " +
+                     std::to_string(nnz) + " entries)", std::to_string(rows) + " x " + std::to_string(cols));
+  }
   if (symmetric) return symmetric_from_triangle(triplets, static_cast<Index>(rows), source);
   SparseMatrix A(static_cast<Index>(rows), static_cast<Index>(cols));
   A.setFromTriplets(triplets.begin(), triplets.end());

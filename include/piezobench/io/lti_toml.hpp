@@ -22,7 +22,7 @@
 
 namespace piezobench::io {
 
-inline constexpr std::size_t kMaxLtiOrder = 1000;
+inline constexpr std::size_t kMaxLtiOrder = 200;
 
 enum class LtiForm { kTransferFunction, kZpk, kStateSpace };
 std::string to_string(LtiForm form);  // "tf", "zpk", "ss"
