@@ -24,7 +24,8 @@ mkdir -p "$artifacts"
 
 # The seeds of a reader: fuzz/seeds/READER, the fixture files of its format and its regression files.
 seed_dirs() {
-  local reader="$1" dir="$build/fuzz-seeds/$reader"
+  local reader="$1"
+  local dir="$build/fuzz-seeds/$reader"
   rm -rf "$dir"
   mkdir -p "$dir"
   [ -d "$root/fuzz/seeds/$reader" ] && cp "$root/fuzz/seeds/$reader"/* "$dir"/
