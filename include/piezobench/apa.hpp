@@ -4,3 +4,4 @@
 #include "piezobench/apa/piezo.hpp"
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/apa/two_dof.hpp"
+#include "piezobench/apa/two_dof_file.hpp"

@@ -1,11 +1,13 @@
 #pragma once
-// The io module: time series and FRF files (.mat, CSV, UFF), JSON encodings, TOML models, atomic
-// writes.
+// The io module: time series and FRF files (.mat, CSV, UFF), JSON encodings, TOML models and the
+// one TOML reader with limits, atomic writes and staged result folders.
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/io/mat_struct.hpp"
+#include "piezobench/io/output_dir.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/toml_table.hpp"
 #include "piezobench/io/units.hpp"

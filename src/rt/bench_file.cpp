@@ -4,13 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <toml++/toml.h>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
-#include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/toml_table.hpp"
 
 namespace piezobench::rt {
 
@@ -47,8 +45,8 @@ class Table {
   [[nodiscard]] std::optional<double> number(const std::string& k) const {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
-    const auto v = n->value<double>();
-    if (!n->is_number() || !v) throw InputError(source_, key(k), "a number", describe_toml(*n));
+    const auto v = io::toml_number(*n);
+    if (!v) throw InputError(source_, key(k), "a number", describe_toml(*n));
     if (!std::isfinite(*v)) throw InputError(source_, key(k), "a finite number", fmt::format("{}", *v));
     return *v;
   }
@@ -177,14 +175,7 @@ void BenchDescription::validate() const {
 }
 
 BenchDescription parse_bench_description(const std::string& text, const std::string& source) {
-  toml::table root;
-  try {
-    root = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    throw InputError(source, "toml",
-                     fmt::format("valid TOML (line {}, column {})", e.source().begin.line, e.source().begin.column),
-                     std::string(e.description()));
-  }
+  const toml::table root = io::parse_toml(text, source);
   const Table top(&root, source, "");
   top.only({"bench", "amplifier", "limits", "encoder", "virtual", "udp", "comedi", "signals"});
   BenchDescription d;
@@ -277,11 +268,7 @@ BenchDescription parse_bench_description(const std::string& text, const std::str
 }
 
 BenchDescription read_bench_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "file", "a readable bench file (TOML)", "a file that cannot be opened");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_bench_description(ss.str(), file.string());
+  return parse_bench_description(io::read_toml_text(file), file.string());
 }
 
 }  // namespace piezobench::rt

@@ -37,7 +37,7 @@ TEST(TomlTable, DeepHeadersAndDottedKeysAreRefusedBeforeParsing) {
   const std::string e1 = test::input_error([&] { (void)parse_toml(header, "h.toml"); }, "line 2");
   EXPECT_TRUE(test::contains(e1, "h.toml")) << e1;
   EXPECT_TRUE(test::contains(e1, "more than 64 parts")) << e1;
-  const std::string dotted = "a" + repeat(".a", 100000) + " = 1\n";
+  const std::string dotted = std::string("a") + repeat(".a", 100000) + " = 1\n";
   test::input_error([&] { (void)parse_toml(dotted, "d.toml"); }, "line 1");
   const std::string inline_key = "t = { a" + repeat(".b", 100) + " = 1 }\n";
   test::input_error([&] { (void)parse_toml(inline_key, "i.toml"); }, "line 1");
@@ -48,7 +48,7 @@ TEST(TomlTable, DeepHeadersAndDottedKeysAreRefusedBeforeParsing) {
 
 // 64 parts, 32 levels, and dots, brackets and newlines inside strings and comments are fine.
 TEST(TomlTable, LimitsCountOnlyKeysAndValuesNotStringsOrComments) {
-  const std::string key = "a" + repeat(".a", 63);
+  const std::string key = std::string("a") + repeat(".a", 63);
   const std::string text = "[" + key + "]\n" + "s = \"" + repeat(".[{", 500) + "\"\n" + "m = '''\n" + repeat("a.b.[\n", 100) +
                            "'''\n# " + repeat(".", 1000) + "\n" + "v = " + repeat("[", 32) + repeat("]", 32) + "\n" +
                            "f = [1.5, 2.5, 3.5]\nt = {}\nu = { x = 1, y.z = [1, 2] }\n";

@@ -117,6 +117,20 @@ TEST(BenchFile, NamesUnknownKeysAndBadValues) {
   EXPECT_TRUE(test::contains(error_of("[bench\n"), "bench.toml"));
 }
 
+// Issue 21.2: bench files go through the TOML reader with limits (a 100,000-part header recursed
+// 30,000 frames deep in toml++); an integer is a number, and a directory is an InputError.
+TEST(BenchFile, HostileTomlIsAnInputError) {
+  std::string deep = "[a";
+  for (int i = 0; i < 100000; ++i) deep += ".a";
+  const std::string e = error_of(deep + "]\n");
+  EXPECT_TRUE(test::contains(e, "bench.toml")) << e;
+  EXPECT_TRUE(test::contains(e, "more than 64 parts")) << e;
+  // Not "expected a number, found a number": the rate check sees 9.2e18.
+  const std::string big = error_of("[bench]\nbackend = \"virtual\"\nsample_rate_Hz = 9223372036854775807\n");
+  EXPECT_TRUE(test::contains(big, "a rate in (0, 1e6] Hz")) << big;
+  EXPECT_THROW(read_bench_file(std::filesystem::path(PIEZOBENCH_SOURCE_DIR) / "docs"), InputError);
+}
+
 TEST(BenchFile, TheDocumentedExamplesRead) {
   for (const char* name : {"bench-virtual.toml", "bench-udp.toml", "bench-comedi.toml"}) {
     const auto path = std::filesystem::path(PIEZOBENCH_SOURCE_DIR) / "docs" / "examples" / name;
