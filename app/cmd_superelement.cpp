@@ -16,6 +16,7 @@
 #include "piezobench/fem/from_step.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
+#include "piezobench/fem/superelement_setup.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/lti/freqresp.hpp"
@@ -37,39 +38,33 @@ struct SuperElementCli {
   bool json = false;
 };
 
-fem::SuperElementFormat choose_format(const SuperElementCli& o) {
-  if (o.format == "auto") return fem::detect_format(o.k_file);
-  const auto f = fem::super_element_format_from_string(o.format);
-  if (!f) throw InputError("", "--format", "auto, ansys, calculix or matrix-market", "'" + o.format + "'");
-  return *f;
-}
-
-// Checks the command-line nodes against the element first, so that messages name the option.
-fem::ModelOptions model_options(const SuperElementCli& o, const fem::SuperElement& se) {
-  fem::ModelOptions m;
-  for (long node : o.fix) {
-    if (!se.has_node(node)) (void)se.index_of(node, fem::Direction::kX, "", "--fix");
-    m.fixed_nodes.push_back(node);
+// The command line as a super-element set-up; messages name the options.
+fem::SuperElementSetup setup_of(const SuperElementCli& o) {
+  fem::SuperElementSetup s;
+  if (o.format != "auto" && !fem::super_element_format_from_string(o.format)) {
+    throw InputError("", "--format", "auto, ansys, calculix or matrix-market", "'" + o.format + "'");
   }
+  s.format = o.format;
+  s.k_file = o.k_file;
+  s.m_file = o.m_file;
+  s.nodes_file = o.nodes_file;
+  s.coordinates_file = o.nlist_file;
+  s.fix_field = "--fix";
+  s.model.fixed_nodes = o.fix;
   for (const std::string& text : o.forces) {
-    const fem::ForcePair f = fem::ForcePair::parse(text, "--force");
-    if (f.node_a >= 0) (void)se.index_of(f.node_a, f.direction, "", "--force " + text);
-    (void)se.index_of(f.node_b, f.direction, "", "--force " + text);
-    m.forces.push_back(f);
+    s.model.forces.push_back(fem::ForcePair::parse(text, "--force"));
+    s.force_fields.push_back("--force " + text);
   }
   for (const std::string& text : o.outputs) {
-    const fem::DisplacementOutput out = fem::DisplacementOutput::parse(text, "--output");
-    if (out.node_a >= 0) (void)se.index_of(out.node_a, out.direction, "", "--output " + text);
-    (void)se.index_of(out.node_b, out.direction, "", "--output " + text);
-    m.outputs.push_back(out);
+    s.model.outputs.push_back(fem::DisplacementOutput::parse(text, "--output"));
+    s.output_fields.push_back("--output " + text);
   }
   for (const std::string& text : o.masses) {
-    const fem::PointMass pm = fem::PointMass::parse(text, "--mass");
-    (void)se.index_of(pm.node, fem::Direction::kX, "", "--mass " + text);
-    m.masses.push_back(pm);
+    s.model.masses.push_back(fem::PointMass::parse(text, "--mass"));
+    s.mass_fields.push_back("--mass " + text);
   }
-  m.damping = fem::Damping::parse(o.damping, "--damping");
-  return m;
+  s.model.damping = fem::Damping::parse(o.damping, "--damping");
+  return s;
 }
 
 int run_superelement(const SuperElementCli& o) {
@@ -77,11 +72,12 @@ int run_superelement(const SuperElementCli& o) {
   if (!(std::isfinite(o.fmax) && o.fmax > o.fmin)) {
     throw InputError("", "--fmax", fmt::format("a frequency > --fmin ({} Hz)", o.fmin), fmt::format("{}", o.fmax));
   }
-  const fem::SuperElementFormat format = choose_format(o);
+  const fem::SuperElementSetup setup = setup_of(o);
+  const fem::SuperElementFormat format = setup.resolved_format();
   if (!o.json) log_line("reading the super element (" + fem::to_string(format) + ")");
-  const fem::SuperElement se = fem::read_super_element(format, o.k_file, o.m_file, o.nodes_file, o.nlist_file);
+  const fem::SuperElement se = setup.load();
   for (const std::string& w : se.warnings) log_line("warning: " + w);
-  const fem::ModelOptions options = model_options(o, se);
+  const fem::ModelOptions& options = setup.model;
   const fem::StructuralModel model = fem::assemble(se, options);
   const fem::Modes modes = fem::modes(model);
 
@@ -148,12 +144,14 @@ int run_superelement(const SuperElementCli& o) {
 
 struct FromStepCli {
   std::string step_file;
-  std::string preset = "apa95ml";
+  std::string preset = "auto";
   double mesh_size = 4.0;
   int order = 2;
   int modes = 30;
   int clamped_modes = 10;
-  std::vector<std::string> regions, materials, remote_points;
+  std::vector<std::string> regions, materials, remote_points, joints, stacks, geo_parameters;
+  double max_memory = 0.0, tool_timeout = 3600.0;
+  std::string axial;
   std::string clamp;
   bool verify = false, keep_temp = false, json = false;
   std::string out = "superelement-from-step";
@@ -164,12 +162,21 @@ struct FromStepCli {
 
 fem::FromStepOptions from_step_options(const FromStepCli& c) {
   fem::FromStepOptions o;
-  if (c.preset == "apa95ml") {
+  std::string preset = c.preset;
+  if (preset == "auto") {
+    const std::string ext = std::filesystem::path(c.step_file).extension().string();
+    preset = ext == ".geo" || ext == ".GEO" ? "apa300ml" : "apa95ml";
+  }
+  if (preset == "apa95ml") {
     o = fem::FromStepOptions::apa95ml();
-  } else if (c.preset == "none") {
+  } else if (preset == "apa95ml-beam") {
+    o = fem::FromStepOptions::apa95ml_beam();
+  } else if (preset == "apa300ml") {
+    o = fem::FromStepOptions::apa300ml();
+  } else if (preset == "none") {
     o.materials["body"] = fem::FromStepOptions::apa95ml().materials.at("body");
   } else {
-    throw InputError("", "--preset", "apa95ml or none", "'" + c.preset + "'");
+    throw InputError("", "--preset", "auto, apa95ml, apa95ml-beam, apa300ml or none", "'" + c.preset + "'");
   }
   if (!c.regions.empty()) {
     o.regions.clear();
@@ -192,6 +199,25 @@ fem::FromStepOptions from_step_options(const FromStepCli& c) {
     o.remote_points.clear();
     for (const std::string& t : c.remote_points) o.remote_points.push_back(fem::RemotePointSpec::parse(t, "--remote-point"));
   }
+  if (!c.remote_points.empty() || !c.joints.empty()) o.joints.clear();
+  for (const std::string& t : c.joints) o.joints.push_back(fem::JointSpec::parse(t, "--joint"));
+  if (!c.remote_points.empty() || !c.joints.empty() || !c.stacks.empty()) o.stacks.clear();
+  for (const std::string& t : c.stacks) o.stacks.push_back(fem::StackSpec::parse(t, "--stack"));
+  for (const std::string& t : c.geo_parameters) {
+    const auto eq = t.find('=');
+    if (eq == std::string::npos || eq == 0) throw InputError("", "--geo-parameter", "NAME=VALUE (a DefineConstant of the .geo)", "'" + t + "'");
+    const std::vector<double> v = parse_number_list(t.substr(eq + 1), "--geo-parameter " + t.substr(0, eq));
+    if (v.size() != 1) throw InputError("", "--geo-parameter", "NAME=VALUE (one number)", "'" + t + "'");
+    o.geo_parameters[t.substr(0, eq)] = v.front();
+  }
+  if (!c.axial.empty()) {
+    o.axial = c.axial == "none" ? "" : c.axial;
+  } else if (std::none_of(o.remote_points.begin(), o.remote_points.end(),
+                          [&](const fem::RemotePointSpec& p) { return o.axial.rfind(p.name + ":", 0) == 0; })) {
+    o.axial.clear();  // the preset's remote point is gone
+  }
+  o.max_memory_GB = c.max_memory;
+  o.tool_timeout_s = c.tool_timeout;
   if (!c.clamp.empty()) {
     o.clamp = c.clamp;
   } else if (std::none_of(o.remote_points.begin(), o.remote_points.end(),
@@ -234,6 +260,18 @@ nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& 
   for (const fem::RegionSpec& reg : o.regions) {
     regions[reg.name] = {{"box_mm", {reg.box.lo.x(), reg.box.lo.y(), reg.box.lo.z(), reg.box.hi.x(), reg.box.hi.y(), reg.box.hi.z()}}};
   }
+  nlohmann::json joints = nlohmann::json::array();
+  for (const fem::JointResult& j : r.joints) {
+    joints.push_back({{"name", j.name}, {"node", j.node}, {"position_m", {j.position_m.x(), j.position_m.y(), j.position_m.z()}}});
+  }
+  nlohmann::json stacks = nlohmann::json::array();
+  for (const fem::StackResult& st : r.stacks) {
+    stacks.push_back({{"from", st.from}, {"to", st.to}, {"node_a", st.node_a}, {"node_b", st.node_b}, {"length_m", st.length_m},
+                      {"axial_stiffness_N_per_m", st.axial_stiffness}, {"mass_kg", st.mass}});
+  }
+  const fem::MeshEstimate& e = r.estimate;
+  const nlohmann::json estimate = {{"volume_mm3", e.volume_mm3}, {"area_mm2", e.area_mm2}, {"elements", e.elements},
+                                   {"nodes", e.nodes}, {"dofs", e.dofs}, {"memory_GB", e.memory_GB}, {"seconds", e.seconds}};
   nlohmann::json seconds = nlohmann::json::object();
   for (const auto& [step, s] : r.seconds) seconds[step] = s;
   nlohmann::json files = nlohmann::json::array();
@@ -260,10 +298,14 @@ nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& 
         {"nodes", r.mesh_nodes},
         {"elements", r.mesh_elements},
         {"elements_per_region", r.region_elements},
-        {"model_dofs", r.model_dofs}}},
+        {"model_dofs", r.model_dofs},
+        {"estimate", estimate}}},
       {"regions", regions},
       {"materials", materials},
       {"remote_points", points},
+      {"joints", joints},
+      {"stacks", stacks},
+      {"geo_parameters", o.geo_parameters},
       {"reduction",
        {{"interface_dofs", r.reduction.interface_dofs},
         {"interior_dofs", r.reduction.interior_dofs},
@@ -276,6 +318,10 @@ nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& 
       {"usage", "piezobench superelement " + k_file + " " + m_file + " " + dof_file + " --fix " + std::to_string(clamp_node)},
       {"clamp", r.clamp},
       {"modes_clamped_Hz", io::to_json(r.modes_clamped_Hz)},
+      {"shell_modes_clamped_Hz", io::to_json(r.shell_modes_clamped_Hz)},
+      {"axial", o.axial},
+      {"axial_stiffness_N_per_m", r.axial_stiffness},
+      {"shell_axial_stiffness_N_per_m", r.shell_axial_stiffness},
       {"free_modes_Hz", io::to_json(r.free_modes_Hz)},
       {"seconds", seconds},
       {"files", files},
@@ -283,9 +329,10 @@ nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& 
       {"warnings", r.reduced.warnings}};
   if (r.reference_modes_Hz) {
     doc["reference_modes_Hz"] = io::to_json(*r.reference_modes_Hz);
-    const Index n = std::min(r.reference_modes_Hz->size(), r.modes_clamped_Hz.size());
+    // ccx's model has no stacks: compare with the reduced model before they are added.
+    const Index n = std::min(r.reference_modes_Hz->size(), r.shell_modes_clamped_Hz.size());
     Eigen::VectorXd rel(n);
-    for (Index i = 0; i < n; ++i) rel(i) = r.modes_clamped_Hz(i) / (*r.reference_modes_Hz)(i) - 1.0;
+    for (Index i = 0; i < n; ++i) rel(i) = r.shell_modes_clamped_Hz(i) / (*r.reference_modes_Hz)(i) - 1.0;
     doc["relative_difference"] = io::to_json(rel);
   }
   return doc;
@@ -314,7 +361,20 @@ int run_from_step(const FromStepCli& c) {
   fmt::print("modes with {} clamped [Hz]:", r.clamp);
   for (Index i = 0; i < r.modes_clamped_Hz.size(); ++i) fmt::print(" {:.6g}", r.modes_clamped_Hz(i));
   fmt::print("\n");
+  if (r.axial_stiffness > 0.0) {
+    fmt::print("static stiffness at {} ({} clamped): {:.4g} N/um with the stacks, {:.4g} N/um without\n", o.axial, r.clamp,
+               1e-6 * r.axial_stiffness, 1e-6 * r.shell_axial_stiffness);
+  }
+  for (const fem::StackResult& st : r.stacks) {
+    fmt::print("stack {} -> {}: beam of {:.4g} mm between nodes {} and {}, E A / L = {:.4g} N/um\n", st.from, st.to, 1e3 * st.length_m,
+               st.node_a, st.node_b, 1e-6 * st.axial_stiffness);
+  }
   if (r.reference_modes_Hz) {
+    if (!r.stacks.empty()) {
+      fmt::print("without the stacks    [Hz]:");
+      for (Index i = 0; i < r.shell_modes_clamped_Hz.size(); ++i) fmt::print(" {:.6g}", r.shell_modes_clamped_Hz(i));
+      fmt::print("\n");
+    }
     fmt::print("ccx on the full mesh  [Hz]:");
     for (Index i = 0; i < r.reference_modes_Hz->size(); ++i) fmt::print(" {:.6g}", (*r.reference_modes_Hz)(i));
     fmt::print("\n");
@@ -331,20 +391,35 @@ CLI::App* add_from_step_command(CLI::App& se, Action& action) {
       "Make a super element from a STEP file: gmsh meshes, ccx assembles (*FREQUENCY,SOLVER=MATRIXSTORAGE), piezobench "
       "reduces (Craig-Bampton) and writes it (Matrix Market + DOF list, Simscape script) into --out. Defaults: APA95ML.step "
       "(docs/from-step.md)");
-  fs->add_option("STEP_FILE", c->step_file, "the CAD geometry (STEP, mm)")->required();
+  fs->add_option("STEP_FILE", c->step_file, "the CAD geometry (STEP, mm), or a gmsh .geo script (OpenCASCADE, mm)")->required();
   fs->add_option("--mesh-size", c->mesh_size, "largest element size, mm")->capture_default_str();
   fs->add_option("--order", c->order, "element order: 2 (C3D10) or 1 (C3D4)")->capture_default_str();
   fs->add_option("--modes", c->modes, "fixed-interface modes kept")->capture_default_str();
   fs->add_option("--preset", c->preset,
-                 "apa95ml: region stack (PZT) in a steel body, remote points top, bottom, stack_a, stack_b; none: one steel "
-                 "body, remote points from --remote-point")
+                 "auto (apa300ml for a .geo input, else apa95ml); apa95ml: region stack (PZT) in a steel body, remote points "
+                 "top, bottom, stack_a, stack_b; apa95ml-beam: the block removed and the stack a beam as in the Ansys model; apa300ml: data/geometry/apa300ml.geo, remote points top, bottom, stack_a, "
+                 "stack_b, joint stack_mid and the three stacks as beams; none: one steel body, remote points from --remote-point")
       ->capture_default_str();
+  fs->add_option("--joint", c->joints,
+                 "NAME:FROM:TO:FRACTION: a 6-DOF node on the line FROM -> TO (remote points or joints), e.g. the junction "
+                 "between stacks (repeatable; replaces the preset's)");
+  fs->add_option("--stack", c->stacks,
+                 "FROM:TO[:E,nu,rho,AREA]: a stack as a beam between two remote points or joints, added to the reduced model "
+                 "(default section: Table 4.1, 48e9,0.31,7800,1e-4; repeatable; replaces the preset's)");
+  fs->add_option("--geo-parameter", c->geo_parameters, "NAME=VALUE: a DefineConstant of a .geo input (mm), repeatable");
+  fs->add_option("--max-memory", c->max_memory,
+                 "refuse meshes whose estimated peak memory exceeds this, GB (0: half the memory, at most 8 GB)")
+      ->capture_default_str();
+  fs->add_option("--axial", c->axial,
+                 "REMOTE_POINT:DIR whose static stiffness (--clamp fixed) is reported, with and without the stacks (presets: "
+                 "top:y; none: no stiffness)");
+  fs->add_option("--tool-timeout", c->tool_timeout, "stop gmsh or ccx after this many seconds (each run)")->capture_default_str();
   fs->add_option("--region", c->regions,
                  "NAME:box:x0,y0,z0,x1,y1,z1 (mm): cut this box out of the bodies as its own material region (repeatable; "
                  "replaces the preset's regions)");
   fs->add_option("--material", c->materials,
-                 "REGION:E,nu,rho (Pa, -, kg/m^3) for body (the rest) or a region (repeatable). Preset: body 190e9,0.3,7800 "
-                 "(steel), stack 48e9,0.31,7800 (PZT)");
+                 "REGION:E,nu,rho (Pa, -, kg/m^3) for body (the rest) or a region, or REGION:none to remove the region "
+                 "(repeatable). Preset apa95ml: body 190e9,0.3,7800 (steel), stack 48e9,0.31,7800 (PZT)");
   fs->add_option("--remote-point", c->remote_points,
                  "NAME:SELECTOR with SELECTOR x|y|z=min|max|MM (planar faces in that plane), box:x0,y0,z0,x1,y1,z1 (faces "
                  "inside, mm) or surface:TAG[,TAG] (gmsh tags, see geometry.txt); repeatable, replaces the preset's");

@@ -88,37 +88,33 @@ class Keys {
 
 }  // namespace
 
-SuperElementSpec read_superelement_spec(const std::filesystem::path& file) {
+SuperElementBench read_superelement_spec(const std::filesystem::path& file) {
   const std::string source = file.string();
   const toml::table table = io::read_toml_file(file);
   Keys keys(table, source);
-  SuperElementSpec s;
+  SuperElementBench s;
   s.file = file;
+  fem::SuperElementSetup& setup = s.setup;
+  setup.source = source;
   const std::filesystem::path dir = file.parent_path();
   const auto resolve = [&](const std::string& p) -> std::filesystem::path {
     if (p.empty()) return {};
     const std::filesystem::path path(p);
     return path.is_absolute() ? path : dir / path;
   };
-  s.k_file = resolve(keys.string("k_file", true));
-  s.m_file = resolve(keys.string("m_file", true));
-  s.nodes_file = resolve(keys.string("nodes_file", true));
-  s.coordinates_file = resolve(keys.string("coordinates_file", false));
-  const std::string format = keys.string("format", false, "auto");
-  if (format == "auto") {
-    s.format = fem::detect_format(s.k_file);
-  } else if (const auto f = fem::super_element_format_from_string(format)) {
-    s.format = *f;
-  } else {
-    throw InputError(source, "format", "auto, ansys, calculix or matrix-market", "'" + format + "'");
-  }
-  for (const auto& [key, path] : {std::pair{"k_file", s.k_file}, {"m_file", s.m_file}, {"nodes_file", s.nodes_file}}) {
+  setup.k_file = resolve(keys.string("k_file", true));
+  setup.m_file = resolve(keys.string("m_file", true));
+  setup.nodes_file = resolve(keys.string("nodes_file", true));
+  setup.coordinates_file = resolve(keys.string("coordinates_file", false));
+  setup.format = keys.string("format", false, "auto");
+  for (const auto& [key, path] : {std::pair{"k_file", setup.k_file}, {"m_file", setup.m_file}, {"nodes_file", setup.nodes_file}}) {
     if (!std::filesystem::is_regular_file(path)) throw InputError(source, key, "an existing file", "'" + path.string() + "'");
   }
-  if (!s.coordinates_file.empty() && !std::filesystem::is_regular_file(s.coordinates_file)) {
-    throw InputError(source, "coordinates_file", "an existing file", "'" + s.coordinates_file.string() + "'");
+  (void)setup.resolved_format();  // an unknown format name is refused here, naming the key
+  if (!setup.coordinates_file.empty() && !std::filesystem::is_regular_file(setup.coordinates_file)) {
+    throw InputError(source, "coordinates_file", "an existing file", "'" + setup.coordinates_file.string() + "'");
   }
-  s.fix = keys.nodes("fix");
+  setup.model.fixed_nodes = keys.nodes("fix");
   const auto sourced = [&](auto parse) {
     try {
       return parse();
@@ -127,15 +123,19 @@ SuperElementSpec read_superelement_spec(const std::filesystem::path& file) {
     }
   };
   const std::string actuator = keys.string("actuator", true);
-  s.actuator = sourced([&] { return fem::ForcePair::parse(actuator, "actuator"); });
-  if (s.actuator.node_a < 0) throw InputError(source, "actuator", "a force pair A:B:DIR", "a single node");
+  const fem::ForcePair act = sourced([&] { return fem::ForcePair::parse(actuator, "actuator"); });
+  if (act.node_a < 0) throw InputError(source, "actuator", "a force pair A:B:DIR", "a single node");
   const std::string sensor = keys.string("sensor", true);
-  s.sensor = sourced([&] { return fem::DisplacementOutput::parse(sensor, "sensor"); });
-  if (s.sensor.node_a < 0) throw InputError(source, "sensor", "a node pair A:B:DIR", "a single node");
+  const fem::DisplacementOutput sen = sourced([&] { return fem::DisplacementOutput::parse(sensor, "sensor"); });
+  if (sen.node_a < 0) throw InputError(source, "sensor", "a node pair A:B:DIR", "a single node");
   const std::string output = keys.string("output", true);
-  s.output = sourced([&] { return fem::DisplacementOutput::parse(output, "output"); });
-  if (s.output.node_a >= 0) throw InputError(source, "output", "one node NODE:DIR (the moving interface)", "a node pair");
-  if (fem::is_rotation(s.output.direction)) throw InputError(source, "output", "a translation (x, y or z)", "a rotation");
+  const fem::DisplacementOutput out = sourced([&] { return fem::DisplacementOutput::parse(output, "output"); });
+  if (out.node_a >= 0) throw InputError(source, "output", "one node NODE:DIR (the moving interface)", "a node pair");
+  if (fem::is_rotation(out.direction)) throw InputError(source, "output", "a translation (x, y or z)", "a rotation");
+  setup.model.forces = {act};
+  setup.model.outputs = {out, sen};
+  setup.force_fields = {"actuator"};
+  setup.output_fields = {"output", "sensor"};
   s.ga = keys.number("ga", s.ga);
   s.gs = keys.number("gs", s.gs);
   if (s.ga == 0.0) throw InputError(source, "ga", "a nonzero actuator sensitivity (N/V)", "0");
@@ -148,8 +148,8 @@ SuperElementSpec read_superelement_spec(const std::filesystem::path& file) {
   if (!(s.max_mode_Hz > 0.0)) throw InputError(source, "max_mode_Hz", "a frequency > 0 Hz", fmt::format("{:g}", s.max_mode_Hz));
   s.guided = keys.boolean("guided", s.guided);
   keys.check_unknown();
-  for (long n : s.fix) {
-    if (n == s.output.node_b) throw InputError(source, "fix", "nodes other than the output node", std::to_string(n));
+  for (long n : setup.model.fixed_nodes) {
+    if (n == out.node_b) throw InputError(source, "fix", "nodes other than the output node", std::to_string(n));
   }
   return s;
 }
@@ -157,70 +157,23 @@ SuperElementSpec read_superelement_spec(const std::filesystem::path& file) {
 SuperElementMechanics load_superelement(const std::filesystem::path& file) {
   SuperElementMechanics m;
   m.spec = read_superelement_spec(file);
-  const SuperElementSpec& s = m.spec;
-  try {
-    m.se = fem::read_super_element(s.format, s.k_file, s.m_file, s.nodes_file, s.coordinates_file);
-    const std::string source = s.file.string();
-    for (long n : s.fix) {
-      if (!m.se.has_node(n)) (void)m.se.index_of(n, fem::Direction::kX, source, "fix");
-    }
-    (void)m.se.index_of(s.actuator.node_a, s.actuator.direction, source, "actuator");
-    (void)m.se.index_of(s.actuator.node_b, s.actuator.direction, source, "actuator");
-    (void)m.se.index_of(s.sensor.node_a, s.sensor.direction, source, "sensor");
-    (void)m.se.index_of(s.sensor.node_b, s.sensor.direction, source, "sensor");
-    (void)m.se.index_of(s.output.node_b, s.output.direction, source, "output");
-  } catch (const InputError& e) {
-    if (e.source().empty()) throw e.with_source(s.file.string());
-    throw;
-  }
+  m.se = m.spec.setup.load();
   return m;
 }
 
 fem::StructuralModel bench_structure(const SuperElementMechanics& mech, double moving_mass) {
-  const SuperElementSpec& s = mech.spec;
-  fem::ModelOptions o;
-  o.fixed_nodes = s.fix;
-  o.masses.push_back({s.output.node_b, moving_mass, 0.0});
-  o.forces.push_back(s.actuator);
-  o.forces.push_back({-1, s.output.node_b, s.output.direction});
-  o.outputs.push_back(s.output);
-  o.outputs.push_back(s.sensor);
-  fem::StructuralModel model = fem::assemble(mech.se, o);
-  if (!s.guided) return model;
-  // The air bearing: the mass node keeps only its translation along the output direction.
-  std::vector<fem::Index> keep;
-  for (std::size_t i = 0; i < model.free_dofs.size(); ++i) {
-    const fem::DofLabel& d = mech.se.dofs[static_cast<std::size_t>(model.free_dofs[i])];
-    if (!d.is_modal() && d.node == s.output.node_b && d.direction != s.output.direction) continue;
-    keep.push_back(static_cast<fem::Index>(i));
-  }
-  fem::StructuralModel g;
-  const auto f = static_cast<fem::Index>(keep.size());
-  g.K.resize(f, f);
-  g.M.resize(f, f);
-  g.C.resize(f, f);
-  g.F.resize(f, model.F.cols());
-  g.T.resize(model.T.rows(), f);
-  for (fem::Index j = 0; j < f; ++j) {
-    const fem::Index jj = keep[static_cast<std::size_t>(j)];
-    for (fem::Index i = 0; i < f; ++i) {
-      const fem::Index ii = keep[static_cast<std::size_t>(i)];
-      g.K(i, j) = model.K(ii, jj);
-      g.M(i, j) = model.M(ii, jj);
-      g.C(i, j) = model.C(ii, jj);
-    }
-    g.F.row(j) = model.F.row(jj);
-    g.T.col(j) = model.T.col(jj);
-    g.free_dofs.push_back(model.free_dofs[static_cast<std::size_t>(jj)]);
-  }
-  g.input_names = model.input_names;
-  g.output_names = model.output_names;
-  return g;
+  const SuperElementBench& s = mech.spec;
+  const fem::DisplacementOutput& out = s.output();
+  fem::ModelOptions o = s.setup.model;  // inputs [actuator], outputs [d_e, sensor]
+  o.masses.push_back({out.node_b, moving_mass, 0.0});
+  o.forces.push_back({-1, out.node_b, out.direction});
+  if (s.guided) o.guided.push_back({out.node_b, out.direction});  // the air bearing
+  return fem::assemble(mech.se, o);
 }
 
 ContinuousPlant superelement_plant(const SuperElementMechanics& mech, double moving_mass, double ga_factor,
                                    const Electrics& e, SuperElementPlantInfo* info) {
-  const SuperElementSpec& s = mech.spec;
+  const SuperElementBench& s = mech.spec;
   const std::string source = s.file.string();
   const fem::StructuralModel model = bench_structure(mech, moving_mass);
   const fem::Modes modes = fem::modes(model);

@@ -10,29 +10,30 @@
 #include "bench/plant.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
+#include "piezobench/fem/superelement_setup.hpp"
 
 namespace piezobench::bench::detail {
 
-struct SuperElementSpec {
-  std::filesystem::path file;  // the TOML file
-  fem::SuperElementFormat format = fem::SuperElementFormat::kAnsysText;
-  std::filesystem::path k_file, m_file, nodes_file, coordinates_file;
-  std::vector<long> fix;
-  fem::ForcePair actuator;
-  fem::DisplacementOutput sensor;
-  fem::DisplacementOutput output;  // absolute: node_a < 0
+// The bench's super element: the set-up (fixed nodes; forces [actuator pair]; outputs [the moving
+// interface (absolute), the sensor stack (relative)]) and the bench's constants.
+struct SuperElementBench {
+  std::filesystem::path file;      // the TOML file
+  fem::SuperElementSetup setup;
   double ga = 23.2;                // N/V
   double gs = 4.9e6;               // V/m
   double modal_damping = 0.01;
   double max_mode_Hz = 20000.0;
   bool guided = true;
+  [[nodiscard]] const fem::ForcePair& actuator() const { return setup.model.forces.at(0); }
+  [[nodiscard]] const fem::DisplacementOutput& output() const { return setup.model.outputs.at(0); }
+  [[nodiscard]] const fem::DisplacementOutput& sensor() const { return setup.model.outputs.at(1); }
 };
 
 // Reads and checks the TOML (InputError naming the file and the key). Does not read the matrices.
-SuperElementSpec read_superelement_spec(const std::filesystem::path& file);
+SuperElementBench read_superelement_spec(const std::filesystem::path& file);
 
 struct SuperElementMechanics {
-  SuperElementSpec spec;
+  SuperElementBench spec;
   fem::SuperElement se;
 };
 // Reads the TOML and the super element it names; checks the nodes against the element.

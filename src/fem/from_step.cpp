@@ -8,11 +8,13 @@
 #include <cstdlib>
 #include <set>
 #include <system_error>
+#include <unistd.h>
 
 #include "fem/from_step_files.hpp"
 #include "fem/from_step_process.hpp"
 #include "fem/text.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/fem/matrix_io.hpp"
 #include "piezobench/fem/structural_model.hpp"
 
@@ -80,7 +82,11 @@ class WorkFolder {
 
 class Runner {
  public:
-  explicit Runner(const FromStepOptions& o) : o_(o) {}
+  explicit Runner(const FromStepOptions& o) : o_(o) {
+    const double gb = o.max_memory_GB > 0.0 ? o.max_memory_GB : default_max_memory_GB();
+    limits_.seconds = o.tool_timeout_s;
+    limits_.address_space_bytes = (2.0 * gb + 1.0) * 1e9;
+  }
 
   void log(const std::string& line) const {
     if (o_.log) o_.log(line);
@@ -124,11 +130,19 @@ class Runner {
     const auto forward = [&](std::string_view line) {
       if (keep(line)) log_line_of(label, line);
     };
+    detail::ProcessResult pr;
     try {
-      return detail::run_process(tool.path, args, cwd, log, forward);
+      pr = detail::run_process(tool.path, args, cwd, log, forward, limits_);
     } catch (const std::system_error& e) {
       throw InputError(tool.path, "executable", "a program that can be started", e.what());
     }
+    if (pr.timed_out) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%g s", limits_.seconds);
+      throw NumericalError(label, std::string("did not finish within ") + buf + " and was stopped (--tool-timeout; log: " + log.string() + ")",
+                           true);
+    }
+    return pr;
   }
 
   void log_line_of(const std::string& label, std::string_view line) const {
@@ -139,6 +153,7 @@ class Runner {
 
  private:
   const FromStepOptions& o_;
+  detail::ProcessLimits limits_;
 };
 
 // gmsh's stages (not its per-curve and per-surface lines), errors and the final count.
@@ -271,12 +286,97 @@ RegionSpec RegionSpec::parse(const std::string& text, const std::string& field) 
 }
 
 Material Material::parse(const std::string& text, const std::string& field) {
-  const std::string form = "E,nu,rho (Pa, -, kg/m^3), e.g. 190e9,0.3,7800";
+  const std::string form = "E,nu,rho (Pa, -, kg/m^3), e.g. 190e9,0.3,7800, or none (the region is removed)";
+  if (detail::lower(std::string(detail::trim(text))) == "none") {
+    Material m;
+    m.removed = true;
+    return m;
+  }
   const auto v = parse_numbers(text, 3, field, form, text);
   if (!(v[0] > 0.0) || !(v[1] > -1.0 && v[1] < 0.5) || !(v[2] > 0.0)) {
     throw InputError("", field, "E > 0, -1 < nu < 0.5, rho > 0", "'" + text + "'");
   }
   return {v[0], v[1], v[2]};
+}
+
+JointSpec JointSpec::parse(const std::string& text, const std::string& field) {
+  const std::string form = "NAME:FROM:TO:FRACTION (FROM, TO: remote points or joints; 0 < FRACTION < 1)";
+  const auto parts = split(text, ':');
+  if (parts.size() != 4) throw InputError("", field, form, "'" + text + "'");
+  JointSpec j;
+  j.name = std::string(detail::trim(parts[0]));
+  j.from = std::string(detail::trim(parts[1]));
+  j.to = std::string(detail::trim(parts[2]));
+  const auto f = detail::parse_double(detail::trim(parts[3]));
+  if (!detail::is_valid_name(j.name) || !detail::is_valid_name(j.from) || !detail::is_valid_name(j.to) || !f || !(*f > 0.0 && *f < 1.0)) {
+    throw InputError("", field, form, "'" + text + "'");
+  }
+  j.fraction = *f;
+  return j;
+}
+
+StackSpec StackSpec::parse(const std::string& text, const std::string& field) {
+  const std::string form = "FROM:TO or FROM:TO:E,nu,rho,AREA (remote points or joints; SI units)";
+  const auto parts = split(text, ':');
+  if (parts.size() != 2 && parts.size() != 3) throw InputError("", field, form, "'" + text + "'");
+  StackSpec st;
+  st.from = std::string(detail::trim(parts[0]));
+  st.to = std::string(detail::trim(parts[1]));
+  if (!detail::is_valid_name(st.from) || !detail::is_valid_name(st.to)) throw InputError("", field, form, "'" + text + "'");
+  if (parts.size() == 3) st.section = BeamSection::parse(std::string(parts[2]), field);
+  return st;
+}
+
+std::string MeshEstimate::to_string() const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "about %.2g elements, %.2g nodes, %.2g DOF, %.3g GB of memory and %.2g s (geometry: %.4g mm^3, %.4g mm^2)",
+                elements, nodes, dofs, memory_GB, seconds, volume_mm3, area_mm2);
+  return buf;
+}
+
+MeshEstimate estimate_mesh(double volume_mm3, double area_mm2, double mesh_size_mm, int element_order) {
+  MeshEstimate e;
+  e.volume_mm3 = volume_mm3;
+  e.area_mm2 = area_mm2;
+  const double h = mesh_size_mm;
+  e.elements = 3.0 * volume_mm3 / (h * h * h) + 4.0 * area_mm2 / (h * h);
+  e.nodes = (element_order == 2 ? 1.65 : 0.3) * e.elements;
+  e.dofs = 3.0 * e.nodes;
+  const double scale = e.dofs / 144000.0;  // the 2 mm APA95ML run (docs/performance.md)
+  e.memory_GB = 0.2 + 1.3 * std::pow(scale, 1.2);
+  e.seconds = 5.0 + 60.0 * std::pow(scale, 1.2);
+  return e;
+}
+
+double default_max_memory_GB() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  const double total = pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) / 1e9 : 8.0;
+  return std::min(8.0, 0.5 * total);
+}
+
+FromStepOptions FromStepOptions::apa300ml() {
+  FromStepOptions o;
+  o.materials["body"] = {200e9, 0.3, 7850.0};
+  o.remote_points = {RemotePointSpec::parse("top:y=max", "default"), RemotePointSpec::parse("bottom:y=min", "default"),
+                     RemotePointSpec::parse("stack_a:x=-30", "default"), RemotePointSpec::parse("stack_b:x=30", "default")};
+  o.joints = {JointSpec::parse("stack_mid:stack_a:stack_b:0.6666666666666666", "default")};
+  o.stacks = {StackSpec::parse("stack_a:stack_mid", "default"), StackSpec::parse("stack_mid:stack_b", "default")};
+  o.clamp = "bottom";
+  o.axial = "top:y";
+  return o;
+}
+
+FromStepOptions FromStepOptions::apa95ml_beam() {
+  FromStepOptions o = apa95ml();
+  o.materials["stack"].removed = true;
+  o.remote_points = {RemotePointSpec::parse("top:y=max", "default"), RemotePointSpec::parse("bottom:y=min", "default"),
+                     RemotePointSpec::parse("stack_a:box:-34.8,-10.01,-11.26,-28.7,10.01,11.26", "default"),
+                     RemotePointSpec::parse("stack_b:box:28.7,-10.01,-11.26,34.8,10.01,11.26", "default")};
+  o.joints = {JointSpec::parse("j1:stack_a:stack_b:0.25", "default"), JointSpec::parse("j2:stack_a:stack_b:0.5", "default"),
+              JointSpec::parse("j3:stack_a:stack_b:0.75", "default")};
+  const BeamSection ansys{48e9, 0.31, 16840.0, 5.235e-5};
+  for (const auto& [a, b] : {std::pair{"stack_a", "j1"}, {"j1", "j2"}, {"j2", "j3"}, {"j3", "stack_b"}}) o.stacks.push_back({a, b, ansys});
+  return o;
 }
 
 FromStepOptions FromStepOptions::apa95ml() {
@@ -292,6 +392,7 @@ FromStepOptions FromStepOptions::apa95ml() {
                      RemotePointSpec::parse("stack_a:x=-34.7793", "default"),
                      RemotePointSpec::parse("stack_b:x=34.7793", "default")};
   o.clamp = "bottom";
+  o.axial = "top:y";
   return o;
 }
 
@@ -329,11 +430,52 @@ void FromStepOptions::validate() const {
     if (materials.count(r.name) == 0) throw InputError(src, "--material", "a material for the region " + r.name, "none");
   }
   if (materials.count("body") == 0) throw InputError(src, "--material", "a material for 'body' (the rest of the model)", "none");
+  if (materials.at("body").removed) throw InputError(src, "--material body", "a material (only regions can be removed)", "none");
+  std::set<std::string> nodes = names;
+  for (const JointSpec& j : joints) {
+    if (!detail::is_valid_name(j.name) || !(j.fraction > 0.0 && j.fraction < 1.0)) {
+      throw InputError(src, "--joint " + j.name, "a name of letters, digits and _ and 0 < FRACTION < 1", "out of range");
+    }
+    for (const std::string& end : {j.from, j.to}) {
+      if (nodes.count(detail::upper(end)) == 0) {
+        throw InputError(src, "--joint " + j.name, "ends that are remote points or joints given before", "'" + end + "'");
+      }
+    }
+    if (!nodes.insert(detail::upper(j.name)).second) throw InputError(src, "--joint", "a name no remote point or joint has", j.name);
+  }
+  for (const StackSpec& st : stacks) {
+    const std::string field = "--stack " + st.from + ":" + st.to;
+    for (const std::string& end : {st.from, st.to}) {
+      if (nodes.count(detail::upper(end)) == 0) throw InputError(src, field, "ends that are remote points or joints", "'" + end + "'");
+    }
+    if (detail::upper(st.from) == detail::upper(st.to)) throw InputError(src, field, "two different ends", "the same twice");
+    const BeamSection& b = st.section;
+    if (!(b.youngs_modulus > 0.0) || !(b.poisson_ratio > -1.0 && b.poisson_ratio < 0.5) || !(b.density > 0.0) || !(b.area > 0.0)) {
+      throw InputError(src, field, "E > 0, -1 < nu < 0.5, rho > 0, AREA > 0", "out of range");
+    }
+  }
+  if (!axial.empty()) {
+    const auto colon = axial.find(':');
+    std::optional<Direction> dir;
+    if (colon != std::string::npos) dir = direction_from_string(axial.substr(colon + 1));
+    if (!dir || is_rotation(*dir) || names.count(detail::upper(axial.substr(0, colon))) == 0) {
+      throw InputError(src, "--axial", "REMOTE_POINT:x|y|z (a remote point and a translation)", "'" + axial + "'");
+    }
+  }
+  for (const auto& [name, value] : geo_parameters) {
+    if (!detail::is_valid_name(name) || !std::isfinite(value)) throw InputError(src, "--geo-parameter", "NAME=VALUE (a finite number)", "'" + name + "'");
+  }
+  if (!(std::isfinite(max_memory_GB) && max_memory_GB >= 0.0)) {
+    throw InputError(src, "--max-memory", "a memory limit >= 0 GB (0: automatic)", detail::g17(max_memory_GB));
+  }
+  if (!(std::isfinite(tool_timeout_s) && tool_timeout_s > 0.0)) {
+    throw InputError(src, "--tool-timeout", "a time limit > 0 s", detail::g17(tool_timeout_s));
+  }
   for (const auto& [name, m] : materials) {
     if (region_names.count(detail::upper(name)) == 0) {
       throw InputError(src, "--material", "a material for 'body' or a region given with --region", "'" + name + "'");
     }
-    if (!(m.youngs_modulus > 0.0) || !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) || !(m.density > 0.0)) {
+    if (!m.removed && (!(m.youngs_modulus > 0.0) || !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) || !(m.density > 0.0))) {
       throw InputError(src, "--material " + name, "E > 0, -1 < nu < 0.5, rho > 0", "out of range");
     }
   }
@@ -362,7 +504,29 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
   r.gmsh = run.check_tool(o.gmsh, "gmsh", "--version", kMinGmsh, "gmsh", w);
   r.ccx = run.check_tool(o.ccx, "ccx", "-v", kMinCcx, "calculix-ccx", w);
   run.log("gmsh " + r.gmsh.version + " (" + r.gmsh.path + "), ccx " + r.ccx.version + " (" + r.ccx.path + ")");
-  copy_into(step_file, w / "model.step");
+  if (detail::lower(step_file.extension().string()) == ".geo") {
+    // A gmsh script (e.g. apa300ml.geo): exported to STEP with its parameters, then as any STEP file.
+    copy_into(step_file, w / "model.geo");
+    std::vector<std::string> args = {"-0", "model.geo"};
+    std::string text;
+    for (const auto& [name, value] : o.geo_parameters) {
+      args.insert(args.end(), {"-setnumber", name, detail::g17(value)});
+      text += " " + name + "=" + detail::g17(value);
+    }
+    args.insert(args.end(), {"-o", "model.step"});
+    run.log("[0/6] exporting the gmsh script to STEP:" + (text.empty() ? std::string(" default parameters") : text));
+    const fs::path export_log = o.out / "gmsh_export.log";
+    const auto e_run = run.run(r.gmsh, "gmsh", args, w, export_log, [](std::string_view l) { return l.find("Error") != std::string_view::npos; });
+    step_done("gmsh export", e_run.seconds);
+    if (e_run.exit_code != 0 || !fs::exists(w / "model.step")) {
+      throw InputError(step_file.string(), "geo", "a gmsh script that gmsh exports to STEP",
+                       "exit code " + std::to_string(e_run.exit_code) + ": " + detail::last_lines(detail::read_file(export_log), "rror", 3) +
+                           " (log: " + export_log.string() + ")");
+    }
+  } else {
+    if (!o.geo_parameters.empty()) throw InputError(step_file.string(), "--geo-parameter", "a .geo input (gmsh script)", "a STEP file");
+    copy_into(step_file, w / "model.step");
+  }
 
   // 1. The geometry: volumes and faces with their bounding boxes.
   run.log("[1/6] reading the geometry (gmsh, OpenCASCADE): " + step_file.string());
@@ -392,11 +556,40 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
                      "no volume" + (errors.empty() ? std::string() : " (" + errors + ")"));
   }
   copy_into(w / "geometry.txt", o.out / "geometry.txt");
-  const auto region_volumes = detail::assign_regions(geometry, o.regions, o.geometry_tolerance_mm);
+  auto region_volumes = detail::assign_regions(geometry, o.regions, o.geometry_tolerance_mm);
   {
     std::string msg = "  " + std::to_string(geometry.volumes.size()) + " volume(s), " + std::to_string(geometry.surfaces.size()) + " faces;";
-    for (const auto& [name, vols] : region_volumes) msg += " " + name + ": " + std::to_string(vols.size()) + " volume(s);";
+    for (const auto& [name, vols] : region_volumes) {
+      msg += " " + name + ": " + std::to_string(vols.size()) + " volume(s)" + (o.materials.at(name).removed ? " (removed)" : "") + ";";
+    }
     run.log(msg + " " + elapsed(g_run.seconds));
+  }
+  for (auto it = region_volumes.begin(); it != region_volumes.end();) {
+    it = o.materials.at(it->first).removed ? region_volumes.erase(it) : std::next(it);
+  }
+
+  // What the mesh would cost, before gmsh starts on it.
+  r.estimate = estimate_mesh(geometry.volume_mm3, geometry.area_mm2, o.mesh_size_mm, o.element_order);
+  {
+    const double limit = o.max_memory_GB > 0.0 ? o.max_memory_GB : default_max_memory_GB();
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "  estimate at %g mm: ", o.mesh_size_mm);
+    run.log(buf + r.estimate.to_string() + "; memory limit " + detail::g17(limit) + " GB");
+    if (r.estimate.memory_GB > limit) {
+      // The smallest mesh size within the limit (the estimate falls as h grows).
+      double lo = o.mesh_size_mm, hi = std::max(1.0, o.mesh_size_mm);
+      while (estimate_mesh(geometry.volume_mm3, geometry.area_mm2, hi, o.element_order).memory_GB > limit && hi < 1e6) hi *= 2.0;
+      for (int k = 0; k < 60; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (estimate_mesh(geometry.volume_mm3, geometry.area_mm2, mid, o.element_order).memory_GB > limit ? lo : hi) = mid;
+      }
+      char hint[64];
+      std::snprintf(hint, sizeof hint, "%.2g", hi * 1.05);
+      std::snprintf(buf, sizeof buf, "--mesh-size %g mm: ", o.mesh_size_mm);
+      throw UsageError("superelement from-step: " + std::string(buf) + r.estimate.to_string() + ", more than the limit of " +
+                       detail::g17(limit) + " GB for this machine. The mesh size is in millimetres: give --mesh-size " + hint +
+                       " or more, or raise the limit with --max-memory GB (gmsh was not started)");
+    }
   }
 
   // 2. Remote points: faces.
@@ -580,6 +773,57 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
   r.clamp = clamp->name;
   ModelOptions bc;
   bc.fixed_nodes = {clamp->ref};
+  const auto clamped_modes_of = [&](const SuperElement& se) {
+    const Modes m = modes(assemble(se, bc));
+    return Eigen::VectorXd(m.frequencies_Hz.head(std::min<Index>(o.clamped_modes, m.frequencies_Hz.size())));
+  };
+  r.shell_modes_clamped_Hz = clamped_modes_of(r.reduced);
+  // Static stiffness at `axial`, clamp fixed: 1 / (K_ff^-1)_jj (the modal DOF are uncoupled from the
+  // interface in K, so this is the full model's static stiffness there).
+  const auto axial_stiffness_of = [&](const SuperElement& se) {
+    if (o.axial.empty()) return 0.0;
+    const auto colon = o.axial.find(':');
+    long node = -1;
+    for (const detail::DeckPoint& p : points) {
+      if (detail::upper(p.name) == detail::upper(o.axial.substr(0, colon))) node = p.ref;
+    }
+    ModelOptions mo = bc;
+    mo.forces = {ForcePair{-1, node, *direction_from_string(o.axial.substr(colon + 1))}};
+    mo.outputs = {DisplacementOutput{-1, node, mo.forces[0].direction}};
+    const StructuralModel sm = assemble(se, mo);
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(sm.K);
+    const double compliance = (sm.T * ldlt.solve(sm.F))(0, 0);
+    return compliance > 0.0 ? 1.0 / compliance : 0.0;
+  };
+  r.shell_axial_stiffness = axial_stiffness_of(r.reduced);
+
+  // Joints and stacks: nodes and beams added to the reduced model (exact: their ends are interface DOF).
+  if (!o.joints.empty() || !o.stacks.empty()) {
+    std::map<std::string, std::pair<long, Eigen::Vector3d>> at;  // upper-case name -> node, position (m)
+    for (const detail::DeckPoint& p : points) at[detail::upper(p.name)] = {p.ref, p.position_m};
+    long next = points.back().rot + 1;
+    for (const JointSpec& j : o.joints) {
+      const auto& a = at.at(detail::upper(j.from));
+      const auto& b = at.at(detail::upper(j.to));
+      const Eigen::Vector3d x = a.second + j.fraction * (b.second - a.second);
+      add_node(r.reduced, next, x);
+      at[detail::upper(j.name)] = {next, x};
+      r.joints.push_back({j.name, next, x});
+      run.log("  joint " + j.name + ": node " + std::to_string(next) + " at " + detail::g17(j.fraction) + " of " + j.from + " -> " + j.to);
+      ++next;
+    }
+    for (const StackSpec& st : o.stacks) {
+      const long a = at.at(detail::upper(st.from)).first, b = at.at(detail::upper(st.to)).first;
+      const BeamMatrices bm = add_beam(r.reduced, a, b, st.section, "--stack " + st.from + ":" + st.to);
+      r.stacks.push_back({st.from, st.to, a, b, bm.length, bm.axial_stiffness, st.section.density * st.section.area * bm.length});
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "  stack %s -> %s: beam of %.4g mm, E A / L = %.4g N/um, %.3g g", st.from.c_str(), st.to.c_str(),
+                    1e3 * bm.length, 1e-6 * bm.axial_stiffness, 1e3 * r.stacks.back().mass);
+      run.log(buf);
+    }
+    r.reduced.source += ", " + std::to_string(o.stacks.size()) + " stack beam(s)";
+  }
+  r.axial_stiffness = axial_stiffness_of(r.reduced);
   const Modes clamped = modes(assemble(r.reduced, bc));
   r.modes_clamped_Hz = clamped.frequencies_Hz.head(std::min<Index>(o.clamped_modes, clamped.frequencies_Hz.size()));
   const Modes free = modes(r.reduced.K, r.reduced.M);

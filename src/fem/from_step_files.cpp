@@ -101,6 +101,9 @@ std::string report_script(const std::string& report_name) {
   s += "  pb_b() = BoundingBox Surface{pb_s(pb_i)};\n";
   s += "  Printf(\"S %g %.17g %.17g %.17g %.17g %.17g %.17g\", pb_s(pb_i), pb_b(0), pb_b(1), pb_b(2), pb_b(3), pb_b(4), pb_b(5)) >> " + f + ";\n";
   s += "EndFor\n";
+  s += "pb_vol = 0;\nFor pb_i In {0:#pb_v()-1}\n  pb_vol += Mass Volume{pb_v(pb_i)};\nEndFor\n";
+  s += "pb_area = 0;\nFor pb_i In {0:#pb_s()-1}\n  pb_area += Mass Surface{pb_s(pb_i)};\nEndFor\n";
+  s += "Printf(\"A %.17g %.17g\", pb_vol, pb_area) >> " + f + ";\n";
   s += "Printf(\"END\") >> " + f + ";\n";
   return s;
 }
@@ -116,6 +119,13 @@ GeometryReport parse_geometry_report(const std::string& text, const std::string&
       return false;
     }
     const auto tok = tokens(t);
+    if (tok.size() == 3 && tok[0] == "A") {
+      const auto v = parse_double(tok[1]), a = parse_double(tok[2]);
+      if (!v || !a || !(*v >= 0.0) || !(*a >= 0.0)) throw InputError(source, "line " + std::to_string(line), "'A volume area'", quote(t));
+      g.volume_mm3 = *v;
+      g.area_mm2 = *a;
+      return true;
+    }
     if (tok.size() != 8 || (tok[0] != "V" && tok[0] != "S")) {
       throw InputError(source, "line " + std::to_string(line), "'V|S tag x0 y0 z0 x1 y1 z1'", quote(t));
     }

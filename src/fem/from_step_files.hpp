@@ -20,6 +20,7 @@ struct GeoEntity {
 struct GeometryReport {
   std::vector<GeoEntity> volumes, surfaces;
   Box3 bounds;  // of all volumes
+  double volume_mm3 = 0.0, area_mm2 = 0.0;  // of all volumes and all faces (the `A` line)
 };
 
 // The geo commands shared by both gmsh runs: OpenCASCADE, millimetres, the STEP file (a name in
@@ -29,7 +30,7 @@ struct GeometryReport {
 [[nodiscard]] std::string geometry_script(const std::string& step_name, const std::vector<RegionSpec>& regions,
                                           double tolerance_mm);
 // Appended to geometry_script for the first run: writes `V tag x0 y0 z0 x1 y1 z1` and
-// `S tag ...` lines into `report_name`.
+// `S tag ...` lines into `report_name`, then `A volume area` (mm^3, mm^2: gmsh's Mass).
 [[nodiscard]] std::string report_script(const std::string& report_name);
 // InputError(source, ...) for malformed lines.
 [[nodiscard]] GeometryReport parse_geometry_report(const std::string& text, const std::string& source);

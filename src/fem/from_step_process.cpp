@@ -2,10 +2,12 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
@@ -81,7 +83,7 @@ std::optional<std::filesystem::path> find_executable(const std::string& name_or_
 
 ProcessResult run_process(const std::filesystem::path& exe, const std::vector<std::string>& args,
                           const std::filesystem::path& cwd, const std::filesystem::path& log,
-                          const std::function<void(std::string_view line)>& on_line) {
+                          const std::function<void(std::string_view line)>& on_line, const ProcessLimits& limits) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::string> storage;
   storage.reserve(args.size() + 1);
@@ -104,6 +106,12 @@ ProcessResult run_process(const std::filesystem::path& exe, const std::vector<st
   pid_t pid = 0;
   const int rc = posix_spawn(&pid, argv[0], fa.get(), nullptr, argv.data(), environ);
   if (rc != 0) throw std::system_error(rc, std::generic_category(), "cannot start " + exe.string());
+  if (limits.address_space_bytes > 0.0) {
+    struct rlimit lim {};
+    lim.rlim_cur = lim.rlim_max = static_cast<rlim_t>(limits.address_space_bytes);
+    (void)::prlimit(pid, RLIMIT_AS, &lim, nullptr);  // best effort: the process may already be gone
+  }
+  bool timed_out = false;
 
   std::ifstream in;
   std::string pending;
@@ -112,6 +120,11 @@ ProcessResult run_process(const std::filesystem::path& exe, const std::vector<st
     const pid_t done = ::waitpid(pid, &status, WNOHANG);
     if (done == pid) break;
     if (done < 0 && errno != EINTR) throw std::system_error(errno, std::generic_category(), "waitpid");
+    if (limits.seconds > 0.0 && !timed_out &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > limits.seconds) {
+      ::kill(pid, SIGKILL);
+      timed_out = true;
+    }
     if (on_line) {
       if (!in.is_open()) in.open(log_path, std::ios::binary);
       if (in.is_open()) pump(in, pending, on_line);
@@ -124,6 +137,7 @@ ProcessResult run_process(const std::filesystem::path& exe, const std::vector<st
     if (!pending.empty()) on_line(pending);
   }
   ProcessResult r;
+  r.timed_out = timed_out;
   if (WIFEXITED(status)) {
     r.exit_code = WEXITSTATUS(status);
   } else if (WIFSIGNALED(status)) {

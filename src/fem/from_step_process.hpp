@@ -16,7 +16,15 @@ namespace piezobench::fem::detail {
 struct ProcessResult {
   int exit_code = -1;   // the program's exit status; 128 + N when killed by signal N
   bool signaled = false;
+  bool timed_out = false;  // killed (SIGKILL) after `limits.seconds`
   double seconds = 0.0;
+};
+
+// Bounds of a run (0: none): wall time (the process is killed past it) and address space
+// (RLIMIT_AS of the child, set with prlimit right after it starts: allocations past it fail).
+struct ProcessLimits {
+  double seconds = 0.0;
+  double address_space_bytes = 0.0;
 };
 
 // Runs `exe` with `args` (argv[1..]; no shell, no word splitting) in `cwd`, stdin from /dev/null,
@@ -25,7 +33,8 @@ struct ProcessResult {
 // std::system_error when the process cannot be started.
 ProcessResult run_process(const std::filesystem::path& exe, const std::vector<std::string>& args,
                           const std::filesystem::path& cwd, const std::filesystem::path& log,
-                          const std::function<void(std::string_view line)>& on_line = {});
+                          const std::function<void(std::string_view line)>& on_line = {},
+                          const ProcessLimits& limits = {});
 
 // "4.8.4" from `gmsh --version`, "2.20" from `ccx -v` ("This is Version 2.20"): the first
 // token that starts with a digit and has a dot; nullopt when there is none.

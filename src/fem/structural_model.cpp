@@ -151,6 +151,12 @@ void ModelOptions::validate(const SuperElement& se) const {
       throw InputError(kSource, field, "each node fixed once", "node " + std::to_string(fixed_nodes[k]) + " again");
     }
   }
+  for (std::size_t k = 0; k < guided.size(); ++k) {
+    const std::string field = "guided[" + std::to_string(k) + "]";
+    (void)se.index_of(guided[k].node, guided[k].direction, kSource, field);
+    if (is_rotation(guided[k].direction)) throw InputError(kSource, field, "a guide along x, y or z", to_string(guided[k].direction));
+    if (fixed.count(guided[k].node) != 0) throw InputError(kSource, field, "a node that is not fixed", "node " + std::to_string(guided[k].node));
+  }
   for (std::size_t k = 0; k < masses.size(); ++k) {
     const std::string field = "masses[" + std::to_string(k) + "]";
     const PointMass& m = masses[k];
@@ -189,11 +195,15 @@ StructuralModel assemble(const SuperElement& se, const ModelOptions& options) {
     }
   }
   const std::set<long> fixed(options.fixed_nodes.begin(), options.fixed_nodes.end());
+  const auto held = [&](const DofLabel& d) {
+    return std::any_of(options.guided.begin(), options.guided.end(),
+                       [&](const Guide& g) { return g.node == d.node && g.direction != d.direction; });
+  };
   StructuralModel out;
   std::vector<Index> position(static_cast<std::size_t>(n), -1);
   for (Index i = 0; i < n; ++i) {
     const DofLabel& d = se.dofs[static_cast<std::size_t>(i)];
-    if (!d.is_modal() && fixed.count(d.node) != 0) continue;
+    if (!d.is_modal() && (fixed.count(d.node) != 0 || held(d))) continue;
     position[static_cast<std::size_t>(i)] = static_cast<Index>(out.free_dofs.size());
     out.free_dofs.push_back(i);
   }

@@ -45,7 +45,7 @@ Electrics electrics() {
   return e;
 }
 
-TEST(SuperElementSpec, ReadsTheKeysAndResolvesRelativePaths) {
+TEST(SuperElementBench, ReadsTheKeysAndResolvesRelativePaths) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   std::ofstream(dir.path() / "K.txt") << "x";
@@ -55,14 +55,15 @@ TEST(SuperElementSpec, ReadsTheKeysAndResolvesRelativePaths) {
                                       "k_file = \"K.txt\"\nm_file = \"M.txt\"\nnodes_file = \"dofs.txt\"\nformat = \"ansys\"\n" +
                                           kNodes + "ga = 12.5\ngs = 3e5\nmodal_damping = 0.02\nmax_mode_Hz = 9000\nguided = false\n",
                                       false);
-  const SuperElementSpec s = read_superelement_spec(file);
-  EXPECT_EQ(s.k_file, dir.path() / "K.txt");
-  EXPECT_EQ(s.fix, std::vector<long>{76429});
-  EXPECT_EQ(s.actuator.node_a, 76430);
-  EXPECT_EQ(s.actuator.node_b, 76433);
-  EXPECT_EQ(s.sensor.node_b, 76440);
-  EXPECT_EQ(s.output.node_b, 76423);
-  EXPECT_EQ(s.output.direction, fem::Direction::kY);
+  const SuperElementBench s = read_superelement_spec(file);
+  EXPECT_EQ(s.setup.k_file, dir.path() / "K.txt");
+  EXPECT_EQ(s.setup.source, file);
+  EXPECT_EQ(s.setup.model.fixed_nodes, std::vector<long>{76429});
+  EXPECT_EQ(s.actuator().node_a, 76430);
+  EXPECT_EQ(s.actuator().node_b, 76433);
+  EXPECT_EQ(s.sensor().node_b, 76440);
+  EXPECT_EQ(s.output().node_b, 76423);
+  EXPECT_EQ(s.output().direction, fem::Direction::kY);
   EXPECT_EQ(s.ga, 12.5);
   EXPECT_EQ(s.gs, 3e5);
   EXPECT_EQ(s.modal_damping, 0.02);
@@ -70,7 +71,7 @@ TEST(SuperElementSpec, ReadsTheKeysAndResolvesRelativePaths) {
   EXPECT_FALSE(s.guided);
 }
 
-TEST(SuperElementSpec, RefusesBadDescriptionsNamingTheKey) {
+TEST(SuperElementBench, RefusesBadDescriptionsNamingTheKey) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   const test::TempDir dir;
   const auto refused = [&](const std::string& text, const std::string& field, bool with_files = true) {

@@ -9,12 +9,15 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 
 #include "fem/from_step_files.hpp"
 #include "fem/from_step_process.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/fem/superelement.hpp"
 #include "test_util.hpp"
 
@@ -487,3 +490,81 @@ TEST(FromStep, Apa95mlAt4mmMatchesCalculixOnTheFullMesh) {
 
 }  // namespace
 }  // namespace piezobench::fem
+
+// ---- issue 15: the APA300ML geometry of the repository, stacks as beams, the size guard ---------
+
+namespace apa300ml {
+const fs::path kGeo = fs::path(PIEZOBENCH_SOURCE_DIR) / "data/geometry/apa300ml.geo";
+bool tools() { return detail::find_executable("gmsh") && detail::find_executable("ccx"); }
+}  // namespace apa300ml
+
+TEST(FromStep, EstimatesTheMeshFromTheGeometry) {
+  // The fit of elements ~ 3 V / h^3 + 4 S / h^2 against APA95ML.step at 2 mm (30,200 C3D10).
+  const MeshEstimate e = estimate_mesh(44907.0, 13986.0, 2.0, 2);
+  EXPECT_NEAR(e.elements, 30827.0, 1.0);
+  EXPECT_NEAR(e.elements / 30200.0, 1.0, 0.05);
+  EXPECT_NEAR(e.nodes, 1.65 * e.elements, 1e-6);
+  EXPECT_NEAR(e.memory_GB, 0.2 + 1.3 * std::pow(3 * 1.65 * 30827.0 / 144000.0, 1.2), 1e-9);
+  // A user thinking in metres: 4 mm written 0.004.
+  const MeshEstimate m = estimate_mesh(44907.0, 13986.0, 0.004, 2);
+  EXPECT_GT(m.elements, 1e12);
+  EXPECT_GT(m.memory_GB, 1e6);
+  EXPECT_GT(default_max_memory_GB(), 0.0);
+  EXPECT_LE(default_max_memory_GB(), 8.0);
+}
+
+TEST(FromStep, RefusesAMeshTooLargeBeforeGmshMeshes) {
+  if (!apa300ml::tools()) GTEST_SKIP() << "gmsh or ccx not installed";
+  test::TempDir dir;
+  FromStepOptions o = FromStepOptions::apa300ml();
+  o.out = dir.path() / "out";
+  o.mesh_size_mm = 0.004;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    (void)superelement_from_step(apa300ml::kGeo, o);
+    ADD_FAILURE() << "expected a UsageError";
+  } catch (const UsageError& e) {
+    const std::string what = e.what();
+    EXPECT_TRUE(test::contains(what, "--mesh-size 0.004")) << what;
+    EXPECT_TRUE(test::contains(what, "--max-memory")) << what;
+    EXPECT_TRUE(test::contains(what, "elements")) << what;
+    EXPECT_EQ(e.exit_code(), ExitCode::kUsage);
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 30.0);
+  EXPECT_FALSE(fs::exists(dir.path() / "out" / "gmsh_mesh.log"));  // gmsh never meshed
+}
+
+// The repository's geometry at a coarse 4 mm (a few seconds): stacks as beams with k = c^E A / L,
+// the joint between actuator and sensor stacks, the reduction against ccx before the stacks.
+TEST(FromStep, Apa300mlGeometryWithStackBeamsAt4mm) {
+  if (!apa300ml::tools()) GTEST_SKIP() << "gmsh or ccx not installed";
+  test::TempDir dir;
+  FromStepOptions o = FromStepOptions::apa300ml();
+  o.out = dir.path() / "out";
+  o.mesh_size_mm = 4.0;
+  o.modes = 12;
+  o.clamped_modes = 4;
+  o.verify = true;
+  o.tool_timeout_s = 120.0;
+  const FromStepResult r = superelement_from_step(apa300ml::kGeo, o);
+  ASSERT_EQ(r.stacks.size(), 2u);
+  EXPECT_NEAR(r.stacks[0].length_m, 0.040, 1e-9);  // the two actuator stacks, remote points 3 -> 4
+  EXPECT_NEAR(r.stacks[0].axial_stiffness, 1.2e8, 1.0);
+  EXPECT_NEAR(r.stacks[1].axial_stiffness, 2.4e8, 1.0);  // the sensor stack, 4 -> 5: 48e9 x 1e-4 / 0.02
+  ASSERT_EQ(r.joints.size(), 1u);
+  EXPECT_NEAR(r.joints[0].position_m.x(), 0.010, 1e-9);
+  EXPECT_EQ(r.reduced.nodal_dofs(), 30);  // 4 remote points and the joint
+  ASSERT_TRUE(r.reference_modes_Hz);
+  for (Index k = 0; k < 3; ++k) {
+    EXPECT_TRUE(test::near(r.shell_modes_clamped_Hz(k), (*r.reference_modes_Hz)(k), kAgainstCcx)) << "mode " << k + 1;
+  }
+  // The figures of docs/apa300ml.md, loosely (4 mm is coarse): shell 0.38 N/um, about 2.7 N/um with
+  // the stacks, first modes near 300 and 410 Hz; the stacks stiffen the model.
+  EXPECT_NEAR(r.shell_axial_stiffness * 1e-6, 0.38, 0.05);
+  EXPECT_NEAR(r.axial_stiffness * 1e-6, 2.7, 0.3);
+  EXPECT_NEAR(r.modes_clamped_Hz(0), 300.0, 25.0);
+  EXPECT_NEAR(r.modes_clamped_Hz(1), 412.0, 30.0);
+  EXPECT_GT(r.modes_clamped_Hz(0), r.shell_modes_clamped_Hz(0));
+  EXPECT_GT(r.estimate.elements, 0.5 * static_cast<double>(r.mesh_elements));
+  EXPECT_LT(r.estimate.elements, 2.0 * static_cast<double>(r.mesh_elements));
+}

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/fem/beam.hpp"
 #include "piezobench/fem/craig_bampton.hpp"
 #include "piezobench/fem/superelement.hpp"
 
@@ -78,14 +79,49 @@ struct RegionSpec {
   static RegionSpec parse(const std::string& text, const std::string& field);
 };
 
-// Linear isotropic elastic material.
+// Linear isotropic elastic material, or `removed`: the region is cut out of the model (not meshed),
+// e.g. a block standing for a stack in the CAD, replaced by stack beams (StackSpec).
 struct Material {
   double youngs_modulus = 0.0;  // Pa
   double poisson_ratio = 0.0;   // -
   double density = 0.0;         // kg/m^3
-  // "E,nu,rho" (SI); InputError naming `field` unless E > 0, -1 < nu < 0.5, rho > 0.
+  bool removed = false;
+  // "E,nu,rho" (SI) or "none" (removed); InputError naming `field` unless E > 0, -1 < nu < 0.5, rho > 0.
   static Material parse(const std::string& text, const std::string& field);
 };
+
+// A node of the super element that is not on the CAD (a junction between two stacks): on the line
+// from remote point (or joint) `from` to `to`, at from + fraction (to - from), 0 < fraction < 1.
+struct JointSpec {
+  std::string name, from, to;
+  double fraction = 0.5;
+  // "NAME:FROM:TO:FRACTION".
+  static JointSpec parse(const std::string& text, const std::string& field);
+};
+
+// A stack (or stacks in series) between two remote points or joints: a beam added to the reduced
+// model (beam.hpp), touching the shell only through the faces of its end remote points.
+struct StackSpec {
+  std::string from, to;
+  BeamSection section;  // default: Table 4.1 (c^E 48 GPa, 1 cm^2), nu 0.31, 7800 kg/m^3
+  // "FROM:TO" or "FROM:TO:E,nu,rho,AREA".
+  static StackSpec parse(const std::string& text, const std::string& field);
+};
+
+// What a mesh size costs, estimated from the geometry before gmsh meshes (fitted on APA95ML.step
+// and apa300ml.geo meshes, docs/from-step.md): elements ~ 3 V / h^3 + 4 S / h^2 (V volume, S
+// surface area, h mesh size), nodes and DOF per element from the element order, peak memory and
+// time of the chain from the measured 2 mm APA95ML run (144k DOF: 1.5 GB, 40-95 s) scaled by DOF^1.2.
+struct MeshEstimate {
+  double volume_mm3 = 0.0, area_mm2 = 0.0;
+  double elements = 0.0, nodes = 0.0, dofs = 0.0;
+  double memory_GB = 0.0;
+  double seconds = 0.0;
+  [[nodiscard]] std::string to_string() const;
+};
+[[nodiscard]] MeshEstimate estimate_mesh(double volume_mm3, double area_mm2, double mesh_size_mm, int element_order);
+// The default of FromStepOptions::max_memory_GB: half the physical memory, at most 8 GB.
+[[nodiscard]] double default_max_memory_GB();
 
 // Defaults for APA95ML.step (../shared/data/apa95ml-ansys, one body: the shell fused with a block
 // standing for the stack): see FromStepOptions::apa95ml().
@@ -97,7 +133,20 @@ struct FromStepOptions {
   std::vector<RegionSpec> regions;
   std::map<std::string, Material> materials;  // by region name; "body" for the rest
   std::vector<RemotePointSpec> remote_points;
+  std::vector<JointSpec> joints;     // extra 6-DOF nodes (stack junctions), after the remote points
+  std::vector<StackSpec> stacks;     // beams between remote points / joints, added after the reduction
+  // A .geo input (gmsh script, e.g. apa300ml.geo) is exported to STEP first, with these
+  // DefineConstant values (gmsh -setnumber NAME VALUE).
+  std::map<std::string, double> geo_parameters;
+  // Refuse (UsageError, exit code 2) when the estimated peak memory of the chain exceeds this
+  // (GB); 0: default_max_memory_GB(). The tools also run under a memory limit of twice this
+  // (address space) plus 1 GB, and each for at most tool_timeout_s.
+  double max_memory_GB = 0.0;
+  double tool_timeout_s = 3600.0;
   std::string clamp;                 // remote point fixed for modes_clamped_Hz (and --verify)
+  // The static stiffness reported (with `clamp` fixed): remote point and direction, "NAME:DIR",
+  // e.g. "top:y" (the presets); empty: none.
+  std::string axial;
   int clamped_modes = 10;            // number of clamped modes reported (and asked from ccx)
   bool verify = false;               // also ccx *FREQUENCY on the full mesh, `clamp` fixed
   bool keep_temp = false;            // keep the work folder (mesh, matrix dumps, ccx results)
@@ -113,9 +162,35 @@ struct FromStepOptions {
   // (E 190 GPa as in the report's model, nu 0.3, 7800 kg/m^3); remote points top (y=max),
   // bottom (y=min), stack_a (x=-34.7793) and stack_b (x=34.7793); clamp "bottom".
   static FromStepOptions apa95ml();
+  // APA95ML.step modelled as the Ansys super element has it (docs/from-step.md): the block removed
+  // (material none), the stack a beam of four segments (joints j1..j3) between stack_a and stack_b,
+  // which hold the end faces and the shell's arch feet (|x| >= 28.7 mm on y = +-10), with the
+  // axial stiffness (3.72e7 N/m) and mass (59.5 g) of the Ansys beams (E 48 GPa, A 5.235e-5 m^2,
+  // rho 16840 kg/m^3 equivalent).
+  static FromStepOptions apa95ml_beam();
+  // data/geometry/apa300ml.geo: steel shell (210 GPa, nu 0.3, 7850 kg/m^3); remote points as in
+  // the report's Fig. 4.1: top (1, y=max), bottom (2, y=min), stack_a (3, x=-30: the actuator
+  // stacks' outer end), stack_b (5, x=30: the sensor stack's outer end); joint stack_mid (4) two
+  // thirds of the way from stack_a to stack_b; stacks stack_a-stack_mid (the two actuator stacks,
+  // 40 mm) and stack_mid-stack_b (the sensor stack, 20 mm) with Table 4.1's c^E and area; clamp bottom.
+  static FromStepOptions apa300ml();
   // InputError naming the option for values out of range, repeated names, a material for an
   // unknown region, a region without material, a clamp that is not a remote point.
   void validate() const;
+};
+
+struct JointResult {
+  std::string name;
+  long node = -1;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+};
+
+struct StackResult {
+  std::string from, to;
+  long node_a = -1, node_b = -1;
+  double length_m = 0.0;
+  double axial_stiffness = 0.0;  // N/m
+  double mass = 0.0;             // kg
 };
 
 struct RemotePointResult {
@@ -137,6 +212,9 @@ struct ToolInfo {
 struct FromStepResult {
   SuperElement reduced;               // remote points (6 DOF each), then the modal DOF
   std::vector<RemotePointResult> remote_points;
+  std::vector<JointResult> joints;
+  std::vector<StackResult> stacks;
+  MeshEstimate estimate;              // before meshing
   std::map<std::string, Index> region_elements;  // elements per region
   Index mesh_nodes = 0, mesh_elements = 0;
   std::string element_type;           // "C3D10" or "C3D4"
@@ -145,7 +223,13 @@ struct FromStepResult {
   std::string clamp;                  // the remote point clamped below
   Eigen::VectorXd modes_clamped_Hz;   // reduced model, `clamp` fixed (first clamped_modes)
   Eigen::VectorXd free_modes_Hz;      // reduced model, free-free (first 6 + clamped_modes)
-  std::optional<Eigen::VectorXd> reference_modes_Hz;  // ccx *FREQUENCY, same boundary condition
+  // ccx *FREQUENCY on the full mesh, same boundary condition, without the stacks; compare with
+  // shell_modes_clamped_Hz (the reduced model before the stacks are added).
+  std::optional<Eigen::VectorXd> reference_modes_Hz;
+  Eigen::VectorXd shell_modes_clamped_Hz;  // reduced model without the stacks, `clamp` fixed
+  // Static stiffness at `axial` with `clamp` fixed (N/m), with and without the stacks; 0 when
+  // no `axial` is asked.
+  double axial_stiffness = 0.0, shell_axial_stiffness = 0.0;
   ToolInfo gmsh, ccx;
   std::vector<std::pair<std::string, double>> seconds;  // wall time per step
   std::vector<std::filesystem::path> files;            // written into the output folder

@@ -60,14 +60,23 @@ struct Damping {
   static Damping parse(const std::string& text, const std::string& field);
 };
 
+// A node that keeps only its translation along `direction` (its five other DOF are clamped): the
+// moving interface on an air bearing.
+struct Guide {
+  long node = -1;
+  Direction direction = Direction::kY;
+};
+
 struct ModelOptions {
   std::vector<long> fixed_nodes;             // every DOF of these nodes is clamped
+  std::vector<Guide> guided;                 // nodes held on a guide
   std::vector<PointMass> masses;
   std::vector<ForcePair> forces;             // inputs, in order
   std::vector<DisplacementOutput> outputs;   // outputs, in order (sensors included)
   Damping damping;                           // none unless asked
   // InputError (source "model options", field e.g. "forces[1]") for unknown nodes, missing
-  // DOF, negative masses, bad damping values, a node fixed twice.
+  // DOF, negative masses, bad damping values, a node fixed twice, a guide along a rotation or on
+  // a fixed node.
   void validate(const SuperElement& se) const;
 };
 
