@@ -456,51 +456,66 @@ void read_analysis(const Reader& r, AnalysisSettings& a) {
   }
 }
 
-SuperElementSpec read_superelement(const Context& ctx, const Reader& r) {
-  r.only({"format", "k_file", "m_file", "nodes_file", "coordinates_file", "fix", "actuator", "output", "masses", "damping", "ga_N_per_V"});
-  SuperElementSpec s;
+CampaignSuperElement read_superelement(const Context& ctx, const Reader& r) {
+  r.only({"format", "k_file", "m_file", "nodes_file", "coordinates_file", "fix", "actuator", "output", "sensor", "masses", "damping"});
+  CampaignSuperElement c;
+  fem::SuperElementSetup& s = c.setup;
+  s.source = ctx.source;
   s.format = r.string("format").value_or("auto");
-  if (s.format != "auto" && s.format != "ansys" && s.format != "calculix" && s.format != "matrix-market") {
+  if (s.format != "auto" && !fem::super_element_format_from_string(s.format)) {
     throw InputError(ctx.source, r.key("format"), "auto, ansys, calculix or matrix-market", "'" + s.format + "'");
   }
-  auto file = [&](const char* k, bool required) -> std::optional<FileSpec> {
+  auto file = [&](const char* k, bool required) -> std::optional<fs::path> {
     const auto given = r.string(k);
     if (!given) {
       if (required) throw InputError(ctx.source, r.key(k), "a file of the super element", "no such key");
       return std::nullopt;
     }
-    FileSpec f;
-    f.key = r.key(k);
-    f.given = *given;
-    f.path = resolve(ctx, *given, f.key);
-    return f;
+    if (std::string(k) == "k_file") c.given = *given;
+    return resolve(ctx, *given, r.key(k));
   };
   s.k_file = *file("k_file", true);
   s.m_file = *file("m_file", true);
   s.nodes_file = *file("nodes_file", true);
-  s.coordinates_file = file("coordinates_file", false);
+  s.coordinates_file = file("coordinates_file", false).value_or(fs::path());
+  s.fix_field = r.key("fix");
   if (const toml::node* n = r.get("fix")) {
     const toml::array* a = n->as_array();
     if (!a) throw InputError(ctx.source, r.key("fix"), "an array of node numbers", describe_toml(*n));
     for (std::size_t i = 0; i < a->size(); ++i) {
       const auto v = (*a)[i].value<int64_t>();
       if (!(*a)[i].is_integer() || !v) throw InputError(ctx.source, r.key("fix") + "[" + std::to_string(i) + "]", "a node number", describe_toml((*a)[i]));
-      s.fix.push_back(static_cast<long>(*v));
+      s.model.fixed_nodes.push_back(static_cast<long>(*v));
     }
   }
   const auto act = r.string("actuator");
   const auto out = r.string("output");
+  const auto sen = r.string("sensor");
   if (!act) throw InputError(ctx.source, r.key("actuator"), "the actuator force pair \"A:B:DIR\"", "no such key");
   if (!out) throw InputError(ctx.source, r.key("output"), "the displacement output \"NODE:DIR\"", "no such key");
-  s.actuator = *act;
-  s.output = *out;
-  s.masses = r.strings("masses");
-  s.damping = r.string("damping").value_or(s.damping);
-  if (const auto g = r.number("ga_N_per_V")) {
-    if (*g == 0.0) throw InputError(ctx.source, r.key("ga_N_per_V"), "a non-zero force constant", "0");
-    s.ga = *g;
+  if (!sen) throw InputError(ctx.source, r.key("sensor"), "the sensor stack \"A:B:DIR\"", "no such key");
+  try {
+    s.model.forces = {fem::ForcePair::parse(*act, r.key("actuator"))};
+    s.model.outputs = {fem::DisplacementOutput::parse(*out, r.key("output")), fem::DisplacementOutput::parse(*sen, r.key("sensor"))};
+    std::size_t k = 0;
+    for (const auto& m : r.strings("masses")) {
+      s.model.masses.push_back(fem::PointMass::parse(m, r.key("masses") + "[" + std::to_string(k) + "]"));
+      s.mass_fields.push_back(r.key("masses") + "[" + std::to_string(k++) + "]");
+    }
+    const fem::Damping d = fem::Damping::parse(r.string("damping").value_or("modal:0.02"), r.key("damping"));
+    if (d.kind != fem::DampingKind::kModal || !(d.zeta > 0.0 && d.zeta < 1.0)) {
+      throw InputError("", r.key("damping"), "modal:ZETA with 0 < ZETA < 1", "'" + r.string("damping").value_or("") + "'");
+    }
+    c.modal_damping = d.zeta;
+  } catch (const InputError& e) {
+    throw e.with_source(ctx.source);
   }
-  return s;
+  if (s.model.outputs[0].node_a >= 0) throw InputError(ctx.source, r.key("output"), "one node NODE:DIR (the moving interface)", "a node pair");
+  if (s.model.outputs[1].node_a < 0) throw InputError(ctx.source, r.key("sensor"), "a node pair A:B:DIR", "one node");
+  if (s.model.forces[0].node_a < 0) throw InputError(ctx.source, r.key("actuator"), "a force pair A:B:DIR", "one node");
+  s.force_fields = {r.key("actuator")};
+  s.output_fields = {r.key("output"), r.key("sensor")};
+  return c;
 }
 
 }  // namespace

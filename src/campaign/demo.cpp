@@ -11,6 +11,9 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include <toml++/toml.h>
+
+#include "campaign/embedded_superelement.hpp"
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/bench/truth.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
@@ -188,6 +191,25 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
       "iff_unit = {}\n\n",
       options.seed, options.fast ? ", fast" : "", options.seed, bench_options.amplifier_gain, bench_options.suspended_mass, added_mass,
       gravity, bench_options.hpf_resistance, std::find(options.units.begin(), options.units.end(), options.iff_unit) != options.units.end() && !options.iff_gains.empty() ? options.iff_unit : 0);
+  // The APA300ML super element shipped in the binary (scripts/superelement/make_apa300ml.sh), put on
+  // the bench by the campaign (report section 4): ga and gs tuned against each unit's FRFs.
+  const fs::path se_toml = detail::write_apa300ml_superelement(dir / "superelement");
+  files.superelement = se_toml;
+  {
+    const toml::table se = toml::parse_file(se_toml.string());
+    const auto text = [&](const char* key) { return se[key].value<std::string>().value_or(""); };
+    toml += fmt::format(
+        "[superelement]                 # the APA300ML super element from our own geometry (docs/apa300ml.md)\n"
+        "format = \"matrix-market\"\n"
+        "k_file = \"superelement/{}\"\nm_file = \"superelement/{}\"\nnodes_file = \"superelement/{}\"\n"
+        "fix = [{}]                  # bottom interface (remote point 2)\n"
+        "actuator = \"{}\"     # remote points 3 -> 4: the two actuator stacks\n"
+        "sensor = \"{}\"       # remote points 4 -> 5: the sensor stack\n"
+        "output = \"{}\"             # top interface (remote point 1): d_e\n"
+        "damping = \"modal:0.02\"\n\n",
+        text("k_file"), text("m_file"), text("nodes_file"), se["fix"][0].value<int64_t>().value_or(0), text("actuator"), text("sensor"),
+        text("output"));
+  }
   for (const int id : options.units) {
     const std::string u = fmt::format("data/unit{}", id);
     toml += fmt::format("[[units]]\nid = {}\nname = \"APA {}\"\n", id, id);

@@ -11,8 +11,10 @@
 #include <numbers>
 #include <thread>
 
+#include "piezobench/apa/piezo.hpp"
 #include "piezobench/campaign/report_document.hpp"
 #include "piezobench/campaign/results_json.hpp"
+#include "piezobench/campaign/superelement_fit.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
@@ -407,55 +409,58 @@ IffStudy iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units) {
 
 // ------------------------------------------------------------------------------------ super element
 
+// Report section 4: the super element on the bench, ga and gs tuned against each unit's measured
+// FRFs (superelement_fit.hpp) and compared with eq. 4.1 (Table 4.1's constants); Figure 4.2's
+// model for the first unit with an FRF.
 SuperElementComparison superelement_comparison(const Campaign& c, const std::vector<UnitAnalysis>& units) {
-  const SuperElementSpec& s = *c.superelement;
-  const std::string src = c.file.string();
-  fem::SuperElementFormat format;
-  if (s.format == "auto") {
-    format = fem::detect_format(s.k_file.path);
-  } else {
-    format = *fem::super_element_format_from_string(s.format);
-  }
-  fem::SuperElement se;
-  try {
-    se = fem::read_super_element(format, s.k_file.path, s.m_file.path, s.nodes_file.path,
-                                 s.coordinates_file ? s.coordinates_file->path : fs::path());
-  } catch (const InputError& e) {
-    throw InputError(src, "superelement", "a readable super element", e.what());
-  }
-  fem::ModelOptions mo;
-  try {
-    mo.fixed_nodes = s.fix;
-    for (const auto& m : s.masses) mo.masses.push_back(fem::PointMass::parse(m, "superelement.masses"));
-    mo.forces.push_back(fem::ForcePair::parse(s.actuator, "superelement.actuator"));
-    mo.outputs.push_back(fem::DisplacementOutput::parse(s.output, "superelement.output"));
-    mo.damping = fem::Damping::parse(s.damping, "superelement.damping");
-    mo.validate(se);
-  } catch (const InputError& e) {
-    throw e.with_source(src);
-  }
-  const fem::StructuralModel model = fem::assemble(se, mo);
-  const fem::Modes modes = fem::modes(model);
-  const VectorXd f = Eigen::VectorXd::LinSpaced(400, std::log10(c.analysis.fmin_hz), std::log10(2.0 * c.analysis.fmax_hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
-  const std::vector<Eigen::MatrixXcd> h = fem::frequency_response(model, kTwoPi * f);
+  const CampaignSuperElement& s = *c.superelement;
+  const fem::SuperElement se = s.setup.load();
+  SuperElementFitOptions fo;
+  fo.moving_mass = c.bench.suspended_mass;
+  fo.amplifier_gain = c.bench.amplifier_gain;
+  fo.modal_damping = s.modal_damping;
+  fo.band_min_hz = std::max(fo.band_min_hz, c.analysis.fmin_hz);
+  const fem::Modes modes = fem::modes(superelement_bench_model(se, s.setup, fo));
+  const apa::PiezoSensitivities eq41 = apa::piezo_sensitivities(apa::PiezoConstants{});
   SuperElementComparison out;
-  Index peak = 0;
-  for (Index k = 0; k < f.size(); ++k) {
-    const double v = std::abs(h[static_cast<std::size_t>(k)](0, 0)) * std::abs(s.ga * c.bench.amplifier_gain);
-    out.magnitude.x.push_back(f(k));
-    out.magnitude.y.push_back(v);
-    if (v > out.magnitude.y[static_cast<std::size_t>(peak)]) peak = k;
-  }
-  std::vector<double> measured;
-  for (const auto& u : units) {
-    if (u.resonance_Hz) measured.push_back(*u.resonance_Hz);
-  }
-  for (Index i = 0; i < std::min<Index>(10, modes.frequencies_Hz.size()); ++i) out.modes_Hz.push_back(modes.frequencies_Hz(i));
-  out.source = s.k_file.given;
+  out.source = s.given;
   out.dofs = static_cast<long>(se.size());
-  out.resonance_Hz = f(peak);
-  if (!measured.empty()) out.measured_resonance_Hz = median(measured);
+  for (Index i = 0; i < std::min<Index>(10, modes.frequencies_Hz.size()); ++i) out.modes_Hz.push_back(modes.frequencies_Hz(i));
+  out.moving_mass = fo.moving_mass;
+  out.eq41_ga = eq41.ga;
+  out.eq41_gs = eq41.gs;
   out.warnings = se.warnings;
+  std::vector<double> ga, gs, measured_res;
+  for (const auto& u : units) {
+    if (!u.frf) continue;
+    const SuperElementFit fit = fit_superelement(se, s.setup, *u.frf, fo);
+    SuperElementUnitFit row;
+    row.unit = u.id;
+    row.name = u.name;
+    row.ga = fit.ga;
+    row.gs = fit.gs;
+    row.ga_relative_to_eq41 = std::abs(fit.ga) / eq41.ga - 1.0;
+    row.gs_relative_to_eq41 = std::abs(fit.gs) / eq41.gs - 1.0;
+    row.band_lo_Hz = fit.band_lo_hz;
+    row.band_hi_Hz = fit.band_hi_hz;
+    row.resonance_Hz = fit.resonance_hz;
+    if (fit.antiresonance_hz > 0.0) row.antiresonance_Hz = fit.antiresonance_hz;
+    row.measured_resonance_Hz = u.resonance_Hz;
+    row.measured_antiresonance_Hz = u.antiresonance_Hz;
+    row.de_error_dB = fit.de_error_dB;
+    row.vs_error_dB = fit.vs_error_dB;
+    out.units.push_back(row);
+    ga.push_back(std::abs(fit.ga));
+    gs.push_back(std::abs(fit.gs));
+    if (u.resonance_Hz) measured_res.push_back(*u.resonance_Hz);
+    if (!out.figure) out.figure = SuperElementComparison::Response{u.id, u.name, fit.freq_hz, fit.de, fit.vs};
+  }
+  if (!out.units.empty()) {
+    out.ga = median(ga);
+    out.gs = median(gs);
+    out.resonance_Hz = out.units.front().resonance_Hz;
+  }
+  if (!measured_res.empty()) out.measured_resonance_Hz = median(measured_res);
   return out;
 }
 
@@ -521,7 +526,7 @@ CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
     r.iff.failed = e.what();
   }
   if (c.superelement) {
-    log("super element: " + c.superelement->k_file.given);
+    log("super element: " + c.superelement->given + " (ga and gs tuned against every unit's FRF)");
     try {
       r.superelement = superelement_comparison(c, units);
     } catch (const NumericalError& e) {

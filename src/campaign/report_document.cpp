@@ -224,8 +224,24 @@ json extra_plots(const CampaignResult& r) {
                            {"unit", *s.unit},
                            {"open_loop_pole", {p.wp * -p.xp, p.wp * std::sqrt(std::max(0.0, 1 - p.xp * p.xp))}}};
   }
-  if (r.superelement && !r.superelement->failed) {
-    extra["superelement"] = {{"f", values(r.superelement->magnitude.x)}, {"abs_um_per_V", values(r.superelement->magnitude.y, 1e6)}};
+  if (r.superelement && !r.superelement->failed && r.superelement->figure) {
+    // Figure 4.2: the tuned model thinned as the unit's measured FRF (unit_plots).
+    const SuperElementComparison::Response& m = *r.superelement->figure;
+    const VectorXd& f = m.freq_Hz;
+    json p = {{"unit", m.name}, {"f", json::array()}, {"de_abs", json::array()}, {"Vs_abs", json::array()}};
+    std::vector<std::complex<double>> de, vs;
+    if (f.size() > 1) {
+      for (const Index k : log_indices(f, std::max(0.5, f(1)), std::min(2.0 * r.campaign.analysis.fmax_hz, f(f.size() - 1)))) {
+        p["f"].push_back(f(k));
+        p["de_abs"].push_back(std::abs(m.de(k)) * 1e6);
+        p["Vs_abs"].push_back(std::abs(m.vs(k)));
+        de.push_back(m.de(k));
+        vs.push_back(m.vs(k));
+      }
+    }
+    p["de_phase"] = unwrapped_degrees(de);
+    p["Vs_phase"] = unwrapped_degrees(vs);
+    extra["superelement"] = p;
   }
   return extra;
 }
@@ -754,40 +770,59 @@ json document(const Campaign& c, const std::vector<UnitPlots>& units, const json
                         {"figures", figs}});
   }
 
-  // ---- Section 4: the super element (Figure 4.2).
+  // ---- Section 4: the super element (Figure 4.2): ga and gs tuned against the measurements,
+  // u -> d_e and u -> V_s, magnitude and phase, with the table of the tuned values.
   {
-    json figs = json::array();
+    json figs = json::array(), tables = json::array();
     std::string text;
     if (extra.contains("superelement")) {
       const json& se = extra["superelement"];
-      json mag = json::array(), phase = json::array();
+      const std::string name = se["unit"].get<std::string>();
+      json de_mag = json::array(), de_ph = json::array(), vs_mag = json::array(), vs_ph = json::array();
       for (const auto& u : units) {
-        if (!has(u.plots, "frf")) continue;
-        mag.push_back(trace(u.name, u.plots["frf"]["f"], u.plots["frf"]["de_abs"], u.name));
-        phase.push_back(trace(u.name, u.plots["frf"]["f"], u.plots["frf"]["de_phase"], u.name));
+        if (u.name != name || !has(u.plots, "frf")) continue;
+        const json& p = u.plots["frf"];
+        de_mag.push_back(trace(u.name + " measured", p["f"], p["de_abs"], "measured"));
+        de_ph.push_back(trace(u.name + " measured", p["f"], p["de_phase"], "measured"));
+        vs_mag.push_back(trace(u.name + " measured", p["f"], p["Vs_abs"], "measured"));
+        vs_ph.push_back(trace(u.name + " measured", p["f"], p["Vs_phase"], "measured"));
+        const auto [xd, yd] = on_branch(se["f"], se["de_phase"], p["f"], p["de_phase"]);
+        de_ph.push_back(trace("super element", xd, yd, "model", true));
+        const auto [xv, yv] = on_branch(se["f"], se["Vs_phase"], p["f"], p["Vs_phase"]);
+        vs_ph.push_back(trace("super element", xv, yv, "model", true));
       }
-      mag.push_back(trace("super element", se["f"], se["abs_um_per_V"], "super element", true));
-      json panels = json::array({panel("|H| [um/V]", true, mag)});
-      if (has(se, "phase_deg")) {
-        const UnitPlots* ref = nullptr;
-        for (const auto& u : units) {
-          if (!ref && has(u.plots, "frf")) ref = &u;
-        }
-        if (ref) {
-          const auto [x, y] = on_branch(se["f"], se["phase_deg"], ref->plots["frf"]["f"], ref->plots["frf"]["de_phase"]);
-          phase.push_back(trace("super element", x, y, "super element", true));
-        } else {
-          phase.push_back(trace("super element", se["f"], se["phase_deg"], "super element", true));
-        }
-        panels.push_back(panel("Phase [deg]", false, phase));
+      de_mag.push_back(trace("super element", se["f"], se["de_abs"], "model", true));
+      vs_mag.push_back(trace("super element", se["f"], se["Vs_abs"], "model", true));
+      const json& sr = results["superelement"];
+      text = fmt::format("The super element ({}, {} DOF) on the bench ({:.3g} kg on the moving interface), its sensitivities tuned "
+                         "against each unit's measured FRFs (docs/apa300ml.md) and compared with eq. 4.1 for Table 4.1's "
+                         "constants: ga {:.3g} N/V, gs {:.3g} V/um.",
+                         sr["source"].get<std::string>(), sr["dofs"].get<long>(), sr["moving_mass_kg"].get<double>(),
+                         sr["eq41"]["ga_N_per_V"].get<double>(), sr["eq41"]["gs_V_per_um"].get<double>());
+      json rows = json::array();
+      for (const auto& row : sr["units"]) {
+        rows.push_back({row["name"], row["ga_N_per_V"], scaled(row["ga_relative_to_eq41"], 100.0), row["gs_V_per_um"],
+                        scaled(row["gs_relative_to_eq41"], 100.0), row["resonance_Hz"], row["measured_resonance_Hz"],
+                        row["antiresonance_Hz"], row["measured_antiresonance_Hz"], row["de_error_dB"], row["vs_error_dB"]});
       }
-      figs.push_back(figure("superelement", "Fig. 4.2: u -> d_e, super element against the measurements", "Frequency [Hz]", true, panels));
-      text = "The super element's u -> d_e (report section 4) against the measured FRFs.";
+      tables.push_back(table("ga and gs tuned per unit against eq. 4.1",
+                             {"unit", "ga [N/V]", "vs eq. 4.1 [%]", "gs [V/um]", "vs eq. 4.1 [%]", "resonance model [Hz]",
+                              "resonance measured [Hz]", "anti-resonance model [Hz]", "anti-resonance measured [Hz]",
+                              "u -> d_e error [dB]", "u -> V_s error [dB]"},
+                             rows, "Errors: median |model / measured| in dB from the tuning band's start to twice the resonance."));
+      figs.push_back(figure("superelement", "Fig. 4.2: super element against the measurement of " + name + " (u -> d_e, u -> V_s)",
+                            "Frequency [Hz]", true,
+                            json::array({panel("|u -> d_e| [um/V]", true, de_mag), panel("d_e phase [deg]", false, de_ph),
+                                         panel("|u -> V_s| [V/V]", true, vs_mag), panel("V_s phase [deg]", false, vs_ph)}),
+                            "Solid: measured (Welch H1); dashed: the super element with the tuned ga and gs (no measurement "
+                            "chain: high-pass, anti-aliasing and delays are not in the model)."));
+    } else if (has(results["superelement"], "failed")) {
+      text = "The super element's comparison failed: " + results["superelement"]["failed"].get<std::string>();
     } else {
       text = "Not part of this campaign: no super element was given. A [superelement] table in the campaign file (docs/campaign.md) "
-             "adds the finite-element model's u -> d_e against the measured FRFs here (report Figure 4.2).";
+             "adds the finite-element model's u -> d_e and u -> V_s against the measured FRFs here (report Figure 4.2).";
     }
-    sections.push_back({{"id", "superelement"}, {"title", "Super element (report 4)"}, {"text", text}, {"figures", figs}});
+    sections.push_back({{"id", "superelement"}, {"title", "Super element (report 4)"}, {"text", text}, {"tables", tables}, {"figures", figs}});
   }
   return {{"title", c.title},
           {"subtitle", fmt::format("{} — piezobench {}", c.file.filename().string(), kVersion)},

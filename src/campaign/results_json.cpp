@@ -294,13 +294,34 @@ json iff(const IffStudy& s) {
 
 json superelement(const SuperElementComparison& s) {
   if (s.failed) return {{"failed", *s.failed}};
+  json units = json::array();
+  for (const auto& u : s.units) {
+    units.push_back({{"unit", u.unit},
+                     {"name", u.name},
+                     {"ga_N_per_V", num(u.ga)},
+                     {"gs_V_per_um", num(u.gs * 1e-6)},
+                     {"ga_relative_to_eq41", num(u.ga_relative_to_eq41)},
+                     {"gs_relative_to_eq41", num(u.gs_relative_to_eq41)},
+                     {"band_Hz", {num(u.band_lo_Hz), num(u.band_hi_Hz)}},
+                     {"resonance_Hz", num(u.resonance_Hz)},
+                     {"antiresonance_Hz", opt(u.antiresonance_Hz)},
+                     {"measured_resonance_Hz", opt(u.measured_resonance_Hz)},
+                     {"measured_antiresonance_Hz", opt(u.measured_antiresonance_Hz)},
+                     {"de_error_dB", num(u.de_error_dB)},
+                     {"vs_error_dB", num(u.vs_error_dB)}});
+  }
   json out = {{"source", s.source},
               {"dofs", s.dofs},
               {"modes_Hz", s.modes_Hz},
-              {"resonance_Hz", s.resonance_Hz},
+              {"moving_mass_kg", num(s.moving_mass)},
+              {"eq41", {{"ga_N_per_V", num(s.eq41_ga)}, {"gs_V_per_um", num(s.eq41_gs * 1e-6)}}},
+              {"units", units},
+              {"ga_N_per_V", opt(s.ga)},
+              {"gs_V_per_um", opt(s.gs, 1e-6)},
+              {"resonance_Hz", opt(s.resonance_Hz)},
               {"measured_resonance_Hz", opt(s.measured_resonance_Hz)},
               {"warnings", s.warnings}};
-  if (s.measured_resonance_Hz) out["relative_difference"] = s.resonance_Hz / *s.measured_resonance_Hz - 1.0;
+  if (s.resonance_Hz && s.measured_resonance_Hz) out["relative_difference"] = num(*s.resonance_Hz / *s.measured_resonance_Hz - 1.0);
   return out;
 }
 

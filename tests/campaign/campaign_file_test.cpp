@@ -216,8 +216,9 @@ TEST(CampaignFile, DocumentedExampleParses) {
   EXPECT_FALSE(c.units[1].has(Experiment::kFrfNoResistor));
   EXPECT_EQ(c.analysis.iff_unit, 1);
   ASSERT_TRUE(c.superelement);
-  EXPECT_EQ(c.superelement->actuator, "3:4:z");
-  EXPECT_DOUBLE_EQ(c.superelement->ga, 23.2);
+  EXPECT_EQ(c.superelement->setup.model.forces.at(0).to_string(), fem::ForcePair::parse("3:4:z", "").to_string());
+  EXPECT_EQ(c.superelement->setup.model.outputs.at(1).node_b, 5);
+  EXPECT_DOUBLE_EQ(c.superelement->modal_damping, 0.02);
 }
 
 TEST(CampaignFile, ExperimentNames) {

@@ -19,6 +19,7 @@
 
 #include "piezobench/control/iff.hpp"
 #include "piezobench/dsp/window.hpp"
+#include "piezobench/fem/superelement_setup.hpp"
 #include "piezobench/metrology/capacitance.hpp"
 #include "piezobench/metrology/flatness.hpp"
 
@@ -111,17 +112,15 @@ struct AnalysisSettings {
   int threads = 0;               // units analysed in parallel; 0 = all cores
 };
 
-// [superelement] (optional): a super element to compare with the measured u -> d_e.
-struct SuperElementSpec {
-  std::string format = "auto";          // auto, ansys, calculix, matrix-market
-  FileSpec k_file, m_file, nodes_file;  // K, M and the DOF list (see fem/superelement.hpp)
-  std::optional<FileSpec> coordinates_file;
-  std::vector<long> fix;                // clamped nodes
-  std::string actuator;                 // force pair "A:B:DIR" (the actuator stacks)
-  std::string output;                   // displacement "NODE:DIR" or "A:B:DIR" (d_e)
-  std::vector<std::string> masses;      // "NODE:KG"
-  std::string damping = "modal:0.02";   // none | modal:ZETA | rayleigh:A:B
-  double ga = -2.58;                    // N/V, force per stack volt
+// [superelement] (optional): a super element put on the bench (report section 4): bottom clamped
+// (fix), the suspended mass on the moving interface (output), guided; the actuator pair and the
+// sensor stack (sensor); ga and gs tuned against each unit's measured FRFs (superelement_fit.hpp).
+// Keys: format, k_file, m_file, nodes_file, coordinates_file, fix, actuator, output, sensor, masses
+// (added to the suspended mass), damping (modal:ZETA).
+struct CampaignSuperElement {
+  fem::SuperElementSetup setup;  // forces [actuator], outputs [output, sensor]; source = the campaign
+  std::string given;             // the K file as written in the campaign
+  double modal_damping = 0.02;
 };
 
 struct Campaign {
@@ -133,7 +132,7 @@ struct Campaign {
   AnalysisSettings analysis;
   std::map<std::string, std::string> channels;  // [channels]: role -> default channel name
   std::vector<UnitSpec> units;                  // in file order
-  std::optional<SuperElementSpec> superelement;
+  std::optional<CampaignSuperElement> superelement;
 };
 
 // Reads and validates a campaign; every measurement file must exist (InputError naming the key).

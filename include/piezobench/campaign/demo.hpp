@@ -8,7 +8,10 @@
 //                                     hysteresis_<A>V (one per amplitude), and for the IFF unit
 //                                     iff_g<G> (one per gain)
 //   DIR/data/truth.json               {seed, units: [bench::truth_json of every unit]}
-//   DIR/campaign.toml                 the campaign (specs chosen from the datasheet and the report)
+//   DIR/superelement/                 the APA300ML super element shipped in the binary (docs/apa300ml.md):
+//                                     apa300ml_K.mtx, apa300ml_M.mtx, apa300ml_dofs.txt, apa300ml.toml
+//   DIR/campaign.toml                 the campaign (specs chosen from the datasheet and the report),
+//                                     with a [superelement] table for report section 4
 //
 // Experiments are simulated in parallel (a pool over (unit, experiment) jobs). `fast` shortens the
 // noise records (FRF 8 s instead of 20 s, IFF 4 s instead of 10 s) for tests.
@@ -35,6 +38,7 @@ struct DemoOptions {
 struct DemoFiles {
   std::filesystem::path campaign;  // DIR/campaign.toml
   std::filesystem::path truth;     // DIR/data/truth.json
+  std::filesystem::path superelement;  // DIR/superelement/apa300ml.toml (with its K, M and DOF list)
   std::vector<std::filesystem::path> data;
 };
 

@@ -286,15 +286,46 @@ struct IffStudy {
   Curve open_loop_poles, open_loop_zeros;  // x Re, y Im [rad/s]
 };
 
-// The super element's u -> d_e against the measured resonances.
+// Report section 4: the super element on the bench, ga and gs tuned against one unit's measured
+// FRFs (superelement_fit.hpp).
+struct SuperElementUnitFit {
+  int unit = 0;
+  std::string name;
+  double ga = 0.0;                   // N/V (signed: the sign that makes the phases agree)
+  double gs = 0.0;                   // V/m
+  double ga_relative_to_eq41 = 0.0;  // |ga| / eq. 4.1's - 1
+  double gs_relative_to_eq41 = 0.0;
+  double band_lo_Hz = 0.0, band_hi_Hz = 0.0;  // the tuning band
+  double resonance_Hz = 0.0;                  // of the tuned model's u -> d_e
+  std::optional<double> antiresonance_Hz;     // of the tuned model's u -> V_s (below the resonance)
+  std::optional<double> measured_resonance_Hz, measured_antiresonance_Hz;  // the unit's (FrfAnalysis)
+  double de_error_dB = 0.0, vs_error_dB = 0.0;  // median |model/measured| in dB (superelement_fit.hpp)
+};
+
+// The super element's comparison with the measurements: every unit with an FRF tuned, medians,
+// eq. 4.1's sensitivities for the bench's piezo constants, and the tuned model of the first such
+// unit for Figure 4.2.
 struct SuperElementComparison {
-  std::string source;        // K file as given
+  std::string source;        // as given in the campaign
   long dofs = 0;
-  std::vector<double> modes_Hz;  // the first ten
-  double resonance_Hz = 0.0;
+  std::vector<double> modes_Hz;  // the first ten of the bench model
+  double moving_mass = 0.0;      // kg, on the moving interface
+  double eq41_ga = 0.0;          // N/V, eq. 4.1 with Table 4.1's constants
+  double eq41_gs = 0.0;          // V/m
+  std::vector<SuperElementUnitFit> units;
+  std::optional<double> ga, gs;  // N/V, V/m: medians of |ga|, |gs| over the units
+  std::optional<double> resonance_Hz;           // the first unit's tuned model
   std::optional<double> measured_resonance_Hz;  // median of the units'
   std::vector<std::string> warnings;
-  Curve magnitude;           // x f [Hz], y |u -> d_e| [m/V]
+  // Figure 4.2: the first tuned unit's model at the measured frequencies (up to the band's end).
+  struct Response {
+    int unit = 0;
+    std::string name;
+    Eigen::VectorXd freq_Hz;
+    Eigen::VectorXcd de;  // u -> d_e, m/V
+    Eigen::VectorXcd vs;  // u -> V_s, V/V
+  };
+  std::optional<Response> figure;
   std::optional<std::string> failed;
 };
 

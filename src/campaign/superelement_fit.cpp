@@ -1,0 +1,142 @@
+#include "piezobench/campaign/superelement_fit.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <vector>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::campaign {
+namespace {
+
+const char* const kSource = "superelement fit";
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The model's u -> [d_e, e_s] per newton of actuator force at `hz`.
+std::vector<Eigen::MatrixXcd> response(const fem::StructuralModel& model, const Eigen::VectorXd& hz) {
+  return fem::frequency_response(model, 2.0 * std::numbers::pi * hz);
+}
+
+}  // namespace
+
+void SuperElementFitOptions::validate() const {
+  if (!(moving_mass >= 0.0 && std::isfinite(moving_mass))) throw InputError(kSource, "moving_mass", "a mass >= 0 kg", fmt::format("{}", moving_mass));
+  if (!(amplifier_gain != 0.0 && std::isfinite(amplifier_gain))) throw InputError(kSource, "amplifier_gain", "a nonzero gain", fmt::format("{}", amplifier_gain));
+  if (!(modal_damping > 0.0 && modal_damping < 1.0)) throw InputError(kSource, "modal_damping", "a damping ratio in (0, 1)", fmt::format("{}", modal_damping));
+  if (!(band_min_hz > 0.0 && std::isfinite(band_min_hz))) throw InputError(kSource, "band_min_hz", "a frequency > 0 Hz", fmt::format("{}", band_min_hz));
+  if (!(band_fraction > 0.0 && band_fraction < 1.0)) throw InputError(kSource, "band_fraction", "a fraction in (0, 1)", fmt::format("{}", band_fraction));
+}
+
+fem::StructuralModel superelement_bench_model(const fem::SuperElement& se, const fem::SuperElementSetup& setup,
+                                              const SuperElementFitOptions& options) {
+  options.validate();
+  const std::string& src = setup.source;
+  if (setup.model.forces.empty()) throw InputError(src, "actuator", "the actuator force pair", "none");
+  if (setup.model.outputs.size() < 2) throw InputError(src, "sensor", "two outputs: d_e and the sensor stack", "fewer");
+  const fem::DisplacementOutput& out = setup.model.outputs[0];
+  if (out.node_a >= 0 || fem::is_rotation(out.direction)) {
+    throw InputError(src, "output", "the moving interface, NODE:x|y|z", out.to_string());
+  }
+  fem::ModelOptions o;
+  o.fixed_nodes = setup.model.fixed_nodes;
+  o.masses = setup.model.masses;
+  o.masses.push_back({out.node_b, options.moving_mass, 0.0});
+  o.guided.push_back({out.node_b, out.direction});
+  o.forces = {setup.model.forces[0]};
+  o.outputs = {setup.model.outputs[0], setup.model.outputs[1]};
+  o.damping.kind = fem::DampingKind::kModal;
+  o.damping.zeta = options.modal_damping;
+  return fem::assemble(se, o);
+}
+
+SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperElementSetup& setup, const dsp::Frf& measured,
+                                 const SuperElementFitOptions& options) {
+  const fem::StructuralModel model = superelement_bench_model(se, setup, options);
+  const Eigen::Index ide = measured.output_index("de");
+  const Eigen::Index ivs = measured.output_index("Vs");
+  const Eigen::VectorXd& f = measured.freq_hz;
+  SuperElementFit r;
+
+  // The model's resonance and anti-resonance on a fine log grid.
+  const Eigen::Index n = 800;
+  const Eigen::VectorXd grid = Eigen::VectorXd::LinSpaced(n, std::log10(std::max(1.0, f(0))), std::log10(std::max(2.0, f(f.size() - 1))))
+                                   .unaryExpr([](double x) { return std::pow(10.0, x); });
+  const std::vector<Eigen::MatrixXcd> hg = response(model, grid);
+  Eigen::Index peak = 0;
+  for (Eigen::Index k = 1; k < n; ++k) {
+    if (std::abs(hg[static_cast<std::size_t>(k)](0, 0)) > std::abs(hg[static_cast<std::size_t>(peak)](0, 0))) peak = k;
+  }
+  r.resonance_hz = grid(peak);
+  Eigen::Index dip = -1;
+  for (Eigen::Index k = 1; k + 1 < peak; ++k) {
+    const double a = std::abs(hg[static_cast<std::size_t>(k)](1, 0));
+    if (a < std::abs(hg[static_cast<std::size_t>(k - 1)](1, 0)) && a < std::abs(hg[static_cast<std::size_t>(k + 1)](1, 0))) dip = k;
+  }
+  r.antiresonance_hz = dip >= 0 ? grid(dip) : 0.0;
+
+  // The measured resonance: the peak of |u -> d_e|.
+  Eigen::Index mpeak = 0;
+  for (Eigen::Index k = 1; k < f.size(); ++k) {
+    if (std::abs(measured.H[static_cast<std::size_t>(ide)](k)) > std::abs(measured.H[static_cast<std::size_t>(ide)](mpeak))) mpeak = k;
+  }
+  r.band_lo_hz = options.band_min_hz;
+  r.band_hi_hz = options.band_fraction * std::min(r.resonance_hz, f(mpeak));
+  std::vector<Eigen::Index> band;
+  for (Eigen::Index k = 0; k < f.size(); ++k) {
+    if (f(k) >= r.band_lo_hz && f(k) <= r.band_hi_hz) band.push_back(k);
+  }
+  if (band.size() < 3) {
+    throw InputError(measured.provenance.source, "frf", fmt::format("frequencies in the tuning band {:.3g}-{:.3g} Hz", r.band_lo_hz, r.band_hi_hz),
+                     fmt::format("{} of them", band.size()));
+  }
+  Eigen::VectorXd fb(static_cast<Eigen::Index>(band.size()));
+  for (std::size_t i = 0; i < band.size(); ++i) fb(static_cast<Eigen::Index>(i)) = f(band[i]);
+  const std::vector<Eigen::MatrixXcd> hb = response(model, fb);
+  std::vector<double> ga_ratio, gs_ratio, de_phase, vs_phase;
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    const std::complex<double> m_de = measured.H[static_cast<std::size_t>(ide)](band[i]);
+    const std::complex<double> m_vs = measured.H[static_cast<std::size_t>(ivs)](band[i]);
+    const std::complex<double> h_de = options.amplifier_gain * hb[i](0, 0);
+    const std::complex<double> h_s = options.amplifier_gain * hb[i](1, 0);
+    ga_ratio.push_back(std::abs(m_de) / std::abs(h_de));
+    de_phase.push_back(std::cos(std::arg(m_de / h_de)));
+    gs_ratio.push_back(std::abs(m_vs) / std::abs(h_s));  // divided by |ga| below
+    vs_phase.push_back(std::cos(std::arg(m_vs / h_s)));
+  }
+  r.ga = median(ga_ratio) * (median(de_phase) < 0.0 ? -1.0 : 1.0);
+  const double ga_sign = r.ga < 0.0 ? -1.0 : 1.0;
+  r.gs = median(gs_ratio) / std::abs(r.ga) * (median(vs_phase) * ga_sign < 0.0 ? -1.0 : 1.0);
+  if (!std::isfinite(r.ga) || !std::isfinite(r.gs) || r.ga == 0.0 || r.gs == 0.0) {
+    throw NumericalError("super element sensitivities", "the model has no response to the actuator in the band", false);
+  }
+
+  // The tuned model at the measured frequencies, and its error up to twice the resonance.
+  Eigen::Index last = f.size();
+  r.freq_hz = f.head(last);
+  const std::vector<Eigen::MatrixXcd> h = response(model, r.freq_hz);
+  r.de.resize(last);
+  r.vs.resize(last);
+  std::vector<double> e_de, e_vs;
+  for (Eigen::Index k = 0; k < last; ++k) {
+    r.de(k) = options.amplifier_gain * r.ga * h[static_cast<std::size_t>(k)](0, 0);
+    r.vs(k) = options.amplifier_gain * r.ga * r.gs * h[static_cast<std::size_t>(k)](1, 0);
+    if (f(k) >= r.band_lo_hz && f(k) <= 2.0 * r.resonance_hz) {
+      e_de.push_back(std::abs(20.0 * std::log10(std::abs(r.de(k)) / std::abs(measured.H[static_cast<std::size_t>(ide)](k)))));
+      e_vs.push_back(std::abs(20.0 * std::log10(std::abs(r.vs(k)) / std::abs(measured.H[static_cast<std::size_t>(ivs)](k)))));
+    }
+  }
+  r.de_error_dB = e_de.empty() ? 0.0 : median(e_de);
+  r.vs_error_dB = e_vs.empty() ? 0.0 : median(e_vs);
+  return r;
+}
+
+}  // namespace piezobench::campaign
