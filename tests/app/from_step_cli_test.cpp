@@ -122,7 +122,7 @@ TEST(FromStepCli, BadInputExitsWithThreeAndSaysWhat) {
       {kStep + out + " --region far:box:100,100,100,101,101,101 --material far:1e9,0.3,1000", {"--region far", "no volume"}},
       {kStep + out + " --material shell:190e9,0.3,7800", {"--material", "shell"}},
       {kStep + out + " --material body:190e9,0.6,7800", {"--material body", "nu"}},
-      {kStep + out + " --preset apa300ml", {"--preset"}},
+      {kStep + out + " --preset apa200ml", {"--preset", "apa300ml"}},  // unknown; the message lists the presets
       {kStep + out + " --clamp middle", {"--clamp", "middle"}},
   };
   for (const Case& c : cases) {
