@@ -488,9 +488,6 @@ TEST(FromStep, Apa95mlAt4mmMatchesCalculixOnTheFullMesh) {
   EXPECT_FALSE(test::contains(all, "Meshing curve")) << "gmsh's per-curve lines are not forwarded";
 }
 
-}  // namespace
-}  // namespace piezobench::fem
-
 // ---- issue 15: the APA300ML geometry of the repository, stacks as beams, the size guard ---------
 
 namespace apa300ml {
@@ -568,3 +565,6 @@ TEST(FromStep, Apa300mlGeometryWithStackBeamsAt4mm) {
   EXPECT_GT(r.estimate.elements, 0.5 * static_cast<double>(r.mesh_elements));
   EXPECT_LT(r.estimate.elements, 2.0 * static_cast<double>(r.mesh_elements));
 }
+
+}  // namespace
+}  // namespace piezobench::fem
