@@ -20,6 +20,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/timeseries.hpp"
+#include "piezobench/io/toml_table.hpp"
 
 namespace piezobench::campaign {
 
@@ -196,7 +197,7 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
   const fs::path se_toml = detail::write_apa300ml_superelement(dir / "superelement");
   files.superelement = se_toml;
   {
-    const toml::table se = toml::parse_file(se_toml.string());
+    const toml::table se = io::read_toml_file(se_toml);
     const auto text = [&](const char* key) { return se[key].value<std::string>().value_or(""); };
     toml += fmt::format(
         "[superelement]                 # the APA300ML super element from our own geometry (docs/apa300ml.md)\n"
