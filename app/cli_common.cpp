@@ -1,6 +1,9 @@
 #include "cli_common.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <filesystem>
 #include <cmath>
 #include <iostream>
 
@@ -43,5 +46,50 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
 }
 
 void log_line(const std::string& message) { std::cerr << "piezobench: " << message << '\n'; }
+
+nlohmann::json quality_json(const core::FitQuality& quality) {
+  return {{"quality", core::to_string(quality.verdict)},
+          {"quality_problems", quality.problems},
+          {"physically_possible", !quality.impossible},
+          {"advice", quality.advice}};
+}
+
+int exit_code_for(const core::FitQuality& quality) {
+  return quality.poor() ? core::kPoorFitExitCode : 0;
+}
+
+int report_quality(const core::FitQuality& quality) {
+  if (quality.poor()) {
+    log_line("warning: the fit is poor (exit code 6): " + quality.summary());
+    if (quality.impossible) log_line("warning: a fitted parameter is not physical: the parameters are not shown as a result");
+  }
+  return exit_code_for(quality);
+}
+
+CLI::Validator parsed_by(const std::function<void(const std::string&)>& parse, const std::string& description) {
+  return CLI::Validator(
+      [parse](std::string& value) -> std::string {
+        try {
+          parse(value);
+        } catch (const Error& e) {
+          return e.what();
+        }
+        return {};
+      },
+      description);
+}
+
+CLI::Validator output_extension(const std::vector<std::string>& extensions) {
+  std::string list;
+  for (const auto& e : extensions) list += (list.empty() ? "" : ", ") + e;
+  return CLI::Validator(
+      [extensions, list](std::string& value) -> std::string {
+        std::string ext = std::filesystem::path(value).extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        if (std::find(extensions.begin(), extensions.end(), ext) != extensions.end()) return {};
+        return "expected a file name ending in one of " + list + ", found '" + value + "'";
+      },
+      "FILE (" + list + ")");
+}
 
 }  // namespace piezobench::app

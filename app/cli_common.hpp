@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fit_quality.hpp"
+
 namespace piezobench::app {
 
 // A command's work, run by main() after the command line is parsed, inside the handler that maps
@@ -33,5 +35,19 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
 
 // A progress or log line on stderr.
 void log_line(const std::string& message);
+
+// A CLI11 check that runs the library's own parser of the option (e.g. dsp::window_type_from_string):
+// its InputError becomes a command-line error, exit 2, before any computation.
+CLI::Validator parsed_by(const std::function<void(const std::string&)>& parse, const std::string& description);
+
+// A fit's verdict in JSON: "quality" ("good"/"poor"), "quality_problems", "advice".
+nlohmann::json quality_json(const core::FitQuality& quality);
+// core::kPoorFitExitCode (6) for a poor fit, else 0.
+int exit_code_for(const core::FitQuality& quality);
+// Prints a poor fit's problems and what to try on stderr; returns exit_code_for(quality).
+int report_quality(const core::FitQuality& quality);
+
+// A check that an output file's extension is one of `extensions` (lower case, with the dot).
+CLI::Validator output_extension(const std::vector<std::string>& extensions);
 
 }  // namespace piezobench::app

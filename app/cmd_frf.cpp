@@ -6,15 +6,21 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/welch.hpp"
+#include "piezobench/ident/features.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/ident/vector_fitting.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
+#include "piezobench/io/lti_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
+#include "piezobench/lti/analysis.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -25,22 +31,16 @@ struct FrfOptions {
   std::string outputs;
   double fs = 0.0;
   std::string window = "hann";
-  Eigen::Index nfft = 1024;
+  Eigen::Index nfft = 0;       // 0: from the record and the resolution (as `run`)
+  double resolution = 0.25;    // Hz, target bin width when nfft is 0
   double overlap = 0.5;
-  std::string detrend = "none";
+  std::string detrend = "mean";
   std::string estimator = "H1";
   std::string out;
   bool json = false;
   std::string delimiter = "auto";  // CSV input only
   std::string decimal = "auto";
 };
-
-// The CLI's short window names ("hann", "hamming", "flattop") are the periodic windows that Welch
-// averaging uses (scipy's defaults); the full names say which is meant.
-dsp::WindowType window_from_cli(const std::string& name) {
-  if (name == "hann" || name == "hamming" || name == "flattop") return dsp::window_type_from_string(name + "-periodic");
-  return dsp::window_type_from_string(name);
-}
 
 nlohmann::json frf_json(const dsp::Frf& frf) {
   nlohmann::json outputs = nlohmann::json::object();
@@ -64,14 +64,6 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
 }
 
 int run_frf(const FrfOptions& o) {
-  dsp::WelchOptions welch;
-  welch.window = window_from_cli(o.window);
-  welch.nfft = o.nfft;
-  welch.overlap = o.overlap;
-  welch.detrend = dsp::detrend_from_string(o.detrend);
-  welch.estimator = dsp::frf_estimator_from_string(o.estimator);
-  welch.validate("command line");
-
   io::ReadOptions read;
   read.fs = o.fs;
   read.channels = split_list(o.outputs, "--output");
@@ -80,13 +72,24 @@ int run_frf(const FrfOptions& o) {
   read.decimal = io::csv_decimal_from_string(o.decimal);
   if (!o.json) log_line("reading " + o.file);
   const io::TimeSeries ts = io::read_timeseries(o.file, read);
+  // The settings `run` uses for a record (dsp::welch_options_for_record), then the options given.
+  dsp::WelchOptions welch = dsp::welch_options_for_record(ts.samples(), ts.sample_rate, o.resolution, "--resolution");
+  welch.window = dsp::window_type_from_string(o.window);
+  if (o.nfft > 0) welch.nfft = o.nfft;
+  welch.overlap = o.overlap;
+  welch.detrend = dsp::detrend_from_string(o.detrend);
+  welch.estimator = dsp::frf_estimator_from_string(o.estimator);
+  welch.validate("command line");
 
   std::vector<dsp::Channel> outputs;
   for (std::size_t i = 1; i < read.channels.size(); ++i) {
     outputs.push_back({read.channels[i], {ts.data.col(static_cast<Eigen::Index>(i)).data(), static_cast<std::size_t>(ts.samples())}});
   }
   const dsp::Channel input{o.input, {ts.data.col(0).data(), static_cast<std::size_t>(ts.samples())}};
-  if (!o.json) log_line(fmt::format("{} samples at {:g} Hz, nfft {}, {} outputs", ts.samples(), ts.sample_rate, o.nfft, outputs.size()));
+  if (!o.json) {
+    log_line(fmt::format("{} samples at {:g} Hz, nfft {} ({:.4g} Hz bins), {} outputs", ts.samples(), ts.sample_rate, welch.nfft,
+                         ts.sample_rate / static_cast<double>(welch.nfft), outputs.size()));
+  }
   const dsp::FrfEstimate estimate = dsp::estimate_frf(input, outputs, ts.sample_rate, welch, o.file);
 
   if (!o.out.empty()) {
@@ -109,14 +112,21 @@ int run_frf(const FrfOptions& o) {
   fmt::print("FRF {} of {} -> {}: {} averages, window {} ({} samples), {:.4g} Hz resolution\n",
              frf.provenance.estimator, frf.input, fmt::join(frf.outputs, ", "), frf.provenance.averages,
              frf.provenance.window, frf.provenance.nfft, frf.freq_hz.size() > 1 ? frf.freq_hz(1) - frf.freq_hz(0) : 0.0);
+  // The summary covers the band the input excited (coherence >= 0.5), not the noise around it.
+  const dsp::FrequencyBand band = dsp::excited_band(frf, 0.5);
+  fmt::print("excited band (coherence >= 0.5): {:.4g} to {:.4g} Hz\n", band.fmin_hz, band.fmax_hz);
   for (std::size_t i = 0; i < frf.outputs.size(); ++i) {
-    Eigen::Index peak = 1;
-    for (Eigen::Index k = 1; k < frf.freq_hz.size(); ++k) {
-      if (std::abs(frf.H[i](k)) > std::abs(frf.H[i](peak))) peak = k;
+    Eigen::Index peak = -1;
+    double coh_sum = 0.0;
+    int count = 0;
+    for (Eigen::Index k = 0; k < frf.freq_hz.size(); ++k) {
+      if (frf.freq_hz(k) < band.fmin_hz || frf.freq_hz(k) > band.fmax_hz) continue;
+      if (peak < 0 || std::abs(frf.H[i](k)) > std::abs(frf.H[i](peak))) peak = k;
+      coh_sum += frf.coherence[i](k);
+      ++count;
     }
-    const double mean_coh = frf.coherence[i].size() > 1 ? frf.coherence[i].tail(frf.coherence[i].size() - 1).mean() : 0.0;
-    fmt::print("  {}: peak |H| {:.4g} at {:.4g} Hz, mean coherence {:.3f}\n", frf.outputs[i], std::abs(frf.H[i](peak)),
-               frf.freq_hz(peak), mean_coh);
+    fmt::print("  {}: peak |H| {:.4g} at {:.4g} Hz, mean coherence {:.3f} in the band\n", frf.outputs[i], std::abs(frf.H[i](peak)),
+               frf.freq_hz(peak), count > 0 ? coh_sum / count : 0.0);
   }
   return 0;
 }
@@ -128,16 +138,26 @@ struct FitOptions {
   double fmax = 0.0;
   std::string outputs;
   std::string asymptote = "d";
-  std::string weighting = "unit";
+  std::string weighting = "output-scale";
   int max_iterations = 50;
   std::string out;
   bool json = false;
 };
 
-// The part of an FRF inside [fmin, fmax] (0 = no bound), for the named outputs (empty = all).
-dsp::Frf select_band(const dsp::Frf& frf, const FitOptions& o) {
+// The part of an FRF inside [fmin, fmax], for the named outputs (empty = all). Without --fmin and
+// --fmax: the band the input excited (dsp::excited_band, coherence >= 0.5), as `run` and
+// `model tune`; a bound given alone keeps the other one open.
+dsp::Frf select_band(const dsp::Frf& frf, FitOptions o) {
   if (o.fmin < 0.0 || (o.fmax > 0.0 && o.fmax <= o.fmin)) {
     throw InputError("", "--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
+  }
+  if (o.fmin == 0.0 && o.fmax == 0.0) {
+    const dsp::FrequencyBand excited = dsp::excited_band(frf, 0.5);
+    if (excited.from_coherence) {
+      o.fmin = excited.fmin_hz;
+      o.fmax = excited.fmax_hz;
+      if (!o.json) log_line(fmt::format("band {:.4g} to {:.4g} Hz: where the coherence is at least 0.5 (--fmin/--fmax to choose)", o.fmin, o.fmax));
+    }
   }
   std::vector<Eigen::Index> keep;
   for (Eigen::Index k = 0; k < frf.freq_hz.size(); ++k) {
@@ -172,24 +192,96 @@ dsp::Frf select_band(const dsp::Frf& frf, const FitOptions& o) {
   return band;
 }
 
-nlohmann::json fit_json(const ident::VectorFittingResult& r, const dsp::Frf& band) {
+// The zeros of output i of the fitted model (its proper part), with Im >= 0, by frequency.
+std::vector<lti::Complex> output_zeros(const ident::VectorFittingResult& r, Eigen::Index i) {
+  lti::StateSpace one = r.model;
+  one.C = r.model.C.row(i);
+  one.D = r.model.D.row(i);
+  const lti::CVector z = lti::zeros(one);
+  std::vector<lti::Complex> out;
+  for (Eigen::Index k = 0; k < z.size(); ++k) {
+    if (z(k).imag() >= 0.0 && std::isfinite(std::abs(z(k)))) out.push_back(z(k));
+  }
+  std::sort(out.begin(), out.end(), [](lti::Complex a, lti::Complex b) { return std::abs(a) < std::abs(b); });
+  return out;
+}
+
+struct ZeroReport {
+  lti::Complex zero;
+  bool lightly_damped = false;            // |damping| < 0.2
+  std::optional<bool> nonminimum_phase;   // for a lightly damped pair: the data's phase, else the model's
+  std::string evidence;                   // "phase of the data (-178 deg)" or "fitted zero"
+};
+
+std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const dsp::Frf& band, Eigen::Index i,
+                                     const ident::VectorFittingOptions& vf) {
+  std::vector<ZeroReport> out;
+  // The phase of the data across each lightly damped zero pair (ident::frf_features).
+  std::vector<ident::AntiResonance> anti;
+  try {
+    ident::FrfFeatureOptions fo;
+    fo.fit = vf;
+    fo.fit.weighting = ident::Weighting::kUnit;
+    if (fo.fit.asymptote == ident::Asymptote::kConstantAndLinear) fo.fit.asymptote = ident::Asymptote::kConstant;
+    fo.fit.fail_if_not_converged = false;
+    anti = ident::frf_features(2 * std::numbers::pi * band.freq_hz, band.H[static_cast<std::size_t>(i)], fo).antiresonances;
+  } catch (const Error&) {
+    // no phase evidence: the fitted zero decides
+  }
+  for (const lti::Complex z : output_zeros(r, i)) {
+    ZeroReport rep;
+    rep.zero = z;
+    const double damping = std::abs(z) > 0.0 ? -z.real() / std::abs(z) : 0.0;
+    rep.lightly_damped = z.imag() > 0.0 && std::abs(damping) < 0.2;
+    if (rep.lightly_damped) {
+      rep.nonminimum_phase = z.real() > 0.0;
+      rep.evidence = "fitted zero";
+      for (const auto& a : anti) {
+        if (std::abs(a.natural_frequency / std::abs(z) - 1.0) < 0.05 && a.phase_verdict != ident::PhaseVerdict::kUndetermined) {
+          rep.nonminimum_phase = a.phase_verdict == ident::PhaseVerdict::kNonMinimumPhase;
+          rep.evidence = fmt::format("phase of the data ({:+.0f} deg across it)", a.phase_change_deg);
+        }
+      }
+    }
+    out.push_back(rep);
+  }
+  return out;
+}
+
+nlohmann::json fit_json(const ident::VectorFittingResult& r, const dsp::Frf& band, const std::vector<std::vector<ZeroReport>>& zeros) {
   nlohmann::json residues = nlohmann::json::array();
   for (Eigen::Index i = 0; i < r.residues.rows(); ++i) residues.push_back(io::to_json(Eigen::VectorXcd(r.residues.row(i).transpose())));
-  return {{"source", band.provenance.source},
-          {"outputs", band.outputs},
-          {"fmin_Hz", band.freq_hz(0)},
-          {"fmax_Hz", band.freq_hz(band.freq_hz.size() - 1)},
-          {"order", r.poles.size()},
-          {"poles", io::to_json(r.poles)},
-          {"residues", residues},
-          {"d", io::to_json(r.d)},
-          {"e", io::to_json(r.e)},
-          {"rms_error", io::to_json(r.rms_error)},
-          {"relative_rms_error", io::to_json(r.relative_rms_error)},
-          {"iterations", r.iterations},
-          {"converged", r.converged},
-          {"convergence", ident::to_string(r.convergence)},
-          {"frequency_scale_rad_per_s", r.frequency_scale}};
+  nlohmann::json per_output = nlohmann::json::object();
+  for (std::size_t i = 0; i < band.outputs.size(); ++i) {
+    nlohmann::json z = nlohmann::json::array();
+    for (const auto& rep : zeros[i]) {
+      z.push_back({{"zero", io::to_json(rep.zero)},
+                   {"frequency_Hz", std::abs(rep.zero) / (2 * std::numbers::pi)},
+                   {"lightly_damped", rep.lightly_damped},
+                   {"nonminimum_phase", rep.nonminimum_phase ? nlohmann::json(*rep.nonminimum_phase) : nlohmann::json(nullptr)},
+                   {"evidence", rep.evidence}});
+    }
+    per_output[band.outputs[i]] = {{"relative_rms_error", io::to_json(r.relative_rms_error_per_output(static_cast<Eigen::Index>(i)))},
+                                   {"zeros", z}};
+  }
+  nlohmann::json doc = {{"source", band.provenance.source},
+                        {"outputs", band.outputs},
+                        {"fmin_Hz", band.freq_hz(0)},
+                        {"fmax_Hz", band.freq_hz(band.freq_hz.size() - 1)},
+                        {"order", r.poles.size()},
+                        {"poles", io::to_json(r.poles)},
+                        {"residues", residues},
+                        {"d", io::to_json(r.d)},
+                        {"e", io::to_json(r.e)},
+                        {"rms_error", io::to_json(r.rms_error)},
+                        {"relative_rms_error", io::to_json(r.relative_rms_error)},
+                        {"per_output", per_output},
+                        {"iterations", r.iterations},
+                        {"converged", r.converged},
+                        {"convergence", ident::to_string(r.convergence)},
+                        {"frequency_scale_rad_per_s", r.frequency_scale}};
+  doc.update(quality_json(r.quality));
+  return doc;
 }
 
 int run_fit(const FitOptions& o) {
@@ -202,11 +294,13 @@ int run_fit(const FitOptions& o) {
   const dsp::Frf band = select_band(io::read_frf(o.file), o);
   if (!o.json) log_line(fmt::format("fitting {} poles to {} points of {}", o.order, band.freq_hz.size(), fmt::join(band.outputs, ", ")));
   const ident::VectorFittingResult r = ident::vector_fit(band, vf);
-  const nlohmann::json document = fit_json(r, band);
+  std::vector<std::vector<ZeroReport>> zeros;
+  for (std::size_t i = 0; i < band.outputs.size(); ++i) zeros.push_back(zero_reports(r, band, static_cast<Eigen::Index>(i), vf));
+  const nlohmann::json document = fit_json(r, band, zeros);
   if (!o.out.empty()) io::write_text_atomically(o.out, document.dump(2) + "\n");
   if (o.json) {
     print_json(document);
-    return 0;
+    return report_quality(r.quality);
   }
   fmt::print("{}\n", r.brief_report());
   fmt::print("{:>26}  {:>10}  {:>9}\n", "pole [rad/s]", "f [Hz]", "damping");
@@ -215,7 +309,91 @@ int run_fit(const FitOptions& o) {
     fmt::print("{:>12.6g} {:+12.6g}j  {:>10.5g}  {:>9.5f}\n", p.real(), p.imag(), std::abs(p) / (2 * std::numbers::pi),
                std::abs(p) > 0 ? -p.real() / std::abs(p) : 0.0);
   }
-  return 0;
+  for (std::size_t i = 0; i < band.outputs.size(); ++i) {
+    fmt::print("{}: relative rms error {:.3g}; zeros of the fitted model:{}\n", band.outputs[i],
+               r.relative_rms_error_per_output(static_cast<Eigen::Index>(i)), zeros[i].empty() ? " none" : "");
+    for (const auto& rep : zeros[i]) {
+      const lti::Complex z = rep.zero;
+      fmt::print("  {:>12.6g} {:+12.6g}j  {:>10.5g} Hz  damping {:+.5f}", z.real(), z.imag(), std::abs(z) / (2 * std::numbers::pi),
+                 std::abs(z) > 0 ? -z.real() / std::abs(z) : 0.0);
+      if (rep.nonminimum_phase) {
+        fmt::print("  lightly damped, {} (from the {})", *rep.nonminimum_phase ? "NON-minimum phase" : "minimum phase", rep.evidence);
+      }
+      fmt::print("\n");
+    }
+  }
+  return report_quality(r.quality);
+}
+
+// `fit iff-plant`: the IFF plant of the report (eq. 2.3 with delay) fitted to u -> Vs; its TOML
+// is what `iff rlocus --plant` reads.
+struct IffPlantOptions {
+  std::string file;
+  std::string output = "Vs";
+  double fmin = 0.0;
+  double fmax = 0.0;
+  double hpf_fmax = 5.0;
+  double min_coherence = 0.5;
+  std::string out;
+  bool json = false;
+};
+
+int run_fit_iff_plant(const IffPlantOptions& o) {
+  if (o.fmin < 0.0 || (o.fmax > 0.0 && o.fmax <= o.fmin)) {
+    throw InputError("", "--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
+  }
+  const dsp::Frf frf = io::read_frf(o.file);
+  const auto i = static_cast<std::size_t>(frf.output_index(o.output));
+  ident::IffPlantFitOptions fo;
+  fo.fmin_hz = o.fmin;
+  fo.fmax_hz = o.fmax;
+  if (o.fmin == 0.0 && o.fmax == 0.0) {
+    const dsp::FrequencyBand excited = dsp::excited_band(frf, o.min_coherence);
+    fo.fmin_hz = excited.fmin_hz;
+    fo.fmax_hz = excited.fmax_hz;
+  }
+  fo.hpf_fmax_hz = o.hpf_fmax;
+  fo.min_coherence = o.min_coherence;
+  if (!o.json) log_line(fmt::format("fitting the IFF plant (eq. 2.3 with delay) to u -> {} of {}, {:.4g} to {:.4g} Hz", o.output, o.file, fo.fmin_hz, fo.fmax_hz));
+  const lti::Vector coh = i < frf.coherence.size() ? frf.coherence[i] : lti::Vector();
+  const ident::IffPlantFit p = ident::fit_iff_plant(2 * std::numbers::pi * frf.freq_hz, frf.H[i], coh, fo, o.file);
+  const double hz = 1.0 / (2 * std::numbers::pi);
+  nlohmann::json doc = {{"source", o.file},
+                        {"output", o.output},
+                        {"band_Hz", {fo.fmin_hz, fo.fmax_hz}},
+                        {"relative_rms_error", io::to_json(p.relative_rms_error)},
+                        {"points", p.points},
+                        {"iterations", p.iterations},
+                        {"status", core::to_string(p.status)},
+                        {"formula", "G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) s / (w_hpf + s) exp(-s delay)"}};
+  if (!p.quality.impossible) {
+    doc["plant"] = {{"g0", io::to_json(p.g0)},          {"wz_Hz", io::to_json(p.wz * hz)},   {"xz", io::to_json(p.xz)},
+                    {"wp_Hz", io::to_json(p.wp * hz)},  {"xp", io::to_json(p.xp)},          {"w_hpf_Hz", io::to_json(p.w_hpf * hz)},
+                    {"delay_s", io::to_json(p.delay)}, {"zero_is_nonminimum_phase", p.zero_is_nonminimum_phase()}};
+  }
+  doc.update(quality_json(p.quality));
+  if (!o.out.empty() && !p.quality.impossible) {
+    io::write_lti_toml(p.transfer_function(), o.out,
+                       fmt::format("IFF plant (eq. 2.3) fitted to u -> {} of {} by piezobench fit iff-plant, {:.4g} to {:.4g} Hz, "
+                                   "relative rms error {:.3g}, quality {}",
+                                   o.output, o.file, fo.fmin_hz, fo.fmax_hz, p.relative_rms_error, core::to_string(p.quality.verdict)));
+    if (!o.json) log_line("wrote " + o.out + " (read by `iff rlocus --plant`)");
+  }
+  if (o.json) {
+    print_json(doc);
+    return report_quality(p.quality);
+  }
+  fmt::print("IFF plant (eq. 2.3 with delay) fitted to u -> {} of {}, {:.4g} to {:.4g} Hz ({} points)\n", o.output, o.file,
+             fo.fmin_hz, fo.fmax_hz, p.points);
+  if (!p.quality.impossible) {
+    fmt::print("  g0 = {:.5g} V/V, wz = {:.5g} Hz, xz = {:+.4g}, wp = {:.5g} Hz, xp = {:.4g}\n", p.g0, p.wz * hz, p.xz, p.wp * hz, p.xp);
+    fmt::print("  high-pass corner {:.4g} Hz, delay {:.4g} us\n", p.w_hpf * hz, p.delay * 1e6);
+    fmt::print("  zero pair: {} phase (xz {} 0)\n", p.zero_is_nonminimum_phase() ? "NON-minimum" : "minimum",
+               p.zero_is_nonminimum_phase() ? "<" : ">=");
+  }
+  fmt::print("  relative rms error {:.3g}, Levenberg-Marquardt {} after {} steps\n", p.relative_rms_error, core::to_string(p.status),
+             p.iterations);
+  return report_quality(p.quality);
 }
 
 }  // namespace
@@ -228,14 +406,24 @@ void add_frf_commands(CLI::App& app, Action& action) {
   frf->add_option("--output", f->outputs, "output channel names, comma-separated (e.g. de,Vs)")->required();
   frf->add_option("--fs", f->fs, "sample rate, Hz (needed when the file has no time vector t)");
   frf->add_option("--window", f->window,
-                  "hann (= hann-periodic), hann-symmetric, hamming (= hamming-periodic), hamming-symmetric, flattop "
-                  "(= flattop-periodic), flattop-symmetric, rectangular")
-      ->capture_default_str();
-  frf->add_option("--nfft", f->nfft, "segment length, samples (any integer >= 2)")->capture_default_str();
+                  "hann (= hann-periodic, scipy's), hann-symmetric, hanning (MATLAB's), hamming (= hamming-periodic), "
+                  "hamming-symmetric, flattop (= flattop-periodic), flattop-symmetric, flattopwin (MATLAB's), rectangular "
+                  "(boxcar, rectwin); any case")
+      ->capture_default_str()
+      ->check(parsed_by([](const std::string& v) { (void)dsp::window_type_from_string(v); }, "WINDOW"));
+  frf->add_option("--nfft", f->nfft, "segment length, samples (0 = as `run`: 1/--resolution seconds, at most a quarter of the record)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  frf->add_option("--resolution", f->resolution, "target bin width when --nfft is 0, Hz")->capture_default_str()->check(CLI::PositiveNumber);
   frf->add_option("--overlap", f->overlap, "overlap of segments, fraction of nfft in [0, 1)")->capture_default_str();
-  frf->add_option("--detrend", f->detrend, "none, mean or linear (per segment)")->capture_default_str();
-  frf->add_option("--estimator", f->estimator, "H1 (noise on the output) or H2 (noise on the input)")->capture_default_str();
-  frf->add_option("--out", f->out, "write the FRF: .csv, .mat or .uff (Universal File Format 58)");
+  frf->add_option("--detrend", f->detrend, "none, mean or linear (per segment)")
+      ->capture_default_str()
+      ->check(parsed_by([](const std::string& v) { (void)dsp::detrend_from_string(v); }, "DETREND"));
+  frf->add_option("--estimator", f->estimator, "H1 (noise on the output) or H2 (noise on the input)")
+      ->capture_default_str()
+      ->check(parsed_by([](const std::string& v) { (void)dsp::frf_estimator_from_string(v); }, "ESTIMATOR"));
+  frf->add_option("--out", f->out, "write the FRF: .csv, .mat or .uff (Universal File Format 58)")
+      ->check(output_extension({".csv", ".mat", ".uff", ".unv", ".uf"}));
   frf->add_flag("--json", f->json, "print one JSON document on stdout");
   frf->add_option("--delimiter", f->delimiter, "CSV input: auto (detected), ',', ';', tab or space")
       ->check(CLI::IsMember({"auto", ",", ";", "tab", "space"}))
@@ -246,18 +434,48 @@ void add_frf_commands(CLI::App& app, Action& action) {
   frf->callback([f, &action] { action = [f] { return run_frf(*f); }; });
 
   auto v = std::make_shared<FitOptions>();
-  CLI::App* fit = app.add_subcommand("fit", "Vector fitting (Gustavsen & Semlyen) of an FRF file: common poles, residues, D");
-  fit->add_option("file", v->file, "FRF file: .csv (freq_Hz,re_NAME,im_NAME[,coh_NAME]...), .mat or .uff")->required()->check(CLI::ExistingFile);
-  fit->add_option("--order", v->order, "number of poles")->required();
-  fit->add_option("--fmin", v->fmin, "lowest frequency used, Hz");
-  fit->add_option("--fmax", v->fmax, "highest frequency used, Hz (0 = all)");
+  CLI::App* fit = app.add_subcommand("fit", "Vector fitting (Gustavsen & Semlyen) of an FRF file: common poles, residues, D, zeros per output; "
+                                            "`fit iff-plant`: the IFF plant of eq. 2.3");
+  fit->require_subcommand(0, 1);
+  fit->add_option("file", v->file, "FRF file: .csv (freq_Hz,re_NAME,im_NAME[,coh_NAME]...), .mat or .uff")->check(CLI::ExistingFile);
+  fit->add_option("--order", v->order, "number of poles")->check(CLI::PositiveNumber);
+  fit->add_option("--fmin", v->fmin, "lowest frequency used, Hz (default: the band where the coherence is at least 0.5)");
+  fit->add_option("--fmax", v->fmax, "highest frequency used, Hz (0 = all; default: as --fmin)");
   fit->add_option("--output", v->outputs, "outputs to fit, comma-separated (default: all, with common poles)");
-  fit->add_option("--asymptote", v->asymptote, "none, d or de (d + s e)")->capture_default_str();
-  fit->add_option("--weighting", v->weighting, "unit, inverse-magnitude or inverse-sqrt-magnitude")->capture_default_str();
+  fit->add_option("--asymptote", v->asymptote, "none, d or de (d + s e)")
+      ->capture_default_str()
+      ->check(parsed_by([](const std::string& x) { (void)ident::asymptote_from_string(x); }, "ASYMPTOTE"));
+  fit->add_option("--weighting", v->weighting,
+                  "output-scale (each output by 1/rms|H|: outputs in other units count alike), unit, inverse-magnitude or "
+                  "inverse-sqrt-magnitude")
+      ->capture_default_str()
+      ->check(parsed_by([](const std::string& x) { (void)ident::weighting_from_string(x); }, "WEIGHTING"));
   fit->add_option("--max-iterations", v->max_iterations, "pole relocations at most")->capture_default_str();
-  fit->add_option("--out", v->out, "write the fitted model as JSON (same document as --json)");
+  fit->add_option("--out", v->out, "write the fitted model as JSON (same document as --json)")->check(output_extension({".json"}));
   fit->add_flag("--json", v->json, "print one JSON document on stdout");
-  fit->callback([v, &action] { action = [v] { return run_fit(*v); }; });
+
+  auto ip = std::make_shared<IffPlantOptions>();
+  CLI::App* iff_plant = fit->add_subcommand("iff-plant", "Fit the IFF plant of the report (eq. 2.3 with delay) to u -> Vs; --out writes "
+                                                         "the TOML that `iff rlocus --plant` reads");
+  iff_plant->add_option("file", ip->file, "FRF file (.csv, .mat, .uff) with the output")->required()->check(CLI::ExistingFile);
+  iff_plant->add_option("--output", ip->output, "the force-sensor output")->capture_default_str();
+  iff_plant->add_option("--fmin", ip->fmin, "lowest frequency used, Hz (default: the band where the coherence is at least --min-coherence)");
+  iff_plant->add_option("--fmax", ip->fmax, "highest frequency used, Hz (0 = all)");
+  iff_plant->add_option("--hpf-fmax", ip->hpf_fmax, "points below this start the high-pass corner, Hz")->capture_default_str()->check(CLI::PositiveNumber);
+  iff_plant->add_option("--min-coherence", ip->min_coherence, "leave out frequencies with a lower coherence")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.999));
+  iff_plant->add_option("--out", ip->out, "write the plant as an LTI TOML file (transfer function with delay)")
+      ->check(output_extension({".toml"}));
+  iff_plant->add_flag("--json", ip->json, "print one JSON document on stdout");
+  iff_plant->callback([ip, &action] { action = [ip] { return run_fit_iff_plant(*ip); }; });
+
+  fit->callback([v, fit, &action] {
+    if (!fit->get_subcommands().empty()) return;
+    if (v->file.empty()) throw CLI::RequiredError("file");
+    if (fit->count("--order") == 0) throw CLI::RequiredError("--order");
+    action = [v] { return run_fit(*v); };
+  });
 }
 
 }  // namespace piezobench::app

@@ -14,6 +14,8 @@
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/apa/two_dof.hpp"
 #include "piezobench/apa/two_dof_file.hpp"
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
@@ -115,6 +117,8 @@ struct TuneCommand {
   std::string frf_file;
   apa::TuningOptions options;
   bool no_refine = false;
+  bool min_coherence_given = false;
+  bool delay_given = false;
   bool json = false;
 };
 
@@ -123,14 +127,44 @@ int run_tune(const TuneCommand& c) {
   o.refine = !c.no_refine;
   o.validate();
   const dsp::Frf frf = io::read_frf(c.frf_file);
-  if (!c.json) log_line(fmt::format("tuning the 2-DoF model on {} ({} frequencies)", c.frf_file, frf.freq_hz.size()));
-  const apa::TwoDofTuning t = apa::tune_two_dof(frf, o);
+  const Eigen::Index de = frf.output_index(o.de_output), vs = frf.output_index(o.vs_output);
+  const auto ude = static_cast<std::size_t>(de), uvs = static_cast<std::size_t>(vs);
+  // The campaign's procedure and defaults (as `run`): the campaign's band (20 to 500 Hz: eq. 2.3
+  // lacks the node relaxation above) inside the band the input excited (coherence), unless given;
+  // the delays and the high-pass corner from the plant fits; then the tuning with that chain removed.
+  const dsp::FrequencyBand excited = dsp::excited_band(frf, 0.5);
+  const bool has_coherence = excited.from_coherence;
+  const ident::ActuatorPlantOptions defaults;
+  if (o.fmin_hz == 0.0) o.fmin_hz = std::max(defaults.fmin_hz, excited.fmin_hz);
+  if (o.fmax_hz == 0.0) o.fmax_hz = std::min(defaults.fmax_hz, excited.fmax_hz);
+  if (c.min_coherence_given) {
+    o.min_coherence = c.options.min_coherence;
+  } else if (has_coherence) {
+    o.min_coherence = defaults.min_coherence;
+  }
+  o.validate();
+  if (!c.json) {
+    log_line(fmt::format("tuning the 2-DoF model on {} ({} frequencies, band {:.4g} to {:.4g} Hz{})", c.frf_file, frf.freq_hz.size(),
+                         o.fmin_hz, o.fmax_hz, has_coherence ? " where the coherence is at least 0.5" : ""));
+  }
+  ident::ActuatorPlantOptions po;  // the Vs fit goes down to the lowest frequency for the high-pass corner
+  po.fmin_hz = o.fmin_hz;
+  po.fmax_hz = o.fmax_hz;
+  po.min_coherence = o.min_coherence;
+  if (o.bench.hpf_resistance > 0.0 && o.bench.hpf_capacitance > 0.0) po.fixed_w_hpf = o.bench.hpf_corner();
+  const lti::Vector omega = kTwoPi * frf.freq_hz;
+  const auto coh = [&](std::size_t i) { return i < frf.coherence.size() ? frf.coherence[i] : lti::Vector(); };
+  const ident::ActuatorPlants plants = ident::fit_actuator_plants(omega, frf.H[ude], coh(ude), frf.H[uvs], coh(uvs), po, c.frf_file);
+  for (const auto& f : plants.failures) log_line("warning: " + f);
+  const bool given_delay = c.delay_given;
+  const apa::TwoDofTuning t = apa::tune_two_dof_measured(frf, o, plants.de && !given_delay ? &*plants.de : nullptr,
+                                                         plants.vs && po.fixed_w_hpf == 0.0 ? &*plants.vs : nullptr);
   if (c.json) {
-    print_json({{"source", c.frf_file},
-                {"model_2dof", params_json(t.params)},
+    nlohmann::json doc = {{"source", c.frf_file},
+                {"model_2dof", t.quality.impossible ? nlohmann::json(nullptr) : params_json(t.params)},
                 {"fit_error", {{"de", io::to_json(t.fit_error_de)}, {"Vs", io::to_json(t.fit_error_vs)}}},
                 {"fit_error_definition", "rms over the frequencies used of |H_model / H_data - 1| per output"},
-                {"initial", params_json(t.initial)},
+                {"initial", t.quality.impossible ? nlohmann::json(nullptr) : params_json(t.initial)},
                 {"initial_fit_error", {{"de", io::to_json(t.initial_fit_error_de)}, {"Vs", io::to_json(t.initial_fit_error_vs)}}},
                 {"features",
                  {{"resonance_Hz", io::to_json(t.features.resonance / kTwoPi)},
@@ -140,21 +174,33 @@ int run_tune(const TuneCommand& c) {
                   {"static_gain_de_um_per_V", io::to_json(t.features.static_gain_de * 1e6)},
                   {"static_gain_Vs_V_per_V", io::to_json(t.features.static_gain_vs)}}},
                 {"amplifier_gain", o.bench.amplifier_gain},
+                {"band_Hz", {o.fmin_hz, o.fmax_hz}},
+                {"min_coherence", o.min_coherence},
+                {"chain", {{"delay_s", t.bench.delay}, {"hpf_corner_Hz", t.bench.hpf_corner() / kTwoPi}}},
                 {"stack_stiffness_ratio", o.stack_stiffness_ratio},
                 {"points", t.points},
                 {"iterations", t.iterations},
                 {"status", apa::to_string(t.status)},
-                {"message", t.message}});
-    return 0;
+                {"message", t.message}};
+    doc.update(quality_json(t.quality));
+    print_json(doc);
+    return report_quality(t.quality);
   }
   const apa::TwoDofParams& p = t.params;
-  fmt::print("2-DoF model tuned on {} (mass {:.4g} kg, amplifier {:.4g} V/V)\n", c.frf_file, p.m, o.bench.amplifier_gain);
+  if (t.quality.impossible) {
+    fmt::print("2-DoF model tuning on {} ({:.4g} to {:.4g} Hz) gave no physical parameters\n{}\n", c.frf_file, o.fmin_hz, o.fmax_hz,
+               t.brief_report());
+    return report_quality(t.quality);
+  }
+  fmt::print("2-DoF model tuned on {} (mass {:.4g} kg, amplifier {:.4g} V/V, {:.4g} to {:.4g} Hz)\n", c.frf_file, p.m,
+             o.bench.amplifier_gain, o.fmin_hz, o.fmax_hz);
+  fmt::print("  chain removed: delay {:.4g} us, high-pass on Vs at {:.4g} Hz\n", t.bench.delay * 1e6, t.bench.hpf_corner() / kTwoPi);
   fmt::print("  k1 = {:.4g} N/um, c1 = {:.4g} Ns/m\n", p.k1 * 1e-6, p.c1);
   fmt::print("  ke = {:.4g} N/um, ce = {:.4g} Ns/m, ka = {:.4g} N/um, ca = {:.4g} Ns/m\n", p.ke * 1e-6, p.ce,
              p.ka * 1e-6, p.ca);
   fmt::print("  ga = {:.4g} N/V, gs = {:.4g} V/um\n", p.ga, p.gs * 1e-6);
-  fmt::print("{}\n{}\n", t.brief_report(), t.message);
-  return 0;
+  fmt::print("{}\n{}\nquality: {}\n", t.brief_report(), t.message, core::to_string(t.quality.verdict));
+  return report_quality(t.quality);
 }
 
 // ------------------------------------------------------------------------------ piezo
@@ -222,16 +268,20 @@ void add_model_commands(CLI::App& app, Action& action) {
       ->check(CLI::ExistingFile);
   tune->add_option("--mass", u->options.mass, "known moving mass m, kg")->capture_default_str();
   add_bench_options(tune, u->options.bench);
-  tune->add_option("--fmin", u->options.fmin_hz, "lowest frequency used, Hz (default: all)");
-  tune->add_option("--fmax", u->options.fmax_hz, "highest frequency used, Hz (default: all)");
-  tune->add_option("--min-coherence", u->options.min_coherence, "leave out frequencies with a lower coherence");
+  tune->add_option("--fmin", u->options.fmin_hz, "lowest frequency used, Hz (default: 20 Hz as `run`, or where the coherence reaches 0.5)");
+  tune->add_option("--fmax", u->options.fmax_hz, "highest frequency used, Hz (default: 500 Hz as `run`, or where the coherence falls below 0.5)");
+  tune->add_option("--min-coherence", u->options.min_coherence, "leave out frequencies with a lower coherence (default 0.5 when the file has coherence)");
   tune->add_option("--stack-ratio", u->options.stack_stiffness_ratio, "ke/ka kept during the refinement (0 = free)")
       ->capture_default_str();
   tune->add_option("--de-output", u->options.de_output, "name of the displacement output")->capture_default_str();
   tune->add_option("--vs-output", u->options.vs_output, "name of the force-sensor output")->capture_default_str();
   tune->add_flag("--no-refine", u->no_refine, "stop after the report's procedure (no least-squares refinement)");
   tune->add_flag("--json", u->json, "print one JSON document on stdout");
-  tune->callback([u, &action] { action = [u] { return run_tune(*u); }; });
+  tune->callback([u, tune, &action] {
+    u->min_coherence_given = tune->count("--min-coherence") > 0;
+    u->delay_given = tune->count("--delay") > 0;
+    action = [u] { return run_tune(*u); };
+  });
 
   auto pz = std::make_shared<PiezoCommand>();
   CLI::App* piezo = app.add_subcommand("piezo", "Stack sensitivities ga, gs and stiffness ka from piezo constants (eq. 4.1)");

@@ -7,7 +7,8 @@ The reference (tests/fixtures/campaign/demo_seed1_results.json) was first writte
 before the campaign's results became typed structs. A change that moves the demo's results on
 purpose regenerates it with the Release build and says in its commit which values moved and why:
     piezobench demo --seed 1 --threads 2 --out /tmp/demo-seed1
-    cp /tmp/demo-seed1/results.json tests/fixtures/campaign/demo_seed1_results.json Every value of the reference must be in NEW under the
+    cp /tmp/demo-seed1/results.json tests/fixtures/campaign/demo_seed1_results.json
+Every value of the reference must be in NEW under the
 same key, or under its new name when RENAMES lists one; numbers agree to a relative tolerance
 (|a - b| <= rtol max(|a|, |b|) + 1e-300), strings, booleans and nulls exactly. Keys only NEW has
 (analyses added later) are listed, not refused. Keys that hold a machine path or the version are

@@ -1,5 +1,9 @@
 #pragma once
-// The core module: errors (InputError, NumericalError, UsageError) and shared constants.
+// The core module: errors (InputError, NumericalError, UsageError), shared constants, the one
+// Levenberg-Marquardt, the one golden-section search and fit-quality verdicts.
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/fit_quality.hpp"
+#include "piezobench/core/least_squares.hpp"
+#include "piezobench/core/minimize.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"

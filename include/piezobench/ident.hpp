@@ -5,4 +5,5 @@
 #include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/modal.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/ident/vector_fitting.hpp"

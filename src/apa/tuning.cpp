@@ -2,14 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <fmt/format.h>
 #include <limits>
 #include <numbers>
 #include <tuple>
+#include <utility>
 #include <vector>
 
-#include "apa/levenberg_marquardt.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/least_squares.hpp"
 
 namespace piezobench::apa {
 
@@ -79,6 +81,44 @@ struct FitData {
   CVector de;    // m/V
   CVector vs;    // V/V
 };
+
+// The quality verdict of a tuning (tuning.hpp).
+core::FitQuality assess(const TwoDofTuning& t, const FitData& d) {
+  core::FitQuality q;
+  const TwoDofParams& p = t.params;
+  bool finite = true;
+  for (const auto& name : TwoDofParams::names()) {
+    const double v = p.get(name);
+    const bool gain = name == "ga" || name == "gs";
+    if (!std::isfinite(v) || (gain ? v == 0.0 : v <= 0.0)) {
+      q.add_problem(fmt::format("{} = {:.4g} is not physical", name, v), false);
+      finite = false;
+    }
+  }
+  const double largest = std::max({p.k1, p.ke, p.ka});
+  for (const auto& [v, name] : {std::pair{p.k1, "k1"}, std::pair{p.ke, "ke"}, std::pair{p.ka, "ka"}}) {
+    if (finite && v < 1e-6 * largest) {
+      q.add_problem(fmt::format("{} = {:.4g} N/m is negligible against {:.4g} N/m: no actuator has such stiffnesses", name, v, largest),
+                    false);
+    }
+  }
+  q.check_error("u -> d_e", t.fit_error_de);
+  q.check_error("u -> Vs", t.fit_error_vs);
+  if (finite) {
+    const double wp = std::sqrt(p.total_stiffness() / p.m), wz = std::sqrt(p.k1 / p.m);
+    const double lo = d.omega(0), hi = d.omega(d.omega.size() - 1);
+    for (const auto& [w, name] : {std::pair{wp, "resonance"}, std::pair{wz, "anti-resonance"}}) {
+      if (!(w >= lo && w <= hi)) {
+        q.add_problem(fmt::format("the model's {} {:.4g} Hz is outside the band used, {:.4g} to {:.4g} Hz", name,
+                                  w / (2 * std::numbers::pi), lo / (2 * std::numbers::pi), hi / (2 * std::numbers::pi)));
+      }
+    }
+  }
+  if (t.status == TuningStatus::kMaxIterations) q.add_problem("the refinement stopped at its iteration limit");
+  q.advise("a band around the anti-resonance and the resonance where the coherence is high (--fmin/--fmax), the "
+           "right --mass and --amplifier-gain, or check that the outputs are d_e (m) and Vs (V)");
+  return q;
+}
 
 FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& source) {
   const Index ide = frf.output_index(o.de_output);
@@ -235,6 +275,7 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
 
   // ---- Step 1: the report's procedure.
   TwoDofTuning out;
+  out.bench = o.bench;
   out.points = n;
   const auto [wp, peak] = extremum(d.omega, d.de, 0, n - 1, /*maximum=*/true, "resonance peak of u -> d_e");
   // The lowest frequency, corrected for the resonance's static amplification 1/(1 - w^2/wp^2).
@@ -304,7 +345,10 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
   out.fit_error_vs = out.initial_fit_error_vs;
   out.status = TuningStatus::kNotRefined;
   out.message = "report's procedure only (refinement disabled)";
-  if (!o.refine) return out;
+  if (!o.refine) {
+    out.quality = assess(out, d);
+    return out;
+  }
 
   // ---- Step 2: Levenberg-Marquardt on the log-parameters.
   Layout layout;
@@ -313,19 +357,48 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
   layout.gs_sign = p.gs > 0.0 ? 1.0 : -1.0;
   layout.ke_ratio = o.stack_stiffness_ratio;
   layout.ce_ratio = o.stack_damping_ratio;
-  detail::LmOptions lm;
+  core::LmOptions lm;
   lm.max_iterations = o.max_iterations;
-  const detail::LmResult r = detail::levenberg_marquardt(
+  const core::LmResult r = core::levenberg_marquardt(
       [&](const Vector& x) { return residuals(layout.unpack(x), d); }, layout.pack(p), lm);
   out.params = layout.unpack(r.x);
   out.iterations = r.iterations;
   std::tie(out.fit_error_de, out.fit_error_vs) = fit_errors(out.params, d);
   out.status = r.converged() ? TuningStatus::kConverged
-               : r.status == detail::LmStatus::kMaxIterations ? TuningStatus::kMaxIterations
+               : r.status == core::LmStatus::kMaxIterations ? TuningStatus::kMaxIterations
                                                               : TuningStatus::kNoProgress;
   out.message = fmt::format("Levenberg-Marquardt: {} after {} steps ({} evaluations), cost {:.4g} -> {:.4g}",
-                            detail::to_string(r.status), r.iterations, r.evaluations, r.initial_cost, r.cost);
+                            core::to_string(r.status), r.iterations, r.evaluations, r.initial_cost, r.cost);
+  out.quality = assess(out, d);
   return out;
+}
+
+TwoDofTuning tune_two_dof_measured(const dsp::Frf& frf, TuningOptions options, const ident::DelayedSecondOrderFit* de_plant,
+                                   const ident::IffPlantFit* vs_plant) {
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  dsp::Frf data = frf;
+  if (vs_plant) {
+    // Only the corner 1 / (R C) matters: keep the R (else the C) given, else the report's 80.6 kOhm.
+    if (options.bench.hpf_resistance > 0.0) {
+      options.bench.hpf_capacitance = 1.0 / (options.bench.hpf_resistance * vs_plant->w_hpf);
+    } else if (options.bench.hpf_capacitance > 0.0) {
+      options.bench.hpf_resistance = 1.0 / (options.bench.hpf_capacitance * vs_plant->w_hpf);
+    } else {
+      options.bench.hpf_resistance = 80.6e3;
+      options.bench.hpf_capacitance = 1.0 / (options.bench.hpf_resistance * vs_plant->w_hpf);
+    }
+  }
+  if (de_plant) {
+    options.bench.delay = std::max(0.0, de_plant->delay);
+    if (vs_plant) {
+      const Eigen::Index vs = data.output_index(options.vs_output);
+      const double extra = vs_plant->delay - options.bench.delay;
+      for (Eigen::Index k = 0; k < data.freq_hz.size(); ++k) {
+        data.H[static_cast<std::size_t>(vs)](k) *= std::exp(std::complex<double>(0.0, kTwoPi * data.freq_hz(k) * extra));
+      }
+    }
+  }
+  return tune_two_dof(data, options);
 }
 
 }  // namespace piezobench::apa

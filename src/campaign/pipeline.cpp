@@ -269,8 +269,6 @@ struct ResonanceLocus {
   }
 };
 
-double damping_of(std::complex<double> p) { return std::abs(p) > 0.0 ? -p.real() / std::abs(p) : 0.0; }
-
 ResonanceLocus resonance_locus(const lti::StateSpace& loop, std::complex<double> resonance_pole) {
   ResonanceLocus r;
   // Gains around the one that makes the loop gain 1 at the resonance.
@@ -285,40 +283,12 @@ ResonanceLocus resonance_locus(const lti::StateSpace& loop, std::complex<double>
   for (Index i = 1; i < r.poles[0].size(); ++i) {
     if (std::abs(r.poles[0](i) - resonance_pole) < std::abs(r.poles[0](r.branch) - resonance_pole)) r.branch = i;
   }
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < r.gains.size(); ++i) {
-    if (damping_of(r.poles[i](r.branch)) > damping_of(r.poles[best](r.branch))) best = i;
-  }
-  // Golden section on log(gain) between the neighbours of the best grid point.
-  double a = std::log(r.gains[std::max<std::size_t>(1, best - (best > 1 ? 1 : 0))]);
-  double b = std::log(r.gains[std::min(r.gains.size() - 1, best + 1)]);
-  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-  auto damping_at = [&](double lg) { return damping_of(r.pole_at(loop, std::exp(lg))); };
-  double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
-  double f1 = damping_at(x1), f2 = damping_at(x2);
-  for (int it = 0; it < 40; ++it) {
-    if (f1 > f2) {
-      b = x2;
-      x2 = x1;
-      f2 = f1;
-      x1 = b - phi * (b - a);
-      f1 = damping_at(x1);
-    } else {
-      a = x1;
-      x1 = x2;
-      f1 = f2;
-      x2 = a + phi * (b - a);
-      f2 = damping_at(x2);
-    }
-  }
-  r.optimal_gain = std::exp(0.5 * (a + b));
-  r.optimal_pole = r.pole_at(loop, r.optimal_gain);
-  r.max_damping = damping_of(r.optimal_pole);
-  if (damping_of(r.poles[best](r.branch)) > r.max_damping) {
-    r.optimal_gain = r.gains[best];
-    r.optimal_pole = r.poles[best](r.branch);
-    r.max_damping = damping_of(r.optimal_pole);
-  }
+  // The optimum is the root locus's (lti::max_damping_on_branch, as control::iff_root_locus and
+  // `iff rlocus`): adaptive grid from g = 0, refined by golden section.
+  const lti::BranchOptimum best = lti::max_damping_on_branch(loop, resonance_pole);
+  r.optimal_gain = best.gain;
+  r.optimal_pole = best.pole;
+  r.max_damping = best.damping;
   return r;
 }
 
@@ -348,7 +318,7 @@ IffStudy iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units) {
   }
   out.unit = chosen->id;
   out.plant = *chosen->iff_plant;
-  const IffPlantFit& p = *chosen->iff_plant;
+  const ident::IffPlantFit& p = *chosen->iff_plant;
   const lti::StateSpace plant = lti::to_state_space(p.transfer_function());
   const lti::StateSpace controller = lti::to_state_space(control::iff_controller(out.controller));
   control::IffLoopOptions lo;

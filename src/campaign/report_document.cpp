@@ -201,7 +201,7 @@ json extra_plots(const CampaignResult& r) {
   json extra = json::object();
   const IffStudy& s = r.iff;
   if (s.plant && !s.failed) {
-    const IffPlantFit& p = *s.plant;
+    const ident::IffPlantFit& p = *s.plant;
     const auto gain_label = [](double g) { return fmt::format("g = {:.3g}", g); };
     json branches = json::array();
     for (const auto& b : s.branches) {

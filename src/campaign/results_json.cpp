@@ -272,13 +272,14 @@ json iff(const IffStudy& s) {
     out["note"] = s.note;
     return out;
   }
-  const IffPlantFit& p = *s.plant;
+  const ident::IffPlantFit& p = *s.plant;
   out["plant"] = {{"g0", p.g0}, {"wz_Hz", p.wz / kTwoPi}, {"xz", p.xz}, {"wp_Hz", p.wp / kTwoPi}, {"xp", p.xp},
                   {"w_hpf_Hz", p.w_hpf / kTwoPi}, {"delay_s", p.delay}, {"source", "IFF plant fit of unit " + std::to_string(*s.unit)}};
   out["max_damping"] = opt(s.max_damping);
   out["optimal_pole"] = io::to_json(s.optimal_pole);
-  out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)|, branch from the "
-                        "resonance pole, maximum damping refined by golden section (delay as a 6th-order Pade approximant)";
+  out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)| (plots), branch from the "
+                        "resonance pole; maximum damping on the adaptive root locus from g = 0 refined by golden section "
+                        "(lti::max_damping_on_branch, as `iff rlocus`; delay as a 6th-order Pade approximant)";
   for (const auto& pole : s.damped_poles) out["damped_poles"].push_back(io::to_json(pole));
   if (!s.damped_poles.empty()) {
     json model = json::array();

@@ -128,8 +128,7 @@ Record load_record(const Campaign& campaign, const FileSpec& spec, Experiment ex
 
 long frf_segment_length(const AnalysisSettings& settings, long samples, double fs) {
   if (settings.nfft > 0) return settings.nfft;
-  const long four_seconds = std::lround(4.0 * fs);
-  return std::max<long>(256, std::min<long>(four_seconds, samples / 4));
+  return static_cast<long>(dsp::segment_length_for_record(samples, fs));
 }
 
 namespace {
@@ -158,12 +157,11 @@ RecordProvenance provenance(const Record& r, const std::vector<std::string>& rol
 
 dsp::Frf welch(const Record& r, const std::string& input, const std::vector<std::string>& outputs,
                const AnalysisSettings& settings, long nfft) {
-  dsp::WelchOptions w;
+  // The settings `frf` uses too (mean removed per segment, H1), with the campaign's window and overlap.
+  dsp::WelchOptions w = dsp::welch_options_for_record(r.ts.samples(), r.ts.sample_rate);
   w.window = settings.window;
   w.nfft = nfft;
   w.overlap = settings.overlap;
-  w.detrend = dsp::Detrend::kMean;  // a linear trend removal per segment would distort the lowest bins
-  w.estimator = dsp::FrfEstimator::kH1;
   w.threads = 1;  // the pipeline parallelizes over units
   const VectorXd in = r.channel(input);
   std::vector<VectorXd> outs;
@@ -378,16 +376,27 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   } catch (const NumericalError& e) {
     record_failure(u, "frf u -> d_e features", e);
   }
-  // u -> d_e as a mass-spring-damper with its own delay (the tuning and the damped plants use it).
-  try {
-    IffPlantFitOptions so;
-    so.fmin_hz = a.fmin_hz;
-    so.fmax_hz = a.fmax_hz;
-    so.min_coherence = 0.5;
-    u.de_plant = fit_delayed_second_order(kTwoPi * frf.freq_hz, frf.H[0], frf.coherence[0], so, c.file.string() + ": " + r.spec.key);
+  // u -> d_e as a mass-spring-damper with its own delay (the tuning and the damped plants use it),
+  // and u -> Vs as the IFF plant (eq. 2.3 with delay): one procedure with `model tune`.
+  // The resistor high-pass: its corner is 1 / (2 pi R C_sensor) (report section 2.5) when the
+  // capacitance is measured; the FRF below a few Hz is dominated by the stacks' creep and
+  // hysteresis, so the corner fitted to it is a cross-check only.
+  const std::optional<double> w_rc = u.capacitance_sensor ? std::optional<double>(1.0 / (c.bench.hpf_resistance * *u.capacitance_sensor))
+                                                          : std::nullopt;
+  const std::string fit_source = c.file.string() + ": " + r.spec.key;
+  ident::ActuatorPlantOptions po;
+  po.fmin_hz = a.fmin_hz;
+  po.fmax_hz = a.fmax_hz;
+  po.iff_fmin_hz = w_rc ? a.fmin_hz : 0.0;
+  po.hpf_fmax_hz = a.hpf_fmax_hz;
+  po.fixed_w_hpf = w_rc.value_or(0.0);
+  po.min_coherence = 0.5;
+  const ident::ActuatorPlants plants =
+      ident::fit_actuator_plants(kTwoPi * frf.freq_hz, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1], po, fit_source);
+  for (const auto& f : plants.failures) u.failed.push_back(f);
+  if (plants.de) {
+    u.de_plant = *plants.de;
     out.de_plant = u.de_plant;
-  } catch (const NumericalError& e) {
-    record_failure(u, "u -> d_e second-order fit", e);
   }
   // u -> Vs: anti-resonance and the NMP verdict.
   std::optional<double> anti_w, anti_z;
@@ -421,40 +430,26 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     hpf.first_order_fit_Hz = h.corner_hz();
     hpf.first_order_fit_points = static_cast<long>(low.omega.size());
   }
-  // The resistor high-pass: its corner is 1 / (2 pi R C_sensor) (report section 2.5) when the
-  // capacitance is measured; the FRF below a few Hz is dominated by the stacks' creep and
-  // hysteresis, so the corner fitted to it is a cross-check only.
-  const std::optional<double> w_rc = u.capacitance_sensor ? std::optional<double>(1.0 / (c.bench.hpf_resistance * *u.capacitance_sensor))
-                                                          : std::nullopt;
   if (w_rc) hpf.r_c_Hz = *w_rc / kTwoPi;
   const VectorXd& coh = frf.coherence[1];
-  const std::string fit_source = c.file.string() + ": " + r.spec.key;
-  try {
-    IffPlantFitOptions io_;
-    io_.fmin_hz = w_rc ? a.fmin_hz : 0.0;
-    io_.fmax_hz = a.fmax_hz;
-    io_.hpf_fmax_hz = a.hpf_fmax_hz;
-    io_.min_coherence = 0.5;
-    io_.fixed_w_hpf = w_rc.value_or(0.0);
-    u.iff_plant = fit_iff_plant(kTwoPi * frf.freq_hz, frf.H[1], coh, io_, fit_source);
+  if (plants.vs) {
+    u.iff_plant = *plants.vs;
     out.iff_plant = u.iff_plant;
-    out.iff_plant_fmin_Hz = io_.fmin_hz;
-    out.iff_plant_fmax_Hz = io_.fmax_hz;
+    out.iff_plant_fmin_Hz = plants.vs_options.fmin_hz;
+    out.iff_plant_fmax_Hz = plants.vs_options.fmax_hz;
     out.iff_plant_w_hpf_measured = w_rc.has_value();
     out.nmp.iff_plant_fit_xz = u.iff_plant->xz;
     if (!w_rc) hpf.iff_plant_fit_Hz = u.iff_plant->w_hpf / kTwoPi;
-  } catch (const NumericalError& e) {
-    record_failure(u, "IFF plant fit", e);
   }
   if (w_rc) {
     // Cross-check: the corner fitted with the rest of eq. 2.3 down to the lowest frequencies.
     try {
-      IffPlantFitOptions free;
+      ident::IffPlantFitOptions free;
       free.fmin_hz = 0.0;
       free.fmax_hz = a.fmax_hz;
       free.hpf_fmax_hz = a.hpf_fmax_hz;
       free.min_coherence = 0.5;
-      hpf.iff_plant_fit_Hz = fit_iff_plant(kTwoPi * frf.freq_hz, frf.H[1], coh, free, fit_source).w_hpf / kTwoPi;
+      hpf.iff_plant_fit_Hz = ident::fit_iff_plant(kTwoPi * frf.freq_hz, frf.H[1], coh, free, fit_source).w_hpf / kTwoPi;
     } catch (const Error& e) {
       hpf.iff_plant_fit_error = e.what();
     }
@@ -520,26 +515,13 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     apa::TuningOptions t;
     t.mass = c.bench.suspended_mass;
     t.bench.amplifier_gain = c.bench.amplifier_gain;
-    // The tuning removes one delay from both outputs: d_e's (from its second-order fit), with
-    // Vs first advanced by the difference (its read-out filter's lag).
-    dsp::Frf data = frf;
-    if (u.iff_plant) {
-      t.bench.hpf_resistance = c.bench.hpf_resistance;
-      t.bench.hpf_capacitance = 1.0 / (c.bench.hpf_resistance * u.iff_plant->w_hpf);
-    }
-    if (u.de_plant) {
-      t.bench.delay = std::max(0.0, u.de_plant->delay);
-      if (u.iff_plant) {
-        const double extra = u.iff_plant->delay - t.bench.delay;
-        for (Index k = 0; k < data.freq_hz.size(); ++k) {
-          data.H[1](k) *= std::exp(std::complex<double>(0.0, kTwoPi * data.freq_hz(k) * extra));
-        }
-      }
-    }
+    if (u.iff_plant) t.bench.hpf_resistance = c.bench.hpf_resistance;
     t.fmin_hz = a.fmin_hz;
     t.fmax_hz = a.fmax_hz;
     t.min_coherence = 0.5;
-    u.model_2dof = Model2DofFit{apa::tune_two_dof(data, t), t.bench, t.fmin_hz, t.fmax_hz};
+    const apa::TwoDofTuning tuned = apa::tune_two_dof_measured(frf, t, u.de_plant ? &*u.de_plant : nullptr,
+                                                               u.iff_plant ? &*u.iff_plant : nullptr);
+    u.model_2dof = Model2DofFit{tuned, tuned.bench, t.fmin_hz, t.fmax_hz};
   } catch (const NumericalError& e) {
     record_failure(u, "2-DoF tuning", e);
   }
@@ -612,9 +594,9 @@ std::vector<DampedPlant> iff(const Campaign& c, const std::vector<Record>& recor
     }
     // The report's second-order fit, for comparison only.
     try {
-      IffPlantFitOptions so;
+      ident::IffPlantFitOptions so;
       so.fit_delay = false;
-      d.second_order = fit_delayed_second_order(b.omega, b.h, b.coherence, so, c.file.string() + ": " + r.spec.key);
+      d.second_order = ident::fit_delayed_second_order(b.omega, b.h, b.coherence, so, c.file.string() + ": " + r.spec.key);
     } catch (const NumericalError&) {
       // left out of results.json (null)
     }

@@ -76,7 +76,7 @@ lti::Index nearest(const lti::CVector& v, lti::Complex target) {
 void IffPlantParams::validate() const {
   if (!std::isfinite(g0) || g0 == 0.0) throw InputError("", "g0", "a finite non-zero gain", std::to_string(g0));
   require_positive(wz, "wz");
-  require_nonnegative(xz, "xz");
+  if (!std::isfinite(xz)) throw InputError("", "xz", "a finite damping ratio (< 0: non-minimum-phase zero)", std::to_string(xz));
   require_positive(wp, "wp");
   require_nonnegative(xp, "xp");
   require_positive(w_hpf, "w_hpf");
@@ -90,6 +90,19 @@ lti::TransferFunction iff_plant(const IffPlantParams& params) {
   const lti::Vector num = params.g0 * convolve(normalized_quadratic(params.wz, params.xz), hpf_num);
   const lti::Vector den = convolve(normalized_quadratic(params.wp, params.xp), hpf_den);
   return lti::TransferFunction(num, den, 0.0, params.delay);
+}
+
+lti::Complex iff_plant_response(const IffPlantParams& p, double omega) {
+  const lti::Complex s(0.0, omega);
+  const lti::Complex num = 1.0 + 2.0 * p.xz * s / p.wz + s * s / (p.wz * p.wz);
+  const lti::Complex den = 1.0 + 2.0 * p.xp * s / p.wp + s * s / (p.wp * p.wp);
+  return p.g0 * num / den * s / (p.w_hpf + s) * std::exp(-s * p.delay);
+}
+
+lti::CVector iff_plant_response(const IffPlantParams& params, const lti::Vector& omega) {
+  lti::CVector h(omega.size());
+  for (lti::Index k = 0; k < omega.size(); ++k) h(k) = iff_plant_response(params, omega(k));
+  return h;
 }
 
 void IffControllerParams::validate() const {

@@ -1,8 +1,12 @@
 #include "piezobench/dsp/frf.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 #include <set>
+
+#include <fmt/format.h>
 
 #include "piezobench/core/error.hpp"
 
@@ -85,6 +89,44 @@ void Frf::validate(const std::string& source) const {
       }
     }
   }
+}
+
+FrequencyBand excited_band(const Frf& frf, double min_coherence) {
+  frf.validate();
+  const Index n = frf.freq_hz.size();
+  FrequencyBand band;
+  Index first_positive = 0;
+  while (first_positive < n && frf.freq_hz(first_positive) <= 0.0) ++first_positive;
+  if (first_positive == n) throw InputError(frf.provenance.source, "freq_Hz", "a frequency above 0 Hz", "none");
+  band.fmin_hz = frf.freq_hz(first_positive);
+  band.fmax_hz = frf.freq_hz(n - 1);
+  Eigen::VectorXd best = Eigen::VectorXd::Constant(n, -1.0);
+  for (const auto& c : frf.coherence) {
+    if (c.size() == n) best = best.cwiseMax(c);
+  }
+  if ((best.array() < 0.0).all()) return band;
+  // Median over 9 neighbouring bins.
+  std::vector<double> window;
+  auto excited = [&](Index k) {
+    if (best(k) < min_coherence) return false;
+    window.clear();
+    for (Index j = std::max(first_positive, k - 4); j <= std::min(n - 1, k + 4); ++j) window.push_back(best(j));
+    std::nth_element(window.begin(), window.begin() + static_cast<std::ptrdiff_t>(window.size() / 2), window.end());
+    return window[window.size() / 2] >= min_coherence;
+  };
+  Index lo = first_positive;
+  while (lo < n && !excited(lo)) ++lo;
+  if (lo == n) {
+    throw InputError(frf.provenance.source, "coherence",
+                     fmt::format("a band where the coherence reaches {:g} (the input excites the outputs)", min_coherence),
+                     fmt::format("at most {:.3g}: check the input and output channels, or the excitation", best.maxCoeff()));
+  }
+  Index hi = n - 1;
+  while (hi > lo && !excited(hi)) --hi;
+  band.fmin_hz = frf.freq_hz(lo);
+  band.fmax_hz = frf.freq_hz(hi);
+  band.from_coherence = true;
+  return band;
 }
 
 }  // namespace piezobench::dsp

@@ -140,6 +140,27 @@ Index WelchOptions::noverlap() const {
   return static_cast<Index>(std::floor(overlap * static_cast<double>(nfft)));
 }
 
+Index segment_length_for_record(Index samples, double sample_rate_hz, double resolution_hz, const std::string& source) {
+  if (!(std::isfinite(sample_rate_hz) && sample_rate_hz > 0.0)) {
+    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_hz));
+  }
+  if (!(std::isfinite(resolution_hz) && resolution_hz > 0.0)) {
+    throw InputError(source, "resolution", "a finite frequency resolution > 0 Hz", std::to_string(resolution_hz));
+  }
+  const auto target = static_cast<Index>(std::lround(sample_rate_hz / resolution_hz));
+  return std::max<Index>(256, std::min<Index>(target, samples / 4));
+}
+
+WelchOptions welch_options_for_record(Index samples, double sample_rate_hz, double resolution_hz, const std::string& source) {
+  WelchOptions o;
+  o.window = WindowType::kHannPeriodic;
+  o.nfft = segment_length_for_record(samples, sample_rate_hz, resolution_hz, source);
+  o.overlap = 0.5;
+  o.detrend = Detrend::kMean;
+  o.estimator = FrfEstimator::kH1;
+  return o;
+}
+
 Channel channel(std::string name, const Eigen::VectorXd& samples) {
   return Channel{std::move(name), std::span<const double>(samples.data(), static_cast<std::size_t>(samples.size()))};
 }

@@ -1,6 +1,8 @@
 #include "piezobench/dsp/window.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <numbers>
 #include <utility>
@@ -10,14 +12,26 @@
 namespace piezobench::dsp {
 namespace {
 
-constexpr std::array<std::pair<WindowType, const char*>, 7> kNames{{
+constexpr std::array<std::pair<WindowType, const char*>, 8> kNames{{
     {WindowType::kRectangular, "rectangular"},
+    {WindowType::kHanning, "hanning"},
     {WindowType::kHannPeriodic, "hann-periodic"},
     {WindowType::kHannSymmetric, "hann-symmetric"},
     {WindowType::kHammingPeriodic, "hamming-periodic"},
     {WindowType::kHammingSymmetric, "hamming-symmetric"},
     {WindowType::kFlatTopPeriodic, "flattop-periodic"},
     {WindowType::kFlatTopSymmetric, "flattop-symmetric"},
+}};
+
+// Other programs' names (scipy.signal.get_window, MATLAB/Octave functions), matched without case.
+constexpr std::array<std::pair<WindowType, const char*>, 7> kAliases{{
+    {WindowType::kHannPeriodic, "hann"},          // scipy "hann" (periodic, its Welch default)
+    {WindowType::kHammingPeriodic, "hamming"},    // scipy "hamming"
+    {WindowType::kFlatTopPeriodic, "flattop"},    // scipy "flattop"
+    {WindowType::kFlatTopSymmetric, "flattopwin"},  // MATLAB flattopwin(M)
+    {WindowType::kRectangular, "boxcar"},         // scipy
+    {WindowType::kRectangular, "rectwin"},        // MATLAB
+    {WindowType::kRectangular, "rect"},
 }};
 
 // scipy.signal.windows.flattop (and MATLAB flattopwin).
@@ -55,10 +69,16 @@ std::string to_string(WindowType type) {
 }
 
 WindowType window_type_from_string(const std::string& name) {
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   std::string known;
   for (const auto& [t, n] : kNames) {
-    if (name == n) return t;
+    if (lower == n) return t;
     known += known.empty() ? n : std::string(", ") + n;
+  }
+  for (const auto& [t, n] : kAliases) {
+    if (lower == n) return t;
+    known += std::string(", ") + n + " (= " + to_string(t) + ")";
   }
   throw InputError("", "window", "one of " + known, "\"" + name + "\"");
 }
@@ -66,6 +86,11 @@ WindowType window_type_from_string(const std::string& name) {
 Eigen::VectorXd make_window(WindowType type, Eigen::Index length) {
   if (length < 1) throw InputError("", "window length", "at least 1", std::to_string(length));
   if (length == 1 || type == WindowType::kRectangular) return Eigen::VectorXd::Ones(length);
+  if (type == WindowType::kHanning) {
+    // MATLAB hanning(M) = hann(M + 2) without its two zero end points.
+    const double a[2] = {0.5, 0.5};
+    return general_cosine_symmetric(length + 2, a, 2).segment(1, length);
+  }
   // Periodic windows are the first `length` points of the symmetric window of length + 1
   // (scipy's _extend/_truncate), i.e. one full period sampled without its repeated end point.
   const Eigen::Index m = is_periodic(type) ? length + 1 : length;
@@ -88,6 +113,7 @@ Eigen::VectorXd make_window(WindowType type, Eigen::Index length) {
       w = general_cosine_symmetric(m, kFlatTop.data(), kFlatTop.size());
       break;
     case WindowType::kRectangular:
+    case WindowType::kHanning:
       break;
   }
   return w.head(length);

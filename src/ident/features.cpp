@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/least_squares.hpp"
+#include "piezobench/core/minimize.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/lti/analysis.hpp"
 
@@ -76,28 +78,6 @@ std::pair<double, Index> phase_change(const Vector& omega, const CVector& h, dou
     prev = k;
   }
   return {total * 180.0 / std::numbers::pi, count};
-}
-
-double golden_section(const auto& f, double a, double b, double tol) {
-  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
-  double c = b - g * (b - a), d = a + g * (b - a);
-  double fc = f(c), fd = f(d);
-  while (std::abs(b - a) > tol) {
-    if (fc < fd) {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - g * (b - a);
-      fc = f(c);
-    } else {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + g * (b - a);
-      fd = f(d);
-    }
-  }
-  return 0.5 * (a + b);
 }
 
 }  // namespace
@@ -315,7 +295,7 @@ HighPassFit fit_high_pass(const Vector& omega, const CVector& h, double max_omeg
   const double step = (l_hi - l_lo) / kGrid;
   const double a = l_lo + step * std::max(best - 1, 0);
   const double b = l_lo + step * std::min(best + 1, kGrid);
-  const double l = golden_section([&](double x) { return gain_and_cost(std::exp(x)).second; }, a, b, 1e-12);
+  const double l = core::golden_section_minimize([&](double x) { return gain_and_cost(std::exp(x)).second; }, a, b).x;
   HighPassFit fit;
   fit.corner = std::exp(l);
   const auto [g, cost] = gain_and_cost(fit.corner);
@@ -364,52 +344,32 @@ SecondOrderFit fit_second_order(const Vector& omega, const CVector& h, const Sec
       rhs(n + k) = r.imag();
     }
     Vector p = a.colPivHouseholderQr().solve(rhs);
-    // Levenberg-Marquardt on the complex output error.
-    const auto residual = [&](const Vector& q, Vector& res) {
+    // Levenberg-Marquardt on the complex output error (analytic Jacobian).
+    const auto residual = [&](const Vector& q) {
+      Vector res(2 * n);
       for (Index k = 0; k < n; ++k) {
         const Complex e = q(0) / (s(k) * s(k) + q(1) * s(k) + q(2)) - h(k);
         res(k) = e.real();
         res(n + k) = e.imag();
       }
-      return res.squaredNorm();
+      return res;
     };
-    Vector res(2 * n), trial_res(2 * n);
-    double cost = residual(p, res);
-    double lambda = 1e-3;
-    Matrix jac(2 * n, 3);
-    int it = 0;
-    for (; it < options.max_iterations; ++it) {
+    const auto jacobian = [&](const Vector& q) {
+      Matrix jac(2 * n, 3);
       for (Index k = 0; k < n; ++k) {
-        const Complex d = s(k) * s(k) + p(1) * s(k) + p(2);
-        const Complex j0 = 1.0 / d, j1 = -p(0) * s(k) / (d * d), j2 = -p(0) / (d * d);
+        const Complex d = s(k) * s(k) + q(1) * s(k) + q(2);
+        const Complex j0 = 1.0 / d, j1 = -q(0) * s(k) / (d * d), j2 = -q(0) / (d * d);
         jac.row(k) << j0.real(), j1.real(), j2.real();
         jac.row(n + k) << j0.imag(), j1.imag(), j2.imag();
       }
-      const Matrix jtj = jac.transpose() * jac;
-      const Vector g = jac.transpose() * res;
-      bool improved = false;
-      for (int tries = 0; tries < 30 && !improved; ++tries) {
-        Matrix lhs = jtj;
-        lhs.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-300);
-        const Vector step = -lhs.ldlt().solve(g);
-        const Vector trial = p + step;
-        const double trial_cost = residual(trial, trial_res);
-        if (std::isfinite(trial_cost) && trial_cost < cost) {
-          const double rel_step = step.norm() / std::max(p.norm(), 1e-300);
-          p = trial;
-          res = trial_res;
-          const double old = cost;
-          cost = trial_cost;
-          lambda = std::max(lambda / 10.0, 1e-12);
-          improved = true;
-          if (rel_step < 1e-13 || old - cost <= 1e-15 * old) it = options.max_iterations;
-        } else {
-          lambda *= 10.0;
-        }
-      }
-      if (!improved) break;
-    }
-    out.iterations = std::min(it, options.max_iterations);
+      return jac;
+    };
+    core::LmOptions lm;
+    lm.max_iterations = options.max_iterations;
+    const core::LmResult fit = core::levenberg_marquardt(residual, jacobian, p, lm);
+    p = fit.x;
+    const double cost = 2.0 * fit.cost;
+    out.iterations = fit.iterations;
     if (!(p(2) > 0.0) || !p.allFinite()) {
       throw NumericalError(src, "the fitted denominator has no positive constant term (not a damped second-order "
                                 "system); check the frequency band",

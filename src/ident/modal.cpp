@@ -281,6 +281,16 @@ LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& option
     result.modes.push_back(m);
     i = j;
   }
+  // Quality: a mode must be stable over min_stable_orders orders and lie inside the band.
+  if (result.modes.empty()) {
+    result.quality.add_problem("no mode stayed stable over " + std::to_string(options.min_stable_orders) + " orders");
+  }
+  for (const Mode& m : result.modes) {
+    if (m.natural_frequency < w_lo || m.natural_frequency > w_hi) {
+      result.quality.add_problem("mode at " + std::to_string(m.frequency_hz()) + " Hz outside the band");
+    }
+  }
+  result.quality.advise("a band around the modes with a high coherence, or more averages");
   return result;
 }
 

@@ -186,6 +186,14 @@ Matrix make_weights(const CMatrix& data, const Matrix& user, Weighting weighting
   if (user.size() > 0) return user;
   if (weighting == Weighting::kUnit) return Matrix::Ones(data.rows(), 1);
   Matrix w(data.rows(), data.cols());
+  if (weighting == Weighting::kOutputScale) {
+    // 1 / rms |f_i|: outputs in different units (m/V and V/V) count alike.
+    for (Index i = 0; i < data.cols(); ++i) {
+      const double rms = std::sqrt(data.col(i).squaredNorm() / static_cast<double>(data.rows()));
+      w.col(i).setConstant(rms > 0.0 ? 1.0 / rms : 1.0);
+    }
+    return w;
+  }
   for (Index i = 0; i < data.cols(); ++i) {
     // A zero sample would get an infinite weight; floor the magnitude at a tiny fraction of the
     // output's largest one.
@@ -695,6 +703,7 @@ std::string to_string(Weighting w) {
     case Weighting::kUnit: return "unit";
     case Weighting::kInverseMagnitude: return "inverse-magnitude";
     case Weighting::kInverseSqrtMagnitude: return "inverse-sqrt-magnitude";
+    case Weighting::kOutputScale: return "output-scale";
   }
   return "unit";
 }
@@ -703,7 +712,8 @@ Weighting weighting_from_string(const std::string& s) {
   if (s == "unit") return Weighting::kUnit;
   if (s == "inverse-magnitude") return Weighting::kInverseMagnitude;
   if (s == "inverse-sqrt-magnitude") return Weighting::kInverseSqrtMagnitude;
-  throw InputError("", "weighting", "one of unit, inverse-magnitude, inverse-sqrt-magnitude", "'" + s + "'");
+  if (s == "output-scale") return Weighting::kOutputScale;
+  throw InputError("", "weighting", "one of unit, output-scale, inverse-magnitude, inverse-sqrt-magnitude", "'" + s + "'");
 }
 
 void VectorFittingOptions::validate() const {
@@ -930,6 +940,30 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
   const double count = static_cast<double>(data.size());
   result.rms_error = std::sqrt((fit - data).squaredNorm() / count);
   result.relative_rms_error = result.rms_error / std::sqrt(data.squaredNorm() / count);
+  // Quality: every output's own relative error (a small output is not hidden by a large one), and
+  // no pole far outside the band of the data (such a pole fits noise or an unexcited band).
+  result.relative_rms_error_per_output.resize(data.cols());
+  for (Index i = 0; i < data.cols(); ++i) {
+    const double e = std::sqrt((fit.col(i) - data.col(i)).squaredNorm() / data.col(i).squaredNorm());
+    result.relative_rms_error_per_output(i) = e;
+    result.quality.check_error("output " + std::to_string(i + 1), e);
+  }
+  const double w_lo = omega.minCoeff() > 0.0 ? omega.minCoeff() : (omega.size() > 1 ? omega(1) : omega(0));
+  const double w_hi = omega.maxCoeff();
+  for (Index k = 0; k < result.poles.size(); ++k) {
+    const Complex p = result.poles(k);
+    if (p.imag() <= 0.0) continue;  // real poles shape the slope; a resonance needs data around it
+    const double w = std::abs(p);
+    if (w > 2.0 * w_hi || w < 0.5 * w_lo) {
+      std::ostringstream text;
+      text << "pole at " << w / (2.0 * std::numbers::pi) << " Hz outside the fitted band " << w_lo / (2.0 * std::numbers::pi)
+           << " to " << w_hi / (2.0 * std::numbers::pi) << " Hz";
+      result.quality.add_problem(text.str());
+    }
+    if (p.real() > 0.0) result.quality.add_problem("unstable pole (Re > 0) at " + std::to_string(w / (2.0 * std::numbers::pi)) + " Hz");
+  }
+  if (!result.converged) result.quality.add_problem("the poles did not settle (not converged)");
+  result.quality.advise("a lower order, a band where the coherence is high (--fmin/--fmax), or --weighting output-scale");
   return result;
 }
 
@@ -939,12 +973,33 @@ VectorFittingResult vector_fit(const dsp::Frf& frf, const VectorFittingOptions& 
   CMatrix data(ns, static_cast<Index>(frf.H.size()));
   for (size_t i = 0; i < frf.H.size(); ++i) data.col(static_cast<Index>(i)) = frf.H[i];
   const Vector omega = 2.0 * std::numbers::pi * frf.freq_hz;
+  VectorFittingResult r;
   try {
-    return vector_fit(omega, data, options);
+    r = vector_fit(omega, data, options);
   } catch (const InputError& e) {
     if (frf.provenance.source.empty()) throw;
     throw e.with_source(frf.provenance.source);
   }
+  // The outputs' names in the verdict, and the data's own evidence: a band where most points have
+  // a low coherence was not excited, whatever the error of the model fitted to its noise.
+  for (auto& problem : r.quality.problems) {
+    for (size_t i = 0; i < frf.outputs.size(); ++i) {
+      const std::string generic = "output " + std::to_string(i + 1) + ":";
+      if (problem.rfind(generic, 0) == 0) problem = frf.outputs[i] + ":" + problem.substr(generic.size());
+    }
+  }
+  for (size_t i = 0; i < frf.coherence.size() && i < frf.outputs.size(); ++i) {
+    const Vector& c = frf.coherence[i];
+    if (c.size() != ns) continue;
+    const auto low = (c.array() < 0.5).count();
+    if (2 * low > ns) {
+      std::ostringstream text;
+      text << frf.outputs[i] << ": coherence below 0.5 at " << low << " of " << ns << " points (the band was not excited)";
+      r.quality.add_problem(text.str());
+    }
+  }
+  r.quality.advise("a band where the coherence is high (--fmin/--fmax)");
+  return r;
 }
 
 }  // namespace piezobench::ident

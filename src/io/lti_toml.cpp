@@ -1,5 +1,7 @@
 #include "piezobench/io/lti_toml.hpp"
 
+#include <fmt/format.h>
+
 #include <fstream>
 #include <optional>
 #include <set>
@@ -8,6 +10,7 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/toml_table.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/transfer_function.hpp"
@@ -189,6 +192,45 @@ LtiFile parse_lti_toml(const std::string& text, const std::string& source) {
 
 LtiFile read_lti_toml(const std::filesystem::path& path) {
   return build(read_toml_file(path), path.string());
+}
+
+namespace {
+
+// A TOML basic string: quotes, backslashes and control characters escaped.
+std::string toml_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(c)));
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+std::string to_lti_toml(const lti::TransferFunction& tf, const std::string& description) {
+  auto list = [](const lti::Vector& v) {
+    std::string out = "[";
+    for (lti::Index i = 0; i < v.size(); ++i) out += (i == 0 ? "" : ", ") + fmt::format("{:.17g}", v(i));
+    return out + "]";
+  };
+  std::string text;
+  if (!description.empty()) text += "description = " + toml_quoted(description) + "\n";
+  text += "num = " + list(tf.num) + "\n";
+  text += "den = " + list(tf.den) + "\n";
+  if (tf.delay > 0.0) text += fmt::format("delay = {:.17g}\n", tf.delay);
+  if (tf.sample_time > 0.0) text += fmt::format("sample_time = {:.17g}\n", tf.sample_time);
+  return text;
+}
+
+void write_lti_toml(const lti::TransferFunction& tf, const std::filesystem::path& path, const std::string& description) {
+  write_text_atomically(path, to_lti_toml(tf, description));
 }
 
 }  // namespace piezobench::io

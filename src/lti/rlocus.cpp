@@ -12,6 +12,7 @@
 
 #include "lti/check.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/minimize.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/freqresp.hpp"
 
@@ -378,33 +379,14 @@ BranchOptimum max_damping_on_branch(const StateSpace& open_loop, Complex start_p
   // bracket is away from 0 (the grid is geometric there), on the gain itself otherwise.
   const bool use_log = lo > 0.0;
   auto to_gain = [&](double t) { return use_log ? std::exp(t) : t; };
-  double a = use_log ? std::log(lo) : lo;
-  double b = use_log ? std::log(hi) : hi;
-  const double inv_phi = (std::sqrt(5.0) - 1.0) / 2.0;
-  double x1 = b - inv_phi * (b - a);
-  double x2 = a + inv_phi * (b - a);
-  double f1 = damping_of(branch_pole(to_gain(x1)), ts);
-  double f2 = damping_of(branch_pole(to_gain(x2)), ts);
   constexpr double kGainTolerance = 1e-6;
-  for (int iter = 0; iter < 300; ++iter) {
-    const double width = use_log ? (b - a) : (b - a) / std::max(b, std::numeric_limits<double>::min());
-    if (width <= kGainTolerance) break;
-    if (f1 >= f2) {
-      b = x2;
-      x2 = x1;
-      f2 = f1;
-      x1 = b - inv_phi * (b - a);
-      f1 = damping_of(branch_pole(to_gain(x1)), ts);
-    } else {
-      a = x1;
-      x1 = x2;
-      f1 = f2;
-      x2 = a + inv_phi * (b - a);
-      f2 = damping_of(branch_pole(to_gain(x2)), ts);
-    }
-  }
-  for (double t : {x1, x2}) {
-    const double g = to_gain(t);
+  core::GoldenSectionOptions golden;
+  golden.tolerance = use_log ? kGainTolerance : kGainTolerance * std::max(hi, std::numeric_limits<double>::min());
+  if (hi > lo) {
+    const core::ScalarMinimum m = core::golden_section_minimize(
+        [&](double t) { return -damping_of(branch_pole(to_gain(t)), ts); }, use_log ? std::log(lo) : lo,
+        use_log ? std::log(hi) : hi, golden);
+    const double g = to_gain(m.x);
     const Complex p = branch_pole(g);
     const double z = damping_of(p, ts);
     if (z > out.damping) {

@@ -19,7 +19,7 @@ std::complex<double> pair(const nlohmann::json& j) { return {j[0].get<double>(),
 
 TEST(FrfCli, MatFileMadeByScipyGivesScipysH1AndCoherence) {
   const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();
-  const test::CliRun r = run_cli("frf " + mat + " --input u_dac --output d_enc,V_force --nfft 512 --overlap 0.5 --json");
+  const test::CliRun r = run_cli("frf " + mat + " --input u_dac --output d_enc,V_force --nfft 512 --overlap 0.5 --detrend none --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto got = nlohmann::json::parse(r.out);
   const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("app/scipy_two_outputs_frf.json")));
@@ -116,7 +116,91 @@ TEST(FrfCli, BadInputNamesFileAndChannel) {
   const test::CliRun zero_power = run_cli("frf " + flat + " --input u --output y --nfft 2");
   EXPECT_EQ(zero_power.exit_code, 3) << zero_power.err;
 
-  EXPECT_EQ(run_cli("frf " + mat + " --input u_dac --output d_enc --window triangle").exit_code, 3);
+}
+
+// Issue 12: `fit --order 2` on both outputs of a lab's Welch FRF (d_e in m/V, Vs in V/V: 1e5 apart)
+// finds the resonance within 1 %: each output is weighted by its own scale.
+TEST(FitCli, BothOutputsOfAScipyWelchFrfGiveTheResonance) {
+  const std::string f = test::fixture_path("ident/two_dof_welch_frf.csv").string();
+  const auto truth = nlohmann::json::parse(test::read_text(test::fixture_path("ident/two_dof_welch_truth.json")));
+  const test::CliRun r = run_cli("fit " + f + " --order 2 --fmin 20 --fmax 400 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["poles"].size(), 2U);
+  const auto p = pair(j["poles"][1]);
+  EXPECT_NEAR(std::abs(p) / (2 * std::numbers::pi) / truth["resonance_Hz"].get<double>(), 1.0, 0.01);
+  EXPECT_EQ(j["quality"], "good");
+  for (const char* name : {"de", "Vs"}) EXPECT_LT(j["per_output"][name]["relative_rms_error"].get<double>(), 0.2) << name;
+  // At order 6 the model has the anti-resonance of Vs: a lightly damped zero pair at sqrt(k1 / m),
+  // reported with a verdict on its phase.
+  const test::CliRun six = run_cli("fit " + f + " --order 6 --fmin 20 --fmax 400 --json");
+  const auto j6 = nlohmann::json::parse(six.out);
+  bool found = false;
+  for (const auto& z : j6["per_output"]["Vs"]["zeros"]) {
+    if (!z["lightly_damped"].get<bool>() || std::abs(z["frequency_Hz"].get<double>() - 41.0) > 5.0) continue;
+    found = true;
+    EXPECT_NEAR(z["frequency_Hz"].get<double>() / truth["antiresonance_Hz"].get<double>(), 1.0, 0.01);
+    EXPECT_TRUE(z["nonminimum_phase"].is_boolean());
+  }
+  EXPECT_TRUE(found) << six.out;
+  const test::CliRun text = run_cli("fit " + f + " --order 6 --fmin 20 --fmax 400");
+  EXPECT_NE(text.out.find("minimum phase"), std::string::npos) << text.out;
+}
+
+// A fit over a band the input did not excite is poor: warning, "quality": "poor", exit 6.
+TEST(FitCli, UnexcitedBandIsAPoorFit) {
+  const std::string f = test::fixture_path("ident/two_dof_welch_frf.csv").string();
+  const test::CliRun r = run_cli("fit " + f + " --output de --order 2 --fmin 700 --fmax 800 --json");
+  EXPECT_EQ(r.exit_code, 6) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["quality"], "poor");
+  EXPECT_NE(r.err.find("warning: the fit is poor"), std::string::npos) << r.err;
+}
+
+// `fit iff-plant` writes the TOML that `iff rlocus --plant` reads.
+TEST(FitCli, IffPlantTomlFeedsTheRootLocus) {
+  test::TempDir dir;
+  const std::string f = test::fixture_path("ident/two_dof_welch_frf.csv").string();
+  const auto truth = nlohmann::json::parse(test::read_text(test::fixture_path("ident/two_dof_welch_truth.json")));
+  const std::string toml = (dir.path() / "plant.toml").string();
+  const test::CliRun r = run_cli("fit iff-plant " + f + " --fmax 500 --out " + toml + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["quality"], "good");
+  EXPECT_NEAR(j["plant"]["wp_Hz"].get<double>() / truth["resonance_Hz"].get<double>(), 1.0, 0.01);
+  EXPECT_NEAR(j["plant"]["wz_Hz"].get<double>() / truth["antiresonance_Hz"].get<double>(), 1.0, 0.01);
+  const test::CliRun rl = run_cli("iff rlocus --plant " + toml + " --json");
+  ASSERT_EQ(rl.exit_code, 0) << rl.err;
+  const auto l = nlohmann::json::parse(rl.out);
+  EXPECT_NEAR(std::abs(pair(l["resonance_pole"])) / (2 * std::numbers::pi) / truth["resonance_Hz"].get<double>(), 1.0, 0.01);
+  EXPECT_GT(l["max_damping"].get<double>(), 0.05);
+}
+
+// Other programs' window names are accepted; a bad option is exit 2 before any computation.
+TEST(FrfCli, MatlabWindowNamesAndBadOptionsBeforeWork) {
+  const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();
+  for (const char* w : {"hanning", "hann", "Hamming", "flattopwin"}) {
+    EXPECT_EQ(run_cli("frf " + mat + " --input u_dac --output d_enc --window " + w + " --json").exit_code, 0) << w;
+  }
+  const test::CliRun xlsx = run_cli("frf " + mat + " --input u_dac --output d_enc --out x.xlsx");
+  EXPECT_EQ(xlsx.exit_code, 2) << xlsx.err;
+  EXPECT_NE(xlsx.err.find(".csv"), std::string::npos) << xlsx.err;
+  EXPECT_EQ(xlsx.err.find("reading"), std::string::npos) << xlsx.err;  // refused before reading the file
+  EXPECT_EQ(run_cli("frf " + mat + " --input u_dac --output d_enc --window triangle").exit_code, 2);
+  EXPECT_EQ(run_cli("frf " + mat + " --input u_dac --output d_enc --detrend quadratic").exit_code, 2);
+  EXPECT_EQ(run_cli("fit " + mat + " --order 2 --out model.txt").exit_code, 2);
+  EXPECT_EQ(run_cli("fit iff-plant " + mat + " --out plant.json").exit_code, 2);
+}
+
+// `frf` without --nfft uses `run`'s settings: segments of 4 s at most a quarter of the record,
+// mean removed (scipy's default detrending).
+TEST(FrfCli, DefaultsAreTheCampaigns) {
+  const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();
+  const test::CliRun r = run_cli("frf " + mat + " --input u_dac --output d_enc --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["nfft"], 1024);  // 4096 samples / 4 (4 s would be 8000)
+  EXPECT_EQ(j["detrend"], "mean");
 }
 
 TEST(FitCli, TooHighAnOrderIsAClearError) {

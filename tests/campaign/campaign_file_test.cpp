@@ -171,7 +171,7 @@ TEST(CampaignFile, BadValues) {
   f.error("[specs]\nstroke_min_um = \"big\"\n[[units]]\nid = 1\n", "specs.stroke_min_um");
   f.error("[bench]\nsuspended_mass_kg = -5.7\n[[units]]\nid = 1\n", "bench.suspended_mass_kg");
   f.error("[bench]\namplifier_gain = nan\n[[units]]\nid = 1\n", "bench.amplifier_gain");
-  f.error("[analysis]\nwindow = \"hann\"\n[[units]]\nid = 1\n", "analysis.window");
+  f.error("[analysis]\nwindow = \"triangle\"\n[[units]]\nid = 1\n", "analysis.window");
   f.error("[analysis]\nfmin_Hz = 100.0\nfmax_Hz = 50.0\n[[units]]\nid = 1\n", "analysis.fmax_Hz");
   f.error("[analysis]\noverlap = 1.0\n[[units]]\nid = 1\n", "analysis.overlap");
   f.error("[[units]]\nid = 1\nstroke = 3\n", "units[0].stroke");

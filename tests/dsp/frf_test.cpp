@@ -88,5 +88,42 @@ TEST(Frf, ValidateRejectsEachKindOfInconsistency) {
   expect_field(f, "freq_hz");
 }
 
+TEST(ExcitedBand, FromTheCoherenceOfTheBestOutputIgnoringDipsAndIsolatedBins) {
+  // 0 .. 100 Hz in 0.5 Hz bins; the input excites 2 .. 60 Hz. Output 0 has an anti-resonance dip
+  // at 30 Hz (3 bins of low coherence), output 1 a single noisy bin of high coherence at 80 Hz.
+  Frf f;
+  const Eigen::Index n = 201;
+  f.freq_hz = Eigen::VectorXd::LinSpaced(n, 0.0, 100.0);
+  f.input = std::string("u");
+  f.outputs = {"a", "b"};
+  f.H = {Eigen::VectorXcd::Ones(n), Eigen::VectorXcd::Ones(n)};
+  Eigen::VectorXd a = Eigen::VectorXd::Constant(n, 0.05), b = Eigen::VectorXd::Constant(n, 0.05);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (f.freq_hz(k) >= 2.0 && f.freq_hz(k) <= 60.0) a(k) = 0.95;
+  }
+  a(60) = a(61) = a(59) = 0.1;  // 29.5 .. 30.5 Hz
+  b(160) = 0.99;                 // 80 Hz
+  f.coherence = {a, b};
+  const FrequencyBand band = excited_band(f, 0.5);
+  EXPECT_TRUE(band.from_coherence);
+  EXPECT_DOUBLE_EQ(band.fmin_hz, 2.0);
+  EXPECT_DOUBLE_EQ(band.fmax_hz, 60.0);
+  // Without coherence: the whole positive grid.
+  f.coherence.clear();
+  const FrequencyBand all = excited_band(f);
+  EXPECT_FALSE(all.from_coherence);
+  EXPECT_DOUBLE_EQ(all.fmin_hz, 0.5);
+  EXPECT_DOUBLE_EQ(all.fmax_hz, 100.0);
+  // Nothing excited: an error that says what to check.
+  f.coherence = {Eigen::VectorXd::Constant(n, 0.1), Eigen::VectorXd::Constant(n, 0.2)};
+  try {
+    (void)excited_band(f);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "coherence");
+    EXPECT_NE(std::string(e.what()).find("check the input and output channels"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace piezobench::dsp

@@ -79,6 +79,23 @@ FrfEstimate estimate_case(const nlohmann::json& c, FrfEstimator estimator = FrfE
   return estimate_frf(channel("u", s.u), {channel("y1", s.y1), channel("y2", s.y2)}, s.fs, o, "fixture");
 }
 
+TEST(Welch, RecordSettingsAreTheCampaignsDefaults) {
+  // 4 s segments (0.25 Hz bins) when the record holds 16 s or more; else a quarter of the record;
+  // never below 256 samples; mean removed; H1, hann-periodic, 50 %.
+  EXPECT_EQ(segment_length_for_record(600000, 10000.0), 40000);
+  EXPECT_EQ(segment_length_for_record(100000, 10000.0), 25000);
+  EXPECT_EQ(segment_length_for_record(600000, 10000.0, 1.0), 10000);
+  EXPECT_EQ(segment_length_for_record(800, 10000.0), 256);
+  const WelchOptions o = welch_options_for_record(600000, 10000.0);
+  EXPECT_EQ(o.nfft, 40000);
+  EXPECT_EQ(o.detrend, Detrend::kMean);
+  EXPECT_EQ(o.window, WindowType::kHannPeriodic);
+  EXPECT_EQ(o.estimator, FrfEstimator::kH1);
+  EXPECT_DOUBLE_EQ(o.overlap, 0.5);
+  EXPECT_THROW((void)segment_length_for_record(1000, 0.0), InputError);
+  EXPECT_THROW((void)segment_length_for_record(1000, 100.0, -1.0), InputError);
+}
+
 TEST(Welch, NoverlapIsOctavesFloorOfTheFraction) {
   for (const auto& c : signals().cases) {
     EXPECT_EQ(options_of(c).noverlap(), c.at("noverlap").get<Index>()) << c.at("name");

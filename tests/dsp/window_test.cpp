@@ -19,21 +19,39 @@ using test::Tolerance;
 // turns that into an absolute (not relative) round-off of the O(1) window.
 constexpr Tolerance kSameFormula{1e-14, 1e-15};
 
-const WindowType kAll[] = {WindowType::kRectangular,      WindowType::kHannPeriodic,    WindowType::kHannSymmetric,
+const WindowType kAll[] = {WindowType::kRectangular,      WindowType::kHanning,         WindowType::kHannPeriodic,    WindowType::kHannSymmetric,
                            WindowType::kHammingPeriodic,  WindowType::kHammingSymmetric, WindowType::kFlatTopPeriodic,
                            WindowType::kFlatTopSymmetric};
 
-TEST(Window, NamesRoundTripAndBareHannIsRejected) {
+TEST(Window, NamesRoundTripAndOtherProgramsNamesAreAccepted) {
   for (WindowType t : kAll) EXPECT_EQ(window_type_from_string(to_string(t)), t);
   EXPECT_EQ(to_string(WindowType::kHannPeriodic), "hann-periodic");
   EXPECT_EQ(to_string(WindowType::kHannSymmetric), "hann-symmetric");
+  // scipy's names (periodic, its Welch default) and MATLAB's, in any case: one parser for the
+  // command line and the campaign file.
+  EXPECT_EQ(window_type_from_string("hann"), WindowType::kHannPeriodic);
+  EXPECT_EQ(window_type_from_string("Hann"), WindowType::kHannPeriodic);
+  EXPECT_EQ(window_type_from_string("hanning"), WindowType::kHanning);
+  EXPECT_EQ(window_type_from_string("hamming"), WindowType::kHammingPeriodic);
+  EXPECT_EQ(window_type_from_string("flattop"), WindowType::kFlatTopPeriodic);
+  EXPECT_EQ(window_type_from_string("flattopwin"), WindowType::kFlatTopSymmetric);
+  EXPECT_EQ(window_type_from_string("boxcar"), WindowType::kRectangular);
+  EXPECT_EQ(window_type_from_string("RECTWIN"), WindowType::kRectangular);
   try {
-    (void)window_type_from_string("hann");
+    (void)window_type_from_string("triangle");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "window");
     EXPECT_NE(std::string(e.what()).find("hann-periodic"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("hanning"), std::string::npos);
   }
+}
+
+TEST(Window, HanningIsMatlabsHanning) {
+  // MATLAB hanning(5) = hann(7)(2:6); scipy.signal.windows.hann(7, sym=True)[1:-1].
+  VectorXd e(5);
+  e << 0.24999999999999994, 0.75, 1.0, 0.7500000000000002, 0.25000000000000033;
+  EXPECT_TRUE(all_near(make_window(WindowType::kHanning, 5), e, kSameFormula));
 }
 
 TEST(Window, EqualsScipyGetWindow) {
@@ -78,7 +96,7 @@ TEST(Window, SymmetryPeriodicityAndLengthOne) {
         continue;
       }
       const std::string name = to_string(t);
-      if (name.find("symmetric") != std::string::npos || t == WindowType::kRectangular) {
+      if (name.find("symmetric") != std::string::npos || t == WindowType::kRectangular || t == WindowType::kHanning) {
         EXPECT_TRUE(all_near(w, w.reverse().eval(), Tolerance{0, 1e-15})) << name << " " << n;
       } else {
         // Periodic: w[k] = w[n - k] for k = 1..n-1 (one period without its end point).

@@ -29,6 +29,22 @@ std::string error_of(const std::string& text) {
   return "no error";
 }
 
+TEST(LtiToml, WrittenTransferFunctionReadsBack) {
+  // The IFF plant form: num/den in descending powers, a delay, a description with quotes.
+  const lti::TransferFunction tf((lti::Vector(4) << 8.7e-6, -7.1e-5, 0.583, 0.0).finished(),
+                                 (lti::Vector(4) << 2.78e-6, 2.79e-5, 1.00005, 2.5155).finished(), 0.0, 300e-6);
+  test::TempDir dir;
+  const auto path = dir.path() / "plant.toml";
+  write_lti_toml(tf, path, "fitted to \"u -> Vs\"");
+  const LtiFile f = read_lti_toml(path);
+  EXPECT_EQ(f.form, LtiForm::kTransferFunction);
+  EXPECT_EQ(f.description, "fitted to \"u -> Vs\"");
+  ASSERT_EQ(f.system.input_delay.size(), 1);
+  EXPECT_DOUBLE_EQ(f.system.input_delay(0), 300e-6);
+  const lti::Vector w = lti::Vector::LinSpaced(20, 1.0, 5000.0);
+  EXPECT_TRUE(test::all_near(lti::freqresp(f.system, w).channel(0, 0), lti::freqresp(tf, w), {1e-12, 0.0}));
+}
+
 TEST(LtiToml, TransferFunctionMatchesItsPolynomials) {
   const LtiFile f = parse_lti_toml("num = [2.0, 6.0]\nden = [1, 3.0, 2.0]\ndescription = 'test'\n", "sys.toml");
   EXPECT_EQ(f.form, LtiForm::kTransferFunction);

@@ -32,7 +32,9 @@
 #include <string>
 
 #include "piezobench/apa/two_dof.hpp"
+#include "piezobench/core/fit_quality.hpp"
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 
 namespace piezobench::apa {
 
@@ -79,6 +81,7 @@ struct TwoDofTuning {
   TwoDofParams params;   // the result (= initial when refine is false)
   TwoDofParams initial;  // after step 1
   TuningFeatures features;
+  TwoDofBench bench;     // the measurement chain removed from the data (delay, high-pass, amplifier)
   // rms over the points used of |H_model / H_data - 1| per output, for params and for initial.
   double fit_error_de = 0.0;
   double fit_error_vs = 0.0;
@@ -88,6 +91,11 @@ struct TwoDofTuning {
   int iterations = 0;       // Levenberg-Marquardt steps
   TuningStatus status = TuningStatus::kNotRefined;
   std::string message;      // one line: what stopped the refinement
+  // Poor: an output's error above core::kPoorRelativeError, the model's resonance or
+  // anti-resonance outside the band, the refinement stopped at max_iterations; impossible: a
+  // parameter not finite or not > 0 (ga, gs: not 0), or a stiffness below 1e-6 of the largest
+  // (ke = 8e19 N/m with k1 = 1e-8 N/m is no actuator).
+  core::FitQuality quality;
 
   // One line with the status, the iterations and the errors.
   [[nodiscard]] std::string brief_report() const;
@@ -98,5 +106,15 @@ struct TwoDofTuning {
 // 8 usable points, non-finite or zero data, and bad options; NumericalError (retry may help)
 // when no resonance / anti-resonance can be found in the band.
 TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& options = {});
+
+// The campaign's procedure on measured FRFs (`run` and `model tune` both call it): the measurement
+// chain found by the plant fits (ident/plant_fit.hpp) is removed before tune_two_dof. The delay is
+// d_e's (from its second-order fit, >= 0), with Vs first advanced by the difference of the two
+// fits' delays (its read-out filter's lag); the high-pass on Vs is the IFF plant fit's corner
+// w_hpf = 1 / (R C), keeping options.bench's R (else its C; else R = 80.6 kOhm, the report's).
+// A plant that is nullptr leaves options.bench as given for its part. The result's `bench` is the
+// chain removed.
+TwoDofTuning tune_two_dof_measured(const dsp::Frf& frf, TuningOptions options, const ident::DelayedSecondOrderFit* de_plant,
+                                   const ident::IffPlantFit* vs_plant);
 
 }  // namespace piezobench::apa

@@ -16,7 +16,7 @@
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/apa/two_dof.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
-#include "piezobench/campaign/iff_plant_fit.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/features.hpp"
@@ -127,8 +127,8 @@ struct FrfAnalysis {
   std::optional<double> static_gain;             // m/V, the unit's (second-order fit, else vector fit)
   std::string static_gain_source;                // "" when there is none
   std::optional<double> static_gain_vs;          // V/V, vector fit of u -> Vs
-  std::optional<DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
-  std::optional<IffPlantFit> iff_plant;          // u -> Vs, eq. 2.3 with delay
+  std::optional<ident::DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
+  std::optional<ident::IffPlantFit> iff_plant;          // u -> Vs, eq. 2.3 with delay
   double iff_plant_fmin_Hz = 0.0, iff_plant_fmax_Hz = 0.0;  // its band
   bool iff_plant_w_hpf_measured = false;         // w_hpf from R C_sensor (else fitted)
   NmpEvidence nmp;
@@ -179,7 +179,7 @@ struct DampedPlant {
   long identified_order = 0;     // of the vector fit
   double fmin_Hz = 0.0, fmax_Hz = 0.0;  // the damped-plant band
   // The report's second-order fit of the same data, for comparison (nullopt when it failed).
-  std::optional<DelayedSecondOrderFit> second_order;
+  std::optional<ident::DelayedSecondOrderFit> second_order;
   double delay_removed = 0.0;    // s
 };
 
@@ -218,8 +218,8 @@ struct UnitAnalysis {
   std::optional<double> k_oc;                // N/m, k1 of the test with every stack open
   std::optional<double> resonance_Hz, antiresonance_Hz, static_gain;  // Hz, Hz, m/V
   std::optional<dsp::Frf> frf;               // u -> [de, Vs] (outputs named "de", "Vs")
-  std::optional<IffPlantFit> iff_plant;      // u -> Vs, eq. 2.3 with delay
-  std::optional<DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
+  std::optional<ident::IffPlantFit> iff_plant;      // u -> Vs, eq. 2.3 with delay
+  std::optional<ident::DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
   std::vector<std::string> not_measured;     // experiments the campaign does not list
   std::vector<std::string> failed;           // "frf: vector fitting failed: ..." (NumericalError)
   // The acceptance (pipeline.hpp).
@@ -265,7 +265,7 @@ struct BatchAnalysis {
 struct IffStudy {
   control::IffControllerParams controller;
   std::optional<int> unit;                 // the unit whose plant is used
-  std::optional<IffPlantFit> plant;
+  std::optional<ident::IffPlantFit> plant;
   std::vector<double> gains;               // of the damped plants with an identified pole
   std::vector<std::complex<double>> damped_poles, model_poles;  // rad/s
   std::vector<double> relative_pole_distance;

@@ -11,11 +11,11 @@
 //                 (ident/features.hpp): static gain, resonance and damping, anti-resonance and
 //                 damping, the non-minimum-phase verdict (phase of the data across the zero, the
 //                 fitted zero, and the sign of xz in the IFF plant fit); the high-pass corner; the
-//                 IFF plant fit (eq. 2.3 with delay, iff_plant_fit.hpp); the stiffness from the
+//                 IFF plant fit (eq. 2.3 with delay, ident/plant_fit.hpp); the stiffness from the
 //                 resonance k = m_sus w^2; the tuned 2-DoF model (apa/tuning.hpp, with the fitted
 //                 high-pass and delay as the measurement chain)
 //                 u -> d_e is also fitted as a mass-spring-damper with its own delay
-//                 (iff_plant_fit.hpp): the d_e and Vs read-outs lag differently
+//                 (ident/plant_fit.hpp): the d_e and Vs read-outs lag differently
 //   stiffness_open_circuit  the same with every stack open: k_oc (k_sc = k1)
 //   frf_without_resistor    u -> Vs without the resistor: the high-pass corner with and without it
 //   iff           per gain g: the damped plant u' -> d_e (Welch) and its pole, the dominant pair of
@@ -33,7 +33,6 @@
 #include <vector>
 
 #include "piezobench/campaign/campaign_file.hpp"
-#include "piezobench/campaign/iff_plant_fit.hpp"
 #include "piezobench/campaign/results.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/ident/features.hpp"
@@ -62,8 +61,9 @@ using Log = std::function<void(const std::string&)>;
 // All analyses of one unit (results.hpp; the acceptance is left to the pipeline) (single-threaded; the pipeline runs units in parallel).
 UnitAnalysis analyze_unit(const Campaign& campaign, const UnitSpec& unit, const Log& log = {});
 
-// Welch segment length used for a record of `samples` at `fs`: the campaign's nfft, or 4 s of data
-// limited to a quarter of the record (at least 256 samples).
+// Welch segment length used for a record of `samples` at `fs`: the campaign's nfft, or
+// dsp::segment_length_for_record (4 s of data limited to a quarter of the record, at least 256
+// samples; the `frf` command's default too).
 long frf_segment_length(const AnalysisSettings& settings, long samples, double fs);
 
 }  // namespace piezobench::campaign

@@ -35,4 +35,18 @@ struct Frf {
   void validate(const std::string& source = "") const;
 };
 
+// The band an FRF's input excited, read from the coherence: its lowest and highest frequency > 0
+// where the coherence of the best output (the largest coherence of the outputs whose coherence is
+// known), and its median over 9 neighbouring bins, are at least min_coherence. A dip inside (an
+// anti-resonance) does not split it; isolated noisy bins outside do not widen it. Without any
+// coherence the whole positive grid is returned (`from_coherence` false).
+struct FrequencyBand {
+  double fmin_hz = 0.0;
+  double fmax_hz = 0.0;
+  bool from_coherence = false;
+};
+// InputError (source: the FRF's) when no bin reaches min_coherence: "the input did not excite the
+// outputs; check the channels".
+FrequencyBand excited_band(const Frf& frf, double min_coherence = 0.5);
+
 }  // namespace piezobench::dsp

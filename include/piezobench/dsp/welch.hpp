@@ -53,6 +53,16 @@ struct WelchOptions {
   [[nodiscard]] Eigen::Index noverlap() const;
 };
 
+// The settings `run` and `frf` share for a record of `samples` at `sample_rate_hz` (one procedure,
+// one set of defaults): segments of 1 / resolution_hz seconds (4 s: 0.25 Hz bins) limited to a
+// quarter of the record (at least 7 averages with 50 % overlap) and to at least 256 samples; the
+// mean removed per segment (a linear-trend removal would distort the lowest bins); hann-periodic,
+// 50 % overlap, H1. InputError (prefixed with `source`) for a non-positive rate or resolution.
+[[nodiscard]] Eigen::Index segment_length_for_record(Eigen::Index samples, double sample_rate_hz,
+                                                     double resolution_hz = 0.25, const std::string& source = "");
+[[nodiscard]] WelchOptions welch_options_for_record(Eigen::Index samples, double sample_rate_hz,
+                                                    double resolution_hz = 0.25, const std::string& source = "");
+
 // A named, borrowed record of samples (the caller keeps the storage alive during the call).
 struct Channel {
   std::string name;

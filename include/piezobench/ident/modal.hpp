@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fit_quality.hpp"
+
 #include "piezobench/ident/vector_fitting.hpp"
 
 namespace piezobench::ident {
@@ -64,6 +66,7 @@ struct StabilizationPole {
 struct LscfResult {
   std::vector<Mode> modes;                     // by increasing frequency
   std::vector<StabilizationPole> diagram;      // every physical pole of every order
+  core::FitQuality quality;                    // poor: no stable mode, or a mode outside the band
 };
 
 // h: points x outputs (common denominator over outputs). Throws InputError for bad data or too few

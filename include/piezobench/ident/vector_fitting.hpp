@@ -19,6 +19,7 @@
 #include <complex>
 #include <string>
 
+#include "piezobench/core/fit_quality.hpp"
 #include "piezobench/lti/state_space.hpp"
 
 namespace piezobench::dsp {
@@ -46,8 +47,9 @@ PoleSpacing pole_spacing_from_string(const std::string& s);  // throws InputErro
 
 // Row weights used when none are passed explicitly ("unit", "inverse-magnitude",
 // "inverse-sqrt-magnitude"; the magnitude ones use |f_i(s_k)| per output, as vectfit3 suggests
-// for data with relative noise or a large dynamic range).
-enum class Weighting { kUnit, kInverseMagnitude, kInverseSqrtMagnitude };
+// for data with relative noise or a large dynamic range; "output-scale" weighs each output by
+// 1 / rms |f_i| over the band, so that outputs in different units (m/V and V/V) count alike).
+enum class Weighting { kUnit, kInverseMagnitude, kInverseSqrtMagnitude, kOutputScale };
 std::string to_string(Weighting w);
 Weighting weighting_from_string(const std::string& s);  // throws InputError
 
@@ -111,6 +113,11 @@ struct VectorFittingResult {
   lti::StateSpace model;
   double rms_error = 0.0;           // sqrt(mean |fit - data|^2) over points and outputs, data units
   double relative_rms_error = 0.0;  // rms_error / sqrt(mean |data|^2)
+  Vector relative_rms_error_per_output;  // the same per output: sqrt(sum |fit - data|^2 / sum |data|^2)
+  // Poor when an output's relative error is above core::kPoorRelativeError, a complex pole lies
+  // outside [lowest / 2, 2 highest] frequency of the data (a resonance the data cannot show; real
+  // poles only shape the slope), a pole is unstable, or the poles did not settle.
+  core::FitQuality quality;
   int iterations = 0;               // pole relocations performed
   bool converged = false;
   Convergence convergence = Convergence::kNotConverged;
@@ -137,6 +144,8 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
 VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data,
                                const VectorFittingOptions& options);
 // All outputs of an FRF (frequencies in Hz are converted to rad/s); errors name frf.provenance.source.
+// The verdict names the outputs and is also poor when an output's coherence is below 0.5 at more
+// than half of the points (a band the input did not excite).
 VectorFittingResult vector_fit(const dsp::Frf& frf, const VectorFittingOptions& options);
 
 }  // namespace piezobench::ident

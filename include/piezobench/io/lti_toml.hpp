@@ -19,6 +19,7 @@
 #include <string>
 
 #include "piezobench/lti/state_space.hpp"
+#include "piezobench/lti/transfer_function.hpp"
 
 namespace piezobench::io {
 
@@ -36,5 +37,10 @@ struct LtiFile {
 LtiFile read_lti_toml(const std::filesystem::path& path);
 // Same, from TOML text; `source` names it in errors.
 LtiFile parse_lti_toml(const std::string& text, const std::string& source);
+
+// A transfer function in the tf form above (num, den, delay when > 0, sample_time when discrete,
+// description), numbers with round-trip precision; read_lti_toml reads it back.
+std::string to_lti_toml(const lti::TransferFunction& tf, const std::string& description = "");
+void write_lti_toml(const lti::TransferFunction& tf, const std::filesystem::path& path, const std::string& description = "");
 
 }  // namespace piezobench::io

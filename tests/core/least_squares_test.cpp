@@ -1,5 +1,5 @@
-// The module's private Levenberg-Marquardt solver on problems with known minima.
-#include "apa/levenberg_marquardt.hpp"
+// The Levenberg-Marquardt solver on problems with known minima.
+#include "piezobench/core/least_squares.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
 
-namespace piezobench::apa::detail {
+namespace piezobench::core {
 namespace {
 
 using Eigen::VectorXd;
@@ -97,4 +97,4 @@ TEST(LevenbergMarquardt, StatusNames) {
 }
 
 }  // namespace
-}  // namespace piezobench::apa::detail
+}  // namespace piezobench::core

@@ -1,10 +1,11 @@
 #pragma once
-// Fit of the IFF plant model of the report (eq. 2.3, section 2.6) to a measured u -> Vs FRF:
+// Fit of the IFF plant model of the report (eq. 2.3, section 2.6; control::iff_plant) to a measured
+// u -> Vs FRF:
 //
 //   G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
 //
 // The report tuned g0, wz, xz, wp, xp and w_hpf by hand and added a 200 us delay to match the phase;
-// here all seven are fitted by Levenberg-Marquardt on the relative complex error
+// here all seven are fitted by Levenberg-Marquardt (core/least_squares.hpp) on the relative complex error
 // sum_k v_k |G(j w_k) / H_k - 1|^2 (magnitude and phase at once) with v_k ~ 1/omega_k, so that on a
 // uniform grid every decade weighs alike (else the mass line above the resonance, which holds most
 // of the points, would decide the fit), with
@@ -18,13 +19,17 @@
 // ident::fit_high_pass on the points below hpf_fmax (when there are three), g0 as the median of
 // |H / G(g0 = 1)| below the anti-resonance, and the delay from the slope of the phase of
 // H / G(delay = 0) above 1.5 wp.
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "piezobench/control/iff.hpp"
+#include "piezobench/core/fit_quality.hpp"
+#include "piezobench/core/least_squares.hpp"
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 
-namespace piezobench::campaign {
+namespace piezobench::ident {
 
 struct IffPlantFitOptions {
   double fmin_hz = 0.0;       // band used (0 = from the lowest positive frequency)
@@ -38,25 +43,24 @@ struct IffPlantFitOptions {
   void validate() const;      // InputError (source "iff plant fit options")
 };
 
-struct IffPlantFit {
-  double g0 = 0.0;       // V/V, signed
-  double wz = 0.0;       // rad/s
-  double xz = 0.0;       // < 0: non-minimum-phase zero pair
-  double wp = 0.0;       // rad/s
-  double xp = 0.0;
-  double w_hpf = 0.0;    // rad/s
-  double delay = 0.0;    // s
+// The fitted plant is a control::IffPlantParams (g0 V/V signed, wz, wp, w_hpf rad/s, xz < 0 for a
+// non-minimum-phase zero pair, xp, delay s) with how well it fits.
+struct IffPlantFit : control::IffPlantParams {
   double relative_rms_error = 0.0;           // rms |G/H - 1| over the points used
   double weighted_relative_rms_error = 0.0;  // the same with the fit's per-decade weights
   double initial_relative_rms_error = 0.0;   // weighted, at the better of the two starts
   long points = 0;
   int iterations = 0;
   bool converged = false;
+  core::LmStatus status = core::LmStatus::kMaxIterations;  // of the better of the two starts
+  // Poor: relative_rms_error above core::kPoorRelativeError, wz or wp outside the band of the points
+  // used, Levenberg-Marquardt stopped at max_iterations; impossible: a negative delay.
+  core::FitQuality quality;
 
   [[nodiscard]] bool zero_is_nonminimum_phase() const { return xz < 0.0; }
-  // G(s) as a transfer function (with the delay), also for xz < 0.
+  // G(s) as a transfer function (with the delay): control::iff_plant(*this).
   [[nodiscard]] lti::TransferFunction transfer_function() const;
-  // G(j omega) at every omega (rad/s).
+  // G(j omega) at every omega (rad/s): control::iff_plant_response(*this, omega).
   [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
 };
 
@@ -81,6 +85,10 @@ struct DelayedSecondOrderFit {
   double relative_rms_error = 0.0; // rms |H_model / H - 1| over the points used
   long points = 0;
   int iterations = 0;
+  core::LmStatus status = core::LmStatus::kMaxIterations;
+  // Poor: relative_rms_error above core::kPoorRelativeError, wn outside the band of the points used,
+  // max_iterations reached; impossible: a negative delay.
+  core::FitQuality quality;
   [[nodiscard]] lti::Complex pole() const;  // -zeta wn + j wn sqrt(1 - zeta^2) (Im >= 0)
   [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
 };
@@ -91,4 +99,32 @@ struct DelayedSecondOrderFit {
 DelayedSecondOrderFit fit_delayed_second_order(const lti::Vector& omega, const lti::CVector& h, const lti::Vector& coherence,
                                                const IffPlantFitOptions& options = {}, const std::string& source = "");
 
-}  // namespace piezobench::campaign
+// Both plants of an actuator's FRFs u -> d_e and u -> Vs, fitted as `run` and `model tune` do (one
+// procedure): u -> d_e by fit_delayed_second_order on [fmin_hz, fmax_hz], u -> Vs by fit_iff_plant
+// on [iff_fmin_hz, fmax_hz] (down to the lowest frequency by default, for the high-pass corner),
+// both on the points with a coherence of at least min_coherence and the delay fitted.
+struct ActuatorPlantOptions {
+  double fmin_hz = 20.0;         // band of the d_e fit
+  double fmax_hz = 500.0;        // band of both fits
+  double iff_fmin_hz = 0.0;      // lowest frequency of the Vs fit
+  double hpf_fmax_hz = 5.0;      // points below this start the high-pass corner
+  double fixed_w_hpf = 0.0;      // rad/s; > 0: the high-pass corner is known (1 / (R C_sensor))
+  double min_coherence = 0.5;
+  void validate() const;         // InputError (source "actuator plant options")
+};
+
+struct ActuatorPlants {
+  std::optional<DelayedSecondOrderFit> de;  // u -> d_e; nullopt when the fit failed
+  std::optional<IffPlantFit> vs;            // u -> Vs
+  IffPlantFitOptions de_options, vs_options;  // as used
+  // "u -> d_e second-order fit: ..." / "IFF plant fit: ..." for a fit that failed (NumericalError).
+  std::vector<std::string> failures;
+};
+
+// omega (rad/s, increasing), each output's H and coherence (empty = unknown) as for the fits above.
+// Data problems are InputErrors; a fit that fails numerically is left out and listed in `failures`.
+ActuatorPlants fit_actuator_plants(const lti::Vector& omega, const lti::CVector& h_de, const lti::Vector& coh_de,
+                                   const lti::CVector& h_vs, const lti::Vector& coh_vs,
+                                   const ActuatorPlantOptions& options = {}, const std::string& source = "");
+
+}  // namespace piezobench::ident

@@ -1,13 +1,14 @@
-#include "apa/levenberg_marquardt.hpp"
+#include "piezobench/core/least_squares.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "piezobench/core/error.hpp"
 
-namespace piezobench::apa::detail {
+namespace piezobench::core {
 
 std::string to_string(LmStatus s) {
   switch (s) {
@@ -39,7 +40,25 @@ double half_norm2(const VectorXd& r) { return 0.5 * r.squaredNorm(); }
 
 }  // namespace
 
+void LmOptions::validate() const {
+  const std::string src = "Levenberg-Marquardt options";
+  if (max_iterations < 1) throw InputError(src, "max_iterations", "at least 1", std::to_string(max_iterations));
+  for (const auto& [v, name] : {std::pair{cost_tolerance, "cost_tolerance"}, std::pair{step_tolerance, "step_tolerance"},
+                                std::pair{gradient_tolerance, "gradient_tolerance"}}) {
+    if (!(std::isfinite(v) && v >= 0.0)) throw InputError(src, name, "a finite tolerance >= 0", std::to_string(v));
+  }
+  for (const auto& [v, name] : {std::pair{initial_lambda, "initial_lambda"}, std::pair{jacobian_step, "jacobian_step"}}) {
+    if (!(std::isfinite(v) && v > 0.0)) throw InputError(src, name, "a finite value > 0", std::to_string(v));
+  }
+}
+
 LmResult levenberg_marquardt(const ResidualFunction& fun, const VectorXd& x0, const LmOptions& options) {
+  return levenberg_marquardt(fun, JacobianFunction(), x0, options);
+}
+
+LmResult levenberg_marquardt(const ResidualFunction& fun, const JacobianFunction& analytic, const VectorXd& x0,
+                             const LmOptions& options) {
+  options.validate();
   LmResult out;
   out.x = x0;
   VectorXd r = fun(x0);
@@ -51,6 +70,10 @@ LmResult levenberg_marquardt(const ResidualFunction& fun, const VectorXd& x0, co
 
   MatrixXd J(m, n);
   auto jacobian = [&](const VectorXd& x) {
+    if (analytic) {
+      J = analytic(x);
+      return;
+    }
     for (Eigen::Index j = 0; j < n; ++j) {
       VectorXd xp = x, xm = x;
       xp(j) += options.jacobian_step;
@@ -121,4 +144,4 @@ LmResult levenberg_marquardt(const ResidualFunction& fun, const VectorXd& x0, co
   return out;
 }
 
-}  // namespace piezobench::apa::detail
+}  // namespace piezobench::core

@@ -1,18 +1,20 @@
-#include "piezobench/campaign/iff_plant_fit.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <utility>
 #include <limits>
 #include <numbers>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/least_squares.hpp"
 #include "piezobench/ident/features.hpp"
 
-namespace piezobench::campaign {
+namespace piezobench::ident {
 
 using lti::Complex;
 using lti::CVector;
@@ -35,12 +37,7 @@ void IffPlantFitOptions::validate() const {
 
 namespace {
 
-Complex model(const IffPlantFit& p, double w) {
-  const Complex s(0.0, w);
-  const Complex num = 1.0 + 2.0 * p.xz * s / p.wz + s * s / (p.wz * p.wz);
-  const Complex den = 1.0 + 2.0 * p.xp * s / p.wp + s * s / (p.wp * p.wp);
-  return p.g0 * num / den * s / (p.w_hpf + s) * std::exp(-s * p.delay);
-}
+Complex model(const IffPlantFit& p, double w) { return control::iff_plant_response(p, w); }
 
 // Scaled parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, log w_hpf, delay / 100 us.
 constexpr double kXzScale = 0.01;
@@ -79,85 +76,29 @@ IffPlantFit from_x(const Eigen::VectorXd& x, double sign, const Layout& l, doubl
   return p;
 }
 
-struct LmOutcome {
-  Eigen::VectorXd x;
-  double cost = 0.0;
-  int iterations = 0;
-  bool converged = false;
-};
+// A fitted frequency (rad/s) must lie inside the band of the points used.
+void check_in_band(core::FitQuality& q, const char* what, double w, const Vector& band) {
+  if (w >= band(0) && w <= band(band.size() - 1)) return;
+  q.add_problem(fmt::format("{} {:.4g} Hz outside the band used, {:.4g} to {:.4g} Hz", what, w / (2 * std::numbers::pi),
+                            band(0) / (2 * std::numbers::pi), band(band.size() - 1) / (2 * std::numbers::pi)));
+}
 
-// Levenberg-Marquardt with Marquardt's diagonal scaling and central-difference Jacobian.
-LmOutcome levenberg_marquardt(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& residual,
-                              Eigen::VectorXd x, int max_iterations) {
-  Eigen::VectorXd r = residual(x);
-  double cost = r.squaredNorm();
-  double lambda = 1e-3;
-  LmOutcome out;
-  const Index n = x.size();
-  for (int it = 0; it < max_iterations; ++it) {
-    out.iterations = it + 1;
-    Eigen::MatrixXd j(r.size(), n);
-    for (Index i = 0; i < n; ++i) {
-      const double h = 1e-6 * std::max(1.0, std::abs(x(i)));
-      Eigen::VectorXd xp = x, xm = x;
-      xp(i) += h;
-      xm(i) -= h;
-      j.col(i) = (residual(xp) - residual(xm)) / (2.0 * h);
-    }
-    const Eigen::MatrixXd jtj = j.transpose() * j;
-    const Eigen::VectorXd g = j.transpose() * r;
-    if (g.lpNorm<Eigen::Infinity>() <= 1e-14 * (cost + 1e-300)) {
-      out.converged = true;
-      break;
-    }
-    bool improved = false;
-    for (int attempt = 0; attempt < 30 && !improved; ++attempt) {
-      Eigen::MatrixXd a = jtj;
-      a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-12);
-      const Eigen::VectorXd dx = a.ldlt().solve(-g);
-      const Eigen::VectorXd xn = x + dx;
-      const Eigen::VectorXd rn = residual(xn);
-      const double cn = rn.allFinite() ? rn.squaredNorm() : std::numeric_limits<double>::infinity();
-      if (cn < cost) {
-        const double gain = (cost - cn) / cost;
-        x = xn;
-        r = rn;
-        cost = cn;
-        lambda = std::max(lambda / 3.0, 1e-12);
-        improved = true;
-        if (gain < 1e-12 || dx.norm() < 1e-10 * (x.norm() + 1e-10)) out.converged = true;
-      } else {
-        lambda *= 4.0;
-      }
-    }
-    if (!improved) {
-      out.converged = true;  // no step lowers the cost: a minimum at the resolution of the Jacobian
-      break;
-    }
-    if (out.converged) break;
-  }
-  out.x = x;
-  out.cost = cost;
-  return out;
+void check_lm(core::FitQuality& q, core::LmStatus status) {
+  if (status == core::LmStatus::kMaxIterations) q.add_problem("Levenberg-Marquardt stopped at its iteration limit");
+}
+
+// Levenberg-Marquardt on the scaled parameters (core/least_squares.hpp).
+core::LmResult least_squares(const core::ResidualFunction& residual, const Eigen::VectorXd& x0, int max_iterations) {
+  core::LmOptions o;
+  o.max_iterations = max_iterations;
+  return core::levenberg_marquardt(residual, x0, o);
 }
 
 }  // namespace
 
-lti::TransferFunction IffPlantFit::transfer_function() const {
-  Vector num(4), den(4);
-  const double a2 = 1.0 / (wz * wz), a1 = 2.0 * xz / wz;
-  num << g0 * a2, g0 * a1, g0, 0.0;
-  const double b2 = 1.0 / (wp * wp), b1 = 2.0 * xp / wp;
-  // (b2 s^2 + b1 s + 1)(s + w_hpf)
-  den << b2, b2 * w_hpf + b1, b1 * w_hpf + 1.0, w_hpf;
-  return lti::TransferFunction(num / b2, den / b2, 0.0, delay);
-}
+lti::TransferFunction IffPlantFit::transfer_function() const { return control::iff_plant(*this); }
 
-CVector IffPlantFit::response(const Vector& omega) const {
-  CVector h(omega.size());
-  for (Index k = 0; k < omega.size(); ++k) h(k) = model(*this, omega(k));
-  return h;
-}
+CVector IffPlantFit::response(const Vector& omega) const { return control::iff_plant_response(*this, omega); }
 
 IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
                           const std::string& source) {
@@ -321,15 +262,17 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
     return r;
   };
   const double n = static_cast<double>(w.size());
-  LmOutcome best;
+  core::LmResult best;
   best.cost = std::numeric_limits<double>::infinity();
   double initial_cost = std::numeric_limits<double>::infinity();
   for (const double zs : {1.0, -1.0}) {
     IffPlantFit s0 = start;
     s0.xz = zs * start.xz;
     const Eigen::VectorXd x0 = to_x(s0, layout);
-    initial_cost = std::min(initial_cost, residual(x0).squaredNorm());
-    const LmOutcome o = levenberg_marquardt(residual, x0, options.max_iterations);
+    const Eigen::VectorXd r0 = residual(x0);
+    if (!r0.allFinite()) continue;
+    initial_cost = std::min(initial_cost, r0.squaredNorm());
+    const core::LmResult o = least_squares(residual, x0, options.max_iterations);
     if (o.cost < best.cost) best = o;
   }
   if (!std::isfinite(best.cost)) {
@@ -339,11 +282,18 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   double plain = 0.0;
   for (Index k = 0; k < w.size(); ++k) plain += std::norm(model(fit, w(k)) / d(k) - 1.0);
   fit.relative_rms_error = std::sqrt(plain / n);
-  fit.weighted_relative_rms_error = std::sqrt(best.cost / n);
+  fit.weighted_relative_rms_error = std::sqrt(2.0 * best.cost / n);
   fit.initial_relative_rms_error = std::sqrt(initial_cost / n);
   fit.points = w.size();
   fit.iterations = best.iterations;
-  fit.converged = best.converged;
+  fit.converged = best.converged();
+  fit.status = best.status;
+  fit.quality.check_error("u -> Vs (IFF plant, eq. 2.3)", fit.relative_rms_error);
+  check_in_band(fit.quality, "anti-resonance wz", fit.wz, w);
+  check_in_band(fit.quality, "resonance wp", fit.wp, w);
+  check_lm(fit.quality, best.status);
+  if (fit.delay < 0.0) fit.quality.add_problem(fmt::format("delay {:.3g} s < 0 (acausal)", fit.delay), false);
+  fit.quality.advise("a band around the anti-resonance and the resonance where the coherence is high");
   return fit;
 }
 
@@ -491,7 +441,10 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   x0(1) = std::log(start.natural_frequency);
   x0(2) = std::log(start.damping);
   if (options.fit_delay) x0(3) = start.delay / kDelayScale;
-  const LmOutcome o = levenberg_marquardt(residual, x0, options.max_iterations);
+  if (!residual(x0).allFinite()) {
+    throw NumericalError("second-order fit (" + source + ")", "the starting point gives a non-finite error", true);
+  }
+  const core::LmResult o = least_squares(residual, x0, options.max_iterations);
   if (!std::isfinite(o.cost)) {
     throw NumericalError("second-order fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
   }
@@ -501,7 +454,50 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   fit.relative_rms_error = std::sqrt(plain / static_cast<double>(w.size()));
   fit.points = w.size();
   fit.iterations = o.iterations;
+  fit.status = o.status;
+  fit.quality.check_error("second-order fit", fit.relative_rms_error);
+  check_in_band(fit.quality, "natural frequency", fit.natural_frequency, w);
+  check_lm(fit.quality, o.status);
+  if (fit.delay < 0.0) fit.quality.add_problem(fmt::format("delay {:.3g} s < 0 (acausal)", fit.delay), false);
+  fit.quality.advise("a band around the resonance where the coherence is high");
   return fit;
 }
 
-}  // namespace piezobench::campaign
+void ActuatorPlantOptions::validate() const {
+  const std::string src = "actuator plant options";
+  for (const auto& [v, name] : {std::pair{fmin_hz, "fmin_hz"}, std::pair{iff_fmin_hz, "iff_fmin_hz"}, std::pair{fixed_w_hpf, "fixed_w_hpf"}}) {
+    if (!(std::isfinite(v) && v >= 0.0)) throw InputError(src, name, "a finite value >= 0", fmt::format("{}", v));
+  }
+  if (!(std::isfinite(fmax_hz) && fmax_hz > fmin_hz && fmax_hz > iff_fmin_hz)) {
+    throw InputError(src, "fmax_hz", "a frequency above fmin_hz and iff_fmin_hz", fmt::format("{}", fmax_hz));
+  }
+  if (!(std::isfinite(hpf_fmax_hz) && hpf_fmax_hz > 0.0)) throw InputError(src, "hpf_fmax_hz", "a frequency > 0 Hz", fmt::format("{}", hpf_fmax_hz));
+  if (!(min_coherence >= 0.0 && min_coherence < 1.0)) throw InputError(src, "min_coherence", "a value in [0, 1)", fmt::format("{}", min_coherence));
+}
+
+ActuatorPlants fit_actuator_plants(const Vector& omega, const CVector& h_de, const Vector& coh_de, const CVector& h_vs,
+                                   const Vector& coh_vs, const ActuatorPlantOptions& options, const std::string& source) {
+  options.validate();
+  ActuatorPlants out;
+  out.de_options.fmin_hz = options.fmin_hz;
+  out.de_options.fmax_hz = options.fmax_hz;
+  out.de_options.min_coherence = options.min_coherence;
+  out.vs_options.fmin_hz = options.iff_fmin_hz;
+  out.vs_options.fmax_hz = options.fmax_hz;
+  out.vs_options.hpf_fmax_hz = options.hpf_fmax_hz;
+  out.vs_options.min_coherence = options.min_coherence;
+  out.vs_options.fixed_w_hpf = options.fixed_w_hpf;
+  try {
+    out.de = fit_delayed_second_order(omega, h_de, coh_de, out.de_options, source);
+  } catch (const NumericalError& e) {
+    out.failures.push_back(std::string("u -> d_e second-order fit: ") + e.what());
+  }
+  try {
+    out.vs = fit_iff_plant(omega, h_vs, coh_vs, out.vs_options, source);
+  } catch (const NumericalError& e) {
+    out.failures.push_back(std::string("IFF plant fit: ") + e.what());
+  }
+  return out;
+}
+
+}  // namespace piezobench::ident
