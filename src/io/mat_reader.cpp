@@ -496,6 +496,13 @@ std::string read_string_attribute(hid_t obj, const char* name, const std::string
   if (H5Aexists(obj, name) <= 0) return "";
   const H5Id attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
   if (!attr.valid()) throw InputError(source, field, "a readable " + std::string(name) + " attribute", "HDF5 cannot open it");
+  // One string: H5Aread writes every element, and the buffers below hold one (an array of 40
+  // strings overran the stack pointer or the heap buffer; found by fuzz_mat_timeseries).
+  const H5Id space(H5Aget_space(attr.get()), H5Sclose);
+  const hssize_t count = space.valid() ? H5Sget_simple_extent_npoints(space.get()) : -1;
+  if (count != 1) {
+    throw InputError(source, field, std::string(name) + " as one string", count < 0 ? std::string("an unreadable shape") : std::to_string(count) + " elements");
+  }
   const H5Id type(H5Aget_type(attr.get()), H5Tclose);
   if (!type.valid() || H5Tget_class(type.get()) != H5T_STRING) {
     throw InputError(source, field, std::string(name) + " as a string attribute", "another type");

@@ -106,6 +106,15 @@ TEST(MatReaderHostile, V73UnwrittenContiguousDatasetIsRefused) {
                  {"v73_declares_2e9.mat", "de (declared 2000000000x1)", "16000000000 bytes of data in the file", "0 bytes"});
 }
 
+// An attribute read by H5Aread fills one element per point of its dataspace: MATLAB_class as an
+// array of strings overran the one-string buffer (found by fuzz_mat_timeseries).
+TEST(MatReaderHostile, V73ClassAttributeHoldingManyStringsIsRefused) {
+  for (const char* name : {"v73_class_vlen_array.mat", "v73_class_fixed_array.mat"}) {
+    expect_refused([&] { (void)read_timeseries(hostile(name), channels({"u", "de"})); },
+                   {name, "de", "MATLAB_class as one string", "40 elements"});
+  }
+}
+
 TEST(MatReaderHostile, EveryHostileFileIsAnInputErrorThroughEveryReader) {
   for (const auto& entry : fs::directory_iterator(test::fixture_path("io/hostile"))) {
     if (entry.path().extension() != ".mat") continue;
