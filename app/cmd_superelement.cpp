@@ -79,13 +79,14 @@ int run_superelement(const SuperElementCli& o) {
   for (const std::string& w : se.warnings) log_line("warning: " + w);
   const fem::ModelOptions& options = setup.model;
   const fem::StructuralModel model = fem::assemble(se, options);
+  if (!o.json) log_line(fmt::format("modes of the constrained model ({} DOF)", model.size()));
   const fem::Modes modes = fem::modes(model);
 
   const Eigen::VectorXd hz = lti::logspace(std::log10(o.fmin), std::log10(o.fmax), o.points);
   std::vector<Eigen::MatrixXcd> H;
   if (model.F.cols() > 0 && model.T.rows() > 0) {
     if (!o.json) log_line(fmt::format("frequency response at {} points on {} DOF", o.points, model.size()));
-    H = fem::frequency_response(model, 2 * std::numbers::pi * hz);
+    H = fem::frequency_response(model, modes, 2 * std::numbers::pi * hz);  // modal superposition
   }
 
   if (o.json) {

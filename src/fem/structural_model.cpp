@@ -313,4 +313,44 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
   return H;
 }
 
+std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, const Modes& modes, const Eigen::VectorXd& omega) {
+  const Index f = model.size();
+  if (modes.shapes.rows() != f || modes.shapes.cols() != f || modes.frequencies_Hz.size() != f) {
+    throw InputError("", "modes", "all " + std::to_string(f) + " modes of the model",
+                     std::to_string(modes.shapes.rows()) + " x " + std::to_string(modes.shapes.cols()) + " shapes");
+  }
+  const Eigen::MatrixXd& phi = modes.shapes;
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(f);
+  if (model.C.size() > 0 && model.C.cwiseAbs().maxCoeff() > 0.0) {
+    Eigen::MatrixXd modal_c = phi.transpose() * model.C * phi;
+    c = modal_c.diagonal();
+    modal_c.diagonal().setZero();
+    // Not diagonal in the modes (or not finite): the dense solution.
+    if (!(modal_c.cwiseAbs().maxCoeff() <= kModalCouplingTolerance * c.cwiseAbs().maxCoeff())) return frequency_response(model, omega);
+  }
+  const Eigen::VectorXd lambda = modes.frequencies_Hz.unaryExpr([](double hz) {
+    const double w = 2 * std::numbers::pi * hz;
+    return std::copysign(w * w, hz);
+  });
+  const Eigen::MatrixXcd t_phi = (model.T * phi).cast<std::complex<double>>();
+  const Eigen::MatrixXcd phi_f = (phi.transpose() * model.F).cast<std::complex<double>>();
+  std::vector<Eigen::MatrixXcd> H;
+  H.reserve(static_cast<std::size_t>(omega.size()));
+  Eigen::VectorXcd inv(f);
+  for (Index k = 0; k < omega.size(); ++k) {
+    const double w = omega(k);
+    if (!std::isfinite(w)) throw InputError("", "omega[" + std::to_string(k) + "]", "a finite frequency", detail::g17(w));
+    for (Index i = 0; i < f; ++i) inv(i) = 1.0 / std::complex<double>(lambda(i) - w * w, w * c(i));
+    Eigen::MatrixXcd h = t_phi * inv.asDiagonal() * phi_f;
+    if (!h.allFinite()) {
+      throw NumericalError("frequency_response (modal superposition)",
+                           "the dynamic stiffness is singular at " + detail::g17(w / (2 * std::numbers::pi)) +
+                               " Hz (an undamped resonance, or a free body at 0 Hz)",
+                           true);
+    }
+    H.push_back(std::move(h));
+  }
+  return H;
+}
+
 }  // namespace piezobench::fem

@@ -115,4 +115,18 @@ struct Modes {
 [[nodiscard]] std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model,
                                                                const Eigen::VectorXd& omega);
 
+// The same H(j w) by modal superposition on `modes` (all f modes of the model, as modes(model)
+// returns them): H = T Phi diag(1 / (w_i^2 - w^2 + j w c_i)) Phi^T F with c = diag(Phi^T C Phi).
+// Exact when C is diagonal in the modes, as every C assemble() builds (none, modal, Rayleigh):
+// O(f^3) once, then O(f (inputs + outputs)) per frequency instead of a dense LU per frequency
+// (2,300 DOF at 500 frequencies: under a minute instead of more than an hour). When Phi^T C Phi
+// has an off-diagonal term above kModalCouplingTolerance times its largest diagonal term, falls
+// back to the dense LU above. Round-off: about 1e-16 of the largest modal term, so a response
+// that cancels to many decades below its terms (a non-collocated transfer far above the last
+// mode) keeps fewer digits than the dense LU's. InputError when `modes` is not the model's full
+// set; NumericalError as above.
+inline constexpr double kModalCouplingTolerance = 1e-8;
+[[nodiscard]] std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, const Modes& modes,
+                                                               const Eigen::VectorXd& omega);
+
 }  // namespace piezobench::fem
