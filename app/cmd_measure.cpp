@@ -7,12 +7,15 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <variant>
 
 #include "cli_common.hpp"
 #include "measure_common.hpp"
+#include "piezobench/bench/tracking.hpp"
 #include "piezobench/bench/truth.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/rt/comedi_backend.hpp"
 #include "piezobench/rt/measure.hpp"
@@ -64,6 +67,10 @@ std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& b) {
   return std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(b.unit, b.seed), rt::bench_options(b), b.seed);
 }
 
+void set_feedforward(bench::ExperimentOptions& options, const std::string& file) {
+  if (!file.empty()) options.feedforward = io::read_hysteresis_model(file);
+}
+
 int run_measurement(const MeasureRequest& r) {
   const bench::Experiment experiment = bench::experiment_from_string(r.experiment);
   bench::ExperimentOptions eo = r.options;
@@ -108,7 +115,7 @@ int run_measurement(const MeasureRequest& r) {
     if (!bench::runs_on_bench(experiment)) {
       throw InputError("", "experiment",
                        "an experiment that runs on the bench's I/O (stroke, hysteresis, stiffness, frf-noise, frf-sweep, "
-                       "iff); record " + r.experiment + " with its own instruments and give the file to `piezobench run`",
+                       "iff, tracking); record " + r.experiment + " with its own instruments and give the file to `piezobench run`",
                        "'" + r.experiment + "'");
     }
     backend = make_backend(*r.bench);
@@ -128,10 +135,25 @@ int run_measurement(const MeasureRequest& r) {
     }
   }
   io::write_timeseries(ts, out);
+  std::optional<bench::TrackingSummary> tracking;
+  if (experiment == bench::Experiment::kTracking) tracking = bench::tracking_summary(ts);
   if (!r.json) {
     fmt::print("wrote {}: {} on unit {}{} ({} samples at {:g} Hz; channels {}{})\n", out, r.experiment, r.unit,
                unit.defective ? " (defective)" : "", ts.samples(), ts.sample_rate, ts.t.size() > 0 ? "t, " : "",
                fmt::join(ts.names, ", "));
+    if (tracking) {
+      for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking->sine},
+                                    {"triangle", tracking->triangle}}) {
+        fmt::print("{:8} hysteresis width {:.2f} % -> {:.2f} % of the stroke ({:.1f} um); rms tracking error {:.3f} um -> "
+                   "{:.3f} um ({:.1f}x)\n",
+                   name, 100.0 * f.width_open, 100.0 * f.width_ff, 1e6 * f.stroke_open, 1e6 * f.rms_open, 1e6 * f.rms_ff,
+                   f.rms_reduction());
+      }
+      fmt::print("feedforward: {}{}; {} samples clamped to the stack range\n",
+                 tracking->identified ? "identified from the open run" : "the given model",
+                 tracking->identified ? fmt::format(" (fit residual {:.3g} % of the stroke)", 100.0 * tracking->fit_relative_residual) : "",
+                 tracking->clamped_samples);
+    }
     if (runner) {
       const rt::IoStats io = runner->report().io();
       fmt::print("I/O: {} exchanges, {} lost, {} late, {} stale inputs, {} errors; round trip p50 {:.1f} us, p99 {:.1f} us\n",
@@ -150,6 +172,18 @@ int run_measurement(const MeasureRequest& r) {
                         {"channels", ts.names},
                         {"units", units},
                         {"settings", settings_json(ts)}};
+  if (tracking) {
+    nlohmann::json t = nlohmann::json::object();
+    for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking->sine},
+                                  {"triangle", tracking->triangle}}) {
+      t[name] = {{"width_open", f.width_open}, {"width_ff", f.width_ff}, {"rms_open_m", f.rms_open}, {"rms_ff_m", f.rms_ff},
+                 {"stroke_open_m", f.stroke_open}, {"rms_reduction", f.rms_reduction()}};
+    }
+    t["identified"] = tracking->identified;
+    t["fit_relative_residual"] = tracking->fit_relative_residual;
+    t["clamped_samples"] = tracking->clamped_samples;
+    doc["tracking"] = t;
+  }
   if (!hardware) {
     doc["truth"] = bench::truth_json(unit, eo.bench);
   } else {
@@ -194,6 +228,7 @@ struct MeasureCli {
   double amplitude = 0.0, duration = 0.0, gain = 0.0;
   CLI::Option *amplitude_option = nullptr, *duration_option = nullptr, *gain_option = nullptr, *seed_option = nullptr,
               *unit_option = nullptr;
+  std::string feedforward;
   bool realtime = false, json = false, open_circuit = false, no_resistor = false;
 };
 
@@ -207,6 +242,7 @@ int run_measure(const MeasureCli& o) {
   if (o.gain_option->count() > 0) r.options.gain = o.gain;
   r.options.bench.actuator_open_circuit = o.open_circuit;
   r.options.bench.hpf_resistor = !o.no_resistor;
+  set_feedforward(r.options, o.feedforward);
   r.unit = o.unit_option->count() > 0 || desc.hardware() ? o.unit : desc.unit;
   r.seed = o.seed_option->count() > 0 || desc.hardware() ? o.seed : desc.seed;
   r.out = o.out;
@@ -277,8 +313,8 @@ int run_serve(const ServeCli& o) {
 void add_measure_commands(CLI::App& app, Action& action) {
   auto o = std::make_shared<MeasureCli>();
   CLI::App* m = app.add_subcommand("measure", "One experiment of the report on the bench a bench file describes, written as a measurement file");
-  m->add_option("experiment", o->experiment, "stroke, hysteresis, stiffness, frf-noise, frf-sweep or iff (virtual bench: also "
-                                             "hammer, flatness, capacitance)")
+  m->add_option("experiment", o->experiment, "stroke, hysteresis, stiffness, frf-noise, frf-sweep, iff or tracking (virtual "
+                                             "bench: also hammer, flatness, capacitance)")
       ->required();
   m->add_option("--bench", o->bench, "bench file (TOML): backend, channels, amplifier, limits (docs/hardware.md)")
       ->required()
@@ -289,6 +325,9 @@ void add_measure_commands(CLI::App& app, Action& action) {
   o->amplitude_option = m->add_option("--amplitude", o->amplitude, "V at the stacks, as for simulate");
   o->duration_option = m->add_option("--duration", o->duration, "s: frf-noise (20), frf-sweep (20), iff (10)");
   o->gain_option = m->add_option("--gain", o->gain, "IFF gain g (280000)");
+  m->add_option("--feedforward", o->feedforward,
+                "tracking: the hysteresis model (TOML, `hysteresis fit`) of the compensated run (default: identified from the open run)")
+      ->check(CLI::ExistingFile);
   m->add_flag("--open-circuit", o->open_circuit,
               "actuator stacks disconnected from the amplifier (stiffness k_oc; a real bench asks the operator first)");
   m->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (a real bench asks the operator first)");

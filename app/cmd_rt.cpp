@@ -11,6 +11,7 @@
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/excitation.hpp"
+#include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/rt/bench_file.hpp"
 #include "piezobench/rt/loop.hpp"
@@ -33,6 +34,10 @@ struct RtOptions {
   std::string excitation = "none";
   double amplitude = 0.05;
   std::string band = "1,1000";
+  double frequency = 1.0;     // sine excitation, Hz
+  double offset = 0.0;        // sine excitation, V at the DAC
+  std::string feedforward;    // hysteresis model (TOML)
+  std::string hysteresis_law = "prandtl-ishlinskii";  // virtual bench
   std::string replay;
   bool realtime = true;
   rt::ActuatorLimits limits;
@@ -88,6 +93,11 @@ int run_rt(const RtOptions& o) {
     bo.va_min = o.limits.va_min;
     bo.va_max = o.limits.va_max;
     bo.amplifier_gain = o.limits.amplifier_gain;
+    try {
+      bo.hysteresis_law = bench::hysteresis_law_from_string(o.hysteresis_law);
+    } catch (const InputError&) {
+      throw InputError("", "--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
+    }
     backend = std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(o.unit, o.seed), bo, o.seed);
     source = {{"bench", "virtual"}, {"unit", o.unit}, {"seed", o.seed}};
   } else if (o.bench == "replay") {
@@ -137,8 +147,25 @@ int run_rt(const RtOptions& o) {
     unlimited.max = 1e6;
     lo.excitation = dsp::band_limited_noise(no, unlimited).u;
     lo.log_settings["amplitude_rms"] = o.amplitude;
+  } else if (o.excitation == "sine") {
+    if (!(std::isfinite(o.frequency) && o.frequency > 0.0 && o.frequency < 0.5 * backend->sample_rate())) {
+      throw InputError("", "--frequency", "a frequency in (0, rate / 2) Hz", fmt::format("{:g}", o.frequency));
+    }
+    // One period (rounded to whole samples), played cyclically.
+    const auto n = static_cast<Eigen::Index>(std::max(2.0, std::round(backend->sample_rate() / o.frequency)));
+    lo.excitation.resize(n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      lo.excitation(k) = o.offset + o.amplitude * std::sin(2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
+    }
+    lo.log_settings["amplitude"] = o.amplitude;
+    lo.log_settings["offset"] = o.offset;
+    lo.log_settings["frequency_Hz"] = backend->sample_rate() / static_cast<double>(n);
   } else if (o.excitation != "none") {
-    throw InputError("", "--excitation", "none or noise", "'" + o.excitation + "'");
+    throw InputError("", "--excitation", "none, noise or sine", "'" + o.excitation + "'");
+  }
+  if (!o.feedforward.empty()) {
+    lo.feedforward = io::read_hysteresis_model(o.feedforward);
+    lo.log_settings["feedforward"] = o.feedforward;
   }
   // The signals are kept in memory for the summary unless the run is long.
   lo.keep_log = o.duration <= 120.0;
@@ -185,6 +212,7 @@ int run_rt(const RtOptions& o) {
                 {"watchdog_trips", r.watchdog_trips},
                 {"nonfinite_sensor_samples", r.nonfinite_sensor_samples},
                 {"stale_sensor_samples", r.stale_sensor_samples},
+                {"feedforward", r.feedforward},
                 {"va_cmd_min_V", r.va_cmd_min},
                 {"va_cmd_max_V", r.va_cmd_max},
                 {"io",
@@ -268,8 +296,14 @@ void add_rt_commands(CLI::App& app, Action& action) {
   rt->add_option("--log", o->log, "write the signals of every cycle to this .mat (or .csv) file");
   rt->add_option("--unit", o->unit, "virtual bench: unit of the batch (1..7)")->capture_default_str();
   rt->add_option("--seed", o->seed, "virtual bench: unit and noise seed; excitation seed")->capture_default_str();
-  rt->add_option("--excitation", o->excitation, "u': none or noise (band-limited, periodic)")->capture_default_str();
-  rt->add_option("--amplitude", o->amplitude, "noise rms, V at the DAC")->capture_default_str();
+  rt->add_option("--excitation", o->excitation, "u': none, noise (band-limited, periodic) or sine")->capture_default_str();
+  rt->add_option("--amplitude", o->amplitude, "noise rms or sine amplitude, V at the DAC")->capture_default_str();
+  rt->add_option("--frequency", o->frequency, "sine frequency, Hz (a whole number of samples per period)")->capture_default_str();
+  rt->add_option("--offset", o->offset, "sine offset, V at the DAC")->capture_default_str();
+  rt->add_option("--hysteresis-law", o->hysteresis_law, "virtual bench: prandtl-ishlinskii or bouc-wen")->capture_default_str();
+  rt->add_option("--feedforward", o->feedforward,
+                 "hysteresis model (TOML, `hysteresis fit`): u' passes through its inverse before the safety clamp")
+      ->check(CLI::ExistingFile);
   rt->add_option("--band", o->band, "noise band LO,HI, Hz")->capture_default_str();
   rt->add_option("--replay", o->replay, "replay: the recorded file (.mat or .csv with channels de and Vs)");
   rt->add_option("--realtime", *realtime, "true: paced by absolute deadlines; false: lockstep, as fast as possible")

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "cli_common.hpp"
+#include "piezobench/core/error.hpp"
 #include "measure_common.hpp"
 
 namespace piezobench::app {
@@ -19,6 +20,8 @@ struct SimulateOptions {
   CLI::Option* gain_option = nullptr;
   bool no_delay = false, no_nmp_zero = false, no_resistor = false, open_circuit = false, no_hysteresis = false, no_creep = false, no_noise = false;
   std::string superelement;
+  std::string hysteresis_law = "prandtl-ishlinskii";
+  std::string feedforward;
   bool json = false;
 };
 
@@ -37,6 +40,12 @@ int run_simulate(const SimulateOptions& o) {
   r.options.bench.hpf_resistor = !o.no_resistor;
   r.options.bench.actuator_open_circuit = o.open_circuit;
   if (!o.superelement.empty()) r.options.bench.superelement = o.superelement;
+  try {
+    r.options.bench.hysteresis_law = bench::hysteresis_law_from_string(o.hysteresis_law);
+  } catch (const InputError&) {
+    throw InputError("", "--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
+  }
+  set_feedforward(r.options, o.feedforward);
   r.unit = o.unit;
   r.seed = o.seed;
   r.out = o.out;
@@ -50,13 +59,13 @@ void add_simulate_commands(CLI::App& app, Action& action) {
   auto o = std::make_shared<SimulateOptions>();
   CLI::App* sim = app.add_subcommand("simulate", "One experiment of the report on the virtual bench, written as a measurement file");
   sim->add_option("experiment", o->experiment,
-                  "stroke, hysteresis, stiffness, frf-noise, frf-sweep, iff, hammer, flatness or capacitance")
+                  "stroke, hysteresis, stiffness, frf-noise, frf-sweep, iff, hammer, flatness, capacitance or tracking")
       ->required();
   sim->add_option("--unit", o->unit, "unit of the batch, 1..7 (3 is defective)")->capture_default_str();
   sim->add_option("--seed", o->seed, "seed of the batch and of the noise (same seed, same file)")->capture_default_str();
   sim->add_option("--out", o->out, "output file, .mat (default) or .csv (default: EXPERIMENT-unitN.mat)");
   o->amplitude_option = sim->add_option("--amplitude", o->amplitude,
-                                        "V at the stacks: hysteresis sine amplitude (20), frf-noise/iff rms (2), "
+                                        "V at the stacks: hysteresis sine amplitude (20), tracking amplitude (80), frf-noise/iff rms (2), "
                                         "frf-sweep amplitude (1); refused beyond the -20..150 V range");
   o->duration_option = sim->add_option("--duration", o->duration, "s: frf-noise (20), frf-sweep (20), iff (10)");
   o->gain_option = sim->add_option("--gain", o->gain, "IFF gain g of the report's controller (280000)");
@@ -64,6 +73,12 @@ void add_simulate_commands(CLI::App& app, Action& action) {
   sim->add_flag("--no-nmp-zero", o->no_nmp_zero, "a minimum-phase anti-resonance on u -> Vs");
   sim->add_flag("--no-hysteresis", o->no_hysteresis, "no hysteresis of the stacks");
   sim->add_flag("--no-creep", o->no_creep, "no creep of the stacks");
+  sim->add_option("--hysteresis-law", o->hysteresis_law,
+                  "law of the stacks' hysteresis: prandtl-ishlinskii (play operators) or bouc-wen (docs/virtual-bench.md)")
+      ->capture_default_str();
+  sim->add_option("--feedforward", o->feedforward,
+                  "tracking: the hysteresis model (TOML, `hysteresis fit`) of the compensated run (default: identified from the open run)")
+      ->check(CLI::ExistingFile);
   sim->add_flag("--no-noise", o->no_noise, "no measurement noise (quantization stays)");
   sim->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (only the ADC's input resistance)");
   sim->add_flag("--open-circuit", o->open_circuit,

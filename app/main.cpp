@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   piezobench::app::add_simulate_commands(app, action);
   piezobench::app::add_measure_commands(app, action);
   piezobench::app::add_run_commands(app, action);
+  piezobench::app::add_hysteresis_commands(app, action);
 
   try {
     app.parse(argc, argv);

@@ -26,6 +26,9 @@ struct MeasureRequest {
   bool realtime = false;             // SCHED_FIFO and mlockall
   std::string log;                   // raw loop log
 };
+// --feedforward MODEL.toml of simulate and measure: the tracking experiment's model (InputError
+// naming the file; a model for another experiment is refused by ExperimentOptions::validate).
+void set_feedforward(bench::ExperimentOptions& options, const std::string& file);
 // Runs the experiment, writes the record, prints the summary (or the JSON document).
 int run_measurement(const MeasureRequest& request);
 

@@ -1,8 +1,9 @@
 #pragma once
-// The io module: time series and FRF files (.mat, CSV, UFF), JSON encodings, TOML models and the
-// one TOML reader with limits, atomic writes and staged result folders.
+// The io module: time series and FRF files (.mat, CSV, UFF), JSON encodings, TOML models (LTI,
+// hysteresis) and the one TOML reader with limits, atomic writes and staged result folders.
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/frf_file.hpp"
+#include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/io/mat_struct.hpp"

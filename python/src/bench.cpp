@@ -35,7 +35,9 @@ const Options<BenchOptions>& bench_options() {
         .add("ground_resistance", &BenchOptions::ground_resistance, "Ohm, the origin of the NMP zero")
         .add("delay", &BenchOptions::delay, "s, total measurement delay (hold included)")
         .add("nonminimum_phase_zero", &BenchOptions::nonminimum_phase_zero, "the lightly damped NMP zero on u -> Vs")
-        .add("hysteresis", &BenchOptions::hysteresis, "Prandtl-Ishlinskii hysteresis")
+        .add("hysteresis", &BenchOptions::hysteresis, "hysteresis of the stacks")
+        .add_enum("hysteresis_law", &BenchOptions::hysteresis_law, &bench::to_string, &hysteresis_law_from_string,
+                  "\"prandtl-ishlinskii\" or \"bouc-wen\"")
         .add("creep", &BenchOptions::creep, "creep of the stacks")
         .add("noise", &BenchOptions::noise, "measurement noise (quantization stays)")
         .add("superelement", &BenchOptions::superelement, "TOML file of a super element replacing the 2-DoF model");
@@ -128,7 +130,7 @@ void bind_bench(py::module_& m) {
       },
       arg("experiment"), arg("unit") = 1, arg("seed") = 1,
       ("Runs one of the report's experiments (stroke, hysteresis, stiffness, frf-noise, frf-sweep, iff,\n"
-       "hammer, flatness, capacitance) on unit `unit` of the batch and returns the record a real bench\n"
+       "hammer, flatness, capacitance, tracking) on unit `unit` of the batch and returns the record a real bench\n"
        "would write, as an io.TimeSeries (channels per experiment: bench/experiments.hpp).\n\n"
        "Keywords (ExperimentOptions):\n" + experiment_options().doc() + bench_doc())
           .c_str());

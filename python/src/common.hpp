@@ -328,5 +328,6 @@ void bind_fem(py::module_& m);
 void bind_io(py::module_& m);
 void bind_bench(py::module_& m);
 void bind_campaign(py::module_& m);
+void bind_hysteresis(py::module_& ident, py::module_& control, py::module_& io);  // hysteresis.cpp
 
 }  // namespace piezobench::python

@@ -66,7 +66,7 @@ PYBIND11_MODULE(_core, m) {
   bind_lti(lti);
   auto dsp = m.def_submodule("dsp", "Welch spectra, H1/H2 and coherence, excitation signals");
   bind_dsp(dsp);
-  auto ident = m.def_submodule("ident", "Vector fitting, FRF features, fits, peak picking, LSCF");
+  auto ident = m.def_submodule("ident", "Vector fitting, FRF features, fits, peak picking, LSCF, hysteresis and creep");
   bind_ident(ident);
   auto control = m.def_submodule("control", "Integral Force Feedback: plant, controller, root locus, discrete IFF");
   bind_control(control);
@@ -80,4 +80,5 @@ PYBIND11_MODULE(_core, m) {
   bind_bench(bench);
   auto campaign = m.def_submodule("campaign", "Run a campaign file and get its results");
   bind_campaign(campaign);
+  bind_hysteresis(ident, control, io);
 }

@@ -11,7 +11,9 @@
 
 #include "bench/flatness.hpp"
 #include "bench/random.hpp"
+#include "piezobench/bench/tracking.hpp"
 #include "piezobench/control/discrete_iff.hpp"
+#include "piezobench/control/hysteresis_feedforward.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/lti/discretize.hpp"
@@ -30,7 +32,7 @@ constexpr Named kNames[] = {{Experiment::kStroke, "stroke"},     {Experiment::kH
                             {Experiment::kStiffness, "stiffness"}, {Experiment::kFrfNoise, "frf-noise"},
                             {Experiment::kFrfSweep, "frf-sweep"},  {Experiment::kIff, "iff"},
                             {Experiment::kHammer, "hammer"},       {Experiment::kFlatness, "flatness"},
-                            {Experiment::kCapacitance, "capacitance"}};
+                            {Experiment::kCapacitance, "capacitance"}, {Experiment::kTracking, "tracking"}};
 
 std::string known_names() {
   std::string s;
@@ -39,7 +41,7 @@ std::string known_names() {
 }
 
 bool uses_amplitude(Experiment e) {
-  return e == Experiment::kHysteresis || e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
+  return e == Experiment::kHysteresis || e == Experiment::kTracking || e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
 }
 bool uses_duration(Experiment e) {
   return e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
@@ -340,6 +342,117 @@ io::TimeSeries iff(BenchRunner& runner, const UnitTruth& unit, const ExperimentO
   return ts;
 }
 
+// The tracking experiment (bench/tracking.hpp).
+io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                        const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double fs = b.sample_rate;
+  const double amplitude = o.amplitude.value_or(80.0);
+  const double offset = 0.5 * (b.va_min + b.va_max);
+  if (offset - amplitude < b.va_min - 1e-12 || offset + amplitude > b.va_max + 1e-12) {
+    throw InputError(kSource, "amplitude",
+                     fmt::format("an amplitude <= {:g} V (offset {:g} V, stack range {:g} V .. {:g} V)",
+                                 std::min(offset - b.va_min, b.va_max - offset), offset, b.va_min, b.va_max),
+                     fmt::format("{:g} V", amplitude));
+  }
+  const double frequency = 1.0, ramp = 1.0;
+  const int periods = 3;
+  const auto n_ramp = static_cast<Eigen::Index>(std::llround(ramp * fs));
+  const auto n_wave = static_cast<Eigen::Index>(std::llround(periods / frequency * fs));
+  const Eigen::Index n = 2 * n_ramp + 2 * n_wave;
+  // Command (V at the stacks) and the blend of the feedforward over the ramps.
+  std::vector<double> c(static_cast<std::size_t>(n)), blend(static_cast<std::size_t>(n), 1.0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / fs;
+    double v = 0.0, w = 1.0;
+    if (k < n_ramp) {
+      w = 0.5 - 0.5 * std::cos(std::numbers::pi * t / ramp);
+      v = offset * w;
+    } else if (k < n_ramp + n_wave) {
+      v = offset + amplitude * std::sin(2.0 * std::numbers::pi * frequency * (t - ramp));
+    } else if (k < n_ramp + 2 * n_wave) {
+      // Triangle from the offset upwards: 0 -> 1 -> -1 -> 0 per period.
+      double phase = frequency * (t - ramp) - periods;
+      phase -= std::floor(phase);
+      const double tri = phase < 0.25 ? 4.0 * phase : phase < 0.75 ? 2.0 - 4.0 * phase : 4.0 * phase - 4.0;
+      v = offset + amplitude * tri;
+    } else {
+      w = 0.5 + 0.5 * std::cos(std::numbers::pi * (t - ramp - 2.0 * periods / frequency) / ramp);
+      v = offset * w;
+    }
+    c[static_cast<std::size_t>(k)] = v;
+    blend[static_cast<std::size_t>(k)] = w;
+  }
+  auto progress_part = [&](double from, double span) -> Progress {
+    if (!progress) return {};
+    return [&progress, from, span](double p) { progress(from + span * p); };
+  };
+  Eigen::VectorXd u(n);
+  for (Eigen::Index k = 0; k < n; ++k) u(k) = c[static_cast<std::size_t>(k)] / b.amplifier_gain;
+  Eigen::MatrixXd open, comp;  // u, Va, de, Vs
+  runner.open_loop(u, detail::derive_seed(seed, stream(Experiment::kTracking, 0)), open, progress_part(0.0, 0.5));
+
+  ident::HysteresisModel model;
+  double fit_residual = 0.0;
+  const bool identified = !o.feedforward.has_value();
+  if (identified) {
+    const Eigen::VectorXd va = open.col(1), de = open.col(2);
+    ident::HysteresisFitOptions fo;
+    fo.creep_time_constants = {1.0, 10.0};
+    const ident::HysteresisFit fit = ident::fit_hysteresis({va.data(), static_cast<std::size_t>(n)},
+                                                           {de.data(), static_cast<std::size_t>(n)}, fs, fo);
+    model = fit.model;
+    fit_residual = fit.relative_residual;
+  } else {
+    model = *o.feedforward;
+  }
+  const std::vector<double> ff = control::apply_feedforward(model, fs, c);
+  std::uint64_t clamped = 0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    double va = c[kk] + blend[kk] * (ff[kk] - c[kk]);
+    if (va < b.va_min || va > b.va_max) {
+      va = std::clamp(va, b.va_min, b.va_max);
+      ++clamped;
+    }
+    u(k) = va / b.amplifier_gain;
+  }
+  runner.open_loop(u, detail::derive_seed(seed, stream(Experiment::kTracking, 1)), comp, progress_part(0.5, 0.5));
+
+  io::TimeSeries ts = make_record({"c", "Va_open", "de_open", "Va_ff", "de_ff"}, {"V", "V", "m", "V", "m"}, n, fs, true);
+  ts.data.col(0) = Eigen::Map<const Eigen::VectorXd>(c.data(), n);
+  ts.data.col(1) = open.col(1);
+  ts.data.col(2) = open.col(2);
+  ts.data.col(3) = comp.col(1);
+  ts.data.col(4) = comp.col(2);
+  common_settings(ts, Experiment::kTracking, unit, b, seed, &runner);
+  ts.settings["amplitude_V"] = amplitude;
+  ts.settings["offset_V"] = offset;
+  ts.settings["frequency_Hz"] = frequency;
+  ts.settings["periods"] = static_cast<double>(periods);
+  ts.settings["ramp_s"] = ramp;
+  ts.settings["feedforward"] = std::string(identified ? "identified" : "given");
+  if (identified) ts.settings["fit_relative_residual"] = fit_residual;
+  ts.settings["clamped_samples"] = static_cast<double>(clamped);
+  ts.settings["target_slope_m_per_V"] = model.gain * model.reference_slope;
+  ts.settings["target_intercept_m"] = model.offset + model.gain * model.reference_intercept;
+  // The figures over the last periods - 1 periods of each waveform (the first one settles the loop).
+  const Eigen::Index per = n_wave / periods;
+  const TrackingFigures sine = tracking_figures(ts, n_ramp + per, n_ramp + n_wave);
+  const TrackingFigures tri = tracking_figures(ts, n_ramp + n_wave + per, n_ramp + 2 * n_wave);
+  for (const auto& [name, f] : {std::pair<const char*, const TrackingFigures&>{"sine", sine}, {"triangle", tri}}) {
+    const std::string w(name);
+    ts.settings["width_open_" + w] = f.width_open;
+    ts.settings["width_ff_" + w] = f.width_ff;
+    ts.settings["rms_open_" + w + "_m"] = f.rms_open;
+    ts.settings["rms_ff_" + w + "_m"] = f.rms_ff;
+    ts.settings["stroke_open_" + w + "_m"] = f.stroke_open;
+  }
+  ts.settings["window_sine_samples"] = fmt::format("{}..{}", n_ramp + per, n_ramp + n_wave);
+  ts.settings["window_triangle_samples"] = fmt::format("{}..{}", n_ramp + n_wave + per, n_ramp + 2 * n_wave);
+  return ts;
+}
+
 io::TimeSeries hammer(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed, const Progress& progress) {
   const BenchOptions& b = o.bench;
   const double fs = b.sample_rate;
@@ -540,11 +653,13 @@ void VirtualRunner::describe(io::TimeSeries& ts) const {
   ts.settings["nmp_zero"] = options_.nonminimum_phase_zero ? 1.0 : 0.0;
   ts.settings["hysteresis"] = options_.hysteresis ? 1.0 : 0.0;
   ts.settings["creep"] = options_.creep ? 1.0 : 0.0;
+  // Only for the second law, so that the default bench's records stay as they were.
+  if (options_.hysteresis_law != HysteresisLaw::kPrandtlIshlinskii) ts.settings["hysteresis_law"] = to_string(options_.hysteresis_law);
 }
 
 bool runs_on_bench(Experiment e) {
   return e == Experiment::kStroke || e == Experiment::kHysteresis || e == Experiment::kStiffness ||
-         e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff;
+         e == Experiment::kFrfNoise || e == Experiment::kFrfSweep || e == Experiment::kIff || e == Experiment::kTracking;
 }
 
 io::TimeSeries run_experiment(Experiment experiment, BenchRunner& runner, const UnitTruth& unit,
@@ -564,9 +679,10 @@ io::TimeSeries run_experiment(Experiment experiment, BenchRunner& runner, const 
     case Experiment::kFrfNoise: ts = frf_noise(runner, unit, options, seed, progress); break;
     case Experiment::kFrfSweep: ts = frf_sweep(runner, unit, options, seed, progress); break;
     case Experiment::kIff: ts = iff(runner, unit, options, seed, progress); break;
+    case Experiment::kTracking: ts = tracking(runner, unit, options, seed, progress); break;
     default:
       throw InputError("", "experiment", "an experiment that runs on the bench (stroke, hysteresis, stiffness, frf-noise, "
-                       "frf-sweep, iff)", "'" + to_string(experiment) + "'");
+                       "frf-sweep, iff, tracking)", "'" + to_string(experiment) + "'");
   }
   ts.validate();
   return ts;
@@ -612,13 +728,17 @@ void ExperimentOptions::validate(Experiment e) const {
   validate();
   const std::string name = to_string(e);
   if (amplitude && !uses_amplitude(e)) {
-    throw InputError(kSource, "amplitude", "no amplitude: only hysteresis, frf-noise, frf-sweep and iff take one",
+    throw InputError(kSource, "amplitude", "no amplitude: only hysteresis, tracking, frf-noise, frf-sweep and iff take one",
                      "an amplitude for " + name);
   }
   if (duration && !uses_duration(e)) {
     throw InputError(kSource, "duration", "no duration: only frf-noise, frf-sweep and iff take one", "a duration for " + name);
   }
   if (gain && e != Experiment::kIff) throw InputError(kSource, "gain", "no gain: only iff takes one", "a gain for " + name);
+  if (feedforward && e != Experiment::kTracking) {
+    throw InputError(kSource, "feedforward", "no feedforward model: only tracking takes one", "a model for " + name);
+  }
+  if (feedforward) feedforward->validate("feedforward");
 }
 
 io::TimeSeries simulate(Experiment experiment, const UnitTruth& unit, const ExperimentOptions& options, std::uint64_t seed,

@@ -18,6 +18,10 @@ PlayHysteresis::PlayHysteresis(const std::array<double, kOperators>& thresholds,
                                const std::array<double, kOperators>& weights)
     : thresholds_(Eigen::Map<const Array>(thresholds.data())), weights_(Eigen::Map<const Array>(weights.data())) {}
 
+BoucWenHysteresis BoucWenHysteresis::bench_default(double scale) { return {1.0 * scale, 0.02}; }
+
+BoucWenHysteresis::BoucWenHysteresis(double a, double beta) : a_(a), beta_(beta), h_max_(beta > 0.0 ? a / (2.0 * beta) : 0.0) {}
+
 Creep::Creep(double voltage_per_decade, double load_per_decade, double sample_time) {
   for (int i = 0; i < kStates; ++i) {
     alpha_(i) = -std::expm1(-kDecimation * sample_time / kTimeConstants[static_cast<std::size_t>(i)]);

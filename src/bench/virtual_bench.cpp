@@ -49,6 +49,14 @@ constexpr std::size_t kMaxConfigs = 4;
 
 }  // namespace
 
+std::string to_string(HysteresisLaw law) { return law == HysteresisLaw::kBoucWen ? "bouc-wen" : "prandtl-ishlinskii"; }
+
+HysteresisLaw hysteresis_law_from_string(const std::string& name) {
+  if (name == "prandtl-ishlinskii") return HysteresisLaw::kPrandtlIshlinskii;
+  if (name == "bouc-wen") return HysteresisLaw::kBoucWen;
+  throw InputError("", "hysteresis_law", "prandtl-ishlinskii or bouc-wen", "'" + name + "'");
+}
+
 void UnitTruth::validate() const {
   const std::string source = fmt::format("unit {}", id);
   model.validate(source);
@@ -141,7 +149,7 @@ struct VirtualBench::State {
     Vec6 x = Vec6::Zero();  // 2-DoF bench state (Va, x, x', xn, V, Vs at the ADC)
     std::size_t ring_pos = 0;
     double out_va = 0.0, out_load = 0.0;  // Va and ka xn at the last sample
-    detail::PlayHysteresis hysteresis;
+    detail::Hysteresis hysteresis;
     detail::Creep creep;
     detail::Xoshiro256 rng;
     std::uint64_t steps = 0;
@@ -362,7 +370,9 @@ VirtualBench::VirtualBench(const UnitTruth& unit, const BenchOptions& options, s
   }
   s.use_hysteresis = options.hysteresis && unit.hysteresis_scale > 0.0;
   s.use_creep = options.creep && (unit.creep_coefficient > 0.0 || unit.load_creep_coefficient > 0.0);
-  s.d.hysteresis = detail::PlayHysteresis::bench_default(unit.hysteresis_scale);
+  s.d.hysteresis = options.hysteresis_law == HysteresisLaw::kBoucWen
+                       ? detail::Hysteresis(detail::BoucWenHysteresis::bench_default(unit.hysteresis_scale))
+                       : detail::Hysteresis(detail::PlayHysteresis::bench_default(unit.hysteresis_scale));
   // The super element has no stack extension to drive the load creep: voltage creep only there.
   s.d.creep = detail::Creep(unit.creep_coefficient, s.superelement() ? 0.0 : unit.load_creep_coefficient, s.ts);
 

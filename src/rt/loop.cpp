@@ -36,6 +36,7 @@ void LoopOptions::validate() const {
   }
   if (log_ring_capacity < 2) throw InputError(source, "log_ring_capacity", "at least 2", std::to_string(log_ring_capacity));
   limits.validate();
+  if (feedforward) feedforward->validate("rt loop: feedforward");
 }
 
 Loop::Loop(Backend& backend, const LoopOptions& options)
@@ -58,6 +59,7 @@ Loop::Loop(Backend& backend, const LoopOptions& options)
   if (rate_ > kMaxSampleRate) {
     throw InputError("backend " + backend.name(), "sample_rate", "at most " + detail::str(kMaxSampleRate) + " Hz", detail::str(rate_) + " Hz");
   }
+  if (options.feedforward) feedforward_.emplace(*options.feedforward, rate_);
   const double cycles = std::round(options.duration * rate_);
   total_cycles_ = static_cast<std::uint64_t>(std::max(1.0, cycles));
   ramp_in_cycles_ = static_cast<std::uint64_t>(std::llround(options.limits.ramp_in * rate_));
@@ -80,6 +82,7 @@ Loop::Loop(Backend& backend, const LoopOptions& options)
     lo.settings["va_max"] = options.limits.va_max;
     lo.settings["slew_rate"] = options.limits.slew_rate;
     lo.settings["realtime"] = options.realtime ? 1.0 : 0.0;
+    lo.settings["feedforward"] = options.feedforward ? 1.0 : 0.0;
     logger_ = std::make_unique<SignalLogger>(lo);
   }
   last_va_cmd_ = guard_.last_output() * options.limits.amplifier_gain;
@@ -166,6 +169,8 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
       options_.excitation.size() > 0
           ? options_.excitation(static_cast<Eigen::Index>(cycle_ % static_cast<std::uint64_t>(options_.excitation.size())))
           : 0.0;
+  // The feedforward's share of the request (V at the DAC): u' through the inverse hysteresis.
+  const double u_ff = feedforward_ ? feedforward_->step(u_prime * amp) / amp : u_prime;
 
   double y = 0.0;
   double request = u_safe;
@@ -180,7 +185,7 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
         y = 0.0;
       }
     }
-    if (!guard_.safe_state()) request = u_safe + r * (u_prime + y - u_safe);
+    if (!guard_.safe_state()) request = u_safe + r * (u_ff + y - u_safe);
   }
   const SafetyGuard::Output out = guard_.limit(request);
   if (!guard_.safe_state() && guard_.saturated_too_long()) {
@@ -189,7 +194,7 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
   }
   if (!guard_.safe_state() && options_.controller && r > 0.0 && (out.clamped || out.slew_limited)) {
     // Anti-windup: the controller's share of what was really applied.
-    iff_.applied((out.u - u_safe) / r + u_safe - u_prime);
+    iff_.applied((out.u - u_safe) / r + u_safe - u_ff);
   }
   backend_.write(out.u);
 
@@ -250,6 +255,7 @@ LoopReport Loop::finish() {
   rep.period_jitter_us = jitter_.summary_us();
   rep.wake_latency_us = latency_.summary_us();
   rep.step_time_us = step_time_.summary_us();
+  rep.feedforward = feedforward_.has_value();
   rep.clamped_samples = guard_.clamped_samples();
   rep.slew_limited_samples = guard_.slew_limited_samples();
   rep.safe_state_events = guard_.safe_state_events();

@@ -25,7 +25,7 @@ io::TimeSeries run(Experiment e, int unit = 1, ExperimentOptions o = {}, std::ui
 double setting(const io::TimeSeries& ts, const std::string& key) { return std::get<double>(ts.settings.at(key)); }
 
 TEST(Experiments, NamesRoundTripAndUnknownNamesAreListed) {
-  EXPECT_EQ(all_experiments().size(), 9U);
+  EXPECT_EQ(all_experiments().size(), 10U);
   for (const Experiment e : all_experiments()) EXPECT_EQ(experiment_from_string(to_string(e)), e);
   const std::string message = test::input_error([] { (void)experiment_from_string("frf"); }, "experiment");
   EXPECT_TRUE(test::contains(message, "frf-noise")) << message;

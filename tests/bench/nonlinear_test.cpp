@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "test_util.hpp"
@@ -122,6 +123,78 @@ TEST(Creep, LoadCreepSettlesWhereTheElasticStrainDrivesIt) {
   Creep c(0.0, load, 1.0);  // 1 s samples: 10^4 s is many times the slowest time constant
   for (int k = 0; k < 10000; ++k) c.update(f, s);
   EXPECT_TRUE(near(c.force(), 3.0 * load * (s - f) / (1.0 + 3.0 * load), 1e-9));
+}
+
+// Bouc-Wen, closed form: from rest, increasing v: h = h_max (1 - exp(-2 beta v)), h_max = a / (2 beta);
+// after a reversal at the top h falls linearly (slope a: the branch's slope is 1) until it is 0,
+// then exponentially towards -h_max.
+TEST(BoucWenHysteresis, BranchesFollowTheClosedForm) {
+  const double a = 1.0, beta = 0.02, hmax = a / (2.0 * beta);
+  BoucWenHysteresis bw(a, beta);
+  double top = 0.0;
+  for (int k = 1; k <= 1000; ++k) top = bw.update(0.1 * k);  // 0 -> 100 V in 1000 steps
+  const double h_top = hmax * (1.0 - std::exp(-2.0 * beta * 100.0));
+  EXPECT_TRUE(near(top, a * 100.0 - h_top, 1e-12));
+  // Down by 10 V: still the linear piece (h_top / a = 21.6 V of it): Va_eff = v + a v - h falls by
+  // 10 V exactly, the extra term stays.
+  EXPECT_TRUE(near(bw.update(90.0), top, 1e-12));
+  // Down to 40 V: the linear piece ends at 100 - h_top / a, then the exponential.
+  const double v0 = 100.0 - h_top / a;
+  const double h = -hmax * (1.0 - std::exp(-2.0 * beta * (v0 - 40.0)));
+  EXPECT_TRUE(near(bw.update(40.0), a * 40.0 - h, 1e-12));
+  bw.reset();
+  EXPECT_EQ(bw.update(0.0), 0.0);
+}
+
+// Rate independence: the same path in 1 step or in 1000 gives the same output.
+TEST(BoucWenHysteresis, IsRateIndependent) {
+  BoucWenHysteresis coarse(1.0, 0.02), fine(1.0, 0.02);
+  const double path[] = {30.0, -10.0, 120.0, 60.0, 75.0, -20.0};
+  double last = 0.0, yc = 0.0, yf = 0.0;
+  for (double target : path) {
+    yc = coarse.update(target);
+    for (int i = 1; i <= 1000; ++i) yf = fine.update(last + (target - last) * i / 1000.0);
+    last = target;
+    EXPECT_TRUE(near(yc, yf, 1e-9)) << target;
+  }
+}
+
+// The bench's second law at 80 V about 65 V: a loop about 18 % of its stroke wide (peak-to-peak
+// deviation from the best line, the width the tracking experiment reports) and a large-signal gain
+// above the small-signal one (1).
+TEST(BoucWenHysteresis, BenchDefaultLoopAt80V) {
+  BoucWenHysteresis bw = BoucWenHysteresis::bench_default(1.0);
+  std::vector<double> v, y;
+  for (int k = 0; k <= 1000; ++k) bw.update(65.0 * k / 1000.0);
+  for (int k = 0; k <= 3000; ++k) {
+    const double x = 65.0 + 80.0 * std::sin(2.0 * std::numbers::pi * k / 1000.0);
+    const double e = x + bw.update(x);
+    if (k >= 1000) {
+      v.push_back(x);
+      y.push_back(e);
+    }
+  }
+  double sv = 0, sy = 0, svv = 0, svy = 0;
+  const double n = static_cast<double>(v.size());
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    sv += v[k];
+    sy += y[k];
+    svv += v[k] * v[k];
+    svy += v[k] * y[k];
+  }
+  const double slope = (svy - sv * sy / n) / (svv - sv * sv / n), icpt = (sy - slope * sv) / n;
+  double lo = 1e300, hi = -1e300, ylo = 1e300, yhi = -1e300;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const double d = y[k] - slope * v[k] - icpt;
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+    ylo = std::min(ylo, y[k]);
+    yhi = std::max(yhi, y[k]);
+  }
+  const double width = (hi - lo) / (yhi - ylo);
+  EXPECT_GT(width, 0.16);
+  EXPECT_LT(width, 0.20);
+  EXPECT_GT((yhi - ylo) / 160.0, 1.5);
 }
 
 }  // namespace

@@ -111,6 +111,12 @@ TEST(Loop, CycleAllocatesNothing) {
   o.limits.ramp_out = 0.01;
   o.excitation = noise(1000, 2.0, 5);  // large: clamps and slew limits too
   o.realtime = true;                   // the real-time path (push, timing), paced by the test
+  ident::HysteresisModel m;            // with the inverse hysteresis feedforward and its creep states
+  m.hysteresis = {1.0, {10.0, 30.0}, {0.2, 0.3}};
+  m.creep_time_constants = {1.0};
+  m.creep_coefficients = {0.01};
+  m.gain = -1.6e-6;
+  o.feedforward = m;
   Loop loop(backend, o);
   loop.start();
   std::uint64_t n = 0;
@@ -209,6 +215,53 @@ TEST(Loop, OutputSaturatedForTheSaturationTimeEntersTheSafeState) {
   const auto u = loop.log().channel("u");
   EXPECT_EQ(u(99), 7.5);
   EXPECT_EQ(u(100), 0.0);
+}
+
+// The inverse hysteresis feedforward sits before the clamp and the slew limit: a command that
+// would exceed the limits (and whose inverse asks for more still) leaves the stack voltage within
+// -20..150 V and the slew limit; where nothing limits it, u is the feedforward's output.
+TEST(Loop, FeedforwardStaysWithinTheLimits) {
+  ident::HysteresisModel m;
+  m.hysteresis = {1.0, {10.0, 30.0, 50.0}, {0.2, 0.3, 0.2}};
+  m.gain = -1.6e-6;
+  m.reference_slope = 1.6;
+  m.reference_intercept = -5.0;
+  FakeBackend backend(discrete_plant(), kFs);
+  LoopOptions o = lockstep_options(0.5);
+  o.controller = false;
+  o.feedforward = m;
+  o.limits.ramp_in = 0.0;
+  o.limits.ramp_out = 0.0;
+  o.limits.slew_rate = 2e4;  // 2 V per sample at the stacks
+  o.excitation.resize(1000);  // 10 Hz, 9 V at the DAC (180 V at the stacks) about 3 V
+  for (Eigen::Index k = 0; k < 1000; ++k) o.excitation(k) = 3.0 + 9.0 * std::sin(2 * M_PI * k / 1000.0);
+  Loop loop(backend, o);
+  run_all(loop);
+  const LoopReport rep = loop.finish();
+  EXPECT_TRUE(rep.feedforward);
+  EXPECT_GT(rep.clamped_samples, 100u);
+  EXPECT_GT(rep.slew_limited_samples, 0u);
+  EXPECT_EQ(rep.safe_state_reason, "none");
+  const auto va = loop.log().channel("Va_cmd");
+  EXPECT_GE(va.minCoeff(), -20.0);
+  EXPECT_LE(va.maxCoeff(), 150.0);
+  EXPECT_NEAR(va.maxCoeff(), 150.0, 1e-9);
+  double max_step = std::abs(va(0));
+  for (Eigen::Index k = 1; k < va.size(); ++k) max_step = std::max(max_step, std::abs(va(k) - va(k - 1)));
+  EXPECT_LE(max_step, 2.0 + 1e-9);
+  // Unlimited samples carry the feedforward's output.
+  control::HysteresisFeedforward ff(m, kFs);
+  const auto u = loop.log().channel("u");
+  const auto flags = loop.log().channel("flags");
+  std::size_t checked = 0;
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    const double expected = ff.step(20.0 * o.excitation(k % 1000)) / 20.0;
+    if (flags(k) == 0.0) {
+      ASSERT_NEAR(u(k), expected, 1e-12) << k;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000u);
 }
 
 // A NaN sample: safe state at that cycle, output to the safe value at the slew limit, controller

@@ -7,6 +7,7 @@
 // Every record also carries the settings `experiment`, `unit`, `seed` (a number up to 2^53, text
 // above), `defective`, `noise`, and for bench experiments `model` ("2dof" or "superelement"),
 // `superelement` (its TOML), `delay_s` (effective), `nmp_zero`, `hysteresis`, `creep` (1 or 0),
+// `hysteresis_law` (only when "bouc-wen"),
 // `amplifier_gain_V_per_V`, `va_min_V`, `va_max_V`, `suspended_mass_kg`, `hpf_resistance_ohm`,
 // `hpf_resistor` (1 or 0), `sensor_shunt_ohm` (what discharges the sensor stack), `actuator_circuit`
 // ("short": on the amplifier, "open": disconnected; the stiffness test measures k_sc and k_oc).
@@ -43,6 +44,9 @@
 //                                 within +-probe_noise_m. Settings: probe_noise_m.
 //   capacitance  C_sensor, C_actuator  LCR readings (F), one sample (no t), error uniform within
 //                                 +-accuracy_relative. Settings: frequency_Hz, accuracy_relative.
+//   tracking     t, c, Va_open, de_open, Va_ff, de_ff  a 1 Hz sine and triangle of `amplitude`
+//                                 (default 80 V) about 65 V, without and with the inverse hysteresis
+//                                 feedforward; bench/tracking.hpp (settings: the figures).
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -51,13 +55,15 @@
 #include <vector>
 
 #include "piezobench/bench/virtual_bench.hpp"
+#include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/io/timeseries.hpp"
 
 namespace piezobench::bench {
 
-enum class Experiment { kStroke, kHysteresis, kStiffness, kFrfNoise, kFrfSweep, kIff, kHammer, kFlatness, kCapacitance };
+enum class Experiment { kStroke, kHysteresis, kStiffness, kFrfNoise, kFrfSweep, kIff, kHammer, kFlatness, kCapacitance, kTracking };
 
-// "stroke", "hysteresis", "stiffness", "frf-noise", "frf-sweep", "iff", "hammer", "flatness", "capacitance".
+// "stroke", "hysteresis", "stiffness", "frf-noise", "frf-sweep", "iff", "hammer", "flatness", "capacitance",
+// "tracking".
 std::string to_string(Experiment e);
 // InputError (field "experiment") listing the known names.
 Experiment experiment_from_string(const std::string& name);
@@ -66,11 +72,13 @@ const std::vector<Experiment>& all_experiments();
 struct ExperimentOptions {
   // Unset values take the experiment's default (the report's settings).
   std::optional<double> amplitude;   // V at the stacks, > 0: hysteresis (sine amplitude, default
-                                     // 20 V), frf-noise and iff (rms, default 2 V), frf-sweep
+                                     // 20 V), tracking (default 80 V), frf-noise and iff (rms, default 2 V), frf-sweep
                                      // (amplitude, default 1 V). Refused, with the limit named, when
                                      // the stack voltage would leave [va_min, va_max]: never clipped.
   std::optional<double> duration;    // s (frf-noise 20 s, frf-sweep 20 s, iff 10 s), in (0, 1e5]
   std::optional<double> gain;        // IFF gain g (iff; default 280000 -> near the optimum)
+  // tracking: the feedforward's model (unset: identified from the open run).
+  std::optional<ident::HysteresisModel> feedforward;
   BenchOptions bench;
   void validate() const;             // InputError naming the field
   // Also refuses an option the experiment does not take (e.g. --duration for stroke).
@@ -135,7 +143,7 @@ class VirtualRunner final : public BenchRunner {
 };
 
 // True for the experiments that run on the bench (a BenchRunner): stroke, hysteresis, stiffness,
-// frf-noise, frf-sweep, iff.
+// frf-noise, frf-sweep, iff, tracking.
 bool runs_on_bench(Experiment experiment);
 
 // Runs one bench experiment (runs_on_bench) through `runner` and returns its record: the same

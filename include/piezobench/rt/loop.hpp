@@ -12,8 +12,13 @@
 //    future deadline (counted as skipped deadlines) instead of running late cycles back to back.
 //  - Lockstep mode (realtime = false): no sleeping; cycles run back to back as fast as possible,
 //    for simulation (tests, the damped-plant study). The log never drops a record then.
-//  - Inside a cycle: read the sensors, check them, step the controller, ramp, clamp, slew-limit,
-//    write the command, push the log record. No allocation, no lock, no I/O other than the
+//  - Inside a cycle: read the sensors, check them, step the controller, pass u' through the
+//    inverse hysteresis feedforward when there is one, ramp, clamp, slew-limit, write the command,
+//    push the log record.
+//  - Feedforward (LoopOptions::feedforward, control/hysteresis_feedforward.hpp): u' is read as a
+//    linear command c = amplifier_gain u' (V at the stacks) and replaced by the stack voltage the
+//    inverse of the identified hysteresis and creep asks for, divided by the amplifier gain. It sits
+//    before the ramps, the clamp and the slew limit, so the limits hold whatever it asks for. No allocation, no lock, no I/O other than the
 //    backend's (tests/rt/loop_test.cpp counts allocations around cycle()).
 //  - Ramps: over ramp_in seconds at the start and ramp_out seconds at the end of the run a factor
 //    r goes 0 -> 1 (-> 0); the controller's gain is r g (bumpless: the gain acts at the sections'
@@ -38,6 +43,8 @@
 #include <Eigen/Core>
 
 #include "piezobench/control/discrete_iff.hpp"
+#include "piezobench/control/hysteresis_feedforward.hpp"
+#include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/rt/backend.hpp"
 #include "piezobench/rt/logger.hpp"
@@ -62,6 +69,8 @@ struct LoopOptions {
   control::DiscreteIffOptions discrete;                // its sample_rate is replaced by the backend's
   ActuatorLimits limits;
   Eigen::VectorXd excitation;  // u' (V at the DAC), played cyclically from cycle 0; empty = 0
+  // Inverse hysteresis feedforward on u' (see above); unset = none. Validated by the Loop.
+  std::optional<ident::HysteresisModel> feedforward;
   // Signal log: kept in memory when `keep_log` (Loop::log()) and/or written to `log_file`.
   std::optional<std::filesystem::path> log_file;
   bool keep_log = false;
@@ -96,6 +105,7 @@ struct LoopReport {
   TimingSummary period_jitter_us;   // |actual period - T| between consecutive wake-ups
   TimingSummary wake_latency_us;    // wake-up time - deadline
   TimingSummary step_time_us;       // execution time of a cycle: read .. log push
+  bool feedforward = false;         // the inverse hysteresis feedforward was on
   std::uint64_t clamped_samples = 0;
   std::uint64_t slew_limited_samples = 0;
   std::uint64_t safe_state_events = 0;
@@ -155,6 +165,7 @@ class Loop {
   std::uint64_t total_cycles_;
   std::uint64_t ramp_in_cycles_, ramp_out_cycles_;
   control::DiscreteIff iff_;
+  std::optional<control::HysteresisFeedforward> feedforward_;
   SafetyGuard guard_;
   std::unique_ptr<SignalLogger> logger_;
   std::unique_ptr<Shared> shared_;  // atomics shared with the watchdog thread

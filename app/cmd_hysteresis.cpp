@@ -1,0 +1,170 @@
+// `piezobench hysteresis fit` (a Prandtl-Ishlinskii model with creep from a Va -> d_e record, written
+// as TOML for `rt --feedforward`) and `piezobench hysteresis creep` (a Prony creep fit of a step record).
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "cli_common.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/ident/hysteresis.hpp"
+#include "piezobench/io/hysteresis_toml.hpp"
+#include "piezobench/io/timeseries.hpp"
+
+namespace piezobench::app {
+namespace {
+
+struct FitOptions {
+  std::string file;
+  std::string input = "Va";
+  std::string output = "de";
+  double fs = 0.0;
+  int operators = 10;
+  double threshold_range = 0.0;
+  std::string creep_tau;
+  double max_residual = 0.02;
+  std::string out;
+  bool json = false;
+};
+
+nlohmann::json model_json(const ident::HysteresisModel& m) {
+  return {{"gain_m_per_V", m.gain},
+          {"offset_m", m.offset},
+          {"reference_slope", m.reference_slope},
+          {"reference_intercept_V", m.reference_intercept},
+          {"input_min_V", m.input_min},
+          {"input_max_V", m.input_max},
+          {"thresholds_V", m.hysteresis.thresholds},
+          {"weights", m.hysteresis.weights},
+          {"creep_time_constants_s", m.creep_time_constants},
+          {"creep_coefficients", m.creep_coefficients}};
+}
+
+io::TimeSeries read_pair(const std::string& file, const std::string& input, const std::string& output, double fs, bool quiet) {
+  io::ReadOptions read;
+  read.fs = fs;
+  read.channels = {input, output};
+  if (!quiet) log_line("reading " + file);
+  return io::read_timeseries(file, read);
+}
+
+int run_fit(const FitOptions& o) {
+  ident::HysteresisFitOptions fo;
+  fo.operators = o.operators;
+  fo.threshold_range = o.threshold_range;
+  if (!o.creep_tau.empty()) fo.creep_time_constants = parse_number_list(o.creep_tau, "--creep-tau");
+  fo.max_relative_residual = o.max_residual;
+  fo.validate();
+  const io::TimeSeries ts = read_pair(o.file, o.input, o.output, o.fs, o.json);
+  const Eigen::VectorXd va = ts.channel(o.input), de = ts.channel(o.output);
+  if (!o.json) log_line(fmt::format("{} samples at {:g} Hz, {} play operators", ts.samples(), ts.sample_rate, fo.operators));
+  const ident::HysteresisFit fit = ident::fit_hysteresis({va.data(), static_cast<std::size_t>(va.size())},
+                                                         {de.data(), static_cast<std::size_t>(de.size())}, ts.sample_rate, fo);
+  const std::vector<double> va_v(va.data(), va.data() + va.size()), de_v(de.data(), de.data() + de.size());
+  const ident::LoopMetrics loop = ident::loop_metrics(va_v, de_v);
+  if (!o.out.empty()) {
+    io::write_hysteresis_model(o.out, fit.model, &fit, o.file);
+    if (!o.json) log_line("wrote " + o.out);
+  }
+  if (o.json) {
+    print_json({{"source", o.file},
+                {"samples", fit.samples},
+                {"sample_rate_Hz", ts.sample_rate},
+                {"model", model_json(fit.model)},
+                {"rms_residual_m", fit.rms_residual},
+                {"relative_residual", fit.relative_residual},
+                {"stroke_m", fit.stroke},
+                {"hysteresis_width", loop.width},
+                {"good", fit.good},
+                {"message", fit.message}});
+  } else {
+    const ident::HysteresisModel& m = fit.model;
+    fmt::print("Prandtl-Ishlinskii model of {} -> {} ({} samples)\n", o.input, o.output, fit.samples);
+    fmt::print("  d_e = {:.6g} m + {:.6g} m/V * (H[Va] + creep)\n", m.offset, m.gain);
+    fmt::print("  thresholds (V): {:.4g}\n", fmt::join(m.hysteresis.thresholds, ", "));
+    fmt::print("  weights:        {:.4g}\n", fmt::join(m.hysteresis.weights, ", "));
+    if (!m.creep_time_constants.empty()) {
+      fmt::print("  creep: time constants (s) {:.4g}; coefficients {:.4g}\n", fmt::join(m.creep_time_constants, ", "),
+                 fmt::join(m.creep_coefficients, ", "));
+    }
+    fmt::print("  compensated line: {:.6g} V/V, {:.6g} V\n", m.reference_slope, m.reference_intercept);
+    fmt::print("  record: stroke {:.6g} um, hysteresis width {:.3g} % of the stroke\n", 1e6 * fit.stroke, 100.0 * loop.width);
+    fmt::print("  fit: rms residual {:.4g} nm ({})\n", 1e9 * fit.rms_residual, fit.message);
+  }
+  if (!fit.good) {
+    log_line("warning: " + fit.message);
+    return static_cast<int>(ExitCode::kNumerical);
+  }
+  return 0;
+}
+
+struct CreepOptions {
+  std::string file;
+  std::string input = "added_mass";
+  std::string output = "de";
+  double fs = 0.0;
+  std::string tau;
+  double max_residual = 0.05;
+  bool json = false;
+};
+
+int run_creep(const CreepOptions& o) {
+  const std::vector<double> tau = o.tau.empty() ? std::vector<double>{} : parse_number_list(o.tau, "--tau");
+  const io::TimeSeries ts = read_pair(o.file, o.input, o.output, o.fs, o.json);
+  const Eigen::VectorXd x = ts.channel(o.input), y = ts.channel(o.output);
+  const ident::CreepFit c = ident::fit_creep({x.data(), static_cast<std::size_t>(x.size())}, {y.data(), static_cast<std::size_t>(y.size())},
+                                             ts.sample_rate, tau, o.max_residual);
+  if (o.json) {
+    print_json({{"source", o.file},
+                {"time_constants_s", c.time_constants},
+                {"coefficients", c.coefficients},
+                {"gain", c.gain},
+                {"offset", c.offset},
+                {"creep_per_decade", c.creep_per_decade},
+                {"rms_residual", c.rms_residual},
+                {"relative_residual", c.relative_residual},
+                {"good", c.good},
+                {"message", c.message}});
+  } else {
+    fmt::print("Creep of {} -> {}: y = {:.6g} + {:.6g} (x + sum_j c_j F_j[x])\n", o.input, o.output, c.offset, c.gain);
+    fmt::print("  time constants (s): {:.4g}\n  coefficients:       {:.4g}\n", fmt::join(c.time_constants, ", "), fmt::join(c.coefficients, ", "));
+    fmt::print("  creep per decade {:.4g} %; fit: {}\n", 100.0 * c.creep_per_decade, c.message);
+  }
+  if (!c.good) {
+    log_line("warning: " + c.message);
+    return static_cast<int>(ExitCode::kNumerical);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_hysteresis_commands(CLI::App& app, Action& action) {
+  CLI::App* h = app.add_subcommand("hysteresis", "Hysteresis and creep of the stacks: identification for the inverse feedforward");
+  h->require_subcommand(1);
+  auto o = std::make_shared<FitOptions>();
+  CLI::App* fit = h->add_subcommand("fit", "Prandtl-Ishlinskii model (+ creep) of a Va -> d_e record, written as TOML (rt --feedforward)");
+  fit->add_option("file", o->file, "time-series file (.mat, .csv) with the stack voltage and the displacement")->required();
+  fit->add_option("--input", o->input, "channel of the stack voltage, V")->capture_default_str();
+  fit->add_option("--output", o->output, "channel of the displacement, m")->capture_default_str();
+  fit->add_option("--fs", o->fs, "sample rate, Hz (default: from the file)");
+  fit->add_option("--operators", o->operators, "play operators")->check(CLI::Range(1, 200))->capture_default_str();
+  fit->add_option("--threshold-range", o->threshold_range, "largest threshold range R, V (thresholds (i - 1/2) R / n; default: half the range of Va)");
+  fit->add_option("--creep-tau", o->creep_tau, "comma-separated creep time constants, s (default: no creep states)");
+  fit->add_option("--max-residual", o->max_residual, "largest rms residual / stroke of a good fit")->capture_default_str();
+  fit->add_option("-o,--out", o->out, "write the model (TOML)");
+  fit->add_flag("--json", o->json, "print one JSON document on stdout");
+  fit->callback([o, &action] { action = [o] { return run_fit(*o); }; });
+
+  auto c = std::make_shared<CreepOptions>();
+  CLI::App* creep = h->add_subcommand("creep", "Prony-series creep of a step record (the stiffness test: added_mass -> de)");
+  creep->add_option("file", c->file, "time-series file (.mat, .csv)")->required();
+  creep->add_option("--input", c->input, "channel of the step")->capture_default_str();
+  creep->add_option("--output", c->output, "channel of the response")->capture_default_str();
+  creep->add_option("--fs", c->fs, "sample rate, Hz (default: from the file)");
+  creep->add_option("--tau", c->tau, "comma-separated time constants, s (default: 1, 10, 100 ... up to half the record)");
+  creep->add_option("--max-residual", c->max_residual, "largest rms residual / range of a good fit")->capture_default_str();
+  creep->add_flag("--json", c->json, "print one JSON document on stdout");
+  creep->callback([c, &action] { action = [c] { return run_creep(*c); }; });
+}
+
+}  // namespace piezobench::app

@@ -1,0 +1,57 @@
+#pragma once
+// The tracking experiment (`measure tracking`, `simulate tracking`): how straight the stroke is
+// against the command, without and with the inverse hysteresis feedforward
+// (control/hysteresis_feedforward.hpp), on any bench (a BenchRunner).
+//
+// The command c (V at the stacks): a 1 s raised-cosine ramp from 0 V to the offset
+// (va_min + va_max) / 2, `periods` periods of a 1 Hz sine of the amplitude, the same number of
+// periods of a 1 Hz triangle of the same amplitude, and a 1 s ramp back to 0 V. It runs twice:
+//  1. open: Va = c (no compensation);
+//  2. compensated: Va = feedforward(c), the model being the one given or else the one identified
+//     from run 1 (ident::fit_hysteresis on its Va, de). It is blended in over the two ramps (the
+//     run starts and ends at 0 V) and clamped to [va_min, va_max] (the clamped samples are counted;
+//     on a real bench the real-time loop's safety layer limits it too).
+// For each waveform (the last `periods` - 1 periods of it) and run: the hysteresis width (peak-to-peak
+// deviation of d_e from its best straight line against c, over the stroke; ident::loop_metrics)
+// and the rms tracking error against the target d_ref = offset + gain (reference_slope c +
+// reference_intercept), the straight line the model's compensated actuator follows (the same
+// target for both runs: without compensation it is about the open loop's own best line, so the
+// open run's error is its loop's deviation).
+//
+// Record channels: t, c (V), Va_open, de_open, Va_ff, de_ff (V, m), sample rate the bench's.
+// Settings (besides the common ones): amplitude_V, offset_V, frequency_Hz (1), periods,
+// feedforward ("identified" or "given"), fit_relative_residual (identified only), clamped_samples,
+// target_slope_m_per_V, target_intercept_m (d_ref),
+// and for w in {sine, triangle}: width_open_w, width_ff_w (fractions), rms_open_w_m, rms_ff_w_m,
+// stroke_open_w_m.
+#include <string>
+
+#include "piezobench/ident/hysteresis.hpp"
+#include "piezobench/io/timeseries.hpp"
+
+namespace piezobench::bench {
+
+struct TrackingFigures {
+  double width_open = 0.0, width_ff = 0.0;  // hysteresis width / stroke
+  double rms_open = 0.0, rms_ff = 0.0;      // m, rms tracking error
+  double stroke_open = 0.0;                 // m
+  [[nodiscard]] double width_reduction() const { return width_ff > 0.0 ? width_open / width_ff : 0.0; }
+  [[nodiscard]] double rms_reduction() const { return rms_ff > 0.0 ? rms_open / rms_ff : 0.0; }
+};
+
+struct TrackingSummary {
+  TrackingFigures sine, triangle;
+  bool identified = true;            // the model came from the open run
+  double fit_relative_residual = 0.0;
+  double clamped_samples = 0.0;
+};
+
+// The figures of a tracking record (its settings). InputError (source: the record's) when it is
+// not one.
+TrackingSummary tracking_summary(const io::TimeSeries& record);
+
+// The figures of one waveform, from the samples [begin, end) of a tracking record's columns (the
+// target line from its settings).
+TrackingFigures tracking_figures(const io::TimeSeries& record, Eigen::Index begin, Eigen::Index end);
+
+}  // namespace piezobench::bench

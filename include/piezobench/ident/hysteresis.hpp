@@ -1,0 +1,166 @@
+#pragma once
+// Hysteresis and creep of a piezoelectric actuator from a record of its stack voltage Va and its
+// displacement d_e: a Prandtl-Ishlinskii (PI) operator with a Prony-series creep, identified by
+// sign-constrained linear least squares (core/nnls.hpp), and its exact inverse.
+//
+// The PI operator (M. Brokate and J. Sprekels, "Hysteresis and Phase Transitions", Springer 1996;
+// K. Kuhnen, "Modeling, identification and compensation of complex hysteretic nonlinearities: a
+// modified Prandtl-Ishlinskii approach", Eur. J. Control 9(4), 2003):
+//     H[v](t) = w_0 v(t) + sum_{i=1..n} w_i P_{r_i}[v](t),
+//     P_r[v](t) = min(max(P_r[v](t-), v(t) - r), v(t) + r),  0 < r_1 < ... < r_n,
+// every play operator starting at 0 with the actuator at rest. It is strictly increasing (and so
+// invertible) when w_0 > 0 and every partial sum w_0 + w_1 + ... + w_i > 0 (w_i >= 0 suffices).
+// Its inverse is again a PI operator (Kuhnen 2003, eq. 10): thresholds r'_i = sum_{j<=i} w_j (r_i - r_j),
+// weights w'_0 = 1 / w_0 and w'_i = -w_i / ((w_0 + ... + w_i)(w_0 + ... + w_{i-1})), starting at 0
+// too, so H^-1[H[v]] = v exactly, sample by sample (the play operators are rate-independent and a
+// sampled signal is the piecewise linear one through its samples).
+//
+// The actuator model (units: V in, m out):
+//     d_e = offset + gain (H[Va] + sum_j c_j F_j[Va]),   w_0 = 1 (H in "effective volts"),
+// F_j the first-order creep states of time constants tau_j (F_j[k+1] = F_j[k] + (1 - exp(-T/tau_j))
+// (Va[k] - F_j[k]), from 0: strictly causal, so a feedforward can cancel them exactly). The
+// identification solves one linear least-squares problem in (w_0, w_i, c_j, offset) with
+// w_0, w_i, c_j >= 0 (an increasing, invertible operator and a creep that grows) after taking the
+// sign of the displacement's slope (the APA shortens with voltage: gain < 0).
+//
+// Loops asymmetric about their centre (which a PI operator cannot draw) show as a residual that
+// stays large as operators are added: the fit reports it and its verdict says so.
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace piezobench::ident {
+
+// H[v] = linear_weight v + sum_i weights[i] P_{thresholds[i]}[v].
+struct PrandtlIshlinskii {
+  double linear_weight = 1.0;     // w_0 (output unit per input unit)
+  std::vector<double> thresholds; // r_i, strictly increasing, > 0 (input unit)
+  std::vector<double> weights;    // w_i (output unit per input unit), same size
+  // InputError (source `source`, default "Prandtl-Ishlinskii operator") naming the field: finite
+  // values, equal sizes, thresholds > 0 and strictly increasing, an invertible operator (w_0 > 0,
+  // partial sums > 0).
+  void validate(const std::string& source = "") const;
+  // Smallest partial sum w_0 + ... + w_i (the smallest slope of any branch); > 0: invertible.
+  [[nodiscard]] double min_slope() const;
+};
+
+// The exact inverse (see the file comment). Validates (InputError).
+PrandtlIshlinskii inverse(const PrandtlIshlinskii& h);
+
+// A PI operator running sample by sample: step(v) advances every play operator to v and returns
+// H[v]. No allocation after construction.
+class PrandtlIshlinskiiOperator {
+ public:
+  PrandtlIshlinskiiOperator() = default;
+  explicit PrandtlIshlinskiiOperator(PrandtlIshlinskii h);  // validates; at rest
+  double step(double v) noexcept {
+    double y = h_.linear_weight * v;
+    const std::size_t n = state_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double r = h_.thresholds[i];
+      double p = state_[i];
+      p = p < v - r ? v - r : p;
+      p = p > v + r ? v + r : p;
+      state_[i] = p;
+      y += h_.weights[i] * p;
+    }
+    return y;
+  }
+  void reset() noexcept;
+  [[nodiscard]] const PrandtlIshlinskii& model() const noexcept { return h_; }
+  [[nodiscard]] const std::vector<double>& state() const noexcept { return state_; }
+
+ private:
+  PrandtlIshlinskii h_;
+  std::vector<double> state_;
+};
+
+// H[v] for a whole record, from rest.
+std::vector<double> evaluate(const PrandtlIshlinskii& h, std::span<const double> v);
+// The play operators' outputs P_{r_i}[v] from rest: v.size() x thresholds.size().
+Eigen::MatrixXd play_outputs(std::span<const double> v, std::span<const double> thresholds);
+// The creep states F_j[v] (see the file comment) from rest: v.size() x time_constants.size().
+Eigen::MatrixXd creep_states(std::span<const double> v, std::span<const double> time_constants, double sample_rate);
+
+// An identified actuator: d_e = offset + gain (H[Va] + sum_j c_j F_j[Va]).
+struct HysteresisModel {
+  PrandtlIshlinskii hysteresis;                 // V -> effective V, linear_weight 1
+  std::vector<double> creep_time_constants;     // tau_j, s
+  std::vector<double> creep_coefficients;       // c_j (relative to the effective voltage), >= 0
+  double gain = 0.0;                            // m per effective V (< 0 for the APA: it shortens)
+  double offset = 0.0;                          // m, d_e at rest
+  // The line the compensated actuator follows: effective voltage = reference_slope c +
+  // reference_intercept for a linear command c (V), the best straight line of the identification
+  // record's effective voltage against Va. With the inverse feedforward, d_e = offset + gain
+  // (reference_slope c + reference_intercept): the stroke the record had, without its loop.
+  double reference_slope = 1.0;
+  double reference_intercept = 0.0;             // V
+  double input_min = 0.0, input_max = 0.0;      // V, range of Va in the identification record
+  // InputError (source `source`, default "hysteresis model") naming the field.
+  void validate(const std::string& source = "") const;
+  // d_e (m) for the stack voltage v (V) sampled at sample_rate (Hz; used by the creep), from rest.
+  [[nodiscard]] std::vector<double> predict(std::span<const double> v, double sample_rate) const;
+};
+
+struct HysteresisFitOptions {
+  int operators = 10;                         // play operators n, 1..200
+  double threshold_range = 0.0;               // V, R: thresholds (i - 1/2) R / n, i = 1..n; 0 = half
+                                              // the range of Va (a larger threshold never turns)
+  std::vector<double> creep_time_constants;   // s, > 0; empty: no creep states
+  double max_relative_residual = 0.02;        // the verdict: rms residual / stroke above it is poor
+  void validate() const;                      // InputError (source "hysteresis fit options")
+};
+
+struct HysteresisFit {
+  HysteresisModel model;
+  double rms_residual = 0.0;        // m, rms of d_e - model
+  double relative_residual = 0.0;   // rms_residual / (max d_e - min d_e)
+  double stroke = 0.0;              // m, max d_e - min d_e
+  std::size_t samples = 0;
+  bool good = false;                // relative_residual <= max_relative_residual
+  std::string message;              // the verdict in words (why it is poor, when it is)
+};
+
+// Identifies the model from Va (V) and d_e (m) sampled at sample_rate (Hz), the record starting at
+// rest (Va = 0 and no history: the play operators' initial state). InputError for mismatched or
+// too short (< 10 samples) records, non-finite samples, or a Va that does not move; NumericalError
+// when the least-squares problem gives no invertible operator (d_e does not follow Va).
+HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double> de, double sample_rate,
+                             const HysteresisFitOptions& options = {});
+
+// Creep of a step record (the stiffness test: the added weight in, d_e out; or a voltage step):
+//     y = offset + gain (x + sum_j c_j F_j[x]),  c_j >= 0,
+// with the creep states of HysteresisModel. creep_per_decade is the mean of c_j when the time
+// constants are a decade apart (a Prony series of equal coefficients one decade apart grows by
+// about that coefficient per decade of time between the first and the last time constant).
+struct CreepFit {
+  std::vector<double> time_constants;  // s
+  std::vector<double> coefficients;    // c_j
+  double gain = 0.0;                   // output per input unit (instantaneous)
+  double offset = 0.0;
+  double creep_per_decade = 0.0;       // mean c_j (relative)
+  double rms_residual = 0.0;           // output unit
+  double relative_residual = 0.0;      // rms / (max y - min y)
+  bool good = false;                   // relative_residual <= max_relative_residual
+  std::string message;
+};
+// time_constants empty: 1, 10, 100 s up to half the record's duration (at least one). InputError
+// as fit_hysteresis; NumericalError when the output does not follow the input.
+CreepFit fit_creep(std::span<const double> input, std::span<const double> output, double sample_rate,
+                   std::vector<double> time_constants = {}, double max_relative_residual = 0.05);
+
+// How straight a response is against its command: the best straight line (least squares) of
+// `output` against `command`, the hysteresis width (peak-to-peak deviation of the output from that
+// line over the stroke: for a loop symmetric about the line, its full width at the centre) and the
+// rms deviation. `reference` (optional): rms of output - (reference_slope command + reference_intercept).
+struct LoopMetrics {
+  double slope = 0.0, intercept = 0.0;  // output = slope command + intercept (best line)
+  double stroke = 0.0;                  // max - min of the output
+  double width = 0.0;                   // (max - min of output - line) / stroke
+  double rms_deviation = 0.0;           // rms of output - line (output unit)
+};
+// InputError for mismatched sizes, fewer than 2 samples, or a command that does not move.
+LoopMetrics loop_metrics(std::span<const double> command, std::span<const double> output);
+
+}  // namespace piezobench::ident

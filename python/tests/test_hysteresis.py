@@ -1,0 +1,85 @@
+"""Hysteresis and creep from Python: identification, the exact inverse, the feedforward, the model
+file and the tracking experiment on the Bouc-Wen bench."""
+
+import numpy as np
+import pytest
+
+import piezobench as pb
+from piezobench import bench, control, ident, io
+
+
+def _record():
+    t = np.arange(0, 4.0, 1e-3)
+    va = np.where(t < 1, 65 * t, 65 + 80 * np.sin(2 * np.pi * (t - 1)))
+    return va
+
+
+def test_inverse_composed_with_the_operator_is_the_identity():
+    rng = np.random.default_rng(3)
+    r = np.cumsum(rng.uniform(1, 20, 8))
+    w = rng.uniform(0, 0.6, 8)
+    v = np.cumsum(rng.normal(0, 5, 3000))
+    y = ident.prandtl_ishlinskii(v, r, w)
+    g = ident.inverse_prandtl_ishlinskii(r, w)
+    back = ident.prandtl_ishlinskii(y, g.thresholds, g.weights, g.linear_weight)
+    np.testing.assert_allclose(back, v, atol=1e-9)
+
+
+def test_fit_recovers_a_prandtl_ishlinskii_record_and_the_feedforward_linearizes_it(tmp_path):
+    va = _record()
+    n, R = 10, 80.0
+    r = (np.arange(n) + 0.5) * R / n
+    w = np.array([0.05, 0.2, 0.0, 0.1, 0.1, 0.0, 0.05, 0.0, 0.02, 0.0])
+    de = 1e-7 - 1.5e-6 * ident.prandtl_ishlinskii(va, r, w)
+    fit = ident.fit_hysteresis(va, de, 1000.0, operators=n)
+    assert fit.good and fit.relative_residual < 1e-9
+    np.testing.assert_allclose(fit.model.weights, w, atol=1e-7)
+    assert fit.model.gain == pytest.approx(-1.5e-6, rel=1e-9)
+    c = _record()
+    applied = control.hysteresis_feedforward(fit.model, c, 1000.0)
+    d = ident.predict_hysteresis(fit.model, applied, 1000.0)
+    m = fit.model
+    np.testing.assert_allclose(d, m.offset + m.gain * (m.reference_slope * c + m.reference_intercept), atol=1e-12)
+    assert ident.loop_metrics(c, d).width < 1e-9
+    assert ident.loop_metrics(va, de).width > 0.1
+    path = tmp_path / "model.toml"
+    io.write_hysteresis_model(str(path), fit.model)
+    back = io.read_hysteresis_model(str(path))
+    np.testing.assert_array_equal(back.weights, fit.model.weights)
+
+
+def test_bad_models_and_records_name_the_field():
+    with pytest.raises(pb.InputError) as e:
+        ident.inverse_prandtl_ishlinskii([5.0, 4.0], [0.1, 0.1])
+    assert e.value.field == "thresholds[1]"
+    with pytest.raises(pb.InputError) as e:
+        control.hysteresis_feedforward({"thresholds": [1.0], "weights": [0.1]}, [0.0, 1.0], 1e3)
+    assert e.value.field == "model.gain"
+    with pytest.raises(pb.InputError):
+        ident.fit_hysteresis([1.0] * 20, [0.0] * 20, 1e3)
+
+
+def test_creep_fit_of_a_step():
+    fs = 100.0
+    x = np.zeros(6000)
+    x[300:4000] = 1.0
+    a = -np.expm1(-1 / (fs * np.array([1.0, 10.0])))
+    f = np.zeros((6000, 2))
+    s = np.zeros(2)
+    for k in range(6000):
+        f[k] = s
+        s = s + a * (x[k] - s)
+    y = 2e-6 * (x + f @ [0.05, 0.1])
+    c = ident.fit_creep(x, y, fs, [1.0, 10.0])
+    np.testing.assert_allclose(c.coefficients, [0.05, 0.1], atol=1e-7)
+
+
+def test_tracking_on_the_bouc_wen_bench():
+    ts = bench.simulate("tracking", unit=2, seed=1, hysteresis_law="bouc-wen")
+    s = ts.settings
+    assert s["width_open_sine"] > 0.15
+    assert s["width_ff_sine"] < 0.03
+    assert s["rms_open_sine_m"] / s["rms_ff_sine_m"] >= 5
+    with pytest.raises(pb.InputError) as e:
+        bench.simulate("tracking", hysteresis_law="preisach")
+    assert e.value.field == "hysteresis_law"

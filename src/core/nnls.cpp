@@ -1,0 +1,120 @@
+#include "piezobench/core/nnls.hpp"
+
+#include <Eigen/QR>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench {
+
+void NnlsOptions::validate() const {
+  if (max_iterations < 0) throw InputError("nnls options", "max_iterations", "an integer >= 0", std::to_string(max_iterations));
+  if (!(std::isfinite(tolerance) && tolerance >= 0.0)) {
+    throw InputError("nnls options", "tolerance", "a finite tolerance >= 0", std::to_string(tolerance));
+  }
+}
+
+namespace {
+
+// Least squares on the passive columns; the other entries of the result are 0.
+Eigen::VectorXd solve_passive(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, const std::vector<bool>& passive) {
+  const Eigen::Index n = a.cols();
+  std::vector<Eigen::Index> cols;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (passive[static_cast<std::size_t>(j)]) cols.push_back(j);
+  }
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(n);
+  if (cols.empty()) return z;
+  Eigen::MatrixXd sub(a.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k) sub.col(static_cast<Eigen::Index>(k)) = a.col(cols[k]);
+  const Eigen::VectorXd zs = sub.colPivHouseholderQr().solve(b);
+  for (std::size_t k = 0; k < cols.size(); ++k) z(cols[k]) = zs(static_cast<Eigen::Index>(k));
+  return z;
+}
+
+}  // namespace
+
+NnlsResult nnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, const std::vector<bool>& free_variables,
+                const NnlsOptions& options) {
+  options.validate();
+  const std::string source = "nnls";
+  if (a.rows() != b.size()) {
+    throw InputError(source, "b", std::to_string(a.rows()) + " rows (those of A)", std::to_string(b.size()));
+  }
+  const Eigen::Index n = a.cols();
+  if (!free_variables.empty() && static_cast<Eigen::Index>(free_variables.size()) != n) {
+    throw InputError(source, "free_variables", std::to_string(n) + " flags (the columns of A)",
+                     std::to_string(free_variables.size()));
+  }
+  if (!a.allFinite() || !b.allFinite()) throw InputError(source, "A, b", "finite entries", "NaN or Inf");
+  auto is_free = [&](Eigen::Index j) { return !free_variables.empty() && free_variables[static_cast<std::size_t>(j)]; };
+
+  NnlsResult r;
+  r.x = Eigen::VectorXd::Zero(n);
+  std::vector<bool> passive(static_cast<std::size_t>(n), false);
+  for (Eigen::Index j = 0; j < n; ++j) passive[static_cast<std::size_t>(j)] = is_free(j);
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double norm1 = n > 0 ? a.cwiseAbs().colwise().sum().maxCoeff() : 0.0;
+  const double tol = options.tolerance > 0.0
+                         ? options.tolerance
+                         : 10.0 * eps * norm1 * static_cast<double>(std::max(a.rows(), n)) * std::max(1.0, b.cwiseAbs().maxCoeff());
+  const int max_iter = options.max_iterations > 0 ? options.max_iterations : 3 * static_cast<int>(std::max<Eigen::Index>(n, 1));
+  r.x = solve_passive(a, b, passive);  // the free variables alone
+
+  r.converged = false;
+  for (r.iterations = 0; r.iterations < max_iter; ++r.iterations) {
+    const Eigen::VectorXd w = a.transpose() * (b - a * r.x);
+    Eigen::Index best = -1;
+    double wmax = tol;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (!passive[static_cast<std::size_t>(j)] && w(j) > wmax) {
+        wmax = w(j);
+        best = j;
+      }
+    }
+    if (best < 0) {
+      r.converged = true;
+      break;
+    }
+    passive[static_cast<std::size_t>(best)] = true;
+    // Inner loop: step towards the unconstrained solution on the passive set until it is feasible.
+    for (int inner = 0; inner <= n; ++inner) {
+      const Eigen::VectorXd z = solve_passive(a, b, passive);
+      double alpha = 1.0;
+      Eigen::Index blocking = -1;
+      for (Eigen::Index j = 0; j < n; ++j) {
+        if (!passive[static_cast<std::size_t>(j)] || is_free(j) || z(j) > 0.0) continue;
+        const double denom = r.x(j) - z(j);
+        const double t = denom > 0.0 ? r.x(j) / denom : 0.0;
+        if (t < alpha) {
+          alpha = t;
+          blocking = j;
+        }
+      }
+      if (blocking < 0) {
+        r.x = z;
+        break;
+      }
+      r.x += alpha * (z - r.x);
+      passive[static_cast<std::size_t>(blocking)] = false;
+      r.x(blocking) = 0.0;
+      for (Eigen::Index j = 0; j < n; ++j) {
+        if (passive[static_cast<std::size_t>(j)] && !is_free(j) && r.x(j) <= 0.0) {
+          passive[static_cast<std::size_t>(j)] = false;
+          r.x(j) = 0.0;
+        }
+      }
+    }
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (!is_free(j) && r.x(j) < 0.0) r.x(j) = 0.0;
+  }
+  r.residual_norm = (a * r.x - b).norm();
+  r.active.assign(static_cast<std::size_t>(n), false);
+  for (Eigen::Index j = 0; j < n; ++j) r.active[static_cast<std::size_t>(j)] = !is_free(j) && !passive[static_cast<std::size_t>(j)];
+  return r;
+}
+
+}  // namespace piezobench
