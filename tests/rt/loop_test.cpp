@@ -226,42 +226,49 @@ TEST(Loop, FeedforwardStaysWithinTheLimits) {
   m.gain = -1.6e-6;
   m.reference_slope = 1.6;
   m.reference_intercept = -5.0;
-  FakeBackend backend(discrete_plant(), kFs);
-  LoopOptions o = lockstep_options(0.5);
-  o.controller = false;
-  o.feedforward = m;
-  o.limits.ramp_in = 0.0;
-  o.limits.ramp_out = 0.0;
-  o.limits.slew_rate = 2e4;  // 2 V per sample at the stacks
-  o.excitation.resize(1000);  // 10 Hz, 9 V at the DAC (180 V at the stacks) about 3 V
-  for (Eigen::Index k = 0; k < 1000; ++k) o.excitation(k) = 3.0 + 9.0 * std::sin(2 * M_PI * k / 1000.0);
-  Loop loop(backend, o);
-  run_all(loop);
-  const LoopReport rep = loop.finish();
-  EXPECT_TRUE(rep.feedforward);
-  EXPECT_GT(rep.clamped_samples, 100u);
-  EXPECT_GT(rep.slew_limited_samples, 0u);
-  EXPECT_EQ(rep.safe_state_reason, "none");
-  const auto va = loop.log().channel("Va_cmd");
-  EXPECT_GE(va.minCoeff(), -20.0);
-  EXPECT_LE(va.maxCoeff(), 150.0);
-  EXPECT_NEAR(va.maxCoeff(), 150.0, 1e-9);
-  double max_step = std::abs(va(0));
-  for (Eigen::Index k = 1; k < va.size(); ++k) max_step = std::max(max_step, std::abs(va(k) - va(k - 1)));
-  EXPECT_LE(max_step, 2.0 + 1e-9);
-  // Unlimited samples carry the feedforward's output.
-  control::HysteresisFeedforward ff(m, kFs);
-  const auto u = loop.log().channel("u");
-  const auto flags = loop.log().channel("flags");
-  std::size_t checked = 0;
-  for (Eigen::Index k = 0; k < u.size(); ++k) {
-    const double expected = ff.step(20.0 * o.excitation(k % 1000)) / 20.0;
-    if (flags(k) == 0.0) {
-      ASSERT_NEAR(u(k), expected, 1e-12) << k;
-      ++checked;
+  // With the default saturation policy the clamped output trips the safe state; with a long
+  // saturation time the run clamps to the end. Either way the limits hold.
+  for (const double saturation_time : {0.1, 10.0}) {
+    SCOPED_TRACE("saturation_time " + std::to_string(saturation_time));
+    FakeBackend backend(discrete_plant(), kFs);
+    LoopOptions o = lockstep_options(0.5);
+    o.controller = false;
+    o.feedforward = m;
+    o.limits.ramp_in = 0.0;
+    o.limits.ramp_out = 0.0;
+    o.limits.slew_rate = 2e4;  // 2 V per sample at the stacks
+    o.limits.saturation_time = saturation_time;
+    o.excitation.resize(1000);  // 10 Hz, 9 V at the DAC (180 V at the stacks) about 3 V
+    for (Eigen::Index k = 0; k < 1000; ++k) o.excitation(k) = 3.0 + 9.0 * std::sin(2 * M_PI * k / 1000.0);
+    Loop loop(backend, o);
+    run_all(loop);
+    const LoopReport rep = loop.finish();
+    EXPECT_TRUE(rep.feedforward);
+    EXPECT_GT(rep.clamped_samples, 100u);
+    EXPECT_GT(rep.slew_limited_samples, 0u);
+    EXPECT_EQ(rep.safe_state_reason, saturation_time < 1.0 ? "output saturated" : "none");
+    const auto va = loop.log().channel("Va_cmd");
+    EXPECT_GE(va.minCoeff(), -20.0);
+    EXPECT_LE(va.maxCoeff(), 150.0);
+    EXPECT_NEAR(va.maxCoeff(), 150.0, 1e-9);
+    double max_step = std::abs(va(0));
+    for (Eigen::Index k = 1; k < va.size(); ++k) max_step = std::max(max_step, std::abs(va(k) - va(k - 1)));
+    EXPECT_LE(max_step, 2.0 + 1e-9);
+    if (saturation_time < 1.0) continue;
+    // Unlimited samples carry the feedforward's output.
+    control::HysteresisFeedforward ff(m, kFs);
+    const auto u = loop.log().channel("u");
+    const auto flags = loop.log().channel("flags");
+    std::size_t checked = 0;
+    for (Eigen::Index k = 0; k < u.size(); ++k) {
+      const double expected = ff.step(20.0 * o.excitation(k % 1000)) / 20.0;
+      if (flags(k) == 0.0) {
+        ASSERT_NEAR(u(k), expected, 1e-12) << k;
+        ++checked;
+      }
     }
+    EXPECT_GT(checked, 1000u);
   }
-  EXPECT_GT(checked, 1000u);
 }
 
 // A NaN sample: safe state at that cycle, output to the safe value at the slew limit, controller
