@@ -66,16 +66,16 @@ int run_fit(const FitOptions& o) {
     if (!o.json) log_line("wrote " + o.out);
   }
   if (o.json) {
-    print_json({{"source", o.file},
+    nlohmann::json doc = {{"source", o.file},
                 {"samples", fit.samples},
                 {"sample_rate_Hz", ts.sample_rate},
                 {"model", model_json(fit.model)},
                 {"rms_residual_m", fit.rms_residual},
                 {"relative_residual", fit.relative_residual},
                 {"stroke_m", fit.stroke},
-                {"hysteresis_width", loop.width},
-                {"good", fit.good},
-                {"message", fit.message}});
+                {"hysteresis_width", loop.width}};
+    doc.update(quality_json(fit.quality));
+    print_json(doc);
   } else {
     const ident::HysteresisModel& m = fit.model;
     fmt::print("Prandtl-Ishlinskii model of {} -> {} ({} samples)\n", o.input, o.output, fit.samples);
@@ -88,13 +88,10 @@ int run_fit(const FitOptions& o) {
     }
     fmt::print("  compensated line: {:.6g} V/V, {:.6g} V\n", m.reference_slope, m.reference_intercept);
     fmt::print("  record: stroke {:.6g} um, hysteresis width {:.3g} % of the stroke\n", 1e6 * fit.stroke, 100.0 * loop.width);
-    fmt::print("  fit: rms residual {:.4g} nm ({})\n", 1e9 * fit.rms_residual, fit.message);
+    fmt::print("  fit: rms residual {:.4g} nm, {:.3g} % of the stroke ({})\n", 1e9 * fit.rms_residual, 100.0 * fit.relative_residual,
+               fit.quality.summary());
   }
-  if (!fit.good) {
-    log_line("warning: " + fit.message);
-    return static_cast<int>(ExitCode::kNumerical);
-  }
-  return 0;
+  return report_quality(fit.quality);
 }
 
 struct CreepOptions {
@@ -114,26 +111,23 @@ int run_creep(const CreepOptions& o) {
   const ident::CreepFit c = ident::fit_creep({x.data(), static_cast<std::size_t>(x.size())}, {y.data(), static_cast<std::size_t>(y.size())},
                                              ts.sample_rate, tau, o.max_residual);
   if (o.json) {
-    print_json({{"source", o.file},
+    nlohmann::json doc = {{"source", o.file},
                 {"time_constants_s", c.time_constants},
                 {"coefficients", c.coefficients},
                 {"gain", c.gain},
                 {"offset", c.offset},
                 {"creep_per_decade", c.creep_per_decade},
                 {"rms_residual", c.rms_residual},
-                {"relative_residual", c.relative_residual},
-                {"good", c.good},
-                {"message", c.message}});
+                {"relative_residual", c.relative_residual}};
+    doc.update(quality_json(c.quality));
+    print_json(doc);
   } else {
     fmt::print("Creep of {} -> {}: y = {:.6g} + {:.6g} (x + sum_j c_j F_j[x])\n", o.input, o.output, c.offset, c.gain);
     fmt::print("  time constants (s): {:.4g}\n  coefficients:       {:.4g}\n", fmt::join(c.time_constants, ", "), fmt::join(c.coefficients, ", "));
-    fmt::print("  creep per decade {:.4g} %; fit: {}\n", 100.0 * c.creep_per_decade, c.message);
+    fmt::print("  creep per decade {:.4g} %; rms residual {:.3g} % of the range ({})\n", 100.0 * c.creep_per_decade,
+               100.0 * c.relative_residual, c.quality.summary());
   }
-  if (!c.good) {
-    log_line("warning: " + c.message);
-    return static_cast<int>(ExitCode::kNumerical);
-  }
-  return 0;
+  return report_quality(c.quality);
 }
 
 }  // namespace

@@ -113,15 +113,16 @@ void bind_hysteresis(py::module_& ident_m, py::module_& control_m, py::module_& 
         d["relative_residual"] = f.relative_residual;
         d["stroke"] = f.stroke;
         d["samples"] = f.samples;
-        d["good"] = f.good;
-        d["message"] = f.message;
+        d["quality"] = core::to_string(f.quality.verdict);
+        d["quality_problems"] = f.quality.problems;
+        d["advice"] = f.quality.advice;
         return result("HysteresisFit", d);
       },
       arg("va"), arg("de"), arg("sample_rate"),
       ("Prandtl-Ishlinskii model (+ creep states) of a record of the stack voltage va (V) and the\n"
        "displacement de (m) starting at rest: d_e = offset + gain (H[Va] + sum_j c_j F_j[Va]), weights and\n"
        "creep coefficients >= 0 by constrained least squares (ident/hysteresis.hpp). Returns a\n"
-       "HysteresisFit (model, rms_residual, relative_residual, stroke, good, message).\n\nKeywords:\n" +
+       "HysteresisFit (model, rms_residual, relative_residual, stroke, quality, quality_problems, advice).\n\nKeywords:\n" +
        fit_options().doc())
           .c_str());
   ident_m.def(
@@ -140,8 +141,9 @@ void bind_hysteresis(py::module_& ident_m, py::module_& control_m, py::module_& 
         d["creep_per_decade"] = c.creep_per_decade;
         d["rms_residual"] = c.rms_residual;
         d["relative_residual"] = c.relative_residual;
-        d["good"] = c.good;
-        d["message"] = c.message;
+        d["quality"] = core::to_string(c.quality.verdict);
+        d["quality_problems"] = c.quality.problems;
+        d["advice"] = c.quality.advice;
         return result("CreepFit", d);
       },
       arg("input"), arg("output"), arg("sample_rate"), arg("time_constants") = py::none(), arg("max_relative_residual") = 0.05,

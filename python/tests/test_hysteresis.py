@@ -32,7 +32,7 @@ def test_fit_recovers_a_prandtl_ishlinskii_record_and_the_feedforward_linearizes
     w = np.array([0.05, 0.2, 0.0, 0.1, 0.1, 0.0, 0.05, 0.0, 0.02, 0.0])
     de = 1e-7 - 1.5e-6 * ident.prandtl_ishlinskii(va, r, w)
     fit = ident.fit_hysteresis(va, de, 1000.0, operators=n)
-    assert fit.good and fit.relative_residual < 1e-9
+    assert fit.quality == "good" and fit.relative_residual < 1e-9
     np.testing.assert_allclose(fit.model.weights, w, atol=1e-7)
     assert fit.model.gain == pytest.approx(-1.5e-6, rel=1e-9)
     c = _record()

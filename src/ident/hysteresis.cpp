@@ -287,11 +287,12 @@ HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double>
   out.stroke = range(de);
   out.rms_residual = std::sqrt(residual.squaredNorm() / static_cast<double>(rows));
   out.relative_residual = out.stroke > 0.0 ? out.rms_residual / out.stroke : 0.0;
-  out.good = out.relative_residual <= options.max_relative_residual;
-  out.message = out.good ? fmt::format("rms residual {:.3g} % of the stroke", 100.0 * out.relative_residual)
-                         : fmt::format("poor fit: rms residual {:.3g} % of the stroke (limit {:.3g} %): more operators, creep "
-                                       "states, or loops a PI operator cannot draw (asymmetric)",
-                                       100.0 * out.relative_residual, 100.0 * options.max_relative_residual);
+  if (!(out.relative_residual <= options.max_relative_residual)) {
+    out.quality.add_problem(fmt::format("d_e: rms residual {:.3g} % of the stroke (limit {:.3g} %)", 100.0 * out.relative_residual,
+                                        100.0 * options.max_relative_residual));
+    out.quality.advise("more operators, creep states (a drifting record), or a record starting at rest; loops asymmetric "
+                       "about their centre are beyond a Prandtl-Ishlinskii operator");
+  }
   return out;
 }
 
@@ -335,10 +336,11 @@ CreepFit fit_creep(std::span<const double> input, std::span<const double> output
   out.rms_residual = std::sqrt(residual.squaredNorm() / static_cast<double>(rows));
   const double stroke = range(output);
   out.relative_residual = stroke > 0.0 ? out.rms_residual / stroke : 0.0;
-  out.good = out.relative_residual <= max_relative_residual;
-  out.message = out.good ? fmt::format("rms residual {:.3g} % of the range", 100.0 * out.relative_residual)
-                         : fmt::format("poor fit: rms residual {:.3g} % of the range (limit {:.3g} %)", 100.0 * out.relative_residual,
-                                       100.0 * max_relative_residual);
+  if (!(out.relative_residual <= max_relative_residual)) {
+    out.quality.add_problem(fmt::format("output: rms residual {:.3g} % of the range (limit {:.3g} %)", 100.0 * out.relative_residual,
+                                        100.0 * max_relative_residual));
+    out.quality.advise("other time constants (a decade apart, within the record), or a record with one clean step");
+  }
   return out;
 }
 

@@ -98,7 +98,7 @@ std::string hysteresis_model_toml(const ident::HysteresisModel& m, const ident::
     s += fmt::format("relative_residual = {:.6g}\n", fit->relative_residual);
     s += fmt::format("stroke_m = {:.6g}\n", fit->stroke);
     s += fmt::format("samples = {}\n", fit->samples);
-    s += fmt::format("good = {}\n", fit->good ? "true" : "false");
+    s += fmt::format("quality = \"{}\"\n", core::to_string(fit->quality.verdict));
     if (!source.empty()) {
       std::ostringstream quoted;
       quoted << toml::value<std::string>(source);  // TOML's escaping

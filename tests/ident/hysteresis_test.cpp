@@ -140,7 +140,7 @@ TEST(HysteresisFit, RecoversAPrandtlIshlinskiiRecord) {
     o.operators = 8;
     o.creep_time_constants = truth.creep_time_constants;
     const HysteresisFit f = fit_hysteresis(va, de, fs, o);
-    EXPECT_TRUE(f.good) << f.message;
+    EXPECT_FALSE(f.quality.poor()) << f.quality.summary();
     EXPECT_LT(f.relative_residual, 1e-9);
     EXPECT_NEAR(f.model.gain, truth.gain, 1e-9 * std::abs(truth.gain));
     EXPECT_NEAR(f.model.offset, truth.offset, 1e-9 * std::abs(truth.offset));
@@ -164,8 +164,8 @@ TEST(HysteresisFit, AsymmetricLoopIsAPoorFit) {
   HysteresisFitOptions o;
   o.max_relative_residual = 0.02;
   const HysteresisFit f = fit_hysteresis(va, de, 1000.0, o);
-  EXPECT_FALSE(f.good);
-  EXPECT_NE(f.message.find("poor fit"), std::string::npos);
+  EXPECT_TRUE(f.quality.poor());
+  EXPECT_NE(f.quality.summary().find("rms residual"), std::string::npos);
 }
 
 TEST(HysteresisFit, RefusesBadRecords) {
@@ -196,7 +196,7 @@ TEST(CreepFit, RecoversAPronySeries) {
     y[k] = 1e-7 + 2e-8 * (x[k] + 0.1 * f(kk, 0) + 0.2 * f(kk, 1));
   }
   const CreepFit c = fit_creep(x, y, fs, tau);
-  EXPECT_TRUE(c.good) << c.message;
+  EXPECT_FALSE(c.quality.poor()) << c.quality.summary();
   EXPECT_NEAR(c.gain, 2e-8, 1e-16);
   EXPECT_NEAR(c.coefficients[0], 0.1, 1e-7);
   EXPECT_NEAR(c.coefficients[1], 0.2, 1e-7);

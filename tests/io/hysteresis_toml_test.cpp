@@ -25,7 +25,6 @@ TEST(HysteresisToml, RoundTripsExactly) {
   ident::HysteresisFit fit;
   fit.rms_residual = 1e-8;
   fit.samples = 100;
-  fit.good = true;
   const std::string text = hysteresis_model_toml(model(), &fit, "rec \"1\".mat");
   const ident::HysteresisModel back = parse_hysteresis_model(text, "m.toml");
   const ident::HysteresisModel m = model();

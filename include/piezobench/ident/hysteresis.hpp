@@ -30,6 +30,8 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fit_quality.hpp"
+
 namespace piezobench::ident {
 
 // H[v] = linear_weight v + sum_i weights[i] P_{thresholds[i]}[v].
@@ -118,8 +120,7 @@ struct HysteresisFit {
   double relative_residual = 0.0;   // rms_residual / (max d_e - min d_e)
   double stroke = 0.0;              // m, max d_e - min d_e
   std::size_t samples = 0;
-  bool good = false;                // relative_residual <= max_relative_residual
-  std::string message;              // the verdict in words (why it is poor, when it is)
+  core::FitQuality quality;         // poor when relative_residual > max_relative_residual
 };
 
 // Identifies the model from Va (V) and d_e (m) sampled at sample_rate (Hz), the record starting at
@@ -142,8 +143,7 @@ struct CreepFit {
   double creep_per_decade = 0.0;       // mean c_j (relative)
   double rms_residual = 0.0;           // output unit
   double relative_residual = 0.0;      // rms / (max y - min y)
-  bool good = false;                   // relative_residual <= max_relative_residual
-  std::string message;
+  core::FitQuality quality;            // poor when relative_residual > max_relative_residual
 };
 // time_constants empty: 1, 10, 100 s up to half the record's duration (at least one). InputError
 // as fit_hysteresis; NumericalError when the output does not follow the input.
