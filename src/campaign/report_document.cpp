@@ -97,6 +97,10 @@ json unit_plots(const Campaign& c, const UnitAnalysis& u) {
     }
     plots["hysteresis"] = loops;
   }
+  if (u.hysteresis_model) {
+    const HysteresisModelFit& h = *u.hysteresis_model;
+    plots["hysteresis_model"] = {{"Va", values(h.loop.x)}, {"de_um", values(h.loop.y, 1e6)}, {"model_um", values(h.model_loop.y, 1e6)}};
+  }
   if (u.stiffness_analysis) plots["stiffness"] = stiffness_curves(*u.stiffness_analysis);
   if (u.stiffness_open_analysis) plots["stiffness_open"] = stiffness_curves(*u.stiffness_open_analysis);
   if (u.frf) {
@@ -669,6 +673,35 @@ json document(const Campaign& c, const std::vector<UnitPlots>& units, const json
       std::vector<std::string> columns = {"unit"};
       for (const double a : amplitudes) columns.push_back(fmt::format("width at {:.3g} V [um] (of the stroke)", a));
       tables.push_back(table("Hysteresis: loop width at the offset per amplitude", columns, rows));
+    }
+    // The Prandtl-Ishlinskii model of the largest loop (docs/hysteresis.md): its fit and the loop it draws.
+    json model_rows = json::array();
+    for (const auto& u : units) {
+      const json m = at(result_of(u), {"hysteresis_model"});
+      if (m.is_null()) continue;
+      json weights = json::array();
+      for (const auto& w : m["weights"]) weights.push_back(fmt::format("{:.3g}", w.get<double>()));
+      model_rows.push_back(json::array({u.name, fmt::format("{:.3g}", m["amplitude_V"].get<double>()),
+                                        fmt::format("{:.3g}", m["gain_um_per_V"].get<double>()), fmt::format("{}", fmt::join(weights, " ")),
+                                        fmt::format("{:.3g} ({:.2f} %)", m["rms_residual_um"].get<double>(), 100.0 * m["relative_residual"].get<double>()),
+                                        fmt::format("{:.1f} % / {:.1f} %", 100.0 * m["hysteresis_width"].get<double>(),
+                                                    100.0 * m["model_hysteresis_width"].get<double>()),
+                                        m["quality"].get<std::string>()}));
+      if (has(u.plots, "hysteresis_model")) {
+        const json& p = u.plots["hysteresis_model"];
+        figs.push_back(figure(fmt::format("hysteresis-model-{}", u.id), u.name + ": hysteresis model against the record", "Va [V]", false,
+                              json::array({panel("d_e [um]", false,
+                                                 json::array({trace("record", p["Va"], p["de_um"], "record"),
+                                                              trace("Prandtl-Ishlinskii model", p["Va"], p["model_um"], "model")}))}),
+                              "The model's inverse is the feedforward of `rt --feedforward` and `measure tracking` "
+                              "(docs/hysteresis.md)."));
+      }
+    }
+    if (!model_rows.empty()) {
+      tables.push_back(table("Hysteresis model (Prandtl-Ishlinskii, largest loop; thresholds (i - 1/2) R / n)",
+                             {"unit", "amplitude [V]", "gain [um/V]", "weights", "rms residual [um] (of the stroke)",
+                              "width: record / model", "fit"},
+                             model_rows));
     }
     if (!figs.empty()) sections.push_back({{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}});
   }

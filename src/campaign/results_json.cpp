@@ -66,6 +66,26 @@ json hysteresis(const std::vector<HysteresisLoop>& loops) {
   return list;
 }
 
+json hysteresis_model(const HysteresisModelFit& h) {
+  const ident::HysteresisModel& m = h.fit.model;
+  json j = {{"amplitude_V", h.amplitude},
+            {"operators", m.hysteresis.thresholds.size()},
+            {"thresholds_V", m.hysteresis.thresholds},
+            {"weights", m.hysteresis.weights},
+            {"gain_um_per_V", m.gain * 1e6},
+            {"offset_um", m.offset * 1e6},
+            {"reference_slope", m.reference_slope},
+            {"reference_intercept_V", m.reference_intercept},
+            {"rms_residual_um", h.fit.rms_residual * 1e6},
+            {"relative_residual", h.fit.relative_residual},
+            {"hysteresis_width", h.width},
+            {"model_hysteresis_width", h.model_width},
+            {"quality", core::to_string(h.fit.quality.verdict)},
+            {"quality_problems", h.fit.quality.problems},
+            {"provenance", provenance(h.provenance)}};
+  return j;
+}
+
 json stiffness(const StiffnessAnalysis& a) {
   const auto& s = a.result;
   const auto& o = a.options;
@@ -356,6 +376,7 @@ json unit_json(const UnitAnalysis& u) {
     r["stroke"] = stroke(*u.stroke_analysis);
   }
   if (!u.hysteresis.empty()) r["hysteresis"] = hysteresis(u.hysteresis);
+  if (u.hysteresis_model) r["hysteresis_model"] = hysteresis_model(*u.hysteresis_model);
   if (u.stiffness_analysis) r["stiffness_static"] = stiffness(*u.stiffness_analysis);
   if (u.stiffness_open_analysis) r["stiffness_open_circuit"] = stiffness(*u.stiffness_open_analysis);
   if (u.frf_analysis) {

@@ -13,6 +13,7 @@
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/ident/dominant_pole.hpp"
+#include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/ident/modal.hpp"
 #include "piezobench/metrology/capacitance.hpp"
 #include "piezobench/metrology/flatness.hpp"
@@ -290,6 +291,22 @@ StrokeAnalysis stroke(const Campaign& c, const Record& r) {
   out.result = metrology::analyze_stroke(va, de, r.ts.sample_rate, {}, c.file.string() + ": " + r.spec.key);
   out.provenance = provenance(r, {"Va", "de"});
   out.de_vs_va = {thin(va), thin(de)};
+  return out;
+}
+
+// The PI model of the largest-amplitude record (it starts at rest, as the identification needs).
+HysteresisModelFit hysteresis_model(const Record& r, double amplitude) {
+  const VectorXd va = r.channel("Va"), de = r.channel("de");
+  const std::span<const double> v(va.data(), static_cast<std::size_t>(va.size())), d(de.data(), static_cast<std::size_t>(de.size()));
+  HysteresisModelFit out;
+  out.fit = ident::fit_hysteresis(v, d, r.ts.sample_rate);
+  out.amplitude = amplitude;
+  out.provenance = provenance(r, {"Va", "de"});
+  const std::vector<double> predicted = out.fit.model.predict(v, r.ts.sample_rate);
+  out.width = ident::loop_metrics(v, d).width;
+  out.model_width = ident::loop_metrics(v, predicted).width;
+  out.loop = {thin(va, 1200), thin(de, 1200)};
+  out.model_loop = {out.loop.x, thin(Eigen::Map<const VectorXd>(predicted.data(), va.size()), 1200)};
   return out;
 }
 
@@ -666,6 +683,18 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
       records.push_back(load_record(c, f, Experiment::kHysteresis));
     }
     u.hysteresis = hysteresis(c, records);
+    std::size_t largest = 0;
+    for (std::size_t i = 1; i < records.size(); ++i) {
+      if (records[i].channel("Va").maxCoeff() - records[i].channel("Va").minCoeff() >
+          records[largest].channel("Va").maxCoeff() - records[largest].channel("Va").minCoeff()) {
+        largest = i;
+      }
+    }
+    try {
+      u.hysteresis_model = hysteresis_model(records[largest], u.hysteresis.empty() ? 0.0 : u.hysteresis.back().result.amplitude);
+    } catch (const NumericalError& e) {
+      record_failure(u, "hysteresis model", e);
+    }
   }
   if (spec.stiffness) {
     say("static stiffness", *spec.stiffness);

@@ -20,6 +20,7 @@
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/features.hpp"
+#include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/metrology/capacitance.hpp"
 #include "piezobench/metrology/flatness.hpp"
 #include "piezobench/metrology/stiffness.hpp"
@@ -76,6 +77,19 @@ struct HysteresisLoop {
   metrology::HysteresisResult result;
   RecordProvenance provenance;
   Curve loop;  // x Va [V], y d_e [m], the part of the record analysed (thinned)
+};
+
+// The Prandtl-Ishlinskii hysteresis model identified from the unit's largest-amplitude hysteresis
+// record (ident::fit_hysteresis, docs/hysteresis.md): what `hysteresis fit` gives for that file.
+struct HysteresisModelFit {
+  ident::HysteresisFit fit;
+  double amplitude = 0.0;      // V, of the record it comes from
+  double width = 0.0;          // hysteresis width of that record (ident::loop_metrics: peak-to-peak
+                               // deviation from the best line / stroke)
+  double model_width = 0.0;    // the same figure for the model's prediction of the record
+  RecordProvenance provenance;
+  Curve loop;                  // x Va [V], y d_e [m]: the record's loop (thinned)
+  Curve model_loop;            // x Va [V], y d_e [m]: the model's prediction of it (thinned)
 };
 
 struct StiffnessAnalysis {
@@ -202,6 +216,7 @@ struct UnitAnalysis {
   std::optional<CapacitanceAnalysis> capacitance_analysis;
   std::optional<StrokeAnalysis> stroke_analysis;
   std::vector<HysteresisLoop> hysteresis;  // by amplitude
+  std::optional<HysteresisModelFit> hysteresis_model;  // from the largest amplitude
   std::optional<StiffnessAnalysis> stiffness_analysis;       // stacks on the amplifier and the resistor
   std::optional<StiffnessAnalysis> stiffness_open_analysis;  // every stack open (k_oc)
   std::optional<FrfAnalysis> frf_analysis;
