@@ -6,6 +6,7 @@
 #include "piezobench/campaign/pipeline.hpp"
 #include "piezobench/campaign/report_document.hpp"
 #include "piezobench/campaign/results.hpp"
+#include "piezobench/campaign/part.hpp"
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/campaign/superelement_fit.hpp"
 #include "piezobench/campaign/unit_analysis.hpp"

@@ -9,6 +9,7 @@
 #include <exception>
 #include <mutex>
 #include <numbers>
+#include <stdexcept>
 #include <thread>
 
 #include "piezobench/apa/piezo.hpp"
@@ -438,17 +439,31 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
 
 // ------------------------------------------------------------------------------------ run
 
-CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
-  std::mutex log_mutex;
-  const Log log = [&](const std::string& line) {
+namespace {
+
+// The progress log of the options, serialized.
+struct LockedLog {
+  std::mutex mutex;
+  const PipelineOptions& options;
+  void operator()(const std::string& line) {
     if (!options.log) return;
-    const std::lock_guard<std::mutex> lock(log_mutex);
+    const std::lock_guard<std::mutex> lock(mutex);
     options.log(line);
-  };
-  const std::size_t n = c.units.size();
+  }
+};
+
+}  // namespace
+
+std::vector<UnitAnalysis> analyze_units(const Campaign& c, const std::vector<std::size_t>& indices, const PipelineOptions& options) {
+  LockedLog locked{{}, options};
+  const Log log = [&](const std::string& line) { locked(line); };
+  const std::size_t n = indices.size();
+  for (const std::size_t i : indices) {
+    if (i >= c.units.size()) throw std::out_of_range("analyze_units: unit index out of range");
+  }
   int threads = options.threads > 0 ? options.threads : c.analysis.threads;
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min<int>(threads, static_cast<int>(n));
+  threads = std::max(1, std::min<int>(threads, static_cast<int>(n)));
   std::vector<UnitAnalysis> units(n);
   std::vector<std::exception_ptr> errors(n);
   std::atomic<std::size_t> next{0};
@@ -457,9 +472,10 @@ CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
     for (;;) {
       const std::size_t i = next.fetch_add(1);
       if (i >= n || stop.load()) return;
+      const UnitSpec& spec = c.units[indices[i]];
       try {
-        units[i] = analyze_unit(c, c.units[i], log);
-        log(fmt::format("{}: done ({} of the experiments not measured, {} analyses failed)", c.units[i].name,
+        units[i] = analyze_unit(c, spec, log);
+        log(fmt::format("{}: done ({} of the experiments not measured, {} analyses failed)", spec.name,
                         units[i].not_measured.size(), units[i].failed.size()));
       } catch (...) {
         errors[i] = std::current_exception();
@@ -475,7 +491,11 @@ CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
   for (const auto& e : errors) {
     if (e) std::rethrow_exception(e);
   }
+  return units;
+}
 
+CampaignResult finish_campaign(const Campaign& c, std::vector<UnitAnalysis> units, const PipelineOptions& options) {
+  LockedLog log{{}, options};
   log("batch: outliers, spread, similarity, acceptance, IFF");
   CampaignResult r;
   r.campaign = c;
@@ -507,6 +527,12 @@ CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
   r.batch = std::move(batch.batch);
   r.units = std::move(units);
   return r;
+}
+
+CampaignResult run_campaign(const Campaign& c, const PipelineOptions& options) {
+  std::vector<std::size_t> all(c.units.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return finish_campaign(c, analyze_units(c, all, options), options);
 }
 
 void remove_outputs(const fs::path& out_dir) {

@@ -32,9 +32,19 @@ struct PipelineOptions {
   Log log;          // progress lines (called under a lock; may be empty)
 };
 
-// Analyses every unit and the batch. InputError for bad data (the first in unit order, the other
-// units stop early); a NumericalError inside an analysis is recorded, not thrown.
+// Analyses every unit and the batch: finish_campaign(analyze_units(every unit)). InputError for bad
+// data (the first in unit order, the other units stop early); a NumericalError inside an analysis
+// is recorded, not thrown.
 CampaignResult run_campaign(const Campaign& campaign, const PipelineOptions& options = {});
+
+// The per-unit half: the units at `indices` into campaign.units, in that order, on a pool of
+// threads (a part of a campaign split over machines, part.hpp). Errors as run_campaign.
+std::vector<UnitAnalysis> analyze_units(const Campaign& campaign, const std::vector<std::size_t>& indices,
+                                        const PipelineOptions& options = {});
+
+// The batch half: acceptance, outliers and spread, similarity, the IFF study and the super element
+// over `units` (every unit of the campaign, in its order; `merge` passes the parts' units).
+CampaignResult finish_campaign(const Campaign& campaign, std::vector<UnitAnalysis> units, const PipelineOptions& options = {});
 
 // Writes results.mat, report.html and results.json (results_json.hpp, report_document.hpp) into
 // `out_dir` (created if needed); returns
