@@ -22,7 +22,7 @@ void add_model_commands(CLI::App& app, Action& action);  // model 2dof, model tu
 void add_superelement_commands(CLI::App& app, Action& action);  // superelement
 void add_simulate_commands(CLI::App& app, Action& action);  // simulate
 void add_measure_commands(CLI::App& app, Action& action);  // measure, bench serve
-void add_run_commands(CLI::App& app, Action& action);  // run, demo
+void add_run_commands(CLI::App& app, Action& action);  // run, merge, demo
 void add_hysteresis_commands(CLI::App& app, Action& action);  // hysteresis fit, hysteresis creep
 
 // Prints exactly one JSON document on stdout (round-trip precision for doubles).

@@ -1,4 +1,5 @@
-// `piezobench run` (the whole characterization of a campaign file) and `piezobench demo` (the
+// `piezobench run` (the whole characterization of a campaign file, or a part of it), `merge` (the
+// parts of a split campaign: docs/cluster.md) and `piezobench demo` (the
 // report's seven-unit campaign simulated on the virtual bench, then run). docs/campaign.md.
 #include <fmt/format.h>
 
@@ -7,13 +8,16 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <regex>
 
 #include "cli_common.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/demo.hpp"
+#include "piezobench/campaign/part.hpp"
 #include "piezobench/campaign/pipeline.hpp"
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/io/output_dir.hpp"
 
 namespace piezobench::app {
@@ -30,6 +34,16 @@ struct RunOptions {
   bool strict = false;
   bool json = false;
   int threads = 0;
+  bool list_units = false;
+  std::string part;   // "K/N"
+  std::string units;  // "3,7-9"
+};
+
+struct MergeOptions {
+  std::vector<std::string> parts;
+  std::string out = "piezobench-results";
+  bool strict = false;
+  bool json = false;
 };
 
 struct DemoCli {
@@ -46,18 +60,16 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Runs the pipeline on a campaign file and writes the outputs; prints the summary.
-int run_pipeline(const fs::path& campaign_file, const fs::path& out, bool strict, bool json, int threads,
-                 nlohmann::json extra = nlohmann::json::object()) {
-  const auto t0 = std::chrono::steady_clock::now();
-  // An earlier run's result set goes first: a run that fails leaves none, never a mix.
-  campaign::remove_outputs(out);
-  log_line("reading " + campaign_file.string());
-  const campaign::Campaign c = campaign::read_campaign(campaign_file);
+campaign::PipelineOptions pipeline_options(int threads) {
   campaign::PipelineOptions po;
   po.threads = threads;
   po.log = [](const std::string& line) { log_line(line); };
-  const campaign::CampaignResult r = campaign::run_campaign(c, po);
+  return po;
+}
+
+// Writes the outputs of a campaign's result and prints the summary (`run` and `merge`).
+int write_and_print(const campaign::CampaignResult& r, const fs::path& out, bool strict, bool json,
+                    std::chrono::steady_clock::time_point t0, const nlohmann::json& extra = nlohmann::json::object()) {
   const std::vector<fs::path> written = campaign::write_outputs(r, out);
   const double elapsed = seconds_since(t0);
   const fs::path report = out / "report.html";
@@ -84,9 +96,103 @@ int run_pipeline(const fs::path& campaign_file, const fs::path& out, bool strict
   return strict && r.rejected > 0 ? kRejected : 0;
 }
 
+// Runs the pipeline on a campaign file and writes the outputs; prints the summary.
+int run_pipeline(const fs::path& campaign_file, const fs::path& out, bool strict, bool json, int threads,
+                 const nlohmann::json& extra = nlohmann::json::object()) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // An earlier run's result set goes first: a run that fails leaves none, never a mix.
+  campaign::remove_outputs(out);
+  log_line("reading " + campaign_file.string());
+  const campaign::Campaign c = campaign::read_campaign(campaign_file);
+  return write_and_print(campaign::run_campaign(c, pipeline_options(threads)), out, strict, json, t0, extra);
+}
+
+// "3,7-9" -> {3, 7, 8, 9}.
+std::vector<int> parse_unit_ids(const std::string& text) {
+  static const std::regex item("^([0-9]+)(-([0-9]+))?$");
+  std::vector<int> ids;
+  for (const std::string& s : split_list(text, "--units")) {
+    std::smatch m;
+    if (!std::regex_match(s, m, item) || m[1].length() > 9 || m[3].length() > 9) {
+      throw UsageError(fmt::format("--units: expected unit ids and ranges like 3,7-9, found '{}'", s));
+    }
+    const int lo = std::stoi(m[1].str());
+    const int hi = m[3].matched ? std::stoi(m[3].str()) : lo;
+    if (hi < lo || hi - lo > 1000000) throw UsageError(fmt::format("--units: expected a range LO-HI with LO <= HI, found '{}'", s));
+    for (int id = lo; id <= hi; ++id) ids.push_back(id);
+  }
+  return ids;
+}
+
+// `run --list-units`: the campaign's unit ids and names, one per line (tab-separated), file order.
+int list_units(const RunOptions& o) {
+  const campaign::Campaign c = campaign::read_campaign(o.campaign);
+  if (o.json) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& u : c.units) list.push_back({{"id", u.id}, {"name", u.name}});
+    print_json({{"campaign", c.file.string()}, {"units", list}});
+  } else {
+    for (const auto& u : c.units) fmt::print("{}\t{}\n", u.id, u.name);
+  }
+  return 0;
+}
+
+// `run --part K/N` / `run --units LIST`: the units' analyses into OUT/part.json (campaign/part.hpp).
+int run_part(const RunOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const fs::path file = fs::path(o.out) / "part.json";
+  std::error_code ec;
+  fs::remove(file, ec);  // a part that fails leaves none
+  log_line("reading " + o.campaign);
+  const campaign::Campaign c = campaign::read_campaign(o.campaign);
+  std::vector<std::size_t> indices;
+  std::string what;
+  try {
+    if (!o.part.empty()) {
+      const auto slash = o.part.find('/');
+      indices = campaign::part_indices(c, std::stoi(o.part.substr(0, slash)), std::stoi(o.part.substr(slash + 1)));
+      what = "part " + o.part;
+    } else {
+      indices = campaign::unit_indices(c, parse_unit_ids(o.units));
+      what = "units " + o.units;
+    }
+  } catch (const InputError& e) {
+    throw UsageError(e.what());  // a command-line value the campaign refuses: exit 2
+  }
+  const std::vector<campaign::UnitAnalysis> units = campaign::analyze_units(c, indices, pipeline_options(o.threads));
+  const fs::path written = campaign::write_part(c, units, o.out);
+  const double elapsed = seconds_since(t0);
+  std::vector<int> ids;
+  for (const auto& u : units) ids.push_back(u.id);
+  if (o.json) {
+    print_json({{"part", written.string()}, {"units", ids}, {"campaign", c.file.string()}, {"campaign_hash", campaign::campaign_hash(c.file)},
+                {"pipeline_seconds", elapsed}});
+  } else {
+    fmt::print("{}: {} of {} units ({}) analysed in {:.1f} s\n", what, units.size(), c.units.size(), fmt::join(ids, ", "), elapsed);
+    fmt::print("part: {}\n", written.string());
+  }
+  return 0;
+}
+
+// `merge PART... --out DIR`: the batch over the parts' units; the outputs of a single `run`.
+int run_merge(const MergeOptions& o) {
+  const io::OutputLock lock(o.out);
+  const auto t0 = std::chrono::steady_clock::now();
+  campaign::remove_outputs(o.out);
+  std::vector<campaign::CampaignPart> parts;
+  for (const auto& p : o.parts) parts.push_back(campaign::read_part(p));
+  log_line(fmt::format("{} parts of {}", parts.size(), parts.front().campaign));
+  campaign::Campaign c = campaign::read_campaign(parts.front().campaign_path);
+  std::vector<campaign::UnitAnalysis> units = campaign::merge_parts(c, parts);
+  c.file = parts.front().campaign;  // as given to `run`: results.json names it the same way
+  return write_and_print(campaign::finish_campaign(c, std::move(units), pipeline_options(0)), o.out, o.strict, o.json, t0);
+}
+
 int run_run(const RunOptions& o) {
   if (o.threads < 0) throw InputError("", "--threads", "0 (all cores) or more", std::to_string(o.threads));
+  if (o.list_units) return list_units(o);
   const io::OutputLock lock(o.out);  // a second run on the same --out is refused (exit 3)
+  if (!o.part.empty() || !o.units.empty()) return run_part(o);
   return run_pipeline(o.campaign, o.out, o.strict, o.json, o.threads);
 }
 
@@ -129,7 +235,30 @@ void add_run_commands(CLI::App& app, Action& action) {
   run->add_flag("--strict", r->strict, "Exit with code 5 when a unit is rejected");
   run->add_flag("--json", r->json, "Print the results as one JSON document on stdout");
   run->add_option("--threads", r->threads, "Units analysed in parallel (0 = all cores)")->capture_default_str();
+  auto* list = run->add_flag("--list-units", r->list_units, "Print the campaign's unit ids and names, one per line (file order), and stop");
+  auto* part = run->add_option("--part", r->part, "Analyse only part K of N of the units (K, K+N, K+2N, ...) into OUT/part.json, for `merge`")
+                   ->check(CLI::Validator(
+                       [](const std::string& v) {
+                         static const std::regex re("^[1-9][0-9]{0,5}/[1-9][0-9]{0,5}$");
+                         if (!std::regex_match(v, re)) return std::string("expected K/N (e.g. 2/8), found '") + v + "'";
+                         const auto slash = v.find('/');
+                         if (std::stoi(v.substr(0, slash)) > std::stoi(v.substr(slash + 1))) return "K above N in '" + v + "'";
+                         return std::string();
+                       },
+                       "K/N", ""));
+  auto* units = run->add_option("--units", r->units, "Analyse only these unit ids (e.g. 3,7-9) into OUT/part.json, for `merge`");
+  part->excludes(units);
+  list->excludes(part);
+  list->excludes(units);
   run->callback([r, &action] { action = [r] { return run_run(*r); }; });
+
+  auto m = std::make_shared<MergeOptions>();
+  CLI::App* merge = app.add_subcommand("merge", "Merge the parts of a split campaign (run --part/--units): the outputs of a single run");
+  merge->add_option("parts", m->parts, "Part folders (each with the part.json of `run --part K/N` or `run --units LIST`)")->required();
+  merge->add_option("--out", m->out, "Output folder (results.json, results.mat, report.html)")->capture_default_str();
+  merge->add_flag("--strict", m->strict, "Exit with code 5 when a unit is rejected");
+  merge->add_flag("--json", m->json, "Print the results as one JSON document on stdout");
+  merge->callback([m, &action] { action = [m] { return run_merge(*m); }; });
 
   auto d = std::make_shared<DemoCli>();
   CLI::App* demo = app.add_subcommand("demo", "Simulate the report's 7-unit campaign on the virtual bench, then run it");

@@ -49,6 +49,52 @@ TEST(RunCli, DemoWritesDataCampaignAndReport) {
   EXPECT_TRUE(contains(strict.err, "report written to")) << strict.err;
 }
 
+// The demo campaign split in two parts and merged gives the demo run's results.json, results.mat
+// and report.html byte for byte (docs/cluster.md); bad parts are refused with exit 3 naming them.
+TEST(RunCli, PartsMergedEqualTheSingleRun) {
+  const fs::path& d = demo_dir();
+  const std::string campaign = (d / "campaign.toml").string();
+  const CliRun list = run_cli("run " + campaign + " --list-units");
+  EXPECT_EQ(list.exit_code, 0) << list.err;
+  EXPECT_EQ(list.out, "1\tAPA 1\n3\tAPA 3\n");
+  TempDir out;
+  const std::string p1 = (out.path() / "p1").string(), p2 = (out.path() / "p2").string(), m = (out.path() / "m").string();
+  const CliRun a = run_cli("run " + campaign + " --part 1/2 --threads 1 --out " + p1);
+  EXPECT_EQ(a.exit_code, 0) << a.err;
+  EXPECT_TRUE(contains(a.out, "part 1/2: 1 of 2 units (1)")) << a.out;
+  const CliRun b = run_cli("run " + campaign + " --units 3 --json --out " + p2);
+  EXPECT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(json::parse(b.out)["units"], json::array({3}));
+  const CliRun merged = run_cli("merge " + p2 + " " + p1 + " --out " + m);
+  ASSERT_EQ(merged.exit_code, 0) << merged.err;
+  for (const std::string f : {"results.json", "results.mat", "report.html"}) {
+    const std::size_t from = f == "results.mat" ? 116 : 0;  // the MAT-file's text header holds its creation time
+    EXPECT_TRUE(read_text(d / f).substr(from) == read_text(fs::path(m) / f).substr(from)) << f;
+  }
+  EXPECT_FALSE(fs::exists(fs::path(p1) / "results.json"));  // a part writes part.json only
+  // Missing, duplicated and foreign parts: exit 3 naming them.
+  const CliRun missing = run_cli("merge " + p1 + " --out " + m);
+  EXPECT_EQ(missing.exit_code, 3);
+  EXPECT_TRUE(contains(missing.err, "unit 3 in none of them")) << missing.err;
+  EXPECT_FALSE(fs::exists(fs::path(m) / "results.json"));  // the earlier set is gone, none written
+  const CliRun twice = run_cli("merge " + p1 + " " + p2 + " " + p1 + " --out " + m);
+  EXPECT_EQ(twice.exit_code, 3);
+  EXPECT_TRUE(contains(twice.err, "also in")) << twice.err;
+  std::string text = read_text(fs::path(p2) / "part.json");
+  const auto at = text.find("fnv1a64:");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at + 8, 16, "0123456789abcdef");
+  write_text(fs::path(p2) / "part.json", text);
+  const CliRun foreign = run_cli("merge " + p1 + " " + p2 + " --out " + m);
+  EXPECT_EQ(foreign.exit_code, 3);
+  EXPECT_TRUE(contains(foreign.err, "p2/part.json") && contains(foreign.err, "another campaign")) << foreign.err;
+  // Bad command lines: exit 2.
+  EXPECT_EQ(run_cli("run " + campaign + " --part 3/2 --out " + p1).exit_code, 2);
+  EXPECT_EQ(run_cli("run " + campaign + " --units 2 --out " + p1).exit_code, 2);
+  EXPECT_EQ(run_cli("run " + campaign + " --units 1-x --out " + p1).exit_code, 2);
+  EXPECT_EQ(run_cli("run " + campaign + " --units 1 --part 1/2 --out " + p1).exit_code, 2);
+}
+
 // A campaign assembled by hand from the demo's records converted to CSV with other channel names,
 // next to a .mat file, gives the same results.
 TEST(RunCli, RunOnACampaignOfCsvAndMatFiles) {
