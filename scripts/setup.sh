@@ -50,6 +50,8 @@ packages=(
   # The fuzz job (docs/fuzzing.md): clang with libFuzzer and the sanitizer runtimes, and the
   # symbolizer of their stack traces.
   clang-14 libclang-rt-14-dev llvm-14
+  # A one-node Slurm for the test of a campaign split over a cluster (tests/slurm, docs/cluster.md).
+  slurm-wlm munge
   # The report's plotting library comes from npm (src/report/js); its test runs headless Chromium.
   nodejs chromium
 )

@@ -65,6 +65,8 @@ for prog in munged slurmctld slurmd sinfo sbatch; do
   command -v "$prog" >/dev/null 2>&1 || cannot "'$prog' is not installed (Debian packages slurm-wlm and munge)"
 done
 
+[ "$(id -u)" -eq 0 ] || cannot "slurmd runs as root (it starts the jobs as their users); run as root, e.g. in CI"
+
 mkdir -p "$dir"/{munge,spool,state,log}
 dir="$(cd "$dir" && pwd)"
 chmod 700 "$dir/munge"

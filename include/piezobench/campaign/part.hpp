@@ -9,7 +9,8 @@
 // decimal; non-finite as "nan", "inf", "-inf"), so that the batch analyses, results.json,
 // results.mat and report.html of `merge` are those of a single `run`. One exception: the state
 // space `model` of a damped plant's vector fit is not carried (poles and residues are, which is
-// what evaluate() uses).
+// what evaluate() uses). A field added to results.hpp's structs goes into part.cpp's field lists
+// too: Part.* and RunCli.PartsMerged* fail when merge no longer reproduces run.
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
