@@ -228,6 +228,22 @@ template <class V> void fields(V& v, metrology::HysteresisResult& s) {
   v("relative_width", s.relative_width); v("periods", s.periods); v("first_sample", s.first_sample); v("samples", s.samples);
 }
 template <class V> void fields(V& v, HysteresisLoop& s) { v("result", s.result); v("provenance", s.provenance); v("loop", s.loop); }
+template <class V> void fields(V& v, ident::PrandtlIshlinskii& s) {
+  v("linear_weight", s.linear_weight); v("thresholds", s.thresholds); v("weights", s.weights);
+}
+template <class V> void fields(V& v, ident::HysteresisModel& s) {
+  v("hysteresis", s.hysteresis); v("creep_time_constants", s.creep_time_constants); v("creep_coefficients", s.creep_coefficients);
+  v("gain", s.gain); v("offset", s.offset); v("reference_slope", s.reference_slope); v("reference_intercept", s.reference_intercept);
+  v("input_min", s.input_min); v("input_max", s.input_max);
+}
+template <class V> void fields(V& v, ident::HysteresisFit& s) {
+  v("model", s.model); v("rms_residual", s.rms_residual); v("relative_residual", s.relative_residual); v("stroke", s.stroke);
+  v("samples", s.samples); v("quality", s.quality);
+}
+template <class V> void fields(V& v, HysteresisModelFit& s) {
+  v("fit", s.fit); v("amplitude", s.amplitude); v("width", s.width); v("model_width", s.model_width); v("provenance", s.provenance);
+  v("loop", s.loop); v("model_loop", s.model_loop);
+}
 template <class V> void fields(V& v, metrology::StaticStiffnessResult& s) {
   v("t_on", s.t_on); v("t_off", s.t_off); v("d_before", s.d_before); v("d_loaded", s.d_loaded); v("d_after", s.d_after);
   v("k1", s.k1); v("k2", s.k2); v("deflection_on", s.deflection_on); v("deflection_off", s.deflection_off);
@@ -323,7 +339,8 @@ template <class V> void fields(V& v, FlexibleModes& s) {
 }
 template <class V> void fields(V& v, UnitAnalysis& s) {
   v("id", s.id); v("name", s.name); v("flatness_analysis", s.flatness_analysis); v("capacitance_analysis", s.capacitance_analysis);
-  v("stroke_analysis", s.stroke_analysis); v("hysteresis", s.hysteresis); v("stiffness_analysis", s.stiffness_analysis);
+  v("stroke_analysis", s.stroke_analysis); v("hysteresis", s.hysteresis); v("hysteresis_model", s.hysteresis_model);
+  v("stiffness_analysis", s.stiffness_analysis);
   v("stiffness_open_analysis", s.stiffness_open_analysis); v("frf_analysis", s.frf_analysis); v("resistor", s.resistor);
   v("model_2dof", s.model_2dof); v("damped", s.damped); v("flexible_modes", s.flexible_modes); v("flatness", s.flatness);
   v("capacitance_sensor", s.capacitance_sensor); v("capacitance_actuator", s.capacitance_actuator); v("stroke", s.stroke);
