@@ -21,6 +21,7 @@
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/lti/analysis.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -224,7 +225,7 @@ std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const 
     fo.fit.weighting = ident::Weighting::kUnit;
     if (fo.fit.asymptote == ident::Asymptote::kConstantAndLinear) fo.fit.asymptote = ident::Asymptote::kConstant;
     fo.fit.fail_if_not_converged = false;
-    anti = ident::frf_features(2 * std::numbers::pi * band.freq_hz, band.H[static_cast<std::size_t>(i)], fo).antiresonances;
+    anti = ident::frf_features(kTwoPi * band.freq_hz, band.H[static_cast<std::size_t>(i)], fo).antiresonances;
   } catch (const Error&) {
     // no phase evidence: the fitted zero decides
   }
@@ -256,7 +257,7 @@ nlohmann::json fit_json(const ident::VectorFittingResult& r, const dsp::Frf& ban
     nlohmann::json z = nlohmann::json::array();
     for (const auto& rep : zeros[i]) {
       z.push_back({{"zero", io::to_json(rep.zero)},
-                   {"frequency_Hz", std::abs(rep.zero) / (2 * std::numbers::pi)},
+                   {"frequency_Hz", std::abs(rep.zero) / kTwoPi},
                    {"lightly_damped", rep.lightly_damped},
                    {"nonminimum_phase", rep.nonminimum_phase ? nlohmann::json(*rep.nonminimum_phase) : nlohmann::json(nullptr)},
                    {"evidence", rep.evidence}});
@@ -306,7 +307,7 @@ int run_fit(const FitOptions& o) {
   fmt::print("{:>26}  {:>10}  {:>9}\n", "pole [rad/s]", "f [Hz]", "damping");
   for (const auto p : r.poles) {
     if (p.imag() < 0.0) continue;
-    fmt::print("{:>12.6g} {:+12.6g}j  {:>10.5g}  {:>9.5f}\n", p.real(), p.imag(), std::abs(p) / (2 * std::numbers::pi),
+    fmt::print("{:>12.6g} {:+12.6g}j  {:>10.5g}  {:>9.5f}\n", p.real(), p.imag(), std::abs(p) / kTwoPi,
                std::abs(p) > 0 ? -p.real() / std::abs(p) : 0.0);
   }
   for (std::size_t i = 0; i < band.outputs.size(); ++i) {
@@ -314,7 +315,7 @@ int run_fit(const FitOptions& o) {
                r.relative_rms_error_per_output(static_cast<Eigen::Index>(i)), zeros[i].empty() ? " none" : "");
     for (const auto& rep : zeros[i]) {
       const lti::Complex z = rep.zero;
-      fmt::print("  {:>12.6g} {:+12.6g}j  {:>10.5g} Hz  damping {:+.5f}", z.real(), z.imag(), std::abs(z) / (2 * std::numbers::pi),
+      fmt::print("  {:>12.6g} {:+12.6g}j  {:>10.5g} Hz  damping {:+.5f}", z.real(), z.imag(), std::abs(z) / kTwoPi,
                  std::abs(z) > 0 ? -z.real() / std::abs(z) : 0.0);
       if (rep.nonminimum_phase) {
         fmt::print("  lightly damped, {} (from the {})", *rep.nonminimum_phase ? "NON-minimum phase" : "minimum phase", rep.evidence);
@@ -356,8 +357,8 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
   fo.min_coherence = o.min_coherence;
   if (!o.json) log_line(fmt::format("fitting the IFF plant (eq. 2.3 with delay) to u -> {} of {}, {:.4g} to {:.4g} Hz", o.output, o.file, fo.fmin_hz, fo.fmax_hz));
   const lti::Vector coh = i < frf.coherence.size() ? frf.coherence[i] : lti::Vector();
-  const ident::IffPlantFit p = ident::fit_iff_plant(2 * std::numbers::pi * frf.freq_hz, frf.H[i], coh, fo, o.file);
-  const double hz = 1.0 / (2 * std::numbers::pi);
+  const ident::IffPlantFit p = ident::fit_iff_plant(kTwoPi * frf.freq_hz, frf.H[i], coh, fo, o.file);
+  const double hz = 1.0 / kTwoPi;
   nlohmann::json doc = {{"source", o.file},
                         {"output", o.output},
                         {"band_Hz", {fo.fmin_hz, fo.fmax_hz}},

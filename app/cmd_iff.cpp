@@ -14,6 +14,7 @@
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/rt/damped_plant_study.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -42,11 +43,11 @@ LoadedSystem load_plant(const RlocusOptions& o) {
     out.system = lti::to_state_space(control::iff_plant(p));
     out.description = {{"source", "report eq. 2.3"},
                        {"g0", p.g0},
-                       {"wz_Hz", p.wz / (2 * std::numbers::pi)},
+                       {"wz_Hz", p.wz / kTwoPi},
                        {"xz", p.xz},
-                       {"wp_Hz", p.wp / (2 * std::numbers::pi)},
+                       {"wp_Hz", p.wp / kTwoPi},
                        {"xp", p.xp},
-                       {"w_hpf_Hz", p.w_hpf / (2 * std::numbers::pi)}};
+                       {"w_hpf_Hz", p.w_hpf / kTwoPi}};
   } else {
     io::LtiFile f = io::read_lti_toml(o.plant_file);
     out.system = std::move(f.system);
@@ -73,7 +74,7 @@ LoadedSystem load_controller(const RlocusOptions& o) {
   return out;
 }
 
-double hz(lti::Complex pole) { return lti::pole_info(pole).natural_frequency / (2 * std::numbers::pi); }
+double hz(lti::Complex pole) { return lti::pole_info(pole).natural_frequency / kTwoPi; }
 
 int run_rlocus(const RlocusOptions& o) {
   if (!(std::isfinite(o.delay) && o.delay >= 0.0)) {
@@ -93,7 +94,7 @@ int run_rlocus(const RlocusOptions& o) {
                      "a loop (plant and controller) of at most " + std::to_string(o.max_order) + " states (--max-order)",
                      std::to_string(order) + " states");
   }
-  if (o.resonance_hz > 0.0) options.resonance = 2 * std::numbers::pi * o.resonance_hz;
+  if (o.resonance_hz > 0.0) options.resonance = kTwoPi * o.resonance_hz;
   if (!o.json) log_line("computing the root locus" + std::string(gains.empty() ? " on an automatic gain grid" : ""));
   const control::IffRootLocus r = control::iff_root_locus(plant.system, controller.system, gains, options);
 

@@ -20,11 +20,11 @@
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/lti/freqresp.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::app {
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr const char* kCommandLine = "command line";
 
 nlohmann::json params_json(const apa::TwoDofParams& p) {

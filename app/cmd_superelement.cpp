@@ -20,6 +20,7 @@
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/lti/freqresp.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -86,7 +87,7 @@ int run_superelement(const SuperElementCli& o) {
   std::vector<Eigen::MatrixXcd> H;
   if (model.F.cols() > 0 && model.T.rows() > 0) {
     if (!o.json) log_line(fmt::format("frequency response at {} points on {} DOF", o.points, model.size()));
-    H = fem::frequency_response(model, modes, 2 * std::numbers::pi * hz);  // modal superposition
+    H = fem::frequency_response(model, modes, kTwoPi * hz);  // modal superposition
   }
 
   if (o.json) {

@@ -9,9 +9,11 @@
 #include <numbers>
 
 #include "piezobench/ident/vector_fitting.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace {
 
+using piezobench::kTwoPi;
 using piezobench::ident::Complex;
 using piezobench::ident::CMatrix;
 using piezobench::ident::CVector;
@@ -24,7 +26,6 @@ struct Problem {
 
 // 10 lightly damped pairs (1 % to 2.8 %) log-spaced from 10 Hz to 1 kHz, data from 3.2 Hz to 3.2 kHz.
 Problem make_problem() {
-  constexpr double kTwoPi = 2.0 * std::numbers::pi;
   constexpr int kPoles = 20, kPoints = 2000;
   CVector poles(kPoles), residues(kPoles);
   for (int i = 0; i < kPoles / 2; ++i) {

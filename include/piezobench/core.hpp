@@ -4,6 +4,7 @@
 // linear least squares.
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/fit_quality.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/core/minimize.hpp"
 #include "piezobench/core/nnls.hpp"

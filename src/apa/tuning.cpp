@@ -12,6 +12,8 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/least_squares.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::apa {
 
@@ -35,26 +37,25 @@ TuningStatus tuning_status_from_string(const std::string& s) {
 
 void TuningOptions::validate() const {
   const std::string src = "tuning options";
-  auto num = [](double v) { return fmt::format("{:.6g}", v); };
-  if (!(std::isfinite(mass) && mass > 0.0)) throw InputError(src, "mass", "a mass > 0 kg", num(mass));
+  if (!(std::isfinite(mass) && mass > 0.0)) throw InputError(src, "mass", "a mass > 0 kg", format_number(mass));
   bench.validate(src);
   if (bench.suspended_mass != 0.0 || bench.added_mass != 0.0) {
     throw InputError(src, "bench.suspended_mass", "0 (the tuned mass is `mass`)",
-                     num(bench.suspended_mass) + " / added " + num(bench.added_mass));
+                     format_number(bench.suspended_mass) + " / added " + format_number(bench.added_mass));
   }
-  if (!(std::isfinite(fmin_hz) && fmin_hz >= 0.0)) throw InputError(src, "fmin_hz", "a frequency >= 0 Hz", num(fmin_hz));
-  if (!(std::isfinite(fmax_hz) && fmax_hz >= 0.0)) throw InputError(src, "fmax_hz", "a frequency >= 0 Hz", num(fmax_hz));
+  if (!(std::isfinite(fmin_hz) && fmin_hz >= 0.0)) throw InputError(src, "fmin_hz", "a frequency >= 0 Hz", format_number(fmin_hz));
+  if (!(std::isfinite(fmax_hz) && fmax_hz >= 0.0)) throw InputError(src, "fmax_hz", "a frequency >= 0 Hz", format_number(fmax_hz));
   if (fmax_hz > 0.0 && fmax_hz <= fmin_hz) {
-    throw InputError(src, "fmax_hz", fmt::format("a frequency above fmin_hz = {} Hz (or 0)", num(fmin_hz)), num(fmax_hz));
+    throw InputError(src, "fmax_hz", fmt::format("a frequency above fmin_hz = {} Hz (or 0)", format_number(fmin_hz)), format_number(fmax_hz));
   }
   if (!(min_coherence >= 0.0 && min_coherence < 1.0)) {
-    throw InputError(src, "min_coherence", "a value in [0, 1)", num(min_coherence));
+    throw InputError(src, "min_coherence", "a value in [0, 1)", format_number(min_coherence));
   }
   if (!(std::isfinite(stack_stiffness_ratio) && stack_stiffness_ratio >= 0.0)) {
-    throw InputError(src, "stack_stiffness_ratio", "a ratio ke/ka > 0 (or 0 = free)", num(stack_stiffness_ratio));
+    throw InputError(src, "stack_stiffness_ratio", "a ratio ke/ka > 0 (or 0 = free)", format_number(stack_stiffness_ratio));
   }
   if (!(std::isfinite(stack_damping_ratio) && stack_damping_ratio >= 0.0)) {
-    throw InputError(src, "stack_damping_ratio", "a ratio ce/ca > 0 (or 0 = free)", num(stack_damping_ratio));
+    throw InputError(src, "stack_damping_ratio", "a ratio ce/ca > 0 (or 0 = free)", format_number(stack_damping_ratio));
   }
   if (max_iterations < 1) throw InputError(src, "max_iterations", "at least 1", std::to_string(max_iterations));
   if (de_output.empty()) throw InputError(src, "de_output", "an output name", "an empty name");
@@ -110,7 +111,7 @@ core::FitQuality assess(const TwoDofTuning& t, const FitData& d) {
     for (const auto& [w, name] : {std::pair{wp, "resonance"}, std::pair{wz, "anti-resonance"}}) {
       if (!(w >= lo && w <= hi)) {
         q.add_problem(fmt::format("the model's {} {:.4g} Hz is outside the band used, {:.4g} to {:.4g} Hz", name,
-                                  w / (2 * std::numbers::pi), lo / (2 * std::numbers::pi), hi / (2 * std::numbers::pi)));
+                                  w / kTwoPi, lo / kTwoPi, hi / kTwoPi));
       }
     }
   }
@@ -149,7 +150,7 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
   const double wc = o.bench.hpf_corner();
   for (Index i = 0; i < n; ++i) {
     const Index k = used[static_cast<std::size_t>(i)];
-    const double w = 2.0 * std::numbers::pi * frf.freq_hz(k);
+    const double w = kTwoPi * frf.freq_hz(k);
     const Complex s(0.0, w);
     Complex chain = o.bench.amplifier_gain * std::exp(-s * o.bench.delay);
     d.omega(i) = w;
@@ -299,7 +300,7 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
   if (!(ktot > p.k1)) {
     throw NumericalError("2-DoF tuning",
                          fmt::format("the resonance ({:.4g} Hz) is not above the anti-resonance ({:.4g} Hz) of u -> Vs",
-                                     wp / (2 * std::numbers::pi), wz / (2 * std::numbers::pi)),
+                                     wp / kTwoPi, wz / kTwoPi),
                          /*retry_may_help=*/true);
   }
   const double series = rk / (1.0 + rk);  // ke ka/(ke + ka) = series ka when ke = rk ka
@@ -375,7 +376,6 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
 
 TwoDofTuning tune_two_dof_measured(const dsp::Frf& frf, TuningOptions options, const ident::DelayedSecondOrderFit* de_plant,
                                    const ident::IffPlantFit* vs_plant) {
-  constexpr double kTwoPi = 2.0 * std::numbers::pi;
   dsp::Frf data = frf;
   if (vs_plant) {
     // Only the corner 1 / (R C) matters: keep the R (else the C) given, else the report's 80.6 kOhm.

@@ -6,16 +6,15 @@
 #include <tuple>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/interconnect.hpp"
 
 namespace piezobench::apa {
 namespace {
 
-std::string num(double v) { return fmt::format("{:.6g}", v); }
-
 void require(bool ok, const std::string& source, const std::string& field, const std::string& expected, double found) {
-  if (!ok) throw InputError(source, field, expected, num(found));
+  if (!ok) throw InputError(source, field, expected, format_number(found));
 }
 
 double TwoDofParams::* member(const std::string& name) {

@@ -10,6 +10,7 @@
 #include "bench/random.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::bench {
 
@@ -65,7 +66,7 @@ UnitTruth batch_unit(int id, std::uint64_t seed) {
   // Flatness: a random tilt of interface 2 and a warp whose peak-to-valley from the least-squares
   // plane is the unit's Table 1.1 value (with a 3 % spread).
   const double target = kFlatnessUm[k] * 1e-6 * (1.0 + 0.03 * xi());
-  u.flatness_tilt_direction = 2.0 * std::numbers::pi * rng.uniform();
+  u.flatness_tilt_direction = kTwoPi * rng.uniform();
   const double share = 0.3 + 0.6 * rng.uniform();
   const double sign = rng.uniform() < 0.5 ? -1.0 : 1.0;
   const Eigen::Matrix<double, 8, 3> layout = detail::probe_layout();

@@ -17,6 +17,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/lti/discretize.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::bench {
 
@@ -151,7 +152,7 @@ io::TimeSeries stroke(BenchRunner& runner, const UnitTruth& unit, const Experime
   const double probe_bw = 2.0;      // Hz
   const double probe_noise = 10e-9;  // m rms
   const auto decimation = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::llround(fs / 1000.0)));
-  const double a = -std::expm1(-2.0 * std::numbers::pi * probe_bw / fs);
+  const double a = -std::expm1(-kTwoPi * probe_bw / fs);
   detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kStroke, 1)));
   const Eigen::Index rows = (n + decimation - 1) / decimation;
   io::TimeSeries ts = make_record({"u", "Va", "de"}, {"V", "V", "m"}, rows, fs / static_cast<double>(decimation), true);
@@ -476,7 +477,7 @@ io::TimeSeries hammer(const UnitTruth& unit, const ExperimentOptions& o, std::ui
   const double freq[2] = {unit.mode_y_Hz, unit.mode_x_Hz};
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
   for (int j = 0; j < 2; ++j) {
-    const double w = 2.0 * std::numbers::pi * freq[j];
+    const double w = kTwoPi * freq[j];
     lti::Matrix a(2, 2), bm(2, 1), c(1, 2), d = lti::Matrix::Zero(1, 1);
     a << 0.0, 1.0, -w * w, -2.0 * unit.mode_damping * w;
     bm << 0.0, 1.0 / modal_mass[j];

@@ -11,6 +11,7 @@
 
 #include "piezobench/io/toml_table.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::bench::detail {
 namespace {
@@ -189,7 +190,7 @@ ContinuousPlant superelement_plant(const SuperElementMechanics& mech, double mov
                      fmt::format("{:g} Hz", s.max_mode_Hz));
   }
   const Eigen::MatrixXd phi = modes.shapes.leftCols(nk);
-  const Eigen::VectorXd w = 2.0 * std::numbers::pi * modes.frequencies_Hz.head(nk);
+  const Eigen::VectorXd w = kTwoPi * modes.frequencies_Hz.head(nk);
   // Static correction: what the truncated modes add at DC, T (K^-1 - Phi W^-2 Phi^T) F.
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(model.K);
   if (ldlt.info() != Eigen::Success) {

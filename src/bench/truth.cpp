@@ -11,6 +11,7 @@
 #include "bench/plant.hpp"
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/lti/analysis.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::bench {
 
@@ -40,7 +41,7 @@ lti::StateSpace channel(const lti::StateSpace& sys, lti::Index output) {
 nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
   const VirtualBench bench(unit, options, 0);
   const lti::StateSpace sys = bench.linear_model();
-  const double two_pi = 2.0 * std::numbers::pi;
+  const double two_pi = kTwoPi;
   nlohmann::json j;
   j["id"] = unit.id;
   j["defective"] = unit.defective;

@@ -14,6 +14,7 @@
 #include "bench/random.hpp"
 #include "bench/superelement_plant.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::bench {
 
@@ -352,13 +353,13 @@ VirtualBench::VirtualBench(const UnitTruth& unit, const BenchOptions& options, s
   s.enc_noise = options.noise ? options.encoder_noise : 0.0;
   s.vs_noise = options.noise ? options.vs_noise : 0.0;
 
-  s.electrics.amplifier_bandwidth = 2.0 * std::numbers::pi * options.amplifier_bandwidth_Hz;
+  s.electrics.amplifier_bandwidth = kTwoPi * options.amplifier_bandwidth_Hz;
   s.electrics.hpf_resistance = options.sensor_shunt_resistance();
   s.electrics.actuator_open_circuit = options.actuator_open_circuit;
   s.electrics.capacitance_sensor = unit.capacitance_sensor;
   s.electrics.capacitance_actuator = unit.capacitance_actuator;
   s.electrics.ground_resistance = options.nonminimum_phase_zero ? options.ground_resistance : 0.0;
-  s.electrics.adc_bandwidth = 2.0 * std::numbers::pi * options.adc_bandwidth_Hz;
+  s.electrics.adc_bandwidth = kTwoPi * options.adc_bandwidth_Hz;
 
   s.params = unit.model;
   s.params.m = options.suspended_mass;

@@ -12,6 +12,7 @@
 #include "piezobench/io/toml_table.hpp"
 #include "piezobench/io/units.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::campaign {
 
@@ -440,15 +441,15 @@ void read_analysis(const Reader& r, AnalysisSettings& a) {
       if (*g == 0.0) throw InputError(r.source(), cr.key("gain"), "a non-zero gain", "0");
       a.controller.gain = *g;
     }
-    double hz = a.controller.w_hpf / (2 * M_PI);
+    double hz = a.controller.w_hpf / (kTwoPi);
     cr.positive("hpf_Hz", hz);
-    a.controller.w_hpf = 2 * M_PI * hz;
-    hz = a.controller.w_lpf / (2 * M_PI);
+    a.controller.w_hpf = kTwoPi * hz;
+    hz = a.controller.w_lpf / (kTwoPi);
     cr.positive("lpf_Hz", hz);
-    a.controller.w_lpf = 2 * M_PI * hz;
-    hz = a.controller.w_robust / (2 * M_PI);
+    a.controller.w_lpf = kTwoPi * hz;
+    hz = a.controller.w_robust / (kTwoPi);
     cr.positive("robust_Hz", hz);
-    a.controller.w_robust = 2 * M_PI * hz;
+    a.controller.w_robust = kTwoPi * hz;
   }
   if (const auto n = r.integer("threads")) {
     if (*n < 0 || *n > 256) throw InputError(r.source(), r.key("threads"), "0 (all cores) .. 256", std::to_string(*n));

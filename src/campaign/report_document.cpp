@@ -565,7 +565,7 @@ json document(const Campaign& c, const std::vector<UnitPlots>& units, const json
         const auto info = [](const json& p) -> std::pair<json, json> {
           if (!p.is_array() || p.size() != 2 || !p[0].is_number()) return {nullptr, nullptr};
           const double re = p[0].get<double>(), im = p[1].get<double>(), w = std::hypot(re, im);
-          return {w / (2.0 * std::numbers::pi), -re / w};
+          return {w / kTwoPi, -re / w};
         };
         const auto [fi, zi] = info(iff["damped_poles"][i]);
         const auto [fm, zm] = has(iff, "model_poles") ? info(iff["model_poles"][i]) : std::pair<json, json>{nullptr, nullptr};

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::campaign {
 namespace {
@@ -23,7 +24,7 @@ double median(std::vector<double> v) {
 
 // The model's u -> [d_e, e_s] per newton of actuator force at `hz`.
 std::vector<Eigen::MatrixXcd> response(const fem::StructuralModel& model, const Eigen::VectorXd& hz) {
-  return fem::frequency_response(model, 2.0 * std::numbers::pi * hz);
+  return fem::frequency_response(model, kTwoPi * hz);
 }
 
 }  // namespace

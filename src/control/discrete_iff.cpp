@@ -6,29 +6,24 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/lti/interconnect.hpp"
 
 namespace piezobench::control {
 namespace {
 
-std::string str(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 }  // namespace
 
 void DiscreteIffOptions::validate() const {
   if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) {
-    throw InputError("", "sample_rate", "a finite positive rate in Hz", str(sample_rate));
+    throw InputError("", "sample_rate", "a finite positive rate in Hz", format_number(sample_rate));
   }
   const double nyquist = std::numbers::pi * sample_rate;
   if (!(std::isfinite(prewarp) && prewarp >= 0.0 && prewarp < nyquist)) {
-    throw InputError("", "prewarp", "0 or a frequency in (0, " + str(nyquist) + ") rad/s", str(prewarp));
+    throw InputError("", "prewarp", "0 or a frequency in (0, " + format_number(nyquist) + ") rad/s", format_number(prewarp));
   }
   if (!(std::isfinite(antiwindup_gain) && antiwindup_gain >= 0.0 && antiwindup_gain <= 1.0)) {
-    throw InputError("", "antiwindup_gain", "a number in [0, 1]", str(antiwindup_gain));
+    throw InputError("", "antiwindup_gain", "a number in [0, 1]", format_number(antiwindup_gain));
   }
 }
 
@@ -36,7 +31,7 @@ DiscreteIff::DiscreteIff(const IffControllerParams& params, const DiscreteIffOpt
     : params_(params), options_(options) {
   params.validate();
   options.validate();
-  if (!std::isfinite(gain)) throw InputError("", "gain", "a finite gain", str(gain));
+  if (!std::isfinite(gain)) throw InputError("", "gain", "a finite gain", format_number(gain));
   gain_ = gain;
   const double ts = 1.0 / options.sample_rate;
   const double w = options.prewarp;

@@ -9,6 +9,7 @@
 
 #include "dsp/fft.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::dsp {
 
@@ -19,18 +20,11 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 const std::string kSource = "excitation";
 
-std::string num(double x) {
-  std::ostringstream os;
-  os.precision(10);
-  os << x;
-  return os.str();
-}
-
 void require(bool ok, const std::string& field, const std::string& expected, const std::string& found) {
   if (!ok) throw InputError(kSource, field, expected, found);
 }
 
-void require_rate(double fs) { require(std::isfinite(fs) && fs > 0.0, "sample_rate", "a finite rate > 0 Hz", num(fs)); }
+void require_rate(double fs) { require(std::isfinite(fs) && fs > 0.0, "sample_rate", "a finite rate > 0 Hz", format_number(fs, 10)); }
 
 // Uniform in [0, 1) with 53 random bits (the top bits of one mt19937_64 draw).
 double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
@@ -60,8 +54,8 @@ void fit_to_bounds(const Eigen::VectorXd& c, const Eigen::VectorXd& v, const Vol
   bounds.validate();
   for (Index k = 0; k < c.size(); ++k) {
     if (c(k) < bounds.min || c(k) > bounds.max) {
-      throw InputError(kSource, level_field, "a level inside [" + num(bounds.min) + ", " + num(bounds.max) + "] V",
-                       num(c(k)) + " V");
+      throw InputError(kSource, level_field, "a level inside [" + format_number(bounds.min, 10) + ", " + format_number(bounds.max, 10) + "] V",
+                       format_number(c(k), 10) + " V");
     }
   }
   double s = 1.0;
@@ -71,8 +65,8 @@ void fit_to_bounds(const Eigen::VectorXd& c, const Eigen::VectorXd& v, const Vol
   }
   if (s < 1.0 && bounds.policy == BoundsPolicy::kReject) {
     throw InputError(kSource, "amplitude",
-                     "a signal inside [" + num(bounds.min) + ", " + num(bounds.max) + "] V",
-                     "one that needs scaling by " + num(s));
+                     "a signal inside [" + format_number(bounds.min, 10) + ", " + format_number(bounds.max, 10) + "] V",
+                     "one that needs scaling by " + format_number(s, 10));
   }
   if (bounds.policy == BoundsPolicy::kClip) s = 1.0;
   out.scale = s;
@@ -127,7 +121,7 @@ SweepType sweep_type_from_string(const std::string& name) {
 
 void VoltageBounds::validate() const {
   if (!(std::isfinite(min) && std::isfinite(max) && min < max)) {
-    throw InputError(kSource, "bounds", "finite min < max", "[" + num(min) + ", " + num(max) + "] V");
+    throw InputError(kSource, "bounds", "finite min < max", "[" + format_number(min, 10) + ", " + format_number(max, 10) + "] V");
   }
 }
 
@@ -137,16 +131,16 @@ void VoltageBounds::validate() const {
 void NoiseOptions::validate() const {
   require_rate(sample_rate);
   require(samples >= 2, "samples", ">= 2", std::to_string(samples));
-  require(std::isfinite(f_low) && f_low >= 0.0, "f_low", ">= 0 Hz", num(f_low));
+  require(std::isfinite(f_low) && f_low >= 0.0, "f_low", ">= 0 Hz", format_number(f_low, 10));
   require(std::isfinite(f_high) && f_high > f_low && f_high <= 0.5 * sample_rate, "f_high",
-          "in (f_low, sample_rate / 2] = (" + num(f_low) + ", " + num(0.5 * sample_rate) + "] Hz", num(f_high));
-  require(std::isfinite(rms) && rms > 0.0, "rms", "> 0 V", num(rms));
-  require(std::isfinite(offset), "offset", "a finite voltage", num(offset));
+          "in (f_low, sample_rate / 2] = (" + format_number(f_low, 10) + ", " + format_number(0.5 * sample_rate, 10) + "] Hz", format_number(f_high, 10));
+  require(std::isfinite(rms) && rms > 0.0, "rms", "> 0 V", format_number(rms, 10));
+  require(std::isfinite(offset), "offset", "a finite voltage", format_number(offset, 10));
   const double df = sample_rate / static_cast<double>(samples);
   const auto first = static_cast<Index>(std::max(1.0, std::ceil(f_low / df)));
   const auto last = static_cast<Index>(std::floor(f_high / df));
-  require(first <= last, "f_high", "a band containing at least one line of spacing " + num(df) + " Hz",
-          "[" + num(f_low) + ", " + num(f_high) + "] Hz");
+  require(first <= last, "f_high", "a band containing at least one line of spacing " + format_number(df, 10) + " Hz",
+          "[" + format_number(f_low, 10) + ", " + format_number(f_high, 10) + "] Hz");
 }
 
 Excitation band_limited_noise(const NoiseOptions& options, const VoltageBounds& bounds) {
@@ -189,8 +183,8 @@ void MultisineOptions::validate() const {
   require(!lines_hz.empty(), "lines_hz", "at least one line", "none");
   require(amplitudes.empty() || amplitudes.size() == lines_hz.size(), "amplitudes",
           "none or one per line (" + std::to_string(lines_hz.size()) + ")", std::to_string(amplitudes.size()));
-  require(std::isfinite(rms) && rms > 0.0, "rms", "> 0 V", num(rms));
-  require(std::isfinite(offset), "offset", "a finite voltage", num(offset));
+  require(std::isfinite(rms) && rms > 0.0, "rms", "> 0 V", format_number(rms, 10));
+  require(std::isfinite(offset), "offset", "a finite voltage", format_number(offset, 10));
   const double df = sample_rate / static_cast<double>(period_samples);
   std::vector<Index> bins;
   for (double f : lines_hz) {
@@ -198,8 +192,8 @@ void MultisineOptions::validate() const {
     const double kr = std::round(k);
     require(std::isfinite(f) && std::abs(k - kr) <= 1e-9 * std::max(1.0, kr) && kr >= 1.0 &&
                 2.0 * kr < static_cast<double>(period_samples),
-            "lines_hz", "multiples of sample_rate / period_samples = " + num(df) + " Hz below sample_rate / 2",
-            num(f) + " Hz");
+            "lines_hz", "multiples of sample_rate / period_samples = " + format_number(df, 10) + " Hz below sample_rate / 2",
+            format_number(f, 10) + " Hz");
     bins.push_back(static_cast<Index>(kr));
   }
   std::sort(bins.begin(), bins.end());
@@ -207,7 +201,7 @@ void MultisineOptions::validate() const {
           "a line given twice");
   double total = 0.0;
   for (double a : amplitudes) {
-    require(std::isfinite(a) && a >= 0.0, "amplitudes", "finite values >= 0", num(a));
+    require(std::isfinite(a) && a >= 0.0, "amplitudes", "finite values >= 0", format_number(a, 10));
     total += a;
   }
   require(amplitudes.empty() || total > 0.0, "amplitudes", "at least one > 0", "all zero");
@@ -272,18 +266,18 @@ Excitation multisine(const MultisineOptions& options, const VoltageBounds& bound
 void SweepOptions::validate() const {
   require_rate(sample_rate);
   require(std::isfinite(duration) && duration > 0.0 && samples_for(duration, sample_rate) >= 2, "duration",
-          "> 0 s and at least 2 samples", num(duration) + " s");
+          "> 0 s and at least 2 samples", format_number(duration, 10) + " s");
   const double nyquist = 0.5 * sample_rate;
   const double lowest = type == SweepType::kLinear ? 0.0 : std::numeric_limits<double>::min();
   require(std::isfinite(f_start) && f_start >= lowest && f_start <= nyquist, "f_start",
-          std::string(type == SweepType::kLinear ? "in [0, " : "in (0, ") + num(nyquist) + "] Hz", num(f_start));
+          std::string(type == SweepType::kLinear ? "in [0, " : "in (0, ") + format_number(nyquist, 10) + "] Hz", format_number(f_start, 10));
   require(std::isfinite(f_end) && f_end >= lowest && f_end <= nyquist, "f_end",
-          std::string(type == SweepType::kLinear ? "in [0, " : "in (0, ") + num(nyquist) + "] Hz", num(f_end));
-  require(type == SweepType::kLinear || f_start != f_end, "f_end", "different from f_start for a log sweep", num(f_end));
-  require(std::isfinite(amplitude) && amplitude >= 0.0, "amplitude", ">= 0 V", num(amplitude));
-  require(std::isfinite(offset), "offset", "a finite voltage", num(offset));
+          std::string(type == SweepType::kLinear ? "in [0, " : "in (0, ") + format_number(nyquist, 10) + "] Hz", format_number(f_end, 10));
+  require(type == SweepType::kLinear || f_start != f_end, "f_end", "different from f_start for a log sweep", format_number(f_end, 10));
+  require(std::isfinite(amplitude) && amplitude >= 0.0, "amplitude", ">= 0 V", format_number(amplitude, 10));
+  require(std::isfinite(offset), "offset", "a finite voltage", format_number(offset, 10));
   require(std::isfinite(ramp_time) && ramp_time >= 0.0 && 2.0 * ramp_time <= duration, "ramp_time",
-          "in [0, duration / 2]", num(ramp_time) + " s");
+          "in [0, duration / 2]", format_number(ramp_time, 10) + " s");
 }
 
 double sweep_frequency(const SweepOptions& o, double t) {
@@ -322,13 +316,13 @@ Excitation sine_sweep(const SweepOptions& options, const VoltageBounds& bounds) 
 
 void OffsetSineOptions::validate() const {
   require_rate(sample_rate);
-  require(std::isfinite(rest), "rest", "a finite voltage", num(rest));
-  require(std::isfinite(offset), "offset", "a finite voltage", num(offset));
-  require(std::isfinite(amplitude) && amplitude >= 0.0, "amplitude", ">= 0 V", num(amplitude));
+  require(std::isfinite(rest), "rest", "a finite voltage", format_number(rest, 10));
+  require(std::isfinite(offset), "offset", "a finite voltage", format_number(offset, 10));
+  require(std::isfinite(amplitude) && amplitude >= 0.0, "amplitude", ">= 0 V", format_number(amplitude, 10));
   require(std::isfinite(frequency) && frequency > 0.0 && frequency < 0.5 * sample_rate, "frequency",
-          "in (0, " + num(0.5 * sample_rate) + ") Hz", num(frequency));
-  require(std::isfinite(cycles) && cycles > 0.0, "cycles", "> 0", num(cycles));
-  require(std::isfinite(ramp_time) && ramp_time >= 0.0, "ramp_time", ">= 0 s", num(ramp_time));
+          "in (0, " + format_number(0.5 * sample_rate, 10) + ") Hz", format_number(frequency, 10));
+  require(std::isfinite(cycles) && cycles > 0.0, "cycles", "> 0", format_number(cycles, 10));
+  require(std::isfinite(ramp_time) && ramp_time >= 0.0, "ramp_time", ">= 0 s", format_number(ramp_time, 10));
 }
 
 Excitation offset_sine(const OffsetSineOptions& options, const VoltageBounds& bounds) {
@@ -348,8 +342,8 @@ Excitation offset_sine(const OffsetSineOptions& options, const VoltageBounds& bo
   // The offset itself must be reachable: c passes through it when the ramp is done.
   bounds.validate();
   if (options.offset < bounds.min || options.offset > bounds.max) {
-    throw InputError(kSource, "offset", "a level inside [" + num(bounds.min) + ", " + num(bounds.max) + "] V",
-                     num(options.offset) + " V");
+    throw InputError(kSource, "offset", "a level inside [" + format_number(bounds.min, 10) + ", " + format_number(bounds.max, 10) + "] V",
+                     format_number(options.offset, 10) + " V");
   }
   Excitation out;
   out.sample_rate = options.sample_rate;
@@ -364,11 +358,11 @@ Excitation offset_sine(const OffsetSineOptions& options, const VoltageBounds& bo
 
 void StepOptions::validate() const {
   require_rate(sample_rate);
-  require(std::isfinite(rest), "rest", "a finite voltage", num(rest));
+  require(std::isfinite(rest), "rest", "a finite voltage", format_number(rest, 10));
   require(!levels.empty(), "levels", "at least one level", "none");
-  for (double l : levels) require(std::isfinite(l), "levels", "finite voltages", num(l));
-  require(std::isfinite(hold_time) && hold_time > 0.0, "hold_time", "> 0 s", num(hold_time));
-  require(std::isfinite(ramp_time) && ramp_time >= 0.0, "ramp_time", ">= 0 s", num(ramp_time));
+  for (double l : levels) require(std::isfinite(l), "levels", "finite voltages", format_number(l, 10));
+  require(std::isfinite(hold_time) && hold_time > 0.0, "hold_time", "> 0 s", format_number(hold_time, 10));
+  require(std::isfinite(ramp_time) && ramp_time >= 0.0, "ramp_time", ">= 0 s", format_number(ramp_time, 10));
 }
 
 Excitation steps(const StepOptions& options, const VoltageBounds& bounds) {

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 
@@ -18,7 +19,7 @@ void DominantPoleOptions::validate() const {
   }
 }
 
-double DominantPole::frequency_hz() const { return natural_frequency / (2.0 * std::numbers::pi); }
+double DominantPole::frequency_hz() const { return natural_frequency / kTwoPi; }
 
 DominantPole dominant_pole(const Vector& omega, const CVector& h, const DominantPoleOptions& options) {
   options.validate();
@@ -40,7 +41,7 @@ DominantPole dominant_pole(const Vector& omega, const CVector& h, const Dominant
   if (best < 0.0) {
     throw NumericalError("dominant pole",
                          fmt::format("the order-{} vector fit has no complex pole with a natural frequency in [{:.4g}, {:.4g}] Hz",
-                                     options.fit.order, lo / (2.0 * std::numbers::pi), hi / (2.0 * std::numbers::pi)),
+                                     options.fit.order, lo / kTwoPi, hi / kTwoPi),
                          true);
   }
   d.peak = best;

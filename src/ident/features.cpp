@@ -9,21 +9,15 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/core/minimize.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/lti/analysis.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr const char* kFeatureSource = "frf features";
-
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 // Checks one response: sizes, finite values, a usable frequency grid.
 void check_response(const char* source, const Vector& omega, const CVector& h) {
@@ -34,7 +28,7 @@ void check_response(const char* source, const Vector& omega, const CVector& h) {
   for (Index k = 0; k < omega.size(); ++k) {
     if (!std::isfinite(omega(k)) || omega(k) < 0.0 || (k > 0 && omega(k) <= omega(k - 1))) {
       throw InputError(source, "omega[" + std::to_string(k) + "]",
-                       "finite, non-negative, strictly increasing frequencies", num(omega(k)));
+                       "finite, non-negative, strictly increasing frequencies", format_number(omega(k)));
     }
     if (!std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
       throw InputError(source, "h[" + std::to_string(k) + "]", "finite value", "non-finite");
@@ -127,7 +121,7 @@ void FrfFeatureOptions::validate() const {
   }
   const auto check = [&](const char* field, double v, double lo, double hi) {
     if (!std::isfinite(v) || v <= lo || v >= hi) {
-      throw InputError(src, field, "value in (" + num(lo) + ", " + num(hi) + ")", num(v));
+      throw InputError(src, field, "value in (" + format_number(lo) + ", " + format_number(hi) + ")", format_number(v));
     }
   };
   check("max_damping", max_damping, 0.0, 1.0);
@@ -257,7 +251,7 @@ HighPassFit fit_high_pass(const Vector& omega, const CVector& h, double max_omeg
   const char* src = "high-pass fit";
   check_response(src, omega, h);
   if (!std::isfinite(max_omega) || max_omega < 0.0) {
-    throw InputError(src, "max_omega", "finite value >= 0 rad/s (0 = all data)", num(max_omega));
+    throw InputError(src, "max_omega", "finite value >= 0 rad/s (0 = all data)", format_number(max_omega));
   }
   std::vector<Index> used;
   for (Index k = 0; k < omega.size(); ++k) {

@@ -6,16 +6,11 @@
 #include <sstream>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 namespace {
-
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 void check_data(const char* source, const Vector& omega, const CMatrix& h) {
   if (omega.size() < 3) throw InputError(source, "omega", "at least 3 frequencies", std::to_string(omega.size()));
@@ -26,7 +21,7 @@ void check_data(const char* source, const Vector& omega, const CMatrix& h) {
   for (Index k = 0; k < omega.size(); ++k) {
     if (!std::isfinite(omega(k)) || omega(k) < 0.0 || (k > 0 && omega(k) <= omega(k - 1))) {
       throw InputError(source, "omega[" + std::to_string(k) + "]",
-                       "finite, non-negative, strictly increasing frequencies", num(omega(k)));
+                       "finite, non-negative, strictly increasing frequencies", format_number(omega(k)));
     }
   }
   if (!h.allFinite()) throw InputError(source, "h", "finite values", "non-finite");
@@ -41,8 +36,8 @@ std::pair<Index, Index> band(const char* source, const Vector& omega, double lo,
     while (last >= 0 && omega(last) > hi) --last;
   }
   if (last - first + 1 < needed) {
-    throw InputError(source, "band", "at least " + std::to_string(needed) + " frequencies between " + num(lo) +
-                                         " and " + (hi > 0.0 ? num(hi) : std::string("the end")) + " rad/s",
+    throw InputError(source, "band", "at least " + std::to_string(needed) + " frequencies between " + format_number(lo) +
+                                         " and " + (hi > 0.0 ? format_number(hi) : std::string("the end")) + " rad/s",
                      std::to_string(std::max<Index>(last - first + 1, 0)));
   }
   return {first, last};
@@ -58,42 +53,42 @@ Mode mode_from_pole(Complex pole) {
 
 }  // namespace
 
-double Mode::frequency_hz() const { return natural_frequency / (2.0 * std::numbers::pi); }
+double Mode::frequency_hz() const { return natural_frequency / kTwoPi; }
 
 void PeakPickingOptions::validate() const {
   const char* src = "peak picking options";
-  if (!std::isfinite(min_omega) || min_omega < 0.0) throw InputError(src, "min_omega", ">= 0 rad/s", num(min_omega));
+  if (!std::isfinite(min_omega) || min_omega < 0.0) throw InputError(src, "min_omega", ">= 0 rad/s", format_number(min_omega));
   if (!std::isfinite(max_omega) || max_omega < 0.0 || (max_omega > 0.0 && max_omega <= min_omega)) {
-    throw InputError(src, "max_omega", "0 (all) or above min_omega", num(max_omega));
+    throw InputError(src, "max_omega", "0 (all) or above min_omega", format_number(max_omega));
   }
   if (!std::isfinite(min_prominence) || min_prominence < 1.0) {
-    throw InputError(src, "min_prominence", ">= 1", num(min_prominence));
+    throw InputError(src, "min_prominence", ">= 1", format_number(min_prominence));
   }
   if (max_modes < 0) throw InputError(src, "max_modes", ">= 0", std::to_string(max_modes));
 }
 
 void LscfOptions::validate() const {
   const char* src = "lscf options";
-  if (!std::isfinite(min_omega) || min_omega < 0.0) throw InputError(src, "min_omega", ">= 0 rad/s", num(min_omega));
+  if (!std::isfinite(min_omega) || min_omega < 0.0) throw InputError(src, "min_omega", ">= 0 rad/s", format_number(min_omega));
   if (!std::isfinite(max_omega) || max_omega < 0.0 || (max_omega > 0.0 && max_omega <= min_omega)) {
-    throw InputError(src, "max_omega", "0 (all) or above min_omega", num(max_omega));
+    throw InputError(src, "max_omega", "0 (all) or above min_omega", format_number(max_omega));
   }
   if (min_order < 1) throw InputError(src, "min_order", ">= 1", std::to_string(min_order));
   if (max_order < min_order) {
     throw InputError(src, "max_order", ">= min_order (" + std::to_string(min_order) + ")", std::to_string(max_order));
   }
   if (!(frequency_tolerance > 0.0 && frequency_tolerance < 1.0)) {
-    throw InputError(src, "frequency_tolerance", "value in (0, 1)", num(frequency_tolerance));
+    throw InputError(src, "frequency_tolerance", "value in (0, 1)", format_number(frequency_tolerance));
   }
   if (!(damping_tolerance > 0.0 && damping_tolerance < 1.0)) {
-    throw InputError(src, "damping_tolerance", "value in (0, 1)", num(damping_tolerance));
+    throw InputError(src, "damping_tolerance", "value in (0, 1)", format_number(damping_tolerance));
   }
   if (min_stable_orders < 1 || min_stable_orders > max_order - min_order + 1) {
     throw InputError(src, "min_stable_orders",
                      "between 1 and the number of orders swept (" + std::to_string(max_order - min_order + 1) + ")",
                      std::to_string(min_stable_orders));
   }
-  if (!(max_damping > 0.0 && max_damping < 1.0)) throw InputError(src, "max_damping", "value in (0, 1)", num(max_damping));
+  if (!(max_damping > 0.0 && max_damping < 1.0)) throw InputError(src, "max_damping", "value in (0, 1)", format_number(max_damping));
 }
 
 std::vector<Mode> peak_picking(const Vector& omega, const CMatrix& h, const PeakPickingOptions& options) {

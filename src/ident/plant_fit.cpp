@@ -13,6 +13,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/ident/features.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 
@@ -79,8 +80,8 @@ IffPlantFit from_x(const Eigen::VectorXd& x, double sign, const Layout& l, doubl
 // A fitted frequency (rad/s) must lie inside the band of the points used.
 void check_in_band(core::FitQuality& q, const char* what, double w, const Vector& band) {
   if (w >= band(0) && w <= band(band.size() - 1)) return;
-  q.add_problem(fmt::format("{} {:.4g} Hz outside the band used, {:.4g} to {:.4g} Hz", what, w / (2 * std::numbers::pi),
-                            band(0) / (2 * std::numbers::pi), band(band.size() - 1) / (2 * std::numbers::pi)));
+  q.add_problem(fmt::format("{} {:.4g} Hz outside the band used, {:.4g} to {:.4g} Hz", what, w / kTwoPi,
+                            band(0) / kTwoPi, band(band.size() - 1) / kTwoPi));
 }
 
 void check_lm(core::FitQuality& q, core::LmStatus status) {
@@ -110,8 +111,8 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
     throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
   }
   std::vector<Index> use;
-  const double wmin = 2 * std::numbers::pi * options.fmin_hz;
-  const double wmax = options.fmax_hz > 0.0 ? 2 * std::numbers::pi * options.fmax_hz : std::numeric_limits<double>::infinity();
+  const double wmin = kTwoPi * options.fmin_hz;
+  const double wmax = options.fmax_hz > 0.0 ? kTwoPi * options.fmax_hz : std::numeric_limits<double>::infinity();
   for (Index k = 0; k < omega.size(); ++k) {
     if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
       throw InputError(source, "H", "finite values", fmt::format("a non-finite value at point {}", k));
@@ -128,7 +129,7 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
     d(static_cast<Index>(i)) = h(use[i]);
   }
   // Starting values.
-  const double w_hpf_band = 2 * std::numbers::pi * options.hpf_fmax_hz;
+  const double w_hpf_band = kTwoPi * options.hpf_fmax_hz;
   Index peak = -1;
   for (Index k = 0; k < w.size(); ++k) {
     if (w(k) > w_hpf_band && (peak < 0 || std::abs(d(k)) > std::abs(d(peak)))) peak = k;
@@ -217,8 +218,8 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
             unwrap = ph;
           } else {
             double step = ph - prev;
-            while (step > std::numbers::pi) step -= 2.0 * std::numbers::pi;
-            while (step < -std::numbers::pi) step += 2.0 * std::numbers::pi;
+            while (step > std::numbers::pi) step -= kTwoPi;
+            while (step < -std::numbers::pi) step += kTwoPi;
             unwrap += step;
           }
           prev = ph;
@@ -314,8 +315,8 @@ void select_band(const Vector& omega, const CVector& h, const Vector& coherence,
   if (coherence.size() != 0 && coherence.size() != h.size()) {
     throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
   }
-  const double wmin = 2 * std::numbers::pi * options.fmin_hz;
-  const double wmax = options.fmax_hz > 0.0 ? 2 * std::numbers::pi * options.fmax_hz : std::numeric_limits<double>::infinity();
+  const double wmin = kTwoPi * options.fmin_hz;
+  const double wmax = options.fmax_hz > 0.0 ? kTwoPi * options.fmax_hz : std::numeric_limits<double>::infinity();
   std::vector<Index> use;
   for (Index k = 0; k < omega.size(); ++k) {
     if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
@@ -359,7 +360,7 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
     if (std::abs(d(k)) > std::abs(d(peak))) peak = k;
   }
   if (peak == 0 || peak == w.size() - 1) {
-    throw InputError(source, "H", "a resonance peak inside the band", fmt::format("the largest |H| at the band's edge ({:.4g} Hz)", w(peak) / (2 * std::numbers::pi)));
+    throw InputError(source, "H", "a resonance peak inside the band", fmt::format("the largest |H| at the band's edge ({:.4g} Hz)", w(peak) / kTwoPi));
   }
   DelayedSecondOrderFit start;
   start.natural_frequency = w(peak);
@@ -392,8 +393,8 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
           unwrap = ph;
         } else {
           double step = ph - prev;
-          while (step > std::numbers::pi) step -= 2.0 * std::numbers::pi;
-          while (step < -std::numbers::pi) step += 2.0 * std::numbers::pi;
+          while (step > std::numbers::pi) step -= kTwoPi;
+          while (step < -std::numbers::pi) step += kTwoPi;
           unwrap += step;
         }
         prev = ph;

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 namespace {
@@ -18,13 +20,6 @@ namespace {
 constexpr const char* kSource = "vector fitting";
 constexpr const char* kOptionsSource = "vector fitting options";
 constexpr Complex kJ{0.0, 1.0};
-
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 // Real poles first (by magnitude), then pairs (p, conj p), Im p > 0 first, by imaginary part.
 // Eigenvalues of a real matrix (Eigen's real Schur form) come as exact conjugates or with an
@@ -213,11 +208,11 @@ void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights
   for (Index k = 0; k < ns; ++k) {
     if (!std::isfinite(omega(k)) || omega(k) < 0.0) {
       throw InputError(kSource, "omega[" + std::to_string(k) + "]", "finite frequency >= 0 rad/s",
-                       num(omega(k)));
+                       format_number(omega(k)));
     }
     if (k > 0 && omega(k) <= omega(k - 1)) {
       throw InputError(kSource, "omega[" + std::to_string(k) + "]", "strictly increasing frequencies",
-                       num(omega(k)) + " after " + num(omega(k - 1)));
+                       format_number(omega(k)) + " after " + format_number(omega(k - 1)));
     }
   }
   if (omega(ns - 1) <= 0.0) throw InputError(kSource, "omega", "at least one frequency > 0", "only 0");
@@ -243,7 +238,7 @@ void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights
     }
     for (Index i = 0; i < weights.size(); ++i) {
       const double w = weights.data()[i];
-      if (!std::isfinite(w) || w <= 0.0) throw InputError(kSource, "weights", "finite values > 0", num(w));
+      if (!std::isfinite(w) || w <= 0.0) throw InputError(kSource, "weights", "finite values > 0", format_number(w));
     }
   }
   // Each output's pole-relocation problem has 2N + terms + 1 unknowns (one removed by the
@@ -722,20 +717,20 @@ void VectorFittingOptions::validate() const {
     throw InputError(kOptionsSource, "max_iterations", ">= 0", std::to_string(max_iterations));
   }
   if (!std::isfinite(pole_tolerance) || pole_tolerance < 0.0) {
-    throw InputError(kOptionsSource, "pole_tolerance", "finite value >= 0", num(pole_tolerance));
+    throw InputError(kOptionsSource, "pole_tolerance", "finite value >= 0", format_number(pole_tolerance));
   }
   if (!std::isfinite(residual_tolerance) || residual_tolerance < 0.0) {
-    throw InputError(kOptionsSource, "residual_tolerance", "finite value >= 0 (0 = off)", num(residual_tolerance));
+    throw InputError(kOptionsSource, "residual_tolerance", "finite value >= 0 (0 = off)", format_number(residual_tolerance));
   }
   if (!std::isfinite(significance_floor) || significance_floor < 0.0 || significance_floor >= 1.0) {
-    throw InputError(kOptionsSource, "significance_floor", "value in [0, 1)", num(significance_floor));
+    throw InputError(kOptionsSource, "significance_floor", "value in [0, 1)", format_number(significance_floor));
   }
   if (!std::isfinite(starting_damping) || starting_damping <= 0.0 || starting_damping >= 1.0) {
-    throw InputError(kOptionsSource, "starting_damping", "value in (0, 1)", num(starting_damping));
+    throw InputError(kOptionsSource, "starting_damping", "value in (0, 1)", format_number(starting_damping));
   }
   if (!std::isfinite(frequency_scale) || frequency_scale < 0.0) {
     throw InputError(kOptionsSource, "frequency_scale", "finite value >= 0 rad/s (0 = automatic)",
-                     num(frequency_scale));
+                     format_number(frequency_scale));
   }
   if (starting_poles.size() > 0) {
     if (starting_poles.size() != order) {
@@ -883,8 +878,8 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
   if (!result.converged && options.max_iterations > 0 && options.fail_if_not_converged) {
     throw NumericalError(kSource,
                          "poles did not settle after " + std::to_string(result.iterations) +
-                             " relocations (last relative change " + num(result.last_pole_change) +
-                             ", tolerance " + num(options.pole_tolerance) +
+                             " relocations (last relative change " + format_number(result.last_pole_change) +
+                             ", tolerance " + format_number(options.pole_tolerance) +
                              "); try another order, more iterations, weights or a looser tolerance",
                          /*retry_may_help=*/true);
   }
@@ -956,11 +951,11 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
     const double w = std::abs(p);
     if (w > 2.0 * w_hi || w < 0.5 * w_lo) {
       std::ostringstream text;
-      text << "pole at " << w / (2.0 * std::numbers::pi) << " Hz outside the fitted band " << w_lo / (2.0 * std::numbers::pi)
-           << " to " << w_hi / (2.0 * std::numbers::pi) << " Hz";
+      text << "pole at " << w / kTwoPi << " Hz outside the fitted band " << w_lo / kTwoPi
+           << " to " << w_hi / kTwoPi << " Hz";
       result.quality.add_problem(text.str());
     }
-    if (p.real() > 0.0) result.quality.add_problem("unstable pole (Re > 0) at " + std::to_string(w / (2.0 * std::numbers::pi)) + " Hz");
+    if (p.real() > 0.0) result.quality.add_problem("unstable pole (Re > 0) at " + std::to_string(w / kTwoPi) + " Hz");
   }
   if (!result.converged) result.quality.add_problem("the poles did not settle (not converged)");
   result.quality.advise("a lower order, a band where the coherence is high (--fmin/--fmax), or --weighting output-scale");
@@ -972,7 +967,7 @@ VectorFittingResult vector_fit(const dsp::Frf& frf, const VectorFittingOptions& 
   const Index ns = frf.freq_hz.size();
   CMatrix data(ns, static_cast<Index>(frf.H.size()));
   for (size_t i = 0; i < frf.H.size(); ++i) data.col(static_cast<Index>(i)) = frf.H[i];
-  const Vector omega = 2.0 * std::numbers::pi * frf.freq_hz;
+  const Vector omega = kTwoPi * frf.freq_hz;
   VectorFittingResult r;
   try {
     r = vector_fit(omega, data, options);

@@ -6,16 +6,9 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::lti::detail {
-
-// A double with enough digits to tell neighbouring values apart in an error message.
-inline std::string str(double value) {
-  std::ostringstream os;
-  os.precision(10);
-  os << value;
-  return os.str();
-}
 
 inline std::string shape(Eigen::Index rows, Eigen::Index cols) {
   return std::to_string(rows) + "x" + std::to_string(cols);
@@ -54,12 +47,12 @@ void require_finite(const Eigen::DenseBase<Derived>& m, const std::string& sourc
 
 inline void require_sample_time(double ts, const std::string& source, const std::string& field = "sample_time") {
   if (!std::isfinite(ts) || ts < 0.0) {
-    throw InputError(source, field, "a finite value >= 0 s (0 = continuous)", str(ts));
+    throw InputError(source, field, "a finite value >= 0 s (0 = continuous)", format_number(ts, 10));
   }
 }
 
 inline void require_delay(double delay, const std::string& source, const std::string& field) {
-  if (!std::isfinite(delay) || delay < 0.0) throw InputError(source, field, "a finite delay >= 0 s", str(delay));
+  if (!std::isfinite(delay) || delay < 0.0) throw InputError(source, field, "a finite delay >= 0 s", format_number(delay, 10));
 }
 
 }  // namespace piezobench::lti::detail

@@ -8,6 +8,7 @@
 
 #include "lti/check.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::lti {
 namespace {
@@ -87,7 +88,7 @@ StateSpace diagonal(const std::vector<StateSpace>& blocks, double ts) {
 }  // namespace
 
 TransferFunction pade(double delay, int order) {
-  if (!std::isfinite(delay) || delay < 0.0) throw InputError("pade", "delay", "a finite delay >= 0 s", detail::str(delay));
+  if (!std::isfinite(delay) || delay < 0.0) throw InputError("pade", "delay", "a finite delay >= 0 s", format_number(delay, 10));
   check_order(order, "pade");
   if (order == 0 || delay == 0.0) return TransferFunction(Vector::Ones(1), Vector::Ones(1));
   const std::vector<double> q = pade_unit_denominator(order);
@@ -117,7 +118,7 @@ StateSpace pade(const StateSpace& sys, int order) {
     const double ratio = tau / ts;
     const double rounded = std::round(ratio);
     if (std::abs(ratio - rounded) > 1e-9 * std::max(1.0, rounded)) {
-      throw InputError("pade", field, "a whole multiple of the sample time " + detail::str(ts) + " s", detail::str(tau) + " s");
+      throw InputError("pade", field, "a whole multiple of the sample time " + format_number(ts, 10) + " s", format_number(tau, 10) + " s");
     }
     return unit_delays(static_cast<Index>(rounded), ts);
   };

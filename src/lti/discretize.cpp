@@ -10,6 +10,7 @@
 
 #include "lti/check.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/lti/conversions.hpp"
 
 namespace piezobench::lti {
@@ -77,7 +78,7 @@ Eigen::PartialPivLU<Matrix> tustin_lu(const Matrix& a, double alpha) {
   Eigen::PartialPivLU<Matrix> lu(Matrix::Identity(n, n) - alpha * a);
   if (!(lu.rcond() > 10.0 * std::numeric_limits<double>::epsilon())) {
     throw NumericalError("c2d (tustin)",
-                         "the system has a pole at s = " + detail::str(1.0 / alpha) +
+                         "the system has a pole at s = " + format_number(1.0 / alpha, 10) +
                              " rad/s, which the bilinear map sends to infinity; choose another sample time",
                          /*retry_may_help=*/true);
   }
@@ -89,7 +90,7 @@ Index delay_samples(double delay, double ts, const std::string& field) {
   const double ratio = delay / ts;
   const double rounded = std::round(ratio);
   if (std::abs(ratio - rounded) > 1e-9 * std::max(1.0, rounded)) {
-    throw InputError("lsim", field, "a whole multiple of the sample time " + detail::str(ts) + " s", detail::str(delay) + " s");
+    throw InputError("lsim", field, "a whole multiple of the sample time " + format_number(ts, 10) + " s", format_number(delay, 10) + " s");
   }
   return static_cast<Index>(rounded);
 }
@@ -114,15 +115,15 @@ DiscretizationMethod discretization_method_from_string(const std::string& name) 
 
 void DiscretizeOptions::validate(double sample_time) const {
   if (!(sample_time > 0.0) || !std::isfinite(sample_time)) {
-    throw InputError("c2d", "sample_time", "a finite time > 0 s", detail::str(sample_time));
+    throw InputError("c2d", "sample_time", "a finite time > 0 s", format_number(sample_time, 10));
   }
   if (method != DiscretizationMethod::kZoh && method != DiscretizationMethod::kTustin) {
     throw InputError("c2d", "method", "zoh or tustin", std::to_string(static_cast<int>(method)));
   }
   const double nyquist = std::numbers::pi / sample_time;
   if (!std::isfinite(prewarp_frequency) || prewarp_frequency < 0.0 || prewarp_frequency >= nyquist) {
-    throw InputError("c2d", "prewarp_frequency", "0 or a frequency in (0, " + detail::str(nyquist) + ") rad/s",
-                     detail::str(prewarp_frequency));
+    throw InputError("c2d", "prewarp_frequency", "0 or a frequency in (0, " + format_number(nyquist, 10) + ") rad/s",
+                     format_number(prewarp_frequency, 10));
   }
 }
 
@@ -153,7 +154,7 @@ StateSpace c2d(const StateSpace& sys, double sample_time, const DiscretizeOption
   sys.validate("c2d");
   if (sys.is_discrete()) {
     throw InputError("c2d", "sample_time", "a continuous system (sample_time 0)",
-                     "a discrete one with Ts = " + detail::str(sys.sample_time) + " s");
+                     "a discrete one with Ts = " + format_number(sys.sample_time, 10) + " s");
   }
   options.validate(sample_time);
   const Index n = sys.states();
@@ -190,7 +191,7 @@ TransferFunction c2d(const TransferFunction& tf, double sample_time, const Discr
   tf.validate("c2d");
   if (tf.is_discrete()) {
     throw InputError("c2d", "sample_time", "a continuous transfer function (sample_time 0)",
-                     "a discrete one with Ts = " + detail::str(tf.sample_time) + " s");
+                     "a discrete one with Ts = " + format_number(tf.sample_time, 10) + " s");
   }
   options.validate(sample_time);
   TransferFunction continuous = tf;
@@ -269,8 +270,8 @@ StateSpace discrete_for_response(const StateSpace& sys, double sample_time, Inde
   }
   if (sys.is_discrete()) {
     if (sample_time != 0.0 && std::abs(sample_time - sys.sample_time) > 1e-12 * sys.sample_time) {
-      throw InputError(method, "sample_time", "0 or the system's sample time " + detail::str(sys.sample_time) + " s",
-                       detail::str(sample_time));
+      throw InputError(method, "sample_time", "0 or the system's sample time " + format_number(sys.sample_time, 10) + " s",
+                       format_number(sample_time, 10));
     }
     return sys;
   }

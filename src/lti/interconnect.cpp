@@ -4,6 +4,7 @@
 
 #include "lti/check.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::lti {
 namespace {
@@ -14,8 +15,8 @@ double common_sample_time(const StateSpace& a, const StateSpace& b, const std::s
   if (a.sample_time == b.sample_time) return a.sample_time;
   if (a.states() == 0 && a.sample_time == 0.0) return b.sample_time;
   if (b.states() == 0 && b.sample_time == 0.0) return a.sample_time;
-  throw InputError(op, "sample_time", "the same sample time for both systems (" + detail::str(a.sample_time) + " s)",
-                   detail::str(b.sample_time) + " s");
+  throw InputError(op, "sample_time", "the same sample time for both systems (" + format_number(a.sample_time, 10) + " s)",
+                   format_number(b.sample_time, 10) + " s");
 }
 
 void reject_delay(const StateSpace& sys, const std::string& op, const std::string& which) {
@@ -119,7 +120,7 @@ StateSpace parallel(const StateSpace& a, const StateSpace& b) {
 
 StateSpace scale(const StateSpace& sys, double k) {
   sys.validate("scale");
-  if (!std::isfinite(k)) throw InputError("scale", "k", "a finite factor", detail::str(k));
+  if (!std::isfinite(k)) throw InputError("scale", "k", "a finite factor", format_number(k, 10));
   StateSpace out = sys;
   out.C *= k;
   out.D *= k;

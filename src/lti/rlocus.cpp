@@ -13,6 +13,7 @@
 #include "lti/check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/minimize.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/freqresp.hpp"
 
@@ -37,7 +38,7 @@ CVector poles_at(const StateSpace& loop, double gain) {
   const double d = loop.D(0, 0);
   const double den = 1.0 + gain * d;
   if (std::abs(den) <= 4.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(gain * d))) {
-    throw NumericalError("rlocus", "1 + k D = 0 at k = " + detail::str(gain) + ": the closed loop is not proper",
+    throw NumericalError("rlocus", "1 + k D = 0 at k = " + format_number(gain, 10) + ": the closed loop is not proper",
                          /*retry_may_help=*/true);
   }
   StateSpace cl = loop;
@@ -216,26 +217,26 @@ double first_gain(const StateSpace& loop, const LoopScales& sc) {
 
 void RootLocusOptions::validate() const {
   if (!std::isfinite(gain_min) || gain_min < 0.0) {
-    throw InputError("rlocus", "gain_min", "a finite gain >= 0", detail::str(gain_min));
+    throw InputError("rlocus", "gain_min", "a finite gain >= 0", format_number(gain_min, 10));
   }
   if (!std::isfinite(gain_max) || gain_max < 0.0 || (gain_max > 0.0 && gain_max <= gain_min)) {
-    throw InputError("rlocus", "gain_max", "0 (automatic) or a finite gain above gain_min = " + detail::str(gain_min),
-                     detail::str(gain_max));
+    throw InputError("rlocus", "gain_max", "0 (automatic) or a finite gain above gain_min = " + format_number(gain_min, 10),
+                     format_number(gain_max, 10));
   }
   if (!std::isfinite(max_relative_step) || max_relative_step <= 0.0 || max_relative_step > 1.0) {
-    throw InputError("rlocus", "max_relative_step", "a fraction in (0, 1]", detail::str(max_relative_step));
+    throw InputError("rlocus", "max_relative_step", "a fraction in (0, 1]", format_number(max_relative_step, 10));
   }
   if (!std::isfinite(settle_fraction) || settle_fraction <= 0.0 || settle_fraction >= 1.0) {
-    throw InputError("rlocus", "settle_fraction", "a fraction in (0, 1)", detail::str(settle_fraction));
+    throw InputError("rlocus", "settle_fraction", "a fraction in (0, 1)", format_number(settle_fraction, 10));
   }
   if (max_points < 2) throw InputError("rlocus", "max_points", "a count >= 2", std::to_string(max_points));
   if (max_order < 1) throw InputError("rlocus", "max_order", "a count >= 1", std::to_string(max_order));
-  if (!std::isfinite(max_work) || max_work <= 0.0) throw InputError("rlocus", "max_work", "a finite budget > 0", detail::str(max_work));
+  if (!std::isfinite(max_work) || max_work <= 0.0) throw InputError("rlocus", "max_work", "a finite budget > 0", format_number(max_work, 10));
 }
 
 CVector closed_loop_poles(const StateSpace& open_loop, double gain) {
   check_loop(open_loop, "closed_loop_poles");
-  if (!std::isfinite(gain)) throw InputError("closed_loop_poles", "gain", "a finite gain", detail::str(gain));
+  if (!std::isfinite(gain)) throw InputError("closed_loop_poles", "gain", "a finite gain", format_number(gain, 10));
   return poles_at(open_loop, gain);
 }
 
@@ -243,7 +244,7 @@ RootLocus rlocus(const StateSpace& open_loop, const std::vector<double>& gains) 
   check_loop(open_loop, "rlocus");
   for (size_t i = 0; i < gains.size(); ++i) {
     if (!std::isfinite(gains[i])) {
-      throw InputError("rlocus", "gains[" + std::to_string(i) + "]", "a finite gain", detail::str(gains[i]));
+      throw InputError("rlocus", "gains[" + std::to_string(i) + "]", "a finite gain", format_number(gains[i], 10));
     }
   }
   RootLocus rl;
@@ -301,9 +302,9 @@ RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& optio
     double next = k == 0.0 ? k_first : k * ratio;
     next = std::min(next, last);
     if (++evaluations > max_evaluations) {
-      throw NumericalError("rlocus", "the adaptive gain grid needed more than " + detail::str(max_evaluations) +
-                           " eigenvalue problems of order " + std::to_string(n) + " (max_work = " + detail::str(options.max_work) +
-                           "); it reached gain " + detail::str(k),
+      throw NumericalError("rlocus", "the adaptive gain grid needed more than " + format_number(max_evaluations, 10) +
+                           " eigenvalue problems of order " + std::to_string(n) + " (max_work = " + format_number(options.max_work, 10) +
+                           "); it reached gain " + format_number(k, 10),
                            /*retry_may_help=*/true);
     }
     const CVector candidate = match_to(current, poles_at(open_loop, next));

@@ -5,12 +5,12 @@
 #include "lti/check.hpp"
 #include "lti/spectral.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::lti {
 
 using detail::require_delay;
 using detail::require_finite;
-using detail::str;
 
 TransferFunction::TransferFunction(Vector numerator, Vector denominator, double ts, double delay_s)
     : num(std::move(numerator)), den(std::move(denominator)), sample_time(ts), delay(delay_s) {
@@ -46,7 +46,7 @@ Zpk::Zpk(CVector z, CVector p, double k, double ts, double delay_s)
 void Zpk::validate(const std::string& source) const {
   require_finite(zeros, source, "zeros");
   require_finite(poles, source, "poles");
-  if (!std::isfinite(gain)) throw InputError(source, "gain", "a finite value", str(gain));
+  if (!std::isfinite(gain)) throw InputError(source, "gain", "a finite value", format_number(gain, 10));
   if (zeros.size() > poles.size()) {
     throw InputError(source, "zeros",
                      "at most as many zeros as poles (" + std::to_string(poles.size()) + ", a proper system)",

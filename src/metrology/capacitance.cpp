@@ -8,14 +8,13 @@
 
 #include "metrology/check.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::metrology {
 
-using detail::num;
-
 void Range::validate(const std::string& source, const std::string& field) const {
   if (std::isnan(min) || std::isnan(max) || min > max) {
-    throw InputError(source, field, "a range [min, max] with min <= max", fmt::format("[{}, {}]", num(min), num(max)));
+    throw InputError(source, field, "a range [min, max] with min <= max", fmt::format("[{}, {}]", format_number(min), format_number(max)));
   }
 }
 
@@ -45,10 +44,10 @@ CapacitanceCheck check_capacitance(double sensor_F, double actuator_F, const Cap
 
 void OutlierOptions::validate() const {
   if (!(std::isfinite(threshold) && threshold > 0.0)) {
-    throw InputError("outlier options", "threshold", "a finite value > 0", num(threshold));
+    throw InputError("outlier options", "threshold", "a finite value > 0", format_number(threshold));
   }
   if (!(std::isfinite(min_relative_deviation) && min_relative_deviation >= 0.0)) {
-    throw InputError("outlier options", "min_relative_deviation", "a finite value >= 0", num(min_relative_deviation));
+    throw InputError("outlier options", "min_relative_deviation", "a finite value >= 0", format_number(min_relative_deviation));
   }
 }
 

@@ -7,19 +7,18 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::metrology::detail {
 
-inline std::string num(double v) { return fmt::format("{:.6g}", v); }
-
 inline void require_finite_positive(double v, const std::string& source, const std::string& field,
                                     const std::string& unit) {
-  if (!(std::isfinite(v) && v > 0.0)) throw InputError(source, field, "a finite value > 0 " + unit, num(v));
+  if (!(std::isfinite(v) && v > 0.0)) throw InputError(source, field, "a finite value > 0 " + unit, format_number(v));
 }
 
 inline void require_finite_nonnegative(double v, const std::string& source, const std::string& field,
                                        const std::string& unit) {
-  if (!(std::isfinite(v) && v >= 0.0)) throw InputError(source, field, "a finite value >= 0 " + unit, num(v));
+  if (!(std::isfinite(v) && v >= 0.0)) throw InputError(source, field, "a finite value >= 0 " + unit, format_number(v));
 }
 
 // Every sample finite, at least `min_samples` of them.

@@ -9,10 +9,10 @@
 
 #include "metrology/check.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::metrology {
 
-using detail::num;
 using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -26,22 +26,22 @@ void StaticStiffnessOptions::validate() const {
   detail::require_finite_nonnegative(t_off, src, "t_off", "s");
   if ((t_on > 0.0) != (t_off > 0.0) || (t_on > 0.0 && t_off <= t_on)) {
     throw InputError(src, "t_off", "both event times 0 (detect) or 0 < t_on < t_off",
-                     fmt::format("t_on {} s, t_off {} s", num(t_on), num(t_off)));
+                     fmt::format("t_on {} s, t_off {} s", format_number(t_on), format_number(t_off)));
   }
   auto window = [&](const std::array<double, 2>& w, const char* field) {
     if (!(std::isfinite(w[0]) && std::isfinite(w[1]) && w[0] < w[1])) {
-      throw InputError(src, field, "a window [from, to) with from < to (s)", fmt::format("[{}, {}]", num(w[0]), num(w[1])));
+      throw InputError(src, field, "a window [from, to) with from < to (s)", fmt::format("[{}, {}]", format_number(w[0]), format_number(w[1])));
     }
   };
   window(before_s, "before_s");
   window(loaded_s, "loaded_s");
   window(after_s, "after_s");
-  if (before_s[1] > 0.0) throw InputError(src, "before_s", "a window before t_on (to <= 0)", num(before_s[1]));
-  if (loaded_s[1] > 0.0) throw InputError(src, "loaded_s", "a window before t_off (to <= 0)", num(loaded_s[1]));
-  if (after_s[0] < 0.0) throw InputError(src, "after_s", "a window after t_off (from >= 0)", num(after_s[0]));
+  if (before_s[1] > 0.0) throw InputError(src, "before_s", "a window before t_on (to <= 0)", format_number(before_s[1]));
+  if (loaded_s[1] > 0.0) throw InputError(src, "loaded_s", "a window before t_off (to <= 0)", format_number(loaded_s[1]));
+  if (after_s[0] < 0.0) throw InputError(src, "after_s", "a window after t_off (from >= 0)", format_number(after_s[0]));
   detail::require_finite_positive(min_time_constant, src, "min_time_constant", "s");
   if (!(std::isfinite(max_time_constant) && max_time_constant > min_time_constant)) {
-    throw InputError(src, "max_time_constant", "a time > min_time_constant", num(max_time_constant));
+    throw InputError(src, "max_time_constant", "a time > min_time_constant", format_number(max_time_constant));
   }
 }
 
@@ -184,7 +184,7 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
   const double settle = options.settle_s;
   auto inside = [&](double from, double to, const char* field, const char* what) {
     if (from < t(0) || to > t(n - 1) + dt) {
-      throw InputError(source, field, fmt::format("the {} window [{}, {}) s inside the record [{}, {}] s", what, num(from), num(to), num(t(0)), num(t(n - 1))),
+      throw InputError(source, field, fmt::format("the {} window [{}, {}) s inside the record [{}, {}] s", what, format_number(from), format_number(to), format_number(t(0)), format_number(t(n - 1))),
                        "a window outside the record");
     }
   };
@@ -192,12 +192,12 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
   inside(r.t_off + options.loaded_s[0], r.t_off + options.loaded_s[1], "t_off", "loaded-reading");
   inside(r.t_off + options.after_s[0], r.t_off + options.after_s[1], "t_off", "reading-after");
   if (r.t_off + options.loaded_s[0] < r.t_on + settle) {
-    throw InputError(source, "t_off", fmt::format("the loaded-reading window after t_on + settle_s = {} s", num(r.t_on + settle)),
-                     fmt::format("a window from {} s", num(r.t_off + options.loaded_s[0])));
+    throw InputError(source, "t_off", fmt::format("the loaded-reading window after t_on + settle_s = {} s", format_number(r.t_on + settle)),
+                     fmt::format("a window from {} s", format_number(r.t_off + options.loaded_s[0])));
   }
   if (t(n - 1) < r.t_off + settle + 0.5) {
-    throw InputError(source, "t_off", fmt::format("at least settle_s + 0.5 s = {} s of record after the mass is taken off", num(settle + 0.5)),
-                     fmt::format("{} s", num(t(n - 1) - r.t_off)));
+    throw InputError(source, "t_off", fmt::format("at least settle_s + 0.5 s = {} s of record after the mass is taken off", format_number(settle + 0.5)),
+                     fmt::format("{} s", format_number(t(n - 1) - r.t_off)));
   }
 
   std::vector<Index> rows;

@@ -8,10 +8,10 @@
 
 #include "metrology/check.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::metrology {
 
-using detail::num;
 using Eigen::Index;
 using Eigen::VectorXd;
 
@@ -103,7 +103,7 @@ StrokeResult analyze_stroke(const Eigen::Ref<const VectorXd>& va, const Eigen::R
   r.va_min = va.minCoeff();
   r.va_max = va.maxCoeff();
   if (r.va_max - r.va_min < 1.0) {
-    throw InputError(source, "Va", "a voltage ramp spanning at least 1 V", fmt::format("{} V", num(r.va_max - r.va_min)));
+    throw InputError(source, "Va", "a voltage ramp spanning at least 1 V", fmt::format("{} V", format_number(r.va_max - r.va_min)));
   }
   r.stroke = ds.maxCoeff() - ds.minCoeff();
   // Straight line d_e = a + b Va (least squares).
@@ -150,13 +150,13 @@ HysteresisResult analyze_hysteresis(const Eigen::Ref<const VectorXd>& va, const 
   r.offset = 0.5 * (hi + lo);
   r.amplitude = 0.5 * (hi - lo);
   if (r.amplitude < 0.1) {
-    throw InputError(source, "Va", "a sine of amplitude >= 0.1 V", fmt::format("{} V", num(r.amplitude)));
+    throw InputError(source, "Va", "a sine of amplitude >= 0.1 V", fmt::format("{} V", format_number(r.amplitude)));
   }
   const Crossings c = crossings(v, d, r.offset, 0.5 * r.amplitude, options.skip_periods);
   if (c.rising.empty() || c.falling.empty()) {
     throw InputError(source, "Va",
                      fmt::format("at least {} periods of the sine (rising and falling through the offset {} V)",
-                                 options.skip_periods + 1, num(r.offset)),
+                                 options.skip_periods + 1, format_number(r.offset)),
                      fmt::format("{} rising and {} falling crossings after the first {} periods",
                                  c.rising.size(), c.falling.size(), options.skip_periods));
   }

@@ -6,6 +6,7 @@
 
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/lti/analysis.hpp"
@@ -17,11 +18,11 @@
 #include "piezobench/rt/loop.hpp"
 #include "piezobench/rt/virtual_backend.hpp"
 #include "rt/util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::rt {
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 const std::string kSource = "damped-plant study";
 
 }  // namespace
@@ -29,7 +30,7 @@ const std::string kSource = "damped-plant study";
 void DampedPlantStudyOptions::validate() const {
   if (gains.empty()) throw InputError(kSource, "gains", "at least one gain", "an empty list");
   for (double g : gains) {
-    if (!(std::isfinite(g) && g >= 0.0)) throw InputError(kSource, "gains", "finite gains >= 0", detail::str(g));
+    if (!(std::isfinite(g) && g >= 0.0)) throw InputError(kSource, "gains", "finite gains >= 0", format_number(g));
   }
   detail::require_positive(duration, "duration", kSource);
   detail::require_nonnegative(settle, "settle", kSource);
@@ -37,13 +38,13 @@ void DampedPlantStudyOptions::validate() const {
   detail::require_nonnegative(f_low, "f_low", kSource);
   const double nyquist = bench.sample_rate / 2.0;
   if (!(std::isfinite(f_high) && f_high > f_low && f_high <= nyquist)) {
-    throw InputError(kSource, "f_high", "a frequency in (f_low, " + detail::str(nyquist) + "] Hz", detail::str(f_high));
+    throw InputError(kSource, "f_high", "a frequency in (f_low, " + format_number(nyquist) + "] Hz", format_number(f_high));
   }
   auto band = [](double lo, double hi, const char* lo_field, const char* hi_field) {
     detail::require_positive(lo, lo_field, kSource);
     if (!(std::isfinite(hi) && hi > lo)) {
-      throw InputError(kSource, hi_field, std::string("a frequency above ") + lo_field + " = " + detail::str(lo) + " Hz",
-                       detail::str(hi));
+      throw InputError(kSource, hi_field, std::string("a frequency above ") + lo_field + " = " + format_number(lo) + " Hz",
+                       format_number(hi));
     }
   };
   band(fit_fmin, fit_fmax, "fit_fmin", "fit_fmax");
@@ -53,7 +54,7 @@ void DampedPlantStudyOptions::validate() const {
   if (nfft < 16) throw InputError(kSource, "nfft", "at least 16 samples", std::to_string(nfft));
   if (duration * bench.sample_rate < static_cast<double>(nfft)) {
     throw InputError(kSource, "duration", "at least one period of nfft = " + std::to_string(nfft) + " samples",
-                     detail::str(duration) + " s");
+                     format_number(duration) + " s");
   }
   detail::require_positive(tolerance, "tolerance", kSource);
   if (pade_order < 1 || pade_order > 20) throw InputError(kSource, "pade_order", "1..20", std::to_string(pade_order));
@@ -90,7 +91,7 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
   study.optimal_gain = locus.optimum.gain;
   if (!(locus.optimum.gain < gain_bound * (1.0 - 1e-6))) {
     throw NumericalError("damped-plant study", "the damping of the resonance branch still grows at the search bound g = " +
-                         detail::str(gain_bound) + "; no optimum below it", false);
+                         format_number(gain_bound) + "; no optimum below it", false);
   }
   study.max_damping = locus.optimum.damping;
 
@@ -155,8 +156,8 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
         if (f >= fmin && f <= fmax && f >= options.f_low && f <= options.f_high) rows.push_back(k);
       }
       if (rows.size() < 8) {
-        throw InputError(kSource, "fit band", "at least 8 excited frequency lines in [" + detail::str(fmin) + ", " +
-                                                  detail::str(fmax) + "] Hz",
+        throw InputError(kSource, "fit band", "at least 8 excited frequency lines in [" + format_number(fmin) + ", " +
+                                                  format_number(fmax) + "] Hz",
                          std::to_string(rows.size()) + " lines");
       }
       omega.resize(static_cast<Eigen::Index>(rows.size()));

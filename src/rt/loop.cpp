@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "rt/util.hpp"
 
 namespace piezobench::rt {
@@ -26,7 +27,7 @@ struct Loop::Shared {
 void LoopOptions::validate() const {
   const std::string source = "rt loop";
   detail::require_positive(duration, "duration", source);
-  if (duration > 1e6) throw InputError(source, "duration", "at most 1e6 s", detail::str(duration));
+  if (duration > 1e6) throw InputError(source, "duration", "at most 1e6 s", format_number(duration));
   if (priority < 1 || priority > 99) throw InputError(source, "priority", "an integer in 1..99", std::to_string(priority));
   detail::require_finite(gain, "gain", source);
   for (Eigen::Index i = 0; i < excitation.size(); ++i) {
@@ -57,7 +58,7 @@ Loop::Loop(Backend& backend, const LoopOptions& options)
       shared_(std::make_unique<Shared>()) {
   detail::require_positive(rate_, "sample_rate", "backend " + backend.name());
   if (rate_ > kMaxSampleRate) {
-    throw InputError("backend " + backend.name(), "sample_rate", "at most " + detail::str(kMaxSampleRate) + " Hz", detail::str(rate_) + " Hz");
+    throw InputError("backend " + backend.name(), "sample_rate", "at most " + format_number(kMaxSampleRate) + " Hz", format_number(rate_) + " Hz");
   }
   if (options.feedforward) feedforward_.emplace(*options.feedforward, rate_);
   const double cycles = std::round(options.duration * rate_);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "rt/util.hpp"
 
 namespace piezobench::rt {
@@ -37,11 +38,11 @@ void ActuatorLimits::validate() const {
   detail::require_finite(va_min, "va_min", kSource);
   detail::require_finite(va_max, "va_max", kSource);
   if (!(va_min < va_max)) {
-    throw InputError(kSource, "va_max", "a value above va_min = " + detail::str(va_min) + " V", detail::str(va_max));
+    throw InputError(kSource, "va_max", "a value above va_min = " + format_number(va_min) + " V", format_number(va_max));
   }
   if (!(std::isfinite(va_safe) && va_safe >= va_min && va_safe <= va_max)) {
-    throw InputError(kSource, "va_safe", "a voltage in [" + detail::str(va_min) + ", " + detail::str(va_max) + "] V",
-                     detail::str(va_safe));
+    throw InputError(kSource, "va_safe", "a voltage in [" + format_number(va_min) + ", " + format_number(va_max) + "] V",
+                     format_number(va_safe));
   }
   detail::require_positive(slew_rate, "slew_rate", kSource);
   detail::require_nonnegative(ramp_in, "ramp_in", kSource);

@@ -17,6 +17,7 @@
 #include <limits>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "rt/util.hpp"
 
 namespace piezobench::rt {
@@ -181,8 +182,8 @@ void UdpBackend::start() {
       const auto r = decode_reply(in, static_cast<std::size_t>(n));
       if (!r || r->type != UdpType::kHelloReply) continue;
       if (std::abs(r->de - sample_rate_) > 1e-9 * sample_rate_) {
-        throw InputError("udp target " + address_.to_string(), "sample rate", detail::str(sample_rate_) + " Hz (the bench file's)",
-                         detail::str(r->de) + " Hz");
+        throw InputError("udp target " + address_.to_string(), "sample rate", format_number(sample_rate_) + " Hz (the bench file's)",
+                         format_number(r->de) + " Hz");
       }
       return;
     }

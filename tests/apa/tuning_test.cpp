@@ -15,6 +15,7 @@
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::apa {
 namespace {
@@ -23,7 +24,6 @@ using lti::Complex;
 using lti::Index;
 using test::near;
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 // The acceptance: stiffnesses and gains within 2 %, stack dampings within 10 % with 1 % noise.
 constexpr double kStiffnessAndGain = 0.02;
 constexpr double kStackDamping = 0.10;

@@ -13,13 +13,13 @@
 
 #include "run_cli.hpp"
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench {
 namespace {
 
 using Complex = std::complex<double>;
 using test::near;
-constexpr double kTwoPi = 2.0 * M_PI;
 
 using Outcome = test::CliRun;
 const auto run = test::run_cli;

@@ -10,12 +10,12 @@
 #include <numbers>
 
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::bench {
 namespace {
 
 using test::near;
-constexpr double kTwoPi = 2 * std::numbers::pi;
 
 TEST(Truth, TwoDofUnitOnTheReportsBench) {
   const UnitTruth u = batch_unit(1, 1);

@@ -16,6 +16,7 @@
 #include "piezobench/lti/discretize.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::control {
 namespace {
@@ -23,7 +24,6 @@ namespace {
 using lti::Complex;
 using lti::Matrix;
 using lti::Vector;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kFs = 10e3;
 constexpr double kPrewarp = kTwoPi * 95.2;
 

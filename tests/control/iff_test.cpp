@@ -10,6 +10,7 @@
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::control {
 namespace {
@@ -17,7 +18,6 @@ namespace {
 using lti::Complex;
 using lti::CVector;
 using lti::Vector;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 Vector conv(const Vector& a, const Vector& b) {
   Vector c = Vector::Zero(a.size() + b.size() - 1);

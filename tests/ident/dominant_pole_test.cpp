@@ -7,11 +7,10 @@
 #include <random>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 namespace {
-
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // A damped plant as IFF makes it: a well damped resonance (80 Hz, 25 %) that dominates, a lightly
 // damped pair with a small residue (a controller pole near a zero, 150 Hz) and a real pole (20 Hz).

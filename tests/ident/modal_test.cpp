@@ -8,13 +8,12 @@
 
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 namespace {
 
 using test::near;
-
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // Hammer test of the APA300ML (report section 1.4): y-bending near 280 Hz and x-bending near
 // 412 Hz. Accelerance (laser vibrometer differentiated), modal superposition of the two modes:

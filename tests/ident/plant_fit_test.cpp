@@ -11,13 +11,13 @@
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 namespace {
 
 using lti::Vector;
 using test::near;
-constexpr double kTwoPi = 2.0 * M_PI;
 
 // The report's plant (section 2.6) with the zero mirrored or not and a 200 us delay.
 IffPlantFit report_plant(double xz) {

@@ -9,6 +9,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "test_util.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
 namespace {
@@ -17,7 +18,6 @@ using test::all_near;
 using test::near;
 using test::Tolerance;
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 // Noise-free data from an exact rational model of the fitted order: vector fitting converges to the
 // generating poles up to the conditioning of the lightly damped pairs (issue 3 asks for 1e-6).
 constexpr double kExactPoles = 1e-6;

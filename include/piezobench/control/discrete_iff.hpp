@@ -18,12 +18,13 @@
 
 #include "piezobench/control/iff.hpp"
 #include "piezobench/lti/state_space.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::control {
 
 struct DiscreteIffOptions {
   double sample_rate = 10e3;                // Hz
-  double prewarp = 2.0 * M_PI * 95.2;       // rad/s, Tustin pre-warping frequency (the resonance); 0 = none
+  double prewarp = kTwoPi * 95.2;           // rad/s, Tustin pre-warping frequency (the resonance); 0 = none
   // Anti-windup: when the caller reports that the output was limited (applied()), the state of the
   // integral-action section is recomputed as if its output had been gain * applied + (1 - gain) *
   // computed, so with 1 the output tracks what was applied. In [0, 1]; 0 = off.

@@ -13,6 +13,7 @@
 #include "piezobench/lti/rlocus.hpp"
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::control {
 
@@ -21,11 +22,11 @@ namespace piezobench::control {
 // non-minimum-phase zero pair (mirrored into the right half plane), which the report's data show.
 struct IffPlantParams {
   double g0 = 0.64;                    // V/V
-  double wz = 2.0 * M_PI * 42.7;       // rad/s, anti-resonance
+  double wz = kTwoPi * 42.7;           // rad/s, anti-resonance
   double xz = 0.004;                   // damping ratio of the zero (< 0: non-minimum phase)
-  double wp = 2.0 * M_PI * 95.2;       // rad/s, resonance
+  double wp = kTwoPi * 95.2;           // rad/s, resonance
   double xp = 0.02;                    // damping ratio of the pole
-  double w_hpf = 2.0 * M_PI * 0.4;     // rad/s, high-pass corner of the resistor across the sensor stack
+  double w_hpf = kTwoPi * 0.4;         // rad/s, high-pass corner of the resistor across the sensor stack
   double delay = 0.0;                  // s (the report adds 200 us to match the phase)
   void validate() const;               // InputError naming the field
 };
@@ -37,9 +38,9 @@ lti::CVector iff_plant_response(const IffPlantParams& params, const lti::Vector&
 // K0(s) = gain * s/(s + w_hpf) * 1/(s + w_lpf) * 1/(s + w_robust): eq. 2.4 at g = 1 (gain = -10).
 struct IffControllerParams {
   double gain = -10.0;                 // 1/s^2 scaling of the report's controller
-  double w_hpf = 2.0 * M_PI * 2.0;     // rad/s, high-pass that limits the low-frequency gain
-  double w_lpf = 2.0 * M_PI * 20.0;    // rad/s, integral action above it
-  double w_robust = 2.0 * M_PI * 2000.0;  // rad/s, roll-off for robustness to high-frequency modes
+  double w_hpf = kTwoPi * 2.0;         // rad/s, high-pass that limits the low-frequency gain
+  double w_lpf = kTwoPi * 20.0;        // rad/s, integral action above it
+  double w_robust = kTwoPi * 2000.0;      // rad/s, roll-off for robustness to high-frequency modes
   void validate() const;
 };
 lti::Zpk iff_controller(const IffControllerParams& params = {});

@@ -1,0 +1,37 @@
+#include "piezobench/core/format.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <limits>
+
+namespace piezobench {
+namespace {
+
+TEST(FormatNumber, SixSignificantDigitsByDefaultAsPrintfG) {
+  EXPECT_EQ(format_number(95.36912), "95.3691");
+  EXPECT_EQ(format_number(1.8e6), "1.8e+06");
+  EXPECT_EQ(format_number(-0.000123456789), "-0.000123457");
+  EXPECT_EQ(format_number(0.0), "0");
+}
+
+TEST(FormatNumber, TenDigitsTellNeighboursApartAndSeventeenRoundTrip) {
+  EXPECT_EQ(format_number(1e-4, 10), "0.0001");
+  EXPECT_EQ(format_number(1.0000000001e-4, 10), "0.0001");      // differs in the 11th digit
+  EXPECT_EQ(format_number(1.000000001e-4, 10), "0.0001000000001");
+  const double x = 0.1 + 0.2;
+  EXPECT_EQ(std::strtod(format_number(x, 17).c_str(), nullptr), x);
+  EXPECT_NE(format_number(x, 17), format_number(0.3, 17));
+}
+
+TEST(FormatNumber, NonFiniteAndClampedDigits) {
+  EXPECT_EQ(format_number(std::numeric_limits<double>::quiet_NaN()), "nan");
+  EXPECT_EQ(format_number(-std::numeric_limits<double>::quiet_NaN()), "nan");
+  EXPECT_EQ(format_number(std::numeric_limits<double>::infinity()), "inf");
+  EXPECT_EQ(format_number(-std::numeric_limits<double>::infinity()), "-inf");
+  EXPECT_EQ(format_number(123.456, 0), "1e+02");   // clamped to 1 digit
+  EXPECT_EQ(format_number(0.1, 40), format_number(0.1, 17));
+}
+
+}  // namespace
+}  // namespace piezobench
