@@ -4,7 +4,7 @@ import numpy as np
 
 
 def _plain(value):
-    if isinstance(value, Result):
+    if isinstance(value, Result) or (hasattr(type(value), "to_dict") and not isinstance(value, type)):
         return value.to_dict()
     if isinstance(value, dict):
         return {k: _plain(v) for k, v in value.items()}
@@ -55,13 +55,38 @@ class Result:
                     for a, b in zip(self._fields.values(), other._fields.values()))
 
     def __repr__(self):
-        parts = []
-        for k, v in self._fields.items():
-            if isinstance(v, np.ndarray):
-                parts.append(f"{k}=<{v.dtype} array {v.shape}>")
-            elif isinstance(v, (list, tuple)) and len(v) > 4:
-                parts.append(f"{k}=[{len(v)} items]")
-            else:
-                r = repr(v)
-                parts.append(f"{k}={r if len(r) <= 60 else r[:57] + '...'}")
-        return f"{self._type}({', '.join(parts)})"
+        return _repr(self._type, self._fields.items())
+
+
+def _repr(type_name, items):
+    parts = []
+    for k, v in items:
+        if isinstance(v, np.ndarray):
+            parts.append(f"{k}=<{v.dtype} array {v.shape}>")
+        elif isinstance(v, (list, tuple)) and len(v) > 4:
+            parts.append(f"{k}=[{len(v)} items]")
+        else:
+            r = repr(v)
+            parts.append(f"{k}={r if len(r) <= 60 else r[:57] + '...'}")
+    return f"{type_name}({', '.join(parts)})"
+
+
+# Typed results bound as classes (campaign.UnitAnalysis, ident.IffPlantFit, ...): their fields are
+# read-only properties, in the order of the C++ struct.
+def properties(cls):
+    """The names of the read-only properties of a typed result class, in declaration order."""
+    names = []
+    for klass in reversed(cls.__mro__):
+        for name, attr in vars(klass).items():
+            if isinstance(attr, property) and not name.startswith("_") and name not in names:
+                names.append(name)
+    return names
+
+
+def typed_to_dict(obj):
+    """The properties of a typed result as a dict (nested results as dicts; arrays stay numpy arrays)."""
+    return {name: _plain(getattr(obj, name)) for name in properties(type(obj))}
+
+
+def typed_repr(obj):
+    return _repr(type(obj).__name__, ((name, getattr(obj, name)) for name in properties(type(obj))))

@@ -93,6 +93,34 @@ const std::string& model_doc() {
 
 }  // namespace
 
+py::dict two_dof_bench_dict(const TwoDofBench& b) { return bench_options().to_dict(b); }
+
+py::object tuning_result(const TwoDofTuning& r) {
+  py::dict feat;
+  feat["resonance"] = r.features.resonance;
+  feat["resonance_damping"] = r.features.resonance_damping;
+  feat["antiresonance"] = r.features.antiresonance;
+  feat["antiresonance_damping"] = r.features.antiresonance_damping;
+  feat["static_gain_de"] = r.features.static_gain_de;
+  feat["static_gain_vs"] = r.features.static_gain_vs;
+  py::dict d;
+  d["params"] = params_options().to_dict(r.params);
+  d["initial"] = params_options().to_dict(r.initial);
+  d["features"] = result("TuningFeatures", feat);
+  d["fit_error_de"] = r.fit_error_de;
+  d["fit_error_vs"] = r.fit_error_vs;
+  d["initial_fit_error_de"] = r.initial_fit_error_de;
+  d["initial_fit_error_vs"] = r.initial_fit_error_vs;
+  d["points"] = r.points;
+  d["iterations"] = r.iterations;
+  d["status"] = to_string(r.status);
+  d["message"] = r.message;
+  d["bench"] = two_dof_bench_dict(r.bench);
+  d["quality"] = py::cast(r.quality);
+  d["brief_report"] = r.brief_report();
+  return result("TwoDofTuning", d);
+}
+
 void bind_apa(py::module_& m) {
   using py::arg;
 
@@ -163,34 +191,43 @@ void bind_apa(py::module_& m) {
         const std::string src = "apa.tune_two_dof";
         const auto& f = frf_arg(frf, src, "frf");
         auto o = tuning_options().from_kwargs(kwargs_dict(kw), src);
-        auto r = without_gil([&] { return tune_two_dof(f, o); });
-        py::dict feat;
-        feat["resonance"] = r.features.resonance;
-        feat["resonance_damping"] = r.features.resonance_damping;
-        feat["antiresonance"] = r.features.antiresonance;
-        feat["antiresonance_damping"] = r.features.antiresonance_damping;
-        feat["static_gain_de"] = r.features.static_gain_de;
-        feat["static_gain_vs"] = r.features.static_gain_vs;
-        py::dict d;
-        d["params"] = params_options().to_dict(r.params);
-        d["initial"] = params_options().to_dict(r.initial);
-        d["features"] = result("TuningFeatures", feat);
-        d["fit_error_de"] = r.fit_error_de;
-        d["fit_error_vs"] = r.fit_error_vs;
-        d["initial_fit_error_de"] = r.initial_fit_error_de;
-        d["initial_fit_error_vs"] = r.initial_fit_error_vs;
-        d["points"] = r.points;
-        d["iterations"] = r.iterations;
-        d["status"] = to_string(r.status);
-        d["message"] = r.message;
-        d["brief_report"] = r.brief_report();
-        return result("TwoDofTuning", d);
+        return tuning_result(without_gil([&] { return tune_two_dof(f, o); }));
       },
       arg("frf"),
       ("Tunes the 2-DoF model to a measured FRF u -> [d_e, Vs] (report section 3): the report's procedure,\n"
        "then Levenberg-Marquardt on the relative complex error. Returns a Result: params and initial\n"
        "(dicts of the 9 parameters, SI), features (rad/s), fit errors (rms relative), points, iterations,\n"
-       "status, message.\n\nKeywords (TuningOptions):\n" + tuning_options().doc())
+       "status, message, bench (the measurement chain removed), quality (ident.FitQuality).\n\n"
+       "Keywords (TuningOptions):\n" + tuning_options().doc())
+          .c_str());
+  m.def(
+      "tune_two_dof_measured",
+      [](py::object frf, py::object de_plant, py::object vs_plant, const py::kwargs& kw) {
+        const std::string src = "apa.tune_two_dof_measured";
+        const auto& f = frf_arg(frf, src, "frf");
+        auto o = tuning_options().from_kwargs(kwargs_dict(kw), src);
+        const ident::DelayedSecondOrderFit* de = nullptr;
+        const ident::IffPlantFit* vs = nullptr;
+        if (!de_plant.is_none()) {
+          if (!py::isinstance<ident::DelayedSecondOrderFit>(de_plant)) {
+            throw InputError(src, "de_plant", "an ident.DelayedSecondOrderFit or None", short_repr(de_plant));
+          }
+          de = &de_plant.cast<const ident::DelayedSecondOrderFit&>();
+        }
+        if (!vs_plant.is_none()) {
+          if (!py::isinstance<ident::IffPlantFit>(vs_plant)) {
+            throw InputError(src, "vs_plant", "an ident.IffPlantFit or None", short_repr(vs_plant));
+          }
+          vs = &vs_plant.cast<const ident::IffPlantFit&>();
+        }
+        return tuning_result(without_gil([&] { return tune_two_dof_measured(f, o, de, vs); }));
+      },
+      arg("frf"), arg("de_plant") = py::none(), arg("vs_plant") = py::none(),
+      ("The campaign's tuning on measured FRFs (`piezobench run` and `model tune`): the measurement chain\n"
+       "found by the plant fits (ident.fit_actuator_plants: de_plant gives the delay, vs_plant the high-pass\n"
+       "corner and Vs's extra lag) removed, then apa.tune_two_dof. A plant that is None leaves the `bench`\n"
+       "keyword's part as given. Returns the same Result as tune_two_dof (bench = the chain removed).\n\n"
+       "Keywords (TuningOptions):\n" + tuning_options().doc())
           .c_str());
 }
 

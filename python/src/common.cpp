@@ -137,6 +137,16 @@ py::object result(const std::string& type, py::dict fields) {
   return cls(type, fields);
 }
 
+py::object typed_to_dict(py::handle self) {
+  static py::object f = py::module_::import("piezobench._result").attr("typed_to_dict");
+  return f(self);
+}
+
+std::string typed_repr(py::handle self) {
+  static py::object f = py::module_::import("piezobench._result").attr("typed_repr");
+  return py::str(f(self));
+}
+
 double number_arg(py::handle value, const std::string& source, const std::string& key) {
   if (py::isinstance<py::bool_>(value) || !(PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()) ||
                                             PyNumber_Check(value.ptr()))) {

@@ -34,6 +34,11 @@ struct RootLocus;
 }
 namespace piezobench::dsp {
 struct Frf;
+struct FrfProvenance;
+}
+namespace piezobench::apa {
+struct TwoDofTuning;
+struct TwoDofBench;
 }
 
 namespace piezobench::python {
@@ -96,6 +101,19 @@ py::array view(const Eigen::MatrixXd& m, py::handle owner);
 // A piezobench.Result: attribute access to `fields`, to_dict(), a readable repr. `type` is its
 // class name as shown by repr (e.g. "TwoDofTuning").
 py::object result(const std::string& type, py::dict fields);
+
+// Typed results bound as classes (ident.IffPlantFit, campaign.UnitAnalysis, ...): read-only
+// properties in the order of the C++ struct, to_dict() (nested typed results as dicts, arrays kept)
+// and a repr listing them. typed() adds to_dict and __repr__ to a py::class_.
+py::object typed_to_dict(py::handle self);
+std::string typed_repr(py::handle self);
+template <class Class>
+Class& typed(Class& cls) {
+  cls.def("to_dict", [](py::handle self) { return typed_to_dict(self); },
+          "The fields as a dict (nested results as dicts; arrays stay numpy arrays).");
+  cls.def("__repr__", [](py::handle self) { return typed_repr(self); });
+  return cls;
+}
 
 // A JSON document as Python values; objects become Results (typed by `type`, nested ones by their
 // key) when as_results, else dicts (campaign.cpp).
@@ -315,6 +333,12 @@ class Options;
 const Options<lti::RootLocusOptions>& root_locus_options();
 // Result(gains, poles): poles[i] are the closed-loop poles at gains[i] (lti.cpp).
 py::object root_locus_result(const lti::RootLocus& r);
+// Result of apa.tune_two_dof (apa.cpp), also campaign.Model2DofFit.tuning.
+py::object tuning_result(const apa::TwoDofTuning& t);
+// How an FRF was estimated (Frf.provenance, campaign.FrfAnalysis.welch) as a dict (dsp.cpp).
+py::dict provenance_dict(const dsp::FrfProvenance& p);
+// apa.TwoDofBench keywords as a dict (apa.cpp).
+py::dict two_dof_bench_dict(const apa::TwoDofBench& b);
 // An argument that must be a dsp.Frf.
 const dsp::Frf& frf_arg(py::handle obj, const std::string& source, const std::string& field);
 

@@ -183,19 +183,6 @@ py::array stack(const std::vector<Eigen::VectorXd>& v, bool single) {
   return out;
 }
 
-py::dict provenance_dict(const FrfProvenance& p) {
-  py::dict d;
-  d["source"] = p.source;
-  d["estimator"] = p.estimator;
-  d["window"] = p.window;
-  d["nfft"] = p.nfft;
-  d["overlap"] = p.overlap;
-  d["detrend"] = p.detrend;
-  d["averages"] = p.averages;
-  d["sample_rate"] = p.sample_rate;
-  return d;
-}
-
 py::object excitation(Excitation&& e) {
   py::dict d;
   const double fs = e.sample_rate;
@@ -234,6 +221,19 @@ void def_excitation(py::module_& m, const char* name, const Options<O>& table, E
 }
 
 }  // namespace
+
+py::dict provenance_dict(const dsp::FrfProvenance& p) {
+  py::dict d;
+  d["source"] = p.source;
+  d["estimator"] = p.estimator;
+  d["window"] = p.window;
+  d["nfft"] = p.nfft;
+  d["overlap"] = p.overlap;
+  d["detrend"] = p.detrend;
+  d["averages"] = p.averages;
+  d["sample_rate"] = p.sample_rate;
+  return d;
+}
 
 const Frf& frf_arg(py::handle obj, const std::string& source, const std::string& field) {
   if (!py::isinstance<Frf>(obj)) throw InputError(source, field, "a dsp.Frf (dsp.frf(...).frf, io.read_frf, dsp.Frf(...))", short_repr(obj));

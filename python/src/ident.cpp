@@ -1,9 +1,15 @@
-// piezobench.ident: include/piezobench/ident/{vector_fitting,features,modal}.hpp
+// piezobench.ident: include/piezobench/ident/{vector_fitting,features,modal,plant_fit}.hpp and the
+// fits' quality verdict (core/fit_quality.hpp)
+#include <cmath>
+
 #include "common.hpp"
+#include "piezobench/core/fit_quality.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/modal.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/ident/vector_fitting.hpp"
+#include "piezobench/lti/transfer_function.hpp"
 
 namespace piezobench::python {
 namespace {
@@ -90,6 +96,58 @@ const Options<LscfOptions>& lscf_options() {
   return t;
 }
 
+const Options<IffPlantFitOptions>& plant_fit_options() {
+  static const Options<IffPlantFitOptions> t = [] {
+    Options<IffPlantFitOptions> o("IffPlantFitOptions");
+    o.add("fmin_hz", &IffPlantFitOptions::fmin_hz, "Hz, band used; 0 = from the lowest positive frequency")
+        .add("fmax_hz", &IffPlantFitOptions::fmax_hz, "Hz; 0 = up to the highest")
+        .add("hpf_fmax_hz", &IffPlantFitOptions::hpf_fmax_hz, "Hz, points below this start the high-pass corner")
+        .add("min_coherence", &IffPlantFitOptions::min_coherence, "points with a known coherence below this are left out")
+        .add("fit_delay", &IffPlantFitOptions::fit_delay, "False: delay fixed at 0")
+        .add("fixed_w_hpf", &IffPlantFitOptions::fixed_w_hpf, "rad/s; > 0: the high-pass corner is known (1 / (R C)), not fitted")
+        .add("max_iterations", &IffPlantFitOptions::max_iterations, "Levenberg-Marquardt steps");
+    return o;
+  }();
+  return t;
+}
+
+const Options<ActuatorPlantOptions>& actuator_plant_options() {
+  static const Options<ActuatorPlantOptions> t = [] {
+    Options<ActuatorPlantOptions> o("ActuatorPlantOptions");
+    o.add("fmin_hz", &ActuatorPlantOptions::fmin_hz, "Hz, lowest frequency of the d_e fit")
+        .add("fmax_hz", &ActuatorPlantOptions::fmax_hz, "Hz, highest frequency of both fits")
+        .add("iff_fmin_hz", &ActuatorPlantOptions::iff_fmin_hz, "Hz, lowest frequency of the Vs fit")
+        .add("hpf_fmax_hz", &ActuatorPlantOptions::hpf_fmax_hz, "Hz, points below this start the high-pass corner")
+        .add("fixed_w_hpf", &ActuatorPlantOptions::fixed_w_hpf, "rad/s; > 0: the high-pass corner is known (1 / (R C_sensor))")
+        .add("min_coherence", &ActuatorPlantOptions::min_coherence, "points with a known coherence below this are left out");
+    return o;
+  }();
+  return t;
+}
+
+// (omega, h, coherence) of fit_iff_plant / fit_delayed_second_order: arrays, or (frf, output name)
+// with the FRF's coherence.
+struct PlantData {
+  Vector omega;
+  CVector h;
+  Vector coherence;
+};
+PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle coherence, const std::string& source) {
+  PlantData d;
+  if (py::isinstance<dsp::Frf>(omega_or_frf)) {
+    const auto& f = frf_arg(omega_or_frf, source, "frf");
+    const auto i = static_cast<std::size_t>(f.output_index(string_arg(h_or_output, source, "output")));
+    d.omega = 2.0 * M_PI * f.freq_hz;
+    d.h = f.H[i];
+    if (i < f.coherence.size()) d.coherence = f.coherence[i];
+    return d;
+  }
+  d.omega = to_vector(omega_or_frf, source, "omega");
+  d.h = to_complex_vector(h_or_output, source, "h");
+  if (!coherence.is_none()) d.coherence = to_vector(coherence, source, "coherence");
+  return d;
+}
+
 py::object vf_result(const VectorFittingResult& r) {
   py::dict d;
   d["poles"] = to_numpy(r.poles);
@@ -104,6 +162,7 @@ py::object vf_result(const VectorFittingResult& r) {
   d["convergence"] = to_string(r.convergence);
   d["last_pole_change"] = r.last_pole_change;
   d["frequency_scale"] = r.frequency_scale;
+  d["quality"] = py::cast(r.quality);
   d["brief_report"] = r.brief_report();
   d["evaluate"] = py::cpp_function(
       [r](py::object omega) { return to_numpy(r.evaluate(to_vector(omega, "VectorFittingResult.evaluate", "omega"))); },
@@ -161,6 +220,134 @@ std::pair<Vector, CMatrix> data_args(py::handle omega, py::handle h, const std::
 void bind_ident(py::module_& m) {
   using py::arg;
 
+  {
+    py::class_<core::FitQuality> c(m, "FitQuality", R"(The quality verdict of a fit (core/fit_quality.hpp).
+
+verdict is "good" or "poor" (an output's relative rms error above 0.2, a resonance outside the band,
+the iterations exhausted, ...); impossible: a parameter has a value no actuator can have (negative
+stiffness, delay, ...), so the fit's parameters are not a result. problems name the output or
+parameter and its number; advice says what to try.)");
+    c.def_property_readonly("verdict", [](const core::FitQuality& q) { return core::to_string(q.verdict); },
+                            "\"good\" or \"poor\"")
+        .def_property_readonly("poor", &core::FitQuality::poor, "verdict == \"poor\"")
+        .def_readonly("impossible", &core::FitQuality::impossible, "a parameter has an impossible value")
+        .def_readonly("problems", &core::FitQuality::problems, "one line per problem (list of str)")
+        .def_readonly("advice", &core::FitQuality::advice, "what to try (\"\" when good)")
+        .def_property_readonly("summary", &core::FitQuality::summary, "\"good\" or \"poor: PROBLEM; ... Try: ADVICE\"");
+    typed(c);
+  }
+  {
+    py::class_<IffPlantFit> c(m, "IffPlantFit", R"(The IFF plant of eq. 2.3 fitted to a u -> Vs FRF (ident/plant_fit.hpp):
+
+  G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
+
+xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant keywords.)");
+    c.def_readonly("g0", &IffPlantFit::g0, "V/V, gain (signed)")
+        .def_readonly("wz", &IffPlantFit::wz, "rad/s, anti-resonance")
+        .def_readonly("xz", &IffPlantFit::xz, "damping ratio of the zero pair (< 0: non-minimum phase)")
+        .def_readonly("wp", &IffPlantFit::wp, "rad/s, resonance")
+        .def_readonly("xp", &IffPlantFit::xp, "damping ratio of the pole pair")
+        .def_readonly("w_hpf", &IffPlantFit::w_hpf, "rad/s, high-pass corner")
+        .def_readonly("delay", &IffPlantFit::delay, "s")
+        .def_property_readonly("wz_hz", [](const IffPlantFit& f) { return f.wz / (2.0 * M_PI); }, "Hz, anti-resonance")
+        .def_property_readonly("wp_hz", [](const IffPlantFit& f) { return f.wp / (2.0 * M_PI); }, "Hz, resonance")
+        .def_property_readonly("w_hpf_hz", [](const IffPlantFit& f) { return f.w_hpf / (2.0 * M_PI); }, "Hz, high-pass corner")
+        .def_readonly("relative_rms_error", &IffPlantFit::relative_rms_error, "rms |G/H - 1| over the points used")
+        .def_readonly("weighted_relative_rms_error", &IffPlantFit::weighted_relative_rms_error, "the same with the fit's per-decade weights")
+        .def_readonly("initial_relative_rms_error", &IffPlantFit::initial_relative_rms_error, "weighted, at the better start")
+        .def_readonly("points", &IffPlantFit::points, "frequencies used")
+        .def_readonly("iterations", &IffPlantFit::iterations, "Levenberg-Marquardt steps")
+        .def_readonly("converged", &IffPlantFit::converged)
+        .def_property_readonly("status", [](const IffPlantFit& f) { return core::to_string(f.status); }, "Levenberg-Marquardt's stop")
+        .def_readonly("quality", &IffPlantFit::quality, "ident.FitQuality")
+        .def_property_readonly("zero_is_nonminimum_phase", &IffPlantFit::zero_is_nonminimum_phase, "xz < 0")
+        .def("params", [](const IffPlantFit& f) {
+          py::dict d;
+          d["g0"] = f.g0; d["wz"] = f.wz; d["xz"] = f.xz; d["wp"] = f.wp; d["xp"] = f.xp; d["w_hpf"] = f.w_hpf; d["delay"] = f.delay;
+          return d;
+        }, "The plant's parameters as the keywords of control.iff_plant / control.iff_root_locus (SI, rad/s).")
+        .def("transfer_function", &IffPlantFit::transfer_function, "G(s) with its delay (lti.TransferFunction).")
+        .def("response", [](const IffPlantFit& f, py::object omega) {
+          return to_numpy(f.response(to_vector(omega, "IffPlantFit.response", "omega")));
+        }, arg("omega"), "G(j omega) at omega (rad/s), complex.");
+    typed(c);
+  }
+  {
+    py::class_<DelayedSecondOrderFit> c(m, "DelayedSecondOrderFit", R"(The mass-spring-damper u -> d_e with the measurement delay
+(ident/plant_fit.hpp): H(s) = k wn^2 / (s^2 + 2 zeta wn s + wn^2) * exp(-s delay).)");
+    c.def_readonly("static_gain", &DelayedSecondOrderFit::static_gain, "k, output / input units (m/V for u -> d_e), signed")
+        .def_readonly("natural_frequency", &DelayedSecondOrderFit::natural_frequency, "wn, rad/s")
+        .def_property_readonly("frequency_hz", [](const DelayedSecondOrderFit& f) { return f.natural_frequency / (2.0 * M_PI); }, "wn in Hz")
+        .def_readonly("damping", &DelayedSecondOrderFit::damping, "zeta")
+        .def_readonly("delay", &DelayedSecondOrderFit::delay, "s")
+        .def_readonly("relative_rms_error", &DelayedSecondOrderFit::relative_rms_error, "rms |H_model / H - 1| over the points used")
+        .def_readonly("points", &DelayedSecondOrderFit::points, "frequencies used")
+        .def_readonly("iterations", &DelayedSecondOrderFit::iterations, "Levenberg-Marquardt steps")
+        .def_property_readonly("status", [](const DelayedSecondOrderFit& f) { return core::to_string(f.status); }, "Levenberg-Marquardt's stop")
+        .def_readonly("quality", &DelayedSecondOrderFit::quality, "ident.FitQuality")
+        .def_property_readonly("pole", &DelayedSecondOrderFit::pole, "rad/s, -zeta wn + j wn sqrt(1 - zeta^2)")
+        .def("response", [](const DelayedSecondOrderFit& f, py::object omega) {
+          return to_numpy(f.response(to_vector(omega, "DelayedSecondOrderFit.response", "omega")));
+        }, arg("omega"), "H(j omega) at omega (rad/s), complex.");
+    typed(c);
+  }
+
+  m.def(
+      "fit_iff_plant",
+      [](py::object omega_or_frf, py::object h_or_output, py::object coherence, const py::kwargs& kw) {
+        const std::string src = "ident.fit_iff_plant";
+        auto o = plant_fit_options().from_kwargs(kwargs_dict(kw), src);
+        auto d = plant_data(omega_or_frf, h_or_output, coherence, src);
+        return without_gil([&] { return fit_iff_plant(d.omega, d.h, d.coherence, o, src); });
+      },
+      arg("omega"), arg("h"), arg("coherence") = py::none(),
+      ("The IFF plant of eq. 2.3 (report section 2.6) with its delay fitted to u -> Vs by Levenberg-Marquardt on\n"
+       "the relative complex error: (omega (rad/s), h (V/V), coherence=None) or (frf, output_name). Returns an\n"
+       "ident.IffPlantFit (g0, wz, xz, wp, xp, w_hpf, delay, errors, quality).\n\nKeywords (IffPlantFitOptions):\n" +
+       plant_fit_options().doc())
+          .c_str());
+  m.def(
+      "fit_delayed_second_order",
+      [](py::object omega_or_frf, py::object h_or_output, py::object coherence, const py::kwargs& kw) {
+        const std::string src = "ident.fit_delayed_second_order";
+        auto o = plant_fit_options().from_kwargs(kwargs_dict(kw), src);
+        auto d = plant_data(omega_or_frf, h_or_output, coherence, src);
+        return without_gil([&] { return fit_delayed_second_order(d.omega, d.h, d.coherence, o, src); });
+      },
+      arg("omega"), arg("h"), arg("coherence") = py::none(),
+      ("k wn^2 / (s^2 + 2 zeta wn s + wn^2) exp(-s delay) fitted to u -> d_e (or a damped plant u' -> d_e):\n"
+       "(omega (rad/s), h, coherence=None) or (frf, output_name). Returns an ident.DelayedSecondOrderFit.\n"
+       "Keywords: fmin_hz, fmax_hz, min_coherence, fit_delay, max_iterations of IffPlantFitOptions:\n" +
+       plant_fit_options().doc())
+          .c_str());
+  m.def(
+      "fit_actuator_plants",
+      [](py::object frf, const std::string& de_output, const std::string& vs_output, const py::kwargs& kw) {
+        const std::string src = "ident.fit_actuator_plants";
+        auto o = actuator_plant_options().from_kwargs(kwargs_dict(kw), src);
+        const auto& f = frf_arg(frf, src, "frf");
+        const auto ide = static_cast<std::size_t>(f.output_index(de_output));
+        const auto ivs = static_cast<std::size_t>(f.output_index(vs_output));
+        const auto coh = [&](std::size_t i) { return i < f.coherence.size() ? f.coherence[i] : Vector(); };
+        const std::string source = f.provenance.source.empty() ? src : f.provenance.source;
+        auto p = without_gil([&] {
+          return fit_actuator_plants(2.0 * M_PI * f.freq_hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
+        });
+        py::dict d;
+        d["de"] = p.de ? py::cast(*p.de) : py::none();
+        d["vs"] = p.vs ? py::cast(*p.vs) : py::none();
+        d["de_options"] = plant_fit_options().to_dict(p.de_options);
+        d["vs_options"] = plant_fit_options().to_dict(p.vs_options);
+        d["failures"] = py::cast(p.failures);
+        return result("ActuatorPlants", d);
+      },
+      arg("frf"), arg("de_output") = "de", arg("vs_output") = "Vs",
+      ("Both plants of an actuator's FRF u -> [d_e, Vs] fitted as `piezobench run` and `model tune` do:\n"
+       "Result(de (ident.DelayedSecondOrderFit or None), vs (ident.IffPlantFit or None), de_options, vs_options,\n"
+       "failures (a fit that failed numerically)). Pass de and vs to apa.tune_two_dof_measured.\n\n"
+       "Keywords (ActuatorPlantOptions):\n" + actuator_plant_options().doc())
+          .c_str());
+
   m.def(
       "vector_fit",
       [](py::object omega_or_frf, py::object data, py::object weights, const py::kwargs& kw) {
@@ -178,7 +365,7 @@ void bind_ident(py::module_& m) {
       ("Vector fitting (Gustavsen & Semlyen 1999, relaxed 2006, fast QR): common poles fitted to\n"
        "data (points,) or (points, outputs) at s = j omega (rad/s); or vector_fit(frf) for every\n"
        "output of a dsp.Frf. Returns a Result: poles, residues, d, e, model (lti.StateSpace), rms_error,\n"
-       "relative_rms_error, iterations, converged, convergence, evaluate(omega).\n\nKeywords:\n" +
+       "relative_rms_error, iterations, converged, convergence, quality (ident.FitQuality), evaluate(omega).\n\nKeywords:\n" +
        vf_options().doc())
           .c_str());
   m.def(
@@ -287,12 +474,13 @@ void bind_ident(py::module_& m) {
         py::dict d;
         d["modes"] = modes;
         d["diagram"] = result("StabilizationDiagram", diag);
+        d["quality"] = py::cast(r.quality);
         return result("LscfResult", d);
       },
       arg("omega"), arg("h"),
       ("Least-squares complex-frequency estimator (PolyMAX-like, single reference) over a range of\n"
        "orders with a stabilization diagram: Result(modes, diagram (order, pole, natural_frequency,\n"
-       "damping, stable as arrays)).\n\nKeywords:\n" + lscf_options().doc())
+       "damping, stable as arrays), quality (ident.FitQuality)).\n\nKeywords:\n" + lscf_options().doc())
           .c_str());
 }
 

@@ -1,30 +1,114 @@
 """piezobench.campaign: a short demo campaign written and run from Python, its typed results
-checked against the virtual bench's truth (as tests/campaign/demo_test.cpp does in C++)."""
+checked against the virtual bench's truth (as tests/campaign/demo_test.cpp does in C++) and against
+the results.json that the command line (`piezobench run`) writes for the same campaign."""
 
 import json
+import os
+import subprocess
 
+import numpy as np
 import pytest
 
 import piezobench as pb
-from piezobench import campaign
+from piezobench import campaign, ident
 
 
-def test_demo_campaign_results_agree_with_the_truth(tmp_path):
-    files = campaign.write_demo(str(tmp_path), fast=True, units=[1], iff_gains=[60e3, 120e3])
-    r = campaign.run(files.campaign, out_dir=str(tmp_path / "out"))
+def _cli():
+    """The piezobench command of the same build (ctest sets PIEZOBENCH_CLI)."""
+    path = os.environ.get("PIEZOBENCH_CLI") or os.path.join(os.path.dirname(__file__), "..", "..", "build", "app",
+                                                             "piezobench")
+    return path if os.path.exists(path) else None
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("demo")
+    files = campaign.write_demo(str(tmp), fast=True, units=[1], iff_gains=[60e3, 120e3])
+    return tmp, files, campaign.run(files.campaign, out_dir=str(tmp / "out"))
+
+
+def test_demo_campaign_results_agree_with_the_truth(demo):
+    tmp, files, r = demo
     truth = json.loads(open(files.truth).read())["units"][0]
-    unit = r.results.units[0]
-    assert unit.id == 1 and unit.accepted and r.accepted == 1 and r.rejected == 0
-    assert unit.frf.resonance_Hz == pytest.approx(truth["resonance_Hz"], rel=0.01)
-    assert unit.frf.antiresonance_Hz == pytest.approx(truth["antiresonance_Hz"], rel=0.01)
-    assert unit.frf.zero_is_nonminimum_phase == truth["zero_is_nonminimum_phase"]
-    assert unit.stiffness_N_per_um.k1 == pytest.approx(truth["stiffness_N_per_um"]["k1"], rel=0.05)
-    # to_dict() is plain data: the same document as results.json on disk.
-    d = r.results.to_dict()
-    on_disk = json.loads((tmp_path / "out" / "results.json").read_text())
-    assert d["units"][0]["id"] == on_disk["units"][0]["id"]
-    assert d["units"][0]["frf"]["resonance_Hz"] == pytest.approx(on_disk["units"][0]["frf"]["resonance_Hz"], rel=1e-12)
+    assert isinstance(r, campaign.CampaignResult)
+    unit = r.units[0]
+    assert isinstance(unit, campaign.UnitAnalysis)
+    assert unit.id == 1 and unit.accepted and unit.reasons == [] and r.accepted == 1 and r.rejected == 0
+    assert unit.resonance_Hz == pytest.approx(truth["resonance_Hz"], rel=0.01)
+    assert unit.antiresonance_Hz == pytest.approx(truth["antiresonance_Hz"], rel=0.01)
+    assert unit.frf_analysis.zero_is_nonminimum_phase == truth["zero_is_nonminimum_phase"]
+    assert unit.k1 * 1e-6 == pytest.approx(truth["stiffness_N_per_um"]["k1"], rel=0.05)
+    # The IFF plant of the unit is an ident.IffPlantFit with its verdict, as ident.fit_iff_plant returns.
+    assert isinstance(unit.iff_plant, ident.IffPlantFit) and unit.iff_plant.quality.verdict == "good"
+    assert unit.iff_plant.zero_is_nonminimum_phase
+    # results.json stays available as Results (the earlier interface) and as plain dicts.
+    assert r.results.units[0].frf.resonance_Hz == unit.resonance_Hz
+    on_disk = json.loads((tmp / "out" / "results.json").read_text())
+    d = r.to_dict()
+    assert d["units"][0]["frf"]["resonance_Hz"] == on_disk["units"][0]["frf"]["resonance_Hz"]
+    assert isinstance(d["units"][0], dict) and isinstance(d["iff"], dict)  # plain data
+    assert unit.json().frf.resonance_Hz == unit.resonance_Hz
     assert any(p.endswith("report.html") for p in r.written)
+    # Read-only, with to_dict() on every typed class.
+    with pytest.raises(AttributeError):
+        unit.k1 = 1.0
+    u = unit.to_dict()
+    assert u["k1"] == unit.k1 and u["frf_analysis"]["hpf"]["corner_Hz"] == unit.frf_analysis.hpf.corner_Hz
+    assert r.unit(1).id == 1
+    with pytest.raises(pb.InputError) as e:
+        r.unit(7)
+    assert e.value.field == "id"
+
+
+def test_typed_results_equal_the_results_json_of_the_command_line(demo):
+    cli = _cli()
+    if cli is None:
+        pytest.skip("the piezobench command is not built (set PIEZOBENCH_CLI)")
+    tmp, files, r = demo
+    out = tmp / "cli"
+    p = subprocess.run([cli, "run", files.campaign, "--out", str(out)], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    j = json.loads((out / "results.json").read_text())
+    ju = j["units"][0]
+    u = r.units[0]
+    # Per unit (SI in Python, the report's units in results.json).
+    assert ju["id"] == u.id and ju["name"] == u.name and ju["accepted"] == u.accepted and ju["reasons"] == u.reasons
+    same = lambda a, b: a == pytest.approx(b, rel=1e-12, abs=0.0)  # noqa: E731
+    assert same(u.k1 / 1e6, ju["stiffness_N_per_um"]["k1"])
+    assert same(u.k2 / 1e6, ju["stiffness_N_per_um"]["k2"])
+    assert same(u.k_oc / 1e6, ju["stiffness_N_per_um"]["k_oc"])
+    assert same(u.k_resonance / 1e6, ju["stiffness_N_per_um"]["resonance"])
+    assert same(u.flatness * 1e6, ju["flatness_um"])
+    assert same(u.stroke * 1e6, ju["stroke_um"])
+    assert same(u.capacitance_sensor * 1e6, ju["capacitance_uF"]["sensor"])
+    assert same(u.capacitance_actuator * 1e6, ju["capacitance_uF"]["actuator"])
+    assert same(u.resonance_Hz, ju["frf"]["resonance_Hz"])
+    assert same(u.antiresonance_Hz, ju["frf"]["antiresonance_Hz"])
+    assert same(u.static_gain * 1e6, ju["frf"]["static_gain_um_per_V"])
+    assert same(u.frf_analysis.hpf.corner_Hz, ju["hpf_corner_Hz"])
+    params = u.model_2dof.tuning.params
+    for name in ("k1", "ke", "ka", "ga", "gs", "m"):
+        assert same(params[name], ju["model_2dof"][name]), name
+    # The batch summary.
+    assert r.accepted == j["summary"]["accepted"] and r.rejected == j["summary"]["rejected"]
+    for s in r.batch.spread:
+        js = j["batch"]["spread"][s.quantity]
+        assert s.units == js["units"]
+        for field in ("min", "max", "median", "relative_spread", "mad"):
+            assert same(getattr(s, field), js[field]), (s.quantity, field)
+    assert sorted(s.quantity for s in r.batch.spread) == sorted(j["batch"]["spread"])
+    assert len(r.batch.outliers) == len(j["batch"]["outliers"])
+    # The IFF study.
+    iff, ji = r.iff, j["iff"]
+    assert iff.unit == ji["unit"]
+    np.testing.assert_allclose(iff.gains, ji["gains"], rtol=1e-12)
+    np.testing.assert_allclose(iff.damped_poles, [complex(*p) for p in ji["damped_poles"]], rtol=1e-12)
+    np.testing.assert_allclose(iff.model_poles, [complex(*p) for p in ji["model_poles"]], rtol=1e-12)
+    assert same(iff.optimal_gain, ji["optimal_gain"]) and same(iff.max_damping, ji["max_damping"])
+    assert same(iff.optimal_pole, complex(*ji["optimal_pole"]))
+    assert same(iff.max_relative_pole_distance, ji["max_relative_pole_distance"])
+    assert same(iff.plant.wz_hz, ji["plant"]["wz_Hz"]) and same(iff.plant.xz, ji["plant"]["xz"])
+    assert same(iff.plant.delay, ji["plant"]["delay_s"])
 
 
 def test_missing_campaign_file():

@@ -80,3 +80,90 @@ def test_peak_picking_and_lscf_find_both_modes():
     assert freqs == pytest.approx([100.0, 300.0], rel=1e-4)
     assert sorted(m.damping for m in r.modes) == pytest.approx([0.01, 0.02], rel=1e-2)
     assert r.diagram.order.size == r.diagram.pole.size > 0
+
+
+# ---- the plant fits of the report (ident/plant_fit.hpp) on scipy-generated responses -----------
+
+def _iff_plant_scipy(w, g0, wz, xz, wp, xp, w_hpf, delay):
+    """Eq. 2.3 with scipy.signal.freqs: g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2)
+    * s / (w_hpf + s) * exp(-s delay)."""
+    from scipy import signal
+    num = g0 * np.polymul([1 / wz**2, 2 * xz / wz, 1.0], [1.0, 0.0])
+    den = np.polymul([1 / wp**2, 2 * xp / wp, 1.0], [1.0, w_hpf])
+    _, h = signal.freqs(num, den, worN=w)
+    return h * np.exp(-1j * w * delay)
+
+
+def test_iff_plant_fit_recovers_a_scipy_eq_2_3_plant_with_its_nonminimum_phase_zero():
+    truth = dict(g0=0.64, wz=2 * np.pi * 42.7, xz=-0.004, wp=2 * np.pi * 95.2, xp=0.02, w_hpf=2 * np.pi * 0.4,
+                 delay=200e-6)
+    w = 2 * np.pi * np.arange(0.5, 1000.01, 0.5)
+    h = _iff_plant_scipy(w, **truth)
+    fit = ident.fit_iff_plant(w, h)
+    assert isinstance(fit, ident.IffPlantFit)
+    for name in ("g0", "wz", "wp", "xp", "w_hpf", "delay"):
+        assert getattr(fit, name) == pytest.approx(truth[name], rel=1e-3), name
+    assert fit.xz == pytest.approx(truth["xz"], abs=1e-4)
+    assert fit.zero_is_nonminimum_phase
+    assert fit.wp_hz == pytest.approx(95.2, rel=1e-3)
+    assert fit.relative_rms_error < 1e-3
+    assert fit.quality.verdict == "good" and not fit.quality.poor and not fit.quality.impossible
+    assert fit.quality.problems == [] and fit.quality.summary == "good"
+    # The fitted model is the control module's plant: same response as scipy's.
+    np.testing.assert_allclose(fit.response(w), h, rtol=2e-3)
+    g = control.iff_plant(**fit.params())
+    np.testing.assert_allclose(np.ravel(lti.freqresp(g, w)), fit.response(w), rtol=1e-9)
+    d = fit.to_dict()
+    assert d["wz"] == fit.wz and d["quality"]["verdict"] == "good"
+    with pytest.raises(AttributeError):
+        fit.wz = 1.0  # read-only
+
+
+def test_delayed_second_order_fit_recovers_a_scipy_mass_spring_damper():
+    from scipy import signal
+    k, wn, zeta, delay = -1.68e-5, 2 * np.pi * 95.4, 0.0056, 250e-6
+    w = 2 * np.pi * np.arange(20.0, 500.0, 0.5)
+    _, h = signal.freqs([k * wn**2], [1.0, 2 * zeta * wn, wn**2], worN=w)
+    h = h * np.exp(-1j * w * delay)
+    fit = ident.fit_delayed_second_order(w, h)
+    assert fit.static_gain == pytest.approx(k, rel=1e-6)
+    assert fit.natural_frequency == pytest.approx(wn, rel=1e-6)
+    assert fit.damping == pytest.approx(zeta, rel=1e-4)
+    assert fit.delay == pytest.approx(delay, rel=1e-4)
+    assert fit.pole == pytest.approx(-zeta * wn + 1j * wn * np.sqrt(1 - zeta**2), rel=1e-6)
+    assert fit.quality.verdict == "good"
+    # Keywords are the C++ options' names, checked.
+    with pytest.raises(pb.InputError) as e:
+        ident.fit_delayed_second_order(w, h, fmax=400.0)
+    assert e.value.field == "fmax"
+
+
+def test_actuator_plants_of_a_scipy_welch_frf_and_the_vector_fit_verdicts(welch_frf):
+    frf, truth = welch_frf
+    plants = ident.fit_actuator_plants(frf)
+    assert plants.failures == []
+    assert plants.de.natural_frequency / (2 * np.pi) == pytest.approx(truth["resonance_Hz"], rel=0.01)
+    assert plants.de.static_gain == pytest.approx(truth["static_gain_de_m_per_V"], rel=0.02)
+    assert plants.de.delay == pytest.approx(truth["effective_delay_s"], rel=0.05)
+    assert plants.vs.wp_hz == pytest.approx(truth["resonance_Hz"], rel=0.01)
+    assert plants.vs.wz_hz == pytest.approx(truth["antiresonance_Hz"], rel=0.01)
+    assert plants.vs.w_hpf_hz == pytest.approx(truth["hpf_corner_Hz"], rel=0.1)
+    assert plants.de.quality.verdict == "good" and plants.vs.quality.verdict == "good"
+    # The same plant from (frf, output) with the FRF's coherence and the options the pair used.
+    vs = ident.fit_iff_plant(frf, "Vs", **plants.vs_options)
+    assert vs.wz == plants.vs.wz and vs.delay == plants.vs.delay
+    # Vector fitting reports its verdict: order 2 over 20-400 Hz finds the resonance (good).
+    w = frf.omega
+    band = (frf.freq_hz >= 20) & (frf.freq_hz <= 400)
+    good = ident.vector_fit(w[band], frf.response("de")[band], order=2)
+    assert good.quality.verdict == "good"
+    assert abs(good.poles[0]) / (2 * np.pi) == pytest.approx(truth["resonance_Hz"], rel=0.01)
+    # Two modes of equal static gain fitted with one pole pair leave an error far above 20 %: poor,
+    # the output and its error named.
+    w2 = np.linspace(10.0, 1000.0, 800)
+    s2 = 1j * w2
+    h2 = sum(wn**2 / (s2**2 + 2 * 0.01 * wn * s2 + wn**2) for wn in (100.0, 500.0))
+    poor = ident.vector_fit(w2, h2, order=2, fail_if_not_converged=False)
+    assert poor.quality.poor and poor.quality.verdict == "poor" and poor.quality.advice
+    assert any("output 1" in p for p in poor.quality.problems), poor.quality.problems
+    assert poor.to_dict()["quality"]["verdict"] == "poor"
