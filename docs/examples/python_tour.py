@@ -4,9 +4,10 @@
 1. a record of the virtual bench (or your own arrays): u, d_e, Vs sampled at fs;
 2. the FRFs u -> d_e and u -> Vs with their coherence (Welch H1);
 3. the non-minimum-phase check of the anti-resonance of u -> Vs;
-4. the IFF design: the plant model from the FRF, the root locus with the report's controller,
-   the gain of maximum damping;
-5. the 2-DoF model tuned to both FRFs.
+4. the IFF design: the report's plant model (eq. 2.3) fitted to the FRF with its delay, the root
+   locus with the report's controller, the gain of maximum damping;
+5. the 2-DoF model tuned to both FRFs, the measurement chain (delay, high-pass) found by the plant
+   fits and removed, as `piezobench run` and `model tune` do.
 Each step checks its numbers against the virtual bench's truth and exits non-zero when one is off.
 """
 
@@ -44,23 +45,22 @@ print(f"anti-resonance {anti.frequency_hz:.2f} Hz (truth {truth.antiresonance_Hz
       f"{'in the RHP' if anti.nonminimum_phase_model else 'in the LHP'}, phase change {anti.phase_change_deg:.0f} deg "
       f"-> {anti.phase_verdict}")
 
-# 4. IFF design with the report's plant model (eq. 2.3): resonance and its damping by peak picking
-#    on u -> d_e, the anti-resonance from step 3, the high-pass corner fitted below 5 Hz; then the
-#    root locus with the report's controller (eq. 2.4) and the gain of maximum damping.
-mode = ident.peak_picking(2 * np.pi * f[band], est.H[0][band], max_modes=1)[0]
-hp = ident.fit_high_pass(2 * np.pi * f[1:], est.H[1][1:], max_omega=2 * np.pi * 5.0)
-plant = control.iff_plant(g0=abs(features.static_gain), wz=anti.natural_frequency, xz=anti.damping,
-                          wp=mode.natural_frequency, xp=mode.damping, w_hpf=hp.corner)
-locus = control.iff_root_locus(plant, control.iff_controller())
-print(f"IFF: resonance {mode.frequency_hz:.2f} Hz, damping {mode.damping:.4f}; high-pass {hp.corner_hz:.2f} Hz; "
-      f"optimal gain {locus.optimum.gain:.3g} -> damping {locus.optimum.damping:.3f}")
+# 4. IFF design with the report's plant model (eq. 2.3): g0, wz, xz, wp, xp, the high-pass corner and
+#    the delay fitted to u -> Vs (the report tuned them by hand); then the root locus with the
+#    report's controller (eq. 2.4) and the gain of maximum damping. xz < 0 is a non-minimum-phase zero.
+plant_fit = ident.fit_iff_plant(est.frf, "Vs", fmax_hz=500.0, min_coherence=0.5)
+print(f"IFF plant fit ({plant_fit.quality.verdict}): wp {plant_fit.wp_hz:.2f} Hz, xp {plant_fit.xp:.4f}; "
+      f"wz {plant_fit.wz_hz:.2f} Hz, xz {plant_fit.xz:.4f}; high-pass {plant_fit.w_hpf_hz:.2f} Hz; "
+      f"delay {plant_fit.delay * 1e6:.0f} us; relative rms error {plant_fit.relative_rms_error:.3f}")
+locus = control.iff_root_locus(control.iff_plant(**plant_fit.params()), control.iff_controller())
+print(f"IFF: optimal gain {locus.optimum.gain:.3g} -> damping {locus.optimum.damping:.3f}")
 
-# 5. The 2-DoF model tuned to both FRFs, the bench's chain (amplifier, high-pass, delay) removed.
-frf = est.frf
-tuning = apa.tune_two_dof(frf, mass=5.7, fmin_hz=2.0, fmax_hz=400.0,
-                          bench={"amplifier_gain": 20.0, "hpf_resistance": 80.6e3,
-                                 "hpf_capacitance": 1.0 / (80.6e3 * hp.corner), "delay": truth.delay_s})
-print(f"2-DoF tuning: {tuning.brief_report}")
+# 5. The 2-DoF model tuned to both FRFs: the plant fits give the delay of d_e and the high-pass of
+#    Vs, which are removed before the report's procedure and the refinement (only the mass is known).
+plants = ident.fit_actuator_plants(est.frf)
+tuning = apa.tune_two_dof_measured(est.frf, plants.de, plants.vs, mass=5.7, fmin_hz=20.0, fmax_hz=400.0,
+                                   min_coherence=0.5)
+print(f"2-DoF tuning ({tuning.quality.summary}): {tuning.brief_report}")
 for name in ("k1", "ke", "ka", "ga", "gs"):
     print(f"  {name} = {tuning.params[name]:.4g}   (truth {truth.model_2dof[name]:.4g})")
 
@@ -68,7 +68,11 @@ checks = [
     ("resonance within 1 %", abs(peak_hz / truth.resonance_Hz - 1) < 0.01),
     ("anti-resonance within 2 %", abs(anti.frequency_hz / truth.antiresonance_Hz - 1) < 0.02),
     ("NMP verdict as the truth", (anti.phase_verdict == "non-minimum-phase") == bool(truth.zero_is_nonminimum_phase)),
+    ("fitted plant: anti-resonance within 2 %", abs(plant_fit.wz_hz / truth.antiresonance_Hz - 1) < 0.02),
+    ("fitted plant: zero pair as the truth", plant_fit.zero_is_nonminimum_phase == bool(truth.zero_is_nonminimum_phase)),
+    ("fitted plant: good", plant_fit.quality.verdict == "good"),
     ("IFF damps the resonance above 10 %", locus.optimum.damping > 0.10),
+    ("tuning: good", tuning.quality.verdict == "good"),
     ("tuned k1 within 5 %", abs(tuning.params["k1"] / truth.model_2dof["k1"] - 1) < 0.05),
 ]
 failed = [name for name, ok in checks if not ok]
