@@ -1,5 +1,6 @@
 // piezobench.dsp: include/piezobench/dsp/*.hpp
 #include "common.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/dsp/welch.hpp"
@@ -273,7 +274,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
            "freq_hz (Hz, increasing); H: 1-D for one output or (outputs, points); outputs: names; coherence "
            "like H (None = unknown).")
       .def_property_readonly("freq_hz", [](py::object self) { return view(self.cast<const Frf&>().freq_hz, self); }, "Hz")
-      .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(2.0 * M_PI * f.freq_hz)); }, "rad/s")
+      .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_hz)); }, "rad/s")
       .def_readonly("input", &Frf::input)
       .def_readonly("outputs", &Frf::outputs)
       .def_property_readonly("H", [](const Frf& f) { return stack(f.H, f.H.size() == 1); },

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "common.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/ident/features.hpp"
@@ -137,7 +138,7 @@ PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle
   if (py::isinstance<dsp::Frf>(omega_or_frf)) {
     const auto& f = frf_arg(omega_or_frf, source, "frf");
     const auto i = static_cast<std::size_t>(f.output_index(string_arg(h_or_output, source, "output")));
-    d.omega = 2.0 * M_PI * f.freq_hz;
+    d.omega = kTwoPi * f.freq_hz;
     d.h = f.H[i];
     if (i < f.coherence.size()) d.coherence = f.coherence[i];
     return d;
@@ -249,9 +250,9 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         .def_readonly("xp", &IffPlantFit::xp, "damping ratio of the pole pair")
         .def_readonly("w_hpf", &IffPlantFit::w_hpf, "rad/s, high-pass corner")
         .def_readonly("delay", &IffPlantFit::delay, "s")
-        .def_property_readonly("wz_hz", [](const IffPlantFit& f) { return f.wz / (2.0 * M_PI); }, "Hz, anti-resonance")
-        .def_property_readonly("wp_hz", [](const IffPlantFit& f) { return f.wp / (2.0 * M_PI); }, "Hz, resonance")
-        .def_property_readonly("w_hpf_hz", [](const IffPlantFit& f) { return f.w_hpf / (2.0 * M_PI); }, "Hz, high-pass corner")
+        .def_property_readonly("wz_hz", [](const IffPlantFit& f) { return f.wz / kTwoPi; }, "Hz, anti-resonance")
+        .def_property_readonly("wp_hz", [](const IffPlantFit& f) { return f.wp / kTwoPi; }, "Hz, resonance")
+        .def_property_readonly("w_hpf_hz", [](const IffPlantFit& f) { return f.w_hpf / kTwoPi; }, "Hz, high-pass corner")
         .def_readonly("relative_rms_error", &IffPlantFit::relative_rms_error, "rms |G/H - 1| over the points used")
         .def_readonly("weighted_relative_rms_error", &IffPlantFit::weighted_relative_rms_error, "the same with the fit's per-decade weights")
         .def_readonly("initial_relative_rms_error", &IffPlantFit::initial_relative_rms_error, "weighted, at the better start")
@@ -277,7 +278,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
 (ident/plant_fit.hpp): H(s) = k wn^2 / (s^2 + 2 zeta wn s + wn^2) * exp(-s delay).)");
     c.def_readonly("static_gain", &DelayedSecondOrderFit::static_gain, "k, output / input units (m/V for u -> d_e), signed")
         .def_readonly("natural_frequency", &DelayedSecondOrderFit::natural_frequency, "wn, rad/s")
-        .def_property_readonly("frequency_hz", [](const DelayedSecondOrderFit& f) { return f.natural_frequency / (2.0 * M_PI); }, "wn in Hz")
+        .def_property_readonly("frequency_hz", [](const DelayedSecondOrderFit& f) { return f.natural_frequency / kTwoPi; }, "wn in Hz")
         .def_readonly("damping", &DelayedSecondOrderFit::damping, "zeta")
         .def_readonly("delay", &DelayedSecondOrderFit::delay, "s")
         .def_readonly("relative_rms_error", &DelayedSecondOrderFit::relative_rms_error, "rms |H_model / H - 1| over the points used")
@@ -331,7 +332,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         const auto coh = [&](std::size_t i) { return i < f.coherence.size() ? f.coherence[i] : Vector(); };
         const std::string source = f.provenance.source.empty() ? src : f.provenance.source;
         auto p = without_gil([&] {
-          return fit_actuator_plants(2.0 * M_PI * f.freq_hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
+          return fit_actuator_plants(kTwoPi * f.freq_hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
         });
         py::dict d;
         d["de"] = p.de ? py::cast(*p.de) : py::none();
