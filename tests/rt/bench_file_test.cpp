@@ -6,52 +6,17 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "comedi_bench_text.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::rt {
 namespace {
 
-const std::string kComedi = R"(
-[bench]
-name = "report bench"
-backend = "comedi"
-sample_rate_Hz = 10000
-[amplifier]
-gain_V_per_V = 20
-[limits]
-va_min_V = -20
-va_max_V = 150
-slew_rate_V_per_s = 1e5
-[encoder]
-resolution_m = 2.5e-9
-[comedi]
-device = "/dev/comedi0"
-calibration = "auto"
-[signals.u]
-subdevice = 1
-channel = 0
-range = [-10, 10]
-scale = 1.0
-unit = "V"
-[signals.d_e]
-subdevice = 2
-channel = 0
-kind = "counter"
-unit = "m"
-[signals.Vs]
-subdevice = 0
-channel = 2
-range = [-10, 10]
-scale = 1.0
-unit = "V"
-)";
+// The rt tests' Comedi bench with a name and the encoder's resolution, no Va monitor.
+const std::string kComedi =
+    test::replace_once(test::replace_once(test::comedi_bench_text("/dev/comedi0", "auto"), "[bench]\n", "[bench]\nname = \"report bench\"\n"),
+                       "[comedi]\n", "[encoder]\nresolution_m = 2.5e-9\n[comedi]\n");
 
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
 
 std::string error_of(const std::string& text) {
   try {
@@ -75,7 +40,7 @@ TEST(BenchFile, ReadsTheComediBench) {
 
 TEST(BenchFile, RefusesARangeThatCannotExpressTheLimits) {
   // 150 V / 20 V/V = 7.5 V at the DAC: a 0..5 V output cannot reach it (nor -1 V).
-  const std::string e = error_of(replace(kComedi, "range = [-10, 10]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]",
+  const std::string e = error_of(test::replace_once(kComedi, "range = [-10, 10]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]",
                                          "range = [0, 5]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]"));
   EXPECT_TRUE(test::contains(e, "signals.u.range")) << e;
   EXPECT_TRUE(test::contains(e, "-1 .. 7.5 V at the DAC")) << e;
@@ -86,21 +51,21 @@ TEST(BenchFile, RefusesAMissingChannel) {
   const std::string e = error_of(text);
   EXPECT_TRUE(test::contains(e, "signals.Vs")) << e;
   EXPECT_TRUE(test::contains(e, "missing channel")) << e;
-  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "subdevice = 0\nchannel = 2", "subdevice = 0")), "signals.Vs.channel"));
+  EXPECT_TRUE(test::contains(error_of(test::replace_once(kComedi, "subdevice = 0\nchannel = 2", "subdevice = 0")), "signals.Vs.channel"));
 }
 
 TEST(BenchFile, RefusesAWrongSignFromUToVa) {
-  std::string e = error_of(replace(kComedi, "range = [-10, 10]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]",
+  std::string e = error_of(test::replace_once(kComedi, "range = [-10, 10]\nscale = 1.0\nunit = \"V\"\n[signals.d_e]",
                                    "range = [-10, 10]\nscale = -1.0\nunit = \"V\"\n[signals.d_e]"));
   EXPECT_TRUE(test::contains(e, "signals.u.scale")) << e;
-  e = error_of(replace(kComedi, "gain_V_per_V = 20", "gain_V_per_V = -20"));
+  e = error_of(test::replace_once(kComedi, "gain_V_per_V = 20", "gain_V_per_V = -20"));
   EXPECT_TRUE(test::contains(e, "amplifier.gain_V_per_V")) << e;
 }
 
 TEST(BenchFile, AHardwareBenchNeedsItsLimits) {
-  std::string e = error_of(replace(kComedi, "va_max_V = 150\n", ""));
+  std::string e = error_of(test::replace_once(kComedi, "va_max_V = 150\n", ""));
   EXPECT_TRUE(test::contains(e, "limits.va_max_V")) << e;
-  e = error_of(replace(kComedi, "slew_rate_V_per_s = 1e5\n", ""));
+  e = error_of(test::replace_once(kComedi, "slew_rate_V_per_s = 1e5\n", ""));
   EXPECT_TRUE(test::contains(e, "limits.slew_rate_V_per_s")) << e;
   const std::string udp = "[bench]\nbackend = \"udp\"\nsample_rate_Hz = 10000\n[udp]\naddress = \"127.0.0.1:5600\"\n";
   e = error_of(udp);
@@ -111,9 +76,9 @@ TEST(BenchFile, AHardwareBenchNeedsItsLimits) {
 }
 
 TEST(BenchFile, NamesUnknownKeysAndBadValues) {
-  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "[encoder]", "[encoder]\nresolution = 1")), "encoder.resolution"));
-  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "backend = \"comedi\"", "backend = \"nidaq\"")), "bench.backend"));
-  EXPECT_TRUE(test::contains(error_of(replace(kComedi, "unit = \"m\"", "unit = \"mm\"")), "signals.d_e.unit"));
+  EXPECT_TRUE(test::contains(error_of(test::replace_once(kComedi, "[encoder]", "[encoder]\nresolution = 1")), "encoder.resolution"));
+  EXPECT_TRUE(test::contains(error_of(test::replace_once(kComedi, "backend = \"comedi\"", "backend = \"nidaq\"")), "bench.backend"));
+  EXPECT_TRUE(test::contains(error_of(test::replace_once(kComedi, "unit = \"m\"", "unit = \"mm\"")), "signals.d_e.unit"));
   EXPECT_TRUE(test::contains(error_of("[bench\n"), "bench.toml"));
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 
+#include "comedi_bench_text.hpp"
 #include "fake_comedi.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
@@ -19,53 +20,13 @@ namespace {
 
 namespace fc = test::fake_comedi;
 
+// The rt tests' Comedi bench on the simulated card, with a ramp time and the Va monitor.
 std::string bench_text(const std::string& calibration = "soft") {
-  return R"(
-[bench]
-backend = "comedi"
-sample_rate_Hz = 10000
-[comedi]
-device = "/dev/comedi-fake0"
-calibration = ")" + calibration + R"("
-[amplifier]
-gain_V_per_V = 20
-[limits]
-va_min_V = -20
-va_max_V = 150
-slew_rate_V_per_s = 1e5
-ramp_s = 0.01
-[signals.u]
-subdevice = 1
-channel = 0
-range = [-10, 10]
-scale = 1.0
-unit = "V"
-[signals.d_e]
-subdevice = 2
-channel = 0
-kind = "counter"
-unit = "m"
-[signals.Vs]
-subdevice = 0
-channel = 2
-range = [-10, 10]
-scale = 1.0
-unit = "V"
-[signals.Va]
-subdevice = 0
-channel = 3
-range = [-0.4, 3.0]
-scale = 50.0
-unit = "V"
-)";
+  return test::replace_once(test::comedi_bench_text("/dev/comedi-fake0", calibration), "slew_rate_V_per_s = 1e5\n",
+                            "slew_rate_V_per_s = 1e5\nramp_s = 0.01\n") +
+         "[signals.Va]\nsubdevice = 0\nchannel = 3\nrange = [-0.4, 3.0]\nscale = 50.0\nunit = \"V\"\n";
 }
 
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
 
 fc::Card& fresh_card() { return fc::reset(bench::batch_unit(1, 1), bench::BenchOptions{}, 7); }
 
@@ -154,15 +115,15 @@ TEST(ComediBackend, RefusesTheCardBeforeAnythingMoves) {
     return what;
   };
   const std::string base = bench_text();
-  std::string e = start_error(replace(base, "subdevice = 0\nchannel = 2", "subdevice = 0\nchannel = 20"));
+  std::string e = start_error(test::replace_once(base, "subdevice = 0\nchannel = 2", "subdevice = 0\nchannel = 20"));
   EXPECT_TRUE(test::contains(e, "signals.Vs.channel")) << e;
   EXPECT_TRUE(test::contains(e, "missing channel")) << e;
-  e = start_error(replace(base, "subdevice = 1\nchannel = 0", "subdevice = 0\nchannel = 0"));
+  e = start_error(test::replace_once(base, "subdevice = 1\nchannel = 0", "subdevice = 0\nchannel = 0"));
   EXPECT_TRUE(test::contains(e, "analog output")) << e;
-  e = start_error(replace(base, "channel = 2\nrange = [-10, 10]", "channel = 2\nrange = [-20, 20]"));
+  e = start_error(test::replace_once(base, "channel = 2\nrange = [-10, 10]", "channel = 2\nrange = [-20, 20]"));
   EXPECT_TRUE(test::contains(e, "signals.Vs.range")) << e;
   EXPECT_TRUE(test::contains(e, "[-10, 10], [-5, 5], [-1, 1]")) << e;
-  e = start_error(replace(base, "/dev/comedi-fake0", "/dev/comedi-none"));
+  e = start_error(test::replace_once(base, "/dev/comedi-fake0", "/dev/comedi-none"));
   EXPECT_TRUE(test::contains(e, "comedi.device")) << e;
 }
 
