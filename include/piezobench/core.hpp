@@ -1,12 +1,14 @@
 #pragma once
 // The core module: errors (InputError, NumericalError, UsageError), shared constants, the one
 // Levenberg-Marquardt, the one golden-section search, fit-quality verdicts and sign-constrained
-// linear least squares.
+// linear least squares, text helpers and whole-file input/output shared by the readers.
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/file.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/core/minimize.hpp"
 #include "piezobench/core/nnls.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"

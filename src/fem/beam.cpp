@@ -3,7 +3,9 @@
 #include <cmath>
 #include <vector>
 
-#include "fem/text.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::fem {
@@ -14,7 +16,7 @@ BeamSection BeamSection::parse(const std::string& text, const std::string& field
   std::string_view rest(text);
   for (;;) {
     const auto comma = rest.find(',');
-    const auto x = detail::parse_double(detail::trim(rest.substr(0, comma)));
+    const auto x = text::parse_double(text::trim(rest.substr(0, comma)));
     if (!x || !std::isfinite(*x)) throw InputError("", field, form, "'" + text + "'");
     v.push_back(*x);
     if (comma == std::string_view::npos) break;

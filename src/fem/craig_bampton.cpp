@@ -11,7 +11,9 @@
 #include <numbers>
 #include <set>
 
-#include "fem/text.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::fem {
@@ -58,7 +60,7 @@ class ShiftInvertOp {
     shifted_->compute(A);
     if (shifted_->info() != Eigen::Success) {
       throw NumericalError("Craig-Bampton (CHOLMOD factorization of K_ii - sigma M_ii)",
-                           "not positive definite for the shift " + detail::g17(sigma) + " (rad/s)^2", true);
+                           "not positive definite for the shift " + format_number(sigma, 17) + " (rad/s)^2", true);
     }
     factor_ = shifted_.get();
   }
@@ -216,11 +218,11 @@ InterfacePoint InterfacePoint::parse(const std::string& text, const std::string&
   const std::string form = "NODE or REF_NODE:ROT_NODE";
   InterfacePoint p;
   const auto colon = text.find(':');
-  const auto node = detail::parse_int(std::string_view(text).substr(0, colon));
+  const auto node = text::parse_int(std::string_view(text).substr(0, colon));
   if (!node || *node < 0) throw InputError("", field, form, "'" + text + "'");
   p.node = static_cast<long>(*node);
   if (colon != std::string::npos) {
-    const auto rot = detail::parse_int(std::string_view(text).substr(colon + 1));
+    const auto rot = text::parse_int(std::string_view(text).substr(colon + 1));
     if (!rot || *rot < 0 || *rot == *node) throw InputError("", field, form, "'" + text + "'");
     p.rot_node = static_cast<long>(*rot);
   }
@@ -230,10 +232,10 @@ InterfacePoint InterfacePoint::parse(const std::string& text, const std::string&
 void CraigBamptonOptions::validate() const {
   if (modes < 0) throw InputError("Craig-Bampton options", "modes", "a number of modes >= 0", std::to_string(modes));
   if (!(std::isfinite(shift) && shift <= 0.0)) {
-    throw InputError("Craig-Bampton options", "shift", "a finite shift <= 0 (rad/s)^2", detail::g17(shift));
+    throw InputError("Craig-Bampton options", "shift", "a finite shift <= 0 (rad/s)^2", format_number(shift, 17));
   }
   if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    throw InputError("Craig-Bampton options", "tolerance", "a value in (0, 1)", detail::g17(tolerance));
+    throw InputError("Craig-Bampton options", "tolerance", "a value in (0, 1)", format_number(tolerance, 17));
   }
   if (max_iterations < 1) throw InputError("Craig-Bampton options", "max_iterations", "a value >= 1", std::to_string(max_iterations));
   if (ncv < 0) throw InputError("Craig-Bampton options", "ncv", "0 (automatic) or a basis size", std::to_string(ncv));

@@ -12,7 +12,9 @@
 
 #include "fem/from_step_files.hpp"
 #include "fem/from_step_process.hpp"
-#include "fem/text.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/fem/matrix_io.hpp"
@@ -43,7 +45,7 @@ std::vector<double> parse_numbers(std::string_view text, std::size_t count, cons
   const auto parts = split(text, ',');
   std::vector<double> out;
   for (const std::string_view p : parts) {
-    const auto v = detail::parse_double(p);
+    const auto v = text::parse_double(p);
     if (!v || !std::isfinite(*v)) throw InputError("", field, form, "'" + whole + "'");
     out.push_back(*v);
   }
@@ -111,7 +113,7 @@ class Runner {
     } catch (const std::system_error& e) {
       throw InputError("--" + name, "executable", "a program that can be started", exe->string() + ": " + e.what());
     }
-    const std::string text = detail::read_file(log);
+    const std::string text = read_file(log);
     const auto version = detail::parse_version(text);
     if (!version || pr.signaled) {
       throw InputError("--" + name, "version",
@@ -146,7 +148,7 @@ class Runner {
   }
 
   void log_line_of(const std::string& label, std::string_view line) const {
-    std::string_view t = detail::trim(line);
+    std::string_view t = text::trim(line);
     if (t.rfind("Info    : ", 0) == 0) t.remove_prefix(10);
     if (!t.empty()) log("  " + label + ": " + std::string(t));
   }
@@ -176,7 +178,7 @@ void copy_into(const fs::path& from, const fs::path& to) {
 }
 
 void write_text(const fs::path& file, const std::string& text) {
-  detail::write_atomically(file, [&](std::ostream& out) { out << text; });
+  write_atomically(file, [&](std::ostream& out) { out << text; });
 }
 
 std::string sanitize_stem(const std::string& stem) {
@@ -205,7 +207,7 @@ bool Box3::contains(const Box3& other, double tolerance) const {
 FaceSelector FaceSelector::parse(const std::string& text, const std::string& field) {
   const std::string form = "x|y|z=min|max|VALUE_MM, box:x0,y0,z0,x1,y1,z1 or surface:TAG[,TAG...]";
   FaceSelector s;
-  const std::string t = detail::lower(std::string(detail::trim(text)));
+  const std::string t = text::to_lower(std::string(text::trim(text)));
   if (t.rfind("box:", 0) == 0) {
     s.kind = Kind::kBox;
     s.box = Box3::parse(t.substr(4), field);
@@ -214,7 +216,7 @@ FaceSelector FaceSelector::parse(const std::string& text, const std::string& fie
   if (t.rfind("surface:", 0) == 0) {
     s.kind = Kind::kSurfaces;
     for (const std::string_view p : split(std::string_view(t).substr(8), ',')) {
-      const auto tag = detail::parse_int(p);
+      const auto tag = text::parse_int(p);
       if (!tag || *tag < 1) throw InputError("", field, form, "'" + text + "'");
       s.surfaces.push_back(static_cast<int>(*tag));
     }
@@ -229,7 +231,7 @@ FaceSelector FaceSelector::parse(const std::string& text, const std::string& fie
   } else if (at == "min") {
     s.at = At::kMin;
   } else {
-    const auto v = detail::parse_double(at);
+    const auto v = text::parse_double(at);
     if (!v || !std::isfinite(*v)) throw InputError("", field, form, "'" + text + "'");
     s.at = At::kValue;
     s.value = *v;
@@ -266,7 +268,7 @@ RemotePointSpec RemotePointSpec::parse(const std::string& text, const std::strin
   const std::string form = "NAME:SELECTOR, e.g. top:y=max (NAME: letters, digits, _)";
   if (colon == std::string::npos) throw InputError("", field, form, "'" + text + "'");
   RemotePointSpec r;
-  r.name = std::string(detail::trim(std::string_view(text).substr(0, colon)));
+  r.name = std::string(text::trim(std::string_view(text).substr(0, colon)));
   if (!detail::is_valid_name(r.name)) throw InputError("", field, form, "'" + text + "'");
   r.selector = FaceSelector::parse(text.substr(colon + 1), field + " " + r.name);
   return r;
@@ -277,8 +279,8 @@ RegionSpec RegionSpec::parse(const std::string& text, const std::string& field) 
   const auto colon = text.find(':');
   if (colon == std::string::npos || text.compare(colon + 1, 4, "box:") != 0) throw InputError("", field, form, "'" + text + "'");
   RegionSpec r;
-  r.name = std::string(detail::trim(std::string_view(text).substr(0, colon)));
-  if (!detail::is_valid_name(r.name) || detail::lower(r.name) == "body") {
+  r.name = std::string(text::trim(std::string_view(text).substr(0, colon)));
+  if (!detail::is_valid_name(r.name) || text::to_lower(r.name) == "body") {
     throw InputError("", field, form + "; 'body' is the rest of the model", "'" + text + "'");
   }
   r.box = Box3::parse(text.substr(colon + 5), field + " " + r.name);
@@ -287,7 +289,7 @@ RegionSpec RegionSpec::parse(const std::string& text, const std::string& field) 
 
 Material Material::parse(const std::string& text, const std::string& field) {
   const std::string form = "E,nu,rho (Pa, -, kg/m^3), e.g. 190e9,0.3,7800, or none (the region is removed)";
-  if (detail::lower(std::string(detail::trim(text))) == "none") {
+  if (text::to_lower(std::string(text::trim(text))) == "none") {
     Material m;
     m.removed = true;
     return m;
@@ -304,10 +306,10 @@ JointSpec JointSpec::parse(const std::string& text, const std::string& field) {
   const auto parts = split(text, ':');
   if (parts.size() != 4) throw InputError("", field, form, "'" + text + "'");
   JointSpec j;
-  j.name = std::string(detail::trim(parts[0]));
-  j.from = std::string(detail::trim(parts[1]));
-  j.to = std::string(detail::trim(parts[2]));
-  const auto f = detail::parse_double(detail::trim(parts[3]));
+  j.name = std::string(text::trim(parts[0]));
+  j.from = std::string(text::trim(parts[1]));
+  j.to = std::string(text::trim(parts[2]));
+  const auto f = text::parse_double(text::trim(parts[3]));
   if (!detail::is_valid_name(j.name) || !detail::is_valid_name(j.from) || !detail::is_valid_name(j.to) || !f || !(*f > 0.0 && *f < 1.0)) {
     throw InputError("", field, form, "'" + text + "'");
   }
@@ -320,8 +322,8 @@ StackSpec StackSpec::parse(const std::string& text, const std::string& field) {
   const auto parts = split(text, ':');
   if (parts.size() != 2 && parts.size() != 3) throw InputError("", field, form, "'" + text + "'");
   StackSpec st;
-  st.from = std::string(detail::trim(parts[0]));
-  st.to = std::string(detail::trim(parts[1]));
+  st.from = std::string(text::trim(parts[0]));
+  st.to = std::string(text::trim(parts[1]));
   if (!detail::is_valid_name(st.from) || !detail::is_valid_name(st.to)) throw InputError("", field, form, "'" + text + "'");
   if (parts.size() == 3) st.section = BeamSection::parse(std::string(parts[2]), field);
   return st;
@@ -399,13 +401,13 @@ FromStepOptions FromStepOptions::apa95ml() {
 void FromStepOptions::validate() const {
   const std::string src = "superelement from-step";
   if (!(std::isfinite(mesh_size_mm) && mesh_size_mm > 0.0)) {
-    throw InputError(src, "--mesh-size", "a mesh size > 0 mm", detail::g17(mesh_size_mm));
+    throw InputError(src, "--mesh-size", "a mesh size > 0 mm", format_number(mesh_size_mm, 17));
   }
   if (element_order != 1 && element_order != 2) throw InputError(src, "--order", "1 (C3D4) or 2 (C3D10)", std::to_string(element_order));
   if (modes < 0) throw InputError(src, "--modes", "a number of modes >= 0", std::to_string(modes));
   if (clamped_modes < 1) throw InputError(src, "--clamped-modes", "at least 1", std::to_string(clamped_modes));
   if (!(std::isfinite(geometry_tolerance_mm) && geometry_tolerance_mm > 0.0)) {
-    throw InputError(src, "--geometry-tolerance", "a tolerance > 0 mm", detail::g17(geometry_tolerance_mm));
+    throw InputError(src, "--geometry-tolerance", "a tolerance > 0 mm", format_number(geometry_tolerance_mm, 17));
   }
   if (remote_points.empty()) throw InputError(src, "--remote-point", "at least one remote point", "none");
   std::set<std::string> names;
@@ -466,10 +468,10 @@ void FromStepOptions::validate() const {
     if (!detail::is_valid_name(name) || !std::isfinite(value)) throw InputError(src, "--geo-parameter", "NAME=VALUE (a finite number)", "'" + name + "'");
   }
   if (!(std::isfinite(max_memory_GB) && max_memory_GB >= 0.0)) {
-    throw InputError(src, "--max-memory", "a memory limit >= 0 GB (0: automatic)", detail::g17(max_memory_GB));
+    throw InputError(src, "--max-memory", "a memory limit >= 0 GB (0: automatic)", format_number(max_memory_GB, 17));
   }
   if (!(std::isfinite(tool_timeout_s) && tool_timeout_s > 0.0)) {
-    throw InputError(src, "--tool-timeout", "a time limit > 0 s", detail::g17(tool_timeout_s));
+    throw InputError(src, "--tool-timeout", "a time limit > 0 s", format_number(tool_timeout_s, 17));
   }
   for (const auto& [name, m] : materials) {
     if (region_names.count(detail::upper(name)) == 0) {
@@ -504,14 +506,14 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
   r.gmsh = run.check_tool(o.gmsh, "gmsh", "--version", kMinGmsh, "gmsh", w);
   r.ccx = run.check_tool(o.ccx, "ccx", "-v", kMinCcx, "calculix-ccx", w);
   run.log("gmsh " + r.gmsh.version + " (" + r.gmsh.path + "), ccx " + r.ccx.version + " (" + r.ccx.path + ")");
-  if (detail::lower(step_file.extension().string()) == ".geo") {
+  if (text::to_lower(step_file.extension().string()) == ".geo") {
     // A gmsh script (e.g. apa300ml.geo): exported to STEP with its parameters, then as any STEP file.
     copy_into(step_file, w / "model.geo");
     std::vector<std::string> args = {"-0", "model.geo"};
     std::string text;
     for (const auto& [name, value] : o.geo_parameters) {
-      args.insert(args.end(), {"-setnumber", name, detail::g17(value)});
-      text += " " + name + "=" + detail::g17(value);
+      args.insert(args.end(), {"-setnumber", name, format_number(value, 17)});
+      text += " " + name + "=" + format_number(value, 17);
     }
     args.insert(args.end(), {"-o", "model.step"});
     run.log("[0/6] exporting the gmsh script to STEP:" + (text.empty() ? std::string(" default parameters") : text));
@@ -520,7 +522,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
     step_done("gmsh export", e_run.seconds);
     if (e_run.exit_code != 0 || !fs::exists(w / "model.step")) {
       throw InputError(step_file.string(), "geo", "a gmsh script that gmsh exports to STEP",
-                       "exit code " + std::to_string(e_run.exit_code) + ": " + detail::last_lines(detail::read_file(export_log), "rror", 3) +
+                       "exit code " + std::to_string(e_run.exit_code) + ": " + detail::last_lines(read_file(export_log), "rror", 3) +
                            " (log: " + export_log.string() + ")");
     }
   } else {
@@ -536,7 +538,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
   const auto g_run = run.run(r.gmsh, "gmsh", {"-0", "geometry.geo", "-o", "geometry.geo_unrolled"}, w, geometry_log,
                              [](std::string_view l) { return l.find("Error") != std::string_view::npos; });
   step_done("gmsh geometry", g_run.seconds);
-  const std::string g_log = detail::read_file(geometry_log);
+  const std::string g_log = read_file(geometry_log);
   if (!fs::exists(w / "geometry.txt")) {
     // gmsh writes its report even when the STEP file does not load: this is not gmsh running a .geo script.
     throw InputError("--gmsh", "gmsh", "gmsh running the geometry script (it writes geometry.txt)",
@@ -549,7 +551,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
                      "gmsh exit code " + std::to_string(g_run.exit_code) + (errors.empty() ? "" : ": " + errors) + " (log: " +
                          geometry_log.string() + ")");
   }
-  const detail::GeometryReport geometry = detail::parse_geometry_report(detail::read_file(w / "geometry.txt"), (w / "geometry.txt").string());
+  const detail::GeometryReport geometry = detail::parse_geometry_report(read_file(w / "geometry.txt"), (w / "geometry.txt").string());
   if (geometry.volumes.empty()) {
     const std::string errors = detail::last_lines(g_log, "ERR", 2);
     throw InputError(step_file.string(), "STEP", "a STEP file with at least one solid",
@@ -574,7 +576,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
     const double limit = o.max_memory_GB > 0.0 ? o.max_memory_GB : default_max_memory_GB();
     char buf[160];
     std::snprintf(buf, sizeof buf, "  estimate at %g mm: ", o.mesh_size_mm);
-    run.log(buf + r.estimate.to_string() + "; memory limit " + detail::g17(limit) + " GB");
+    run.log(buf + r.estimate.to_string() + "; memory limit " + format_number(limit, 17) + " GB");
     if (r.estimate.memory_GB > limit) {
       // The smallest mesh size within the limit (the estimate falls as h grows).
       double lo = o.mesh_size_mm, hi = std::max(1.0, o.mesh_size_mm);
@@ -587,7 +589,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
       std::snprintf(hint, sizeof hint, "%.2g", hi * 1.05);
       std::snprintf(buf, sizeof buf, "--mesh-size %g mm: ", o.mesh_size_mm);
       throw UsageError("superelement from-step: " + std::string(buf) + r.estimate.to_string() + ", more than the limit of " +
-                       detail::g17(limit) + " GB for this machine. The mesh size is in millimetres: give --mesh-size " + hint +
+                       format_number(limit, 17) + " GB for this machine. The mesh size is in millimetres: give --mesh-size " + hint +
                        " or more, or raise the limit with --max-memory GB (gmsh was not started)");
     }
   }
@@ -633,7 +635,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
   step_done("gmsh mesh", m_run.seconds);
   if (m_run.exit_code != 0 || !fs::exists(w / "gmsh.inp")) {
     throw NumericalError("gmsh meshing", "exit code " + std::to_string(m_run.exit_code) + ": " +
-                                             detail::last_lines(detail::read_file(mesh_log), "Error", 3) + " (log: " + mesh_log.string() + ")",
+                                             detail::last_lines(read_file(mesh_log), "Error", 3) + " (log: " + mesh_log.string() + ")",
                          true);
   }
   const detail::GmshMesh mesh = detail::read_gmsh_inp(w / "gmsh.inp");
@@ -717,7 +719,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
   step_done("ccx matrices", c_run.seconds);
   if (c_run.exit_code != 0 || !fs::exists(w / "matrices.sti") || !fs::exists(w / "matrices.mas") || !fs::exists(w / "matrices.dof")) {
     throw NumericalError("ccx (*FREQUENCY,SOLVER=MATRIXSTORAGE)",
-                         "exit code " + std::to_string(c_run.exit_code) + ": " + detail::last_lines(detail::read_file(ccx_log), "ERROR", 3) +
+                         "exit code " + std::to_string(c_run.exit_code) + ": " + detail::last_lines(read_file(ccx_log), "ERROR", 3) +
                              " (log: " + ccx_log.string() + ", deck: " + (o.out / "matrices.inp").string() + ")",
                          false);
   }
@@ -809,7 +811,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
       add_node(r.reduced, next, x);
       at[detail::upper(j.name)] = {next, x};
       r.joints.push_back({j.name, next, x});
-      run.log("  joint " + j.name + ": node " + std::to_string(next) + " at " + detail::g17(j.fraction) + " of " + j.from + " -> " + j.to);
+      run.log("  joint " + j.name + ": node " + std::to_string(next) + " at " + format_number(j.fraction, 17) + " of " + j.from + " -> " + j.to);
       ++next;
     }
     for (const StackSpec& st : o.stacks) {
@@ -848,7 +850,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
     step_done("ccx reference", v_run.seconds);
     if (v_run.exit_code != 0 || !fs::exists(w / "reference.dat")) {
       throw NumericalError("ccx (*FREQUENCY, reference)",
-                           "exit code " + std::to_string(v_run.exit_code) + ": " + detail::last_lines(detail::read_file(ref_log), "ERROR", 3) +
+                           "exit code " + std::to_string(v_run.exit_code) + ": " + detail::last_lines(read_file(ref_log), "ERROR", 3) +
                                " (log: " + ref_log.string() + ")",
                            false);
     }

@@ -6,15 +6,22 @@
 #include <set>
 #include <sstream>
 
-#include "fem/text.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::fem::detail {
+using text::for_each_line;
+using text::parse_double;
+using text::parse_int;
+using text::quote;
+using text::tokens;
+using text::trim;
+
 namespace {
 
 const char* const kAxes[3] = {"x", "y", "z"};
-
-std::string num(double v) { return g17(v); }
 
 std::string gnum(double v) {
   char buf[40];
@@ -67,7 +74,7 @@ std::string geometry_script(const std::string& step_name, const std::vector<Regi
   s += "// written by piezobench superelement from-step\n";
   s += "SetFactory(\"OpenCASCADE\");\n";
   s += "Geometry.OCCTargetUnit = \"MM\";\n";
-  s += "Geometry.ToleranceBoolean = " + num(tolerance_mm) + ";\n";
+  s += "Geometry.ToleranceBoolean = " + format_number(tolerance_mm, 17) + ";\n";
   s += "Merge \"" + step_name + "\";\n";
   s += "pb_body() = Volume{:};\n";
   for (const RegionSpec& r : regions) {
@@ -75,8 +82,8 @@ std::string geometry_script(const std::string& step_name, const std::vector<Regi
     s += "// region " + r.name + "\n";
     s += "If (#pb_body() > 0)\n";
     s += "  pb_box = newv;\n";
-    s += "  Box(pb_box) = {" + num(r.box.lo.x()) + ", " + num(r.box.lo.y()) + ", " + num(r.box.lo.z()) + ", " + num(d.x()) +
-         ", " + num(d.y()) + ", " + num(d.z()) + "};\n";
+    s += "  Box(pb_box) = {" + format_number(r.box.lo.x(), 17) + ", " + format_number(r.box.lo.y(), 17) + ", " + format_number(r.box.lo.z(), 17) + ", " + format_number(d.x(), 17) +
+         ", " + format_number(d.y(), 17) + ", " + format_number(d.z(), 17) + "};\n";
     s += "  pb_in() = BooleanIntersection{ Volume{pb_body()}; }{ Volume{pb_box}; Delete; };\n";
     s += "  If (#pb_in() > 0)\n";
     s += "    pb_all() = BooleanFragments{ Volume{pb_body()}; Delete; }{ Volume{pb_in()}; Delete; };\n";
@@ -251,7 +258,7 @@ std::string mesh_script(const std::map<std::string, std::vector<int>>& region_vo
   for (const auto& [name, surfaces] : point_surfaces) {
     s += "Physical Surface(\"F_" + upper(name) + "\") = {" + list(surfaces) + "};\n";
   }
-  s += "Mesh.MeshSizeMax = " + num(mesh_size_mm) + ";\n";
+  s += "Mesh.MeshSizeMax = " + format_number(mesh_size_mm, 17) + ";\n";
   s += "Mesh.MeshSizeFromCurvature = 0;\n";
   s += "Mesh.ElementOrder = " + std::to_string(element_order) + ";\n";
   s += "Mesh.SecondOrderLinear = 0;\n";
@@ -437,8 +444,8 @@ std::string ccx_deck(const std::string& mesh_inp_name, const std::map<std::strin
   s += "*INCLUDE, INPUT=" + mesh_inp_name + "\n";
   for (const std::string& r : regions) {
     const Material& m = materials.at(r);
-    s += "*MATERIAL, NAME=M_" + upper(r) + "\n*ELASTIC\n" + num(m.youngs_modulus) + ", " + num(m.poisson_ratio) + "\n*DENSITY\n" +
-         num(m.density) + "\n";
+    s += "*MATERIAL, NAME=M_" + upper(r) + "\n*ELASTIC\n" + format_number(m.youngs_modulus, 17) + ", " + format_number(m.poisson_ratio, 17) + "\n*DENSITY\n" +
+         format_number(m.density, 17) + "\n";
     s += "*SOLID SECTION, ELSET=E_" + upper(r) + ", MATERIAL=M_" + upper(r) + "\n";
   }
   for (const DeckPoint& p : points) {

@@ -5,13 +5,15 @@
 #include <fstream>
 #include <set>
 
-#include "fem/text.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::fem {
 namespace {
 
-using detail::quote;
+using text::quote;
 using Triplet = Eigen::Triplet<double, int>;
 
 std::string at_line(std::size_t line) { return "line " + std::to_string(line); }
@@ -45,7 +47,7 @@ SparseMatrix symmetric_from_triangle(std::vector<Triplet>& triplets, Index n, co
 
 SparseMatrix read_calculix_matrix(const std::filesystem::path& file, Index n, const ProgressCallback& progress) {
   const std::string source = file.string();
-  const std::string text = detail::read_file(file);
+  const std::string text = read_file(file);
   std::vector<Triplet> triplets;
   triplets.reserve(text.size() / 30);
   std::size_t line = 0;
@@ -57,12 +59,12 @@ SparseMatrix read_calculix_matrix(const std::filesystem::path& file, Index n, co
     if (end == std::string::npos) end = size;
     ++line;
     std::string_view s(text.data() + start, end - start);
-    if (!detail::trim(s).empty()) {
+    if (!text::trim(s).empty()) {
       const std::string_view whole = s;
-      const auto i = detail::take_int(s);
-      const auto j = i ? detail::take_int(s) : std::nullopt;
-      const auto v = j ? detail::take_double(s) : std::nullopt;
-      if (!v || !detail::trim(s).empty()) {
+      const auto i = text::take_int(s);
+      const auto j = i ? text::take_int(s) : std::nullopt;
+      const auto v = j ? text::take_double(s) : std::nullopt;
+      if (!v || !text::trim(s).empty()) {
         throw InputError(source, at_line(line), "'row col value' (1-based, CalculiX MATRIXSTORAGE)", quote(whole));
       }
       if (*i < 1 || *j < 1 || *i > n || *j > n) {
@@ -97,15 +99,15 @@ SparseMatrix read_calculix_matrix(const std::filesystem::path& file, Index n, co
 }
 
 std::vector<DofLabel> read_calculix_dofs(const std::filesystem::path& file) {
-  const std::string text = detail::read_file(file);
+  const std::string text = read_file(file);
   std::vector<DofLabel> out;
   std::set<std::pair<long, int>> seen;
-  detail::for_each_line(text, [&](std::size_t line, std::string_view l) {
-    const std::string_view t = detail::trim(l);
+  text::for_each_line(text, [&](std::size_t line, std::string_view l) {
+    const std::string_view t = text::trim(l);
     if (t.empty()) return true;
     const std::size_t dot = t.find('.');
-    const auto node = dot == std::string_view::npos ? std::nullopt : detail::parse_int(t.substr(0, dot));
-    const auto dir = node ? detail::parse_int(t.substr(dot + 1)) : std::nullopt;
+    const auto node = dot == std::string_view::npos ? std::nullopt : text::parse_int(t.substr(0, dot));
+    const auto dir = node ? text::parse_int(t.substr(dot + 1)) : std::nullopt;
     if (!dir || *node < 0 || *dir < 1 || *dir > 6) {
       throw InputError(file.string(), at_line(line), "'node.direction' with direction 1..6 (CalculiX .dof)", quote(t));
     }
@@ -145,13 +147,13 @@ namespace {
 
 void read_inp_nodes_into(const std::filesystem::path& file, std::map<long, Eigen::Vector3d>& nodes, int depth) {
   if (depth > 10) throw InputError(file.string(), "*INCLUDE", "at most 10 nested includes", "more");
-  const std::string text = detail::read_file(file);
+  const std::string text = read_file(file);
   bool in_node_block = false;
-  detail::for_each_line(text, [&](std::size_t line, std::string_view l) {
-    const std::string_view t = detail::trim(l);
+  text::for_each_line(text, [&](std::size_t line, std::string_view l) {
+    const std::string_view t = text::trim(l);
     if (t.empty() || t.rfind("**", 0) == 0) return true;
     if (t.front() == '*') {
-      const std::string keyword = detail::lower(std::string(t));
+      const std::string keyword = text::to_lower(std::string(t));
       const auto comma = keyword.find(',');
       std::string name = keyword.substr(0, comma);
       name.erase(std::remove(name.begin(), name.end(), ' '), name.end());
@@ -160,21 +162,21 @@ void read_inp_nodes_into(const std::filesystem::path& file, std::map<long, Eigen
         const auto pos = keyword.find("input=");
         if (pos == std::string::npos) throw InputError(file.string(), at_line(line), "*INCLUDE,INPUT=file", quote(t));
         // Keep the original spelling of the file name.
-        std::string included(detail::trim(t.substr(pos + 6)));
+        std::string included(text::trim(t.substr(pos + 6)));
         if (!included.empty() && included.front() == '"') included = included.substr(1, included.find('"', 1) - 1);
         read_inp_nodes_into(file.parent_path() / included, nodes, depth + 1);
       }
       return true;
     }
     if (!in_node_block) return true;
-    const auto tok = detail::tokens(t, /*commas=*/true);
-    const auto id = tok.empty() ? std::nullopt : detail::parse_int(tok[0]);
+    const auto tok = text::tokens(t, /*commas=*/true);
+    const auto id = tok.empty() ? std::nullopt : text::parse_int(tok[0]);
     if (!id || tok.size() < 2 || tok.size() > 4) {
       throw InputError(file.string(), at_line(line), "a node line 'id, x[, y[, z]]'", quote(t));
     }
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     for (std::size_t k = 1; k < tok.size(); ++k) {
-      const auto v = detail::parse_double(tok[k]);
+      const auto v = text::parse_double(tok[k]);
       if (!v || !std::isfinite(*v)) throw InputError(file.string(), at_line(line), "finite coordinates", quote(t));
       p(static_cast<Index>(k - 1)) = *v;
     }
@@ -194,19 +196,19 @@ std::map<long, Eigen::Vector3d> read_inp_nodes(const std::filesystem::path& inp_
 
 SparseMatrix read_matrix_market(const std::filesystem::path& file) {
   const std::string source = file.string();
-  const std::string text = detail::read_file(file);
+  const std::string text = read_file(file);
   bool symmetric = false;
   bool have_banner = false, have_size = false;
   long long rows = 0, cols = 0, nnz = 0;
   std::vector<Triplet> triplets;
-  detail::for_each_line(text, [&](std::size_t line, std::string_view l) {
+  text::for_each_line(text, [&](std::size_t line, std::string_view l) {
     if (!have_banner) {
-      const auto t = detail::tokens(l);
+      const auto t = text::tokens(l);
       if (t.size() != 5 || t[0] != "%%MatrixMarket") {
         throw InputError(source, "header", "'%%MatrixMarket matrix coordinate real symmetric|general'", quote(l));
       }
-      const std::string object = detail::lower(std::string(t[1])), format = detail::lower(std::string(t[2])),
-                        field = detail::lower(std::string(t[3])), symmetry = detail::lower(std::string(t[4]));
+      const std::string object = text::to_lower(std::string(t[1])), format = text::to_lower(std::string(t[2])),
+                        field = text::to_lower(std::string(t[3])), symmetry = text::to_lower(std::string(t[4]));
       if (object != "matrix" || format != "coordinate") {
         throw InputError(source, "header", "a 'matrix coordinate' file", std::string(t[1]) + " " + std::string(t[2]));
       }
@@ -220,13 +222,13 @@ SparseMatrix read_matrix_market(const std::filesystem::path& file) {
       have_banner = true;
       return true;
     }
-    const std::string_view t = detail::trim(l);
+    const std::string_view t = text::trim(l);
     if (t.empty() || t.front() == '%') return true;
-    const auto tok = detail::tokens(t);
+    const auto tok = text::tokens(t);
     if (!have_size) {
-      const auto r = tok.size() == 3 ? detail::parse_int(tok[0]) : std::nullopt;
-      const auto c = r ? detail::parse_int(tok[1]) : std::nullopt;
-      const auto z = c ? detail::parse_int(tok[2]) : std::nullopt;
+      const auto r = tok.size() == 3 ? text::parse_int(tok[0]) : std::nullopt;
+      const auto c = r ? text::parse_int(tok[1]) : std::nullopt;
+      const auto z = c ? text::parse_int(tok[2]) : std::nullopt;
       if (!z || *r < 1 || *c < 1 || *z < 0 || *r > 10000000 || *c > 10000000) {
         throw InputError(source, at_line(line), "the size line 'rows cols entries'", quote(t));
       }
@@ -240,9 +242,9 @@ SparseMatrix read_matrix_market(const std::filesystem::path& file) {
       have_size = true;
       return true;
     }
-    const auto i = tok.size() == 3 ? detail::parse_int(tok[0]) : std::nullopt;
-    const auto j = i ? detail::parse_int(tok[1]) : std::nullopt;
-    const auto v = j ? detail::parse_double(tok[2]) : std::nullopt;
+    const auto i = tok.size() == 3 ? text::parse_int(tok[0]) : std::nullopt;
+    const auto j = i ? text::parse_int(tok[1]) : std::nullopt;
+    const auto v = j ? text::parse_double(tok[2]) : std::nullopt;
     if (!v) throw InputError(source, at_line(line), "an entry 'row col value'", quote(t));
     if (*i < 1 || *j < 1 || *i > rows || *j > cols) {
       throw InputError(source, at_line(line), "indices within " + std::to_string(rows) + " x " + std::to_string(cols), quote(t));
@@ -279,7 +281,7 @@ void write_matrix_market(const std::filesystem::path& file, const Eigen::MatrixX
   if (A.rows() != A.cols()) {
     throw InputError(file.string(), "matrix", "a square symmetric matrix", std::to_string(A.rows()) + " x " + std::to_string(A.cols()));
   }
-  detail::write_atomically(file, [&](std::ostream& out) {
+  write_atomically(file, [&](std::ostream& out) {
     out << "%%MatrixMarket matrix coordinate real symmetric\n";
     if (!comment.empty()) {
       std::size_t start = 0;
@@ -296,28 +298,28 @@ void write_matrix_market(const std::filesystem::path& file, const Eigen::MatrixX
     out << A.rows() << ' ' << A.cols() << ' ' << nnz << '\n';
     for (Index j = 0; j < A.cols(); ++j)
       for (Index i = j; i < A.rows(); ++i)
-        if (A(i, j) != 0.0) out << i + 1 << ' ' << j + 1 << ' ' << detail::g17(A(i, j)) << '\n';
+        if (A(i, j) != 0.0) out << i + 1 << ' ' << j + 1 << ' ' << format_number(A(i, j), 17) << '\n';
   });
 }
 
 DofList read_dof_list(const std::filesystem::path& file) {
-  const std::string text = detail::read_file(file);
+  const std::string text = read_file(file);
   DofList out;
   int expected_mode = 1;
-  detail::for_each_line(text, [&](std::size_t line, std::string_view l) {
-    std::string_view t = detail::trim(l);
-    if (const auto hash = t.find('#'); hash != std::string_view::npos) t = detail::trim(t.substr(0, hash));
+  text::for_each_line(text, [&](std::size_t line, std::string_view l) {
+    std::string_view t = text::trim(l);
+    if (const auto hash = t.find('#'); hash != std::string_view::npos) t = text::trim(t.substr(0, hash));
     if (t.empty()) return true;
-    const auto tok = detail::tokens(t);
-    if (detail::lower(std::string(tok[0])) == "mode") {
-      const auto k = tok.size() == 2 ? detail::parse_int(tok[1]) : std::nullopt;
+    const auto tok = text::tokens(t);
+    if (text::to_lower(std::string(tok[0])) == "mode") {
+      const auto k = tok.size() == 2 ? text::parse_int(tok[1]) : std::nullopt;
       if (!k || *k != expected_mode) {
         throw InputError(file.string(), at_line(line), "'MODE " + std::to_string(expected_mode) + "'", quote(t));
       }
       out.dofs.push_back(DofLabel::modal(expected_mode++));
       return true;
     }
-    const auto node = detail::parse_int(tok[0]);
+    const auto node = text::parse_int(tok[0]);
     const auto dir = tok.size() >= 2 ? direction_from_string(std::string(tok[1])) : std::nullopt;
     if (!node || *node < 0 || !dir || (tok.size() != 2 && tok.size() != 5)) {
       throw InputError(file.string(), at_line(line), "'NODE LABEL [X Y Z]' or 'MODE k'", quote(t));
@@ -327,7 +329,7 @@ DofList read_dof_list(const std::filesystem::path& file) {
     if (tok.size() == 5) {
       Eigen::Vector3d p;
       for (int k = 0; k < 3; ++k) {
-        const auto v = detail::parse_double(tok[static_cast<std::size_t>(k + 2)]);
+        const auto v = text::parse_double(tok[static_cast<std::size_t>(k + 2)]);
         if (!v || !std::isfinite(*v)) throw InputError(file.string(), at_line(line), "finite coordinates X Y Z (m)", quote(t));
         p(k) = *v;
       }
@@ -343,7 +345,7 @@ DofList read_dof_list(const std::filesystem::path& file) {
 }
 
 void write_dof_list(const std::filesystem::path& file, const SuperElement& se) {
-  detail::write_atomically(file, [&](std::ostream& out) {
+  write_atomically(file, [&](std::ostream& out) {
     out << "# piezobench DOF list: one row per matrix row\n"
         << "# NODE LABEL X Y Z (nodal DOF, labels UX UY UZ ROTX ROTY ROTZ, coordinates in m) or MODE k\n";
     if (!se.source.empty()) out << "# from " << se.source << '\n';
@@ -355,7 +357,7 @@ void write_dof_list(const std::filesystem::path& file, const SuperElement& se) {
       out << d.node << ' ' << ansys_label(d.direction);
       const auto it = se.coordinates.find(d.node);
       if (it != se.coordinates.end()) {
-        out << ' ' << detail::g17(it->second.x()) << ' ' << detail::g17(it->second.y()) << ' ' << detail::g17(it->second.z());
+        out << ' ' << format_number(it->second.x(), 17) << ' ' << format_number(it->second.y(), 17) << ' ' << format_number(it->second.z(), 17);
       }
       out << '\n';
     }
@@ -397,12 +399,12 @@ std::filesystem::path write_simscape(const std::filesystem::path& dir, const std
   const auto write_matrix = [](std::ostream& out, const char* name, const Eigen::MatrixXd& A) {
     out << name << " = [\n";
     for (Index i = 0; i < A.rows(); ++i) {
-      for (Index j = 0; j < A.cols(); ++j) out << (j ? " " : "  ") << detail::g17(A(i, j));
+      for (Index j = 0; j < A.cols(); ++j) out << (j ? " " : "  ") << format_number(A(i, j), 17);
       out << '\n';
     }
     out << "];\n";
   };
-  detail::write_atomically(file, [&](std::ostream& out) {
+  write_atomically(file, [&](std::ostream& out) {
     out << "% Reduced Order Flexible Solid data written by piezobench"
         << (se.source.empty() ? std::string() : " from " + se.source) << "\n"
         << "% frames: one per interface node, 6 DOF each (x y z rx ry rz), then " << se.modal_dofs()

@@ -7,7 +7,9 @@
 #include <numbers>
 #include <set>
 
-#include "fem/text.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::fem {
@@ -20,7 +22,7 @@ std::vector<std::string> split(const std::string& text, char sep) {
   std::size_t start = 0;
   while (true) {
     const std::size_t end = text.find(sep, start);
-    out.emplace_back(detail::trim(std::string_view(text).substr(start, end == std::string::npos ? std::string::npos : end - start)));
+    out.emplace_back(text::trim(std::string_view(text).substr(start, end == std::string::npos ? std::string::npos : end - start)));
     if (end == std::string::npos) break;
     start = end + 1;
   }
@@ -28,7 +30,7 @@ std::vector<std::string> split(const std::string& text, char sep) {
 }
 
 long parse_node(const std::string& token, const std::string& text, const std::string& field, const std::string& form) {
-  const auto v = detail::parse_int(token);
+  const auto v = text::parse_int(token);
   if (!v || *v < 0) throw InputError("", field, form, "'" + text + "'");
   return static_cast<long>(*v);
 }
@@ -40,7 +42,7 @@ Direction parse_direction(const std::string& token, const std::string& text, con
 }
 
 double finite_number(const std::string& token, const std::string& text, const std::string& field, const std::string& form) {
-  const auto v = detail::parse_double(token);
+  const auto v = text::parse_double(token);
   if (!v || !std::isfinite(*v)) throw InputError("", field, form, "'" + text + "'");
   return *v;
 }
@@ -112,7 +114,7 @@ std::string to_string(DampingKind k) {
 }
 
 std::optional<DampingKind> damping_kind_from_string(const std::string& text) {
-  const std::string s = detail::lower(text);
+  const std::string s = text::to_lower(text);
   if (s == "none") return DampingKind::kNone;
   if (s == "modal") return DampingKind::kModal;
   if (s == "rayleigh") return DampingKind::kRayleigh;
@@ -160,9 +162,9 @@ void ModelOptions::validate(const SuperElement& se) const {
   for (std::size_t k = 0; k < masses.size(); ++k) {
     const std::string field = "masses[" + std::to_string(k) + "]";
     const PointMass& m = masses[k];
-    if (!(std::isfinite(m.mass) && m.mass >= 0.0)) throw InputError(kSource, field, "a mass >= 0 kg", detail::g17(m.mass));
+    if (!(std::isfinite(m.mass) && m.mass >= 0.0)) throw InputError(kSource, field, "a mass >= 0 kg", format_number(m.mass, 17));
     if (!(std::isfinite(m.rotary_inertia) && m.rotary_inertia >= 0.0)) {
-      throw InputError(kSource, field, "a rotary inertia >= 0 kg m^2", detail::g17(m.rotary_inertia));
+      throw InputError(kSource, field, "a rotary inertia >= 0 kg m^2", format_number(m.rotary_inertia, 17));
     }
     for (Direction d : {Direction::kX, Direction::kY, Direction::kZ}) (void)se.index_of(m.node, d, kSource, field);
   }
@@ -179,9 +181,9 @@ void ModelOptions::validate(const SuperElement& se) const {
     if (outputs[k].node_a == outputs[k].node_b) throw InputError(kSource, field, "two different nodes", "the same node twice");
   }
   const Damping& d = damping;
-  if (!(std::isfinite(d.zeta) && d.zeta >= 0.0)) throw InputError(kSource, "damping.zeta", "a damping ratio >= 0", detail::g17(d.zeta));
-  if (!(std::isfinite(d.alpha) && d.alpha >= 0.0)) throw InputError(kSource, "damping.alpha", "a value >= 0 (1/s)", detail::g17(d.alpha));
-  if (!(std::isfinite(d.beta) && d.beta >= 0.0)) throw InputError(kSource, "damping.beta", "a value >= 0 (s)", detail::g17(d.beta));
+  if (!(std::isfinite(d.zeta) && d.zeta >= 0.0)) throw InputError(kSource, "damping.zeta", "a damping ratio >= 0", format_number(d.zeta, 17));
+  if (!(std::isfinite(d.alpha) && d.alpha >= 0.0)) throw InputError(kSource, "damping.alpha", "a value >= 0 (1/s)", format_number(d.alpha, 17));
+  if (!(std::isfinite(d.beta) && d.beta >= 0.0)) throw InputError(kSource, "damping.beta", "a value >= 0 (s)", format_number(d.beta, 17));
 }
 
 StructuralModel assemble(const SuperElement& se, const ModelOptions& options) {
@@ -297,14 +299,14 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
   Eigen::MatrixXcd Z(model.size(), model.size());
   for (Index k = 0; k < omega.size(); ++k) {
     const double w = omega(k);
-    if (!std::isfinite(w)) throw InputError("", "omega[" + std::to_string(k) + "]", "a finite frequency", detail::g17(w));
+    if (!std::isfinite(w)) throw InputError("", "omega[" + std::to_string(k) + "]", "a finite frequency", format_number(w, 17));
     Z.real() = model.K - w * w * model.M;
     Z.imag() = w * model.C;
     const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(Z);
     Eigen::MatrixXcd h = T * lu.solve(F);
     if (!h.allFinite()) {
       throw NumericalError("frequency_response (dense LU of K - w^2 M + j w C)",
-                           "the dynamic stiffness is singular at " + detail::g17(w / (2 * std::numbers::pi)) +
+                           "the dynamic stiffness is singular at " + format_number(w / (2 * std::numbers::pi), 17) +
                                " Hz (an undamped resonance, or a free body at 0 Hz)",
                            true);
     }
@@ -339,12 +341,12 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
   Eigen::VectorXcd inv(f);
   for (Index k = 0; k < omega.size(); ++k) {
     const double w = omega(k);
-    if (!std::isfinite(w)) throw InputError("", "omega[" + std::to_string(k) + "]", "a finite frequency", detail::g17(w));
+    if (!std::isfinite(w)) throw InputError("", "omega[" + std::to_string(k) + "]", "a finite frequency", format_number(w, 17));
     for (Index i = 0; i < f; ++i) inv(i) = 1.0 / std::complex<double>(lambda(i) - w * w, w * c(i));
     Eigen::MatrixXcd h = t_phi * inv.asDiagonal() * phi_f;
     if (!h.allFinite()) {
       throw NumericalError("frequency_response (modal superposition)",
-                           "the dynamic stiffness is singular at " + detail::g17(w / (2 * std::numbers::pi)) +
+                           "the dynamic stiffness is singular at " + format_number(w / (2 * std::numbers::pi), 17) +
                                " Hz (an undamped resonance, or a free body at 0 Hz)",
                            true);
     }

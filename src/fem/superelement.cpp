@@ -3,17 +3,20 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <set>
 
-#include "fem/text.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/fem/matrix_io.hpp"
 
 namespace piezobench::fem {
 namespace {
 
-using detail::quote;
+using text::quote;
 
 double signed_hz(double lambda) {
   return std::copysign(std::sqrt(std::abs(lambda)), lambda) / (2 * std::numbers::pi);
@@ -50,14 +53,14 @@ int mantissa_digits(std::string_view number) {
 // `[ i, j]: value` entries after a `MAT_x:` header, in any layout of lines and blanks.
 AnsysMatrix read_ansys_matrix(const std::filesystem::path& file, const std::string& expected_header) {
   const std::string source = file.string();
-  const std::string text = detail::read_file(file);
+  const std::string text = read_file(file);
   std::string_view s(text);
   // Header: the first non-blank line.
   const std::size_t first = s.find_first_not_of(" \t\r\n");
   if (first == std::string_view::npos) throw InputError(source, "header", "'" + expected_header + "' then entries", "an empty file");
   std::size_t eol = s.find('\n', first);
   if (eol == std::string_view::npos) eol = s.size();
-  const std::string_view header = detail::trim(s.substr(first, eol - first));
+  const std::string_view header = text::trim(s.substr(first, eol - first));
   if (header.rfind("MAT_", 0) != 0) {
     throw InputError(source, "header", "a first line '" + expected_header + "' (Ansys CMS text export)", quote(header));
   }
@@ -78,7 +81,7 @@ AnsysMatrix read_ansys_matrix(const std::filesystem::path& file, const std::stri
   };
   while (true) {
     // Skip blanks, counting lines.
-    while (!s.empty() && detail::is_space(s.front())) {
+    while (!s.empty() && text::is_space(s.front())) {
       if (s.front() == '\n') ++line;
       s.remove_prefix(1);
     }
@@ -86,11 +89,11 @@ AnsysMatrix read_ansys_matrix(const std::filesystem::path& file, const std::stri
     if (s.front() != '[') fail("an entry '[ i, j]: value'", s.substr(0, s.find('\n')));
     std::string_view at = s;
     s.remove_prefix(1);
-    const auto i = detail::take_int(s);
+    const auto i = text::take_int(s);
     while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
     if (!i || s.empty() || s.front() != ',') fail("an entry '[ i, j]: value'", at.substr(0, at.find('\n')));
     s.remove_prefix(1);
-    const auto j = detail::take_int(s);
+    const auto j = text::take_int(s);
     while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
     if (!j || s.size() < 2 || s[0] != ']' || s[1] != ':') fail("an entry '[ i, j]: value'", at.substr(0, at.find('\n')));
     s.remove_prefix(2);
@@ -101,13 +104,13 @@ AnsysMatrix read_ansys_matrix(const std::filesystem::path& file, const std::stri
       return std::string(buf);
     };
     std::string_view number_start = s;
-    const auto v = detail::take_double(s);
+    const auto v = text::take_double(s);
     if (!v) fail("a number after '" + entry() + ":'", at.substr(0, at.find('\n')));
-    if (!s.empty() && !detail::is_space(s.front()) && s.front() != '[') {
+    if (!s.empty() && !text::is_space(s.front()) && s.front() != '[') {
       fail("a blank after the value of '" + entry() + "'", at.substr(0, at.find('\n')));
     }
     if (*i < 1 || *j < 1) throw InputError(source, entry(), "1-based indices", "an index < 1 at line " + std::to_string(line));
-    if (!std::isfinite(*v)) throw InputError(source, entry(), "a finite value", detail::g17(*v) + " at line " + std::to_string(line));
+    if (!std::isfinite(*v)) throw InputError(source, entry(), "a finite value", format_number(*v, 17) + " at line " + std::to_string(line));
     digits = std::max(digits, mantissa_digits(number_start.substr(0, static_cast<std::size_t>(s.data() - number_start.data()))));
     n = std::max({n, *i, *j});
     entries.push_back({*i, *j, *v});
@@ -156,16 +159,16 @@ struct AnsysListing {
 // Master DOF rows `NODE LABEL` and node-list rows `NODE X Y Z [...]`; everything else (titles,
 // banners) is ignored.
 AnsysListing read_ansys_listing(const std::filesystem::path& file) {
-  const std::string text = detail::read_file(file);
+  const std::string text = read_file(file);
   AnsysListing out;
-  detail::for_each_line(text, [&](std::size_t number, std::string_view line) {
-    const auto t = detail::tokens(line);
+  text::for_each_line(text, [&](std::size_t number, std::string_view line) {
+    const auto t = text::tokens(line);
     if (t.size() < 2) return true;
-    const auto node = detail::parse_int(t[0]);
+    const auto node = text::parse_int(t[0]);
     if (!node) return true;
     if (t.size() == 2) {
       const auto d = direction_from_string(std::string(t[1]));
-      if (!d || detail::parse_int(t[1])) {
+      if (!d || text::parse_int(t[1])) {
         throw InputError(file.string(), "line " + std::to_string(number), "a master DOF 'NODE UX|UY|UZ|ROTX|ROTY|ROTZ'", quote(line));
       }
       if (*node < 0) throw InputError(file.string(), "line " + std::to_string(number), "a node number >= 0", quote(line));
@@ -173,7 +176,7 @@ AnsysListing read_ansys_listing(const std::filesystem::path& file) {
       return true;
     }
     if (t.size() >= 4) {
-      const auto x = detail::parse_double(t[1]), y = detail::parse_double(t[2]), z = detail::parse_double(t[3]);
+      const auto x = text::parse_double(t[1]), y = text::parse_double(t[2]), z = text::parse_double(t[3]);
       if (x && y && z) {
         if (!std::isfinite(*x) || !std::isfinite(*y) || !std::isfinite(*z)) {
           throw InputError(file.string(), "node " + std::to_string(*node), "finite coordinates", quote(line));
@@ -257,7 +260,7 @@ std::string ansys_label(Direction d) {
 }
 
 std::optional<Direction> direction_from_string(const std::string& text) {
-  const std::string s = detail::lower(std::string(detail::trim(text)));
+  const std::string s = text::to_lower(std::string(text::trim(text)));
   static const std::pair<const char*, Direction> names[] = {
       {"x", Direction::kX},     {"y", Direction::kY},     {"z", Direction::kZ},     {"rx", Direction::kRx},
       {"ry", Direction::kRy},   {"rz", Direction::kRz},   {"ux", Direction::kX},    {"uy", Direction::kY},
@@ -280,7 +283,7 @@ std::string to_string(SuperElementFormat f) {
 }
 
 std::optional<SuperElementFormat> super_element_format_from_string(const std::string& text) {
-  const std::string s = detail::lower(text);
+  const std::string s = text::to_lower(text);
   if (s == "ansys") return SuperElementFormat::kAnsysText;
   if (s == "calculix" || s == "ccx") return SuperElementFormat::kCalculix;
   if (s == "matrix-market" || s == "mtx") return SuperElementFormat::kMatrixMarket;
@@ -288,7 +291,7 @@ std::optional<SuperElementFormat> super_element_format_from_string(const std::st
 }
 
 SuperElementFormat detect_format(const std::filesystem::path& k_file) {
-  const std::string ext = detail::lower(k_file.extension().string());
+  const std::string ext = text::to_lower(k_file.extension().string());
   if (ext == ".sti" || ext == ".mas" || ext == ".dof") return SuperElementFormat::kCalculix;
   if (ext == ".mtx") return SuperElementFormat::kMatrixMarket;
   std::ifstream in(k_file);
@@ -365,7 +368,7 @@ void SuperElement::validate(double symmetry_tolerance) const {
         for (Index i = 0; i < n; ++i)
           if (!std::isfinite((*A)(i, j)))
             throw InputError(source, std::string(name) + "[" + std::to_string(i + 1) + "," + std::to_string(j + 1) + "]",
-                             "a finite value", detail::g17((*A)(i, j)));
+                             "a finite value", format_number((*A)(i, j), 17));
     }
     const double big = A->cwiseAbs().maxCoeff();
     for (Index j = 0; j < n; ++j) {
@@ -374,8 +377,8 @@ void SuperElement::validate(double symmetry_tolerance) const {
         const double m = std::max(std::abs(a), std::abs(b));
         if (std::abs(a - b) > symmetry_tolerance * m && m > 1e-12 * big) {
           throw InputError(source, std::string(name) + "[" + std::to_string(i + 1) + "," + std::to_string(j + 1) + "]",
-                           "a symmetric matrix (relative tolerance " + detail::g17(symmetry_tolerance) + ")",
-                           detail::g17(a) + " against " + detail::g17(b) + " at [" + std::to_string(j + 1) + "," +
+                           "a symmetric matrix (relative tolerance " + format_number(symmetry_tolerance, 17) + ")",
+                           format_number(a, 17) + " against " + format_number(b, 17) + " at [" + std::to_string(j + 1) + "," +
                                std::to_string(i + 1) + "]");
         }
       }
@@ -385,13 +388,13 @@ void SuperElement::validate(double symmetry_tolerance) const {
   if (llt.info() != Eigen::Success) {
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (M + M.transpose()), Eigen::EigenvaluesOnly);
     throw InputError(source, "M", "a positive definite mass matrix",
-                     "smallest eigenvalue " + detail::g17(es.eigenvalues()(0)) + " kg");
+                     "smallest eigenvalue " + format_number(es.eigenvalues()(0), 17) + " kg");
   }
 }
 
 void ImportOptions::validate() const {
   if (!(symmetry_tolerance >= 0.0 && symmetry_tolerance < 1.0)) {
-    throw InputError("import options", "symmetry_tolerance", "a value in [0, 1)", detail::g17(symmetry_tolerance));
+    throw InputError("import options", "symmetry_tolerance", "a value in [0, 1)", format_number(symmetry_tolerance, 17));
   }
   if (max_dense_size < 1) throw InputError("import options", "max_dense_size", "a size >= 1", std::to_string(max_dense_size));
 }

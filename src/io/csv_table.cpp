@@ -5,12 +5,18 @@
 #include <optional>
 #include <set>
 
-#include "io/file_util.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 
 namespace piezobench::io::detail {
 namespace fs = std::filesystem;
+using text::quote;
+using text::trim;
+using text::parse_double;
+using text::split;
 
 namespace {
 
@@ -278,21 +284,21 @@ Eigen::MatrixXd CsvTable::read(const std::vector<int>& target, Eigen::Index ntar
 namespace piezobench::io {
 
 char csv_delimiter_from_string(const std::string& s) {
-  const std::string l = detail::to_lower(s);
+  const std::string l = text::to_lower(s);
   if (l.empty() || l == "auto") return 0;
   if (l == "," || l == "comma") return ',';
   if (l == ";" || l == "semicolon") return ';';
   if (l == "tab" || l == "\t" || l == "\\t") return '\t';
   if (l == "space" || l == "blank" || l == "blanks" || l == " ") return ' ';
-  throw InputError("command line", "--delimiter", "auto, ',', ';', tab or space", detail::quote(s));
+  throw InputError("command line", "--delimiter", "auto, ',', ';', tab or space", text::quote(s));
 }
 
 char csv_decimal_from_string(const std::string& s) {
-  const std::string l = detail::to_lower(s);
+  const std::string l = text::to_lower(s);
   if (l.empty() || l == "auto") return 0;
   if (l == "." || l == "point") return '.';
   if (l == "," || l == "comma") return ',';
-  throw InputError("command line", "--decimal", "auto, '.' or ','", detail::quote(s));
+  throw InputError("command line", "--decimal", "auto, '.' or ','", text::quote(s));
 }
 
 }  // namespace piezobench::io

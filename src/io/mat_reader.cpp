@@ -1,5 +1,5 @@
 // Reading MAT files: v5/v7 through matio after a structural check of every variable against the
-// bytes the file holds, v7.3 through HDF5 directly (see file_util.hpp for the bounds).
+// bytes the file holds, v7.3 through HDF5 directly (see mat_file.hpp for the bounds).
 #include <hdf5.h>
 #include <zlib.h>
 
@@ -13,8 +13,9 @@
 #include <limits>
 #include <mutex>
 
-#include "io/file_util.hpp"
+#include "io/mat_file.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/text.hpp"
 
 namespace piezobench::io::detail {
 namespace fs = std::filesystem;
@@ -206,7 +207,7 @@ class V5Checker {
     } else {
       skip(padded(name_tag.bytes), path + " (name)");
     }
-    if (depth == 0 && !name.empty()) path = quote(name);
+    if (depth == 0 && !name.empty()) path = text::quote(name);
     const std::string what = path + " (declared " + shape + ")";
 
     if (cls == 1) {  // cell: one matrix element per cell
@@ -353,7 +354,7 @@ bool check_mat_file(const fs::path& file) {
   const bool big = header[126] == 'M' && header[127] == 'I';
   if (!little && !big) {
     throw InputError(file.string(), "file", "a MAT file (v5, v7 or v7.3)",
-                     "no MATLAB header (bytes 126-127 are " + quote(std::string_view(header + 126, 2)) + ")");
+                     "no MATLAB header (bytes 126-127 are " + text::quote(std::string_view(header + 126, 2)) + ")");
   }
   // Version 0x0200 is v7.3: an HDF5 file (at byte 512).
   const auto version = static_cast<unsigned>(
@@ -704,7 +705,7 @@ MatVarPtr read_h5_var(const Mat73Input& in, hid_t parent, const std::string& nam
   const std::string source = in.source();
   const H5Var v = open_h5_var(in, parent, name, field);
   if (v.group) {
-    if (v.cls != MAT_C_STRUCT) throw InputError(source, field, "a struct group", "MATLAB class " + quote(v.class_name));
+    if (v.cls != MAT_C_STRUCT) throw InputError(source, field, "a struct group", "MATLAB class " + text::quote(v.class_name));
     return read_h5_struct(in, v, name, field, depth);
   }
   const size_t n = product(v.dims);

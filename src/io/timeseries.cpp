@@ -15,13 +15,16 @@
 #include <unordered_map>
 
 #include "io/csv_table.hpp"
-#include "io/file_util.hpp"
+#include "io/mat_file.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/io/units.hpp"
 
 namespace piezobench::io {
 namespace fs = std::filesystem;
-using detail::quote;
+using text::quote;
 
 namespace {
 
@@ -33,12 +36,6 @@ constexpr const char* kChannelOrder = "channels";  // comma-separated names, in 
 // Samples read from a .mat file at once (256 KiB): large enough for full-speed reads, small enough
 // for the checks that follow each piece to find it in the L2 cache.
 constexpr Eigen::Index kReadChunk = Eigen::Index{1} << 15;
-
-std::string format_number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
 
 // NaN/Inf check with the channel and the first bad sample in the message.
 void check_finite(const std::string& source, const std::string& channel, const Eigen::Ref<const Eigen::VectorXd>& v) {
@@ -125,8 +122,8 @@ double sample_rate_from_time(const std::string& source, const Eigen::VectorXd& t
   for (Eigen::Index k = 1; k < n; ++k) {
     if (!(t(k) > t(k - 1))) {
       throw InputError(source, kTime, "a strictly increasing time vector",
-                       "t[" + std::to_string(k) + "] = " + format_number(t(k)) + " after t[" + std::to_string(k - 1) +
-                           "] = " + format_number(t(k - 1)));
+                       "t[" + std::to_string(k) + "] = " + format_number(t(k), 10) + " after t[" + std::to_string(k - 1) +
+                           "] = " + format_number(t(k - 1), 10));
     }
   }
   const double dt = (t(n - 1) - t(0)) / static_cast<double>(n - 1);
@@ -136,8 +133,8 @@ double sample_rate_from_time(const std::string& source, const Eigen::VectorXd& t
     const double expected = t(0) + static_cast<double>(k) * dt;
     const double deviation = std::abs(t(k) - expected) / dt;
     if (deviation > tol) {
-      throw InputError(source, kTime, "uniform sampling (deviation <= " + format_number(tol) + " sample periods)",
-                       "t[" + std::to_string(k) + "] = " + format_number(t(k)) + ", " + format_number(deviation) +
+      throw InputError(source, kTime, "uniform sampling (deviation <= " + format_number(tol, 10) + " sample periods)",
+                       "t[" + std::to_string(k) + "] = " + format_number(t(k), 10) + ", " + format_number(deviation, 10) +
                            " periods away from uniform");
     }
   }
@@ -154,19 +151,19 @@ double resolve_sample_rate(const std::string& source, const Eigen::VectorXd& t, 
   if (t.size() >= 2) fs_time = sample_rate_from_time(source, t, tol, t_prechecked);
   if (t.size() == 1) check_finite(source, kTime, t);
   if (fs_file && !(std::isfinite(*fs_file) && *fs_file > 0.0)) {
-    throw InputError(source, kFs, "a positive finite sample rate in Hz", format_number(*fs_file));
+    throw InputError(source, kFs, "a positive finite sample rate in Hz", format_number(*fs_file, 10));
   }
   if (fs_option > 0.0 && fs_time && !agree(fs_option, *fs_time, tol)) {
-    throw InputError(source, "fs", "a sample rate consistent with t (" + format_number(*fs_time) + " Hz from t)",
-                     "fs = " + format_number(fs_option) + " Hz given");
+    throw InputError(source, "fs", "a sample rate consistent with t (" + format_number(*fs_time, 10) + " Hz from t)",
+                     "fs = " + format_number(fs_option, 10) + " Hz given");
   }
   if (fs_option > 0.0 && fs_file && !agree(fs_option, *fs_file, tol)) {
-    throw InputError(source, "fs", "a sample rate consistent with the file's fs = " + format_number(*fs_file) + " Hz",
-                     "fs = " + format_number(fs_option) + " Hz given");
+    throw InputError(source, "fs", "a sample rate consistent with the file's fs = " + format_number(*fs_file, 10) + " Hz",
+                     "fs = " + format_number(fs_option, 10) + " Hz given");
   }
   if (fs_file && fs_time && !agree(*fs_file, *fs_time, tol)) {
-    throw InputError(source, kFs, "a sample rate consistent with t (" + format_number(*fs_time) + " Hz from t)",
-                     "fs = " + format_number(*fs_file) + " Hz in the file");
+    throw InputError(source, kFs, "a sample rate consistent with t (" + format_number(*fs_time, 10) + " Hz from t)",
+                     "fs = " + format_number(*fs_file, 10) + " Hz in the file");
   }
   if (fs_option > 0.0) return fs_option;
   if (fs_file) return *fs_file;
@@ -175,12 +172,12 @@ double resolve_sample_rate(const std::string& source, const Eigen::VectorXd& t, 
 }
 
 bool is_time_name(const std::string& name) {
-  const std::string l = detail::to_lower(name);
+  const std::string l = text::to_lower(name);
   return l == "t" || l == "time";
 }
 
 bool is_rate_name(const std::string& name) {
-  const std::string l = detail::to_lower(name);
+  const std::string l = text::to_lower(name);
   return l == "fs" || l == "sample_rate" || l == "sample_rate_hz" || l == "samplerate" || l == "sampling_rate";
 }
 
@@ -200,14 +197,14 @@ std::vector<std::string> struct_field_names(const matvar_t& var) {
 std::optional<double> rate_from_text(const std::string& text, const std::string& source, const std::string& field) {
   const size_t sep = text.find_first_of(":=");
   if (sep == std::string::npos) return std::nullopt;
-  std::string key(detail::trim(std::string_view(text).substr(0, sep)));
+  std::string key(text::trim(std::string_view(text).substr(0, sep)));
   std::string unit;
   if (const size_t open = key.find_first_of("[("); open != std::string::npos) {
     const size_t close = key.find_first_of("])", open);
-    unit = std::string(detail::trim(std::string_view(key).substr(open + 1, close == std::string::npos ? std::string::npos : close - open - 1)));
-    key = std::string(detail::trim(std::string_view(key).substr(0, open)));
+    unit = std::string(text::trim(std::string_view(key).substr(open + 1, close == std::string::npos ? std::string::npos : close - open - 1)));
+    key = std::string(text::trim(std::string_view(key).substr(0, open)));
   }
-  std::string lower = detail::to_lower(key);
+  std::string lower = text::to_lower(key);
   std::replace(lower.begin(), lower.end(), ' ', '_');
   if (lower.size() > 3 && lower.compare(lower.size() - 3, 3, "_hz") == 0) {
     lower.resize(lower.size() - 3);
@@ -217,13 +214,13 @@ std::optional<double> rate_from_text(const std::string& text, const std::string&
       lower != "sampling_frequency") {
     return std::nullopt;
   }
-  std::string_view value = detail::trim(std::string_view(text).substr(sep + 1));
+  std::string_view value = text::trim(std::string_view(text).substr(sep + 1));
   if (const size_t blank = value.find_first_of(" \t"); blank != std::string_view::npos) {
     if (!unit.empty()) throw InputError(source, field, "one unit for the sample rate", quote(text));
-    unit = std::string(detail::trim(value.substr(blank)));
+    unit = std::string(text::trim(value.substr(blank)));
     value = value.substr(0, blank);
   }
-  const std::optional<double> v = detail::parse_double(value);
+  const std::optional<double> v = text::parse_double(value);
   if (!v || !(std::isfinite(*v) && *v > 0.0)) throw InputError(source, field, "a positive sample rate", quote(value));
   if (unit.empty()) return *v;
   const Unit u = unit_from_string(unit, source, field);
@@ -273,7 +270,7 @@ std::vector<std::string> available_names(const std::vector<std::string>& names) 
 [[noreturn]] void throw_unknown_channel(const std::string& source, const std::string& name,
                                         const std::vector<std::string>& available) {
   throw InputError(source, "channel " + name,
-                   "one of the channels in the file (" + detail::join(available_names(available)) + ")",
+                   "one of the channels in the file (" + text::join(available_names(available)) + ")",
                    quote(name));
 }
 
@@ -354,7 +351,7 @@ void validate_series(const TimeSeries& ts, bool samples) {
                      std::to_string(units.size()));
   }
   if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) {
-    throw InputError(source, "sample_rate", "a positive finite rate in Hz", format_number(sample_rate));
+    throw InputError(source, "sample_rate", "a positive finite rate in Hz", format_number(sample_rate, 10));
   }
   if (samples) {
     for (Eigen::Index j = 0; j < data.cols(); ++j) check_finite(source, names[static_cast<size_t>(j)], data.col(j));
@@ -379,9 +376,9 @@ void validate_series(const TimeSeries& ts, bool samples) {
 void TimeSeries::validate() const { validate_series(*this, /*samples=*/true); }
 
 void ReadOptions::validate() const {
-  if (!(std::isfinite(fs) && fs >= 0.0)) throw InputError("ReadOptions", "fs", "0 (from t) or a positive rate in Hz", format_number(fs));
+  if (!(std::isfinite(fs) && fs >= 0.0)) throw InputError("ReadOptions", "fs", "0 (from t) or a positive rate in Hz", format_number(fs, 10));
   if (!(std::isfinite(time_tolerance) && time_tolerance > 0.0 && time_tolerance < 0.5)) {
-    throw InputError("ReadOptions", "time_tolerance", "a fraction of a sample period in (0, 0.5)", format_number(time_tolerance));
+    throw InputError("ReadOptions", "time_tolerance", "a fraction of a sample period in (0, 0.5)", format_number(time_tolerance, 10));
   }
   std::set<std::string> seen;
   for (const std::string& c : channels) {
@@ -401,7 +398,7 @@ std::string to_string(MatVersion v) {
 }
 
 MatVersion mat_version_from_string(const std::string& s) {
-  const std::string l = detail::to_lower(s);
+  const std::string l = text::to_lower(s);
   if (l == "v5" || l == "5" || l == "-v5" || l == "v7" || l == "7" || l == "-v7" || l == "v6" || l == "-v6") return MatVersion::kV5;
   if (l == "v7.3" || l == "7.3" || l == "-v7.3" || l == "v73") return MatVersion::kV73;
   throw InputError("", "mat version", "v5, v7 or v7.3", quote(s));
@@ -410,7 +407,7 @@ MatVersion mat_version_from_string(const std::string& s) {
 // ---- readers --------------------------------------------------------------------------------
 
 TimeSeries read_timeseries(const fs::path& file, const ReadOptions& options) {
-  const std::string ext = detail::lower_extension(file);
+  const std::string ext = text::to_lower(file.extension().string());
   if (ext == ".mat") return read_timeseries_mat(file, options);
   if (ext == ".csv") return read_timeseries_csv(file, options);
   throw InputError(file.string(), "file", "a .mat or .csv file", "extension " + quote(ext));
@@ -469,7 +466,7 @@ MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOpti
     if (!exists) {
       std::vector<std::string> names;
       for (const auto& v : vars) names.push_back(v.name);
-      throw InputError(file.string(), "group " + options.group, "a struct variable of the file (" + detail::join(names) + ")",
+      throw InputError(file.string(), "group " + options.group, "a struct variable of the file (" + text::join(names) + ")",
                        quote(options.group));
     }
     layout.group = options.group;
@@ -488,7 +485,7 @@ MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOpti
   if (order_var != vars.end() && order_var->class_type == MAT_C_CHAR) {
     const std::string list = detail::to_text(*detail::read_mat_variable(mat, file, kChannelOrder), file.string(), kChannelOrder);
     std::vector<std::string> ordered;
-    for (std::string_view part : detail::split(list, ',')) ordered.emplace_back(detail::trim(part));
+    for (std::string_view part : text::split(list, ',')) ordered.emplace_back(text::trim(part));
     std::vector<std::string> sorted_listed = ordered, sorted_found = layout.channels;
     std::sort(sorted_listed.begin(), sorted_listed.end());
     std::sort(sorted_found.begin(), sorted_found.end());
@@ -765,7 +762,7 @@ TimeSeries read_timeseries_csv(const fs::path& file, const ReadOptions& options)
 // ---- writers --------------------------------------------------------------------------------
 
 void write_timeseries(const TimeSeries& ts, const fs::path& file, const MatWriteOptions& options) {
-  const std::string ext = detail::lower_extension(file);
+  const std::string ext = text::to_lower(file.extension().string());
   if (ext == ".mat") return write_timeseries_mat(ts, file, options);
   if (ext == ".csv") return write_timeseries_csv(ts, file);
   throw InputError(file.string(), "output file", "a .mat or .csv file", "extension " + quote(ext));
@@ -783,7 +780,7 @@ void validate_for_writing(const TimeSeries& ts, const fs::path& file, bool mat) 
   const std::string target = file.string();
   if (!mat) {
     for (const std::string& name : ts.names) {
-      if (name.find_first_of(",\n\r[]\"") != std::string::npos || name.front() == '#' || name != detail::trim(name)) {
+      if (name.find_first_of(",\n\r[]\"") != std::string::npos || name.front() == '#' || name != text::trim(name)) {
         throw InputError(target, "channel " + name, "a name without ',', brackets, quotes, line breaks or edge spaces", quote(name));
       }
     }
@@ -820,7 +817,7 @@ void write_timeseries_mat(const TimeSeries& ts, const fs::path& file, const MatW
       w.write(detail::make_real_column(ts.names[static_cast<size_t>(j)], ts.data.col(j)));
     }
     w.write(detail::make_scalar(kFs, ts.sample_rate));
-    w.write(detail::make_text(kChannelOrder, detail::join(ts.names, ",")));
+    w.write(detail::make_text(kChannelOrder, text::join(ts.names, ",")));
     std::vector<std::pair<std::string, detail::MatVarPtr>> unit_fields;
     if (ts.t.size() > 0) unit_fields.emplace_back(kTime, detail::make_text(kTime, "s"));
     for (size_t j = 0; j < ts.units.size(); ++j) {
@@ -844,12 +841,12 @@ void write_timeseries_mat(const TimeSeries& ts, const fs::path& file, const MatW
 
 void write_timeseries_csv(const TimeSeries& ts, const fs::path& file) {
   validate_for_writing(ts, file, /*mat=*/false);
-  detail::write_atomically(file, [&](std::ostream& out) {
+  write_atomically(file, [&](std::ostream& out) {
     const bool has_t = ts.t.size() > 0;
     std::string line;
     // CSV has no other place for the rate: without a time column it goes in a comment line
     // that read_timeseries_csv understands (and other tools skip as a comment).
-    if (!has_t) out << "# sample_rate_Hz: " << detail::format_g17(ts.sample_rate) << '\n';
+    if (!has_t) out << "# sample_rate_Hz: " << format_number(ts.sample_rate, 17) << '\n';
     if (has_t) line += "t [s]";
     for (size_t j = 0; j < ts.names.size(); ++j) {
       if (has_t || j > 0) line += ',';
@@ -860,7 +857,7 @@ void write_timeseries_csv(const TimeSeries& ts, const fs::path& file) {
     char buf[32];
     for (Eigen::Index k = 0; k < ts.data.rows(); ++k) {
       line.clear();
-      if (has_t) line += detail::format_g17(ts.t(k));
+      if (has_t) line += format_number(ts.t(k), 17);
       for (Eigen::Index j = 0; j < ts.data.cols(); ++j) {
         if (has_t || j > 0) line += ',';
         const int n = std::snprintf(buf, sizeof buf, "%.17g", ts.data(k, j));

@@ -2,8 +2,10 @@
 
 #include <array>
 
-#include "io/file_util.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 
 namespace piezobench::io {
 
@@ -96,7 +98,7 @@ std::string to_string(Quantity q) {
 }
 
 std::optional<Unit> find_unit(std::string_view symbol) {
-  symbol = detail::trim(symbol);
+  symbol = text::trim(symbol);
   for (const Entry& e : kUnits) {
     if (symbol == e.symbol) return Unit{e.symbol, e.quantity, e.to_si, e.si};
   }
@@ -115,7 +117,7 @@ std::string known_units() {
 
 Unit unit_from_string(std::string_view symbol, const std::string& source, const std::string& field) {
   if (std::optional<Unit> u = find_unit(symbol)) return *u;
-  throw InputError(source, field, "a known unit (" + known_units() + ")", "unit " + detail::quote(detail::trim(symbol)));
+  throw InputError(source, field, "a known unit (" + known_units() + ")", "unit " + text::quote(text::trim(symbol)));
 }
 
 }  // namespace piezobench::io

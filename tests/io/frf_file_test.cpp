@@ -11,7 +11,9 @@
 #include <cstring>
 #include <fstream>
 
-#include "io/file_util.hpp"
+#include "io/mat_file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
 
@@ -145,7 +147,7 @@ TEST(FrfCsv, MalformedFilesNameFileAndColumn) {
     const fs::path file = dir.path() / "bad.csv";
     write_bytes(file, text);
     const std::string msg = input_error([&] { (void)read_frf(file); });
-    EXPECT_TRUE(contains(msg, file.string()) && contains(msg, expected)) << detail::quote(text) << ": " << msg;
+    EXPECT_TRUE(contains(msg, file.string()) && contains(msg, expected)) << text::quote(text) << ": " << msg;
   }
 }
 
@@ -213,7 +215,7 @@ void expect_uff_round_trip(const dsp::Frf& back, const dsp::Frf& frf) {
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
-  for (std::string_view l : detail::split(text, '\n')) out.emplace_back(l);
+  for (std::string_view l : text::split(text, '\n')) out.emplace_back(l);
   return out;
 }
 

@@ -11,7 +11,9 @@
 #include <tuple>
 #include <nlohmann/json.hpp>
 
-#include "io/file_util.hpp"
+#include "io/mat_file.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
 
@@ -172,7 +174,7 @@ TEST(TimeSeriesCsv, RateFromTimeAndConsistencyWithFs) {
   TempDir dir;
   const fs::path file = dir.path() / "t.csv";
   std::string text = "t,x\n";
-  for (int k = 0; k < 100; ++k) text += detail::format_g17(k * 0.001) + "," + std::to_string(k) + "\n";
+  for (int k = 0; k < 100; ++k) text += format_number(k * 0.001, 17) + "," + std::to_string(k) + "\n";
   write_text(file, text);
   EXPECT_NEAR(read_timeseries_csv(file).sample_rate, 1000.0, 1e-9);
   ReadOptions ok;
@@ -489,7 +491,7 @@ TEST(TimeSeriesValidation, MalformedCsvFiles) {
     ReadOptions options;
     options.fs = 100.0;
     const std::string msg = input_error([&] { (void)read_timeseries(file, options); });
-    EXPECT_TRUE(contains(msg, file.string()) && contains(msg, expected)) << "case " << detail::quote(text) << ": " << msg;
+    EXPECT_TRUE(contains(msg, file.string()) && contains(msg, expected)) << "case " << text::quote(text) << ": " << msg;
   }
   EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(dir.path() / "missing.csv"); }), "no such file"));
   EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(dir.path() / "x.txt"); }), ".txt"));

@@ -1,12 +1,11 @@
 #pragma once
 // Output files that are either complete or absent: the text is written to a temporary file in the
-// target's directory and renamed over the target, so a failure never leaves half a file.
-#include <filesystem>
-#include <string>
+// target's directory and renamed over the target, so a failure never leaves half a file. The
+// implementation is core's (core/file.hpp, shared with fem); io re-exports it.
+#include "piezobench/core/file.hpp"
 
 namespace piezobench::io {
 
-// Writes `text` to `target` atomically; InputError (source = target) when it cannot.
-void write_text_atomically(const std::filesystem::path& target, const std::string& text);
+using piezobench::write_text_atomically;
 
 }  // namespace piezobench::io

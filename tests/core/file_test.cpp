@@ -1,7 +1,5 @@
-// Tests of the private io helpers: atomic output files and strict number parsing.
-#include "io/file_util.hpp"
-
-#include "piezobench/io/atomic_file.hpp"
+// Tests of core/file.hpp: whole-file reading and atomic output files.
+#include "piezobench/core/file.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -12,7 +10,7 @@
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
 
-namespace piezobench::io::detail {
+namespace piezobench {
 namespace {
 
 namespace fs = std::filesystem;
@@ -90,46 +88,8 @@ TEST(AtomicFile, DiskFullDuringWriteLeavesNoFile) {
   EXPECT_EQ(entries(dir.path()), 0u);
 }
 
-TEST(ParseDouble, AcceptsWholeNumbersOnly) {
-  EXPECT_EQ(parse_double(" 1.5 ").value(), 1.5);
-  EXPECT_EQ(parse_double("+2e3").value(), 2000.0);
-  EXPECT_EQ(parse_double("-0.25E-1").value(), -0.025);
-  EXPECT_EQ(parse_double("1.0D+02", /*fortran=*/true).value(), 100.0);
-  EXPECT_FALSE(parse_double("1.0D+02").has_value());
-  EXPECT_FALSE(parse_double("1.5x").has_value());
-  EXPECT_FALSE(parse_double("").has_value());
-  EXPECT_FALSE(parse_double("abc").has_value());
-  EXPECT_FALSE(parse_double("+-1").has_value());
-  EXPECT_TRUE(std::isnan(parse_double("nan").value()));
-  EXPECT_TRUE(std::isinf(parse_double("1e999").value()));
-  EXPECT_EQ(parse_double("0.1").value(), 0.1);
-  EXPECT_EQ(parse_double(format_g17(0.1 + 0.2)).value(), 0.1 + 0.2);
-}
-
-TEST(ParseInt, RejectsFractionsAndText) {
-  EXPECT_EQ(parse_int("   58").value(), 58);
-  EXPECT_EQ(parse_int("-1").value(), -1);
-  EXPECT_FALSE(parse_int("5.0").has_value());
-  EXPECT_FALSE(parse_int("5b").has_value());
-}
-
-TEST(MatlabIdentifier, FollowsMatlabRules) {
-  EXPECT_TRUE(is_matlab_identifier("d_enc2"));
-  EXPECT_FALSE(is_matlab_identifier("2d"));
-  EXPECT_FALSE(is_matlab_identifier("_x"));
-  EXPECT_FALSE(is_matlab_identifier("a b"));
-  EXPECT_FALSE(is_matlab_identifier(std::string(64, 'a')));
-  EXPECT_TRUE(is_matlab_identifier(std::string(63, 'a')));
-}
-
-}  // namespace
-}  // namespace piezobench::io::detail
-
-namespace piezobench::io {
-namespace {
-
 TEST(WriteTextAtomically, WritesTheWholeTextOrNothing) {
-  test::TempDir dir;
+  TempDir dir;
   const auto target = dir.path() / "model.json";
   write_text_atomically(target, "{\"a\": 1}\n");
   EXPECT_EQ(test::read_text(target), "{\"a\": 1}\n");
@@ -140,5 +100,20 @@ TEST(WriteTextAtomically, WritesTheWholeTextOrNothing) {
   EXPECT_EQ(files, 1U);  // no temporary left behind
 }
 
+TEST(ReadFile, ReadsBytesAndNamesAMissingFile) {
+  TempDir dir;
+  const fs::path file = dir.path() / "data.bin";
+  const std::string bytes("a\0b\r\nc", 6);
+  std::ofstream(file, std::ios::binary) << bytes;
+  EXPECT_EQ(read_file(file), bytes);
+  try {
+    (void)read_file(dir.path() / "missing.txt");
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.txt"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)read_file(dir.path()), InputError);
+}
+
 }  // namespace
-}  // namespace piezobench::io
+}  // namespace piezobench

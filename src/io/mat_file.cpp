@@ -1,237 +1,24 @@
-#include "io/file_util.hpp"
+#include "io/mat_file.hpp"
 
-#include "piezobench/io/atomic_file.hpp"
-
-#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <bit>
-#include <cstdint>
-#include <atomic>
 #include <cctype>
 #include <cerrno>
-#include <charconv>
-#include <cmath>
 #include <complex>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <mutex>
-#include <random>
-#include <sstream>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/core/text.hpp"
 
 namespace piezobench::io::detail {
 namespace fs = std::filesystem;
-
-// ---- atomic files ---------------------------------------------------------------------------
-
-namespace {
-
-std::string errno_text(int err) { return std::strerror(err); }
-
-// A name that no other writer (thread or process) picks: pid, a per-process counter and a random
-// tag; O_EXCL below makes a collision an error rather than a shared file.
-fs::path temp_name_for(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
-  static thread_local std::mt19937_64 rng{std::random_device{}()};
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  char tag[64];
-  std::snprintf(tag, sizeof tag, ".tmp-%d-%u-%08llx", static_cast<int>(::getpid()), counter.fetch_add(1),
-                static_cast<unsigned long long>(rng() & 0xffffffffULL));
-  // Hidden, and the target's extension stays last so tools that sniff extensions behave.
-  return dir / ("." + target.filename().string() + tag + target.extension().string());
-}
-
-void fsync_path(const fs::path& path, int flags) {
-  const int fd = ::open(path.c_str(), flags);
-  if (fd < 0) return;
-  (void)::fsync(fd);
-  ::close(fd);
-}
-
-}  // namespace
-
-AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
-  if (target_.empty() || !target_.has_filename()) {
-    throw InputError(target_.string(), "output file", "a file name", "an empty name or a directory");
-  }
-  for (int attempt = 0; attempt < 16; ++attempt) {
-    temp_ = temp_name_for(target_);
-    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      ::close(fd);
-      return;
-    }
-    if (errno != EEXIST) {
-      const int err = errno;
-      temp_.clear();
-      throw InputError(target_.string(), "output file", "a writable location",
-                       "cannot create a file in that directory (" + errno_text(err) + ")");
-    }
-  }
-  temp_.clear();
-  throw InputError(target_.string(), "output file", "a free temporary name", "16 collisions");
-}
-
-AtomicFile::~AtomicFile() {
-  if (!committed_ && !temp_.empty()) {
-    std::error_code ec;
-    fs::remove(temp_, ec);
-  }
-}
-
-void AtomicFile::commit() {
-  // Data first, then the name: after a crash the target is either the old file or the new one.
-  fsync_path(temp_, O_RDONLY | O_CLOEXEC);
-  if (std::rename(temp_.c_str(), target_.c_str()) != 0) {
-    const int err = errno;
-    throw InputError(target_.string(), "output file", "a replaceable file",
-                     "cannot rename the temporary file onto it (" + errno_text(err) + ")");
-  }
-  committed_ = true;
-  fsync_path(target_.has_parent_path() ? target_.parent_path() : fs::path("."), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-}
-
-void write_atomically(const fs::path& target, const std::function<void(std::ostream&)>& body) {
-  AtomicFile out(target);
-  {
-    std::ofstream stream(out.temp_path(), std::ios::binary | std::ios::trunc);
-    if (!stream) {
-      throw InputError(target.string(), "output file", "a writable file", "cannot open the temporary file");
-    }
-    body(stream);
-    stream.flush();
-    if (!stream) {
-      throw InputError(target.string(), "output file", "a complete write",
-                       "a write error (disk full or file size limit?)");
-    }
-    stream.close();
-    if (stream.fail()) {
-      throw InputError(target.string(), "output file", "a complete write", "an error when closing the file");
-    }
-  }
-  out.commit();
-}
-
-std::string read_file(const fs::path& file) {
-  std::error_code ec;
-  if (!fs::exists(file, ec)) throw InputError(file.string(), "file", "an existing file", "no such file");
-  if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "a regular file", "a directory");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "file", "a readable file", "cannot open it");
-  std::string content;
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw InputError(file.string(), "file", "a readable file", "cannot determine its size");
-  content.resize(static_cast<size_t>(size));
-  in.seekg(0, std::ios::beg);
-  in.read(content.data(), size);
-  if (in.gcount() != size) throw InputError(file.string(), "file", "a readable file", "a read error");
-  return content;
-}
-
-// ---- text -----------------------------------------------------------------------------------
-
-std::string to_lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
-std::string lower_extension(const fs::path& file) { return to_lower(file.extension().string()); }
-
-std::string_view trim(std::string_view s) {
-  const auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; };
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> split(std::string_view s, char sep) {
-  std::vector<std::string_view> parts;
-  size_t start = 0;
-  for (;;) {
-    const size_t pos = s.find(sep, start);
-    if (pos == std::string_view::npos) {
-      parts.push_back(s.substr(start));
-      return parts;
-    }
-    parts.push_back(s.substr(start, pos - start));
-    start = pos + 1;
-  }
-}
-
-std::optional<double> parse_double(std::string_view token, bool fortran) {
-  token = trim(token);
-  if (token.empty()) return std::nullopt;
-  std::string buffer;
-  if (fortran && token.find_first_of("dD") != std::string_view::npos) {
-    buffer.assign(token);
-    std::replace(buffer.begin(), buffer.end(), 'd', 'e');
-    std::replace(buffer.begin(), buffer.end(), 'D', 'E');
-    token = buffer;
-  }
-  // from_chars rejects a leading '+', which spreadsheets and Fortran write.
-  if (token.front() == '+') {
-    token.remove_prefix(1);
-    if (token.empty() || token.front() == '-' || token.front() == '+') return std::nullopt;
-  }
-  double value = 0.0;
-  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (ec == std::errc::result_out_of_range) {
-    // Overflow is a non-finite value for the caller to report; underflow is a zero.
-    std::string copy(token);
-    return std::strtod(copy.c_str(), nullptr);
-  }
-  if (ec != std::errc() || ptr != token.data() + token.size()) return std::nullopt;
-  return value;
-}
-
-std::optional<long long> parse_int(std::string_view token) {
-  token = trim(token);
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return std::nullopt;
-  long long value = 0;
-  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (ec != std::errc() || ptr != token.data() + token.size()) return std::nullopt;
-  return value;
-}
-
-std::string format_g17(double v) {
-  char buf[32];
-  const int n = std::snprintf(buf, sizeof buf, "%.17g", v);
-  return std::string(buf, static_cast<size_t>(n));
-}
-
-std::string quote(std::string_view text) {
-  std::string out = "'";
-  const size_t limit = 40;
-  for (size_t i = 0; i < text.size() && i < limit; ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (std::isprint(c) != 0) {
-      out += static_cast<char>(c);
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
-    }
-  }
-  if (text.size() > limit) out += "...";
-  return out + "'";
-}
-
-std::string join(const std::vector<std::string>& items, const std::string& sep) {
-  std::string out;
-  for (size_t i = 0; i < items.size(); ++i) {
-    if (i > 0) out += sep;
-    out += items[i];
-  }
-  return out;
-}
 
 bool is_matlab_identifier(const std::string& name) {
   if (name.empty() || name.size() > 63) return false;
@@ -536,7 +323,7 @@ std::vector<std::string> create_and_fill_isolated(const fs::path& temp, const fs
   int fds[2];
   if (::pipe(fds) != 0) {
     const int err = errno;
-    throw InputError(file.string(), "output file", "a pipe for the writer process", errno_text(err));
+    throw InputError(file.string(), "output file", "a pipe for the writer process", std::string(std::strerror(err)));
   }
   std::fflush(nullptr);  // buffered output must not be written twice
   const pid_t pid = ::fork();
@@ -544,7 +331,7 @@ std::vector<std::string> create_and_fill_isolated(const fs::path& temp, const fs
     const int err = errno;
     ::close(fds[0]);
     ::close(fds[1]);
-    throw InputError(file.string(), "output file", "a writer process", "fork failed (" + errno_text(err) + ")");
+    throw InputError(file.string(), "output file", "a writer process", "fork failed (" + std::string(std::strerror(err)) + ")");
   }
   if (pid == 0) {
     ::close(fds[0]);
@@ -552,7 +339,7 @@ std::vector<std::string> create_and_fill_isolated(const fs::path& temp, const fs
     std::string message;
     try {
       const std::vector<std::string> names = create_and_fill(temp, file, true, compress, fill);
-      message = "\n" + join(names, "\n");  // leading newline: success
+      message = "\n" + text::join(names, "\n");  // leading newline: success
     } catch (const std::exception& e) {
       message = e.what();
       code = 1;
@@ -586,7 +373,7 @@ std::vector<std::string> create_and_fill_isolated(const fs::path& temp, const fs
   }
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && !message.empty() && message.front() == '\n') {
     std::vector<std::string> names;
-    for (std::string_view n : split(std::string_view(message).substr(1), '\n')) {
+    for (std::string_view n : text::split(std::string_view(message).substr(1), '\n')) {
       if (!n.empty()) names.emplace_back(n);
     }
     return names;
@@ -622,11 +409,3 @@ void write_mat_atomically(const fs::path& file, bool v73, bool compress, const s
 }
 
 }  // namespace piezobench::io::detail
-
-namespace piezobench::io {
-
-void write_text_atomically(const std::filesystem::path& target, const std::string& text) {
-  detail::write_atomically(target, [&](std::ostream& out) { out << text; });
-}
-
-}  // namespace piezobench::io

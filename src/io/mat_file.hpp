@@ -1,6 +1,7 @@
 #pragma once
-// Private helpers shared by the io readers and writers: atomic output files, text parsing and
-// thin RAII wrappers around matio.
+// Private MAT-file layer of io: thin RAII wrappers around matio, the bounded reader (v5/v7 through
+// matio, v7.3 through HDF5: mat_reader.cpp) and the atomic writer (the v7.3 writer runs in a forked
+// child so that a crash inside HDF5 cannot take the program down: mat_file.cpp).
 #include <matio.h>
 
 #include <Eigen/Dense>
@@ -8,59 +9,12 @@
 #include <functional>
 #include <memory>
 #include <optional>
-#include <ostream>
 #include <string>
-#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace piezobench::io::detail {
 
-// A file written under a temporary name in the target's directory and renamed over the target
-// by commit(). Until then the target is untouched; the destructor removes an uncommitted
-// temporary, so an exception anywhere in a writer leaves no partial file behind.
-class AtomicFile {
- public:
-  // Creates the (empty) temporary file; InputError (source = target) if that is impossible.
-  explicit AtomicFile(std::filesystem::path target);
-  ~AtomicFile();
-  AtomicFile(const AtomicFile&) = delete;
-  AtomicFile& operator=(const AtomicFile&) = delete;
-
-  [[nodiscard]] const std::filesystem::path& temp_path() const { return temp_; }
-  [[nodiscard]] const std::filesystem::path& target() const { return target_; }
-  // Flushes the temporary to disk and renames it over the target; InputError on failure.
-  void commit();
-
- private:
-  std::filesystem::path target_;
-  std::filesystem::path temp_;
-  bool committed_ = false;
-};
-
-// Writes a text (or binary) file atomically: `body` writes into a stream on the temporary file;
-// a stream failure (disk full, file size limit) becomes an InputError and no file is left.
-void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& body);
-
-// The whole file; InputError (field "file") when it cannot be read.
-[[nodiscard]] std::string read_file(const std::filesystem::path& file);
-
-// Lower-case extension including the dot (".mat").
-[[nodiscard]] std::string lower_extension(const std::filesystem::path& file);
-[[nodiscard]] std::string to_lower(std::string s);
-[[nodiscard]] std::string_view trim(std::string_view s);
-// Splits at every `sep` (no quoting).
-[[nodiscard]] std::vector<std::string_view> split(std::string_view s, char sep);
-// Strict number parsing: the whole (trimmed) token must be a number ("nan"/"inf" accepted, so the
-// caller can report them as non-finite values rather than as text). Fortran 'D' exponents are
-// accepted when fortran is true.
-[[nodiscard]] std::optional<double> parse_double(std::string_view token, bool fortran = false);
-[[nodiscard]] std::optional<long long> parse_int(std::string_view token);
-// %.17g (round-trips every double).
-[[nodiscard]] std::string format_g17(double v);
-// Shows a piece of a file in an error message: quoted, at most 40 characters.
-[[nodiscard]] std::string quote(std::string_view text);
-// "a, b, c"
-[[nodiscard]] std::string join(const std::vector<std::string>& items, const std::string& sep = ", ");
 // Letter first, then letters, digits and '_', at most 63 characters.
 [[nodiscard]] bool is_matlab_identifier(const std::string& name);
 

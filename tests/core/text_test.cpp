@@ -1,0 +1,73 @@
+// Tests of core/text.hpp: the text helpers shared by the io and fem readers.
+#include "piezobench/core/text.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "piezobench/core/format.hpp"
+
+namespace piezobench::text {
+namespace {
+
+TEST(ParseDouble, AcceptsWholeNumbersOnly) {
+  EXPECT_EQ(parse_double(" 1.5 ").value(), 1.5);
+  EXPECT_EQ(parse_double("+2e3").value(), 2000.0);
+  EXPECT_EQ(parse_double("-0.25E-1").value(), -0.025);
+  EXPECT_EQ(parse_double("1.0D+02", /*fortran=*/true).value(), 100.0);
+  EXPECT_FALSE(parse_double("1.0D+02").has_value());
+  EXPECT_FALSE(parse_double("1.5x").has_value());
+  EXPECT_FALSE(parse_double("").has_value());
+  EXPECT_FALSE(parse_double("abc").has_value());
+  EXPECT_FALSE(parse_double("+-1").has_value());
+  EXPECT_TRUE(std::isnan(parse_double("nan").value()));
+  EXPECT_TRUE(std::isinf(parse_double("1e999").value()));
+  EXPECT_EQ(parse_double("0.1").value(), 0.1);
+  EXPECT_EQ(parse_double(format_number(0.1 + 0.2, 17)).value(), 0.1 + 0.2);
+}
+
+TEST(ParseInt, RejectsFractionsAndText) {
+  EXPECT_EQ(parse_int("   58").value(), 58);
+  EXPECT_EQ(parse_int("-1").value(), -1);
+  EXPECT_FALSE(parse_int("5.0").has_value());
+  EXPECT_FALSE(parse_int("5b").has_value());
+}
+
+TEST(TakeDouble, AdvancesPastTheNumberOnly) {
+  std::string_view s = "  +1.25e2, 7";
+  EXPECT_EQ(take_double(s).value(), 125.0);
+  EXPECT_EQ(s, ", 7");
+  std::string_view bad = "x1";
+  EXPECT_FALSE(take_double(bad).has_value());
+  EXPECT_EQ(bad, "x1");
+  std::string_view n = " 42 3";
+  EXPECT_EQ(take_int(n).value(), 42);
+  EXPECT_EQ(n, " 3");
+}
+
+TEST(Tokens, SplitsAtBlanksAndOptionallyCommas) {
+  EXPECT_EQ(tokens("  a\tb  c "), (std::vector<std::string_view>{"a", "b", "c"}));
+  EXPECT_EQ(tokens("1, 2,3", /*commas=*/true), (std::vector<std::string_view>{"1", "2", "3"}));
+  EXPECT_EQ(split("a,,b", ','), (std::vector<std::string_view>{"a", "", "b"}));
+}
+
+TEST(ForEachLine, NumbersLinesAndDropsCarriageReturns) {
+  std::vector<std::string> lines;
+  for_each_line("one\r\ntwo\nthree", [&](std::size_t number, std::string_view line) {
+    lines.push_back(std::to_string(number) + ":" + std::string(line));
+    return number < 2;
+  });
+  EXPECT_EQ(lines, (std::vector<std::string>{"1:one", "2:two"}));
+}
+
+TEST(Quote, ShortensAndEscapes) {
+  EXPECT_EQ(quote("abc"), "'abc'");
+  EXPECT_EQ(quote(std::string("a\x01", 2)), "'a\\x01'");
+  EXPECT_EQ(quote(std::string(50, 'x')), "'" + std::string(40, 'x') + "...'");
+  EXPECT_EQ(trim(" \t x y \r\n"), "x y");
+  EXPECT_EQ(to_lower("HeLLo.MAT"), "hello.mat");
+  EXPECT_EQ(join({"a", "b", "c"}), "a, b, c");
+}
+
+}  // namespace
+}  // namespace piezobench::text
