@@ -296,11 +296,7 @@ dsp::Frf read_frf_mat(const fs::path& file) {
     }
   }
   if (frf.provenance.source.empty()) frf.provenance.source = source;
-  try {
-    frf.validate(source);
-  } catch (const InputError& e) {
-    throw e.with_source(source);
-  }
+  frf.validate(source);  // every message names source
   return frf;
 }
 

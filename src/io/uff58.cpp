@@ -664,11 +664,7 @@ dsp::Frf read_frf_uff58(const fs::path& file) {
     for (const std::string& o : frf.outputs) frf.coherence.emplace_back(coherence[o]->y.real());
   }
   frf.provenance.source = source;
-  try {
-    frf.validate(source);
-  } catch (const InputError& e) {
-    throw e.with_source(source);
-  }
+  frf.validate(source);  // every message names source
   return frf;
 }
 
