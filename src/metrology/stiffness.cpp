@@ -53,51 +53,117 @@ struct Fit {
   Index used = 0;
 };
 
+// The log creep term log10(1 + s / tau) at s >= 0 after the event (log, not log10: the fit below
+// evaluates it some 10 million times per record, and glibc's log is the faster one).
+double creep_term(double s, double inv_tau) {
+  constexpr double kInvLn10 = 0.43429448190325182765;
+  return std::log(1.0 + s * inv_tau) * kInvLn10;
+}
+
 // Model columns at time t (log creep with time constant tau).
 void basis_row(double t, double t_on, double t_off, double tau, double* row) {
   const double on = t >= t_on ? 1.0 : 0.0;
   const double off = t >= t_off ? 1.0 : 0.0;
   row[0] = 1.0;
   row[1] = on;
-  row[2] = on * std::log10(1.0 + std::max(0.0, t - t_on) / tau);
+  row[2] = on * creep_term(std::max(0.0, t - t_on), 1.0 / tau);
   row[3] = off;
-  row[4] = off * std::log10(1.0 + std::max(0.0, t - t_off) / tau);
+  row[4] = off * creep_term(std::max(0.0, t - t_off), 1.0 / tau);
 }
 
-// Least squares of the creep model over `rows` through its 5 x 5 normal equations, accumulated
-// row by row: no n x 5 matrix per time constant (the grid below fits 43 of them on records of a
-// few hundred thousand samples). The columns are of order 1, so the normal equations lose nothing
-// that matters here; the residual is summed directly when `exact_sse` (else b'b - b'A x, ample for
-// comparing time constants).
-Fit fit_creep(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de, const std::vector<Index>& rows,
-              double t_on, double t_off, double tau, const std::string& source, bool exact_sse = false) {
-  Eigen::Matrix<double, 5, 5> ata = Eigen::Matrix<double, 5, 5>::Zero();
-  Eigen::Matrix<double, 5, 1> atb = Eigen::Matrix<double, 5, 1>::Zero();
-  double btb = 0.0;
-  Eigen::Matrix<double, 5, 1> row;
+// The record's rows split by the model's pieces (before t_on: [1 0 0 0 0]; from t_on: [1 1 a 0 0];
+// from t_off: [1 1 a 1 b], with a, b the log creep terms) and the sums that do not depend on tau:
+// per time constant only a and b are evaluated and summed, no row of five columns and no rank
+// update (the grid below fits 43 time constants on records of a few hundred thousand samples).
+struct CreepRows {
+  std::vector<double> s_on, d_on;          // rows in [t_on, t_off): t - t_on, de
+  std::vector<double> s_on2, s_off, d_off;  // rows from t_off: t - t_on, t - t_off, de
+  // de is taken about its mean over the rows (added back to the offset d0): b'b - b'A x then
+  // cancels far less, and the grid's sums of squares stay good to ~1e-12 instead of ~1e-8.
+  double mean = 0.0;
+  double n = 0.0, sum_d = 0.0, sum_dd = 0.0, sum_d_on = 0.0, sum_d_off = 0.0;
+};
+
+CreepRows split_rows(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de, const std::vector<Index>& rows,
+                     double t_on, double t_off) {
+  CreepRows c;
+  for (const Index k : rows) c.mean += de(k);
+  c.mean /= static_cast<double>(rows.size());
   for (const Index k : rows) {
-    basis_row(t(k), t_on, t_off, tau, row.data());
-    ata.selfadjointView<Eigen::Lower>().rankUpdate(row);
-    atb += row * de(k);
-    btb += de(k) * de(k);
+    const double tk = t(k), d = de(k) - c.mean;
+    c.n += 1.0;
+    c.sum_d += d;
+    c.sum_dd += d * d;
+    if (tk >= t_off) {
+      c.s_on2.push_back(tk - t_on);
+      c.s_off.push_back(tk - t_off);
+      c.d_off.push_back(d);
+      c.sum_d_on += d;
+      c.sum_d_off += d;
+    } else if (tk >= t_on) {
+      c.s_on.push_back(tk - t_on);
+      c.d_on.push_back(d);
+      c.sum_d_on += d;
+    }
   }
-  ata = ata.selfadjointView<Eigen::Lower>();
+  return c;
+}
+
+// Least squares of the creep model over `rows` through its 5 x 5 normal equations. The columns are
+// of order 1, so the normal equations lose nothing that matters here; the residual is summed
+// directly when `exact_sse` (else b'b - b'A x, ample for comparing time constants).
+Fit fit_creep(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de, const std::vector<Index>& rows,
+              const CreepRows& c, double t_on, double t_off, double tau, const std::string& source, bool exact_sse = false) {
+  const double inv_tau = 1.0 / tau;
+  double sa = 0.0, saa = 0.0, sad = 0.0;                              // a over the rows from t_on
+  double sa2 = 0.0, sb = 0.0, sbb = 0.0, sab = 0.0, sbd = 0.0;        // a and b over the rows from t_off
+  for (std::size_t i = 0; i < c.s_on.size(); ++i) {
+    const double a = creep_term(c.s_on[i], inv_tau);
+    sa += a;
+    saa += a * a;
+    sad += a * c.d_on[i];
+  }
+  for (std::size_t i = 0; i < c.s_off.size(); ++i) {
+    const double a = creep_term(c.s_on2[i], inv_tau);
+    const double b = creep_term(c.s_off[i], inv_tau);
+    sa2 += a;
+    saa += a * a;
+    sad += a * c.d_off[i];
+    sb += b;
+    sbb += b * b;
+    sab += a * b;
+    sbd += b * c.d_off[i];
+  }
+  sa += sa2;
+  const double n_on = static_cast<double>(c.s_on.size() + c.s_off.size());
+  const double n_off = static_cast<double>(c.s_off.size());
+  Eigen::Matrix<double, 5, 5> ata;
+  ata << c.n, n_on, sa, n_off, sb,  //
+      n_on, n_on, sa, n_off, sb,    //
+      sa, sa, saa, sa2, sab,        //
+      n_off, n_off, sa2, n_off, sb, //
+      sb, sb, sab, sb, sbb;
+  Eigen::Matrix<double, 5, 1> atb;
+  atb << c.sum_d, c.sum_d_on, sad, c.sum_d_off, sbd;
   const Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 5, 5>> qr(ata);
   if (qr.rank() < 5) {
     throw NumericalError("static stiffness (" + source + ")", "the creep model is singular on this record", false);
   }
+  const Eigen::Matrix<double, 5, 1> x = qr.solve(atb);
   Fit f;
-  f.coef = qr.solve(atb);
+  f.coef = x;
+  f.coef(0) += c.mean;
   f.used = static_cast<Index>(rows.size());
   if (exact_sse) {
     f.sse = 0.0;
+    Eigen::Matrix<double, 5, 1> row;
     for (const Index k : rows) {
       basis_row(t(k), t_on, t_off, tau, row.data());
       const double r = row.dot(f.coef) - de(k);
       f.sse += r * r;
     }
   } else {
-    f.sse = std::max(0.0, btb - atb.dot(f.coef));
+    f.sse = std::max(0.0, c.sum_dd - atb.dot(x));
   }
   return f;
 }
@@ -206,6 +272,7 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
     const bool settling = (tk >= r.t_on && tk < r.t_on + settle) || (tk >= r.t_off && tk < r.t_off + settle);
     if (!settling) rows.push_back(k);
   }
+  const CreepRows split = split_rows(t, de, rows, r.t_on, r.t_off);
   // Grid over log10(tau), then a parabola through the best point and its neighbours.
   constexpr int kGrid = 41;
   const double l0 = std::log10(options.min_time_constant);
@@ -213,7 +280,7 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
   std::vector<double> sse(kGrid);
   int best = 0;
   for (int i = 0; i < kGrid; ++i) {
-    sse[static_cast<std::size_t>(i)] = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, l0 + (l1 - l0) * i / (kGrid - 1)), source).sse;
+    sse[static_cast<std::size_t>(i)] = fit_creep(t, de, rows, split, r.t_on, r.t_off, std::pow(10.0, l0 + (l1 - l0) * i / (kGrid - 1)), source).sse;
     if (sse[static_cast<std::size_t>(i)] < sse[static_cast<std::size_t>(best)]) best = i;
   }
   const double h = (l1 - l0) / (kGrid - 1);
@@ -225,8 +292,8 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
     const double denom = ym - 2.0 * y0 + yp;
     if (denom > 0.0) lbest += 0.5 * h * (ym - yp) / denom;
   }
-  Fit f = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, lbest), source, true);
-  const Fit at_grid = fit_creep(t, de, rows, r.t_on, r.t_off, std::pow(10.0, l0 + h * best), source, true);
+  Fit f = fit_creep(t, de, rows, split, r.t_on, r.t_off, std::pow(10.0, lbest), source, true);
+  const Fit at_grid = fit_creep(t, de, rows, split, r.t_on, r.t_off, std::pow(10.0, l0 + h * best), source, true);
   if (at_grid.sse < f.sse) {
     f = at_grid;
     lbest = l0 + h * best;
