@@ -242,6 +242,27 @@ fem::FromStepOptions from_step_options(const FromStepCli& c) {
   return o;
 }
 
+// The super element's files among the outputs and the command that uses them.
+struct SuperElementFiles {
+  std::string k_file, m_file, dof_file;
+  long clamp_node = -1;
+
+  explicit SuperElementFiles(const fem::FromStepResult& r) {
+    for (const auto& f : r.files) {
+      const std::string name = f.filename().string();
+      if (name.size() > 6 && name.compare(name.size() - 6, 6, "_K.mtx") == 0) k_file = f.string();
+      if (name.size() > 6 && name.compare(name.size() - 6, 6, "_M.mtx") == 0) m_file = f.string();
+      if (name.size() > 9 && name.compare(name.size() - 9, 9, "_dofs.txt") == 0) dof_file = f.string();
+    }
+    for (const fem::RemotePointResult& p : r.remote_points) {
+      if (p.name == r.clamp) clamp_node = p.node;
+    }
+  }
+  [[nodiscard]] std::string usage() const {
+    return "piezobench superelement " + k_file + " " + m_file + " " + dof_file + " --fix " + std::to_string(clamp_node);
+  }
+};
+
 nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& o, const fem::FromStepResult& r) {
   nlohmann::json points = nlohmann::json::array();
   for (const fem::RemotePointResult& p : r.remote_points) {
@@ -278,17 +299,7 @@ nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& 
   for (const auto& [step, s] : r.seconds) seconds[step] = s;
   nlohmann::json files = nlohmann::json::array();
   for (const auto& f : r.files) files.push_back(f.string());
-  std::string k_file, m_file, dof_file;
-  for (const auto& f : r.files) {
-    const std::string name = f.filename().string();
-    if (name.size() > 6 && name.compare(name.size() - 6, 6, "_K.mtx") == 0) k_file = f.string();
-    if (name.size() > 6 && name.compare(name.size() - 6, 6, "_M.mtx") == 0) m_file = f.string();
-    if (name.size() > 9 && name.compare(name.size() - 9, 9, "_dofs.txt") == 0) dof_file = f.string();
-  }
-  long clamp_node = -1;
-  for (const fem::RemotePointResult& p : r.remote_points) {
-    if (p.name == r.clamp) clamp_node = p.node;
-  }
+  const SuperElementFiles se_files(r);
   nlohmann::json doc = {
       {"step", c.step_file},
       {"out", o.out.string()},
@@ -316,8 +327,8 @@ nlohmann::json from_step_json(const FromStepCli& c, const fem::FromStepOptions& 
         {"factor_nonzeros", r.reduction.factor_nonzeros},
         {"eigensolver_restarts", r.reduction.eigensolver_iterations},
         {"solves", r.reduction.eigensolver_operations}}},
-      {"super_element", {{"dofs", r.reduced.size()}, {"modal_dofs", r.reduced.modal_dofs()}, {"K", k_file}, {"M", m_file}, {"dof_list", dof_file}}},
-      {"usage", "piezobench superelement " + k_file + " " + m_file + " " + dof_file + " --fix " + std::to_string(clamp_node)},
+      {"super_element", {{"dofs", r.reduced.size()}, {"modal_dofs", r.reduced.modal_dofs()}, {"K", se_files.k_file}, {"M", se_files.m_file}, {"dof_list", se_files.dof_file}}},
+      {"usage", se_files.usage()},
       {"clamp", r.clamp},
       {"modes_clamped_Hz", io::to_json(r.modes_clamped_Hz)},
       {"shell_modes_clamped_Hz", io::to_json(r.shell_modes_clamped_Hz)},
@@ -381,7 +392,7 @@ int run_from_step(const FromStepCli& c) {
     for (Index i = 0; i < r.reference_modes_Hz->size(); ++i) fmt::print(" {:.6g}", (*r.reference_modes_Hz)(i));
     fmt::print("\n");
   }
-  fmt::print("use it: {}\n", doc["usage"].get<std::string>());
+  fmt::print("use it: {}\n", SuperElementFiles(r).usage());
   for (const std::string& w : r.reduced.warnings) fmt::print("warning: {}\n", w);
   return 0;
 }

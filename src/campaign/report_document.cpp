@@ -64,45 +64,88 @@ std::vector<Index> log_indices(const VectorXd& f, double fmin, double fmax, int 
   return idx;
 }
 
+// A response's curves as the figures draw them: frequencies, |H| (scaled), unwrapped phase in
+// degrees and, for measurements, the coherence (null where there is none).
+struct Bode {
+  json f = json::array(), abs = json::array(), phase = json::array(), coh = json::array();
+};
+
 // |H|, coherence and unwrapped phase of one output at the indices `idx` (|H| times `scale`).
-json frf_lines(const dsp::Frf& frf, Index output, const std::vector<Index>& idx, double scale) {
+Bode frf_lines(const dsp::Frf& frf, Index output, const std::vector<Index>& idx, double scale) {
   const auto o = static_cast<std::size_t>(output);
-  json p = {{"f", json::array()}, {"abs", json::array()}, {"coh", json::array()}};
+  Bode p;
   std::vector<std::complex<double>> h;
   for (const Index k : idx) {
-    p["f"].push_back(frf.freq_hz(k));
-    p["abs"].push_back(std::abs(frf.H[o](k)) * scale);
-    p["coh"].push_back(frf.coherence[o].size() > 0 ? json(frf.coherence[o](k)) : json(nullptr));
+    p.f.push_back(frf.freq_hz(k));
+    p.abs.push_back(std::abs(frf.H[o](k)) * scale);
+    p.coh.push_back(frf.coherence[o].size() > 0 ? json(frf.coherence[o](k)) : json(nullptr));
     h.push_back(frf.H[o](k));
   }
-  p["phase"] = unwrapped_degrees(h);
+  p.phase = unwrapped_degrees(h);
   return p;
 }
 
-json stiffness_curves(const StiffnessAnalysis& s) {
-  return {{"t", values(s.de.x)}, {"de_um", values(s.de.y, 1e6)}, {"fit_um", values(s.fit.y, 1e6)}};
+// A model's response h(k) at the frequencies f(k) [Hz], |h| times `scale`.
+Bode model_lines(const json& f, const std::vector<std::complex<double>>& h, double scale) {
+  Bode p;
+  p.f = f;
+  for (const auto& v : h) p.abs.push_back(std::abs(v) * scale);
+  p.phase = unwrapped_degrees(h);
+  return p;
 }
 
-// The curves of one unit's analyses, under the keys the figures read.
-json unit_plots(const Campaign& c, const UnitAnalysis& u) {
-  json plots = json::object();
-  if (u.flatness_analysis) plots["flatness_deviation_um"] = values(u.flatness_analysis->deviation, 1e6);
-  if (u.stroke_analysis) {
-    plots["stroke"] = {{"Va", values(u.stroke_analysis->de_vs_va.x)}, {"de_um", values(u.stroke_analysis->de_vs_va.y, 1e6)}};
-  }
-  if (!u.hysteresis.empty()) {
-    json loops = json::array();
-    for (const auto& h : u.hysteresis) {
-      loops.push_back({{"amplitude_V", h.result.amplitude}, {"Va", values(h.loop.x)}, {"de_um", values(h.loop.y, 1e6)}});
-    }
-    plots["hysteresis"] = loops;
-  }
+// x against y (thinned records).
+struct XY {
+  json x, y;
+};
+
+struct HysteresisCurves {
+  double amplitude_V = 0.0;
+  XY loop;  // Va [V], d_e [um]
+};
+
+struct StiffnessCurves {
+  json t, de_um, fit_um;
+};
+
+struct DampedCurves {
+  double gain = 0.0;
+  Bode measured, fit;  // u' -> d_e [um/V]; the vector fit with the delay put back
+};
+
+// What the figures draw of one unit, made from its typed results.
+struct UnitCurves {
+  const UnitAnalysis* result = nullptr;
+  std::optional<Bode> de, vs;              // measured u -> d_e [um/V], u -> Vs [V/V] (same f)
+  std::optional<Bode> model_de, model_vs;  // the tuned 2-DoF model
+  std::optional<Bode> iff_fit;             // eq. 2.3 with delay, at vs's frequencies
+  std::optional<Bode> nmp;                 // u -> Vs, every line around the anti-resonance
+  std::optional<Bode> resistor_with, resistor_without;  // u -> Vs below 20 Hz
+  std::vector<DampedCurves> damped;        // the identified damped plants
+  std::optional<XY> hammer;                // force -> velocity |H|
+  std::optional<XY> stroke;                // Va [V], d_e [um]
+  std::vector<HysteresisCurves> hysteresis;
+  std::optional<StiffnessCurves> stiffness, stiffness_open;
+  std::optional<XY> hysteresis_model_record;  // Va [V], d_e [um]
+  json hysteresis_model_um;                   // the model's d_e [um] at the same Va
+
+  [[nodiscard]] const std::string& name() const { return result->name; }
+};
+
+StiffnessCurves stiffness_curves(const StiffnessAnalysis& s) { return {values(s.de.x), values(s.de.y, 1e6), values(s.fit.y, 1e6)}; }
+
+UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
+  UnitCurves out;
+  out.result = &u;
+  if (u.stroke_analysis) out.stroke = XY{values(u.stroke_analysis->de_vs_va.x), values(u.stroke_analysis->de_vs_va.y, 1e6)};
+  for (const auto& h : u.hysteresis) out.hysteresis.push_back({h.result.amplitude, {values(h.loop.x), values(h.loop.y, 1e6)}});
   if (u.hysteresis_model) {
     const HysteresisModelFit& h = *u.hysteresis_model;
-    plots["hysteresis_model"] = {{"Va", values(h.loop.x)}, {"de_um", values(h.loop.y, 1e6)}, {"model_um", values(h.model_loop.y, 1e6)}};
+    out.hysteresis_model_record = XY{values(h.loop.x), values(h.loop.y, 1e6)};
+    out.hysteresis_model_um = values(h.model_loop.y, 1e6);
   }
-  if (u.stiffness_analysis) plots["stiffness"] = stiffness_curves(*u.stiffness_analysis);
-  if (u.stiffness_open_analysis) plots["stiffness_open"] = stiffness_curves(*u.stiffness_open_analysis);
+  if (u.stiffness_analysis) out.stiffness = stiffness_curves(*u.stiffness_analysis);
+  if (u.stiffness_open_analysis) out.stiffness_open = stiffness_curves(*u.stiffness_open_analysis);
   if (u.frf) {
     const dsp::Frf& frf = *u.frf;
     const VectorXd& f = frf.freq_hz;
@@ -110,35 +153,23 @@ json unit_plots(const Campaign& c, const UnitAnalysis& u) {
     VectorXd w(static_cast<Index>(idx.size()));
     for (std::size_t i = 0; i < idx.size(); ++i) w(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
     if (u.model_2dof) {
-      apa::TwoDofBench b = u.model_2dof->bench;
-      const lti::CMatrix hm = apa::two_dof_response(u.model_2dof->tuning.params, b, w);
-      json m = {{"f", json::array()}, {"de_abs", json::array()}, {"Vs_abs", json::array()}};
+      const lti::CMatrix hm = apa::two_dof_response(u.model_2dof->tuning.params, u.model_2dof->bench, w);
+      json fm = json::array();
       std::vector<std::complex<double>> mde, mvs;
       for (Index k = 0; k < w.size(); ++k) {
-        m["f"].push_back(w(k) / kTwoPi);
-        m["de_abs"].push_back(std::abs(hm(k, 0)) * 1e6);
-        m["Vs_abs"].push_back(std::abs(hm(k, 1)));
+        fm.push_back(w(k) / kTwoPi);
         mde.push_back(hm(k, 0));
         mvs.push_back(hm(k, 1));
       }
-      m["de_phase"] = unwrapped_degrees(mde);
-      m["Vs_phase"] = unwrapped_degrees(mvs);
-      plots["model"] = m;
+      out.model_de = model_lines(fm, mde, 1e6);
+      out.model_vs = model_lines(fm, mvs, 1.0);
     }
-    const json de = frf_lines(frf, 0, idx, 1e6), vs = frf_lines(frf, 1, idx, 1.0);
-    json p = {{"f", de["f"]}, {"de_abs", de["abs"]}, {"de_coh", de["coh"]}, {"de_phase", de["phase"]},
-              {"Vs_abs", vs["abs"]}, {"Vs_coh", vs["coh"]}, {"Vs_phase", vs["phase"]}};
+    out.de = frf_lines(frf, 0, idx, 1e6);
+    out.vs = frf_lines(frf, 1, idx, 1.0);
     if (u.iff_plant) {
       const Eigen::VectorXcd g = u.iff_plant->response(w);
-      p["iff_fit_abs"] = json::array();
-      std::vector<std::complex<double>> hg;
-      for (Index k = 0; k < g.size(); ++k) {
-        p["iff_fit_abs"].push_back(std::abs(g(k)));
-        hg.push_back(g(k));
-      }
-      p["iff_fit_phase"] = unwrapped_degrees(hg);
+      out.iff_fit = model_lines(out.vs->f, std::vector<std::complex<double>>(g.data(), g.data() + g.size()), 1.0);
     }
-    plots["frf"] = p;
     // Every line around the anti-resonance (report Figure 2.6: coherence and phase there).
     if (u.antiresonance_Hz) {
       const double fz = *u.antiresonance_Hz;
@@ -146,9 +177,7 @@ json unit_plots(const Campaign& c, const UnitAnalysis& u) {
       for (Index k = 0; k < f.size(); ++k) {
         if (f(k) >= 0.7 * fz && f(k) <= 1.4 * fz) near.push_back(k);
       }
-      json z = frf_lines(frf, 1, near, 1.0);
-      z["antiresonance_Hz"] = fz;
-      plots["nmp"] = z;
+      out.nmp = frf_lines(frf, 1, near, 1.0);
     }
   }
   if (u.resistor) {
@@ -157,12 +186,9 @@ json unit_plots(const Campaign& c, const UnitAnalysis& u) {
       const VectorXd& f = v.frf.freq_hz;
       return frf_lines(v.frf, 0, log_indices(f, v.lowest_line_Hz, std::min(20.0, f(f.size() - 1)), 200), 1.0);
     };
-    json r = json::object();
-    if (u.resistor->with_resistor) r["with"] = lines(*u.resistor->with_resistor);
-    r["without"] = lines(u.resistor->without_resistor);
-    plots["resistor"] = r;
+    if (u.resistor->with_resistor) out.resistor_with = lines(*u.resistor->with_resistor);
+    out.resistor_without = lines(u.resistor->without_resistor);
   }
-  json damped = json::array();
   for (const DampedPlant& d : u.damped) {
     if (!d.identified) continue;
     const VectorXd& f = d.frf.freq_hz;
@@ -172,90 +198,27 @@ json unit_plots(const Campaign& c, const UnitAnalysis& u) {
     for (std::size_t i = 0; i < idx.size(); ++i) om(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
     // The fit (delay removed) with the delay put back, to sit on the measurement.
     const Eigen::MatrixXcd fit = d.identified->fit.evaluate(om);
-    json p = {{"gain", d.gain}, {"f", json::array()}, {"abs", json::array()}, {"fit_abs", json::array()}};
+    json fd = json::array();
     std::vector<std::complex<double>> hm, hf;
     for (std::size_t i = 0; i < idx.size(); ++i) {
       const auto k = static_cast<Index>(i);
-      const std::complex<double> g = fit(k, 0) * std::exp(std::complex<double>(0.0, -om(k) * d.delay_removed));
-      p["f"].push_back(f(idx[i]));
-      p["abs"].push_back(std::abs(d.frf.H[0](idx[i])) * 1e6);
-      p["fit_abs"].push_back(std::abs(g) * 1e6);
+      fd.push_back(f(idx[i]));
       hm.push_back(d.frf.H[0](idx[i]));
-      hf.push_back(g);
+      hf.push_back(fit(k, 0) * std::exp(std::complex<double>(0.0, -om(k) * d.delay_removed)));
     }
-    p["phase"] = unwrapped_degrees(hm);
-    p["fit_phase"] = unwrapped_degrees(hf);
-    damped.push_back(p);
+    out.damped.push_back({d.gain, model_lines(fd, hm, 1e6), model_lines(fd, hf, 1e6)});
   }
-  if (!u.damped.empty()) plots["damped"] = damped;
   if (u.flexible_modes) {
     const dsp::Frf& frf = u.flexible_modes->frf;
-    json x = json::array(), y = json::array();
+    XY h{json::array(), json::array()};
     for (const Index k : log_indices(frf.freq_hz, std::max(1.0, frf.freq_hz(1)), frf.freq_hz(frf.freq_hz.size() - 1), 500)) {
-      x.push_back(frf.freq_hz(k));
-      y.push_back(std::abs(frf.H[0](k)));
+      h.x.push_back(frf.freq_hz(k));
+      h.y.push_back(std::abs(frf.H[0](k)));
     }
-    plots["hammer"] = {{"f", x}, {"abs", y}};
+    out.hammer = h;
   }
-  return plots;
+  return out;
 }
-
-// The batch-level curves: the root locus of the IFF study, the super element's u -> d_e.
-json extra_plots(const CampaignResult& r) {
-  json extra = json::object();
-  const IffStudy& s = r.iff;
-  if (s.plant && !s.failed) {
-    const ident::IffPlantFit& p = *s.plant;
-    const auto gain_label = [](double g) { return fmt::format("g = {:.3g}", g); };
-    json branches = json::array();
-    for (const auto& b : s.branches) {
-      json text = json::array();
-      for (const double g : b.gains) text.push_back(gain_label(g));
-      branches.push_back({{"re", values(b.re_im.x)}, {"im", values(b.re_im.y)}, {"text", text}, {"resonance_branch", b.resonance_branch}});
-    }
-    json damped = json::array(), model = json::array();
-    for (std::size_t i = 0; i < s.gains.size(); ++i) {
-      damped.push_back({{"gain", s.gains[i]}, {"re", s.damped_poles[i].real()}, {"im", s.damped_poles[i].imag()}});
-      model.push_back({{"gain", s.gains[i]}, {"re", s.model_poles[i].real()}, {"im", s.model_poles[i].imag()}});
-    }
-    extra["root_locus"] = {{"branches", branches},
-                           {"open_loop_poles", {{"re", values(s.open_loop_poles.x)}, {"im", values(s.open_loop_poles.y)}}},
-                           {"open_loop_zeros", {{"re", values(s.open_loop_zeros.x)}, {"im", values(s.open_loop_zeros.y)}}},
-                           {"damped", damped},
-                           {"model_at_gains", model},
-                           {"optimum", {{"gain", s.optimal_gain.value_or(0.0)}, {"re", s.optimal_pole.real()}, {"im", s.optimal_pole.imag()},
-                                        {"damping", s.max_damping.value_or(0.0)}}},
-                           {"unit", *s.unit},
-                           {"open_loop_pole", {p.wp * -p.xp, p.wp * std::sqrt(std::max(0.0, 1 - p.xp * p.xp))}}};
-  }
-  if (r.superelement && !r.superelement->failed && r.superelement->figure) {
-    // Figure 4.2: the tuned model thinned as the unit's measured FRF (unit_plots).
-    const SuperElementComparison::Response& m = *r.superelement->figure;
-    const VectorXd& f = m.freq_Hz;
-    json p = {{"unit", m.name}, {"f", json::array()}, {"de_abs", json::array()}, {"Vs_abs", json::array()}};
-    std::vector<std::complex<double>> de, vs;
-    if (f.size() > 1) {
-      for (const Index k : log_indices(f, std::max(0.5, f(1)), std::min(2.0 * r.campaign.analysis.fmax_hz, f(f.size() - 1)))) {
-        p["f"].push_back(f(k));
-        p["de_abs"].push_back(std::abs(m.de(k)) * 1e6);
-        p["Vs_abs"].push_back(std::abs(m.vs(k)));
-        de.push_back(m.de(k));
-        vs.push_back(m.vs(k));
-      }
-    }
-    p["de_phase"] = unwrapped_degrees(de);
-    p["Vs_phase"] = unwrapped_degrees(vs);
-    extra["superelement"] = p;
-  }
-  return extra;
-}
-
-// What the figures read of a unit.
-struct UnitPlots {
-  int id = 0;
-  std::string name;
-  json plots;
-};
 
 // ------------------------------------------------------------------------------------ layout
 
@@ -288,19 +251,6 @@ json table(const std::string& title, const std::vector<std::string>& columns, js
   return t;
 }
 
-bool has(const json& j, const char* key) { return j.is_object() && j.contains(key) && !j[key].is_null(); }
-
-// j[a][b]... or null.
-json at(const json& j, std::initializer_list<const char*> path) {
-  const json* v = &j;
-  for (const char* k : path) {
-    if (!has(*v, k)) return nullptr;
-    v = &(*v)[k];
-  }
-  return *v;
-}
-json scaled(const json& v, double s) { return v.is_number() ? json(v.get<double>() * s) : json(nullptr); }
-
 // A model's phase drawn on the measurement's branch: each model point is moved by the multiple of
 // 360 degrees that brings it nearest to the measured phase at the nearest frequency (phases are
 // defined modulo 360 degrees; unwrapped separately, a model and its measurement can sit one turn
@@ -330,22 +280,22 @@ std::pair<json, json> on_branch(const json& f_model, const json& ph_model, const
 }
 
 // Magnitude and phase (and coherence) of one output, all units, the measurement solid and a model
-// dashed, the model's phase on the measurement's branch.
-json frf_figure(const std::vector<UnitPlots>& units, const std::string& out, const std::string& id, const std::string& title,
-                const std::string& unit_label, const std::string& model_key, const std::string& model_abs,
-                const std::string& model_phase, const std::string& model_name, bool coherence, const std::string& text) {
+// dashed, the model's phase on the measurement's branch. `measured` and `model` pick the curves of
+// a unit (model: nullptr when the unit has none).
+json frf_figure(const std::vector<UnitCurves>& units, const std::function<const Bode*(const UnitCurves&)>& measured,
+                const std::function<const Bode*(const UnitCurves&)>& model, const std::string& id, const std::string& title,
+                const std::string& unit_label, const std::string& model_name, bool coherence, const std::string& text) {
   json mag = json::array(), phase = json::array(), coh = json::array();
   for (const auto& u : units) {
-    if (!has(u.plots, "frf")) continue;
-    const json& p = u.plots["frf"];
-    mag.push_back(trace(u.name, p["f"], p[out + "_abs"], u.name));
-    phase.push_back(trace(u.name, p["f"], p[out + "_phase"], u.name));
-    if (coherence) coh.push_back(trace(u.name, p["f"], p[out + "_coh"], u.name));
-    const json m = model_key.empty() ? p : at(u.plots, {model_key.c_str()});
-    if (has(m, model_abs.c_str()) && has(m, model_phase.c_str())) {
-      mag.push_back(trace(u.name + " " + model_name, m["f"], m[model_abs], u.name, true));
-      const auto [x, y] = on_branch(m["f"], m[model_phase], p["f"], p[out + "_phase"]);
-      phase.push_back(trace(u.name + " " + model_name, x, y, u.name, true));
+    const Bode* p = measured(u);
+    if (!p) continue;
+    mag.push_back(trace(u.name(), p->f, p->abs, u.name()));
+    phase.push_back(trace(u.name(), p->f, p->phase, u.name()));
+    if (coherence) coh.push_back(trace(u.name(), p->f, p->coh, u.name()));
+    if (const Bode* m = model(u)) {
+      mag.push_back(trace(u.name() + " " + model_name, m->f, m->abs, u.name(), true));
+      const auto [x, y] = on_branch(m->f, m->phase, p->f, p->phase);
+      phase.push_back(trace(u.name() + " " + model_name, x, y, u.name(), true));
     }
   }
   json panels = json::array({panel("|H| [" + unit_label + "]", true, mag), panel("Phase [deg]", false, phase)});
@@ -353,522 +303,552 @@ json frf_figure(const std::vector<UnitPlots>& units, const std::string& out, con
   return figure(id, title, "Frequency [Hz]", true, panels, text);
 }
 
+const Bode* measured_de(const UnitCurves& u) { return u.de ? &*u.de : nullptr; }
+const Bode* measured_vs(const UnitCurves& u) { return u.vs ? &*u.vs : nullptr; }
+const Bode* model_de(const UnitCurves& u) { return u.model_de ? &*u.model_de : nullptr; }
+const Bode* model_vs(const UnitCurves& u) { return u.model_vs ? &*u.model_vs : nullptr; }
+const Bode* iff_fit(const UnitCurves& u) { return u.iff_fit ? &*u.iff_fit : nullptr; }
+
 std::string amplitude_label(double a) { return fmt::format("{:.3g} V", a); }
 
-// The document from the results.json document, the units' curves and the batch curves.
-json document(const Campaign& c, const std::vector<UnitPlots>& units, const json& results, const json& extra) {
-  json sections = json::array();
-  const auto any = [&](const char* key) {
-    return std::any_of(units.begin(), units.end(), [&](const UnitPlots& u) { return has(u.plots, key); });
+// The table cells hold the numbers of results.json as results_json.cpp writes them: `plain` for
+// the numbers it writes as they are, io::to_json (non-finite as "nan", "inf") for the others.
+json plain(const std::optional<double>& v, double scale = 1.0) { return v ? json(*v * scale) : json(nullptr); }
+// A finite number times `scale`, else null (percentages of numbers written through io::to_json).
+json finite_scaled(double v, double scale) { return std::isfinite(v) ? json(v * scale) : json(nullptr); }
+
+// ---- the sections
+
+json frf_section(const std::vector<UnitCurves>& units) {
+  json figs = json::array();
+  figs.push_back(frf_figure(units, measured_de, model_de, "frf-de", "Fig. 2.5a: u -> d_e", "um/V", "2-DoF model", true,
+                            "Solid: measured (Welch H1); dashed: the tuned 2-DoF model (section 3). The model's phase is drawn "
+                            "on the measurement's branch (modulo 360 deg)."));
+  figs.push_back(frf_figure(units, measured_vs, iff_fit, "frf-vs", "Fig. 2.5b: u -> Vs", "V/V", "IFF plant fit", true,
+                            "Solid: measured; dashed: the IFF plant fit (eq. 2.3 with delay). The phase falls by 180 deg at the "
+                            "anti-resonance: a non-minimum-phase zero."));
+  json rows = json::array();
+  for (const auto& u : units) {
+    if (!u.result->frf_analysis) continue;
+    const FrfAnalysis& f = *u.result->frf_analysis;
+    const json verdict = f.zero_is_nonminimum_phase ? json(*f.zero_is_nonminimum_phase ? "non-minimum phase" : "minimum phase") : json(nullptr);
+    rows.push_back({u.name(), io::to_json(f.static_gain, 1e6), io::to_json(f.resonance_Hz), io::to_json(f.resonance_damping),
+                    io::to_json(f.antiresonance_Hz), io::to_json(f.antiresonance_damping), verdict,
+                    f.nmp.zero ? json(f.nmp.zero->phase_change_deg) : json(nullptr), io::to_json(f.shell_stiffness, 1e-6),
+                    plain(f.hpf.corner_Hz)});
+  }
+  json tables = json::array({table("FRF features per unit",
+                                   {"unit", "static gain [um/V]", "resonance [Hz]", "damping", "anti-resonance [Hz]", "zero damping",
+                                    "zero", "phase change at the zero [deg]", "k_shell [N/um]", "HPF corner [Hz]"},
+                                   rows, "Zero damping < 0: the zero is in the right half plane.")});
+  return {{"id", "frf"}, {"title", "Frequency responses (report 2.3)"},
+          {"text", "FRFs from the DAC voltage u to the encoder d_e and to the force-sensor voltage Vs, all units "
+                   "overlaid, with the coherence."},
+          {"tables", tables}, {"figures", figs}};
+}
+
+json nmp_section(const std::vector<UnitCurves>& units) {
+  json coh = json::array(), phase = json::array(), mag = json::array();
+  json rows = json::array();
+  for (const auto& u : units) {
+    if (!u.nmp) continue;
+    const Bode& z = *u.nmp;
+    mag.push_back(trace(u.name(), z.f, z.abs, u.name(), false, "lines+markers"));
+    coh.push_back(trace(u.name(), z.f, z.coh, u.name(), false, "lines+markers"));
+    phase.push_back(trace(u.name(), z.f, z.phase, u.name(), false, "lines+markers"));
+    json row = {u.name(), nullptr, nullptr, nullptr, nullptr, nullptr};
+    if (const auto& f = u.result->frf_analysis) {
+      row = {u.name(), io::to_json(f->antiresonance_Hz), io::to_json(f->antiresonance_damping),
+             f->nmp.zero ? json(f->nmp.zero->phase_change_deg) : json(nullptr),
+             f->nmp.zero ? json(ident::to_string(f->nmp.zero->phase_verdict)) : json(nullptr), f->nmp.verdict_from};
+    }
+    rows.push_back(row);
+  }
+  return {{"id", "nmp"}, {"title", "The non-minimum-phase zero (report 2.4)"},
+          {"text", "u -> Vs around the anti-resonance, every frequency line. A minimum-phase zero pair raises the phase by 180 deg, "
+                   "a non-minimum-phase one lowers it by 180 deg; the coherence says whether the data there can be trusted."},
+          {"tables", json::array({table("Verdict per unit",
+                                        {"unit", "anti-resonance [Hz]", "zero damping", "phase change [deg]", "verdict of the phase",
+                                         "verdict from"},
+                                        rows)})},
+          {"figures", json::array({figure("nmp-zoom", "Fig. 2.6: u -> Vs at the anti-resonance", "Frequency [Hz]", false,
+                                          json::array({panel("|H| [V/V]", true, mag), panel("Coherence", false, coh),
+                                                       panel("Phase [deg]", false, phase)}))})}};
+}
+
+// The corner of u -> Vs with or without the resistor as the table shows it.
+json corner_cell(const LowFrequencyVs& v) {
+  if (!v.fitted_corner_Hz) return nullptr;
+  if (v.observable) return *v.fitted_corner_Hz;
+  return fmt::format("below {:.2g} (not observable)", v.lowest_line_Hz / 3.0);
+}
+
+std::optional<json> resistor_section(const Campaign& c, const std::vector<UnitCurves>& units) {
+  json mag = json::array(), phase = json::array(), rows = json::array();
+  for (const auto& u : units) {
+    if (!u.result->resistor) continue;
+    const ResistorComparison& r = *u.result->resistor;
+    for (const bool with : {true, false}) {
+      const std::optional<Bode>& p = with ? u.resistor_with : u.resistor_without;
+      if (!p) continue;
+      const std::string name = u.name() + (with ? ", with R" : ", without R");
+      mag.push_back(trace(name, p->f, p->abs, name));
+      phase.push_back(trace(name, p->f, p->phase, name));
+    }
+    const auto& hpf = u.result->frf_analysis;
+    rows.push_back({u.name(), r.with_resistor ? corner_cell(*r.with_resistor) : json(nullptr), corner_cell(r.without_resistor),
+                    plain(r.without_resistor.fitted_corner_Hz), r.without_resistor.lowest_line_Hz,
+                    hpf ? plain(hpf->hpf.r_c_Hz) : json(nullptr)});
+  }
+  if (mag.empty()) return std::nullopt;
+  return json{{"id", "resistor"}, {"title", "The resistor across the force sensor (report 2.5)"},
+              {"text", fmt::format("u -> Vs at low frequency with and without the {:.3g} kOhm resistor in parallel with the sensor "
+                                   "stack: with it, a high-pass at 1/(2 pi R C).", c.bench.hpf_resistance * 1e-3)},
+              {"tables", json::array({table("High-pass corner per unit",
+                                            {"unit", "with R [Hz]", "without R [Hz]", "fitted without R [Hz]", "lowest line [Hz]",
+                                             "1/(2 pi R C_sensor) [Hz]"},
+                                            rows,
+                                            "First-order high-pass fitted below the campaign's hpf_fmax_Hz. A corner below a third "
+                                            "of the record's lowest line is reported as not observable.")})},
+              {"figures", json::array({figure("resistor", "Fig. 2.7: u -> Vs with and without the resistor", "Frequency [Hz]", true,
+                                              json::array({panel("|H| [V/V]", true, mag), panel("Phase [deg]", false, phase)}))})}};
+}
+
+// Frequency [Hz] and damping of a pole [rad/s] for the table; nulls when it is not finite.
+std::pair<json, json> pole_cells(std::complex<double> p) {
+  if (!std::isfinite(p.real()) || !std::isfinite(p.imag())) return {nullptr, nullptr};
+  const double w = std::abs(p);
+  return {w / kTwoPi, -p.real() / w};
+}
+
+// Figure 2.10b: the root locus of the fitted plant with the report's controller.
+json root_locus_figure(const IffStudy& s) {
+  const auto gain_label = [](double g) { return fmt::format("g = {:.3g}", g); };
+  json traces = json::array();
+  for (const auto& b : s.branches) {
+    json text = json::array();
+    for (const double g : b.gains) text.push_back(gain_label(g));
+    traces.push_back(with_text(trace("root locus of the model", values(b.re_im.x), values(b.re_im.y), "root locus of the model"), text));
+  }
+  traces.push_back(trace("open-loop poles", values(s.open_loop_poles.x), values(s.open_loop_poles.y), "", false, "markers"));
+  traces.push_back(trace("open-loop zeros", values(s.open_loop_zeros.x), values(s.open_loop_zeros.y), "", true, "markers"));
+  // The model's poles and the identified ones at the measured gains.
+  const auto at_gains = [&](const std::vector<std::complex<double>>& poles) {
+    json re = json::array(), im = json::array(), text = json::array();
+    for (std::size_t i = 0; i < s.gains.size(); ++i) {
+      re.push_back(poles[i].real());
+      im.push_back(poles[i].imag());
+      text.push_back(gain_label(s.gains[i]));
+    }
+    return std::tuple{re, im, text};
   };
-  const json& result_units = results["units"];
-  const auto result_of = [&](const UnitPlots& u) -> json {
-    for (const auto& r : result_units) {
-      if (r.contains("id") && r["id"] == u.id) return r;
+  {
+    const auto [re, im, text] = at_gains(s.model_poles);
+    traces.push_back(with_text(trace("model at the measured gains", re, im, "", true, "markers"), text));
+  }
+  {
+    const auto [re, im, text] = at_gains(s.damped_poles);
+    if (!re.empty()) traces.push_back(with_text(trace("identified damped poles", re, im, "", false, "markers"), text));
+  }
+  traces.push_back(with_text(trace("optimum", json::array({s.optimal_pole.real()}), json::array({s.optimal_pole.imag()}), "", false, "markers"),
+                             json::array({fmt::format("g = {:.3g}, damping {:.2f}", s.optimal_gain.value_or(0.0), s.max_damping.value_or(0.0))})));
+  return figure("root-locus", fmt::format("Fig. 2.10b: root locus, APA {}", *s.unit), "Re [rad/s]", false,
+                json::array({panel("Im [rad/s]", false, traces)}),
+                "Closed-loop poles of 1 - g K(s) G(s) = 0 for the fitted plant G (eq. 2.3 with delay) and the report's "
+                "controller K (eq. 2.4), every branch inside 3 w_p; open circles: the model's poles at the measured gains; "
+                "filled: the poles identified on the measured damped plants (dominant pair of a vector fit). Hover for "
+                "the gains.");
+}
+
+std::optional<json> iff_section(const std::vector<UnitCurves>& units, const IffStudy& s) {
+  json figs = json::array(), tables = json::array(), warnings = json::array();
+  // Figure 2.8: the IFF plant of the IFF unit against its fit.
+  const UnitCurves* iff_unit = nullptr;
+  for (const auto& u : units) {
+    if (!iff_unit && u.iff_fit && (s.failed || !s.unit || *s.unit == u.result->id)) iff_unit = &u;
+  }
+  if (iff_unit) {
+    const Bode& p = *iff_unit->vs;
+    const Bode& fit = *iff_unit->iff_fit;
+    const auto [x, y] = on_branch(fit.f, fit.phase, p.f, p.phase);
+    figs.push_back(figure("iff-plant", fmt::format("Fig. 2.8: IFF plant of {} and its fit (eq. 2.3)", iff_unit->name()), "Frequency [Hz]", true,
+                          json::array({panel("|H| [V/V]", true,
+                                             json::array({trace("measured", p.f, p.abs, "measured"),
+                                                          trace("fit (eq. 2.3 with delay)", fit.f, fit.abs, "fit", true)})),
+                                       panel("Phase [deg]", false,
+                                             json::array({trace("measured", p.f, p.phase, "measured"),
+                                                          trace("fit (eq. 2.3 with delay)", x, y, "fit", true)})),
+                                       panel("Coherence", false, json::array({trace("measured", p.f, p.coh, "measured")}))}),
+                          "u -> Vs of the unit whose IFF data make the batch's IFF result, against the fitted plant model."));
+  }
+  json prow = json::array();
+  for (const auto& u : units) {
+    if (!u.result->frf_analysis || !u.result->frf_analysis->iff_plant) continue;
+    const ident::IffPlantFit& f = *u.result->frf_analysis->iff_plant;
+    prow.push_back({u.name(), f.g0, f.wz / kTwoPi, f.xz, f.wp / kTwoPi, f.xp, f.w_hpf / kTwoPi, f.delay * 1e6, f.relative_rms_error});
+  }
+  if (!prow.empty()) {
+    tables.push_back(table("IFF plant (eq. 2.3) per unit",
+                           {"unit", "g0", "w_z [Hz]", "xi_z", "w_p [Hz]", "xi_p", "w_HPF [Hz]", "delay [us]", "relative rms error"}, prow,
+                           "The report's hand-tuned values: g0 0.64, w_z 42.7 Hz, xi_z 0.4 %, w_p 95.2 Hz, xi_p 2 %, "
+                           "w_HPF 0.4 Hz, 200 us."));
+  }
+  if (s.plant && !s.failed) figs.push_back(root_locus_figure(s));
+  json mag = json::array(), phase = json::array();
+  for (const auto& u : units) {
+    for (const DampedCurves& d : u.damped) {
+      const std::string name = fmt::format("{} g = {:.3g}", u.name(), d.gain);
+      mag.push_back(trace(name, d.measured.f, d.measured.abs, name));
+      mag.push_back(trace(name + " fit", d.fit.f, d.fit.abs, name, true));
+      phase.push_back(trace(name, d.measured.f, d.measured.phase, name));
+      const auto [x, y] = on_branch(d.fit.f, d.fit.phase, d.measured.f, d.measured.phase);
+      phase.push_back(trace(name + " fit", x, y, name, true));
     }
-    return json::object();
+  }
+  if (!mag.empty()) {
+    figs.push_back(figure("damped-plants", "Fig. 2.10a: damped plants u' -> d_e", "Frequency [Hz]", true,
+                          json::array({panel("|H| [um/V]", true, mag), panel("Phase [deg]", false, phase)}),
+                          "Solid: measured; dashed: the vector fits whose dominant pole is the identified damped pole."));
+  }
+  if (!s.failed && s.plant && !s.gains.empty()) {
+    json rows = json::array();
+    for (std::size_t i = 0; i < s.gains.size(); ++i) {
+      const auto [fi, zi] = pole_cells(s.damped_poles.at(i));
+      const auto [fm, zm] = i < s.model_poles.size() ? pole_cells(s.model_poles[i]) : std::pair<json, json>{nullptr, nullptr};
+      rows.push_back({s.gains[i], fi, zi, fm, zm, i < s.relative_pole_distance.size() ? json(s.relative_pole_distance[i]) : json(nullptr)});
+    }
+    tables.push_back(table("Damped poles against the model's root locus",
+                           {"gain g", "identified [Hz]", "identified damping", "model [Hz]", "model damping", "relative distance"},
+                           rows,
+                           fmt::format("Optimal gain of the model {}, maximum damping {}.",
+                                       s.optimal_gain ? fmt::format("{:.3g}", *s.optimal_gain) : "-",
+                                       s.plant && s.max_damping ? fmt::format("{:.2f}", *s.max_damping) : "-")));
+  }
+  if (!s.failed && s.plant && !s.damped_poles.empty() && s.warning) warnings.push_back(*s.warning);
+  if (figs.empty() && tables.empty()) return std::nullopt;
+  return json{{"id", "iff"}, {"title", "Integral Force Feedback (report 2.6)"}, {"warnings", warnings}, {"tables", tables},
+              {"figures", figs}};
+}
+
+json model_section(const std::vector<UnitCurves>& units) {
+  json figs = json::array();
+  figs.push_back(frf_figure(units, measured_de, model_de, "model-de", "Fig. 3.4a: 2-DoF model against the measurement, u -> d_e", "um/V",
+                            "2-DoF model", false, "Solid: measured; dashed: the tuned 2-DoF model."));
+  figs.push_back(frf_figure(units, measured_vs, model_vs, "model-vs", "Fig. 3.4b: 2-DoF model against the measurement, u -> Vs", "V/V",
+                            "2-DoF model", false,
+                            "Solid: measured; dashed: the tuned 2-DoF model. Its zero is minimum phase: where the measured phase "
+                            "falls through the anti-resonance, the model's (drawn on the measurement's branch) jumps by one turn."));
+  json rows = json::array();
+  for (const auto& u : units) {
+    if (!u.result->model_2dof) continue;
+    const apa::TwoDofTuning& t = u.result->model_2dof->tuning;
+    const apa::TwoDofParams& m = t.params;
+    rows.push_back({u.name(), m.m, m.k1 * 1e-6, m.c1, m.ke * 1e-6, m.ce, m.ka * 1e-6, m.ca, m.ga, m.gs * 1e-6, t.fit_error_de, t.fit_error_vs});
+  }
+  return {{"id", "model"}, {"title", "Two degrees-of-freedom model (report 3)"},
+          {"tables", json::array({table("2-DoF parameters per unit (Table 3.1)",
+                                        {"unit", "m [kg]", "k1 [N/um]", "c1 [Ns/m]", "ke [N/um]", "ce [Ns/m]", "ka [N/um]",
+                                         "ca [Ns/m]", "ga [N/V]", "gs [V/um]", "error d_e", "error Vs"},
+                                        rows, "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46.")})},
+          {"figures", figs}};
+}
+
+// (Va - middle) / half range against (d_e - middle) / half range: every loop fills [-1, 1].
+json normalized(const json& v) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& x : v) {
+    if (x.is_number()) lo = std::min(lo, x.get<double>()), hi = std::max(hi, x.get<double>());
+  }
+  json out = json::array();
+  for (const auto& x : v) out.push_back(x.is_number() && hi > lo ? json((2.0 * x.get<double>() - lo - hi) / (hi - lo)) : json(nullptr));
+  return out;
+}
+
+std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
+  json figs = json::array(), rows = json::array();
+  bool absolute = false;
+  std::vector<double> amplitudes;
+  for (const auto& u : units) {
+    for (const auto& h : u.result->hysteresis) {
+      const double a = std::round(h.result.amplitude * 10.0) / 10.0;
+      if (std::find(amplitudes.begin(), amplitudes.end(), a) == amplitudes.end()) amplitudes.push_back(a);
+    }
+  }
+  std::sort(amplitudes.begin(), amplitudes.end());
+  for (const auto& u : units) {
+    if (u.hysteresis.empty()) continue;
+    json loops = json::array(), normalized_loops = json::array();
+    for (const auto& loop : u.hysteresis) {
+      const std::string name = amplitude_label(loop.amplitude_V);
+      loops.push_back(trace(name, loop.loop.x, loop.loop.y, name));
+      normalized_loops.push_back(trace(name, normalized(loop.loop.x), normalized(loop.loop.y), name));
+    }
+    if (!absolute) {
+      figs.push_back(figure("hysteresis", fmt::format("Fig. 2.3: {}, d_e against Va for each amplitude", u.name()), "Va [V]", false,
+                            json::array({panel("d_e [um]", false, loops)})));
+      absolute = true;
+    }
+    figs.push_back(figure(fmt::format("hysteresis-{}", u.result->id), u.name() + ": hysteresis loops, normalized", "(Va - mid) / half range",
+                          false, json::array({panel("(d_e - mid) / half range", false, normalized_loops)}),
+                          "Each loop scaled to fill [-1, 1] on both axes, so the small ones can be told apart: the wider the "
+                          "loop, the larger the hysteresis relative to the stroke."));
+    json row = json::array({u.name()});
+    for (const double a : amplitudes) {
+      json cell = nullptr;
+      for (const auto& h : u.result->hysteresis) {
+        if (std::abs(h.result.amplitude - a) < 0.05) cell = fmt::format("{:.3g} ({:.1f} %)", h.result.width * 1e6, 100.0 * h.result.relative_width);
+      }
+      row.push_back(cell);
+    }
+    rows.push_back(row);
+  }
+  json stroke = json::array();
+  for (const auto& u : units) {
+    if (u.stroke) stroke.push_back(trace(u.name(), u.stroke->x, u.stroke->y, u.name()));
+  }
+  if (!stroke.empty()) {
+    figs.push_back(figure("stroke", "Fig. 1.4b: stroke, displacement against the stack voltage (slow ramp)", "Va [V]", false,
+                          json::array({panel("d_e [um]", false, stroke)})));
+  }
+  json tables = json::array();
+  if (!rows.empty()) {
+    std::vector<std::string> columns = {"unit"};
+    for (const double a : amplitudes) columns.push_back(fmt::format("width at {:.3g} V [um] (of the stroke)", a));
+    tables.push_back(table("Hysteresis: loop width at the offset per amplitude", columns, rows));
+  }
+  // The Prandtl-Ishlinskii model of the largest loop (docs/hysteresis.md): its fit and the loop it draws.
+  json model_rows = json::array();
+  for (const auto& u : units) {
+    if (!u.result->hysteresis_model) continue;
+    const HysteresisModelFit& h = *u.result->hysteresis_model;
+    const ident::HysteresisModel& m = h.fit.model;
+    json weights = json::array();
+    for (const double w : m.hysteresis.weights) weights.push_back(fmt::format("{:.3g}", w));
+    model_rows.push_back(json::array({u.name(), fmt::format("{:.3g}", h.amplitude), fmt::format("{:.3g}", m.gain * 1e6),
+                                      fmt::format("{}", fmt::join(weights, " ")),
+                                      fmt::format("{:.3g} ({:.2f} %)", h.fit.rms_residual * 1e6, 100.0 * h.fit.relative_residual),
+                                      fmt::format("{:.1f} % / {:.1f} %", 100.0 * h.width, 100.0 * h.model_width),
+                                      core::to_string(h.fit.quality.verdict)}));
+    const XY& p = *u.hysteresis_model_record;
+    figs.push_back(figure(fmt::format("hysteresis-model-{}", u.result->id), u.name() + ": hysteresis model against the record", "Va [V]", false,
+                          json::array({panel("d_e [um]", false,
+                                             json::array({trace("record", p.x, p.y, "record"),
+                                                          trace("Prandtl-Ishlinskii model", p.x, u.hysteresis_model_um, "model")}))}),
+                          "The model's inverse is the feedforward of `rt --feedforward` and `measure tracking` "
+                          "(docs/hysteresis.md)."));
+  }
+  if (!model_rows.empty()) {
+    tables.push_back(table("Hysteresis model (Prandtl-Ishlinskii, largest loop; thresholds (i - 1/2) R / n)",
+                           {"unit", "amplitude [V]", "gain [um/V]", "weights", "rms residual [um] (of the stroke)",
+                            "width: record / model", "fit"},
+                           model_rows));
+  }
+  if (figs.empty()) return std::nullopt;
+  return json{{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}};
+}
+
+// results.json writes stiffness_N_per_um only when one of these is known.
+bool has_stiffness(const UnitAnalysis& u) { return u.k1 || u.k_resonance || u.k_oc; }
+
+std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitCurves>& units) {
+  json traces = json::array(), rows = json::array();
+  for (const auto& u : units) {
+    for (const bool open : {false, true}) {
+      const std::optional<StiffnessCurves>& s = open ? u.stiffness_open : u.stiffness;
+      if (!s) continue;
+      const std::string name = u.name() + (open ? ", stacks open" : "");
+      traces.push_back(trace(name, s->t, s->de_um, name));
+      traces.push_back(trace(name + " creep fit", s->t, s->fit_um, name, true));
+    }
+    const UnitAnalysis& r = *u.result;
+    if (has_stiffness(r)) {
+      rows.push_back({u.name(), io::to_json(r.k1, 1e-6), io::to_json(r.k2, 1e-6), io::to_json(r.k1, 1e-6), io::to_json(r.k_oc, 1e-6),
+                      io::to_json(r.k_resonance, 1e-6),
+                      r.stiffness_analysis ? json(r.stiffness_analysis->result.creep_on * 1e6) : json(nullptr)});
+    }
+  }
+  if (traces.empty() && rows.empty()) return std::nullopt;
+  json figs = json::array();
+  if (!traces.empty()) {
+    figs.push_back(figure("stiffness", "Fig. 2.4: d_e during the added-mass test", "Time [s]", false,
+                          json::array({panel("d_e [um]", false, traces)})));
+  }
+  return json{{"id", "stiffness"},
+              {"title", "Static stiffness (report 2.2)"},
+              {"text", fmt::format("Added mass {:g} kg put on and taken off; dashed: the fitted logarithmic creep model. k_sc: the stacks "
+                                   "short-circuited (actuators on the amplifier, sensor on the resistor), which is k1; k_oc: the same test "
+                                   "with every stack open (report: about 2.3 and 1.7 N/um).",
+                                   c.bench.added_mass)},
+              {"tables", json::array({table("Stiffness per unit [N/um]",
+                                            {"unit", "k1", "k2", "k_sc", "k_oc", "from the resonance", "creep under load [um/decade]"}, rows)})},
+              {"figures", figs}};
+}
+
+std::optional<json> modes_section(const std::vector<UnitCurves>& units) {
+  json traces = json::array();
+  for (const auto& u : units) {
+    if (u.hammer) traces.push_back(trace(u.name(), u.hammer->x, u.hammer->y, u.name()));
+  }
+  if (traces.empty()) return std::nullopt;
+  return json{{"id", "modes"}, {"title", "Flexible modes, hammer test (report 1.4)"},
+              {"figures", json::array({figure("hammer", "Fig. 1.7: force -> vibrometer velocity", "Frequency [Hz]", true,
+                                              json::array({panel("|H| [m/s/N]", true, traces)}))})}};
+}
+
+// Bars with both limits of every spec.
+json batch_section(const Campaign& c, const std::vector<UnitAnalysis>& units) {
+  json names = json::array();
+  for (const auto& u : units) names.push_back(u.name);
+  const auto bars = [&](const std::string& name, const std::function<json(const UnitAnalysis&)>& value) {
+    json y = json::array();
+    for (const auto& u : units) y.push_back(value(u));
+    return trace(name, names, y, "", false, "bars");
   };
+  const auto limit = [&](const std::string& name, double v) {
+    json y = json::array();
+    for (std::size_t i = 0; i < names.size(); ++i) y.push_back(v);
+    return trace(fmt::format("{} {:.3g}", name, v), names, y, "", true, "lines");
+  };
+  const auto range = [&](json& t, const std::string& what, const std::optional<metrology::Range>& r, double scale) {
+    if (!r) return;
+    t.push_back(limit(what + " minimum", r->min * scale));
+    if (std::isfinite(r->max)) t.push_back(limit(what + " maximum", r->max * scale));
+  };
+  const auto capacitance = [](double CapacitanceAnalysis::*which) {
+    return [which](const UnitAnalysis& u) { return u.capacitance_analysis ? json((*u.capacitance_analysis).*which * 1e6) : json(nullptr); };
+  };
+  const auto stiffness = [](std::optional<double> UnitAnalysis::*which) {
+    return [which](const UnitAnalysis& u) { return has_stiffness(u) ? io::to_json(u.*which, 1e-6) : json(nullptr); };
+  };
+  json figs = json::array();
+  {
+    json t = json::array({bars("sensor stack", capacitance(&CapacitanceAnalysis::sensor)),
+                          bars("actuator stacks", capacitance(&CapacitanceAnalysis::actuator))});
+    range(t, "sensor", c.specs.capacitance_sensor, 1e6);
+    range(t, "actuator", c.specs.capacitance_actuator, 1e6);
+    figs.push_back(figure("batch-capacitance", "Capacitance (Table 1.2)", "", false, json::array({panel("C [uF]", false, t)})));
+  }
+  {
+    json t = json::array({bars("k1", stiffness(&UnitAnalysis::k1)), bars("k2", stiffness(&UnitAnalysis::k2)),
+                          bars("k_oc", stiffness(&UnitAnalysis::k_oc)), bars("from the resonance", stiffness(&UnitAnalysis::k_resonance))});
+    range(t, "stiffness", c.specs.stiffness, 1e-6);
+    figs.push_back(figure("batch-stiffness", "Stiffness (Table 2.1)", "", false, json::array({panel("k [N/um]", false, t)})));
+  }
+  {
+    json t = json::array({bars("flatness", [](const UnitAnalysis& u) {
+      return u.flatness_analysis ? json(u.flatness_analysis->flatness * 1e6) : json(nullptr);
+    })});
+    if (c.specs.flatness_max) t.push_back(limit("flatness maximum", *c.specs.flatness_max * 1e6));
+    figs.push_back(figure("batch-flatness", "Flatness (Table 1.1, " + metrology::to_string(c.specs.flatness_method) + ")", "", false,
+                          json::array({panel("flatness [um]", false, t)})));
+  }
+  {
+    json t = json::array({bars("stroke", [](const UnitAnalysis& u) {
+      return u.stroke_analysis ? json(u.stroke_analysis->result.stroke * 1e6) : json(nullptr);
+    })});
+    if (c.specs.stroke_min) t.push_back(limit("stroke minimum", *c.specs.stroke_min * 1e6));
+    figs.push_back(figure("batch-stroke", "Stroke (Figure 1.4)", "", false, json::array({panel("stroke [um]", false, t)}),
+                          "The specification gives a minimum stroke only."));
+  }
+  return {{"id", "batch"}, {"title", "Batch comparison"},
+          {"text", "Dashed lines: the specification's limits (both where it has two)."},
+          {"figures", figs}};
+}
 
-  // ---- Section 2.3: frequency responses (Figure 2.5), 2.4: the NMP zero (Figure 2.6).
-  if (any("frf")) {
-    json figs = json::array();
-    figs.push_back(frf_figure(units, "de", "frf-de", "Fig. 2.5a: u -> d_e", "um/V", "model", "de_abs", "de_phase", "2-DoF model", true,
-                              "Solid: measured (Welch H1); dashed: the tuned 2-DoF model (section 3). The model's phase is drawn "
-                              "on the measurement's branch (modulo 360 deg)."));
-    figs.push_back(frf_figure(units, "Vs", "frf-vs", "Fig. 2.5b: u -> Vs", "V/V", "", "iff_fit_abs", "iff_fit_phase", "IFF plant fit", true,
-                              "Solid: measured; dashed: the IFF plant fit (eq. 2.3 with delay). The phase falls by 180 deg at the "
-                              "anti-resonance: a non-minimum-phase zero."));
+// Section 4: the super element (Figure 4.2): ga and gs tuned against the measurements, u -> d_e
+// and u -> V_s, magnitude and phase, with the table of the tuned values.
+json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>& units) {
+  json figs = json::array(), tables = json::array();
+  std::string text;
+  const auto& s = r.superelement;
+  if (s && !s->failed && s->figure) {
+    // Figure 4.2: the tuned model thinned as the unit's measured FRF (unit_curves).
+    const SuperElementComparison::Response& m = *s->figure;
+    const VectorXd& f = m.freq_Hz;
+    json fm = json::array();
+    std::vector<std::complex<double>> de, vs;
+    if (f.size() > 1) {
+      for (const Index k : log_indices(f, std::max(0.5, f(1)), std::min(2.0 * r.campaign.analysis.fmax_hz, f(f.size() - 1)))) {
+        fm.push_back(f(k));
+        de.push_back(m.de(k));
+        vs.push_back(m.vs(k));
+      }
+    }
+    const Bode se_de = model_lines(fm, de, 1e6), se_vs = model_lines(fm, vs, 1.0);
+    json de_mag = json::array(), de_ph = json::array(), vs_mag = json::array(), vs_ph = json::array();
+    for (const auto& u : units) {
+      if (u.name() != m.name || !u.de) continue;
+      const Bode &pd = *u.de, &pv = *u.vs;
+      de_mag.push_back(trace(u.name() + " measured", pd.f, pd.abs, "measured"));
+      de_ph.push_back(trace(u.name() + " measured", pd.f, pd.phase, "measured"));
+      vs_mag.push_back(trace(u.name() + " measured", pv.f, pv.abs, "measured"));
+      vs_ph.push_back(trace(u.name() + " measured", pv.f, pv.phase, "measured"));
+      const auto [xd, yd] = on_branch(se_de.f, se_de.phase, pd.f, pd.phase);
+      de_ph.push_back(trace("super element", xd, yd, "model", true));
+      const auto [xv, yv] = on_branch(se_vs.f, se_vs.phase, pv.f, pv.phase);
+      vs_ph.push_back(trace("super element", xv, yv, "model", true));
+    }
+    de_mag.push_back(trace("super element", se_de.f, se_de.abs, "model", true));
+    vs_mag.push_back(trace("super element", se_vs.f, se_vs.abs, "model", true));
+    text = fmt::format("The super element ({}, {} DOF) on the bench ({:.3g} kg on the moving interface), its sensitivities tuned "
+                       "against each unit's measured FRFs (docs/apa300ml.md) and compared with eq. 4.1 for Table 4.1's "
+                       "constants: ga {:.3g} N/V, gs {:.3g} V/um.",
+                       s->source, s->dofs, s->moving_mass, s->eq41_ga, s->eq41_gs * 1e-6);
     json rows = json::array();
-    for (const auto& u : units) {
-      const json r = result_of(u);
-      if (!has(r, "frf")) continue;
-      const json& f = r["frf"];
-      const json verdict = at(f, {"zero_is_nonminimum_phase"});
-      rows.push_back({u.name, at(f, {"static_gain_um_per_V"}), at(f, {"resonance_Hz"}), at(f, {"resonance_damping"}),
-                      at(f, {"antiresonance_Hz"}), at(f, {"antiresonance_damping"}),
-                      verdict.is_boolean() ? json(verdict.get<bool>() ? "non-minimum phase" : "minimum phase") : json(nullptr),
-                      at(f, {"nmp_evidence", "phase_change_deg"}), at(f, {"shell_stiffness_N_per_um"}), at(r, {"hpf_corner_Hz"})});
+    for (const SuperElementUnitFit& row : s->units) {
+      rows.push_back({row.name, io::to_json(row.ga), finite_scaled(row.ga_relative_to_eq41, 100.0), io::to_json(row.gs * 1e-6),
+                      finite_scaled(row.gs_relative_to_eq41, 100.0), io::to_json(row.resonance_Hz), io::to_json(row.measured_resonance_Hz),
+                      io::to_json(row.antiresonance_Hz), io::to_json(row.measured_antiresonance_Hz), io::to_json(row.de_error_dB),
+                      io::to_json(row.vs_error_dB)});
     }
-    json tables = json::array({table("FRF features per unit",
-                                     {"unit", "static gain [um/V]", "resonance [Hz]", "damping", "anti-resonance [Hz]", "zero damping",
-                                      "zero", "phase change at the zero [deg]", "k_shell [N/um]", "HPF corner [Hz]"},
-                                     rows, "Zero damping < 0: the zero is in the right half plane.")});
-    sections.push_back({{"id", "frf"}, {"title", "Frequency responses (report 2.3)"},
-                        {"text", "FRFs from the DAC voltage u to the encoder d_e and to the force-sensor voltage Vs, all units "
-                                 "overlaid, with the coherence."},
-                        {"tables", tables}, {"figures", figs}});
+    tables.push_back(table("ga and gs tuned per unit against eq. 4.1",
+                           {"unit", "ga [N/V]", "vs eq. 4.1 [%]", "gs [V/um]", "vs eq. 4.1 [%]", "resonance model [Hz]",
+                            "resonance measured [Hz]", "anti-resonance model [Hz]", "anti-resonance measured [Hz]",
+                            "u -> d_e error [dB]", "u -> V_s error [dB]"},
+                           rows, "Errors: median |model / measured| in dB from the tuning band's start to twice the resonance."));
+    figs.push_back(figure("superelement", "Fig. 4.2: super element against the measurement of " + m.name + " (u -> d_e, u -> V_s)",
+                          "Frequency [Hz]", true,
+                          json::array({panel("|u -> d_e| [um/V]", true, de_mag), panel("d_e phase [deg]", false, de_ph),
+                                       panel("|u -> V_s| [V/V]", true, vs_mag), panel("V_s phase [deg]", false, vs_ph)}),
+                          "Solid: measured (Welch H1); dashed: the super element with the tuned ga and gs (no measurement "
+                          "chain: high-pass, anti-aliasing and delays are not in the model)."));
+  } else if (s && s->failed) {
+    text = "The super element's comparison failed: " + *s->failed;
+  } else {
+    text = "Not part of this campaign: no super element was given. A [superelement] table in the campaign file (docs/campaign.md) "
+           "adds the finite-element model's u -> d_e and u -> V_s against the measured FRFs here (report Figure 4.2).";
   }
-  if (any("nmp")) {
-    json coh = json::array(), phase = json::array(), mag = json::array();
-    json rows = json::array();
-    for (const auto& u : units) {
-      if (!has(u.plots, "nmp")) continue;
-      const json& z = u.plots["nmp"];
-      mag.push_back(trace(u.name, z["f"], z["abs"], u.name, false, "lines+markers"));
-      coh.push_back(trace(u.name, z["f"], z["coh"], u.name, false, "lines+markers"));
-      phase.push_back(trace(u.name, z["f"], z["phase"], u.name, false, "lines+markers"));
-      const json r = result_of(u);
-      rows.push_back({u.name, at(r, {"frf", "antiresonance_Hz"}), at(r, {"frf", "antiresonance_damping"}),
-                      at(r, {"frf", "nmp_evidence", "phase_change_deg"}), at(r, {"frf", "nmp_evidence", "phase_verdict"}),
-                      at(r, {"frf", "nmp_evidence", "verdict_from"})});
-    }
-    sections.push_back(
-        {{"id", "nmp"}, {"title", "The non-minimum-phase zero (report 2.4)"},
-         {"text", "u -> Vs around the anti-resonance, every frequency line. A minimum-phase zero pair raises the phase by 180 deg, "
-                  "a non-minimum-phase one lowers it by 180 deg; the coherence says whether the data there can be trusted."},
-         {"tables", json::array({table("Verdict per unit",
-                                       {"unit", "anti-resonance [Hz]", "zero damping", "phase change [deg]", "verdict of the phase",
-                                        "verdict from"},
-                                       rows)})},
-         {"figures", json::array({figure("nmp-zoom", "Fig. 2.6: u -> Vs at the anti-resonance", "Frequency [Hz]", false,
-                                         json::array({panel("|H| [V/V]", true, mag), panel("Coherence", false, coh),
-                                                      panel("Phase [deg]", false, phase)}))})}});
-  }
-
-  // ---- Section 2.5: the resistor (Figure 2.7).
-  {
-    json mag = json::array(), phase = json::array(), rows = json::array();
-    for (const auto& u : units) {
-      if (!has(u.plots, "resistor")) continue;
-      for (const char* which : {"with", "without"}) {
-        const json p = at(u.plots, {"resistor", which});
-        if (p.is_null()) continue;
-        const std::string name = u.name + (std::string(which) == "with" ? ", with R" : ", without R");
-        mag.push_back(trace(name, p["f"], p["abs"], name));
-        phase.push_back(trace(name, p["f"], p["phase"], name));
-      }
-      const json r = at(result_of(u), {"hpf_resistor"});
-      const auto corner = [&](const char* which) -> json {
-        const json w = at(r, {which});
-        if (w.is_null()) return nullptr;
-        if (has(w, "corner_Hz")) return w["corner_Hz"];
-        return has(w, "below_Hz") ? json(fmt::format("below {:.2g} (not observable)", w["below_Hz"].get<double>())) : json(nullptr);
-      };
-      rows.push_back({u.name, corner("with_resistor"), corner("without_resistor"), at(r, {"without_resistor", "fitted_corner_Hz"}),
-                      at(r, {"without_resistor", "lowest_line_Hz"}), at(result_of(u), {"hpf", "R_C_Hz"})});
-    }
-    if (!mag.empty()) {
-      sections.push_back(
-          {{"id", "resistor"}, {"title", "The resistor across the force sensor (report 2.5)"},
-           {"text", fmt::format("u -> Vs at low frequency with and without the {:.3g} kOhm resistor in parallel with the sensor "
-                                "stack: with it, a high-pass at 1/(2 pi R C).", c.bench.hpf_resistance * 1e-3)},
-           {"tables", json::array({table("High-pass corner per unit",
-                                         {"unit", "with R [Hz]", "without R [Hz]", "fitted without R [Hz]", "lowest line [Hz]",
-                                          "1/(2 pi R C_sensor) [Hz]"},
-                                         rows,
-                                         "First-order high-pass fitted below the campaign's hpf_fmax_Hz. A corner below a third "
-                                         "of the record's lowest line is reported as not observable.")})},
-           {"figures", json::array({figure("resistor", "Fig. 2.7: u -> Vs with and without the resistor", "Frequency [Hz]", true,
-                                           json::array({panel("|H| [V/V]", true, mag), panel("Phase [deg]", false, phase)}))})}});
-    }
-  }
-
-  // ---- Section 2.6: IFF (Figures 2.8, 2.10).
-  {
-    json figs = json::array(), tables = json::array(), warnings = json::array();
-    // Figure 2.8: the IFF plant of the IFF unit against its fit.
-    const UnitPlots* iff_unit = nullptr;
-    const json iff = at(results, {"iff"});
-    for (const auto& u : units) {
-      if (!iff_unit && has(u.plots, "frf") && has(u.plots["frf"], "iff_fit_abs") && (!has(iff, "unit") || iff["unit"] == u.id)) iff_unit = &u;
-    }
-    if (iff_unit) {
-      const json& p = iff_unit->plots["frf"];
-      const auto [x, y] = on_branch(p["f"], p["iff_fit_phase"], p["f"], p["Vs_phase"]);
-      figs.push_back(figure("iff-plant", fmt::format("Fig. 2.8: IFF plant of {} and its fit (eq. 2.3)", iff_unit->name), "Frequency [Hz]", true,
-                            json::array({panel("|H| [V/V]", true,
-                                               json::array({trace("measured", p["f"], p["Vs_abs"], "measured"),
-                                                            trace("fit (eq. 2.3 with delay)", p["f"], p["iff_fit_abs"], "fit", true)})),
-                                         panel("Phase [deg]", false,
-                                               json::array({trace("measured", p["f"], p["Vs_phase"], "measured"),
-                                                            trace("fit (eq. 2.3 with delay)", x, y, "fit", true)})),
-                                         panel("Coherence", false, json::array({trace("measured", p["f"], p["Vs_coh"], "measured")}))}),
-                            "u -> Vs of the unit whose IFF data make the batch's IFF result, against the fitted plant model."));
-    }
-    json prow = json::array();
-    for (const auto& u : units) {
-      const json f = at(result_of(u), {"frf", "iff_plant_fit"});
-      if (f.is_null()) continue;
-      prow.push_back({u.name, f["g0"], f["wz_Hz"], f["xz"], f["wp_Hz"], f["xp"], f["w_hpf_Hz"], scaled(f["delay_s"], 1e6),
-                      f["relative_rms_error"]});
-    }
-    if (!prow.empty()) {
-      tables.push_back(table("IFF plant (eq. 2.3) per unit",
-                             {"unit", "g0", "w_z [Hz]", "xi_z", "w_p [Hz]", "xi_p", "w_HPF [Hz]", "delay [us]", "relative rms error"}, prow,
-                             "The report's hand-tuned values: g0 0.64, w_z 42.7 Hz, xi_z 0.4 %, w_p 95.2 Hz, xi_p 2 %, "
-                             "w_HPF 0.4 Hz, 200 us."));
-    }
-    if (extra.contains("root_locus")) {
-      const json& rl = extra["root_locus"];
-      const auto gain_text = [](const json& list) {
-        json re = json::array(), im = json::array(), text = json::array();
-        for (const auto& d : list) {
-          re.push_back(d["re"]);
-          im.push_back(d["im"]);
-          text.push_back(fmt::format("g = {:.3g}", d["gain"].get<double>()));
-        }
-        return std::tuple{re, im, text};
-      };
-      json traces = json::array();
-      for (const auto& b : rl["branches"]) {
-        traces.push_back(with_text(trace("root locus of the model", b["re"], b["im"], "root locus of the model"), b["text"]));
-      }
-      if (has(rl, "open_loop_poles")) {
-        traces.push_back(trace("open-loop poles", rl["open_loop_poles"]["re"], rl["open_loop_poles"]["im"], "", false, "markers"));
-      }
-      if (has(rl, "open_loop_zeros")) {
-        traces.push_back(trace("open-loop zeros", rl["open_loop_zeros"]["re"], rl["open_loop_zeros"]["im"], "", true, "markers"));
-      }
-      if (has(rl, "model_at_gains")) {
-        const auto [re, im, text] = gain_text(rl["model_at_gains"]);
-        traces.push_back(with_text(trace("model at the measured gains", re, im, "", true, "markers"), text));
-      }
-      {
-        const auto [re, im, text] = gain_text(rl["damped"]);
-        if (!re.empty()) traces.push_back(with_text(trace("identified damped poles", re, im, "", false, "markers"), text));
-      }
-      if (has(rl, "optimum")) {
-        const json& o = rl["optimum"];
-        traces.push_back(with_text(trace("optimum", json::array({o["re"]}), json::array({o["im"]}), "", false, "markers"),
-                                   json::array({fmt::format("g = {:.3g}, damping {:.2f}", o["gain"].get<double>(), o["damping"].get<double>())})));
-      }
-      figs.push_back(figure("root-locus", fmt::format("Fig. 2.10b: root locus, APA {}", rl["unit"].get<int>()), "Re [rad/s]", false,
-                            json::array({panel("Im [rad/s]", false, traces)}),
-                            "Closed-loop poles of 1 - g K(s) G(s) = 0 for the fitted plant G (eq. 2.3 with delay) and the report's "
-                            "controller K (eq. 2.4), every branch inside 3 w_p; open circles: the model's poles at the measured gains; "
-                            "filled: the poles identified on the measured damped plants (dominant pair of a vector fit). Hover for "
-                            "the gains."));
-    }
-    json mag = json::array(), phase = json::array();
-    for (const auto& u : units) {
-      if (!has(u.plots, "damped")) continue;
-      for (const auto& d : u.plots["damped"]) {
-        const std::string name = fmt::format("{} g = {:.3g}", u.name, d["gain"].get<double>());
-        mag.push_back(trace(name, d["f"], d["abs"], name));
-        mag.push_back(trace(name + " fit", d["f"], d["fit_abs"], name, true));
-        if (has(d, "phase")) {
-          phase.push_back(trace(name, d["f"], d["phase"], name));
-          const auto [x, y] = on_branch(d["f"], d["fit_phase"], d["f"], d["phase"]);
-          phase.push_back(trace(name + " fit", x, y, name, true));
-        }
-      }
-    }
-    if (!mag.empty()) {
-      figs.push_back(figure("damped-plants", "Fig. 2.10a: damped plants u' -> d_e", "Frequency [Hz]", true,
-                            json::array({panel("|H| [um/V]", true, mag), panel("Phase [deg]", false, phase)}),
-                            "Solid: measured; dashed: the vector fits whose dominant pole is the identified damped pole."));
-    }
-    if (has(iff, "gains") && !iff["gains"].empty()) {
-      json rows = json::array();
-      const json distance = at(iff, {"relative_pole_distance"});
-      for (std::size_t i = 0; i < iff["gains"].size(); ++i) {
-        const auto info = [](const json& p) -> std::pair<json, json> {
-          if (!p.is_array() || p.size() != 2 || !p[0].is_number()) return {nullptr, nullptr};
-          const double re = p[0].get<double>(), im = p[1].get<double>(), w = std::hypot(re, im);
-          return {w / kTwoPi, -re / w};
-        };
-        const auto [fi, zi] = info(iff["damped_poles"][i]);
-        const auto [fm, zm] = has(iff, "model_poles") ? info(iff["model_poles"][i]) : std::pair<json, json>{nullptr, nullptr};
-        rows.push_back({iff["gains"][i], fi, zi, fm, zm, distance.is_array() ? distance[i] : json(nullptr)});
-      }
-      tables.push_back(table("Damped poles against the model's root locus",
-                             {"gain g", "identified [Hz]", "identified damping", "model [Hz]", "model damping", "relative distance"},
-                             rows,
-                             fmt::format("Optimal gain of the model {}, maximum damping {}.",
-                                         has(iff, "optimal_gain") ? fmt::format("{:.3g}", iff["optimal_gain"].get<double>()) : "-",
-                                         has(iff, "max_damping") ? fmt::format("{:.2f}", iff["max_damping"].get<double>()) : "-")));
-    }
-    if (has(iff, "warning")) warnings.push_back(iff["warning"]);
-    if (!figs.empty() || !tables.empty()) {
-      sections.push_back({{"id", "iff"}, {"title", "Integral Force Feedback (report 2.6)"}, {"warnings", warnings}, {"tables", tables},
-                          {"figures", figs}});
-    }
-  }
-
-  // ---- Section 3: the 2-DoF model (Figure 3.4).
-  if (any("model")) {
-    json figs = json::array();
-    figs.push_back(frf_figure(units, "de", "model-de", "Fig. 3.4a: 2-DoF model against the measurement, u -> d_e", "um/V", "model", "de_abs",
-                              "de_phase", "2-DoF model", false, "Solid: measured; dashed: the tuned 2-DoF model."));
-    figs.push_back(frf_figure(units, "Vs", "model-vs", "Fig. 3.4b: 2-DoF model against the measurement, u -> Vs", "V/V", "model", "Vs_abs",
-                              "Vs_phase", "2-DoF model", false,
-                              "Solid: measured; dashed: the tuned 2-DoF model. Its zero is minimum phase: where the measured phase "
-                              "falls through the anti-resonance, the model's (drawn on the measurement's branch) jumps by one turn."));
-    json rows = json::array();
-    for (const auto& u : units) {
-      const json r = result_of(u);
-      const json m = at(r, {"model_2dof"});
-      if (m.is_null()) continue;
-      rows.push_back({u.name, m["m"], scaled(m["k1"], 1e-6), m["c1"], scaled(m["ke"], 1e-6), m["ce"], scaled(m["ka"], 1e-6), m["ca"], m["ga"],
-                      scaled(m["gs"], 1e-6), at(r, {"model_2dof_fit", "relative_error_de"}), at(r, {"model_2dof_fit", "relative_error_Vs"})});
-    }
-    sections.push_back({{"id", "model"}, {"title", "Two degrees-of-freedom model (report 3)"},
-                        {"tables", json::array({table("2-DoF parameters per unit (Table 3.1)",
-                                                      {"unit", "m [kg]", "k1 [N/um]", "c1 [Ns/m]", "ke [N/um]", "ce [Ns/m]", "ka [N/um]",
-                                                       "ca [Ns/m]", "ga [N/V]", "gs [V/um]", "error d_e", "error Vs"},
-                                                      rows, "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46.")})},
-                        {"figures", figs}});
-  }
-
-  // ---- Section 2.1 and 1.3: hysteresis and stroke (Figures 2.3, 1.4b).
-  {
-    json figs = json::array(), rows = json::array();
-    bool absolute = false;
-    std::vector<double> amplitudes;
-    for (const auto& u : units) {
-      for (const auto& h : at(result_of(u), {"hysteresis"})) {
-        const double a = std::round(h["amplitude_V"].get<double>() * 10.0) / 10.0;
-        if (std::find(amplitudes.begin(), amplitudes.end(), a) == amplitudes.end()) amplitudes.push_back(a);
-      }
-    }
-    std::sort(amplitudes.begin(), amplitudes.end());
-    for (const auto& u : units) {
-      if (!has(u.plots, "hysteresis") || u.plots["hysteresis"].empty()) continue;
-      json loops = json::array(), normalized = json::array();
-      for (const auto& loop : u.plots["hysteresis"]) {
-        const std::string name = amplitude_label(loop["amplitude_V"].get<double>());
-        loops.push_back(trace(name, loop["Va"], loop["de_um"], name));
-        // (Va - middle) / half range against (d_e - middle) / half range: every loop fills [-1, 1].
-        const auto norm = [](const json& v) {
-          double lo = INFINITY, hi = -INFINITY;
-          for (const auto& x : v) {
-            if (x.is_number()) lo = std::min(lo, x.get<double>()), hi = std::max(hi, x.get<double>());
-          }
-          json out = json::array();
-          for (const auto& x : v) out.push_back(x.is_number() && hi > lo ? json((2.0 * x.get<double>() - lo - hi) / (hi - lo)) : json(nullptr));
-          return out;
-        };
-        normalized.push_back(trace(name, norm(loop["Va"]), norm(loop["de_um"]), name));
-      }
-      if (!absolute) {
-        figs.push_back(figure("hysteresis", fmt::format("Fig. 2.3: {}, d_e against Va for each amplitude", u.name), "Va [V]", false,
-                              json::array({panel("d_e [um]", false, loops)})));
-        absolute = true;
-      }
-      figs.push_back(figure(fmt::format("hysteresis-{}", u.id), u.name + ": hysteresis loops, normalized", "(Va - mid) / half range", false,
-                            json::array({panel("(d_e - mid) / half range", false, normalized)}),
-                            "Each loop scaled to fill [-1, 1] on both axes, so the small ones can be told apart: the wider the "
-                            "loop, the larger the hysteresis relative to the stroke."));
-      json row = json::array({u.name});
-      const json list = at(result_of(u), {"hysteresis"});
-      for (const double a : amplitudes) {
-        json cell = nullptr;
-        for (const auto& h : list) {
-          if (std::abs(h["amplitude_V"].get<double>() - a) < 0.05) cell = fmt::format("{:.3g} ({:.1f} %)", h["width_um"].get<double>(), 100.0 * h["relative_width"].get<double>());
-        }
-        row.push_back(cell);
-      }
-      rows.push_back(row);
-    }
-    json stroke = json::array();
-    for (const auto& u : units) {
-      if (has(u.plots, "stroke")) stroke.push_back(trace(u.name, u.plots["stroke"]["Va"], u.plots["stroke"]["de_um"], u.name));
-    }
-    if (!stroke.empty()) {
-      figs.push_back(figure("stroke", "Fig. 1.4b: stroke, displacement against the stack voltage (slow ramp)", "Va [V]", false,
-                            json::array({panel("d_e [um]", false, stroke)})));
-    }
-    json tables = json::array();
-    if (!rows.empty()) {
-      std::vector<std::string> columns = {"unit"};
-      for (const double a : amplitudes) columns.push_back(fmt::format("width at {:.3g} V [um] (of the stroke)", a));
-      tables.push_back(table("Hysteresis: loop width at the offset per amplitude", columns, rows));
-    }
-    // The Prandtl-Ishlinskii model of the largest loop (docs/hysteresis.md): its fit and the loop it draws.
-    json model_rows = json::array();
-    for (const auto& u : units) {
-      const json m = at(result_of(u), {"hysteresis_model"});
-      if (m.is_null()) continue;
-      json weights = json::array();
-      for (const auto& w : m["weights"]) weights.push_back(fmt::format("{:.3g}", w.get<double>()));
-      model_rows.push_back(json::array({u.name, fmt::format("{:.3g}", m["amplitude_V"].get<double>()),
-                                        fmt::format("{:.3g}", m["gain_um_per_V"].get<double>()), fmt::format("{}", fmt::join(weights, " ")),
-                                        fmt::format("{:.3g} ({:.2f} %)", m["rms_residual_um"].get<double>(), 100.0 * m["relative_residual"].get<double>()),
-                                        fmt::format("{:.1f} % / {:.1f} %", 100.0 * m["hysteresis_width"].get<double>(),
-                                                    100.0 * m["model_hysteresis_width"].get<double>()),
-                                        m["quality"].get<std::string>()}));
-      if (has(u.plots, "hysteresis_model")) {
-        const json& p = u.plots["hysteresis_model"];
-        figs.push_back(figure(fmt::format("hysteresis-model-{}", u.id), u.name + ": hysteresis model against the record", "Va [V]", false,
-                              json::array({panel("d_e [um]", false,
-                                                 json::array({trace("record", p["Va"], p["de_um"], "record"),
-                                                              trace("Prandtl-Ishlinskii model", p["Va"], p["model_um"], "model")}))}),
-                              "The model's inverse is the feedforward of `rt --feedforward` and `measure tracking` "
-                              "(docs/hysteresis.md)."));
-      }
-    }
-    if (!model_rows.empty()) {
-      tables.push_back(table("Hysteresis model (Prandtl-Ishlinskii, largest loop; thresholds (i - 1/2) R / n)",
-                             {"unit", "amplitude [V]", "gain [um/V]", "weights", "rms residual [um] (of the stroke)",
-                              "width: record / model", "fit"},
-                             model_rows));
-    }
-    if (!figs.empty()) sections.push_back({{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}});
-  }
-
-  // ---- Section 2.2: stiffness (Figure 2.4), short and open circuit.
-  {
-    json traces = json::array(), rows = json::array();
-    for (const auto& u : units) {
-      for (const char* key : {"stiffness", "stiffness_open"}) {
-        if (!has(u.plots, key)) continue;
-        const std::string name = u.name + (std::string(key) == "stiffness" ? "" : ", stacks open");
-        traces.push_back(trace(name, u.plots[key]["t"], u.plots[key]["de_um"], name));
-        traces.push_back(trace(name + " creep fit", u.plots[key]["t"], u.plots[key]["fit_um"], name, true));
-      }
-      const json k = at(result_of(u), {"stiffness_N_per_um"});
-      if (!k.is_null()) {
-        rows.push_back({u.name, at(k, {"k1"}), at(k, {"k2"}), at(k, {"k_sc"}), at(k, {"k_oc"}), at(k, {"resonance"}),
-                        at(result_of(u), {"stiffness_static", "creep_um_per_decade", "on"})});
-      }
-    }
-    if (!traces.empty() || !rows.empty()) {
-      json figs = json::array();
-      if (!traces.empty()) {
-        figs.push_back(figure("stiffness", "Fig. 2.4: d_e during the added-mass test", "Time [s]", false,
-                              json::array({panel("d_e [um]", false, traces)})));
-      }
-      sections.push_back(
-          {{"id", "stiffness"},
-           {"title", "Static stiffness (report 2.2)"},
-           {"text", fmt::format("Added mass {:g} kg put on and taken off; dashed: the fitted logarithmic creep model. k_sc: the stacks "
-                                "short-circuited (actuators on the amplifier, sensor on the resistor), which is k1; k_oc: the same test "
-                                "with every stack open (report: about 2.3 and 1.7 N/um).",
-                                c.bench.added_mass)},
-           {"tables", json::array({table("Stiffness per unit [N/um]",
-                                         {"unit", "k1", "k2", "k_sc", "k_oc", "from the resonance", "creep under load [um/decade]"}, rows)})},
-           {"figures", figs}});
-    }
-  }
-
-  // ---- Section 1.4: flexible modes (Figure 1.7).
-  {
-    json traces = json::array();
-    for (const auto& u : units) {
-      if (has(u.plots, "hammer")) traces.push_back(trace(u.name, u.plots["hammer"]["f"], u.plots["hammer"]["abs"], u.name));
-    }
-    if (!traces.empty()) {
-      sections.push_back({{"id", "modes"}, {"title", "Flexible modes, hammer test (report 1.4)"},
-                          {"figures", json::array({figure("hammer", "Fig. 1.7: force -> vibrometer velocity", "Frequency [Hz]", true,
-                                                          json::array({panel("|H| [m/s/N]", true, traces)}))})}});
-    }
-  }
-
-  // ---- Batch comparison: bars with both limits of every spec.
-  {
-    json names = json::array();
-    for (const auto& u : units) names.push_back(u.name);
-    auto bars = [&](const std::string& name, std::initializer_list<const char*> path) {
-      json y = json::array();
-      for (const auto& r : result_units) y.push_back(at(r, path));
-      return trace(name, names, y, "", false, "bars");
-    };
-    auto limit = [&](const std::string& name, double v) {
-      json y = json::array();
-      for (std::size_t i = 0; i < names.size(); ++i) y.push_back(v);
-      return trace(fmt::format("{} {:.3g}", name, v), names, y, "", true, "lines");
-    };
-    auto range = [&](json& t, const std::string& what, const std::optional<metrology::Range>& r, double scale) {
-      if (!r) return;
-      t.push_back(limit(what + " minimum", r->min * scale));
-      if (std::isfinite(r->max)) t.push_back(limit(what + " maximum", r->max * scale));
-    };
-    json figs = json::array();
-    {
-      json t = json::array({bars("sensor stack", {"capacitance_uF", "sensor"}), bars("actuator stacks", {"capacitance_uF", "actuator"})});
-      range(t, "sensor", c.specs.capacitance_sensor, 1e6);
-      range(t, "actuator", c.specs.capacitance_actuator, 1e6);
-      figs.push_back(figure("batch-capacitance", "Capacitance (Table 1.2)", "", false, json::array({panel("C [uF]", false, t)})));
-    }
-    {
-      json t = json::array({bars("k1", {"stiffness_N_per_um", "k1"}), bars("k2", {"stiffness_N_per_um", "k2"}),
-                            bars("k_oc", {"stiffness_N_per_um", "k_oc"}), bars("from the resonance", {"stiffness_N_per_um", "resonance"})});
-      range(t, "stiffness", c.specs.stiffness, 1e-6);
-      figs.push_back(figure("batch-stiffness", "Stiffness (Table 2.1)", "", false, json::array({panel("k [N/um]", false, t)})));
-    }
-    {
-      json t = json::array({bars("flatness", {"flatness_um"})});
-      if (c.specs.flatness_max) t.push_back(limit("flatness maximum", *c.specs.flatness_max * 1e6));
-      figs.push_back(figure("batch-flatness", "Flatness (Table 1.1, " + metrology::to_string(c.specs.flatness_method) + ")", "", false,
-                            json::array({panel("flatness [um]", false, t)})));
-    }
-    {
-      json t = json::array({bars("stroke", {"stroke_um"})});
-      if (c.specs.stroke_min) t.push_back(limit("stroke minimum", *c.specs.stroke_min * 1e6));
-      figs.push_back(figure("batch-stroke", "Stroke (Figure 1.4)", "", false, json::array({panel("stroke [um]", false, t)}),
-                            "The specification gives a minimum stroke only."));
-    }
-    sections.push_back({{"id", "batch"}, {"title", "Batch comparison"},
-                        {"text", "Dashed lines: the specification's limits (both where it has two)."},
-                        {"figures", figs}});
-  }
-
-  // ---- Section 4: the super element (Figure 4.2): ga and gs tuned against the measurements,
-  // u -> d_e and u -> V_s, magnitude and phase, with the table of the tuned values.
-  {
-    json figs = json::array(), tables = json::array();
-    std::string text;
-    if (extra.contains("superelement")) {
-      const json& se = extra["superelement"];
-      const std::string name = se["unit"].get<std::string>();
-      json de_mag = json::array(), de_ph = json::array(), vs_mag = json::array(), vs_ph = json::array();
-      for (const auto& u : units) {
-        if (u.name != name || !has(u.plots, "frf")) continue;
-        const json& p = u.plots["frf"];
-        de_mag.push_back(trace(u.name + " measured", p["f"], p["de_abs"], "measured"));
-        de_ph.push_back(trace(u.name + " measured", p["f"], p["de_phase"], "measured"));
-        vs_mag.push_back(trace(u.name + " measured", p["f"], p["Vs_abs"], "measured"));
-        vs_ph.push_back(trace(u.name + " measured", p["f"], p["Vs_phase"], "measured"));
-        const auto [xd, yd] = on_branch(se["f"], se["de_phase"], p["f"], p["de_phase"]);
-        de_ph.push_back(trace("super element", xd, yd, "model", true));
-        const auto [xv, yv] = on_branch(se["f"], se["Vs_phase"], p["f"], p["Vs_phase"]);
-        vs_ph.push_back(trace("super element", xv, yv, "model", true));
-      }
-      de_mag.push_back(trace("super element", se["f"], se["de_abs"], "model", true));
-      vs_mag.push_back(trace("super element", se["f"], se["Vs_abs"], "model", true));
-      const json& sr = results["superelement"];
-      text = fmt::format("The super element ({}, {} DOF) on the bench ({:.3g} kg on the moving interface), its sensitivities tuned "
-                         "against each unit's measured FRFs (docs/apa300ml.md) and compared with eq. 4.1 for Table 4.1's "
-                         "constants: ga {:.3g} N/V, gs {:.3g} V/um.",
-                         sr["source"].get<std::string>(), sr["dofs"].get<long>(), sr["moving_mass_kg"].get<double>(),
-                         sr["eq41"]["ga_N_per_V"].get<double>(), sr["eq41"]["gs_V_per_um"].get<double>());
-      json rows = json::array();
-      for (const auto& row : sr["units"]) {
-        rows.push_back({row["name"], row["ga_N_per_V"], scaled(row["ga_relative_to_eq41"], 100.0), row["gs_V_per_um"],
-                        scaled(row["gs_relative_to_eq41"], 100.0), row["resonance_Hz"], row["measured_resonance_Hz"],
-                        row["antiresonance_Hz"], row["measured_antiresonance_Hz"], row["de_error_dB"], row["vs_error_dB"]});
-      }
-      tables.push_back(table("ga and gs tuned per unit against eq. 4.1",
-                             {"unit", "ga [N/V]", "vs eq. 4.1 [%]", "gs [V/um]", "vs eq. 4.1 [%]", "resonance model [Hz]",
-                              "resonance measured [Hz]", "anti-resonance model [Hz]", "anti-resonance measured [Hz]",
-                              "u -> d_e error [dB]", "u -> V_s error [dB]"},
-                             rows, "Errors: median |model / measured| in dB from the tuning band's start to twice the resonance."));
-      figs.push_back(figure("superelement", "Fig. 4.2: super element against the measurement of " + name + " (u -> d_e, u -> V_s)",
-                            "Frequency [Hz]", true,
-                            json::array({panel("|u -> d_e| [um/V]", true, de_mag), panel("d_e phase [deg]", false, de_ph),
-                                         panel("|u -> V_s| [V/V]", true, vs_mag), panel("V_s phase [deg]", false, vs_ph)}),
-                            "Solid: measured (Welch H1); dashed: the super element with the tuned ga and gs (no measurement "
-                            "chain: high-pass, anti-aliasing and delays are not in the model)."));
-    } else if (has(results["superelement"], "failed")) {
-      text = "The super element's comparison failed: " + results["superelement"]["failed"].get<std::string>();
-    } else {
-      text = "Not part of this campaign: no super element was given. A [superelement] table in the campaign file (docs/campaign.md) "
-             "adds the finite-element model's u -> d_e and u -> V_s against the measured FRFs here (report Figure 4.2).";
-    }
-    sections.push_back({{"id", "superelement"}, {"title", "Super element (report 4)"}, {"text", text}, {"tables", tables}, {"figures", figs}});
-  }
-  return {{"title", c.title},
-          {"subtitle", fmt::format("{} — piezobench {}", c.file.filename().string(), kVersion)},
-          {"results", results},
-          {"sections", sections}};
+  return {{"id", "superelement"}, {"title", "Super element (report 4)"}, {"text", text}, {"tables", tables}, {"figures", figs}};
 }
 
 }  // namespace
 
 json report_document(const CampaignResult& result) {
-  std::vector<UnitPlots> units;
-  for (const auto& u : result.units) units.push_back({u.id, u.name, unit_plots(result.campaign, u)});
-  return document(result.campaign, units, results_json(result), extra_plots(result));
+  const Campaign& c = result.campaign;
+  std::vector<UnitCurves> units;
+  for (const auto& u : result.units) units.push_back(unit_curves(c, u));
+  const auto any = [&](const std::function<bool(const UnitCurves&)>& has) { return std::any_of(units.begin(), units.end(), has); };
+  json sections = json::array();
+  // Section 2.3: frequency responses (Figure 2.5), 2.4: the NMP zero (Figure 2.6).
+  if (any([](const UnitCurves& u) { return u.de.has_value(); })) sections.push_back(frf_section(units));
+  if (any([](const UnitCurves& u) { return u.nmp.has_value(); })) sections.push_back(nmp_section(units));
+  // Section 2.5: the resistor (Figure 2.7); 2.6: IFF (Figures 2.8, 2.10).
+  for (const auto& section : {resistor_section(c, units), iff_section(units, result.iff)}) {
+    if (section) sections.push_back(*section);
+  }
+  // Section 3: the 2-DoF model (Figure 3.4).
+  if (any([](const UnitCurves& u) { return u.model_de.has_value(); })) sections.push_back(model_section(units));
+  // Sections 2.1 and 1.3: hysteresis and stroke (Figures 2.3, 1.4b); 2.2: stiffness (Figure 2.4),
+  // short and open circuit; 1.4: flexible modes (Figure 1.7).
+  for (const auto& section : {quasi_static_section(units), stiffness_section(c, units), modes_section(units)}) {
+    if (section) sections.push_back(*section);
+  }
+  sections.push_back(batch_section(c, result.units));
+  sections.push_back(superelement_section(result, units));
+  return {{"title", c.title},
+          {"subtitle", fmt::format("{} — piezobench {}", c.file.filename().string(), kVersion)},
+          {"results", results_json(result)},
+          {"sections", sections}};
 }
 
 }  // namespace piezobench::campaign

@@ -13,7 +13,6 @@ using nlohmann::json;
 namespace {
 
 json num(double v) { return io::to_json(v); }
-json opt(const std::optional<double>& v, double scale = 1.0) { return v ? num(*v * scale) : json(nullptr); }
 
 json provenance(const RecordProvenance& p) {
   json ch = json::object();
@@ -36,7 +35,7 @@ json flatness(const FlatnessAnalysis& f) {
   for (const auto& i : f.per_interface) per_interface.push_back({{"interface", i.id}, {"least_squares_um", i.least_squares * 1e6}});
   return {{"method", metrology::to_string(f.method)},
           {"least_squares_um", f.least_squares * 1e6},
-          {"minimum_zone_um", opt(f.minimum_zone, 1e6)},
+          {"minimum_zone_um", io::to_json(f.minimum_zone, 1e6)},
           {"points", f.points},
           {"per_interface", per_interface},
           {"probe_accuracy_um", f.probe_accuracy * 1e6},
@@ -133,7 +132,7 @@ json frf(const FrfAnalysis& f) {
   if (f.fit_vs) out["fit_Vs"] = vector_fit(*f.fit_vs);
   if (f.static_gain_vs) out["static_gain_Vs_V_per_V"] = *f.static_gain_vs;
   if (f.static_gain_vector_fit) out["static_gain_vector_fit_um_per_V"] = *f.static_gain_vector_fit * 1e6;
-  out["static_gain_um_per_V"] = opt(f.static_gain, 1e6);
+  out["static_gain_um_per_V"] = io::to_json(f.static_gain, 1e6);
   if (!f.static_gain_source.empty()) out["static_gain_source"] = f.static_gain_source;
   if (f.de_plant) {
     const auto& p = *f.de_plant;
@@ -178,12 +177,12 @@ json frf(const FrfAnalysis& f) {
     out["resonance_vector_fit_Hz"] = *f.resonance_vector_fit_Hz;
     out["resonance_vector_fit_damping"] = *f.resonance_vector_fit_damping;
   }
-  out["resonance_Hz"] = opt(f.resonance_Hz);
-  out["resonance_damping"] = opt(f.resonance_damping);
-  out["antiresonance_Hz"] = opt(f.antiresonance_Hz);
-  out["antiresonance_damping"] = opt(f.antiresonance_damping);
+  out["resonance_Hz"] = io::to_json(f.resonance_Hz);
+  out["resonance_damping"] = io::to_json(f.resonance_damping);
+  out["antiresonance_Hz"] = io::to_json(f.antiresonance_Hz);
+  out["antiresonance_damping"] = io::to_json(f.antiresonance_damping);
   out["zero_is_nonminimum_phase"] = f.zero_is_nonminimum_phase ? json(*f.zero_is_nonminimum_phase) : json(nullptr);
-  out["shell_stiffness_N_per_um"] = opt(f.shell_stiffness, 1e-6);
+  out["shell_stiffness_N_per_um"] = io::to_json(f.shell_stiffness, 1e-6);
   return out;
 }
 
@@ -285,7 +284,7 @@ json batch(const BatchAnalysis& b) {
 json iff(const IffStudy& s) {
   if (s.failed) return {{"gains", json::array()}, {"damped_poles", json::array()}, {"optimal_gain", nullptr}, {"failed", *s.failed}};
   const control::IffControllerParams& k = s.controller;
-  json out = {{"unit", s.unit ? json(*s.unit) : json(nullptr)}, {"gains", s.gains}, {"damped_poles", json::array()}, {"optimal_gain", opt(s.optimal_gain)}};
+  json out = {{"unit", s.unit ? json(*s.unit) : json(nullptr)}, {"gains", s.gains}, {"damped_poles", json::array()}, {"optimal_gain", io::to_json(s.optimal_gain)}};
   out["controller"] = {{"gain", k.gain}, {"hpf_Hz", k.w_hpf / kTwoPi}, {"lpf_Hz", k.w_lpf / kTwoPi}, {"robust_Hz", k.w_robust / kTwoPi},
                        {"formula", "K(s) = gain g s/(s + w_hpf) 1/(s + w_lpf) 1/(s + w_robust) (eq. 2.4)"}};
   if (!s.plant) {
@@ -295,7 +294,7 @@ json iff(const IffStudy& s) {
   const ident::IffPlantFit& p = *s.plant;
   out["plant"] = {{"g0", p.g0}, {"wz_Hz", p.wz / kTwoPi}, {"xz", p.xz}, {"wp_Hz", p.wp / kTwoPi}, {"xp", p.xp},
                   {"w_hpf_Hz", p.w_hpf / kTwoPi}, {"delay_s", p.delay}, {"source", "IFF plant fit of unit " + std::to_string(*s.unit)}};
-  out["max_damping"] = opt(s.max_damping);
+  out["max_damping"] = io::to_json(s.max_damping);
   out["optimal_pole"] = io::to_json(s.optimal_pole);
   out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)| (plots), branch from the "
                         "resonance pole; maximum damping on the adaptive root locus from g = 0 refined by golden section "
@@ -325,9 +324,9 @@ json superelement(const SuperElementComparison& s) {
                      {"gs_relative_to_eq41", num(u.gs_relative_to_eq41)},
                      {"band_Hz", {num(u.band_lo_Hz), num(u.band_hi_Hz)}},
                      {"resonance_Hz", num(u.resonance_Hz)},
-                     {"antiresonance_Hz", opt(u.antiresonance_Hz)},
-                     {"measured_resonance_Hz", opt(u.measured_resonance_Hz)},
-                     {"measured_antiresonance_Hz", opt(u.measured_antiresonance_Hz)},
+                     {"antiresonance_Hz", io::to_json(u.antiresonance_Hz)},
+                     {"measured_resonance_Hz", io::to_json(u.measured_resonance_Hz)},
+                     {"measured_antiresonance_Hz", io::to_json(u.measured_antiresonance_Hz)},
                      {"de_error_dB", num(u.de_error_dB)},
                      {"vs_error_dB", num(u.vs_error_dB)}});
   }
@@ -337,10 +336,10 @@ json superelement(const SuperElementComparison& s) {
               {"moving_mass_kg", num(s.moving_mass)},
               {"eq41", {{"ga_N_per_V", num(s.eq41_ga)}, {"gs_V_per_um", num(s.eq41_gs * 1e-6)}}},
               {"units", units},
-              {"ga_N_per_V", opt(s.ga)},
-              {"gs_V_per_um", opt(s.gs, 1e-6)},
-              {"resonance_Hz", opt(s.resonance_Hz)},
-              {"measured_resonance_Hz", opt(s.measured_resonance_Hz)},
+              {"ga_N_per_V", io::to_json(s.ga)},
+              {"gs_V_per_um", io::to_json(s.gs, 1e-6)},
+              {"resonance_Hz", io::to_json(s.resonance_Hz)},
+              {"measured_resonance_Hz", io::to_json(s.measured_resonance_Hz)},
               {"warnings", s.warnings}};
   if (s.resonance_Hz && s.measured_resonance_Hz) out["relative_difference"] = num(*s.resonance_Hz / *s.measured_resonance_Hz - 1.0);
   return out;
@@ -389,8 +388,8 @@ json unit_json(const UnitAnalysis& u) {
   if (u.k1 || u.k_resonance || u.k_oc) {
     // k_sc: the stacks short-circuited (on the amplifier, the sensor on R) = k1; k_oc: every stack
     // open, read the same way (report section 2.2).
-    r["stiffness_N_per_um"] = {{"k1", opt(u.k1, 1e-6)}, {"k2", opt(u.k2, 1e-6)}, {"resonance", opt(u.k_resonance, 1e-6)},
-                               {"k_sc", opt(u.k1, 1e-6)}, {"k_oc", opt(u.k_oc, 1e-6)}};
+    r["stiffness_N_per_um"] = {{"k1", io::to_json(u.k1, 1e-6)}, {"k2", io::to_json(u.k2, 1e-6)}, {"resonance", io::to_json(u.k_resonance, 1e-6)},
+                               {"k_sc", io::to_json(u.k1, 1e-6)}, {"k_oc", io::to_json(u.k_oc, 1e-6)}};
   }
   if (!u.damped.empty()) r["iff_damped_plants"] = damped_plants(u.damped);
   if (u.flexible_modes) r["flexible_modes"] = flexible_modes(*u.flexible_modes);

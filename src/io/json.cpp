@@ -10,6 +10,10 @@ nlohmann::json to_json(double value) {
   return value;
 }
 
+nlohmann::json to_json(const std::optional<double>& value, double scale) {
+  return value ? to_json(*value * scale) : nlohmann::json(nullptr);
+}
+
 nlohmann::json to_json(std::complex<double> value) {
   return nlohmann::json::array({to_json(value.real()), to_json(value.imag())});
 }

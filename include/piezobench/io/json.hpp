@@ -3,12 +3,15 @@
 // non-finite numbers as the strings "inf", "-inf" and "nan" (JSON has no such numbers).
 #include <Eigen/Dense>
 #include <complex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <vector>
 
 namespace piezobench::io {
 
 nlohmann::json to_json(double value);
+// value times `scale` as above, null when absent.
+nlohmann::json to_json(const std::optional<double>& value, double scale = 1.0);
 nlohmann::json to_json(std::complex<double> value);
 nlohmann::json to_json(const Eigen::VectorXd& values);
 nlohmann::json to_json(const Eigen::VectorXcd& values);
