@@ -53,7 +53,7 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
   const auto& p = frf.provenance;
   return {{"source", p.source},
           {"input", frf.input},
-          {"freq_Hz", io::to_json(frf.freq_hz)},
+          {"freq_Hz", io::to_json(frf.freq_Hz)},
           {"window", {{"name", p.window}, {"length", p.nfft}, {"periodic", p.window.find("periodic") != std::string::npos}}},
           {"nfft", p.nfft},
           {"overlap", p.overlap},
@@ -112,22 +112,22 @@ int run_frf(const FrfOptions& o) {
   const dsp::Frf& frf = estimate.frf;
   fmt::print("FRF {} of {} -> {}: {} averages, window {} ({} samples), {:.4g} Hz resolution\n",
              frf.provenance.estimator, frf.input, fmt::join(frf.outputs, ", "), frf.provenance.averages,
-             frf.provenance.window, frf.provenance.nfft, frf.freq_hz.size() > 1 ? frf.freq_hz(1) - frf.freq_hz(0) : 0.0);
+             frf.provenance.window, frf.provenance.nfft, frf.freq_Hz.size() > 1 ? frf.freq_Hz(1) - frf.freq_Hz(0) : 0.0);
   // The summary covers the band the input excited (coherence >= 0.5), not the noise around it.
   const dsp::FrequencyBand band = dsp::excited_band(frf, 0.5);
-  fmt::print("excited band (coherence >= 0.5): {:.4g} to {:.4g} Hz\n", band.fmin_hz, band.fmax_hz);
+  fmt::print("excited band (coherence >= 0.5): {:.4g} to {:.4g} Hz\n", band.fmin_Hz, band.fmax_Hz);
   for (std::size_t i = 0; i < frf.outputs.size(); ++i) {
     Eigen::Index peak = -1;
     double coh_sum = 0.0;
     int count = 0;
-    for (Eigen::Index k = 0; k < frf.freq_hz.size(); ++k) {
-      if (frf.freq_hz(k) < band.fmin_hz || frf.freq_hz(k) > band.fmax_hz) continue;
+    for (Eigen::Index k = 0; k < frf.freq_Hz.size(); ++k) {
+      if (frf.freq_Hz(k) < band.fmin_Hz || frf.freq_Hz(k) > band.fmax_Hz) continue;
       if (peak < 0 || std::abs(frf.H[i](k)) > std::abs(frf.H[i](peak))) peak = k;
       coh_sum += frf.coherence[i](k);
       ++count;
     }
     fmt::print("  {}: peak |H| {:.4g} at {:.4g} Hz, mean coherence {:.3f} in the band\n", frf.outputs[i], std::abs(frf.H[i](peak)),
-               frf.freq_hz(peak), count > 0 ? coh_sum / count : 0.0);
+               frf.freq_Hz(peak), count > 0 ? coh_sum / count : 0.0);
   }
   return 0;
 }
@@ -155,14 +155,14 @@ dsp::Frf select_band(const dsp::Frf& frf, FitOptions o) {
   if (o.fmin == 0.0 && o.fmax == 0.0) {
     const dsp::FrequencyBand excited = dsp::excited_band(frf, 0.5);
     if (excited.from_coherence) {
-      o.fmin = excited.fmin_hz;
-      o.fmax = excited.fmax_hz;
+      o.fmin = excited.fmin_Hz;
+      o.fmax = excited.fmax_Hz;
       if (!o.json) log_line(fmt::format("band {:.4g} to {:.4g} Hz: where the coherence is at least 0.5 (--fmin/--fmax to choose)", o.fmin, o.fmax));
     }
   }
   std::vector<Eigen::Index> keep;
-  for (Eigen::Index k = 0; k < frf.freq_hz.size(); ++k) {
-    if (frf.freq_hz(k) >= o.fmin && (o.fmax <= 0.0 || frf.freq_hz(k) <= o.fmax)) keep.push_back(k);
+  for (Eigen::Index k = 0; k < frf.freq_Hz.size(); ++k) {
+    if (frf.freq_Hz(k) >= o.fmin && (o.fmax <= 0.0 || frf.freq_Hz(k) <= o.fmax)) keep.push_back(k);
   }
   if (keep.empty()) {
     throw InputError(o.file, "freq_Hz", fmt::format("frequencies inside [{:g}, {:g}] Hz", o.fmin, o.fmax), "none");
@@ -176,16 +176,16 @@ dsp::Frf select_band(const dsp::Frf& frf, FitOptions o) {
   dsp::Frf band;
   band.input = frf.input;
   band.provenance = frf.provenance;
-  band.freq_hz.resize(static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t k = 0; k < keep.size(); ++k) band.freq_hz(static_cast<Eigen::Index>(k)) = frf.freq_hz(keep[k]);
+  band.freq_Hz.resize(static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t k = 0; k < keep.size(); ++k) band.freq_Hz(static_cast<Eigen::Index>(k)) = frf.freq_Hz(keep[k]);
   for (const Eigen::Index i : outs) {
     const auto ui = static_cast<std::size_t>(i);
     band.outputs.push_back(frf.outputs[ui]);
-    Eigen::VectorXcd h(band.freq_hz.size());
+    Eigen::VectorXcd h(band.freq_Hz.size());
     for (std::size_t k = 0; k < keep.size(); ++k) h(static_cast<Eigen::Index>(k)) = frf.H[ui](keep[k]);
     band.H.push_back(h);
     if (ui < frf.coherence.size() && frf.coherence[ui].size() > 0) {
-      Eigen::VectorXd c(band.freq_hz.size());
+      Eigen::VectorXd c(band.freq_Hz.size());
       for (std::size_t k = 0; k < keep.size(); ++k) c(static_cast<Eigen::Index>(k)) = frf.coherence[ui](keep[k]);
       band.coherence.push_back(c);
     }
@@ -225,7 +225,7 @@ std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const 
     fo.fit.weighting = ident::Weighting::kUnit;
     if (fo.fit.asymptote == ident::Asymptote::kConstantAndLinear) fo.fit.asymptote = ident::Asymptote::kConstant;
     fo.fit.fail_if_not_converged = false;
-    anti = ident::frf_features(kTwoPi * band.freq_hz, band.H[static_cast<std::size_t>(i)], fo).antiresonances;
+    anti = ident::frf_features(kTwoPi * band.freq_Hz, band.H[static_cast<std::size_t>(i)], fo).antiresonances;
   } catch (const Error&) {
     // no phase evidence: the fitted zero decides
   }
@@ -267,8 +267,8 @@ nlohmann::json fit_json(const ident::VectorFittingResult& r, const dsp::Frf& ban
   }
   nlohmann::json doc = {{"source", band.provenance.source},
                         {"outputs", band.outputs},
-                        {"fmin_Hz", band.freq_hz(0)},
-                        {"fmax_Hz", band.freq_hz(band.freq_hz.size() - 1)},
+                        {"fmin_Hz", band.freq_Hz(0)},
+                        {"fmax_Hz", band.freq_Hz(band.freq_Hz.size() - 1)},
                         {"order", r.poles.size()},
                         {"poles", io::to_json(r.poles)},
                         {"residues", residues},
@@ -293,7 +293,7 @@ int run_fit(const FitOptions& o) {
   vf.max_iterations = o.max_iterations;
   vf.validate();
   const dsp::Frf band = select_band(io::read_frf(o.file), o);
-  if (!o.json) log_line(fmt::format("fitting {} poles to {} points of {}", o.order, band.freq_hz.size(), fmt::join(band.outputs, ", ")));
+  if (!o.json) log_line(fmt::format("fitting {} poles to {} points of {}", o.order, band.freq_Hz.size(), fmt::join(band.outputs, ", ")));
   const ident::VectorFittingResult r = ident::vector_fit(band, vf);
   std::vector<std::vector<ZeroReport>> zeros;
   for (std::size_t i = 0; i < band.outputs.size(); ++i) zeros.push_back(zero_reports(r, band, static_cast<Eigen::Index>(i), vf));
@@ -346,22 +346,22 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
   const dsp::Frf frf = io::read_frf(o.file);
   const auto i = static_cast<std::size_t>(frf.output_index(o.output));
   ident::IffPlantFitOptions fo;
-  fo.fmin_hz = o.fmin;
-  fo.fmax_hz = o.fmax;
+  fo.fmin_Hz = o.fmin;
+  fo.fmax_Hz = o.fmax;
   if (o.fmin == 0.0 && o.fmax == 0.0) {
     const dsp::FrequencyBand excited = dsp::excited_band(frf, o.min_coherence);
-    fo.fmin_hz = excited.fmin_hz;
-    fo.fmax_hz = excited.fmax_hz;
+    fo.fmin_Hz = excited.fmin_Hz;
+    fo.fmax_Hz = excited.fmax_Hz;
   }
-  fo.hpf_fmax_hz = o.hpf_fmax;
+  fo.hpf_fmax_Hz = o.hpf_fmax;
   fo.min_coherence = o.min_coherence;
-  if (!o.json) log_line(fmt::format("fitting the IFF plant (eq. 2.3 with delay) to u -> {} of {}, {:.4g} to {:.4g} Hz", o.output, o.file, fo.fmin_hz, fo.fmax_hz));
+  if (!o.json) log_line(fmt::format("fitting the IFF plant (eq. 2.3 with delay) to u -> {} of {}, {:.4g} to {:.4g} Hz", o.output, o.file, fo.fmin_Hz, fo.fmax_Hz));
   const lti::Vector coh = i < frf.coherence.size() ? frf.coherence[i] : lti::Vector();
-  const ident::IffPlantFit p = ident::fit_iff_plant(kTwoPi * frf.freq_hz, frf.H[i], coh, fo, o.file);
+  const ident::IffPlantFit p = ident::fit_iff_plant(kTwoPi * frf.freq_Hz, frf.H[i], coh, fo, o.file);
   const double hz = 1.0 / kTwoPi;
   nlohmann::json doc = {{"source", o.file},
                         {"output", o.output},
-                        {"band_Hz", {fo.fmin_hz, fo.fmax_hz}},
+                        {"band_Hz", {fo.fmin_Hz, fo.fmax_Hz}},
                         {"relative_rms_error", io::to_json(p.relative_rms_error)},
                         {"points", p.points},
                         {"iterations", p.iterations},
@@ -377,7 +377,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
     io::write_lti_toml(p.transfer_function(), o.out,
                        fmt::format("IFF plant (eq. 2.3) fitted to u -> {} of {} by piezobench fit iff-plant, {:.4g} to {:.4g} Hz, "
                                    "relative rms error {:.3g}, quality {}",
-                                   o.output, o.file, fo.fmin_hz, fo.fmax_hz, p.relative_rms_error, core::to_string(p.quality.verdict)));
+                                   o.output, o.file, fo.fmin_Hz, fo.fmax_Hz, p.relative_rms_error, core::to_string(p.quality.verdict)));
     if (!o.json) log_line("wrote " + o.out + " (read by `iff rlocus --plant`)");
   }
   if (o.json) {
@@ -385,7 +385,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
     return report_quality(p.quality);
   }
   fmt::print("IFF plant (eq. 2.3 with delay) fitted to u -> {} of {}, {:.4g} to {:.4g} Hz ({} points)\n", o.output, o.file,
-             fo.fmin_hz, fo.fmax_hz, p.points);
+             fo.fmin_Hz, fo.fmax_Hz, p.points);
   if (!p.quality.impossible) {
     fmt::print("  g0 = {:.5g} V/V, wz = {:.5g} Hz, xz = {:+.4g}, wp = {:.5g} Hz, xp = {:.4g}\n", p.g0, p.wz * hz, p.xz, p.wp * hz, p.xp);
     fmt::print("  high-pass corner {:.4g} Hz, delay {:.4g} us\n", p.w_hpf * hz, p.delay * 1e6);

@@ -25,7 +25,7 @@ struct RlocusOptions {
   std::string gains;
   double delay = 0.0;
   int pade_order = 6;
-  double resonance_hz = 0.0;
+  double resonance_Hz = 0.0;
   int max_order = lti::RootLocusOptions{}.max_order;
   double max_work = lti::RootLocusOptions{}.max_work;
   bool json = false;
@@ -94,7 +94,7 @@ int run_rlocus(const RlocusOptions& o) {
                      "a loop (plant and controller) of at most " + std::to_string(o.max_order) + " states (--max-order)",
                      std::to_string(order) + " states");
   }
-  if (o.resonance_hz > 0.0) options.resonance = kTwoPi * o.resonance_hz;
+  if (o.resonance_Hz > 0.0) options.resonance = kTwoPi * o.resonance_Hz;
   if (!o.json) log_line("computing the root locus" + std::string(gains.empty() ? " on an automatic gain grid" : ""));
   const control::IffRootLocus r = control::iff_root_locus(plant.system, controller.system, gains, options);
 
@@ -160,8 +160,8 @@ int run_study(const StudyOptions& o) {
   if (o.json) {
     nlohmann::json gains = nlohmann::json::array(), id = nlohmann::json::array(), model = nlohmann::json::array(),
                    err = nlohmann::json::array(), id_damping = nlohmann::json::array(),
-                   model_damping = nlohmann::json::array(), id_hz = nlohmann::json::array(),
-                   model_hz = nlohmann::json::array(), so_poles = nlohmann::json::array(),
+                   model_damping = nlohmann::json::array(), id_Hz = nlohmann::json::array(),
+                   model_Hz = nlohmann::json::array(), so_poles = nlohmann::json::array(),
                    so_damping = nlohmann::json::array(), so_err = nlohmann::json::array(),
                    frf_rms = nlohmann::json::array(), coherence = nlohmann::json::array(),
                    fit_rms = nlohmann::json::array(), clamped = nlohmann::json::array();
@@ -172,8 +172,8 @@ int run_study(const StudyOptions& o) {
       err.push_back(p.relative_error);
       id_damping.push_back(p.identified_damping);
       model_damping.push_back(p.model_damping);
-      id_hz.push_back(p.identified_frequency_hz);
-      model_hz.push_back(p.model_frequency_hz);
+      id_Hz.push_back(p.identified_frequency_Hz);
+      model_Hz.push_back(p.model_frequency_Hz);
       so_poles.push_back(io::to_json(p.second_order_pole));
       so_damping.push_back(p.second_order_damping);
       so_err.push_back(p.second_order_relative_error);
@@ -193,8 +193,8 @@ int run_study(const StudyOptions& o) {
                 {"relative_errors", err},
                 {"identified_damping", id_damping},
                 {"model_damping", model_damping},
-                {"identified_frequency_Hz", id_hz},
-                {"model_frequency_Hz", model_hz},
+                {"identified_frequency_Hz", id_Hz},
+                {"model_frequency_Hz", model_Hz},
                 {"second_order", {{"poles", so_poles}, {"damping", so_damping}, {"relative_errors", so_err}}},
                 {"fit_relative_rms_error", fit_rms},
                 {"frf_model_relative_rms", frf_rms},
@@ -212,8 +212,8 @@ int run_study(const StudyOptions& o) {
   fmt::print("damped plant u' -> d_e on the virtual bench (unit {}, seed {}), report Figure 2.10\n", o.unit, o.seed);
   fmt::print("{:>10}  {:>22}  {:>22}  {:>7}  {:>16}\n", "gain g", "identified f [Hz], z", "model f [Hz], z", "error", "2nd-order error");
   for (const auto& p : s.points) {
-    fmt::print("{:>10.4g}  {:>12.2f}, {:>7.4f}  {:>12.2f}, {:>7.4f}  {:>6.2f}%  {:>15.2f}%\n", p.gain, p.identified_frequency_hz,
-               p.identified_damping, p.model_frequency_hz, p.model_damping, 100 * p.relative_error,
+    fmt::print("{:>10.4g}  {:>12.2f}, {:>7.4f}  {:>12.2f}, {:>7.4f}  {:>6.2f}%  {:>15.2f}%\n", p.gain, p.identified_frequency_Hz,
+               p.identified_damping, p.model_frequency_Hz, p.model_damping, 100 * p.relative_error,
                100 * p.second_order_relative_error);
   }
   fmt::print("model optimum: g = {:.4g}, damping {:.4f}\n", s.optimal_gain, s.max_damping);
@@ -238,7 +238,7 @@ void add_iff_commands(CLI::App& app, Action& action) {
   rl->add_option("--pade-order", o->pade_order, "order of the Pade approximant of delays in the loop")
       ->check(CLI::Range(1, 20))
       ->capture_default_str();
-  rl->add_option("--resonance-hz", o->resonance_hz,
+  rl->add_option("--resonance-hz", o->resonance_Hz,
                  "frequency of the resonance whose damping is optimized (default: the plant's least damped pole)");
   rl->add_option("--max-order", o->max_order, "largest loop order (plant + controller states) accepted")
       ->check(CLI::Range(1, 5000))

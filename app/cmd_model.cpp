@@ -135,8 +135,8 @@ int run_tune(const TuneCommand& c) {
   const dsp::FrequencyBand excited = dsp::excited_band(frf, 0.5);
   const bool has_coherence = excited.from_coherence;
   const ident::ActuatorPlantOptions defaults;
-  if (o.fmin_hz == 0.0) o.fmin_hz = std::max(defaults.fmin_hz, excited.fmin_hz);
-  if (o.fmax_hz == 0.0) o.fmax_hz = std::min(defaults.fmax_hz, excited.fmax_hz);
+  if (o.fmin_Hz == 0.0) o.fmin_Hz = std::max(defaults.fmin_Hz, excited.fmin_Hz);
+  if (o.fmax_Hz == 0.0) o.fmax_Hz = std::min(defaults.fmax_Hz, excited.fmax_Hz);
   if (c.min_coherence_given) {
     o.min_coherence = c.options.min_coherence;
   } else if (has_coherence) {
@@ -144,15 +144,15 @@ int run_tune(const TuneCommand& c) {
   }
   o.validate();
   if (!c.json) {
-    log_line(fmt::format("tuning the 2-DoF model on {} ({} frequencies, band {:.4g} to {:.4g} Hz{})", c.frf_file, frf.freq_hz.size(),
-                         o.fmin_hz, o.fmax_hz, has_coherence ? " where the coherence is at least 0.5" : ""));
+    log_line(fmt::format("tuning the 2-DoF model on {} ({} frequencies, band {:.4g} to {:.4g} Hz{})", c.frf_file, frf.freq_Hz.size(),
+                         o.fmin_Hz, o.fmax_Hz, has_coherence ? " where the coherence is at least 0.5" : ""));
   }
   ident::ActuatorPlantOptions po;  // the Vs fit goes down to the lowest frequency for the high-pass corner
-  po.fmin_hz = o.fmin_hz;
-  po.fmax_hz = o.fmax_hz;
+  po.fmin_Hz = o.fmin_Hz;
+  po.fmax_Hz = o.fmax_Hz;
   po.min_coherence = o.min_coherence;
   if (o.bench.hpf_resistance > 0.0 && o.bench.hpf_capacitance > 0.0) po.fixed_w_hpf = o.bench.hpf_corner();
-  const lti::Vector omega = kTwoPi * frf.freq_hz;
+  const lti::Vector omega = kTwoPi * frf.freq_Hz;
   const auto coh = [&](std::size_t i) { return i < frf.coherence.size() ? frf.coherence[i] : lti::Vector(); };
   const ident::ActuatorPlants plants = ident::fit_actuator_plants(omega, frf.H[ude], coh(ude), frf.H[uvs], coh(uvs), po, c.frf_file);
   for (const auto& f : plants.failures) log_line("warning: " + f);
@@ -174,7 +174,7 @@ int run_tune(const TuneCommand& c) {
                   {"static_gain_de_um_per_V", io::to_json(t.features.static_gain_de * 1e6)},
                   {"static_gain_Vs_V_per_V", io::to_json(t.features.static_gain_vs)}}},
                 {"amplifier_gain", o.bench.amplifier_gain},
-                {"band_Hz", {o.fmin_hz, o.fmax_hz}},
+                {"band_Hz", {o.fmin_Hz, o.fmax_Hz}},
                 {"min_coherence", o.min_coherence},
                 {"chain", {{"delay_s", t.bench.delay}, {"hpf_corner_Hz", t.bench.hpf_corner() / kTwoPi}}},
                 {"stack_stiffness_ratio", o.stack_stiffness_ratio},
@@ -188,12 +188,12 @@ int run_tune(const TuneCommand& c) {
   }
   const apa::TwoDofParams& p = t.params;
   if (t.quality.impossible) {
-    fmt::print("2-DoF model tuning on {} ({:.4g} to {:.4g} Hz) gave no physical parameters\n{}\n", c.frf_file, o.fmin_hz, o.fmax_hz,
+    fmt::print("2-DoF model tuning on {} ({:.4g} to {:.4g} Hz) gave no physical parameters\n{}\n", c.frf_file, o.fmin_Hz, o.fmax_Hz,
                t.brief_report());
     return report_quality(t.quality);
   }
   fmt::print("2-DoF model tuned on {} (mass {:.4g} kg, amplifier {:.4g} V/V, {:.4g} to {:.4g} Hz)\n", c.frf_file, p.m,
-             o.bench.amplifier_gain, o.fmin_hz, o.fmax_hz);
+             o.bench.amplifier_gain, o.fmin_Hz, o.fmax_Hz);
   fmt::print("  chain removed: delay {:.4g} us, high-pass on Vs at {:.4g} Hz\n", t.bench.delay * 1e6, t.bench.hpf_corner() / kTwoPi);
   fmt::print("  k1 = {:.4g} N/um, c1 = {:.4g} Ns/m\n", p.k1 * 1e-6, p.c1);
   fmt::print("  ke = {:.4g} N/um, ce = {:.4g} Ns/m, ka = {:.4g} N/um, ca = {:.4g} Ns/m\n", p.ke * 1e-6, p.ce,
@@ -268,8 +268,8 @@ void add_model_commands(CLI::App& app, Action& action) {
       ->check(CLI::ExistingFile);
   tune->add_option("--mass", u->options.mass, "known moving mass m, kg")->capture_default_str();
   add_bench_options(tune, u->options.bench);
-  tune->add_option("--fmin", u->options.fmin_hz, "lowest frequency used, Hz (default: 20 Hz as `run`, or where the coherence reaches 0.5)");
-  tune->add_option("--fmax", u->options.fmax_hz, "highest frequency used, Hz (default: 500 Hz as `run`, or where the coherence falls below 0.5)");
+  tune->add_option("--fmin", u->options.fmin_Hz, "lowest frequency used, Hz (default: 20 Hz as `run`, or where the coherence reaches 0.5)");
+  tune->add_option("--fmax", u->options.fmax_Hz, "highest frequency used, Hz (default: 500 Hz as `run`, or where the coherence falls below 0.5)");
   tune->add_option("--min-coherence", u->options.min_coherence, "leave out frequencies with a lower coherence (default 0.5 when the file has coherence)");
   tune->add_option("--stack-ratio", u->options.stack_stiffness_ratio, "ke/ka kept during the refinement (0 = free)")
       ->capture_default_str();

@@ -29,10 +29,10 @@ print(f"record: {u.size} samples at {fs:g} Hz")
 
 # 2. FRFs: H1 and coherence of both outputs in one pass (0.25 Hz resolution).
 est = dsp.frf(u, [de, vs], fs, outputs=["de", "Vs"], nfft=40_000, overlap=0.5, window="hann-periodic")
-f = est.freq_hz
+f = est.freq_Hz
 band = (f >= 2.0) & (f <= 400.0)
-peak_hz = f[band][np.argmax(np.abs(est.H[0][band]))]
-print(f"FRF: resonance peak at {peak_hz:.2f} Hz (truth {truth.resonance_Hz:.2f} Hz), "
+peak_Hz = f[band][np.argmax(np.abs(est.H[0][band]))]
+print(f"FRF: resonance peak at {peak_Hz:.2f} Hz (truth {truth.resonance_Hz:.2f} Hz), "
       f"median coherence {np.median(est.coherence[:, band]):.3f}")
 
 # 3. NMP check of u -> Vs: the zero fitted by vector fitting (20-500 Hz, the campaign's band) and
@@ -40,17 +40,17 @@ print(f"FRF: resonance peak at {peak_hz:.2f} Hz (truth {truth.resonance_Hz:.2f} 
 fit_band = (f >= 20.0) & (f <= 500.0)
 w = 2 * np.pi * f[fit_band]
 features = ident.frf_features(w, est.H[1][fit_band], fit={"order": 8, "fail_if_not_converged": False})
-anti = min(features.antiresonances, key=lambda a: abs(a.frequency_hz - truth.antiresonance_Hz))
-print(f"anti-resonance {anti.frequency_hz:.2f} Hz (truth {truth.antiresonance_Hz:.2f} Hz): fitted zero "
+anti = min(features.antiresonances, key=lambda a: abs(a.frequency_Hz - truth.antiresonance_Hz))
+print(f"anti-resonance {anti.frequency_Hz:.2f} Hz (truth {truth.antiresonance_Hz:.2f} Hz): fitted zero "
       f"{'in the RHP' if anti.nonminimum_phase_model else 'in the LHP'}, phase change {anti.phase_change_deg:.0f} deg "
       f"-> {anti.phase_verdict}")
 
 # 4. IFF design with the report's plant model (eq. 2.3): g0, wz, xz, wp, xp, the high-pass corner and
 #    the delay fitted to u -> Vs (the report tuned them by hand); then the root locus with the
 #    report's controller (eq. 2.4) and the gain of maximum damping. xz < 0 is a non-minimum-phase zero.
-plant_fit = ident.fit_iff_plant(est.frf, "Vs", fmax_hz=500.0, min_coherence=0.5)
-print(f"IFF plant fit ({plant_fit.quality.verdict}): wp {plant_fit.wp_hz:.2f} Hz, xp {plant_fit.xp:.4f}; "
-      f"wz {plant_fit.wz_hz:.2f} Hz, xz {plant_fit.xz:.4f}; high-pass {plant_fit.w_hpf_hz:.2f} Hz; "
+plant_fit = ident.fit_iff_plant(est.frf, "Vs", fmax_Hz=500.0, min_coherence=0.5)
+print(f"IFF plant fit ({plant_fit.quality.verdict}): wp {plant_fit.wp_Hz:.2f} Hz, xp {plant_fit.xp:.4f}; "
+      f"wz {plant_fit.wz_Hz:.2f} Hz, xz {plant_fit.xz:.4f}; high-pass {plant_fit.w_hpf_Hz:.2f} Hz; "
       f"delay {plant_fit.delay * 1e6:.0f} us; relative rms error {plant_fit.relative_rms_error:.3f}")
 locus = control.iff_root_locus(control.iff_plant(**plant_fit.params()), control.iff_controller())
 print(f"IFF: optimal gain {locus.optimum.gain:.3g} -> damping {locus.optimum.damping:.3f}")
@@ -58,17 +58,17 @@ print(f"IFF: optimal gain {locus.optimum.gain:.3g} -> damping {locus.optimum.dam
 # 5. The 2-DoF model tuned to both FRFs: the plant fits give the delay of d_e and the high-pass of
 #    Vs, which are removed before the report's procedure and the refinement (only the mass is known).
 plants = ident.fit_actuator_plants(est.frf)
-tuning = apa.tune_two_dof_measured(est.frf, plants.de, plants.vs, mass=5.7, fmin_hz=20.0, fmax_hz=400.0,
+tuning = apa.tune_two_dof_measured(est.frf, plants.de, plants.vs, mass=5.7, fmin_Hz=20.0, fmax_Hz=400.0,
                                    min_coherence=0.5)
 print(f"2-DoF tuning ({tuning.quality.summary}): {tuning.brief_report}")
 for name in ("k1", "ke", "ka", "ga", "gs"):
     print(f"  {name} = {tuning.params[name]:.4g}   (truth {truth.model_2dof[name]:.4g})")
 
 checks = [
-    ("resonance within 1 %", abs(peak_hz / truth.resonance_Hz - 1) < 0.01),
-    ("anti-resonance within 2 %", abs(anti.frequency_hz / truth.antiresonance_Hz - 1) < 0.02),
+    ("resonance within 1 %", abs(peak_Hz / truth.resonance_Hz - 1) < 0.01),
+    ("anti-resonance within 2 %", abs(anti.frequency_Hz / truth.antiresonance_Hz - 1) < 0.02),
     ("NMP verdict as the truth", (anti.phase_verdict == "non-minimum-phase") == bool(truth.zero_is_nonminimum_phase)),
-    ("fitted plant: anti-resonance within 2 %", abs(plant_fit.wz_hz / truth.antiresonance_Hz - 1) < 0.02),
+    ("fitted plant: anti-resonance within 2 %", abs(plant_fit.wz_Hz / truth.antiresonance_Hz - 1) < 0.02),
     ("fitted plant: zero pair as the truth", plant_fit.zero_is_nonminimum_phase == bool(truth.zero_is_nonminimum_phase)),
     ("fitted plant: good", plant_fit.quality.verdict == "good"),
     ("IFF damps the resonance above 10 %", locus.optimum.damping > 0.10),

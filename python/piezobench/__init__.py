@@ -12,7 +12,7 @@ The C++ library behind the `piezobench` command, with numpy arrays in and out:
     piezobench.bench     the virtual test bench: units, experiments as arrays, linear models
     piezobench.campaign  run a campaign file; typed results with to_dict()
 
-Units are SI (frequencies in rad/s unless a name ends in _hz). Errors are
+Units are SI (frequencies in rad/s unless a name ends in _Hz). Errors are
 piezobench.InputError (bad data or argument: .source, .field, .expected, .found) and
 piezobench.NumericalError (a method failed: .method, .retry_may_help). See docs/python.md.
 """

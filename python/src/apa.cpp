@@ -62,8 +62,8 @@ const Options<TuningOptions>& tuning_options() {
     o.add("mass", &TuningOptions::mass, "kg, the known moving mass")
         .add_nested("bench", &TuningOptions::bench, bench_options(),
                     "measurement chain removed before fitting (apa.two_dof_bench keywords; masses 0)")
-        .add("fmin_hz", &TuningOptions::fmin_hz, "Hz, band used; 0 = from the lowest point")
-        .add("fmax_hz", &TuningOptions::fmax_hz, "Hz; 0 = to the highest point")
+        .add("fmin_Hz", &TuningOptions::fmin_Hz, "Hz, band used; 0 = from the lowest point")
+        .add("fmax_Hz", &TuningOptions::fmax_Hz, "Hz; 0 = to the highest point")
         .add("min_coherence", &TuningOptions::min_coherence, "points below this coherence are left out")
         .add("stack_stiffness_ratio", &TuningOptions::stack_stiffness_ratio, "ke / ka imposed in the refinement; 0 = free")
         .add("stack_damping_ratio", &TuningOptions::stack_damping_ratio, "ce / ca imposed in the refinement; 0 = free")

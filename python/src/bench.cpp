@@ -75,8 +75,8 @@ py::object unit_result(const UnitTruth& u) {
   d["hysteresis_scale"] = u.hysteresis_scale;
   d["creep_coefficient"] = u.creep_coefficient;
   d["load_creep_coefficient"] = u.load_creep_coefficient;
-  d["mode_y_hz"] = u.mode_y_Hz;
-  d["mode_x_hz"] = u.mode_x_Hz;
+  d["mode_y_Hz"] = u.mode_y_Hz;
+  d["mode_x_Hz"] = u.mode_x_Hz;
   d["mode_damping"] = u.mode_damping;
   d["defective"] = u.defective;
   d["defect"] = u.defect;

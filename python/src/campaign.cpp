@@ -108,7 +108,7 @@ void bind_result_classes(py::module_& m) {
   }
   {
     py::class_<HighPassCorner> c(m, "HighPassCorner", "The resistor high-pass of the force sensor's read-out (Hz).");
-    c.def_readonly("first_order_fit_Hz", &HighPassCorner::first_order_fit_Hz, "Hz, first-order fit below hpf_fmax_hz")
+    c.def_readonly("first_order_fit_Hz", &HighPassCorner::first_order_fit_Hz, "Hz, first-order fit below hpf_fmax_Hz")
         .def_readonly("first_order_fit_points", &HighPassCorner::first_order_fit_points)
         .def_readonly("r_c_Hz", &HighPassCorner::r_c_Hz, "Hz, 1 / (2 pi R C_sensor) when C_sensor is measured")
         .def_readonly("iff_plant_fit_Hz", &HighPassCorner::iff_plant_fit_Hz, "Hz, eq. 2.3 fitted down to the lowest frequency")
@@ -160,7 +160,7 @@ void bind_result_classes(py::module_& m) {
     py::class_<ident::DominantPole> c(m, "DominantPole", "The dominant pole pair of a vector fit (ident/dominant_pole.hpp).");
     c.def_readonly("pole", &ident::DominantPole::pole, "rad/s, Im > 0")
         .def_readonly("natural_frequency", &ident::DominantPole::natural_frequency, "rad/s")
-        .def_property_readonly("frequency_hz", &ident::DominantPole::frequency_hz, "Hz")
+        .def_property_readonly("frequency_Hz", &ident::DominantPole::frequency_Hz, "Hz")
         .def_readonly("damping", &ident::DominantPole::damping)
         .def_readonly("peak", &ident::DominantPole::peak, "its peak contribution, data units")
         .def_property_readonly("relative_rms_error", [](const ident::DominantPole& p) { return p.fit.relative_rms_error; },

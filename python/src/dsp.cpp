@@ -63,7 +63,7 @@ const Options<MultisineOptions>& multisine_options() {
     o.add("sample_rate", &MultisineOptions::sample_rate, "Hz")
         .add("period_samples", &MultisineOptions::period_samples, "N, samples per period (>= 2)")
         .add("periods", &MultisineOptions::periods, "periods generated (>= 1)")
-        .add("lines_hz", &MultisineOptions::lines_hz, "Hz, each a multiple k sample_rate / N, 1 <= k < N/2")
+        .add("lines_Hz", &MultisineOptions::lines_Hz, "Hz, each a multiple k sample_rate / N, 1 <= k < N/2")
         .add("amplitudes", &MultisineOptions::amplitudes, "relative amplitude per line; empty = equal")
         .add("rms", &MultisineOptions::rms, "V, rms of the varying part before scaling")
         .add("offset", &MultisineOptions::offset, "V")
@@ -195,7 +195,7 @@ py::object excitation(Excitation&& e) {
   d["scaled"] = e.scaled;
   d["scale"] = e.scale;
   d["clipped"] = e.clipped;
-  d["lines_hz"] = to_numpy(std::move(e.lines_hz));
+  d["lines_Hz"] = to_numpy(std::move(e.lines_Hz));
   d["seed"] = e.seed;
   return result("Excitation", d);
 }
@@ -216,7 +216,7 @@ void def_excitation(py::module_& m, const char* name, const Options<O>& table, E
         return excitation(without_gil([&] { return f(o, b); }));
       },
       py::arg("bounds") = py::none(),
-      (doc + "\nReturns a Result: u (V), t (s), sample_rate (Hz), kind, scaled, scale, clipped, lines_hz, seed.\n\n"
+      (doc + "\nReturns a Result: u (V), t (s), sample_rate (Hz), kind, scaled, scale, clipped, lines_Hz, seed.\n\n"
              "bounds: dict of\n" + bounds_options().doc("    ") + "\nKeywords:\n" + table.doc())
           .c_str());
 }
@@ -246,16 +246,16 @@ void bind_dsp(py::module_& m) {
 
   py::class_<Frf>(m, "Frf", R"(A frequency response: one input, named outputs, a common grid (dsp/frf.hpp).
 
-H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says how it was estimated.)")
-      .def(py::init([](py::object freq_hz, py::object H, py::object outputs, const std::string& input,
+H[i][k] = output i / input at freq_Hz[k]; coherence where known; provenance says how it was estimated.)")
+      .def(py::init([](py::object freq_Hz, py::object H, py::object outputs, const std::string& input,
                        py::object coherence) {
              const std::string src = "dsp.Frf";
              Frf f;
-             f.freq_hz = to_vector(freq_hz, src, "freq_hz");
+             f.freq_Hz = to_vector(freq_Hz, src, "freq_Hz");
              f.input = input;
              auto h = to_complex_matrix(H, src, "H");
              // H: (points,) for one output, or (outputs, points).
-             if (h.cols() == 1 && h.rows() == f.freq_hz.size()) h.transposeInPlace();
+             if (h.cols() == 1 && h.rows() == f.freq_Hz.size()) h.transposeInPlace();
              for (Index i = 0; i < h.rows(); ++i) f.H.push_back(h.row(i).transpose());
              if (outputs.is_none()) {
                for (Index i = 0; i < h.rows(); ++i) f.outputs.push_back(h.rows() == 1 ? "y" : "y" + std::to_string(i));
@@ -264,17 +264,17 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
              }
              if (!coherence.is_none()) {
                auto c = to_matrix(coherence, src, "coherence", true);
-               if (c.cols() == 1 && c.rows() == f.freq_hz.size()) c.transposeInPlace();
+               if (c.cols() == 1 && c.rows() == f.freq_Hz.size()) c.transposeInPlace();
                for (Index i = 0; i < c.rows(); ++i) f.coherence.push_back(c.row(i).transpose());
              }
              f.validate(src);
              return f;
            }),
-           arg("freq_hz"), arg("H"), arg("outputs") = py::none(), arg("input") = "u", arg("coherence") = py::none(),
-           "freq_hz (Hz, increasing); H: 1-D for one output or (outputs, points); outputs: names; coherence "
+           arg("freq_Hz"), arg("H"), arg("outputs") = py::none(), arg("input") = "u", arg("coherence") = py::none(),
+           "freq_Hz (Hz, increasing); H: 1-D for one output or (outputs, points); outputs: names; coherence "
            "like H (None = unknown).")
-      .def_property_readonly("freq_hz", [](py::object self) { return view(self.cast<const Frf&>().freq_hz, self); }, "Hz")
-      .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_hz)); }, "rad/s")
+      .def_property_readonly("freq_Hz", [](py::object self) { return view(self.cast<const Frf&>().freq_Hz, self); }, "Hz")
+      .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_Hz)); }, "rad/s")
       .def_readonly("input", &Frf::input)
       .def_readonly("outputs", &Frf::outputs)
       .def_property_readonly("H", [](const Frf& f) { return stack(f.H, f.H.size() == 1); },
@@ -289,7 +289,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
       .def("__repr__", [](const Frf& f) {
         std::string outs;
         for (const auto& o : f.outputs) outs += (outs.empty() ? "" : ", ") + o;
-        return "Frf(input=" + f.input + ", outputs=[" + outs + "], points=" + std::to_string(f.freq_hz.size()) + ")";
+        return "Frf(input=" + f.input + ", outputs=[" + outs + "], points=" + std::to_string(f.freq_Hz.size()) + ")";
       });
 
   m.def("window", [](const std::string& type, Index length) { return to_numpy(make_window(window_type_from_string(type), length)); },
@@ -303,7 +303,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
         auto a = vector_arg(x, "dsp.welch", "x", false);
         Channel in{"x", span(a)};
         auto s = without_gil([&] { return cross_spectra(in, {}, fs, o, "dsp.welch"); });
-        return py::make_tuple(to_numpy(std::move(s.freq_hz)), to_numpy(std::move(s.Suu)));
+        return py::make_tuple(to_numpy(std::move(s.freq_Hz)), to_numpy(std::move(s.Suu)));
       },
       arg("x"), arg("fs"),
       ("(f, Pxx): one-sided power spectral density of x, [x]^2/Hz, at f (Hz), as scipy.signal.welch with\n"
@@ -318,7 +318,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
         for (std::size_t i = 0; i < ys.arrays.size(); ++i) outs.push_back(Channel{ys.names[i], span(ys.arrays[i])});
         Channel in{"x", span(a)};
         auto s = without_gil([&] { return cross_spectra(in, outs, fs, o, "dsp.csd"); });
-        return py::make_tuple(to_numpy(std::move(s.freq_hz)), stack(s.Suy, ys.single));
+        return py::make_tuple(to_numpy(std::move(s.freq_Hz)), stack(s.Suy, ys.single));
       },
       arg("x"), arg("y"), arg("fs"),
       ("(f, Pxy): cross spectral density conj(X) Y, [x][y]/Hz, as scipy.signal.csd(x, y). y may hold\n"
@@ -332,7 +332,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
         auto e = estimate(a, ys, fs, o, input, "dsp.frf");
         py::dict d;
         const bool single = ys.single;
-        d["freq_hz"] = to_numpy(e.spectra.freq_hz);
+        d["freq_Hz"] = to_numpy(e.spectra.freq_Hz);
         d["H"] = stack(e.frf.H, single);
         d["coherence"] = stack(e.frf.coherence, single);
         d["Suu"] = to_numpy(std::move(e.spectra.Suu));
@@ -345,7 +345,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
       arg("u"), arg("y"), arg("fs"), arg("outputs") = py::none(), arg("input") = "u",
       ("H1 (or H2) and coherence of every output in one pass over the data (the samples are read in\n"
        "place, without copies, and the GIL is released). u: input (1-D), y: one output (1-D), a list,\n"
-       "or (outputs, samples); fs: Hz; outputs: names. Returns a Result: freq_hz, H, coherence,\n"
+       "or (outputs, samples); fs: Hz; outputs: names. Returns a Result: freq_Hz, H, coherence,\n"
        "Suu, Syy, Suy (1-D for one output, else (outputs, points)), averages, and frf (a dsp.Frf)." + keywords)
           .c_str());
   m.def(
@@ -356,7 +356,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
         auto a = vector_arg(u, "dsp.h1", "u", false);
         auto ys = outputs_arg(y, "dsp.h1", py::none());
         auto e = estimate(a, ys, fs, o, "u", "dsp.h1");
-        return py::make_tuple(to_numpy(std::move(e.frf.freq_hz)), stack(e.frf.H, ys.single));
+        return py::make_tuple(to_numpy(std::move(e.frf.freq_Hz)), stack(e.frf.H, ys.single));
       },
       arg("u"), arg("y"), arg("fs"), ("(f, H1): H1 = Suy / Suu (scipy: csd(u, y) / welch(u))." + keywords).c_str());
   m.def(
@@ -367,7 +367,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
         auto a = vector_arg(u, "dsp.h2", "u", false);
         auto ys = outputs_arg(y, "dsp.h2", py::none());
         auto e = estimate(a, ys, fs, o, "u", "dsp.h2");
-        return py::make_tuple(to_numpy(std::move(e.frf.freq_hz)), stack(e.frf.H, ys.single));
+        return py::make_tuple(to_numpy(std::move(e.frf.freq_Hz)), stack(e.frf.H, ys.single));
       },
       arg("u"), arg("y"), arg("fs"), ("(f, H2): H2 = Syy / Syu (scipy: welch(y) / conj(csd(u, y)))." + keywords).c_str());
   m.def(
@@ -377,7 +377,7 @@ H[i][k] = output i / input at freq_hz[k]; coherence where known; provenance says
         auto a = vector_arg(u, "dsp.coherence", "u", false);
         auto ys = outputs_arg(y, "dsp.coherence", py::none());
         auto e = estimate(a, ys, fs, o, "u", "dsp.coherence");
-        return py::make_tuple(to_numpy(std::move(e.frf.freq_hz)), stack(e.frf.coherence, ys.single));
+        return py::make_tuple(to_numpy(std::move(e.frf.freq_Hz)), stack(e.frf.coherence, ys.single));
       },
       arg("u"), arg("y"), arg("fs"),
       ("(f, Cuy): magnitude-squared coherence |Suy|^2 / (Suu Syy), as scipy.signal.coherence." + keywords).c_str());

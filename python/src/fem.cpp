@@ -223,12 +223,12 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
       [](py::object K, py::object M) {
         auto r = fem::modes(to_matrix(K, "fem.modes", "K"), to_matrix(M, "fem.modes", "M"));
         py::dict d;
-        d["frequencies_hz"] = to_numpy(std::move(r.frequencies_Hz));
+        d["frequencies_Hz"] = to_numpy(std::move(r.frequencies_Hz));
         d["shapes"] = to_numpy(std::move(r.shapes));
         return result("Modes", d);
       },
       arg("K"), arg("M"),
-      "Undamped modes K phi = w^2 M phi: Result(frequencies_hz (signed, ascending), shapes (mass-normalized columns)).");
+      "Undamped modes K phi = w^2 M phi: Result(frequencies_Hz (signed, ascending), shapes (mass-normalized columns)).");
   m.def(
       "assemble",
       [](const SuperElement& se, const std::vector<long>& fixed_nodes, const std::vector<std::string>& masses,
@@ -256,9 +256,9 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
         d["performed"] = r.performed;
         d["free_free"] = r.free_free;
         d["spoiled"] = r.spoiled;
-        d["lowest_modes_hz"] = to_numpy(std::move(r.lowest_modes_Hz));
+        d["lowest_modes_Hz"] = to_numpy(std::move(r.lowest_modes_Hz));
         d["rigid_fraction"] = to_numpy(std::move(r.rigid_fraction));
-        d["first_flexible_hz"] = r.first_flexible_Hz;
+        d["first_flexible_Hz"] = r.first_flexible_Hz;
         d["message"] = r.message;
         return result("RigidBodyCheck", d);
       },
@@ -279,7 +279,7 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
         auto r = without_gil([&] { return craig_bampton(model, points, o); });
         py::dict d;
         d["reduced"] = py::cast(std::move(r.reduced));
-        d["fixed_interface_hz"] = to_numpy(std::move(r.fixed_interface_Hz));
+        d["fixed_interface_Hz"] = to_numpy(std::move(r.fixed_interface_Hz));
         d["interior_dofs"] = r.interior_dofs;
         d["interface_dofs"] = r.interface_dofs;
         d["factor_nonzeros"] = r.factor_nonzeros;
@@ -289,7 +289,7 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
       },
       arg("model"), arg("interface"),
       ("Craig-Bampton reduction of a fem.SparseModel to a super element: interface points are nodes\n"
-       "(int or \"NODE\") or \"REF:ROT\" rigid bodies. Result(reduced (SuperElement), fixed_interface_hz, ...).\n\n"
+       "(int or \"NODE\") or \"REF:ROT\" rigid bodies. Result(reduced (SuperElement), fixed_interface_Hz, ...).\n\n"
        "Keywords (CraigBamptonOptions):\n" + cb_options().doc())
           .c_str());
 }

@@ -100,9 +100,9 @@ const Options<LscfOptions>& lscf_options() {
 const Options<IffPlantFitOptions>& plant_fit_options() {
   static const Options<IffPlantFitOptions> t = [] {
     Options<IffPlantFitOptions> o("IffPlantFitOptions");
-    o.add("fmin_hz", &IffPlantFitOptions::fmin_hz, "Hz, band used; 0 = from the lowest positive frequency")
-        .add("fmax_hz", &IffPlantFitOptions::fmax_hz, "Hz; 0 = up to the highest")
-        .add("hpf_fmax_hz", &IffPlantFitOptions::hpf_fmax_hz, "Hz, points below this start the high-pass corner")
+    o.add("fmin_Hz", &IffPlantFitOptions::fmin_Hz, "Hz, band used; 0 = from the lowest positive frequency")
+        .add("fmax_Hz", &IffPlantFitOptions::fmax_Hz, "Hz; 0 = up to the highest")
+        .add("hpf_fmax_Hz", &IffPlantFitOptions::hpf_fmax_Hz, "Hz, points below this start the high-pass corner")
         .add("min_coherence", &IffPlantFitOptions::min_coherence, "points with a known coherence below this are left out")
         .add("fit_delay", &IffPlantFitOptions::fit_delay, "False: delay fixed at 0")
         .add("fixed_w_hpf", &IffPlantFitOptions::fixed_w_hpf, "rad/s; > 0: the high-pass corner is known (1 / (R C)), not fitted")
@@ -115,10 +115,10 @@ const Options<IffPlantFitOptions>& plant_fit_options() {
 const Options<ActuatorPlantOptions>& actuator_plant_options() {
   static const Options<ActuatorPlantOptions> t = [] {
     Options<ActuatorPlantOptions> o("ActuatorPlantOptions");
-    o.add("fmin_hz", &ActuatorPlantOptions::fmin_hz, "Hz, lowest frequency of the d_e fit")
-        .add("fmax_hz", &ActuatorPlantOptions::fmax_hz, "Hz, highest frequency of both fits")
-        .add("iff_fmin_hz", &ActuatorPlantOptions::iff_fmin_hz, "Hz, lowest frequency of the Vs fit")
-        .add("hpf_fmax_hz", &ActuatorPlantOptions::hpf_fmax_hz, "Hz, points below this start the high-pass corner")
+    o.add("fmin_Hz", &ActuatorPlantOptions::fmin_Hz, "Hz, lowest frequency of the d_e fit")
+        .add("fmax_Hz", &ActuatorPlantOptions::fmax_Hz, "Hz, highest frequency of both fits")
+        .add("iff_fmin_Hz", &ActuatorPlantOptions::iff_fmin_Hz, "Hz, lowest frequency of the Vs fit")
+        .add("hpf_fmax_Hz", &ActuatorPlantOptions::hpf_fmax_Hz, "Hz, points below this start the high-pass corner")
         .add("fixed_w_hpf", &ActuatorPlantOptions::fixed_w_hpf, "rad/s; > 0: the high-pass corner is known (1 / (R C_sensor))")
         .add("min_coherence", &ActuatorPlantOptions::min_coherence, "points with a known coherence below this are left out");
     return o;
@@ -138,7 +138,7 @@ PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle
   if (py::isinstance<dsp::Frf>(omega_or_frf)) {
     const auto& f = frf_arg(omega_or_frf, source, "frf");
     const auto i = static_cast<std::size_t>(f.output_index(string_arg(h_or_output, source, "output")));
-    d.omega = kTwoPi * f.freq_hz;
+    d.omega = kTwoPi * f.freq_Hz;
     d.h = f.H[i];
     if (i < f.coherence.size()) d.coherence = f.coherence[i];
     return d;
@@ -175,7 +175,7 @@ py::dict modal(const ModalFeature& f) {
   py::dict d;
   d["root"] = f.root;
   d["natural_frequency"] = f.natural_frequency;
-  d["frequency_hz"] = f.frequency_hz();
+  d["frequency_Hz"] = f.frequency_Hz();
   d["damping"] = f.damping;
   return d;
 }
@@ -205,7 +205,7 @@ py::object mode_result(const Mode& md) {
   py::dict d;
   d["pole"] = md.pole;
   d["natural_frequency"] = md.natural_frequency;
-  d["frequency_hz"] = md.frequency_hz();
+  d["frequency_Hz"] = md.frequency_Hz();
   d["damping"] = md.damping;
   d["stable_orders"] = md.stable_orders;
   return result("Mode", d);
@@ -250,9 +250,9 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         .def_readonly("xp", &IffPlantFit::xp, "damping ratio of the pole pair")
         .def_readonly("w_hpf", &IffPlantFit::w_hpf, "rad/s, high-pass corner")
         .def_readonly("delay", &IffPlantFit::delay, "s")
-        .def_property_readonly("wz_hz", [](const IffPlantFit& f) { return f.wz / kTwoPi; }, "Hz, anti-resonance")
-        .def_property_readonly("wp_hz", [](const IffPlantFit& f) { return f.wp / kTwoPi; }, "Hz, resonance")
-        .def_property_readonly("w_hpf_hz", [](const IffPlantFit& f) { return f.w_hpf / kTwoPi; }, "Hz, high-pass corner")
+        .def_property_readonly("wz_Hz", [](const IffPlantFit& f) { return f.wz / kTwoPi; }, "Hz, anti-resonance")
+        .def_property_readonly("wp_Hz", [](const IffPlantFit& f) { return f.wp / kTwoPi; }, "Hz, resonance")
+        .def_property_readonly("w_hpf_Hz", [](const IffPlantFit& f) { return f.w_hpf / kTwoPi; }, "Hz, high-pass corner")
         .def_readonly("relative_rms_error", &IffPlantFit::relative_rms_error, "rms |G/H - 1| over the points used")
         .def_readonly("weighted_relative_rms_error", &IffPlantFit::weighted_relative_rms_error, "the same with the fit's per-decade weights")
         .def_readonly("initial_relative_rms_error", &IffPlantFit::initial_relative_rms_error, "weighted, at the better start")
@@ -278,7 +278,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
 (ident/plant_fit.hpp): H(s) = k wn^2 / (s^2 + 2 zeta wn s + wn^2) * exp(-s delay).)");
     c.def_readonly("static_gain", &DelayedSecondOrderFit::static_gain, "k, output / input units (m/V for u -> d_e), signed")
         .def_readonly("natural_frequency", &DelayedSecondOrderFit::natural_frequency, "wn, rad/s")
-        .def_property_readonly("frequency_hz", [](const DelayedSecondOrderFit& f) { return f.natural_frequency / kTwoPi; }, "wn in Hz")
+        .def_property_readonly("frequency_Hz", [](const DelayedSecondOrderFit& f) { return f.natural_frequency / kTwoPi; }, "wn in Hz")
         .def_readonly("damping", &DelayedSecondOrderFit::damping, "zeta")
         .def_readonly("delay", &DelayedSecondOrderFit::delay, "s")
         .def_readonly("relative_rms_error", &DelayedSecondOrderFit::relative_rms_error, "rms |H_model / H - 1| over the points used")
@@ -318,7 +318,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
       arg("omega"), arg("h"), arg("coherence") = py::none(),
       ("k wn^2 / (s^2 + 2 zeta wn s + wn^2) exp(-s delay) fitted to u -> d_e (or a damped plant u' -> d_e):\n"
        "(omega (rad/s), h, coherence=None) or (frf, output_name). Returns an ident.DelayedSecondOrderFit.\n"
-       "Keywords: fmin_hz, fmax_hz, min_coherence, fit_delay, max_iterations of IffPlantFitOptions:\n" +
+       "Keywords: fmin_Hz, fmax_Hz, min_coherence, fit_delay, max_iterations of IffPlantFitOptions:\n" +
        plant_fit_options().doc())
           .c_str());
   m.def(
@@ -332,7 +332,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         const auto coh = [&](std::size_t i) { return i < f.coherence.size() ? f.coherence[i] : Vector(); };
         const std::string source = f.provenance.source.empty() ? src : f.provenance.source;
         auto p = without_gil([&] {
-          return fit_actuator_plants(kTwoPi * f.freq_hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
+          return fit_actuator_plants(kTwoPi * f.freq_Hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
         });
         py::dict d;
         d["de"] = p.de ? py::cast(*p.de) : py::none();
@@ -398,14 +398,14 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         auto r = fit_high_pass(w, hv, max_omega);
         py::dict d;
         d["corner"] = r.corner;
-        d["corner_hz"] = r.corner_hz();
+        d["corner_Hz"] = r.corner_Hz();
         d["gain"] = r.gain;
         d["relative_rms_error"] = r.relative_rms_error;
         return result("HighPassFit", d);
       },
       arg("omega"), arg("h"), arg("max_omega") = 0.0,
       "First-order high-pass g s / (s + corner) fitted to the points with omega <= max_omega (rad/s; 0 = all):\n"
-      "Result(corner (rad/s), corner_hz, gain, relative_rms_error).");
+      "Result(corner (rad/s), corner_Hz, gain, relative_rms_error).");
   m.def(
       "fit_second_order",
       [](py::object omega, py::object h, const py::kwargs& kw) {
@@ -417,7 +417,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         py::dict d;
         d["static_gain"] = r.static_gain;
         d["natural_frequency"] = r.natural_frequency;
-        d["frequency_hz"] = r.frequency_hz();
+        d["frequency_Hz"] = r.frequency_Hz();
         d["damping"] = r.damping;
         d["poles"] = to_numpy(std::move(r.poles));
         d["feedthrough"] = r.feedthrough;
@@ -427,7 +427,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
       },
       arg("omega"), arg("h"),
       ("k wn^2 / (s^2 + 2 zeta wn s + wn^2) fitted to h at j omega (rad/s): Result(static_gain,\n"
-       "natural_frequency (rad/s), frequency_hz, damping, poles, feedthrough, relative_rms_error, iterations).\n\n"
+       "natural_frequency (rad/s), frequency_Hz, damping, poles, feedthrough, relative_rms_error, iterations).\n\n"
        "Keywords:\n" + second_order_options().doc())
           .c_str());
   m.def(
@@ -443,7 +443,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
       },
       arg("omega"), arg("h"),
       ("Modes from the peaks of sum |H|^2 (h: (points,) or (points, outputs)), damping from the half-power\n"
-       "bandwidth: a list of Result(pole, natural_frequency (rad/s), frequency_hz, damping).\n\nKeywords:\n" +
+       "bandwidth: a list of Result(pole, natural_frequency (rad/s), frequency_Hz, damping).\n\nKeywords:\n" +
        peak_options().doc())
           .c_str());
   m.def(

@@ -54,15 +54,15 @@ def test_measured_tuning_of_a_scipy_welch_frf_with_only_the_mass(welch_frf):
     from piezobench import ident
     frf, truth = welch_frf
     plants = ident.fit_actuator_plants(frf, min_coherence=0.5)
-    r = apa.tune_two_dof_measured(frf, plants.de, plants.vs, mass=5.7, fmin_hz=20.0, fmax_hz=500.0, min_coherence=0.5)
+    r = apa.tune_two_dof_measured(frf, plants.de, plants.vs, mass=5.7, fmin_Hz=20.0, fmax_Hz=500.0, min_coherence=0.5)
     for name in ("k1", "ke", "ka", "ga", "gs"):
         assert r.params[name] == pytest.approx(truth[name], rel=0.03), name
     assert r.quality.verdict == "good" and not r.quality.impossible
     assert r.bench["delay"] == pytest.approx(truth["effective_delay_s"], rel=0.05)
-    corner_hz = 1 / (2 * np.pi * r.bench["hpf_resistance"] * r.bench["hpf_capacitance"])
-    assert corner_hz == pytest.approx(truth["hpf_corner_Hz"], rel=0.1)
+    corner_Hz = 1 / (2 * np.pi * r.bench["hpf_resistance"] * r.bench["hpf_capacitance"])
+    assert corner_Hz == pytest.approx(truth["hpf_corner_Hz"], rel=0.1)
     # A 2 ms delay instead of the fitted 0.25 ms leaves no model that fits: a poor verdict, with advice.
-    bad = apa.tune_two_dof_measured(frf, None, plants.vs, mass=5.7, fmin_hz=20.0, fmax_hz=500.0, min_coherence=0.5,
+    bad = apa.tune_two_dof_measured(frf, None, plants.vs, mass=5.7, fmin_Hz=20.0, fmax_Hz=500.0, min_coherence=0.5,
                                     bench={"delay": 0.002})
     assert bad.quality.poor and bad.quality.problems
     with pytest.raises(pb.InputError) as e:

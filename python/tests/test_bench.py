@@ -13,7 +13,7 @@ def test_frf_noise_record_gives_the_true_resonance():
     assert ts.sample_rate == 10e3 and ts.samples == 80_000
     assert ts.settings["experiment"] == "frf-noise"
     est = dsp.frf(ts["u"], [ts["de"], ts["Vs"]], ts.sample_rate, outputs=["de", "Vs"], nfft=20_000)
-    f = est.freq_hz
+    f = est.freq_Hz
     band = (f > 60) & (f < 150)
     peak = f[band][np.argmax(np.abs(est.H[0][band]))]
     truth = bench.truth(2, 5)

@@ -107,7 +107,7 @@ def test_typed_results_equal_the_results_json_of_the_command_line(demo):
     assert same(iff.optimal_gain, ji["optimal_gain"]) and same(iff.max_damping, ji["max_damping"])
     assert same(iff.optimal_pole, complex(*ji["optimal_pole"]))
     assert same(iff.max_relative_pole_distance, ji["max_relative_pole_distance"])
-    assert same(iff.plant.wz_hz, ji["plant"]["wz_Hz"]) and same(iff.plant.xz, ji["plant"]["xz"])
+    assert same(iff.plant.wz_Hz, ji["plant"]["wz_Hz"]) and same(iff.plant.xz, ji["plant"]["xz"])
     assert same(iff.plant.delay, ji["plant"]["delay_s"])
 
 

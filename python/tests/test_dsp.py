@@ -75,7 +75,7 @@ def test_window_equals_scipy_get_window():
 
 
 def test_excitations():
-    ms = dsp.multisine(sample_rate=1000.0, period_samples=1000, periods=2, lines_hz=[10.0, 20.0, 50.0], rms=0.5,
+    ms = dsp.multisine(sample_rate=1000.0, period_samples=1000, periods=2, lines_Hz=[10.0, 20.0, 50.0], rms=0.5,
                        offset=3.0)
     assert ms.u.shape == (2000,)
     # Exactly the three lines, with the requested rms, on top of the offset.

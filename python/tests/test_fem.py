@@ -25,7 +25,7 @@ def test_modes_equal_scipy_eigh():
     K[0, 0] += 1e6  # held at node 1
     r = fem.modes(K, M)
     ref = np.sqrt(np.abs(scipy.linalg.eigh(K, M, eigvals_only=True))) / (2 * np.pi)
-    np.testing.assert_allclose(r.frequencies_hz, ref, rtol=1e-10)
+    np.testing.assert_allclose(r.frequencies_Hz, ref, rtol=1e-10)
     np.testing.assert_allclose(r.shapes.T @ M @ r.shapes, np.eye(8), atol=1e-10)
 
 
@@ -63,7 +63,7 @@ def test_craig_bampton_condenses_statically_and_keeps_the_low_modes():
     np.testing.assert_allclose(red.K[:2, :2], schur, rtol=1e-8)
     # The fixed-interface modes are the interior's eigenvalues.
     ref = np.sqrt(scipy.linalg.eigh(K[np.ix_(i, i)], M[np.ix_(i, i)], eigvals_only=True)[:10]) / (2 * np.pi)
-    np.testing.assert_allclose(r.fixed_interface_hz, ref, rtol=1e-8)
+    np.testing.assert_allclose(r.fixed_interface_Hz, ref, rtol=1e-8)
     # The lowest modes of the reduced model converge to the full model's.
     full = np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True)[:3]) / (2 * np.pi)
-    np.testing.assert_allclose(fem.modes(red.K, red.M).frequencies_hz[:3], full, rtol=1e-3)
+    np.testing.assert_allclose(fem.modes(red.K, red.M).frequencies_Hz[:3], full, rtol=1e-3)

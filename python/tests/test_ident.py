@@ -42,11 +42,11 @@ def test_frf_features_find_the_nmp_zero_of_the_iff_plant():
     feat = ident.frf_features(w, h, fit={"order": 6})
     assert len(feat.antiresonances) == 1 and len(feat.resonances) == 1
     anti = feat.antiresonances[0]
-    assert anti.frequency_hz == pytest.approx(42.7, rel=1e-4)
+    assert anti.frequency_Hz == pytest.approx(42.7, rel=1e-4)
     assert anti.damping == pytest.approx(0.004, rel=1e-2)
     assert anti.nonminimum_phase_model
     assert anti.phase_verdict == "non-minimum-phase"
-    assert feat.resonances[0].frequency_hz == pytest.approx(95.2, rel=1e-4)
+    assert feat.resonances[0].frequency_Hz == pytest.approx(95.2, rel=1e-4)
     assert feat.to_dict()["antiresonances"][0]["phase_verdict"] == "non-minimum-phase"
     # The same plant with the zero mirrored: minimum phase.
     h_mp = lti.freqresp(control.iff_plant(xz=0.004), w)
@@ -105,7 +105,7 @@ def test_iff_plant_fit_recovers_a_scipy_eq_2_3_plant_with_its_nonminimum_phase_z
         assert getattr(fit, name) == pytest.approx(truth[name], rel=1e-3), name
     assert fit.xz == pytest.approx(truth["xz"], abs=1e-4)
     assert fit.zero_is_nonminimum_phase
-    assert fit.wp_hz == pytest.approx(95.2, rel=1e-3)
+    assert fit.wp_Hz == pytest.approx(95.2, rel=1e-3)
     assert fit.relative_rms_error < 1e-3
     assert fit.quality.verdict == "good" and not fit.quality.poor and not fit.quality.impossible
     assert fit.quality.problems == [] and fit.quality.summary == "good"
@@ -145,16 +145,16 @@ def test_actuator_plants_of_a_scipy_welch_frf_and_the_vector_fit_verdicts(welch_
     assert plants.de.natural_frequency / (2 * np.pi) == pytest.approx(truth["resonance_Hz"], rel=0.01)
     assert plants.de.static_gain == pytest.approx(truth["static_gain_de_m_per_V"], rel=0.02)
     assert plants.de.delay == pytest.approx(truth["effective_delay_s"], rel=0.05)
-    assert plants.vs.wp_hz == pytest.approx(truth["resonance_Hz"], rel=0.01)
-    assert plants.vs.wz_hz == pytest.approx(truth["antiresonance_Hz"], rel=0.01)
-    assert plants.vs.w_hpf_hz == pytest.approx(truth["hpf_corner_Hz"], rel=0.1)
+    assert plants.vs.wp_Hz == pytest.approx(truth["resonance_Hz"], rel=0.01)
+    assert plants.vs.wz_Hz == pytest.approx(truth["antiresonance_Hz"], rel=0.01)
+    assert plants.vs.w_hpf_Hz == pytest.approx(truth["hpf_corner_Hz"], rel=0.1)
     assert plants.de.quality.verdict == "good" and plants.vs.quality.verdict == "good"
     # The same plant from (frf, output) with the FRF's coherence and the options the pair used.
     vs = ident.fit_iff_plant(frf, "Vs", **plants.vs_options)
     assert vs.wz == plants.vs.wz and vs.delay == plants.vs.delay
     # Vector fitting reports its verdict: order 2 over 20-400 Hz finds the resonance (good).
     w = frf.omega
-    band = (frf.freq_hz >= 20) & (frf.freq_hz <= 400)
+    band = (frf.freq_Hz >= 20) & (frf.freq_Hz <= 400)
     good = ident.vector_fit(w[band], frf.response("de")[band], order=2)
     assert good.quality.verdict == "good"
     assert abs(good.poles[0]) / (2 * np.pi) == pytest.approx(truth["resonance_Hz"], rel=0.01)

@@ -43,10 +43,10 @@ void TuningOptions::validate() const {
     throw InputError(src, "bench.suspended_mass", "0 (the tuned mass is `mass`)",
                      format_number(bench.suspended_mass) + " / added " + format_number(bench.added_mass));
   }
-  if (!(std::isfinite(fmin_hz) && fmin_hz >= 0.0)) throw InputError(src, "fmin_hz", "a frequency >= 0 Hz", format_number(fmin_hz));
-  if (!(std::isfinite(fmax_hz) && fmax_hz >= 0.0)) throw InputError(src, "fmax_hz", "a frequency >= 0 Hz", format_number(fmax_hz));
-  if (fmax_hz > 0.0 && fmax_hz <= fmin_hz) {
-    throw InputError(src, "fmax_hz", fmt::format("a frequency above fmin_hz = {} Hz (or 0)", format_number(fmin_hz)), format_number(fmax_hz));
+  if (!(std::isfinite(fmin_Hz) && fmin_Hz >= 0.0)) throw InputError(src, "fmin_Hz", "a frequency >= 0 Hz", format_number(fmin_Hz));
+  if (!(std::isfinite(fmax_Hz) && fmax_Hz >= 0.0)) throw InputError(src, "fmax_Hz", "a frequency >= 0 Hz", format_number(fmax_Hz));
+  if (fmax_Hz > 0.0 && fmax_Hz <= fmin_Hz) {
+    throw InputError(src, "fmax_Hz", fmt::format("a frequency above fmin_Hz = {} Hz (or 0)", format_number(fmin_Hz)), format_number(fmax_Hz));
   }
   if (!(min_coherence >= 0.0 && min_coherence < 1.0)) {
     throw InputError(src, "min_coherence", "a value in [0, 1)", format_number(min_coherence));
@@ -128,9 +128,9 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
     return static_cast<std::size_t>(i) < frf.coherence.size() && frf.coherence[static_cast<std::size_t>(i)].size() > 0;
   };
   std::vector<Index> used;
-  for (Index k = 0; k < frf.freq_hz.size(); ++k) {
-    const double f = frf.freq_hz(k);
-    if (f <= 0.0 || f < o.fmin_hz || (o.fmax_hz > 0.0 && f > o.fmax_hz)) continue;
+  for (Index k = 0; k < frf.freq_Hz.size(); ++k) {
+    const double f = frf.freq_Hz(k);
+    if (f <= 0.0 || f < o.fmin_Hz || (o.fmax_Hz > 0.0 && f > o.fmax_Hz)) continue;
     if (o.min_coherence > 0.0) {
       if (has_coh(ide) && frf.coherence[static_cast<std::size_t>(ide)](k) < o.min_coherence) continue;
       if (has_coh(ivs) && frf.coherence[static_cast<std::size_t>(ivs)](k) < o.min_coherence) continue;
@@ -150,7 +150,7 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
   const double wc = o.bench.hpf_corner();
   for (Index i = 0; i < n; ++i) {
     const Index k = used[static_cast<std::size_t>(i)];
-    const double w = kTwoPi * frf.freq_hz(k);
+    const double w = kTwoPi * frf.freq_Hz(k);
     const Complex s(0.0, w);
     Complex chain = o.bench.amplifier_gain * std::exp(-s * o.bench.delay);
     d.omega(i) = w;
@@ -160,7 +160,7 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
     for (const auto& [value, name] : {std::pair{d.de(i), o.de_output}, std::pair{d.vs(i), o.vs_output}}) {
       if (!(std::isfinite(value.real()) && std::isfinite(value.imag())) || value == Complex(0.0)) {
         throw InputError(source, name, "finite nonzero values",
-                         fmt::format("{} + {}j at {} Hz", value.real(), value.imag(), frf.freq_hz(k)));
+                         fmt::format("{} + {}j at {} Hz", value.real(), value.imag(), frf.freq_Hz(k)));
       }
     }
   }
@@ -393,8 +393,8 @@ TwoDofTuning tune_two_dof_measured(const dsp::Frf& frf, TuningOptions options, c
     if (vs_plant) {
       const Eigen::Index vs = data.output_index(options.vs_output);
       const double extra = vs_plant->delay - options.bench.delay;
-      for (Eigen::Index k = 0; k < data.freq_hz.size(); ++k) {
-        data.H[static_cast<std::size_t>(vs)](k) *= std::exp(std::complex<double>(0.0, kTwoPi * data.freq_hz(k) * extra));
+      for (Eigen::Index k = 0; k < data.freq_Hz.size(); ++k) {
+        data.H[static_cast<std::size_t>(vs)](k) *= std::exp(std::complex<double>(0.0, kTwoPi * data.freq_Hz(k) * extra));
       }
     }
   }

@@ -416,16 +416,16 @@ void read_analysis(const Reader& r, AnalysisSettings& a) {
     if (!(*o >= 0.0 && *o < 1.0)) throw InputError(r.source(), r.key("overlap"), "a fraction in [0, 1)", fmt::format("{}", *o));
     a.overlap = *o;
   }
-  r.positive("fmin_Hz", a.fmin_hz);
-  r.positive("fmax_Hz", a.fmax_hz);
-  if (a.fmax_hz <= a.fmin_hz) throw InputError(r.source(), r.key("fmax_Hz"), fmt::format("a frequency above fmin_Hz = {} Hz", a.fmin_hz), fmt::format("{}", a.fmax_hz));
-  r.positive("hpf_fmax_Hz", a.hpf_fmax_hz);
-  r.positive("damped_fmin_Hz", a.damped_fmin_hz);
-  r.positive("damped_fmax_Hz", a.damped_fmax_hz);
-  if (a.damped_fmax_hz <= a.damped_fmin_hz) throw InputError(r.source(), r.key("damped_fmax_Hz"), "a frequency above damped_fmin_Hz", fmt::format("{}", a.damped_fmax_hz));
-  r.positive("hammer_fmin_Hz", a.hammer_fmin_hz);
-  r.positive("hammer_fmax_Hz", a.hammer_fmax_hz);
-  if (a.hammer_fmax_hz <= a.hammer_fmin_hz) throw InputError(r.source(), r.key("hammer_fmax_Hz"), "a frequency above hammer_fmin_Hz", fmt::format("{}", a.hammer_fmax_hz));
+  r.positive("fmin_Hz", a.fmin_Hz);
+  r.positive("fmax_Hz", a.fmax_Hz);
+  if (a.fmax_Hz <= a.fmin_Hz) throw InputError(r.source(), r.key("fmax_Hz"), fmt::format("a frequency above fmin_Hz = {} Hz", a.fmin_Hz), fmt::format("{}", a.fmax_Hz));
+  r.positive("hpf_fmax_Hz", a.hpf_fmax_Hz);
+  r.positive("damped_fmin_Hz", a.damped_fmin_Hz);
+  r.positive("damped_fmax_Hz", a.damped_fmax_Hz);
+  if (a.damped_fmax_Hz <= a.damped_fmin_Hz) throw InputError(r.source(), r.key("damped_fmax_Hz"), "a frequency above damped_fmin_Hz", fmt::format("{}", a.damped_fmax_Hz));
+  r.positive("hammer_fmin_Hz", a.hammer_fmin_Hz);
+  r.positive("hammer_fmax_Hz", a.hammer_fmax_Hz);
+  if (a.hammer_fmax_Hz <= a.hammer_fmin_Hz) throw InputError(r.source(), r.key("hammer_fmax_Hz"), "a frequency above hammer_fmin_Hz", fmt::format("{}", a.hammer_fmax_Hz));
   if (const auto n = r.integer("fit_order")) {
     if (*n < 2 || *n > 40) throw InputError(r.source(), r.key("fit_order"), "an order in 2..40", std::to_string(*n));
     a.fit_order = *n;

@@ -273,7 +273,7 @@ template <class V> void fields(V& v, dsp::FrfProvenance& s) {
   v("detrend", s.detrend); v("averages", s.averages); v("sample_rate", s.sample_rate);
 }
 template <class V> void fields(V& v, dsp::Frf& s) {
-  v("freq_hz", s.freq_hz); v("input", s.input); v("outputs", s.outputs); v("H", s.H); v("coherence", s.coherence); v("provenance", s.provenance);
+  v("freq_Hz", s.freq_Hz); v("input", s.input); v("outputs", s.outputs); v("H", s.H); v("coherence", s.coherence); v("provenance", s.provenance);
 }
 template <class V> void fields(V& v, ident::DelayedSecondOrderFit& s) {
   v("static_gain", s.static_gain); v("natural_frequency", s.natural_frequency); v("damping", s.damping); v("delay", s.delay);

@@ -85,7 +85,7 @@ struct BatchOutput {
 // Interpolates |H| of one output onto the log grid `f` (NaN outside the data).
 VectorXd magnitude_on(const dsp::Frf& frf, Index output, const VectorXd& f) {
   VectorXd out(f.size());
-  const VectorXd& g = frf.freq_hz;
+  const VectorXd& g = frf.freq_Hz;
   for (Index k = 0; k < f.size(); ++k) {
     const auto it = std::lower_bound(g.data(), g.data() + g.size(), f(k));
     const Index j = it - g.data();
@@ -133,10 +133,10 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
     if (u.frf) with_frf.push_back(&u);
   }
   if (with_frf.size() >= 2) {
-    const VectorXd f = Eigen::VectorXd::LinSpaced(120, std::log10(c.analysis.fmin_hz), std::log10(c.analysis.fmax_hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
+    const VectorXd f = Eigen::VectorXd::LinSpaced(120, std::log10(c.analysis.fmin_Hz), std::log10(c.analysis.fmax_Hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
     FrfSimilarity sim;
-    sim.fmin_Hz = c.analysis.fmin_hz;
-    sim.fmax_Hz = c.analysis.fmax_hz;
+    sim.fmin_Hz = c.analysis.fmin_Hz;
+    sim.fmax_Hz = c.analysis.fmax_Hz;
     sim.units.resize(with_frf.size());
     double worst = 0.0;
     for (Index o = 0; o < 2; ++o) {
@@ -390,7 +390,7 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
   fo.moving_mass = c.bench.suspended_mass;
   fo.amplifier_gain = c.bench.amplifier_gain;
   fo.modal_damping = s.modal_damping;
-  fo.band_min_hz = std::max(fo.band_min_hz, c.analysis.fmin_hz);
+  fo.band_min_Hz = std::max(fo.band_min_Hz, c.analysis.fmin_Hz);
   const fem::Modes modes = fem::modes(superelement_bench_model(se, s.setup, fo));
   const apa::PiezoSensitivities eq41 = apa::piezo_sensitivities(apa::PiezoConstants{});
   SuperElementComparison out;
@@ -412,10 +412,10 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
     row.gs = fit.gs;
     row.ga_relative_to_eq41 = std::abs(fit.ga) / eq41.ga - 1.0;
     row.gs_relative_to_eq41 = std::abs(fit.gs) / eq41.gs - 1.0;
-    row.band_lo_Hz = fit.band_lo_hz;
-    row.band_hi_Hz = fit.band_hi_hz;
-    row.resonance_Hz = fit.resonance_hz;
-    if (fit.antiresonance_hz > 0.0) row.antiresonance_Hz = fit.antiresonance_hz;
+    row.band_lo_Hz = fit.band_lo_Hz;
+    row.band_hi_Hz = fit.band_hi_Hz;
+    row.resonance_Hz = fit.resonance_Hz;
+    if (fit.antiresonance_Hz > 0.0) row.antiresonance_Hz = fit.antiresonance_Hz;
     row.measured_resonance_Hz = u.resonance_Hz;
     row.measured_antiresonance_Hz = u.antiresonance_Hz;
     row.de_error_dB = fit.de_error_dB;
@@ -424,7 +424,7 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
     ga.push_back(std::abs(fit.ga));
     gs.push_back(std::abs(fit.gs));
     if (u.resonance_Hz) measured_res.push_back(*u.resonance_Hz);
-    if (!out.figure) out.figure = SuperElementComparison::Response{u.id, u.name, fit.freq_hz, fit.de, fit.vs};
+    if (!out.figure) out.figure = SuperElementComparison::Response{u.id, u.name, fit.freq_Hz, fit.de, fit.vs};
   }
   if (!out.units.empty()) {
     out.ga = median(ga);

@@ -76,7 +76,7 @@ Bode frf_lines(const dsp::Frf& frf, Index output, const std::vector<Index>& idx,
   Bode p;
   std::vector<std::complex<double>> h;
   for (const Index k : idx) {
-    p.f.push_back(frf.freq_hz(k));
+    p.f.push_back(frf.freq_Hz(k));
     p.abs.push_back(std::abs(frf.H[o](k)) * scale);
     p.coh.push_back(frf.coherence[o].size() > 0 ? json(frf.coherence[o](k)) : json(nullptr));
     h.push_back(frf.H[o](k));
@@ -148,8 +148,8 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
   if (u.stiffness_open_analysis) out.stiffness_open = stiffness_curves(*u.stiffness_open_analysis);
   if (u.frf) {
     const dsp::Frf& frf = *u.frf;
-    const VectorXd& f = frf.freq_hz;
-    const std::vector<Index> idx = log_indices(f, std::max(0.5, f(1)), std::min(2.0 * c.analysis.fmax_hz, f(f.size() - 1)));
+    const VectorXd& f = frf.freq_Hz;
+    const std::vector<Index> idx = log_indices(f, std::max(0.5, f(1)), std::min(2.0 * c.analysis.fmax_Hz, f(f.size() - 1)));
     VectorXd w(static_cast<Index>(idx.size()));
     for (std::size_t i = 0; i < idx.size(); ++i) w(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
     if (u.model_2dof) {
@@ -183,7 +183,7 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
   if (u.resistor) {
     // Figure 2.7: up to 20 Hz.
     const auto lines = [](const LowFrequencyVs& v) {
-      const VectorXd& f = v.frf.freq_hz;
+      const VectorXd& f = v.frf.freq_Hz;
       return frf_lines(v.frf, 0, log_indices(f, v.lowest_line_Hz, std::min(20.0, f(f.size() - 1)), 200), 1.0);
     };
     if (u.resistor->with_resistor) out.resistor_with = lines(*u.resistor->with_resistor);
@@ -191,9 +191,9 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
   }
   for (const DampedPlant& d : u.damped) {
     if (!d.identified) continue;
-    const VectorXd& f = d.frf.freq_hz;
+    const VectorXd& f = d.frf.freq_Hz;
     const std::vector<Index> idx =
-        log_indices(f, std::max(f(1), 0.5 * c.analysis.damped_fmin_hz), std::min(f(f.size() - 1), 2.0 * c.analysis.damped_fmax_hz), 300);
+        log_indices(f, std::max(f(1), 0.5 * c.analysis.damped_fmin_Hz), std::min(f(f.size() - 1), 2.0 * c.analysis.damped_fmax_Hz), 300);
     VectorXd om(static_cast<Index>(idx.size()));
     for (std::size_t i = 0; i < idx.size(); ++i) om(static_cast<Index>(i)) = kTwoPi * f(idx[i]);
     // The fit (delay removed) with the delay put back, to sit on the measurement.
@@ -211,8 +211,8 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
   if (u.flexible_modes) {
     const dsp::Frf& frf = u.flexible_modes->frf;
     XY h{json::array(), json::array()};
-    for (const Index k : log_indices(frf.freq_hz, std::max(1.0, frf.freq_hz(1)), frf.freq_hz(frf.freq_hz.size() - 1), 500)) {
-      h.x.push_back(frf.freq_hz(k));
+    for (const Index k : log_indices(frf.freq_Hz, std::max(1.0, frf.freq_Hz(1)), frf.freq_Hz(frf.freq_Hz.size() - 1), 500)) {
+      h.x.push_back(frf.freq_Hz(k));
       h.y.push_back(std::abs(frf.H[0](k)));
     }
     out.hammer = h;
@@ -768,7 +768,7 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
     json fm = json::array();
     std::vector<std::complex<double>> de, vs;
     if (f.size() > 1) {
-      for (const Index k : log_indices(f, std::max(0.5, f(1)), std::min(2.0 * r.campaign.analysis.fmax_hz, f(f.size() - 1)))) {
+      for (const Index k : log_indices(f, std::max(0.5, f(1)), std::min(2.0 * r.campaign.analysis.fmax_Hz, f(f.size() - 1)))) {
         fm.push_back(f(k));
         de.push_back(m.de(k));
         vs.push_back(m.vs(k));

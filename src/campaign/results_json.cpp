@@ -207,7 +207,7 @@ json damped_plants(const std::vector<DampedPlant>& plants) {
     json entry = {{"gain", d.gain}, {"provenance", provenance(d.provenance)}, {"welch", welch(d.frf.provenance)},
                   {"delay_removed_s", d.delay_removed}, {"fit", nullptr}, {"second_order_fit", nullptr}};
     if (d.identified) {
-      entry["fit"] = {{"frequency_Hz", d.identified->frequency_hz()},
+      entry["fit"] = {{"frequency_Hz", d.identified->frequency_Hz()},
                       {"damping", d.identified->damping},
                       {"pole", io::to_json(d.identified->pole)},
                       {"order", d.identified_order},
@@ -429,7 +429,7 @@ json results_json(const CampaignResult& r) {
             {"overlap", a.overlap},
             {"detrend", "linear"},
             {"estimator", "H1"},
-            {"band_Hz", {a.fmin_hz, a.fmax_hz}},
+            {"band_Hz", {a.fmin_Hz, a.fmax_Hz}},
             {"fit_order", a.fit_order},
             {"bench", {{"amplifier_gain", c.bench.amplifier_gain}, {"suspended_mass_kg", c.bench.suspended_mass},
                        {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},

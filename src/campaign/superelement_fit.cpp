@@ -35,7 +35,7 @@ void SuperElementFitOptions::validate() const {
   if (!(moving_mass >= 0.0 && std::isfinite(moving_mass))) throw InputError(kSource, "moving_mass", "a mass >= 0 kg", fmt::format("{}", moving_mass));
   if (!(amplifier_gain != 0.0 && std::isfinite(amplifier_gain))) throw InputError(kSource, "amplifier_gain", "a nonzero gain", fmt::format("{}", amplifier_gain));
   if (!(modal_damping > 0.0 && modal_damping < 1.0)) throw InputError(kSource, "modal_damping", "a damping ratio in (0, 1)", fmt::format("{}", modal_damping));
-  if (!(band_min_hz > 0.0 && std::isfinite(band_min_hz))) throw InputError(kSource, "band_min_hz", "a frequency > 0 Hz", fmt::format("{}", band_min_hz));
+  if (!(band_min_Hz > 0.0 && std::isfinite(band_min_Hz))) throw InputError(kSource, "band_min_Hz", "a frequency > 0 Hz", fmt::format("{}", band_min_Hz));
   if (!(band_fraction > 0.0 && band_fraction < 1.0)) throw InputError(kSource, "band_fraction", "a fraction in (0, 1)", fmt::format("{}", band_fraction));
 }
 
@@ -67,7 +67,7 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
   const fem::Modes modes = fem::modes(model);
   const Eigen::Index ide = measured.output_index("de");
   const Eigen::Index ivs = measured.output_index("Vs");
-  const Eigen::VectorXd& f = measured.freq_hz;
+  const Eigen::VectorXd& f = measured.freq_Hz;
   SuperElementFit r;
 
   // The model's resonance and anti-resonance on a fine log grid.
@@ -79,27 +79,27 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
   for (Eigen::Index k = 1; k < n; ++k) {
     if (std::abs(hg[static_cast<std::size_t>(k)](0, 0)) > std::abs(hg[static_cast<std::size_t>(peak)](0, 0))) peak = k;
   }
-  r.resonance_hz = grid(peak);
+  r.resonance_Hz = grid(peak);
   Eigen::Index dip = -1;
   for (Eigen::Index k = 1; k + 1 < peak; ++k) {
     const double a = std::abs(hg[static_cast<std::size_t>(k)](1, 0));
     if (a < std::abs(hg[static_cast<std::size_t>(k - 1)](1, 0)) && a < std::abs(hg[static_cast<std::size_t>(k + 1)](1, 0))) dip = k;
   }
-  r.antiresonance_hz = dip >= 0 ? grid(dip) : 0.0;
+  r.antiresonance_Hz = dip >= 0 ? grid(dip) : 0.0;
 
   // The measured resonance: the peak of |u -> d_e|.
   Eigen::Index mpeak = 0;
   for (Eigen::Index k = 1; k < f.size(); ++k) {
     if (std::abs(measured.H[static_cast<std::size_t>(ide)](k)) > std::abs(measured.H[static_cast<std::size_t>(ide)](mpeak))) mpeak = k;
   }
-  r.band_lo_hz = options.band_min_hz;
-  r.band_hi_hz = options.band_fraction * std::min(r.resonance_hz, f(mpeak));
+  r.band_lo_Hz = options.band_min_Hz;
+  r.band_hi_Hz = options.band_fraction * std::min(r.resonance_Hz, f(mpeak));
   std::vector<Eigen::Index> band;
   for (Eigen::Index k = 0; k < f.size(); ++k) {
-    if (f(k) >= r.band_lo_hz && f(k) <= r.band_hi_hz) band.push_back(k);
+    if (f(k) >= r.band_lo_Hz && f(k) <= r.band_hi_Hz) band.push_back(k);
   }
   if (band.size() < 3) {
-    throw InputError(measured.provenance.source, "frf", fmt::format("frequencies in the tuning band {:.3g}-{:.3g} Hz", r.band_lo_hz, r.band_hi_hz),
+    throw InputError(measured.provenance.source, "frf", fmt::format("frequencies in the tuning band {:.3g}-{:.3g} Hz", r.band_lo_Hz, r.band_hi_Hz),
                      fmt::format("{} of them", band.size()));
   }
   Eigen::VectorXd fb(static_cast<Eigen::Index>(band.size()));
@@ -125,15 +125,15 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
 
   // The tuned model at the measured frequencies, and its error up to twice the resonance.
   Eigen::Index last = f.size();
-  r.freq_hz = f.head(last);
-  const std::vector<Eigen::MatrixXcd> h = response(model, modes, r.freq_hz);
+  r.freq_Hz = f.head(last);
+  const std::vector<Eigen::MatrixXcd> h = response(model, modes, r.freq_Hz);
   r.de.resize(last);
   r.vs.resize(last);
   std::vector<double> e_de, e_vs;
   for (Eigen::Index k = 0; k < last; ++k) {
     r.de(k) = options.amplifier_gain * r.ga * h[static_cast<std::size_t>(k)](0, 0);
     r.vs(k) = options.amplifier_gain * r.ga * r.gs * h[static_cast<std::size_t>(k)](1, 0);
-    if (f(k) >= r.band_lo_hz && f(k) <= 2.0 * r.resonance_hz) {
+    if (f(k) >= r.band_lo_Hz && f(k) <= 2.0 * r.resonance_Hz) {
       e_de.push_back(std::abs(20.0 * std::log10(std::abs(r.de(k)) / std::abs(measured.H[static_cast<std::size_t>(ide)](k)))));
       e_vs.push_back(std::abs(20.0 * std::log10(std::abs(r.vs(k)) / std::abs(measured.H[static_cast<std::size_t>(ivs)](k)))));
     }

@@ -181,8 +181,8 @@ struct Band {
 
 Band band(const dsp::Frf& frf, Index output, double fmin, double fmax, double min_coherence = 0.0) {
   std::vector<Index> keep;
-  for (Index k = 0; k < frf.freq_hz.size(); ++k) {
-    const double f = frf.freq_hz(k);
+  for (Index k = 0; k < frf.freq_Hz.size(); ++k) {
+    const double f = frf.freq_Hz(k);
     if (f <= 0.0 || f < fmin || (fmax > 0.0 && f > fmax)) continue;
     const auto& coh = frf.coherence[static_cast<std::size_t>(output)];
     if (coh.size() > 0 && coh(k) < min_coherence) continue;
@@ -194,7 +194,7 @@ Band band(const dsp::Frf& frf, Index output, double fmin, double fmax, double mi
   b.coherence.resize(static_cast<Index>(keep.size()));
   for (std::size_t i = 0; i < keep.size(); ++i) {
     const auto j = static_cast<Index>(i);
-    b.omega(j) = kTwoPi * frf.freq_hz(keep[i]);
+    b.omega(j) = kTwoPi * frf.freq_Hz(keep[i]);
     b.h(j) = frf.H[static_cast<std::size_t>(output)](keep[i]);
     const auto& coh = frf.coherence[static_cast<std::size_t>(output)];
     b.coherence(j) = coh.size() > 0 ? coh(keep[i]) : 1.0;
@@ -366,10 +366,10 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   out.provenance.input = "u";
   out.provenance.outputs = {"de", "Vs"};
   out.welch = frf.provenance;
-  const Band de = band(frf, 0, a.fmin_hz, a.fmax_hz);
-  const Band vs = band(frf, 1, a.fmin_hz, a.fmax_hz);
+  const Band de = band(frf, 0, a.fmin_Hz, a.fmax_Hz);
+  const Band vs = band(frf, 1, a.fmin_Hz, a.fmax_Hz);
   if (de.omega.size() < 20) {
-    throw InputError(c.file.string(), r.spec.key, fmt::format("at least 20 FRF points in [{}, {}] Hz", a.fmin_hz, a.fmax_hz),
+    throw InputError(c.file.string(), r.spec.key, fmt::format("at least 20 FRF points in [{}, {}] Hz", a.fmin_Hz, a.fmax_Hz),
                      fmt::format("{} (resolution {} Hz)", de.omega.size(), r.ts.sample_rate / static_cast<double>(nfft)));
   }
   ident::FrfFeatureOptions fo;
@@ -402,14 +402,14 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
                                                           : std::nullopt;
   const std::string fit_source = c.file.string() + ": " + r.spec.key;
   ident::ActuatorPlantOptions po;
-  po.fmin_hz = a.fmin_hz;
-  po.fmax_hz = a.fmax_hz;
-  po.iff_fmin_hz = w_rc ? a.fmin_hz : 0.0;
-  po.hpf_fmax_hz = a.hpf_fmax_hz;
+  po.fmin_Hz = a.fmin_Hz;
+  po.fmax_Hz = a.fmax_Hz;
+  po.iff_fmin_Hz = w_rc ? a.fmin_Hz : 0.0;
+  po.hpf_fmax_Hz = a.hpf_fmax_Hz;
   po.fixed_w_hpf = w_rc.value_or(0.0);
   po.min_coherence = 0.5;
   const ident::ActuatorPlants plants =
-      ident::fit_actuator_plants(kTwoPi * frf.freq_hz, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1], po, fit_source);
+      ident::fit_actuator_plants(kTwoPi * frf.freq_Hz, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1], po, fit_source);
   for (const auto& f : plants.failures) u.failed.push_back(f);
   if (plants.de) {
     u.de_plant = *plants.de;
@@ -440,11 +440,11 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     record_failure(u, "frf u -> Vs features", e);
   }
   // High-pass corner (first-order fit at low frequency) and the IFF plant fit (eq. 2.3).
-  const Band low = band(frf, 1, 0.0, a.hpf_fmax_hz, 0.5);
+  const Band low = band(frf, 1, 0.0, a.hpf_fmax_Hz, 0.5);
   HighPassCorner& hpf = out.hpf;
   if (low.omega.size() >= 3) {
     const ident::HighPassFit h = ident::fit_high_pass(low.omega, low.h);
-    hpf.first_order_fit_Hz = h.corner_hz();
+    hpf.first_order_fit_Hz = h.corner_Hz();
     hpf.first_order_fit_points = static_cast<long>(low.omega.size());
   }
   if (w_rc) hpf.r_c_Hz = *w_rc / kTwoPi;
@@ -452,8 +452,8 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   if (plants.vs) {
     u.iff_plant = *plants.vs;
     out.iff_plant = u.iff_plant;
-    out.iff_plant_fmin_Hz = plants.vs_options.fmin_hz;
-    out.iff_plant_fmax_Hz = plants.vs_options.fmax_hz;
+    out.iff_plant_fmin_Hz = plants.vs_options.fmin_Hz;
+    out.iff_plant_fmax_Hz = plants.vs_options.fmax_Hz;
     out.iff_plant_w_hpf_measured = w_rc.has_value();
     out.nmp.iff_plant_fit_xz = u.iff_plant->xz;
     if (!w_rc) hpf.iff_plant_fit_Hz = u.iff_plant->w_hpf / kTwoPi;
@@ -462,11 +462,11 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     // Cross-check: the corner fitted with the rest of eq. 2.3 down to the lowest frequencies.
     try {
       ident::IffPlantFitOptions free;
-      free.fmin_hz = 0.0;
-      free.fmax_hz = a.fmax_hz;
-      free.hpf_fmax_hz = a.hpf_fmax_hz;
+      free.fmin_Hz = 0.0;
+      free.fmax_Hz = a.fmax_Hz;
+      free.hpf_fmax_Hz = a.hpf_fmax_Hz;
       free.min_coherence = 0.5;
-      hpf.iff_plant_fit_Hz = ident::fit_iff_plant(kTwoPi * frf.freq_hz, frf.H[1], coh, free, fit_source).w_hpf / kTwoPi;
+      hpf.iff_plant_fit_Hz = ident::fit_iff_plant(kTwoPi * frf.freq_Hz, frf.H[1], coh, free, fit_source).w_hpf / kTwoPi;
     } catch (const Error& e) {
       hpf.iff_plant_fit_error = e.what();
     }
@@ -533,12 +533,12 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     t.mass = c.bench.suspended_mass;
     t.bench.amplifier_gain = c.bench.amplifier_gain;
     if (u.iff_plant) t.bench.hpf_resistance = c.bench.hpf_resistance;
-    t.fmin_hz = a.fmin_hz;
-    t.fmax_hz = a.fmax_hz;
+    t.fmin_Hz = a.fmin_Hz;
+    t.fmax_Hz = a.fmax_Hz;
     t.min_coherence = 0.5;
     const apa::TwoDofTuning tuned = apa::tune_two_dof_measured(frf, t, u.de_plant ? &*u.de_plant : nullptr,
                                                                u.iff_plant ? &*u.iff_plant : nullptr);
-    u.model_2dof = Model2DofFit{tuned, tuned.bench, t.fmin_hz, t.fmax_hz};
+    u.model_2dof = Model2DofFit{tuned, tuned.bench, t.fmin_Hz, t.fmax_Hz};
   } catch (const NumericalError& e) {
     record_failure(u, "2-DoF tuning", e);
   }
@@ -546,7 +546,7 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
 
 // The low-frequency u -> Vs with or without the resistor across the sensor stack (report section
 // 2.5, Figure 2.7): Welch with segments of half the record (the lowest lines matter here), a
-// first-order high-pass fitted below hpf_fmax_hz (ident::fit_high_pass). A corner below a third of
+// first-order high-pass fitted below hpf_fmax_Hz (ident::fit_high_pass). A corner below a third of
 // the lowest line (where it would change |H| there by less than 5 %) is not observable in the
 // record: it is reported as an upper bound, not as a number.
 LowFrequencyVs low_frequency_vs(const Campaign& c, const Record& r) {
@@ -556,13 +556,13 @@ LowFrequencyVs low_frequency_vs(const Campaign& c, const Record& r) {
   LowFrequencyVs out;
   out.frf = welch(r, "u", {"Vs"}, a, std::max(256L, nfft));
   out.provenance = provenance(r, {"u", "Vs"});
-  out.lowest_line_Hz = out.frf.freq_hz.size() > 1 ? out.frf.freq_hz(1) : 0.0;
-  out.fmax_Hz = a.hpf_fmax_hz;
-  const Band low = band(out.frf, 0, 0.0, a.hpf_fmax_hz);
+  out.lowest_line_Hz = out.frf.freq_Hz.size() > 1 ? out.frf.freq_Hz(1) : 0.0;
+  out.fmax_Hz = a.hpf_fmax_Hz;
+  const Band low = band(out.frf, 0, 0.0, a.hpf_fmax_Hz);
   if (low.omega.size() >= 3) {
     const ident::HighPassFit h = ident::fit_high_pass(low.omega, low.h);
-    out.fitted_corner_Hz = h.corner_hz();
-    out.observable = h.corner_hz() >= out.lowest_line_Hz / 3.0;
+    out.fitted_corner_Hz = h.corner_Hz();
+    out.observable = h.corner_Hz() >= out.lowest_line_Hz / 3.0;
     out.relative_rms_error = h.relative_rms_error;
     out.points = static_cast<long>(low.omega.size());
   }
@@ -592,18 +592,18 @@ std::vector<DampedPlant> iff(const Campaign& c, const std::vector<Record>& recor
     d.provenance = provenance(r, {"u_prime", "de"});
     d.frf = welch(r, "u_prime", {"de"}, a, nfft);
     d.delay_removed = delay;
-    Band b = band(d.frf, 0, a.damped_fmin_hz, a.damped_fmax_hz);
+    Band b = band(d.frf, 0, a.damped_fmin_Hz, a.damped_fmax_Hz);
     for (Index k = 0; k < b.omega.size(); ++k) b.h(k) *= std::exp(std::complex<double>(0.0, b.omega(k) * delay));
-    d.fmin_Hz = a.damped_fmin_hz;
-    d.fmax_Hz = a.damped_fmax_hz;
+    d.fmin_Hz = a.damped_fmin_Hz;
+    d.fmax_Hz = a.damped_fmax_Hz;
     try {
       // The damped pole: the dominant pair of a vector fit (ident/dominant_pole.hpp, the method of
       // `iff study`), not the report's second-order fit, which misplaces it by up to 50 % once the
       // controller's poles have moved into the band.
       ident::DominantPoleOptions po;
       po.fit.order = a.fit_order;
-      po.omega_min = kTwoPi * a.damped_fmin_hz;
-      po.omega_max = kTwoPi * a.damped_fmax_hz;
+      po.omega_min = kTwoPi * a.damped_fmin_Hz;
+      po.omega_max = kTwoPi * a.damped_fmax_Hz;
       d.identified_order = po.fit.order;
       d.identified = ident::dominant_pole(b.omega, b.h, po);
     } catch (const NumericalError& e) {
@@ -627,21 +627,21 @@ FlexibleModes hammer(const Campaign& c, const Record& r, UnitAnalysis& u) {
   const AnalysisSettings& a = c.analysis;
   const long nfft = std::min<long>(std::lround(r.ts.sample_rate), static_cast<long>(r.ts.samples()) / 2);
   const dsp::Frf frf = welch(r, "F", {"v"}, a, nfft);
-  const Band b = band(frf, 0, a.hammer_fmin_hz, a.hammer_fmax_hz);
+  const Band b = band(frf, 0, a.hammer_fmin_Hz, a.hammer_fmax_Hz);
   FlexibleModes out;
   out.provenance = provenance(r, {"F", "v"});
   out.welch = frf.provenance;
   try {
     ident::PeakPickingOptions po;
     po.max_modes = 6;
-    for (const auto& m : ident::peak_picking(b.omega, b.h, po)) out.peak_picking.push_back({m.frequency_hz(), m.damping, 0});
+    for (const auto& m : ident::peak_picking(b.omega, b.h, po)) out.peak_picking.push_back({m.frequency_Hz(), m.damping, 0});
   } catch (const NumericalError& e) {
     record_failure(u, "hammer peak picking", e);
   }
   try {
     ident::LscfOptions lo;
     lo.max_order = std::min<Index>(24, b.omega.size() - 1);
-    for (const auto& m : ident::lscf(b.omega, b.h, lo).modes) out.lscf.push_back({m.frequency_hz(), m.damping, m.stable_orders});
+    for (const auto& m : ident::lscf(b.omega, b.h, lo).modes) out.lscf.push_back({m.frequency_Hz(), m.damping, m.stable_orders});
   } catch (const NumericalError& e) {
     record_failure(u, "hammer LSCF", e);
   }

@@ -167,8 +167,8 @@ Excitation band_limited_noise(const NoiseOptions& options, const VoltageBounds& 
   out.sample_rate = options.sample_rate;
   out.kind = "noise";
   out.seed = options.seed;
-  out.lines_hz.resize(2);
-  out.lines_hz << static_cast<double>(first) * df, static_cast<double>(last) * df;
+  out.lines_Hz.resize(2);
+  out.lines_Hz << static_cast<double>(first) * df, static_cast<double>(last) * df;
   fit_to_bounds(Eigen::VectorXd::Constant(n, options.offset), v, bounds, "offset", out);
   return out;
 }
@@ -180,24 +180,24 @@ void MultisineOptions::validate() const {
   require_rate(sample_rate);
   require(period_samples >= 2, "period_samples", ">= 2", std::to_string(period_samples));
   require(periods >= 1, "periods", ">= 1", std::to_string(periods));
-  require(!lines_hz.empty(), "lines_hz", "at least one line", "none");
-  require(amplitudes.empty() || amplitudes.size() == lines_hz.size(), "amplitudes",
-          "none or one per line (" + std::to_string(lines_hz.size()) + ")", std::to_string(amplitudes.size()));
+  require(!lines_Hz.empty(), "lines_Hz", "at least one line", "none");
+  require(amplitudes.empty() || amplitudes.size() == lines_Hz.size(), "amplitudes",
+          "none or one per line (" + std::to_string(lines_Hz.size()) + ")", std::to_string(amplitudes.size()));
   require(std::isfinite(rms) && rms > 0.0, "rms", "> 0 V", format_number(rms, 10));
   require(std::isfinite(offset), "offset", "a finite voltage", format_number(offset, 10));
   const double df = sample_rate / static_cast<double>(period_samples);
   std::vector<Index> bins;
-  for (double f : lines_hz) {
+  for (double f : lines_Hz) {
     const double k = f / df;
     const double kr = std::round(k);
     require(std::isfinite(f) && std::abs(k - kr) <= 1e-9 * std::max(1.0, kr) && kr >= 1.0 &&
                 2.0 * kr < static_cast<double>(period_samples),
-            "lines_hz", "multiples of sample_rate / period_samples = " + format_number(df, 10) + " Hz below sample_rate / 2",
+            "lines_Hz", "multiples of sample_rate / period_samples = " + format_number(df, 10) + " Hz below sample_rate / 2",
             format_number(f, 10) + " Hz");
     bins.push_back(static_cast<Index>(kr));
   }
   std::sort(bins.begin(), bins.end());
-  require(std::adjacent_find(bins.begin(), bins.end()) == bins.end(), "lines_hz", "distinct lines",
+  require(std::adjacent_find(bins.begin(), bins.end()) == bins.end(), "lines_Hz", "distinct lines",
           "a line given twice");
   double total = 0.0;
   for (double a : amplitudes) {
@@ -209,7 +209,7 @@ void MultisineOptions::validate() const {
 
 Eigen::VectorXd multisine_phases(const MultisineOptions& options) {
   options.validate();
-  const auto lines = static_cast<Index>(options.lines_hz.size());
+  const auto lines = static_cast<Index>(options.lines_Hz.size());
   Eigen::VectorXd phi(lines);
   if (options.phases == MultisinePhases::kRandom) {
     std::mt19937_64 rng(options.seed);
@@ -236,14 +236,14 @@ Excitation multisine(const MultisineOptions& options, const VoltageBounds& bound
   const Eigen::VectorXd phi = multisine_phases(options);  // validates
   const Index n = options.period_samples;
   const double df = options.sample_rate / static_cast<double>(n);
-  const auto lines = static_cast<Index>(options.lines_hz.size());
+  const auto lines = static_cast<Index>(options.lines_Hz.size());
 
   // One period from its spectrum: line k at bin m has DFT coefficient (N/2) A e^{i phi}.
   Eigen::VectorXcd spectrum = Eigen::VectorXcd::Zero(n / 2 + 1);
   double power = 0.0;
   for (Index k = 0; k < lines; ++k) {
     const double a = options.amplitudes.empty() ? 1.0 : options.amplitudes[static_cast<std::size_t>(k)];
-    const auto m = static_cast<Index>(std::round(options.lines_hz[static_cast<std::size_t>(k)] / df));
+    const auto m = static_cast<Index>(std::round(options.lines_Hz[static_cast<std::size_t>(k)] / df));
     spectrum(m) = std::polar(0.5 * static_cast<double>(n) * a, phi(k));
     power += 0.5 * a * a;
   }
@@ -255,7 +255,7 @@ Excitation multisine(const MultisineOptions& options, const VoltageBounds& bound
   out.sample_rate = options.sample_rate;
   out.kind = "multisine-" + to_string(options.phases);
   out.seed = options.phases == MultisinePhases::kRandom ? options.seed : 0;
-  out.lines_hz = Eigen::Map<const Eigen::VectorXd>(options.lines_hz.data(), lines);
+  out.lines_Hz = Eigen::Map<const Eigen::VectorXd>(options.lines_Hz.data(), lines);
   fit_to_bounds(Eigen::VectorXd::Constant(v.size(), options.offset), v, bounds, "offset", out);
   return out;
 }
@@ -348,7 +348,7 @@ Excitation offset_sine(const OffsetSineOptions& options, const VoltageBounds& bo
   Excitation out;
   out.sample_rate = options.sample_rate;
   out.kind = "offset-sine";
-  out.lines_hz = Eigen::VectorXd::Constant(1, options.frequency);
+  out.lines_Hz = Eigen::VectorXd::Constant(1, options.frequency);
   fit_to_bounds(c, v, bounds, "rest", out);
   return out;
 }

@@ -34,18 +34,18 @@ std::string format_value(double v) {
 
 void Frf::validate(const std::string& source) const {
   const std::string src = source.empty() ? provenance.source : source;
-  const Index n = freq_hz.size();
-  if (n < 1) throw InputError(src, "freq_hz", "at least one frequency", "none");
-  if (std::isfinite(freq_hz(0)) && freq_hz(0) < 0.0) {
-    throw InputError(src, "freq_hz", "frequencies >= 0 Hz (one-sided FRF)", format_value(freq_hz(0)) + " Hz at index 0");
+  const Index n = freq_Hz.size();
+  if (n < 1) throw InputError(src, "freq_Hz", "at least one frequency", "none");
+  if (std::isfinite(freq_Hz(0)) && freq_Hz(0) < 0.0) {
+    throw InputError(src, "freq_Hz", "frequencies >= 0 Hz (one-sided FRF)", format_value(freq_Hz(0)) + " Hz at index 0");
   }
   for (Index k = 0; k < n; ++k) {
-    if (!std::isfinite(freq_hz(k))) {
-      throw InputError(src, "freq_hz", "finite frequencies", "non-finite value at index " + std::to_string(k));
+    if (!std::isfinite(freq_Hz(k))) {
+      throw InputError(src, "freq_Hz", "finite frequencies", "non-finite value at index " + std::to_string(k));
     }
-    if (k > 0 && !(freq_hz(k) > freq_hz(k - 1))) {
-      throw InputError(src, "freq_hz", "strictly increasing frequencies",
-                       std::to_string(freq_hz(k - 1)) + " then " + std::to_string(freq_hz(k)) + " at index " +
+    if (k > 0 && !(freq_Hz(k) > freq_Hz(k - 1))) {
+      throw InputError(src, "freq_Hz", "strictly increasing frequencies",
+                       std::to_string(freq_Hz(k - 1)) + " then " + std::to_string(freq_Hz(k)) + " at index " +
                            std::to_string(k));
     }
   }
@@ -68,7 +68,7 @@ void Frf::validate(const std::string& source) const {
     for (Index k = 0; k < n; ++k) {
       if (!std::isfinite(H[i](k).real()) || !std::isfinite(H[i](k).imag())) {
         throw InputError(src, outputs[i], "finite response values",
-                         "non-finite value at " + std::to_string(freq_hz(k)) + " Hz (index " + std::to_string(k) + ")");
+                         "non-finite value at " + std::to_string(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
       }
     }
     if (!coherence.empty()) {
@@ -79,12 +79,12 @@ void Frf::validate(const std::string& source) const {
       for (Index k = 0; k < n; ++k) {
         if (!std::isfinite(coherence[i](k))) {
           throw InputError(src, outputs[i] + " coherence", "finite values",
-                           "non-finite value at " + std::to_string(freq_hz(k)) + " Hz (index " + std::to_string(k) + ")");
+                           "non-finite value at " + std::to_string(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
         }
         // Magnitude-squared coherence lies in [0, 1]; the tolerance admits round-off only.
         if (coherence[i](k) < 0.0 || coherence[i](k) > 1.0 + 1e-9) {
           throw InputError(src, outputs[i] + " coherence", "values in [0, 1]",
-                           format_value(coherence[i](k)) + " at " + format_value(freq_hz(k)) + " Hz (index " + std::to_string(k) + ")");
+                           format_value(coherence[i](k)) + " at " + format_value(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
         }
       }
     }
@@ -93,13 +93,13 @@ void Frf::validate(const std::string& source) const {
 
 FrequencyBand excited_band(const Frf& frf, double min_coherence) {
   frf.validate();
-  const Index n = frf.freq_hz.size();
+  const Index n = frf.freq_Hz.size();
   FrequencyBand band;
   Index first_positive = 0;
-  while (first_positive < n && frf.freq_hz(first_positive) <= 0.0) ++first_positive;
+  while (first_positive < n && frf.freq_Hz(first_positive) <= 0.0) ++first_positive;
   if (first_positive == n) throw InputError(frf.provenance.source, "freq_Hz", "a frequency above 0 Hz", "none");
-  band.fmin_hz = frf.freq_hz(first_positive);
-  band.fmax_hz = frf.freq_hz(n - 1);
+  band.fmin_Hz = frf.freq_Hz(first_positive);
+  band.fmax_Hz = frf.freq_Hz(n - 1);
   Eigen::VectorXd best = Eigen::VectorXd::Constant(n, -1.0);
   for (const auto& c : frf.coherence) {
     if (c.size() == n) best = best.cwiseMax(c);
@@ -123,8 +123,8 @@ FrequencyBand excited_band(const Frf& frf, double min_coherence) {
   }
   Index hi = n - 1;
   while (hi > lo && !excited(hi)) --hi;
-  band.fmin_hz = frf.freq_hz(lo);
-  band.fmax_hz = frf.freq_hz(hi);
+  band.fmin_Hz = frf.freq_Hz(lo);
+  band.fmax_Hz = frf.freq_Hz(hi);
   band.from_coherence = true;
   return band;
 }

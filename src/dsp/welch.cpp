@@ -140,21 +140,21 @@ Index WelchOptions::noverlap() const {
   return static_cast<Index>(std::floor(overlap * static_cast<double>(nfft)));
 }
 
-Index segment_length_for_record(Index samples, double sample_rate_hz, double resolution_hz, const std::string& source) {
-  if (!(std::isfinite(sample_rate_hz) && sample_rate_hz > 0.0)) {
-    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_hz));
+Index segment_length_for_record(Index samples, double sample_rate_Hz, double resolution_Hz, const std::string& source) {
+  if (!(std::isfinite(sample_rate_Hz) && sample_rate_Hz > 0.0)) {
+    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_Hz));
   }
-  if (!(std::isfinite(resolution_hz) && resolution_hz > 0.0)) {
-    throw InputError(source, "resolution", "a finite frequency resolution > 0 Hz", std::to_string(resolution_hz));
+  if (!(std::isfinite(resolution_Hz) && resolution_Hz > 0.0)) {
+    throw InputError(source, "resolution", "a finite frequency resolution > 0 Hz", std::to_string(resolution_Hz));
   }
-  const auto target = static_cast<Index>(std::lround(sample_rate_hz / resolution_hz));
+  const auto target = static_cast<Index>(std::lround(sample_rate_Hz / resolution_Hz));
   return std::max<Index>(256, std::min<Index>(target, samples / 4));
 }
 
-WelchOptions welch_options_for_record(Index samples, double sample_rate_hz, double resolution_hz, const std::string& source) {
+WelchOptions welch_options_for_record(Index samples, double sample_rate_Hz, double resolution_Hz, const std::string& source) {
   WelchOptions o;
   o.window = WindowType::kHannPeriodic;
-  o.nfft = segment_length_for_record(samples, sample_rate_hz, resolution_hz, source);
+  o.nfft = segment_length_for_record(samples, sample_rate_Hz, resolution_Hz, source);
   o.overlap = 0.5;
   o.detrend = Detrend::kMean;
   o.estimator = FrfEstimator::kH1;
@@ -165,11 +165,11 @@ Channel channel(std::string name, const Eigen::VectorXd& samples) {
   return Channel{std::move(name), std::span<const double>(samples.data(), static_cast<std::size_t>(samples.size()))};
 }
 
-CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_hz,
+CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_Hz,
                            const WelchOptions& options, const std::string& source) {
   options.validate(source);
-  if (!(std::isfinite(sample_rate_hz) && sample_rate_hz > 0.0)) {
-    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_hz));
+  if (!(std::isfinite(sample_rate_Hz) && sample_rate_Hz > 0.0)) {
+    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_Hz));
   }
   // Finite samples are not checked in a pass of their own (records reach 10^7 samples per
   // channel): a NaN or Inf in a segment makes every bin of that segment's spectrum non-finite, so
@@ -281,15 +281,15 @@ CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& out
   result.nfft = nfft;
   result.noverlap = noverlap;
   result.averages = nseg;
-  result.sample_rate = sample_rate_hz;
-  result.freq_hz.resize(nbins);
+  result.sample_rate = sample_rate_Hz;
+  result.freq_Hz.resize(nbins);
   for (Index k = 0; k < nbins; ++k) {
-    result.freq_hz(k) = static_cast<double>(k) * sample_rate_hz / static_cast<double>(nfft);
+    result.freq_Hz(k) = static_cast<double>(k) * sample_rate_Hz / static_cast<double>(nfft);
   }
 
   // Density scaling 1 / (fs sum w^2), averaged over the segments, one-sided: every bin that has a
   // negative-frequency twin (all but DC and, for even nfft, Nyquist) counts twice.
-  const double scale = 1.0 / (sample_rate_hz * window.squaredNorm() * static_cast<double>(nseg));
+  const double scale = 1.0 / (sample_rate_Hz * window.squaredNorm() * static_cast<double>(nseg));
   Eigen::VectorXd factor = Eigen::VectorXd::Constant(nbins, 2.0 * scale);
   factor(0) = scale;
   if (nfft % 2 == 0) factor(nbins - 1) = scale;
@@ -332,7 +332,7 @@ Frf frf_from_spectra(const CrossSpectra& spectra, FrfEstimator estimator, const 
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
   Frf frf;
-  frf.freq_hz = spectra.freq_hz;
+  frf.freq_Hz = spectra.freq_Hz;
   frf.input = spectra.input;
   frf.outputs = spectra.outputs;
   for (std::size_t o = 0; o < spectra.Suy.size(); ++o) {
@@ -366,24 +366,24 @@ Frf frf_from_spectra(const CrossSpectra& spectra, FrfEstimator estimator, const 
   return frf;
 }
 
-FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_hz,
+FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_Hz,
                          const WelchOptions& options, const std::string& source) {
   if (outputs.empty()) throw InputError(source, "outputs", "at least one output channel", "none");
   FrfEstimate estimate;
-  estimate.spectra = cross_spectra(input, outputs, sample_rate_hz, options, source);
+  estimate.spectra = cross_spectra(input, outputs, sample_rate_Hz, options, source);
   estimate.frf = frf_from_spectra(estimate.spectra, options.estimator, source);
   // The fraction the user asked for (noverlap / nfft may differ from it by the floor).
   estimate.frf.provenance.overlap = options.overlap;
   return estimate;
 }
 
-Eigen::VectorXd welch_psd(const Eigen::VectorXd& x, double sample_rate_hz, const WelchOptions& options) {
-  return cross_spectra(channel("x", x), {}, sample_rate_hz, options).Suu;
+Eigen::VectorXd welch_psd(const Eigen::VectorXd& x, double sample_rate_Hz, const WelchOptions& options) {
+  return cross_spectra(channel("x", x), {}, sample_rate_Hz, options).Suu;
 }
 
-Eigen::VectorXcd welch_csd(const Eigen::VectorXd& x, const Eigen::VectorXd& y, double sample_rate_hz,
+Eigen::VectorXcd welch_csd(const Eigen::VectorXd& x, const Eigen::VectorXd& y, double sample_rate_Hz,
                            const WelchOptions& options) {
-  return cross_spectra(channel("x", x), {channel("y", y)}, sample_rate_hz, options).Suy[0];
+  return cross_spectra(channel("x", x), {channel("y", y)}, sample_rate_Hz, options).Suy[0];
 }
 
 }  // namespace piezobench::dsp

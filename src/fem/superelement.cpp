@@ -18,7 +18,7 @@ namespace {
 
 using text::quote;
 
-double signed_hz(double lambda) {
+double signed_Hz(double lambda) {
   return std::copysign(std::sqrt(std::abs(lambda)), lambda) / (2 * std::numbers::pi);
 }
 
@@ -591,13 +591,13 @@ RigidBodyCheck check_rigid_body_modes(const SuperElement& se, double relative_th
   out.lowest_modes_Hz.resize(6);
   out.rigid_fraction.resize(6);
   for (Index k = 0; k < 6; ++k) {
-    out.lowest_modes_Hz(k) = signed_hz(es.eigenvalues()(k));
+    out.lowest_modes_Hz(k) = signed_Hz(es.eigenvalues()(k));
     // M-orthogonal projection of the (mass-normalized) mode on span(R): its squared M-norm.
     const Eigen::VectorXd b = MR.transpose() * es.eigenvectors().col(k);
     const Eigen::VectorXd c = rmr.solve(b);
     out.rigid_fraction(k) = b.dot(c);
   }
-  out.first_flexible_Hz = signed_hz(es.eigenvalues()(6));
+  out.first_flexible_Hz = signed_Hz(es.eigenvalues()(6));
   out.free_free = (out.rigid_fraction.array() > 0.9).all();
   const double worst = out.lowest_modes_Hz.cwiseAbs().maxCoeff();
   out.spoiled = out.free_free && worst > relative_threshold * std::abs(out.first_flexible_Hz);

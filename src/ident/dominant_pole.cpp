@@ -19,7 +19,7 @@ void DominantPoleOptions::validate() const {
   }
 }
 
-double DominantPole::frequency_hz() const { return natural_frequency / kTwoPi; }
+double DominantPole::frequency_Hz() const { return natural_frequency / kTwoPi; }
 
 DominantPole dominant_pole(const Vector& omega, const CVector& h, const DominantPoleOptions& options) {
   options.validate();

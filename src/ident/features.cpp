@@ -76,9 +76,9 @@ std::pair<double, Index> phase_change(const Vector& omega, const CVector& h, dou
 
 }  // namespace
 
-double ModalFeature::frequency_hz() const { return natural_frequency / kTwoPi; }
-double HighPassFit::corner_hz() const { return corner / kTwoPi; }
-double SecondOrderFit::frequency_hz() const { return natural_frequency / kTwoPi; }
+double ModalFeature::frequency_Hz() const { return natural_frequency / kTwoPi; }
+double HighPassFit::corner_Hz() const { return corner / kTwoPi; }
+double SecondOrderFit::frequency_Hz() const { return natural_frequency / kTwoPi; }
 
 std::string to_string(StaticGainSource s) {
   return s == StaticGainSource::kModelDcGain ? "model-dc-gain" : "data-plateau";
@@ -240,7 +240,7 @@ FrfFeatures frf_features(const dsp::Frf& frf, const std::string& output, const F
   frf.validate();
   const Index i = frf.output_index(output);
   try {
-    return frf_features(kTwoPi * frf.freq_hz, frf.H[static_cast<size_t>(i)], options);
+    return frf_features(kTwoPi * frf.freq_Hz, frf.H[static_cast<size_t>(i)], options);
   } catch (const InputError& e) {
     if (frf.provenance.source.empty()) throw;
     throw e.with_source(frf.provenance.source + " (output " + output + ")");

@@ -53,7 +53,7 @@ Mode mode_from_pole(Complex pole) {
 
 }  // namespace
 
-double Mode::frequency_hz() const { return natural_frequency / kTwoPi; }
+double Mode::frequency_Hz() const { return natural_frequency / kTwoPi; }
 
 void PeakPickingOptions::validate() const {
   const char* src = "peak picking options";
@@ -282,7 +282,7 @@ LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& option
   }
   for (const Mode& m : result.modes) {
     if (m.natural_frequency < w_lo || m.natural_frequency > w_hi) {
-      result.quality.add_problem("mode at " + std::to_string(m.frequency_hz()) + " Hz outside the band");
+      result.quality.add_problem("mode at " + std::to_string(m.frequency_Hz()) + " Hz outside the band");
     }
   }
   result.quality.advise("a band around the modes with a high coherence, or more averages");

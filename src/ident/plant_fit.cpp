@@ -24,11 +24,11 @@ using lti::Vector;
 
 void IffPlantFitOptions::validate() const {
   const std::string src = "iff plant fit options";
-  if (!(std::isfinite(fmin_hz) && fmin_hz >= 0.0)) throw InputError(src, "fmin_hz", "a frequency >= 0 Hz", fmt::format("{}", fmin_hz));
-  if (!(std::isfinite(fmax_hz) && fmax_hz >= 0.0) || (fmax_hz > 0.0 && fmax_hz <= fmin_hz)) {
-    throw InputError(src, "fmax_hz", "0 or a frequency above fmin_hz", fmt::format("{}", fmax_hz));
+  if (!(std::isfinite(fmin_Hz) && fmin_Hz >= 0.0)) throw InputError(src, "fmin_Hz", "a frequency >= 0 Hz", fmt::format("{}", fmin_Hz));
+  if (!(std::isfinite(fmax_Hz) && fmax_Hz >= 0.0) || (fmax_Hz > 0.0 && fmax_Hz <= fmin_Hz)) {
+    throw InputError(src, "fmax_Hz", "0 or a frequency above fmin_Hz", fmt::format("{}", fmax_Hz));
   }
-  if (!(std::isfinite(hpf_fmax_hz) && hpf_fmax_hz > 0.0)) throw InputError(src, "hpf_fmax_hz", "a frequency > 0 Hz", fmt::format("{}", hpf_fmax_hz));
+  if (!(std::isfinite(hpf_fmax_Hz) && hpf_fmax_Hz > 0.0)) throw InputError(src, "hpf_fmax_Hz", "a frequency > 0 Hz", fmt::format("{}", hpf_fmax_Hz));
   if (!(std::isfinite(fixed_w_hpf) && fixed_w_hpf >= 0.0)) {
     throw InputError(src, "fixed_w_hpf", "0 (fitted) or a corner > 0 rad/s", fmt::format("{}", fixed_w_hpf));
   }
@@ -111,8 +111,8 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
     throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
   }
   std::vector<Index> use;
-  const double wmin = kTwoPi * options.fmin_hz;
-  const double wmax = options.fmax_hz > 0.0 ? kTwoPi * options.fmax_hz : std::numeric_limits<double>::infinity();
+  const double wmin = kTwoPi * options.fmin_Hz;
+  const double wmax = options.fmax_Hz > 0.0 ? kTwoPi * options.fmax_Hz : std::numeric_limits<double>::infinity();
   for (Index k = 0; k < omega.size(); ++k) {
     if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
       throw InputError(source, "H", "finite values", fmt::format("a non-finite value at point {}", k));
@@ -129,7 +129,7 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
     d(static_cast<Index>(i)) = h(use[i]);
   }
   // Starting values.
-  const double w_hpf_band = kTwoPi * options.hpf_fmax_hz;
+  const double w_hpf_band = kTwoPi * options.hpf_fmax_Hz;
   Index peak = -1;
   for (Index k = 0; k < w.size(); ++k) {
     if (w(k) > w_hpf_band && (peak < 0 || std::abs(d(k)) > std::abs(d(peak)))) peak = k;
@@ -315,8 +315,8 @@ void select_band(const Vector& omega, const CVector& h, const Vector& coherence,
   if (coherence.size() != 0 && coherence.size() != h.size()) {
     throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
   }
-  const double wmin = kTwoPi * options.fmin_hz;
-  const double wmax = options.fmax_hz > 0.0 ? kTwoPi * options.fmax_hz : std::numeric_limits<double>::infinity();
+  const double wmin = kTwoPi * options.fmin_Hz;
+  const double wmax = options.fmax_Hz > 0.0 ? kTwoPi * options.fmax_Hz : std::numeric_limits<double>::infinity();
   std::vector<Index> use;
   for (Index k = 0; k < omega.size(); ++k) {
     if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
@@ -466,13 +466,13 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
 
 void ActuatorPlantOptions::validate() const {
   const std::string src = "actuator plant options";
-  for (const auto& [v, name] : {std::pair{fmin_hz, "fmin_hz"}, std::pair{iff_fmin_hz, "iff_fmin_hz"}, std::pair{fixed_w_hpf, "fixed_w_hpf"}}) {
+  for (const auto& [v, name] : {std::pair{fmin_Hz, "fmin_Hz"}, std::pair{iff_fmin_Hz, "iff_fmin_Hz"}, std::pair{fixed_w_hpf, "fixed_w_hpf"}}) {
     if (!(std::isfinite(v) && v >= 0.0)) throw InputError(src, name, "a finite value >= 0", fmt::format("{}", v));
   }
-  if (!(std::isfinite(fmax_hz) && fmax_hz > fmin_hz && fmax_hz > iff_fmin_hz)) {
-    throw InputError(src, "fmax_hz", "a frequency above fmin_hz and iff_fmin_hz", fmt::format("{}", fmax_hz));
+  if (!(std::isfinite(fmax_Hz) && fmax_Hz > fmin_Hz && fmax_Hz > iff_fmin_Hz)) {
+    throw InputError(src, "fmax_Hz", "a frequency above fmin_Hz and iff_fmin_Hz", fmt::format("{}", fmax_Hz));
   }
-  if (!(std::isfinite(hpf_fmax_hz) && hpf_fmax_hz > 0.0)) throw InputError(src, "hpf_fmax_hz", "a frequency > 0 Hz", fmt::format("{}", hpf_fmax_hz));
+  if (!(std::isfinite(hpf_fmax_Hz) && hpf_fmax_Hz > 0.0)) throw InputError(src, "hpf_fmax_Hz", "a frequency > 0 Hz", fmt::format("{}", hpf_fmax_Hz));
   if (!(min_coherence >= 0.0 && min_coherence < 1.0)) throw InputError(src, "min_coherence", "a value in [0, 1)", fmt::format("{}", min_coherence));
 }
 
@@ -480,12 +480,12 @@ ActuatorPlants fit_actuator_plants(const Vector& omega, const CVector& h_de, con
                                    const Vector& coh_vs, const ActuatorPlantOptions& options, const std::string& source) {
   options.validate();
   ActuatorPlants out;
-  out.de_options.fmin_hz = options.fmin_hz;
-  out.de_options.fmax_hz = options.fmax_hz;
+  out.de_options.fmin_Hz = options.fmin_Hz;
+  out.de_options.fmax_Hz = options.fmax_Hz;
   out.de_options.min_coherence = options.min_coherence;
-  out.vs_options.fmin_hz = options.iff_fmin_hz;
-  out.vs_options.fmax_hz = options.fmax_hz;
-  out.vs_options.hpf_fmax_hz = options.hpf_fmax_hz;
+  out.vs_options.fmin_Hz = options.iff_fmin_Hz;
+  out.vs_options.fmax_Hz = options.fmax_Hz;
+  out.vs_options.hpf_fmax_Hz = options.hpf_fmax_Hz;
   out.vs_options.min_coherence = options.min_coherence;
   out.vs_options.fixed_w_hpf = options.fixed_w_hpf;
   try {

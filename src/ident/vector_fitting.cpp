@@ -964,10 +964,10 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
 
 VectorFittingResult vector_fit(const dsp::Frf& frf, const VectorFittingOptions& options) {
   frf.validate(frf.provenance.source);
-  const Index ns = frf.freq_hz.size();
+  const Index ns = frf.freq_Hz.size();
   CMatrix data(ns, static_cast<Index>(frf.H.size()));
   for (size_t i = 0; i < frf.H.size(); ++i) data.col(static_cast<Index>(i)) = frf.H[i];
-  const Vector omega = kTwoPi * frf.freq_hz;
+  const Vector omega = kTwoPi * frf.freq_Hz;
   VectorFittingResult r;
   try {
     r = vector_fit(omega, data, options);

@@ -94,8 +94,8 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file) {
       if (coh) line += ",coh_" + name;
     }
     out << line << '\n';
-    for (Index k = 0; k < frf.freq_hz.size(); ++k) {
-      line = format_number(frf.freq_hz(k), 17);
+    for (Index k = 0; k < frf.freq_Hz.size(); ++k) {
+      line = format_number(frf.freq_Hz(k), 17);
       for (size_t i = 0; i < frf.outputs.size(); ++i) {
         line += ',' + format_number(frf.H[i](k).real(), 17);
         line += ',' + format_number(frf.H[i](k).imag(), 17);
@@ -176,7 +176,7 @@ dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) {
     for (int p = 0; p < per_output; ++p) target[static_cast<size_t>(slots[static_cast<size_t>(p)])] = 1 + static_cast<int>(i) * per_output + p;
   }
   const Eigen::MatrixXd data = table.read(target, 1 + static_cast<Index>(frf.outputs.size()) * per_output);
-  frf.freq_hz = data.col(0) * freq_factor;
+  frf.freq_Hz = data.col(0) * freq_factor;
   for (size_t i = 0; i < frf.outputs.size(); ++i) {
     const Index base = 1 + static_cast<Index>(i) * per_output;
     Eigen::VectorXcd h(data.rows());
@@ -218,7 +218,7 @@ void write_frf_mat(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
     }
   }
   detail::write_mat_atomically(file, options.mat_version == MatVersion::kV73, /*compress=*/false, [&](detail::MatWriter& w) {
-    w.write(detail::make_real_column(kFreq, frf.freq_hz));
+    w.write(detail::make_real_column(kFreq, frf.freq_Hz));
     w.write(detail::make_text("input", frf.input));
     w.write(detail::make_text("outputs", text::join(frf.outputs, ",")));
     for (size_t i = 0; i < frf.outputs.size(); ++i) {
@@ -240,7 +240,7 @@ dsp::Frf read_frf_mat(const fs::path& file) {
     throw InputError(source, kFreq, "a frequency vector in Hz", "no such variable (variables: " + text::join(names) + ")");
   }
   dsp::Frf frf;
-  frf.freq_hz = detail::to_real_vector(*detail::read_mat_variable(mat.get(), file, kFreq), source, kFreq);
+  frf.freq_Hz = detail::to_real_vector(*detail::read_mat_variable(mat.get(), file, kFreq), source, kFreq);
   if (has("input")) frf.input = detail::to_text(*detail::read_mat_variable(mat.get(), file, "input"), source, "input");
   if (has("outputs")) {
     const std::string list = detail::to_text(*detail::read_mat_variable(mat.get(), file, "outputs"), source, "outputs");

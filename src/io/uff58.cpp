@@ -170,16 +170,16 @@ void write_frf_uff58(const dsp::Frf& frf, const fs::path& file, const FrfWriteOp
   };
   for (const std::string& o : frf.outputs) check_name(o, "output");
   check_name(frf.input, "input");
-  if (frf.freq_hz.minCoeff() < 0.0) throw InputError(file.string(), "freq_hz", "frequencies >= 0 Hz", format_number(frf.freq_hz.minCoeff(), 10));
+  if (frf.freq_Hz.minCoeff() < 0.0) throw InputError(file.string(), "freq_Hz", "frequencies >= 0 Hz", format_number(frf.freq_Hz.minCoeff(), 10));
   const std::string input = frf.input.empty() ? std::string("input") : frf.input;
   const std::string id5 = provenance_line(frf.provenance);
   write_atomically(file, [&](std::ostream& out) {
     for (size_t i = 0; i < frf.outputs.size(); ++i) {
       const int node = static_cast<int>(i) + 1;
-      write_dataset(out, kFuncFrf, node, frf.outputs[i], node, input, options.reference_node, frf.freq_hz, &frf.H[i], nullptr,
+      write_dataset(out, kFuncFrf, node, frf.outputs[i], node, input, options.reference_node, frf.freq_Hz, &frf.H[i], nullptr,
                     options, id5);
       if (!frf.coherence.empty()) {
-        write_dataset(out, kFuncCoherence, node, frf.outputs[i], node, input, options.reference_node, frf.freq_hz, nullptr,
+        write_dataset(out, kFuncCoherence, node, frf.outputs[i], node, input, options.reference_node, frf.freq_Hz, nullptr,
                       &frf.coherence[i], options, id5);
       }
     }
@@ -632,15 +632,15 @@ dsp::Frf read_frf_uff58(const fs::path& file) {
     if (first == nullptr) {
       first = &d;
       frf.input = in;
-      frf.freq_hz = d.x;
+      frf.freq_Hz = d.x;
       parse_provenance(d.id[4], frf.provenance);
     } else {
       if (in != frf.input) {
         throw InputError(source, where + " reference", "the reference of the first FRF (" + frf.input + ")", quote(in));
       }
-      const double scale = frf.freq_hz.cwiseAbs().maxCoeff();
-      if (d.x.size() != frf.freq_hz.size() || (d.x - frf.freq_hz).cwiseAbs().maxCoeff() > 1e-5 * scale) {
-        throw InputError(source, where + " abscissa", "the frequency grid of the first FRF (" + std::to_string(frf.freq_hz.size()) + " points)",
+      const double scale = frf.freq_Hz.cwiseAbs().maxCoeff();
+      if (d.x.size() != frf.freq_Hz.size() || (d.x - frf.freq_Hz).cwiseAbs().maxCoeff() > 1e-5 * scale) {
+        throw InputError(source, where + " abscissa", "the frequency grid of the first FRF (" + std::to_string(frf.freq_Hz.size()) + " points)",
                          "a different grid (" + std::to_string(d.x.size()) + " points)");
       }
     }
@@ -658,7 +658,7 @@ dsp::Frf read_frf_uff58(const fs::path& file) {
   bool all = true;
   for (const std::string& o : frf.outputs) {
     const auto it = coherence.find(o);
-    all = all && it != coherence.end() && it->second->x.size() == frf.freq_hz.size();
+    all = all && it != coherence.end() && it->second->x.size() == frf.freq_Hz.size();
   }
   if (all) {
     for (const std::string& o : frf.outputs) frf.coherence.emplace_back(coherence[o]->y.real());

@@ -151,8 +151,8 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
     // The lines of a band (excited ones only), rad/s, and the FRF there with the delay removed.
     auto lines = [&](double fmin, double fmax, lti::Vector& omega, lti::CVector& h, lti::CVector& raw) {
       std::vector<Eigen::Index> rows;
-      for (Eigen::Index k = 0; k < est.frf.freq_hz.size(); ++k) {
-        const double f = est.frf.freq_hz(k);
+      for (Eigen::Index k = 0; k < est.frf.freq_Hz.size(); ++k) {
+        const double f = est.frf.freq_Hz(k);
         if (f >= fmin && f <= fmax && f >= options.f_low && f <= options.f_high) rows.push_back(k);
       }
       if (rows.size() < 8) {
@@ -165,7 +165,7 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
       raw.resize(omega.size());
       for (Eigen::Index j = 0; j < omega.size(); ++j) {
         const Eigen::Index k = rows[static_cast<std::size_t>(j)];
-        omega(j) = kTwoPi * est.frf.freq_hz(k);
+        omega(j) = kTwoPi * est.frf.freq_Hz(k);
         raw(j) = est.frf.H[0](k);
         h(j) = raw(j) * (options.remove_delay ? std::polar(1.0, omega(j) * study.delay) : lti::Complex(1.0));
       }
@@ -176,7 +176,7 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
     p.model_pole = locus.locus.poles[i](locus.resonance_branch);
     if (p.model_pole.imag() < 0.0) p.model_pole = std::conj(p.model_pole);
     const lti::PoleInfo info = lti::pole_info(p.model_pole);
-    p.model_frequency_hz = info.natural_frequency / kTwoPi;
+    p.model_frequency_Hz = info.natural_frequency / kTwoPi;
     p.model_damping = info.damping;
 
     // Identified pole: vector fit, then the dominant complex pair in the resonance band.
@@ -191,13 +191,13 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
     p.identified_pole = dominant.pole;
     const ident::VectorFittingResult& vf = dominant.fit;
     const lti::PoleInfo id = lti::pole_info(p.identified_pole);
-    p.identified_frequency_hz = id.natural_frequency / kTwoPi;
+    p.identified_frequency_Hz = id.natural_frequency / kTwoPi;
     p.identified_damping = id.damping;
     p.fit_relative_rms_error = vf.relative_rms_error;
     p.relative_error = std::abs(p.identified_pole - p.model_pole) / std::abs(p.model_pole);
     double coherence = 0.0;
-    for (Eigen::Index k = 0; k < est.frf.freq_hz.size(); ++k) {
-      const double f = est.frf.freq_hz(k);
+    for (Eigen::Index k = 0; k < est.frf.freq_Hz.size(); ++k) {
+      const double f = est.frf.freq_Hz(k);
       if (f >= options.fit_fmin && f <= options.fit_fmax && f >= options.f_low && f <= options.f_high) {
         coherence += est.frf.coherence[0](k) / static_cast<double>(omega.size());
       }
@@ -220,7 +220,7 @@ DampedPlantStudy run_damped_plant_study(const DampedPlantStudyOptions& options) 
     so.method = ident::SecondOrderMethod::kVectorFitting;
     const ident::SecondOrderFit fit = ident::fit_second_order(omega2, h2, so);
     p.second_order_pole = fit.poles(0).imag() >= 0.0 ? fit.poles(0) : fit.poles(1);
-    p.second_order_frequency_hz = fit.frequency_hz();
+    p.second_order_frequency_Hz = fit.frequency_Hz();
     p.second_order_damping = fit.damping;
     p.second_order_rms_error = fit.relative_rms_error;
     p.second_order_relative_error = std::abs(p.second_order_pole - p.model_pole) / std::abs(p.model_pole);

@@ -45,16 +45,16 @@ TwoDofParams truth() {
 
 // The bench FRFs u -> [d_e, Vs] by direct solve; noise: H (1 + n), n complex Gaussian with
 // E|n|^2 = noise^2.
-dsp::Frf make_frf(const TwoDofParams& p, const TwoDofBench& b, const lti::Vector& f_hz, double noise, unsigned seed) {
+dsp::Frf make_frf(const TwoDofParams& p, const TwoDofBench& b, const lti::Vector& f_Hz, double noise, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, noise / std::sqrt(2.0));
   dsp::Frf frf;
-  frf.freq_hz = f_hz;
+  frf.freq_Hz = f_Hz;
   frf.input = "u";
   frf.outputs = {"de", "Vs"};
-  frf.H.assign(2, lti::CVector(f_hz.size()));
-  for (Index k = 0; k < f_hz.size(); ++k) {
-    const Complex s(0.0, kTwoPi * f_hz(k));
+  frf.H.assign(2, lti::CVector(f_Hz.size()));
+  for (Index k = 0; k < f_Hz.size(); ++k) {
+    const Complex s(0.0, kTwoPi * f_Hz(k));
     const Complex z1 = p.k1 + p.c1 * s, ze = p.ke + p.ce * s, za = p.ka + p.ca * s;
     Eigen::Matrix2cd K;
     K << p.m * s * s + z1 + ze, -ze, -ze, ze + za;
@@ -171,8 +171,8 @@ TEST(Tuning, BadInput) {
   o.vs_output = "Vsensor";
   EXPECT_THROW((void)tune_two_dof(frf, o), InputError);
   o = TuningOptions{};
-  o.fmin_hz = 500.0;
-  o.fmax_hz = 502.0;
+  o.fmin_Hz = 500.0;
+  o.fmax_Hz = 502.0;
   try {
     (void)tune_two_dof(frf, o);
     ADD_FAILURE() << "too few points accepted";
@@ -180,8 +180,8 @@ TEST(Tuning, BadInput) {
     EXPECT_EQ(e.field(), "freq_Hz");
   }
   // A band above the resonance has no peak: a numerical failure that other settings may fix.
-  o.fmin_hz = 200.0;
-  o.fmax_hz = 0.0;
+  o.fmin_Hz = 200.0;
+  o.fmax_Hz = 0.0;
   try {
     (void)tune_two_dof(frf, o);
     ADD_FAILURE() << "no resonance accepted";
@@ -198,7 +198,7 @@ TEST(Tuning, BadInput) {
       {"mass", [](TuningOptions& t) { t.mass = 0.0; }},
       {"amplifier_gain", [](TuningOptions& t) { t.bench.amplifier_gain = 0.0; }},
       {"bench.suspended_mass", [](TuningOptions& t) { t.bench.added_mass = 1.0; }},
-      {"fmax_hz", [](TuningOptions& t) { t.fmin_hz = 10.0, t.fmax_hz = 5.0; }},
+      {"fmax_Hz", [](TuningOptions& t) { t.fmin_Hz = 10.0, t.fmax_Hz = 5.0; }},
       {"min_coherence", [](TuningOptions& t) { t.min_coherence = 1.0; }},
       {"stack_stiffness_ratio", [](TuningOptions& t) { t.stack_stiffness_ratio = -2.0; }},
       {"max_iterations", [](TuningOptions& t) { t.max_iterations = 0; }},
@@ -222,12 +222,12 @@ TEST(Tuning, BadInput) {
 TEST(Tuning, MeasuredProcedureOnAScipyWelchFrf) {
   const dsp::Frf frf = io::read_frf(test::fixture_path("ident/two_dof_welch_frf.csv"));
   const auto truth = nlohmann::json::parse(test::read_text(test::fixture_path("ident/two_dof_welch_truth.json")));
-  const lti::Vector w = 2.0 * std::numbers::pi * frf.freq_hz;
+  const lti::Vector w = 2.0 * std::numbers::pi * frf.freq_Hz;
   const ident::ActuatorPlants plants = ident::fit_actuator_plants(w, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1]);
   ASSERT_TRUE(plants.de && plants.vs);
   TuningOptions o;
-  o.fmin_hz = 20.0;
-  o.fmax_hz = 500.0;
+  o.fmin_Hz = 20.0;
+  o.fmax_Hz = 500.0;
   o.min_coherence = 0.5;
   const TwoDofTuning t = tune_two_dof_measured(frf, o, &*plants.de, &*plants.vs);
   for (const char* key : {"k1", "ke", "ka", "ga", "gs"}) {

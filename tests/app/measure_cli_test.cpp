@@ -82,25 +82,25 @@ class ServeProcess {
   std::string address_;
 };
 
-std::complex<double> h1_at(const io::TimeSeries& ts, double f_hz, double* peak_hz = nullptr) {
+std::complex<double> h1_at(const io::TimeSeries& ts, double f_Hz, double* peak_Hz = nullptr) {
   dsp::WelchOptions wo;
   wo.nfft = 4096;
   const Eigen::VectorXd u = ts.channel("u"), de = ts.channel("de");
   const dsp::FrfEstimate e = dsp::estimate_frf(dsp::channel("u", u), {dsp::channel("de", de)}, ts.sample_rate, wo);
   Eigen::Index k = 0;
-  if (peak_hz != nullptr) {
+  if (peak_Hz != nullptr) {
     // The resonance: the largest |H1| between 50 and 300 Hz.
     double best = 0.0;
-    for (Eigen::Index i = 0; i < e.frf.freq_hz.size(); ++i) {
-      const double f = e.frf.freq_hz(i);
+    for (Eigen::Index i = 0; i < e.frf.freq_Hz.size(); ++i) {
+      const double f = e.frf.freq_Hz(i);
       if (f > 50.0 && f < 300.0 && std::abs(e.frf.H[0](i)) > best) {
         best = std::abs(e.frf.H[0](i));
         k = i;
       }
     }
-    *peak_hz = e.frf.freq_hz(k);
+    *peak_Hz = e.frf.freq_Hz(k);
   } else {
-    (e.frf.freq_hz.array() - f_hz).abs().minCoeff(&k);
+    (e.frf.freq_Hz.array() - f_Hz).abs().minCoeff(&k);
   }
   return e.frf.H[0](k);
 }

@@ -85,7 +85,7 @@ TEST(CampaignFile, CompleteExample) {
   EXPECT_DOUBLE_EQ(*c.specs.stroke_min, 200e-6);
   EXPECT_DOUBLE_EQ(c.specs.outliers.threshold, 4.0);
   EXPECT_EQ(c.analysis.nfft, 20000);
-  EXPECT_DOUBLE_EQ(c.analysis.fmax_hz, 400.0);
+  EXPECT_DOUBLE_EQ(c.analysis.fmax_Hz, 400.0);
   EXPECT_DOUBLE_EQ(c.analysis.controller.gain, -12.0);
   EXPECT_NEAR(c.analysis.controller.w_hpf, 2 * M_PI * 3.0, 1e-12);
   EXPECT_NEAR(c.analysis.controller.w_lpf, 2 * M_PI * 20.0, 1e-12);  // default kept

@@ -51,8 +51,8 @@ TEST(Noise, PowerOnlyInsideTheBandWithTheRequestedRms) {
   EXPECT_LT(mag.tail(mag.size() - 801).maxCoeff(), 1e-12 * in_band);
   // White inside the band: every line carries power (no line below 1e-3 of the largest).
   EXPECT_GT(mag.segment(80, 721).minCoeff(), 1e-3 * in_band);
-  EXPECT_DOUBLE_EQ(e.lines_hz(0), 20.0);
-  EXPECT_DOUBLE_EQ(e.lines_hz(1), 200.0);
+  EXPECT_DOUBLE_EQ(e.lines_Hz(0), 20.0);
+  EXPECT_DOUBLE_EQ(e.lines_Hz(1), 200.0);
 }
 
 TEST(Noise, ReproducibleFromTheSeed) {
@@ -119,7 +119,7 @@ MultisineOptions multisine_options(MultisinePhases phases) {
   o.sample_rate = 1024.0;
   o.period_samples = 1024;  // 1 Hz lines
   o.periods = 3;
-  for (int f = 10; f <= 300; f += 10) o.lines_hz.push_back(f);
+  for (int f = 10; f <= 300; f += 10) o.lines_Hz.push_back(f);
   o.rms = 0.2;
   o.offset = 1.0;
   o.phases = phases;
@@ -175,12 +175,12 @@ TEST(Multisine, RandomPhasesFollowTheSeed) {
 
 TEST(Multisine, OffGridLineIsRejected) {
   MultisineOptions o = multisine_options(MultisinePhases::kSchroeder);
-  o.lines_hz.push_back(10.5);
+  o.lines_Hz.push_back(10.5);
   try {
     (void)multisine(o);
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), "lines_hz");
+    EXPECT_EQ(e.field(), "lines_Hz");
   }
   EXPECT_EQ(multisine_phases_from_string("random"), MultisinePhases::kRandom);
 }

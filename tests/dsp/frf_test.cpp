@@ -11,7 +11,7 @@ namespace {
 
 Frf two_outputs() {
   Frf f;
-  f.freq_hz = Eigen::VectorXd::LinSpaced(5, 1.0, 5.0);
+  f.freq_Hz = Eigen::VectorXd::LinSpaced(5, 1.0, 5.0);
   f.input = std::string("u");  // (assigning the literal trips GCC 12 -Wrestrict, PR 105651)
   f.outputs.emplace_back("d_e");
   f.outputs.emplace_back("V_s");
@@ -53,8 +53,8 @@ TEST(Frf, ValidateRejectsEachKindOfInconsistency) {
     }
   };
   Frf f = two_outputs();
-  f.freq_hz(3) = f.freq_hz(2);
-  expect_field(f, "freq_hz");
+  f.freq_Hz(3) = f.freq_Hz(2);
+  expect_field(f, "freq_Hz");
   f = two_outputs();
   f.H[1](2) = std::numeric_limits<double>::quiet_NaN();
   expect_field(f, "V_s");
@@ -84,8 +84,8 @@ TEST(Frf, ValidateRejectsEachKindOfInconsistency) {
   f.coherence[0](1) = 1.0 + 1e-12;  // round-off of |Suy|^2 / (Suu Syy) on a noiseless record
   EXPECT_NO_THROW(f.validate());
   f = two_outputs();
-  f.freq_hz(0) = -1.0;
-  expect_field(f, "freq_hz");
+  f.freq_Hz(0) = -1.0;
+  expect_field(f, "freq_Hz");
 }
 
 TEST(ExcitedBand, FromTheCoherenceOfTheBestOutputIgnoringDipsAndIsolatedBins) {
@@ -93,27 +93,27 @@ TEST(ExcitedBand, FromTheCoherenceOfTheBestOutputIgnoringDipsAndIsolatedBins) {
   // at 30 Hz (3 bins of low coherence), output 1 a single noisy bin of high coherence at 80 Hz.
   Frf f;
   const Eigen::Index n = 201;
-  f.freq_hz = Eigen::VectorXd::LinSpaced(n, 0.0, 100.0);
+  f.freq_Hz = Eigen::VectorXd::LinSpaced(n, 0.0, 100.0);
   f.input = std::string("u");
   f.outputs = {"a", "b"};
   f.H = {Eigen::VectorXcd::Ones(n), Eigen::VectorXcd::Ones(n)};
   Eigen::VectorXd a = Eigen::VectorXd::Constant(n, 0.05), b = Eigen::VectorXd::Constant(n, 0.05);
   for (Eigen::Index k = 0; k < n; ++k) {
-    if (f.freq_hz(k) >= 2.0 && f.freq_hz(k) <= 60.0) a(k) = 0.95;
+    if (f.freq_Hz(k) >= 2.0 && f.freq_Hz(k) <= 60.0) a(k) = 0.95;
   }
   a(60) = a(61) = a(59) = 0.1;  // 29.5 .. 30.5 Hz
   b(160) = 0.99;                 // 80 Hz
   f.coherence = {a, b};
   const FrequencyBand band = excited_band(f, 0.5);
   EXPECT_TRUE(band.from_coherence);
-  EXPECT_DOUBLE_EQ(band.fmin_hz, 2.0);
-  EXPECT_DOUBLE_EQ(band.fmax_hz, 60.0);
+  EXPECT_DOUBLE_EQ(band.fmin_Hz, 2.0);
+  EXPECT_DOUBLE_EQ(band.fmax_Hz, 60.0);
   // Without coherence: the whole positive grid.
   f.coherence.clear();
   const FrequencyBand all = excited_band(f);
   EXPECT_FALSE(all.from_coherence);
-  EXPECT_DOUBLE_EQ(all.fmin_hz, 0.5);
-  EXPECT_DOUBLE_EQ(all.fmax_hz, 100.0);
+  EXPECT_DOUBLE_EQ(all.fmin_Hz, 0.5);
+  EXPECT_DOUBLE_EQ(all.fmax_Hz, 100.0);
   // Nothing excited: an error that says what to check.
   f.coherence = {Eigen::VectorXd::Constant(n, 0.1), Eigen::VectorXd::Constant(n, 0.2)};
   try {

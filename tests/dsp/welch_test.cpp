@@ -114,7 +114,7 @@ TEST(Welch, EqualsScipyCsdWelchCoherence) {
     SCOPED_TRACE(ref.at("name").get<std::string>());
     const FrfEstimate e = estimate_case(signals().cases[i]);
     const CrossSpectra& sp = e.spectra;
-    EXPECT_TRUE(all_near(sp.freq_hz, vec(ref.at("freq_hz")), kReference));
+    EXPECT_TRUE(all_near(sp.freq_Hz, vec(ref.at("freq_Hz")), kReference));
     EXPECT_TRUE(all_near(sp.Suu, vec(ref.at("Suu")), kReference));
     const char* labels[2] = {"y1", "y2"};
     for (std::size_t o = 0; o < 2; ++o) {
@@ -140,7 +140,7 @@ TEST(Welch, EqualsOctaveCpsdTfestimateMscohere) {
     ++compared;
     SCOPED_TRACE(ref.at("name").get<std::string>());
     const FrfEstimate e = estimate_case(signals().cases[i]);
-    EXPECT_TRUE(all_near(e.spectra.freq_hz, vec(ref.at("freq_hz")), kReference));
+    EXPECT_TRUE(all_near(e.spectra.freq_Hz, vec(ref.at("freq_Hz")), kReference));
     EXPECT_TRUE(all_near(e.spectra.Suu, vec(ref.at("Suu")), kReference));
     const char* labels[2] = {"y1", "y2"};
     for (std::size_t o = 0; o < 2; ++o) {
@@ -179,7 +179,7 @@ TEST(Welch, ProvenanceDescribesTheEstimate) {
   EXPECT_EQ(e.frf.provenance.source, "fixture");
   EXPECT_EQ(e.frf.input, "u");
   EXPECT_EQ(e.frf.outputs, (std::vector<std::string>{"y1", "y2"}));
-  EXPECT_EQ(e.frf.freq_hz.size(), 64);
+  EXPECT_EQ(e.frf.freq_Hz.size(), 64);
   EXPECT_NO_THROW(e.frf.validate());
 }
 
@@ -240,7 +240,7 @@ TEST(Welch, OutputNoiseBiasesH2ButNotH1) {
   const FrfEstimate h1 = estimate_frf(channel("u", u), {channel("y", y)}, 1.0, o);
   o.estimator = FrfEstimator::kH2;
   const FrfEstimate h2 = estimate_frf(channel("u", u), {channel("y", y)}, 1.0, o);
-  const Index bins = h1.frf.freq_hz.size();
+  const Index bins = h1.frf.freq_Hz.size();
   EXPECT_TRUE(near(h1.frf.H[0].real().mean(), g, 3e-3));
   EXPECT_TRUE(near(h2.frf.H[0].real().mean(), g * (1 + r), 3e-3));
   EXPECT_TRUE(near(h1.frf.coherence[0].mean(), 1.0 / (1 + r), 3e-3));

@@ -66,7 +66,7 @@ Dense independent_model() {
 
 // H(w) of UY(76423) for the stack pair on 76430 (-) / 76440 (+) along x, 76429 clamped, an
 // optional point mass on 76423.
-Eigen::VectorXcd independent_response(const Eigen::VectorXd& omega, double added_mass, Eigen::VectorXd* modes_hz = nullptr) {
+Eigen::VectorXcd independent_response(const Eigen::VectorXd& omega, double added_mass, Eigen::VectorXd* modes_Hz = nullptr) {
   Dense d = independent_model();
   for (const char* l : {"UX", "UY", "UZ"}) d.M(d.index.at({76423, l}), d.index.at({76423, l})) += added_mass;
   std::vector<int> keep;
@@ -93,9 +93,9 @@ Eigen::VectorXcd independent_response(const Eigen::VectorXd& omega, double added
     const Eigen::MatrixXcd Z = (K - omega(k) * omega(k) * M).cast<std::complex<double>>();
     h(k) = Eigen::FullPivLU<Eigen::MatrixXcd>(Z).solve(F)(out);
   }
-  if (modes_hz != nullptr) {
+  if (modes_Hz != nullptr) {
     const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(K, M, Eigen::EigenvaluesOnly);
-    *modes_hz = es.eigenvalues().cwiseAbs().cwiseSqrt() / (2 * kPi);
+    *modes_Hz = es.eigenvalues().cwiseAbs().cwiseSqrt() / (2 * kPi);
   }
   return h;
 }
@@ -178,15 +178,15 @@ TEST(StructuralModel, MatchesAnIndependentDenseSolutionWithTenKilograms) {
   const StructuralModel model = assemble(apa95ml(), check_options(10.0));
   ASSERT_EQ(model.size(), 102);
   const Eigen::VectorXd hz = lti::logspace(0.0, 4.0, 250);
-  Eigen::VectorXd modes_hz;
-  const Eigen::VectorXcd expected = independent_response(2 * kPi * hz, 10.0, &modes_hz);
+  Eigen::VectorXd modes_Hz;
+  const Eigen::VectorXcd expected = independent_response(2 * kPi * hz, 10.0, &modes_Hz);
   const std::vector<Eigen::MatrixXcd> H = frequency_response(model, 2 * kPi * hz);
   // Same modes from the library.
   const Modes m = modes(model);
-  EXPECT_TRUE(test::all_near(m.frequencies_Hz.head(10), modes_hz.head(10), {1e-9, 0}));
+  EXPECT_TRUE(test::all_near(m.frequencies_Hz.head(10), modes_Hz.head(10), {1e-9, 0}));
   int compared = 0;
   for (Eigen::Index k = 0; k < hz.size(); ++k) {
-    const double nearest = (modes_hz.array() - hz(k)).abs().minCoeff();
+    const double nearest = (modes_Hz.array() - hz(k)).abs().minCoeff();
     if (nearest < 0.02 * hz(k)) continue;  // away from resonances
     ++compared;
     EXPECT_TRUE(test::near<std::complex<double>>(H[static_cast<std::size_t>(k)](0, 0), expected(k), {1e-6, 0}))

@@ -45,7 +45,7 @@ TEST(DominantPole, FindsTheDominantPairNotTheSpuriousOne) {
   const DominantPole d = dominant_pole(w, h, o);
   EXPECT_LT(std::abs(d.pole - g.p1) / std::abs(g.p1), 1e-6);
   EXPECT_NEAR(d.damping, 0.25, 1e-6);
-  EXPECT_NEAR(d.frequency_hz(), 80.0, 1e-4);
+  EXPECT_NEAR(d.frequency_Hz(), 80.0, 1e-4);
   EXPECT_LT(d.fit.relative_rms_error, 1e-6);
 }
 

@@ -96,7 +96,7 @@ TEST(FrfFeatures, TwoDofDisplacementGivesResonanceAndStaticGain) {
   o.fit.order = 3;  // the model's order: a pair and the real pole of the stacks' dampers
   const FrfFeatures f = frf_features(omega, response(omega, [&](Complex s) { return apa.de(s); }), o);
   ASSERT_EQ(f.resonances.size(), 1u);
-  EXPECT_TRUE(near(f.resonances[0].frequency_hz(), 95.4, kReportFrequency));
+  EXPECT_TRUE(near(f.resonances[0].frequency_Hz(), 95.4, kReportFrequency));
   const Complex p = apa.resonance_pole();
   EXPECT_TRUE(near(f.resonances[0].natural_frequency, std::abs(p), kExactFit));
   EXPECT_TRUE(near(f.resonances[0].damping, -p.real() / std::abs(p), kExactFit));
@@ -116,10 +116,10 @@ TEST(FrfFeatures, TwoDofSensorVoltageGivesAntiResonance) {
   o.fit.order = 3;
   const FrfFeatures f = frf_features(omega, response(omega, [&](Complex s) { return apa.vs(s); }), o);
   ASSERT_EQ(f.resonances.size(), 1u);
-  EXPECT_TRUE(near(f.resonances[0].frequency_hz(), 95.4, kReportFrequency));
+  EXPECT_TRUE(near(f.resonances[0].frequency_Hz(), 95.4, kReportFrequency));
   ASSERT_EQ(f.antiresonances.size(), 1u);
   const AntiResonance& a = f.antiresonances[0];
-  EXPECT_TRUE(near(a.frequency_hz(), 41.1, kReportFrequency));
+  EXPECT_TRUE(near(a.frequency_Hz(), 41.1, kReportFrequency));
   EXPECT_TRUE(near(a.natural_frequency, std::sqrt(apa.k1 / apa.m), kExactFit));
   EXPECT_TRUE(near(a.damping, apa.c1 / (2.0 * std::sqrt(apa.k1 * apa.m)), 1e-5));
   EXPECT_FALSE(a.nonminimum_phase_model);
@@ -137,7 +137,7 @@ TEST(FrfFeatures, MirroredZeroIsFlaggedNonMinimumPhaseByBothVerdicts) {
   const FrfFeatures f = frf_features(omega, response(omega, [&](Complex s) { return apa.vs(s, true); }), o);
   ASSERT_EQ(f.antiresonances.size(), 1u);
   const AntiResonance& a = f.antiresonances[0];
-  EXPECT_TRUE(near(a.frequency_hz(), 41.1, kReportFrequency));
+  EXPECT_TRUE(near(a.frequency_Hz(), 41.1, kReportFrequency));
   EXPECT_TRUE(a.nonminimum_phase_model);
   EXPECT_GT(a.root.real(), 0.0);
   EXPECT_EQ(a.phase_verdict, PhaseVerdict::kNonMinimumPhase);
@@ -156,8 +156,8 @@ TEST(FrfFeatures, NoisyOverParameterizedFitKeepsOnlyTheRealFeatures) {
     const FrfFeatures f = frf_features(omega, h, o);
     ASSERT_EQ(f.resonances.size(), 1u) << "mirror " << mirror;
     ASSERT_EQ(f.antiresonances.size(), 1u) << "mirror " << mirror;
-    EXPECT_TRUE(near(f.resonances[0].frequency_hz(), 95.4, kReportFrequency));
-    EXPECT_TRUE(near(f.antiresonances[0].frequency_hz(), 41.1, kReportFrequency));
+    EXPECT_TRUE(near(f.resonances[0].frequency_Hz(), 95.4, kReportFrequency));
+    EXPECT_TRUE(near(f.antiresonances[0].frequency_Hz(), 41.1, kReportFrequency));
     EXPECT_EQ(f.antiresonances[0].nonminimum_phase_model, mirror);
     EXPECT_EQ(f.antiresonances[0].phase_verdict,
               mirror ? PhaseVerdict::kNonMinimumPhase : PhaseVerdict::kMinimumPhase);
@@ -177,10 +177,10 @@ TEST(FrfFeatures, HighPassedSensorVoltageReadsThePlateau) {
   EXPECT_EQ(f.static_gain_source, StaticGainSource::kDataPlateau);
   EXPECT_TRUE(near(f.static_gain, apa.static_gain_vs(), kReportGain));
   ASSERT_EQ(f.antiresonances.size(), 1u);
-  EXPECT_TRUE(near(f.antiresonances[0].frequency_hz(), 41.1, kReportFrequency));
+  EXPECT_TRUE(near(f.antiresonances[0].frequency_Hz(), 41.1, kReportFrequency));
 
   const HighPassFit hp = fit_high_pass(omega, h, kTwoPi * 3.0);
-  EXPECT_TRUE(near(hp.corner_hz(), 0.39, 0.02));  // the report's 0.39 Hz (2 digits)
+  EXPECT_TRUE(near(hp.corner_Hz(), 0.39, 0.02));  // the report's 0.39 Hz (2 digits)
   EXPECT_TRUE(near(hp.corner, wc, 0.01));          // within 1 % of 1/(RC): the plant is not flat to 3 Hz
   EXPECT_TRUE(near(hp.gain, apa.static_gain_vs(), 0.01));
 }
@@ -230,11 +230,11 @@ TEST(FrfFeatures, SecondOrderFitWithNoise) {
 TEST(FrfFeatures, FrfOverloadNamesSourceAndOutput) {
   const TwoDof apa;
   dsp::Frf frf;
-  frf.freq_hz = log_grid(1.0, 2000.0, 500) / kTwoPi;
+  frf.freq_Hz = log_grid(1.0, 2000.0, 500) / kTwoPi;
   frf.input = "u";
   frf.outputs = {"de", "Vs"};
-  frf.H = {response(kTwoPi * frf.freq_hz, [&](Complex s) { return apa.de(s); }),
-           response(kTwoPi * frf.freq_hz, [&](Complex s) { return apa.vs(s); })};
+  frf.H = {response(kTwoPi * frf.freq_Hz, [&](Complex s) { return apa.de(s); }),
+           response(kTwoPi * frf.freq_Hz, [&](Complex s) { return apa.vs(s); })};
   frf.provenance.source = "apa1.mat";
   FrfFeatureOptions o;
   o.fit.order = 3;

@@ -50,8 +50,8 @@ TEST(PeakPicking, FindsTheTwoBendingModesWithHalfPowerDamping) {
   // the accelerance weighting (s^2, peak at wn / sqrt(1 - 2 zeta^2)) move the peak of |H| by up to
   // ~0.2 % from wn: the method's own bias, not round-off.
   constexpr double kPeakBias = 3e-3;
-  EXPECT_TRUE(near(modes[0].frequency_hz(), 280.0, kPeakBias));
-  EXPECT_TRUE(near(modes[1].frequency_hz(), 412.0, kPeakBias));
+  EXPECT_TRUE(near(modes[0].frequency_Hz(), 280.0, kPeakBias));
+  EXPECT_TRUE(near(modes[1].frequency_Hz(), 412.0, kPeakBias));
   EXPECT_TRUE(near(modes[0].damping, 0.01, 0.05));
   EXPECT_TRUE(near(modes[1].damping, 0.015, 0.05));
 }
@@ -68,7 +68,7 @@ TEST(PeakPicking, ProminenceAndBandSelectModes) {
   o.min_omega = kTwoPi * 350.0;
   modes = peak_picking(omega, h, o);
   ASSERT_EQ(modes.size(), 1u);
-  EXPECT_TRUE(near(modes[0].frequency_hz(), 412.0, 3e-3));
+  EXPECT_TRUE(near(modes[0].frequency_Hz(), 412.0, 3e-3));
   o = PeakPickingOptions{};
   o.min_prominence = 1e6;
   EXPECT_TRUE(peak_picking(omega, h, o).empty());
@@ -80,8 +80,8 @@ TEST(PeakPicking, NoisyDataStillGivesBothModes) {
   const std::vector<Mode> modes = peak_picking(omega, hammer_frf(omega, model, 0.01, 3));
   // 1 % noise creates tiny local maxima; the prominence rule (6 dB) removes them.
   ASSERT_EQ(modes.size(), 2u);
-  EXPECT_TRUE(near(modes[0].frequency_hz(), 280.0, 4e-3));
-  EXPECT_TRUE(near(modes[1].frequency_hz(), 412.0, 4e-3));
+  EXPECT_TRUE(near(modes[0].frequency_Hz(), 280.0, 4e-3));
+  EXPECT_TRUE(near(modes[1].frequency_Hz(), 412.0, 4e-3));
   EXPECT_TRUE(near(modes[0].damping, 0.01, 0.15));
   EXPECT_TRUE(near(modes[1].damping, 0.015, 0.15));
 }
@@ -95,8 +95,8 @@ TEST(Lscf, StabilizationDiagramGivesBothModes) {
   o.max_order = 24;
   const LscfResult r = lscf(omega, hammer_frf(omega, model, 0.0, 0), o);
   ASSERT_EQ(r.modes.size(), 2u);
-  EXPECT_TRUE(near(r.modes[0].frequency_hz(), 280.0, 1e-4));
-  EXPECT_TRUE(near(r.modes[1].frequency_hz(), 412.0, 1e-4));
+  EXPECT_TRUE(near(r.modes[0].frequency_Hz(), 280.0, 1e-4));
+  EXPECT_TRUE(near(r.modes[1].frequency_Hz(), 412.0, 1e-4));
   EXPECT_TRUE(near(r.modes[0].damping, 0.01, 1e-2));
   EXPECT_TRUE(near(r.modes[1].damping, 0.015, 1e-2));
   EXPECT_GE(r.modes[0].stable_orders, o.min_stable_orders);
@@ -118,8 +118,8 @@ TEST(Lscf, NoisyDataAndSeveralOutputs) {
   o.max_order = 30;
   const LscfResult r = lscf(omega, h, o);
   ASSERT_EQ(r.modes.size(), 2u);
-  EXPECT_TRUE(near(r.modes[0].frequency_hz(), 280.0, 1e-3));
-  EXPECT_TRUE(near(r.modes[1].frequency_hz(), 412.0, 1e-3));
+  EXPECT_TRUE(near(r.modes[0].frequency_Hz(), 280.0, 1e-3));
+  EXPECT_TRUE(near(r.modes[1].frequency_Hz(), 412.0, 1e-3));
   EXPECT_TRUE(near(r.modes[0].damping, 0.01, 0.05));
   EXPECT_TRUE(near(r.modes[1].damping, 0.015, 0.05));
 }

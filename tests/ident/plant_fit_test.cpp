@@ -79,8 +79,8 @@ TEST(IffPlantFit, NoisyDataWithKnownCorner) {
   std::normal_distribution<double> n(0.0, 0.01 / std::sqrt(2.0));
   for (Eigen::Index k = 0; k < h.size(); ++k) h(k) *= std::complex<double>(1.0 + n(rng), n(rng));
   IffPlantFitOptions o;
-  o.fmin_hz = 20.0;
-  o.fmax_hz = 500.0;
+  o.fmin_Hz = 20.0;
+  o.fmax_Hz = 500.0;
   o.fixed_w_hpf = p.w_hpf;
   const IffPlantFit fit = fit_iff_plant(w, h, Vector(), o);
   EXPECT_DOUBLE_EQ(fit.w_hpf, p.w_hpf);
@@ -116,8 +116,8 @@ TEST(DelayedSecondOrderFit, RecoversMassSpringDamperWithDelay) {
   p.delay = 232e-6;
   const Vector w = grid();
   IffPlantFitOptions o;
-  o.fmin_hz = 20.0;
-  o.fmax_hz = 500.0;
+  o.fmin_Hz = 20.0;
+  o.fmax_Hz = 500.0;
   const DelayedSecondOrderFit fit = fit_delayed_second_order(w, p.response(w), Vector(), o);
   EXPECT_TRUE(near(fit.static_gain, p.static_gain, 1e-8));
   EXPECT_TRUE(near(fit.natural_frequency, p.natural_frequency, 1e-8));
@@ -145,15 +145,15 @@ TEST(IffPlantFit, BadInput) {
   EXPECT_TRUE(test::contains(test::input_error([&] { (void)fit_iff_plant(w, bad, Vector(), {}, src); }, "H"), "point 5"));
   test::input_error([&] { (void)fit_iff_plant(w, h, Vector::Ones(3), {}, src); }, "coherence");
   IffPlantFitOptions narrow;
-  narrow.fmin_hz = 200.0;
-  narrow.fmax_hz = 201.0;
+  narrow.fmin_Hz = 200.0;
+  narrow.fmax_Hz = 201.0;
   test::input_error([&] { (void)fit_iff_plant(w, h, Vector(), narrow, src); }, "H");
   IffPlantFitOptions o;
   o.fixed_w_hpf = -1.0;
   test::input_error([&] { (void)fit_iff_plant(w, h, Vector(), o); }, "fixed_w_hpf");
   // A band without a peak inside.
   IffPlantFitOptions edge;
-  edge.fmin_hz = 300.0;
+  edge.fmin_Hz = 300.0;
   test::input_error([&] { (void)fit_delayed_second_order(w, h, Vector(), edge, src); }, "H");
 }
 
@@ -163,7 +163,7 @@ TEST(IffPlantFit, BadInput) {
 TEST(ActuatorPlants, ScipyWelchFrfOfTheTwoDofModel) {
   const dsp::Frf frf = io::read_frf(test::fixture_path("ident/two_dof_welch_frf.csv"));
   const auto truth = nlohmann::json::parse(test::read_text(test::fixture_path("ident/two_dof_welch_truth.json")));
-  const Vector w = kTwoPi * frf.freq_hz;
+  const Vector w = kTwoPi * frf.freq_Hz;
   ActuatorPlantOptions o;  // 20 .. 500 Hz for d_e, 0 .. 500 Hz for Vs, coherence >= 0.5
   const ActuatorPlants p = fit_actuator_plants(w, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1], o, "two_dof_welch_frf.csv");
   ASSERT_TRUE(p.failures.empty()) << p.failures.front();

@@ -35,7 +35,7 @@ constexpr double kUffAbscissaRel = 1e-5;
 // Two outputs with a lightly damped mode (complex values over several decades) and coherence.
 dsp::Frf sample_frf(const Eigen::VectorXd& freq) {
   dsp::Frf frf;
-  frf.freq_hz = freq;
+  frf.freq_Hz = freq;
   frf.input = "u";
   frf.outputs = {"de", "Vs"};
   const Index n = freq.size();
@@ -82,7 +82,7 @@ void expect_exact(const dsp::Frf& got, const dsp::Frf& want, bool input_kept) {
   if (input_kept) {
     EXPECT_EQ(got.input, want.input);
   }
-  EXPECT_TRUE(all_near(got.freq_hz, want.freq_hz, kExact));
+  EXPECT_TRUE(all_near(got.freq_Hz, want.freq_Hz, kExact));
   ASSERT_EQ(got.H.size(), want.H.size());
   ASSERT_EQ(got.coherence.size(), want.coherence.size());
   for (size_t i = 0; i < want.H.size(); ++i) {
@@ -121,7 +121,7 @@ TEST(FrfCsv, ColumnsInAnyOrderCommentsAndNoCoherence) {
   ASSERT_EQ(frf.outputs, std::vector<std::string>{"a"});
   EXPECT_EQ(frf.H[0](0), std::complex<double>(3, 2));
   EXPECT_EQ(frf.H[0](1), std::complex<double>(5, -4e-3));
-  EXPECT_EQ(frf.freq_hz(1), 2.5);
+  EXPECT_EQ(frf.freq_Hz(1), 2.5);
 }
 
 TEST(FrfCsv, MalformedFilesNameFileAndColumn) {
@@ -199,7 +199,7 @@ TEST(FrfMat, MissingAndWrongVariablesAreNamed) {
 void expect_uff_round_trip(const dsp::Frf& back, const dsp::Frf& frf) {
   EXPECT_EQ(back.outputs, frf.outputs);
   EXPECT_EQ(back.input, frf.input);
-  EXPECT_TRUE(all_near(back.freq_hz, frf.freq_hz, Tolerance{kUffAbscissaRel, 1e-12}));
+  EXPECT_TRUE(all_near(back.freq_Hz, frf.freq_Hz, Tolerance{kUffAbscissaRel, 1e-12}));
   ASSERT_EQ(back.H.size(), 2u);
   ASSERT_EQ(back.coherence.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
@@ -260,7 +260,7 @@ TEST(FrfUff, UnitsLabelsAreHonouredOrRefused) {
   };
   write_lines();
   const dsp::Frf back = read_frf(file);
-  EXPECT_TRUE(test::near(back.freq_hz(1), 1e3 * frf.freq_hz(1), {1e-5, 0.0}));
+  EXPECT_TRUE(test::near(back.freq_Hz(1), 1e3 * frf.freq_Hz(1), {1e-5, 0.0}));
   EXPECT_TRUE(test::near(back.H[0](7), 1e-6 * frf.H[0](7), {1e-11, 0.0}));
   EXPECT_TRUE(test::near(back.H[1](7), frf.H[1](7), {1e-11, 0.0}));  // the second dataset is unlabelled
   relabel(10, "furlong");
@@ -277,7 +277,7 @@ TEST(FrfCsv, LabDialectsAndScipysWelchFile) {
   const fs::path file = dir.path() / "semi.csv";
   write_bytes(file, "freq [kHz];re_a;im_a\n0,5;1,5;-2\n1;3;4\n");
   const dsp::Frf frf = read_frf(file);
-  EXPECT_EQ(frf.freq_hz(0), 500.0);
+  EXPECT_EQ(frf.freq_Hz(0), 500.0);
   EXPECT_EQ(frf.H[0](0), std::complex<double>(1.5, -2.0));
   write_bytes(file, "freq_Hz;re_a;im_a\n1;2;3\n2;3\n");
   test::expect_input_error([&] { (void)read_frf(file); }, {"semi.csv", "line 3", "';'-separated (detected)"});
@@ -285,7 +285,7 @@ TEST(FrfCsv, LabDialectsAndScipysWelchFile) {
   const dsp::Frf w = read_frf(test::fixture_path("io/lab/welch_frf.csv"));
   const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("io/lab/expected.json")));
   ASSERT_EQ(w.outputs, (std::vector<std::string>{"d_e", "Vs"}));
-  ASSERT_EQ(static_cast<size_t>(w.freq_hz.size()), ref["freq_Hz"].size());
+  ASSERT_EQ(static_cast<size_t>(w.freq_Hz.size()), ref["freq_Hz"].size());
   for (size_t i = 0; i < 2; ++i) {
     const auto& e = ref["outputs"][w.outputs[i]];
     for (size_t k = 0; k < e["H"].size(); ++k) {
@@ -379,7 +379,7 @@ TEST(FrfUff, BinaryDataset58bBuiltByHand) {
   const dsp::Frf frf = read_frf(file);
   ASSERT_EQ(frf.outputs, (std::vector<std::string>{"accel 11", "12-Y"}));  // label, else node/direction
   EXPECT_EQ(frf.input, "7+Z");
-  EXPECT_TRUE(all_near(frf.freq_hz, Eigen::Map<const Eigen::VectorXd>(x_even.data(), 5), kExact));
+  EXPECT_TRUE(all_near(frf.freq_Hz, Eigen::Map<const Eigen::VectorXd>(x_even.data(), 5), kExact));
   for (size_t k = 0; k < y1.size(); ++k) {
     EXPECT_EQ(frf.H[0](static_cast<Index>(k)), y1[k]);  // binary: bit-exact
     EXPECT_EQ(frf.H[1](static_cast<Index>(k)), y2[k]);
@@ -393,7 +393,7 @@ TEST(FrfUff, BinaryDataset58bBuiltByHand) {
     write_bytes(file, dataset_58b(true, false, x_bytes, 3, "NONE", x_uneven, y2));
     const dsp::Frf be = read_frf_uff58(file);
     EXPECT_EQ(be.outputs, std::vector<std::string>{"3-Y"});
-    EXPECT_TRUE(all_near(be.freq_hz, Eigen::Map<const Eigen::VectorXd>(x_uneven.data(), 5), kExact));
+    EXPECT_TRUE(all_near(be.freq_Hz, Eigen::Map<const Eigen::VectorXd>(x_uneven.data(), 5), kExact));
     for (size_t k = 0; k < y2.size(); ++k) EXPECT_EQ(be.H[0](static_cast<Index>(k)), y2[k]);
   }
 }
@@ -455,11 +455,11 @@ TEST(FrfUff, GridsAndReferencesMustAgree) {
   dsp::Frf one = sample_frf(even_grid(11));
   write_frf_uff58(one, a);
   one.outputs = {"x", "y"};
-  one.freq_hz *= 2.0;
+  one.freq_Hz *= 2.0;
   write_frf_uff58(one, b);
   write_bytes(both, test::read_text(a) + test::read_text(b));
   EXPECT_TRUE(contains(input_error([&] { (void)read_frf(both); }), "frequency grid"));
-  one.freq_hz /= 2.0;
+  one.freq_Hz /= 2.0;
   one.input = "v";
   write_frf_uff58(one, b);
   write_bytes(both, test::read_text(a) + test::read_text(b));

@@ -38,13 +38,13 @@ TEST(DampedPlantStudy, IdentifiedPolesFollowTheRootLocus) {
     if (p.gain > 0.0) {
       EXPECT_LT(p.frf_model_relative_rms, 0.03);
     }
-    EXPECT_GT(p.identified_frequency_hz, 50.0);
-    EXPECT_LT(p.identified_frequency_hz, 100.0);
+    EXPECT_GT(p.identified_frequency_Hz, 50.0);
+    EXPECT_LT(p.identified_frequency_Hz, 100.0);
   }
   EXPECT_TRUE(s.within_tolerance);
   EXPECT_LT(s.max_relative_error, 0.05);
   // Open loop: the bench's lightly damped 95 Hz resonance.
-  EXPECT_TRUE(test::near(s.points[0].identified_frequency_hz, s.points[0].model_frequency_hz, 0.005));
+  EXPECT_TRUE(test::near(s.points[0].identified_frequency_Hz, s.points[0].model_frequency_Hz, 0.005));
   EXPECT_LT(s.points[0].identified_damping, 0.02);
   // Damping grows with the gain up to the optimum, and the pole moves to lower frequencies
   // (report section 2.6).
@@ -52,7 +52,7 @@ TEST(DampedPlantStudy, IdentifiedPolesFollowTheRootLocus) {
   EXPECT_GT(s.points[1].identified_damping, 5.0 * s.points[0].identified_damping);
   EXPECT_GT(s.points[2].identified_damping, s.points[1].identified_damping);
   EXPECT_GT(s.points[2].identified_damping, 0.3);
-  EXPECT_LT(s.points[2].identified_frequency_hz, s.points[1].identified_frequency_hz);
+  EXPECT_LT(s.points[2].identified_frequency_Hz, s.points[1].identified_frequency_Hz);
   // The model pole is a closed-loop pole of linear_model() (delay by a 6th-order Pade
   // approximant) with g K0(s) in positive feedback u = u' + g K0 Vs, computed here independently of
   // the root-locus code.

@@ -45,8 +45,8 @@ struct TuningOptions {
   // added_mass must be 0 (the mass is `mass`).
   TwoDofBench bench;
   // Frequency band used, Hz; 0 = from the lowest / to the highest point. Points at 0 Hz are never used.
-  double fmin_hz = 0.0;
-  double fmax_hz = 0.0;
+  double fmin_Hz = 0.0;
+  double fmax_Hz = 0.0;
   // Points where the coherence of either output is known and below this are left out.
   double min_coherence = 0.0;
   // ke / ka imposed during the refinement (the initial procedure always uses it, or 2 when 0);

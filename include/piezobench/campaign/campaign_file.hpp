@@ -99,13 +99,13 @@ struct AnalysisSettings {
   // Band of the FRF features, the tuning and the IFF plant fit. Below ~10 Hz the stacks' creep and
   // hysteresis raise the small-signal gain of noise-excited FRFs by 10-30 % (virtual bench), so the
   // stiffness line is read between 20 Hz and the resonance.
-  double fmin_hz = 20.0;
-  double fmax_hz = 500.0;        // above, the force sensor's anti-aliasing filter and the node relaxation, which eq. 2.3 lacks
-  double hpf_fmax_hz = 5.0;      // band below which the high-pass corner is fitted
-  double damped_fmin_hz = 5.0;   // band of the damped-plant second-order fits
-  double damped_fmax_hz = 400.0;
-  double hammer_fmin_hz = 100.0; // band searched for flexible modes
-  double hammer_fmax_hz = 1000.0;
+  double fmin_Hz = 20.0;
+  double fmax_Hz = 500.0;        // above, the force sensor's anti-aliasing filter and the node relaxation, which eq. 2.3 lacks
+  double hpf_fmax_Hz = 5.0;      // band below which the high-pass corner is fitted
+  double damped_fmin_Hz = 5.0;   // band of the damped-plant second-order fits
+  double damped_fmax_Hz = 400.0;
+  double hammer_fmin_Hz = 100.0; // band searched for flexible modes
+  double hammer_fmax_Hz = 1000.0;
   long fit_order = 6;            // vector-fitting order of the FRF features
   int iff_unit = 0;              // unit whose IFF data make the batch's `iff` result (0 = first with IFF data)
   control::IffControllerParams controller;  // eq. 2.4 (iff_controller = {gain, hpf_Hz, lpf_Hz, robust_Hz})

@@ -123,7 +123,7 @@ struct NmpEvidence {
 
 // The resistor high-pass of the force sensor's read-out.
 struct HighPassCorner {
-  std::optional<double> first_order_fit_Hz;  // first-order fit below hpf_fmax_hz
+  std::optional<double> first_order_fit_Hz;  // first-order fit below hpf_fmax_Hz
   long first_order_fit_points = 0;
   std::optional<double> r_c_Hz;              // 1 / (2 pi R C_sensor) when C_sensor is measured
   std::optional<double> iff_plant_fit_Hz;    // eq. 2.3 fitted down to the lowest frequency
@@ -164,7 +164,7 @@ struct Model2DofFit {
 
 // u -> Vs at low frequency with or without the resistor across the sensor stack (report section
 // 2.5, Figure 2.7): Welch with segments of half the record, a first-order high-pass fitted below
-// hpf_fmax_hz. A corner below a third of the lowest line is not observable in the record.
+// hpf_fmax_Hz. A corner below a third of the lowest line is not observable in the record.
 struct LowFrequencyVs {
   RecordProvenance provenance;
   dsp::Frf frf;                         // u -> Vs

@@ -26,7 +26,7 @@ struct SuperElementFitOptions {
   double moving_mass = 5.7;      // kg, on the moving interface
   double amplifier_gain = 20.0;  // V/V
   double modal_damping = 0.02;   // every mode of the bench model
-  double band_min_hz = 5.0;      // tuning band: from here ...
+  double band_min_Hz = 5.0;      // tuning band: from here ...
   double band_fraction = 0.5;    // ... to this fraction of the lower of the two resonances
   // InputError (source "superelement fit") for values out of range.
   void validate() const;
@@ -35,12 +35,12 @@ struct SuperElementFitOptions {
 struct SuperElementFit {
   double ga = 0.0;                 // N/V
   double gs = 0.0;                 // V/m
-  double band_lo_hz = 0.0, band_hi_hz = 0.0;
-  double resonance_hz = 0.0;       // first peak of the model's u -> d_e
-  double antiresonance_hz = 0.0;   // dip of the model's u -> V_s below the resonance (0: none)
+  double band_lo_Hz = 0.0, band_hi_Hz = 0.0;
+  double resonance_Hz = 0.0;       // first peak of the model's u -> d_e
+  double antiresonance_Hz = 0.0;   // dip of the model's u -> V_s below the resonance (0: none)
   double de_error_dB = 0.0;        // median |20 log10 model/measured| of u -> d_e, band_lo .. 2 x resonance
   double vs_error_dB = 0.0;        // same for u -> V_s
-  Eigen::VectorXd freq_hz;         // the measured frequencies up to the measured band's end
+  Eigen::VectorXd freq_Hz;         // the measured frequencies up to the measured band's end
   Eigen::VectorXcd de, vs;         // the tuned model there: u -> d_e (m/V), u -> V_s (V/V)
 };
 

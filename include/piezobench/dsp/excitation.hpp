@@ -38,7 +38,7 @@ struct Excitation {
   bool scaled = false;           // v was scaled by `scale` < 1 to fit the bounds
   double scale = 1.0;
   Eigen::Index clipped = 0;      // samples clamped (BoundsPolicy::kClip)
-  Eigen::VectorXd lines_hz;      // multisine: the excited lines; noise: the first and last line
+  Eigen::VectorXd lines_Hz;      // multisine: the excited lines; noise: the first and last line
   std::uint64_t seed = 0;        // random signals: the seed used
 };
 
@@ -71,7 +71,7 @@ struct MultisineOptions {
   double sample_rate = 10e3;         // Hz, > 0
   Eigen::Index period_samples = 0;   // N >= 2
   Eigen::Index periods = 1;          // >= 1
-  std::vector<double> lines_hz;      // each k * sample_rate / N with 1 <= k < N/2 (1e-9 relative), distinct
+  std::vector<double> lines_Hz;      // each k * sample_rate / N with 1 <= k < N/2 (1e-9 relative), distinct
   std::vector<double> amplitudes;    // relative amplitudes (>= 0, one per line); empty = all equal
   double rms = 0.1;                  // V, rms of the varying part before any scaling
   double offset = 0.0;               // V

@@ -21,10 +21,10 @@ struct FrfProvenance {
 };
 
 struct Frf {
-  Eigen::VectorXd freq_hz;                 // Hz, >= 0, strictly increasing
+  Eigen::VectorXd freq_Hz;                 // Hz, >= 0, strictly increasing
   std::string input;                       // input channel name
   std::vector<std::string> outputs;        // output channel names
-  std::vector<Eigen::VectorXcd> H;         // H[i](k): output i / input at freq_hz(k)
+  std::vector<Eigen::VectorXcd> H;         // H[i](k): output i / input at freq_Hz(k)
   std::vector<Eigen::VectorXd> coherence;  // same layout as H, in [0, 1]; empty vector = unknown
   FrfProvenance provenance;
 
@@ -41,8 +41,8 @@ struct Frf {
 // anti-resonance) does not split it; isolated noisy bins outside do not widen it. Without any
 // coherence the whole positive grid is returned (`from_coherence` false).
 struct FrequencyBand {
-  double fmin_hz = 0.0;
-  double fmax_hz = 0.0;
+  double fmin_Hz = 0.0;
+  double fmax_Hz = 0.0;
   bool from_coherence = false;
 };
 // InputError (source: the FRF's) when no bin reaches min_coherence: "the input did not excite the

@@ -53,15 +53,15 @@ struct WelchOptions {
   [[nodiscard]] Eigen::Index noverlap() const;
 };
 
-// The settings `run` and `frf` share for a record of `samples` at `sample_rate_hz` (one procedure,
-// one set of defaults): segments of 1 / resolution_hz seconds (4 s: 0.25 Hz bins) limited to a
+// The settings `run` and `frf` share for a record of `samples` at `sample_rate_Hz` (one procedure,
+// one set of defaults): segments of 1 / resolution_Hz seconds (4 s: 0.25 Hz bins) limited to a
 // quarter of the record (at least 7 averages with 50 % overlap) and to at least 256 samples; the
 // mean removed per segment (a linear-trend removal would distort the lowest bins); hann-periodic,
 // 50 % overlap, H1. InputError (prefixed with `source`) for a non-positive rate or resolution.
-[[nodiscard]] Eigen::Index segment_length_for_record(Eigen::Index samples, double sample_rate_hz,
-                                                     double resolution_hz = 0.25, const std::string& source = "");
-[[nodiscard]] WelchOptions welch_options_for_record(Eigen::Index samples, double sample_rate_hz,
-                                                    double resolution_hz = 0.25, const std::string& source = "");
+[[nodiscard]] Eigen::Index segment_length_for_record(Eigen::Index samples, double sample_rate_Hz,
+                                                     double resolution_Hz = 0.25, const std::string& source = "");
+[[nodiscard]] WelchOptions welch_options_for_record(Eigen::Index samples, double sample_rate_Hz,
+                                                    double resolution_Hz = 0.25, const std::string& source = "");
 
 // A named, borrowed record of samples (the caller keeps the storage alive during the call).
 struct Channel {
@@ -75,7 +75,7 @@ Channel channel(std::string name, Eigen::VectorXd&& samples) = delete;
 
 // One-sided spectral densities of one input and several outputs.
 struct CrossSpectra {
-  Eigen::VectorXd freq_hz;              // k * fs / nfft, k = 0 .. floor(nfft/2)
+  Eigen::VectorXd freq_Hz;              // k * fs / nfft, k = 0 .. floor(nfft/2)
   std::string input;                    // input channel name
   std::vector<std::string> outputs;     // output channel names
   Eigen::VectorXd Suu;                  // input PSD, [u]^2/Hz
@@ -90,11 +90,11 @@ struct CrossSpectra {
 };
 
 // All spectra in one pass over the data. Preconditions checked (InputError, prefixed with
-// `source`, field = the channel name): sample_rate_hz finite and > 0 (field "sample rate"), every
+// `source`, field = the channel name): sample_rate_Hz finite and > 0 (field "sample rate"), every
 // output as long as the input, every sample finite (the message gives the first bad index), the
 // record at least nfft samples long. Zero outputs are allowed (then only Suu is computed).
 CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& outputs,
-                           double sample_rate_hz, const WelchOptions& options,
+                           double sample_rate_Hz, const WelchOptions& options,
                            const std::string& source = "");
 
 // H1 or H2 and the coherence of every output. InputError (field = input name) when the input has
@@ -109,12 +109,12 @@ struct FrfEstimate {
   Frf frf;               // options.estimator; provenance filled in (source, window, nfft, ...)
   CrossSpectra spectra;  // the raw densities it was computed from
 };
-FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_hz,
+FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_Hz,
                          const WelchOptions& options, const std::string& source = "");
 
 // Single-channel conveniences (same conventions): scipy welch(x) and csd(x, y).
-Eigen::VectorXd welch_psd(const Eigen::VectorXd& x, double sample_rate_hz, const WelchOptions& options);
-Eigen::VectorXcd welch_csd(const Eigen::VectorXd& x, const Eigen::VectorXd& y, double sample_rate_hz,
+Eigen::VectorXd welch_psd(const Eigen::VectorXd& x, double sample_rate_Hz, const WelchOptions& options);
+Eigen::VectorXcd welch_csd(const Eigen::VectorXd& x, const Eigen::VectorXd& y, double sample_rate_Hz,
                            const WelchOptions& options);
 
 }  // namespace piezobench::dsp

@@ -30,7 +30,7 @@ struct DominantPole {
   double damping = 0.0;            // -Re pole / |pole|
   double peak = 0.0;               // its peak contribution |r| / |Re p|, data units
   VectorFittingResult fit;         // the model it comes from (its relative_rms_error is the fit's error)
-  [[nodiscard]] double frequency_hz() const;
+  [[nodiscard]] double frequency_Hz() const;
 };
 
 // omega, h as for vector_fit (one output). InputError as vector_fit; NumericalError when the fit

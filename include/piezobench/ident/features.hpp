@@ -9,7 +9,7 @@
 // the measured phase across the anti-resonance (a minimum-phase zero pair raises the phase by
 // 180 deg, a mirrored one lowers it by 180 deg, as in report section 2.3).
 //
-// All frequencies are rad/s unless the name says _hz; responses are complex, output / input.
+// All frequencies are rad/s unless the name says _Hz; responses are complex, output / input.
 #include <string>
 #include <vector>
 
@@ -37,7 +37,7 @@ struct ModalFeature {
   Complex root;                    // rad/s, the member of the pair with Im > 0
   double natural_frequency = 0.0;  // |root|, rad/s
   double damping = 0.0;            // |Re root| / |root| (positive also for a mirrored zero)
-  [[nodiscard]] double frequency_hz() const;
+  [[nodiscard]] double frequency_Hz() const;
 };
 
 struct AntiResonance : ModalFeature {
@@ -94,7 +94,7 @@ struct HighPassFit {
   double corner = 0.0;              // rad/s
   double gain = 0.0;                // high-frequency gain g, signed
   double relative_rms_error = 0.0;  // rms |model - data| / rms |data| over the fitted points
-  [[nodiscard]] double corner_hz() const;
+  [[nodiscard]] double corner_Hz() const;
 };
 HighPassFit fit_high_pass(const Vector& omega, const CVector& h, double max_omega = 0.0);
 
@@ -119,7 +119,7 @@ struct SecondOrderFit {
   double feedthrough = 0.0;         // d of the vector-fitting model (0 for nls)
   double relative_rms_error = 0.0;
   int iterations = 0;
-  [[nodiscard]] double frequency_hz() const;
+  [[nodiscard]] double frequency_Hz() const;
 };
 SecondOrderFit fit_second_order(const Vector& omega, const CVector& h,
                                 const SecondOrderFitOptions& options = {});

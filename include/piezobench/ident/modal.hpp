@@ -28,7 +28,7 @@ struct Mode {
   double natural_frequency = 0.0;  // rad/s
   double damping = 0.0;
   Index stable_orders = 0;         // LSCF: length of the chain of stable poles; peak picking: 0
-  [[nodiscard]] double frequency_hz() const;
+  [[nodiscard]] double frequency_Hz() const;
 };
 
 struct PeakPickingOptions {

@@ -32,9 +32,9 @@
 namespace piezobench::ident {
 
 struct IffPlantFitOptions {
-  double fmin_hz = 0.0;       // band used (0 = from the lowest positive frequency)
-  double fmax_hz = 1000.0;    // 0 = up to the highest
-  double hpf_fmax_hz = 5.0;   // points below this start the high-pass corner
+  double fmin_Hz = 0.0;       // band used (0 = from the lowest positive frequency)
+  double fmax_Hz = 1000.0;    // 0 = up to the highest
+  double hpf_fmax_Hz = 5.0;   // points below this start the high-pass corner
   double min_coherence = 0.0; // points with a known coherence below this are left out
   bool fit_delay = true;      // false: delay fixed at 0
   double fixed_w_hpf = 0.0;   // rad/s; > 0: the high-pass corner is not fitted but set to this
@@ -93,21 +93,21 @@ struct DelayedSecondOrderFit {
   [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
 };
 
-// omega (rad/s, increasing) and h as for fit_iff_plant; options.fmin_hz/fmax_hz/min_coherence,
+// omega (rad/s, increasing) and h as for fit_iff_plant; options.fmin_Hz/fmax_Hz/min_coherence,
 // fit_delay and max_iterations apply (the high-pass options do not). InputError for bad data,
 // fewer than 8 usable points or no peak inside the band.
 DelayedSecondOrderFit fit_delayed_second_order(const lti::Vector& omega, const lti::CVector& h, const lti::Vector& coherence,
                                                const IffPlantFitOptions& options = {}, const std::string& source = "");
 
 // Both plants of an actuator's FRFs u -> d_e and u -> Vs, fitted as `run` and `model tune` do (one
-// procedure): u -> d_e by fit_delayed_second_order on [fmin_hz, fmax_hz], u -> Vs by fit_iff_plant
-// on [iff_fmin_hz, fmax_hz] (down to the lowest frequency by default, for the high-pass corner),
+// procedure): u -> d_e by fit_delayed_second_order on [fmin_Hz, fmax_Hz], u -> Vs by fit_iff_plant
+// on [iff_fmin_Hz, fmax_Hz] (down to the lowest frequency by default, for the high-pass corner),
 // both on the points with a coherence of at least min_coherence and the delay fitted.
 struct ActuatorPlantOptions {
-  double fmin_hz = 20.0;         // band of the d_e fit
-  double fmax_hz = 500.0;        // band of both fits
-  double iff_fmin_hz = 0.0;      // lowest frequency of the Vs fit
-  double hpf_fmax_hz = 5.0;      // points below this start the high-pass corner
+  double fmin_Hz = 20.0;         // band of the d_e fit
+  double fmax_Hz = 500.0;        // band of both fits
+  double iff_fmin_Hz = 0.0;      // lowest frequency of the Vs fit
+  double hpf_fmax_Hz = 5.0;      // points below this start the high-pass corner
   double fixed_w_hpf = 0.0;      // rad/s; > 0: the high-pass corner is known (1 / (R C_sensor))
   double min_coherence = 0.5;
   void validate() const;         // InputError (source "actuator plant options")

@@ -75,11 +75,11 @@ struct DampedPlantStudyOptions {
 struct DampedPlantPoint {
   double gain = 0.0;
   lti::Complex identified_pole;        // rad/s, Im > 0
-  double identified_frequency_hz = 0.0;
+  double identified_frequency_Hz = 0.0;
   double identified_damping = 0.0;
   double fit_relative_rms_error = 0.0; // of the vector fit
   lti::Complex second_order_pole;      // rad/s, Im >= 0: the report-style second-order fit
-  double second_order_frequency_hz = 0.0;
+  double second_order_frequency_Hz = 0.0;
   double second_order_damping = 0.0;
   double second_order_relative_error = 0.0;  // |second order - model| / |model|
   double second_order_rms_error = 0.0;       // relative rms of that fit
@@ -88,7 +88,7 @@ struct DampedPlantPoint {
   // with nfft = 10000, whose lines are 1 Hz apart; the identified pole is not affected).
   double frf_model_relative_rms = 0.0;
   lti::Complex model_pole;             // rad/s, the root locus's resonance branch at this gain
-  double model_frequency_hz = 0.0;
+  double model_frequency_Hz = 0.0;
   double model_damping = 0.0;
   double relative_error = 0.0;         // |identified - model| / |model|
   double mean_coherence = 0.0;         // over the fit band
