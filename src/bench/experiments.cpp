@@ -174,10 +174,15 @@ io::TimeSeries stroke(BenchRunner& runner, const UnitTruth& unit, const Experime
 }
 
 // A record of the open-loop channels u, Va, de (and Vs when `with_vs`) from the runner's columns.
-io::TimeSeries open_loop_record(const Eigen::MatrixXd& y, double fs, bool with_vs) {
-  io::TimeSeries ts = with_vs ? make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, y.rows(), fs, true)
-                              : make_record({"u", "Va", "de"}, {"V", "V", "m"}, y.rows(), fs, true);
-  ts.data = with_vs ? y : Eigen::MatrixXd(y.leftCols(3));
+io::TimeSeries open_loop_record(Eigen::MatrixXd&& y, double fs, bool with_vs) {
+  io::TimeSeries ts = with_vs ? make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, 0, fs, false)
+                              : make_record({"u", "Va", "de"}, {"V", "V", "m"}, 0, fs, false);
+  ts.t = Eigen::VectorXd::LinSpaced(y.rows(), 0.0, static_cast<double>(y.rows() - 1) / fs);
+  if (with_vs) {
+    ts.data = std::move(y);  // a 100 s record is 32 MB: moved, not copied
+  } else {
+    ts.data = y.leftCols(3);
+  }
   return ts;
 }
 
@@ -204,7 +209,7 @@ io::TimeSeries hysteresis(BenchRunner& runner, const UnitTruth& unit, const Expe
   const dsp::Excitation ex = dsp::offset_sine(s, bounds);
   Eigen::MatrixXd y;
   runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kHysteresis, 0)), y, progress);
-  io::TimeSeries ts = open_loop_record(y, b.sample_rate, false);
+  io::TimeSeries ts = open_loop_record(std::move(y), b.sample_rate, false);
   common_settings(ts, Experiment::kHysteresis, unit, b, seed, &runner);
   ts.settings["amplitude_V"] = amplitude;
   ts.settings["offset_V"] = offset;
@@ -272,7 +277,7 @@ io::TimeSeries frf_noise(BenchRunner& runner, const UnitTruth& unit, const Exper
   const dsp::Excitation& ex = noise.excitation;
   Eigen::MatrixXd y;
   runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 0)), y, progress);
-  io::TimeSeries ts = open_loop_record(y, b.sample_rate, true);
+  io::TimeSeries ts = open_loop_record(std::move(y), b.sample_rate, true);
   common_settings(ts, Experiment::kFrfNoise, unit, b, seed, &runner);
   ts.settings["duration_s"] = duration;
   ts.settings["rms_V"] = no.rms;
@@ -305,7 +310,7 @@ io::TimeSeries frf_sweep(BenchRunner& runner, const UnitTruth& unit, const Exper
   check_range(ex.u, b, fmt::format("a sweep of {:g} V amplitude at the stacks", va_amplitude));
   Eigen::MatrixXd y;
   runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kFrfSweep, 0)), y, progress);
-  io::TimeSeries ts = open_loop_record(y, b.sample_rate, true);
+  io::TimeSeries ts = open_loop_record(std::move(y), b.sample_rate, true);
   common_settings(ts, Experiment::kFrfSweep, unit, b, seed, &runner);
   ts.settings["duration_s"] = duration;
   ts.settings["f0_Hz"] = so.f_start;

@@ -113,8 +113,9 @@ void copy_real_vector(const matvar_t& var, const std::string& source, const std:
 // A char row as a string; InputError naming `field` otherwise.
 [[nodiscard]] std::string to_text(const matvar_t& var, const std::string& source, const std::string& field);
 
-// Builders for writing (the returned variables own copies of their data).
-[[nodiscard]] MatVarPtr make_real_column(const std::string& name, const Eigen::VectorXd& v);
+// Builders for writing (the returned variables own copies of their data, except make_real_column's).
+// A view of v's data, not a copy (a 100 s record's channel is 8 MB): write it before v changes.
+[[nodiscard]] MatVarPtr make_real_column(const std::string& name, const Eigen::Ref<const Eigen::VectorXd>& v);
 [[nodiscard]] MatVarPtr make_complex_column(const std::string& name, const Eigen::VectorXcd& v);
 [[nodiscard]] MatVarPtr make_scalar(const std::string& name, double v);
 [[nodiscard]] MatVarPtr make_text(const std::string& name, const std::string& text);
