@@ -183,6 +183,31 @@ void bind_result_classes(py::module_& m) {
     typed(c);
   }
   {
+    py::class_<bench::TrackingFigures> c(m, "TrackingFigures", "One waveform of the tracking experiment (bench/tracking.hpp).");
+    c.def_readonly("width_open", &bench::TrackingFigures::width_open, "hysteresis width / stroke, without the feedforward")
+        .def_readonly("width_ff", &bench::TrackingFigures::width_ff, "the same with it")
+        .def_readonly("rms_open", &bench::TrackingFigures::rms_open, "m, rms tracking error without")
+        .def_readonly("rms_ff", &bench::TrackingFigures::rms_ff, "m, with")
+        .def_readonly("stroke_open", &bench::TrackingFigures::stroke_open, "m")
+        .def_property_readonly("rms_reduction", &bench::TrackingFigures::rms_reduction, "rms_open / rms_ff");
+    typed(c);
+  }
+  {
+    py::class_<TrackingAnalysis> c(m, "TrackingAnalysis", "The tracking record: d_e against the command without and with the inverse "
+                                                          "hysteresis feedforward (docs/hysteresis.md).");
+    c.def_readonly("sine", &TrackingAnalysis::sine, "campaign.TrackingFigures of the 1 Hz sine")
+        .def_readonly("triangle", &TrackingAnalysis::triangle, "campaign.TrackingFigures of the triangle")
+        .def_readonly("amplitude", &TrackingAnalysis::amplitude, "V")
+        .def_readonly("feedforward", &TrackingAnalysis::feedforward, "\"identified\" (from the open run) or \"given\"")
+        .def_readonly("clamped_samples", &TrackingAnalysis::clamped_samples)
+        .def_readonly("provenance", &TrackingAnalysis::provenance)
+        .def_readonly("sine_open", &TrackingAnalysis::sine_open, "campaign.Curve: x command [V], y d_e [m]")
+        .def_readonly("sine_ff", &TrackingAnalysis::sine_ff)
+        .def_readonly("triangle_open", &TrackingAnalysis::triangle_open)
+        .def_readonly("triangle_ff", &TrackingAnalysis::triangle_ff);
+    typed(c);
+  }
+  {
     py::class_<UnitAnalysis> c(m, "UnitAnalysis", R"(One unit's results (campaign/results.hpp): the numbers the batch and the
 acceptance use (SI: m, F, N/m, m/V; frequencies in Hz; None = not available), the FRF analysis, the
 tuned 2-DoF model, the damped plants, and the acceptance (accepted, reasons). json() is the unit's
@@ -206,6 +231,7 @@ entry of results.json (every analysis, in the units its keys name).)");
         .def_readonly("frf_analysis", &UnitAnalysis::frf_analysis, "campaign.FrfAnalysis or None")
         .def_readonly("model_2dof", &UnitAnalysis::model_2dof, "campaign.Model2DofFit or None")
         .def_readonly("damped", &UnitAnalysis::damped, "list of campaign.DampedPlant, by gain")
+        .def_readonly("tracking", &UnitAnalysis::tracking, "campaign.TrackingAnalysis or None")
         .def_readonly("not_measured", &UnitAnalysis::not_measured, "experiments the campaign does not list")
         .def_readonly("failed", &UnitAnalysis::failed, "one line per analysis that failed")
         .def_readonly("accepted", &UnitAnalysis::accepted, "the acceptance")
@@ -353,7 +379,7 @@ void bind_campaign(py::module_& m) {
       "write_demo",
       [](const std::string& dir, std::uint64_t seed, bool fast, const std::vector<int>& units,
          const std::vector<double>& hysteresis_amplitudes, const std::vector<double>& iff_gains, int iff_unit,
-         int threads) {
+         int tracking_unit, int threads) {
         DemoOptions o;
         o.seed = seed;
         o.fast = fast;
@@ -361,6 +387,7 @@ void bind_campaign(py::module_& m) {
         o.hysteresis_amplitudes = hysteresis_amplitudes;
         o.iff_gains = iff_gains;
         o.iff_unit = iff_unit;
+        o.tracking_unit = tracking_unit;
         o.threads = threads;
         auto f = without_gil([&] { return write_demo_campaign(dir, o); });
         py::dict d;
@@ -373,9 +400,10 @@ void bind_campaign(py::module_& m) {
       },
       arg("dir"), arg("seed") = DemoOptions{}.seed, arg("fast") = DemoOptions{}.fast, arg("units") = DemoOptions{}.units,
       arg("hysteresis_amplitudes") = DemoOptions{}.hysteresis_amplitudes, arg("iff_gains") = DemoOptions{}.iff_gains,
-      arg("iff_unit") = DemoOptions{}.iff_unit, arg("threads") = DemoOptions{}.threads,
+      arg("iff_unit") = DemoOptions{}.iff_unit, arg("tracking_unit") = DemoOptions{}.tracking_unit, arg("threads") = DemoOptions{}.threads,
       "Simulates the report's campaign on the virtual bench into DIR (data files, campaign.toml,\n"
-      "data/truth.json): Result(campaign, truth, data). fast = shorter records for tests.");
+      "data/truth.json): Result(campaign, truth, data). fast = shorter records for tests; tracking_unit: the unit\n"
+      "with a tracking record (0: none).");
 }
 
 }  // namespace piezobench::python

@@ -55,6 +55,12 @@ def test_demo_campaign_results_agree_with_the_truth(demo):
     u = unit.to_dict()
     assert u["k1"] == unit.k1 and u["frf_analysis"]["hpf"]["corner_Hz"] == unit.frf_analysis.hpf.corner_Hz
     assert r.unit(1).id == 1
+    # The tracking record of the demo's unit 1: the inverse feedforward of the unit's hysteresis model.
+    t = unit.tracking
+    assert isinstance(t, campaign.TrackingAnalysis) and t.feedforward == "given" and t.amplitude == 80.0
+    assert t.sine.width_open > 0.15 and t.sine.width_ff < 0.03 and t.sine.rms_reduction >= 5.0
+    assert t.triangle.rms_ff * 1e6 == pytest.approx(d["units"][0]["tracking"]["triangle"]["rms_ff_um"], rel=1e-12)
+    assert len(t.sine_open.x) == len(t.sine_ff.y) > 100
     with pytest.raises(pb.InputError) as e:
         r.unit(7)
     assert e.value.field == "id"

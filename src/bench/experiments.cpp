@@ -443,9 +443,13 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
   ts.settings["target_slope_m_per_V"] = model.gain * model.reference_slope;
   ts.settings["target_intercept_m"] = model.offset + model.gain * model.reference_intercept;
   // The figures over the last periods - 1 periods of each waveform (the first one settles the loop).
-  const Eigen::Index per = n_wave / periods;
-  const TrackingFigures sine = tracking_figures(ts, n_ramp + per, n_ramp + n_wave);
-  const TrackingFigures tri = tracking_figures(ts, n_ramp + n_wave + per, n_ramp + 2 * n_wave);
+  const TrackingLayout layout = tracking_layout(ts);
+  const auto figures = [&](Eigen::Index begin, Eigen::Index end) {
+    const auto col = [&](Eigen::Index j) { return std::span<const double>(ts.data.col(j).data() + begin, static_cast<std::size_t>(end - begin)); };
+    return tracking_figures(col(0), col(2), col(4), layout.target_slope, layout.target_intercept);
+  };
+  const TrackingFigures sine = figures(layout.sine_begin, layout.sine_end);
+  const TrackingFigures tri = figures(layout.triangle_begin, layout.triangle_end);
   for (const auto& [name, f] : {std::pair<const char*, const TrackingFigures&>{"sine", sine}, {"triangle", tri}}) {
     const std::string w(name);
     ts.settings["width_open_" + w] = f.width_open;
@@ -454,8 +458,8 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
     ts.settings["rms_ff_" + w + "_m"] = f.rms_ff;
     ts.settings["stroke_open_" + w + "_m"] = f.stroke_open;
   }
-  ts.settings["window_sine_samples"] = fmt::format("{}..{}", n_ramp + per, n_ramp + n_wave);
-  ts.settings["window_triangle_samples"] = fmt::format("{}..{}", n_ramp + n_wave + per, n_ramp + 2 * n_wave);
+  ts.settings["window_sine_samples"] = fmt::format("{}..{}", layout.sine_begin, layout.sine_end);
+  ts.settings["window_triangle_samples"] = fmt::format("{}..{}", layout.triangle_begin, layout.triangle_end);
   return ts;
 }
 

@@ -12,11 +12,6 @@ namespace piezobench::bench {
 
 namespace {
 
-std::span<const double> column(const io::TimeSeries& r, const std::string& name, Eigen::Index begin, Eigen::Index end) {
-  const Eigen::Index j = r.index(name);
-  return {r.data.col(j).data() + begin, static_cast<std::size_t>(end - begin)};
-}
-
 double setting(const io::TimeSeries& r, const std::string& key) {
   const auto it = r.settings.find(key);
   if (it == r.settings.end() || !std::holds_alternative<double>(it->second)) {
@@ -27,29 +22,49 @@ double setting(const io::TimeSeries& r, const std::string& key) {
 
 }  // namespace
 
-TrackingFigures tracking_figures(const io::TimeSeries& r, Eigen::Index begin, Eigen::Index end) {
-  if (begin < 0 || end > r.samples() || end - begin < 2) {
-    throw InputError(r.source, "samples", fmt::format("a window within 0..{}", r.samples()), fmt::format("{}..{}", begin, end));
+TrackingFigures tracking_figures(std::span<const double> c, std::span<const double> de_open, std::span<const double> de_ff,
+                                 double target_slope, double target_intercept) {
+  if (de_open.size() != c.size() || de_ff.size() != c.size() || c.size() < 2) {
+    throw InputError("tracking figures", "samples", fmt::format("c, de_open and de_ff of one size >= 2 (c: {})", c.size()),
+                     fmt::format("de_open {}, de_ff {}", de_open.size(), de_ff.size()));
   }
-  const std::span<const double> c = column(r, "c", begin, end);
-  const std::span<const double> de_open = column(r, "de_open", begin, end);
-  const std::span<const double> de_ff = column(r, "de_ff", begin, end);
   const ident::LoopMetrics open = ident::loop_metrics(c, de_open);
   const ident::LoopMetrics ff = ident::loop_metrics(c, de_ff);
   TrackingFigures f;
   f.width_open = open.width;
   f.width_ff = ff.width;
   f.stroke_open = open.stroke;
-  const double slope = setting(r, "target_slope_m_per_V"), intercept = setting(r, "target_intercept_m");
   double sum_open = 0.0, sum_ff = 0.0;
   for (std::size_t k = 0; k < c.size(); ++k) {
-    const double target = slope * c[k] + intercept;
+    const double target = target_slope * c[k] + target_intercept;
     sum_open += (de_open[k] - target) * (de_open[k] - target);
     sum_ff += (de_ff[k] - target) * (de_ff[k] - target);
   }
   f.rms_open = std::sqrt(sum_open / static_cast<double>(c.size()));
   f.rms_ff = std::sqrt(sum_ff / static_cast<double>(c.size()));
   return f;
+}
+
+TrackingLayout tracking_layout(const io::TimeSeries& r) {
+  TrackingLayout l;
+  const double fs = r.sample_rate, ramp = setting(r, "ramp_s"), periods = setting(r, "periods"), frequency = setting(r, "frequency_Hz");
+  if (!(periods >= 2.0 && periods == std::floor(periods))) throw InputError(r.source, "periods", "a whole number >= 2", fmt::format("{}", periods));
+  if (!(frequency > 0.0 && ramp >= 0.0)) throw InputError(r.source, "frequency_Hz", "> 0 (with ramp_s >= 0)", fmt::format("{} (ramp_s {})", frequency, ramp));
+  const auto n_ramp = static_cast<Eigen::Index>(std::llround(ramp * fs));
+  const auto n_wave = static_cast<Eigen::Index>(std::llround(periods / frequency * fs));
+  const Eigen::Index per = n_wave / static_cast<Eigen::Index>(periods);
+  l.sine_begin = n_ramp + per;
+  l.sine_end = n_ramp + n_wave;
+  l.triangle_begin = n_ramp + n_wave + per;
+  l.triangle_end = n_ramp + 2 * n_wave;
+  if (l.triangle_end > r.samples()) {
+    throw InputError(r.source, "samples", fmt::format("at least {} (ramp_s, periods, frequency_Hz of a tracking record)", l.triangle_end),
+                     std::to_string(r.samples()));
+  }
+  l.target_slope = setting(r, "target_slope_m_per_V");
+  l.target_intercept = setting(r, "target_intercept_m");
+  l.amplitude = setting(r, "amplitude_V");
+  return l;
 }
 
 TrackingSummary tracking_summary(const io::TimeSeries& r) {

@@ -30,6 +30,7 @@ std::string to_string(Experiment e) {
     case Experiment::kFrfNoResistor: return "frf_without_resistor";
     case Experiment::kIff: return "iff";
     case Experiment::kHammer: return "hammer";
+    case Experiment::kTracking: return "tracking";
   }
   return "unknown";
 }
@@ -38,7 +39,7 @@ const std::vector<Experiment>& all_experiments() {
   static const std::vector<Experiment> all = {Experiment::kFlatness, Experiment::kCapacitance, Experiment::kStroke,
                                               Experiment::kHysteresis, Experiment::kStiffness, Experiment::kStiffnessOpen,
                                               Experiment::kFrf, Experiment::kFrfNoResistor, Experiment::kIff,
-                                              Experiment::kHammer};
+                                              Experiment::kHammer, Experiment::kTracking};
   return all;
 }
 
@@ -57,7 +58,8 @@ const std::vector<std::string>& required_roles(Experiment e) {
       {Experiment::kStroke, {"Va", "de"}},              {Experiment::kHysteresis, {"Va", "de"}},
       {Experiment::kStiffness, {"de"}},                 {Experiment::kFrf, {"u", "de", "Vs"}},
       {Experiment::kStiffnessOpen, {"de"}},             {Experiment::kFrfNoResistor, {"u", "Vs"}},
-      {Experiment::kIff, {"u_prime", "de"}},            {Experiment::kHammer, {"F", "v"}}};
+      {Experiment::kIff, {"u_prime", "de"}},            {Experiment::kHammer, {"F", "v"}},
+      {Experiment::kTracking, {"c", "de_open", "de_ff"}}};
   return roles.at(e);
 }
 
@@ -82,6 +84,7 @@ bool UnitSpec::has(Experiment e) const {
     case Experiment::kFrfNoResistor: return frf_no_resistor.has_value();
     case Experiment::kIff: return !iff.empty();
     case Experiment::kHammer: return hammer.has_value();
+    case Experiment::kTracking: return tracking.has_value();
   }
   return false;
 }
@@ -337,6 +340,7 @@ UnitSpec read_unit(const Context& ctx, const toml::table& t, std::size_t index) 
       case Experiment::kFrf: u.frf = f; break;
       case Experiment::kFrfNoResistor: u.frf_no_resistor = f; break;
       case Experiment::kHammer: u.hammer = f; break;
+      case Experiment::kTracking: u.tracking = f; break;
       default: break;
     }
   }

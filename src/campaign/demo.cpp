@@ -18,6 +18,7 @@
 #include "piezobench/bench/truth.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/io/toml_table.hpp"
@@ -41,6 +42,9 @@ void DemoOptions::validate() const {
   for (const double g : iff_gains) {
     if (!(g >= 0.0)) throw InputError("demo", "iff_gains", "gains >= 0", fmt::format("{}", g));
   }
+  if (tracking_unit != 0 && std::find(units.begin(), units.end(), tracking_unit) == units.end()) {
+    throw InputError("demo", "tracking_unit", "0 (none) or one of the simulated units", std::to_string(tracking_unit));
+  }
   if (threads < 0) throw InputError("demo", "threads", "0 (all cores) or more", std::to_string(threads));
 }
 
@@ -54,6 +58,7 @@ struct Job {
   double cost = 1.0;  // for scheduling (longest first)
   bool open_circuit = false;  // every stack open: the actuators disconnected, no resistor (k_oc)
   bool no_resistor = false;   // no resistor across the sensor stack (report section 2.5)
+  std::string tracking_file = {};  // hysteresis: then the tracking experiment with the model of this record
 };
 
 std::string number_tag(double v) { return fmt::format("{:g}", v); }
@@ -85,8 +90,17 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
     jobs.push_back({id, bench::Experiment::kStiffness, {}, {}, {}, "data/" + u + "_stiffness-open.mat", 2.0, true, true});
     jobs.push_back({id, bench::Experiment::kFrfNoise, {}, {}, frf_s, "data/" + u + "_frf-noise.mat", frf_s / 10.0});
     jobs.push_back({id, bench::Experiment::kHammer, {}, {}, {}, "data/" + u + "_hammer.mat", 1.0});
+    const std::string tracking_file = id == options.tracking_unit ? "data/" + u + "_tracking.mat" : "";
+    const auto largest = std::max_element(options.hysteresis_amplitudes.begin(), options.hysteresis_amplitudes.end());
     for (const double a : options.hysteresis_amplitudes) {
       jobs.push_back({id, bench::Experiment::kHysteresis, a, {}, {}, "data/" + u + "_hysteresis_" + number_tag(a) + "V.mat", 0.5});
+      if (a == *largest && !tracking_file.empty()) {
+        jobs.back().tracking_file = tracking_file;
+        jobs.back().cost += 1.0;
+      }
+    }
+    if (largest == options.hysteresis_amplitudes.end() && !tracking_file.empty()) {
+      jobs.push_back({id, bench::Experiment::kTracking, {}, {}, {}, tracking_file, 1.0});  // model identified from its open run
     }
     if (id == options.iff_unit) {
       // Figure 2.7 on the IFF unit: u -> Vs without the resistor.
@@ -121,6 +135,17 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
         eo.duration = j.duration;
         const io::TimeSeries ts = bench::simulate(j.experiment, truths.at(j.unit), eo, options.seed);
         io::write_timeseries(ts, dir / j.file);
+        if (!j.tracking_file.empty()) {
+          // The tracking experiment with the unit's hysteresis model as the campaign identifies it
+          // (the same fit of the same record: campaign hysteresis_model).
+          bench::ExperimentOptions to;
+          to.bench = bench_options;
+          const Eigen::VectorXd va = ts.channel("Va"), de = ts.channel("de");
+          to.feedforward = ident::fit_hysteresis({va.data(), static_cast<std::size_t>(va.size())},
+                                                 {de.data(), static_cast<std::size_t>(de.size())}, ts.sample_rate)
+                               .model;
+          io::write_timeseries(bench::simulate(bench::Experiment::kTracking, truths.at(j.unit), to, options.seed), dir / j.tracking_file);
+        }
         const std::lock_guard<std::mutex> lock(log_mutex);
         if (j.experiment == bench::Experiment::kStiffness) {
           io::TimeSeries head;
@@ -146,7 +171,10 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
   }
 
   DemoFiles files;
-  for (const Job& j : jobs) files.data.push_back(dir / j.file);
+  for (const Job& j : jobs) {
+    files.data.push_back(dir / j.file);
+    if (!j.tracking_file.empty()) files.data.push_back(dir / j.tracking_file);
+  }
   std::sort(files.data.begin(), files.data.end());
 
   // The truth.
@@ -222,6 +250,7 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
     toml += "]\n";
     toml += fmt::format("stiffness = \"{}_stiffness.mat\"\nstiffness_open_circuit = \"{}_stiffness-open.mat\"\n", u, u);
     toml += fmt::format("frf = \"{}_frf-noise.mat\"\nhammer = \"{}_hammer.mat\"\n", u, u);
+    if (id == options.tracking_unit) toml += fmt::format("tracking = \"{}_tracking.mat\"\n", u);
     if (id == options.iff_unit) toml += fmt::format("frf_without_resistor = \"{}_frf-noise-no-resistor.mat\"\n", u);
     if (id == options.iff_unit && !options.iff_gains.empty()) {
       toml += "iff = [\n";

@@ -244,6 +244,14 @@ template <class V> void fields(V& v, HysteresisModelFit& s) {
   v("fit", s.fit); v("amplitude", s.amplitude); v("width", s.width); v("model_width", s.model_width); v("provenance", s.provenance);
   v("loop", s.loop); v("model_loop", s.model_loop);
 }
+template <class V> void fields(V& v, bench::TrackingFigures& s) {
+  v("width_open", s.width_open); v("width_ff", s.width_ff); v("rms_open", s.rms_open); v("rms_ff", s.rms_ff); v("stroke_open", s.stroke_open);
+}
+template <class V> void fields(V& v, TrackingAnalysis& s) {
+  v("sine", s.sine); v("triangle", s.triangle); v("amplitude", s.amplitude); v("feedforward", s.feedforward);
+  v("clamped_samples", s.clamped_samples); v("provenance", s.provenance); v("sine_open", s.sine_open); v("sine_ff", s.sine_ff);
+  v("triangle_open", s.triangle_open); v("triangle_ff", s.triangle_ff);
+}
 template <class V> void fields(V& v, metrology::StaticStiffnessResult& s) {
   v("t_on", s.t_on); v("t_off", s.t_off); v("d_before", s.d_before); v("d_loaded", s.d_loaded); v("d_after", s.d_after);
   v("k1", s.k1); v("k2", s.k2); v("deflection_on", s.deflection_on); v("deflection_off", s.deflection_off);
@@ -339,7 +347,7 @@ template <class V> void fields(V& v, FlexibleModes& s) {
 }
 template <class V> void fields(V& v, UnitAnalysis& s) {
   v("id", s.id); v("name", s.name); v("flatness_analysis", s.flatness_analysis); v("capacitance_analysis", s.capacitance_analysis);
-  v("stroke_analysis", s.stroke_analysis); v("hysteresis", s.hysteresis); v("hysteresis_model", s.hysteresis_model);
+  v("stroke_analysis", s.stroke_analysis); v("hysteresis", s.hysteresis); v("hysteresis_model", s.hysteresis_model); v("tracking", s.tracking);
   v("stiffness_analysis", s.stiffness_analysis);
   v("stiffness_open_analysis", s.stiffness_open_analysis); v("frf_analysis", s.frf_analysis); v("resistor", s.resistor);
   v("model_2dof", s.model_2dof); v("damped", s.damped); v("flexible_modes", s.flexible_modes); v("flatness", s.flatness);

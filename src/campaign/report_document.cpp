@@ -108,6 +108,11 @@ struct StiffnessCurves {
   json t, de_um, fit_um;
 };
 
+// One waveform of the tracking record: d_e against the command without and with the feedforward.
+struct TrackingCurves {
+  json c, open_um, ff_um;  // V, um, um
+};
+
 struct DampedCurves {
   double gain = 0.0;
   Bode measured, fit;  // u' -> d_e [um/V]; the vector fit with the delay put back
@@ -128,6 +133,7 @@ struct UnitCurves {
   std::optional<StiffnessCurves> stiffness, stiffness_open;
   std::optional<XY> hysteresis_model_record;  // Va [V], d_e [um]
   json hysteresis_model_um;                   // the model's d_e [um] at the same Va
+  std::optional<TrackingCurves> tracking_sine, tracking_triangle;
 
   [[nodiscard]] const std::string& name() const { return result->name; }
 };
@@ -143,6 +149,11 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
     const HysteresisModelFit& h = *u.hysteresis_model;
     out.hysteresis_model_record = XY{values(h.loop.x), values(h.loop.y, 1e6)};
     out.hysteresis_model_um = values(h.model_loop.y, 1e6);
+  }
+  if (u.tracking) {
+    const auto loop = [](const Curve& open, const Curve& ff) { return TrackingCurves{values(open.x), values(open.y, 1e6), values(ff.y, 1e6)}; };
+    out.tracking_sine = loop(u.tracking->sine_open, u.tracking->sine_ff);
+    out.tracking_triangle = loop(u.tracking->triangle_open, u.tracking->triangle_ff);
   }
   if (u.stiffness_analysis) out.stiffness = stiffness_curves(*u.stiffness_analysis);
   if (u.stiffness_open_analysis) out.stiffness_open = stiffness_curves(*u.stiffness_open_analysis);
@@ -642,6 +653,39 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
                            {"unit", "amplitude [V]", "gain [um/V]", "weights", "rms residual [um] (of the stroke)",
                             "width: record / model", "fit"},
                            model_rows));
+  }
+  // The tracking experiment (bench/tracking.hpp): d_e against the command without and with the
+  // inverse of the model as a feedforward.
+  json tracking_rows = json::array();
+  for (const auto& u : units) {
+    if (!u.result->tracking) continue;
+    const TrackingAnalysis& t = *u.result->tracking;
+    for (const auto& [w, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", t.sine}, {"triangle", t.triangle}}) {
+      tracking_rows.push_back(json::array({u.name(), fmt::format("1 Hz {}, {:.3g} V", w, t.amplitude),
+                                           fmt::format("{:.1f} % -> {:.2f} %", 100.0 * f.width_open, 100.0 * f.width_ff),
+                                           fmt::format("{:.2f} -> {:.2f} ({:.1f}x)", f.rms_open * 1e6, f.rms_ff * 1e6, f.rms_reduction()),
+                                           fmt::format("{:.0f}", f.stroke_open * 1e6),
+                                           t.feedforward == "given" ? "the given model" : "identified from the open run"}));
+    }
+    json panels = json::array();
+    for (const auto& [w, q] : {std::pair<const char*, const TrackingCurves&>{"sine", *u.tracking_sine}, {"triangle", *u.tracking_triangle}}) {
+      panels.push_back(panel(fmt::format("{}: d_e [um]", w), false,
+                             json::array({trace("without compensation", q.c, q.open_um, "without compensation"),
+                                          trace("with the inverse feedforward", q.c, q.ff_um, "with the inverse feedforward")})));
+    }
+    figs.push_back(figure(fmt::format("tracking-{}", u.result->id),
+                          u.name() + ": d_e against the command, without and with the inverse hysteresis feedforward", "command [V]", false,
+                          panels,
+                          "The 1 Hz sine and triangle of the tracking experiment (`measure tracking`), the last periods of each: "
+                          "with the model's inverse in front of the amplifier the loop closes onto a straight line "
+                          "(docs/hysteresis.md)."));
+  }
+  if (!tracking_rows.empty()) {
+    tables.push_back(table("Tracking without -> with the inverse hysteresis feedforward",
+                           {"unit", "command", "hysteresis width (of the stroke)", "rms tracking error [um]", "stroke [um]", "feedforward"},
+                           tracking_rows,
+                           "Hysteresis width: peak-to-peak deviation of d_e from its best straight line against the command, over the "
+                           "stroke. rms tracking error: against the straight line the compensated actuator follows (the record's target)."));
   }
   if (figs.empty()) return std::nullopt;
   return json{{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}};

@@ -85,6 +85,16 @@ json hysteresis_model(const HysteresisModelFit& h) {
   return j;
 }
 
+json tracking(const TrackingAnalysis& t) {
+  const auto figures = [](const bench::TrackingFigures& f) {
+    return json{{"width_open", num(f.width_open)},         {"width_ff", num(f.width_ff)},
+                {"rms_open_um", num(f.rms_open * 1e6)},    {"rms_ff_um", num(f.rms_ff * 1e6)},
+                {"rms_reduction", num(f.rms_reduction())}, {"stroke_open_um", num(f.stroke_open * 1e6)}};
+  };
+  return {{"amplitude_V", num(t.amplitude)}, {"feedforward", t.feedforward},         {"clamped_samples", num(t.clamped_samples)},
+          {"sine", figures(t.sine)},         {"triangle", figures(t.triangle)},     {"provenance", provenance(t.provenance)}};
+}
+
 json stiffness(const StiffnessAnalysis& a) {
   const auto& s = a.result;
   const auto& o = a.options;
@@ -376,6 +386,7 @@ json unit_json(const UnitAnalysis& u) {
   }
   if (!u.hysteresis.empty()) r["hysteresis"] = hysteresis(u.hysteresis);
   if (u.hysteresis_model) r["hysteresis_model"] = hysteresis_model(*u.hysteresis_model);
+  if (u.tracking) r["tracking"] = tracking(*u.tracking);
   if (u.stiffness_analysis) r["stiffness_static"] = stiffness(*u.stiffness_analysis);
   if (u.stiffness_open_analysis) r["stiffness_open_circuit"] = stiffness(*u.stiffness_open_analysis);
   if (u.frf_analysis) {

@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "piezobench/apa/tuning.hpp"
+#include "piezobench/bench/tracking.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/welch.hpp"
@@ -307,6 +308,31 @@ HysteresisModelFit hysteresis_model(const Record& r, double amplitude) {
   out.model_width = ident::loop_metrics(v, predicted).width;
   out.loop = {thin(va, 1200), thin(de, 1200)};
   out.model_loop = {out.loop.x, thin(Eigen::Map<const VectorXd>(predicted.data(), va.size()), 1200)};
+  return out;
+}
+
+// The tracking record: its figures recomputed from the samples over the record's windows.
+TrackingAnalysis tracking(const Record& r) {
+  const bench::TrackingLayout l = bench::tracking_layout(r.ts);
+  const VectorXd c = r.channel("c"), open = r.channel("de_open"), ff = r.channel("de_ff");
+  TrackingAnalysis out;
+  const auto window = [&](Index begin, Index end, bench::TrackingFigures& f, Curve& curve_open, Curve& curve_ff) {
+    const auto n = static_cast<std::size_t>(end - begin);
+    f = bench::tracking_figures({c.data() + begin, n}, {open.data() + begin, n}, {ff.data() + begin, n}, l.target_slope, l.target_intercept);
+    const VectorXd x = c.segment(begin, end - begin);
+    curve_open = {thin(x, 800), thin(VectorXd(open.segment(begin, end - begin)), 800)};
+    curve_ff = {curve_open.x, thin(VectorXd(ff.segment(begin, end - begin)), 800)};
+  };
+  window(l.sine_begin, l.sine_end, out.sine, out.sine_open, out.sine_ff);
+  window(l.triangle_begin, l.triangle_end, out.triangle, out.triangle_open, out.triangle_ff);
+  out.amplitude = l.amplitude;
+  if (const auto it = r.ts.settings.find("feedforward"); it != r.ts.settings.end() && std::holds_alternative<std::string>(it->second)) {
+    out.feedforward = std::get<std::string>(it->second);
+  }
+  if (const auto it = r.ts.settings.find("clamped_samples"); it != r.ts.settings.end() && std::holds_alternative<double>(it->second)) {
+    out.clamped_samples = std::get<double>(it->second);
+  }
+  out.provenance = provenance(r, {"c", "de_open", "de_ff"});
   return out;
 }
 
@@ -695,6 +721,10 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
     } catch (const NumericalError& e) {
       record_failure(u, "hysteresis model", e);
     }
+  }
+  if (spec.tracking) {
+    say("tracking without and with the hysteresis feedforward", *spec.tracking);
+    u.tracking = tracking(load_record(c, *spec.tracking, Experiment::kTracking));
   }
   if (spec.stiffness) {
     say("static stiffness", *spec.stiffness);

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/core/error.hpp"
@@ -67,6 +69,50 @@ TEST(Tracking, GivenModelAndOptionChecks) {
   wrong.feedforward = o.feedforward;
   EXPECT_THROW(simulate(Experiment::kHysteresis, batch_unit(2, 1), wrong, 1), InputError);
   EXPECT_THROW(tracking_summary(simulate(Experiment::kCapacitance, batch_unit(2, 1), {}, 1)), InputError);
+}
+
+// A synthetic record whose figures are known: c = 65 + 80 sin(2 pi t), de_open = line + h cos(2 pi t)
+// (an ellipse around the line: cos is orthogonal to sin and to 1 over whole periods, so the line
+// is the best one, the width is 2 h / stroke and the rms error h / sqrt(2)); de_ff = the line.
+TEST(Tracking, LayoutAndFiguresOfAKnownRecord) {
+  const double fs = 1000.0, slope = -1.2e-6, intercept = 3e-6, h = 10e-6;
+  const Eigen::Index n = 8000;  // 1 s ramp, 3 + 3 periods, 1 s ramp
+  io::TimeSeries r;
+  r.source = "known.mat";
+  r.sample_rate = fs;
+  r.names = {"c", "Va_open", "de_open", "Va_ff", "de_ff"};
+  r.data.setZero(n, 5);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / fs, ph = 2.0 * std::numbers::pi * t;
+    r.data(k, 0) = 65.0 + 80.0 * std::sin(ph);
+    r.data(k, 2) = slope * r.data(k, 0) + intercept + h * std::cos(ph);
+    r.data(k, 4) = slope * r.data(k, 0) + intercept;
+  }
+  r.settings = {{"ramp_s", 1.0}, {"periods", 3.0}, {"frequency_Hz", 1.0}, {"amplitude_V", 80.0},
+                {"target_slope_m_per_V", slope}, {"target_intercept_m", intercept}};
+  const TrackingLayout l = tracking_layout(r);
+  EXPECT_EQ(l.sine_begin, 2000);
+  EXPECT_EQ(l.sine_end, 4000);
+  EXPECT_EQ(l.triangle_begin, 5000);
+  EXPECT_EQ(l.triangle_end, 7000);
+  EXPECT_EQ(l.amplitude, 80.0);
+  const auto col = [&](Eigen::Index j) {
+    return std::span<const double>(r.data.col(j).data() + l.sine_begin, static_cast<std::size_t>(l.sine_end - l.sine_begin));
+  };
+  const TrackingFigures f = tracking_figures(col(0), col(2), col(4), l.target_slope, l.target_intercept);
+  const double stroke = f.stroke_open;
+  EXPECT_NEAR(f.width_open, 2.0 * h / stroke, 1e-3 * 2.0 * h / stroke);
+  EXPECT_NEAR(f.rms_open, h / std::sqrt(2.0), 1e-9 * h);
+  EXPECT_NEAR(f.width_ff, 0.0, 1e-9);
+  EXPECT_NEAR(f.rms_ff, 0.0, 1e-15);
+  // Missing settings and too short a record name what is wrong.
+  io::TimeSeries bad = r;
+  bad.settings.erase("periods");
+  EXPECT_THROW((void)tracking_layout(bad), InputError);
+  bad = r;
+  bad.settings["frequency_Hz"] = 0.5;  // 3 periods of 2 s: 14 s > 8 s
+  EXPECT_THROW((void)tracking_layout(bad), InputError);
+  EXPECT_THROW((void)tracking_figures(col(0), col(2).first(10), col(4), slope, intercept), InputError);
 }
 
 }  // namespace

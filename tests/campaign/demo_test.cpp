@@ -22,9 +22,9 @@ TEST(Demo, ResultsAgreeWithTheBenchTruth) {
   o.units = {1, 3};
   const DemoFiles files = write_demo_campaign(dir.path(), o);
   EXPECT_TRUE(std::filesystem::exists(files.campaign));
-  // 11 records per unit (the stiffness test twice: stacks short-circuited and open), 4 IFF gains
-  // and u -> Vs without the resistor on unit 1.
-  EXPECT_EQ(files.data.size(), 2u * 11u + 5u);
+  // 11 records per unit (the stiffness test twice: stacks short-circuited and open), 4 IFF gains,
+  // u -> Vs without the resistor and the tracking record on unit 1.
+  EXPECT_EQ(files.data.size(), 2u * 11u + 6u);
   const json truth = json::parse(test::read_text(files.truth));
   const CampaignResult r = run_campaign(read_campaign(files.campaign));
   const json results = results_json(r);
@@ -80,6 +80,19 @@ TEST(Demo, ResultsAgreeWithTheBenchTruth) {
   }
   // The resistor (report section 2.5, Figure 2.7) on unit 1: the corner with it near 1/(2 pi R C),
   // without it not observable in the record (the truth's 0.003 Hz is far below its lowest line).
+  // The tracking record of unit 1 (issue 18's check on the bench's own PI law): the inverse of the
+  // model the campaign identifies from the 80 V hysteresis record cuts the hysteresis width to
+  // below 3 % of the stroke and the rms tracking error at least 5 times; unit 3 has none.
+  const json& tr = results["units"][0]["tracking"];
+  EXPECT_EQ(tr["feedforward"], "given");
+  EXPECT_EQ(tr["amplitude_V"].get<double>(), 80.0);
+  for (const char* w : {"sine", "triangle"}) {
+    EXPECT_GT(tr[w]["width_open"].get<double>(), 0.15) << w;
+    EXPECT_LT(tr[w]["width_ff"].get<double>(), 0.03) << w;
+    EXPECT_GE(tr[w]["rms_reduction"].get<double>(), 5.0) << w;
+  }
+  EXPECT_FALSE(results["units"][1].contains("tracking"));
+  EXPECT_EQ(results["units"][1]["not_measured"].back(), "tracking");
   const json& hr = results["units"][0]["hpf_resistor"];
   EXPECT_TRUE(near(hr["with_resistor"]["corner_Hz"].get<double>(), truth["units"][0]["hpf_corner_with_resistor_Hz"].get<double>(), 0.1));
   EXPECT_FALSE(hr["without_resistor"]["observable"].get<bool>());
@@ -98,6 +111,8 @@ TEST(Demo, BadOptions) {
   o = {};
   o.units = {2};
   test::input_error([&] { (void)write_demo_campaign(dir.path(), o); }, "iff_unit");
+  o.iff_unit = 2;
+  test::input_error([&] { (void)write_demo_campaign(dir.path(), o); }, "tracking_unit");
 }
 
 }  // namespace

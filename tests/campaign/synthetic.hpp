@@ -132,6 +132,27 @@ inline io::TimeSeries hysteresis_record(double amplitude, double phi) {
   return series({"Va", "de"}, data, 1000.0);
 }
 
+// A tracking record (bench/tracking.hpp's layout: 1 s ramp, 3 + 3 periods, 1 s ramp; here the
+// sine throughout) with known figures: c = 65 + 80 sin(2 pi t), channel "cmd"; de_open = the target
+// line + h cos(2 pi t) (an ellipse about the line, which is its best line: width 2 h / stroke, rms
+// error h / sqrt(2)); de_ff = the line plus h / 10 cos.
+inline io::TimeSeries tracking_record(double h) {
+  const Eigen::Index n = 8000;
+  const double slope = -1.2e-6, intercept = 3e-6;
+  Eigen::MatrixXd data(n, 3);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double wt = 2 * M_PI * k / 1000.0;
+    data(k, 0) = 65.0 + 80.0 * std::sin(wt);
+    data(k, 1) = slope * data(k, 0) + intercept + h * std::cos(wt);
+    data(k, 2) = slope * data(k, 0) + intercept + 0.1 * h * std::cos(wt);
+  }
+  io::TimeSeries ts = series({"cmd", "de_open", "de_ff"}, data, 1000.0);
+  ts.settings = {{"experiment", std::string("tracking")}, {"ramp_s", 1.0}, {"periods", 3.0}, {"frequency_Hz", 1.0},
+                 {"amplitude_V", 80.0}, {"target_slope_m_per_V", slope}, {"target_intercept_m", intercept},
+                 {"feedforward", std::string("given")}, {"clamped_samples", 0.0}};
+  return ts;
+}
+
 // Added mass on at 3 s, off at 13 s, step deflections -m g / k (no creep): k1 = k2 = k.
 inline io::TimeSeries stiffness_record(double k) {
   const Eigen::Index n = 20000;

@@ -26,6 +26,7 @@ struct Files {
     io::write_timeseries(syn::stiffness_record(1.9e6), dir.path() / "stiff.mat");
     io::write_timeseries(syn::damped_record(2 * M_PI * 90.0, 0.2, 1e5, 8.0), dir.path() / "iff.mat");
     io::write_timeseries(syn::hammer_record(), dir.path() / "hammer.mat");
+    io::write_timeseries(syn::tracking_record(10e-6), dir.path() / "tracking.mat");
     syn::write_flatness_csv(dir.path() / "flat.csv", 2e-6);
   }
   Campaign campaign(const std::string& units) const {
@@ -52,6 +53,7 @@ stiffness_open_circuit = "stiff.mat"
 frf_without_resistor = { file = "frf.mat", channels = { Vs = "V_sensor" } }
 iff = "iff.mat"
 hammer = "hammer.mat"
+tracking = { file = "tracking.mat", channels = { c = "cmd" } }
 flatness = { file = "flat.csv", channels = { x = "x_pos", y = "y_pos", z = "height" } }
 )";
 
@@ -109,6 +111,17 @@ TEST(UnitAnalysis, EveryAnalysisOnKnownRecords) {
   EXPECT_TRUE(near(*u.k_resonance, 5.7 * std::pow(truth.resonance, 2), 2e-3));
   // Quasi-static analyses.
   EXPECT_TRUE(near(*u.stroke, 170.0 * 1.5e-6, 1e-6));
+  // Tracking: the figures of the known ellipses, from the samples of each window.
+  ASSERT_TRUE(u.tracking);
+  for (const bench::TrackingFigures* t : {&u.tracking->sine, &u.tracking->triangle}) {
+    EXPECT_NEAR(t->width_open, 2.0 * 10e-6 / t->stroke_open, 1e-9);
+    EXPECT_NEAR(t->rms_open, 10e-6 / std::sqrt(2.0), 1e-12);
+    EXPECT_NEAR(t->rms_ff, 1e-6 / std::sqrt(2.0), 1e-12);
+    EXPECT_NEAR(t->rms_reduction(), 10.0, 1e-6);
+  }
+  EXPECT_EQ(u.tracking->feedforward, "given");
+  EXPECT_EQ(u.tracking->provenance.key, "units[0].tracking");
+  EXPECT_EQ(u.tracking->sine_open.x.size(), u.tracking->sine_ff.y.size());
   ASSERT_EQ(u.hysteresis.size(), 2u);
   EXPECT_TRUE(near(u.hysteresis[0].result.relative_width, std::sin(0.03), 1e-3));  // sorted by amplitude
   EXPECT_TRUE(near(u.hysteresis[1].result.relative_width, std::sin(0.1), 1e-4));

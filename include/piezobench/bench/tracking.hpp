@@ -24,6 +24,7 @@
 // target_slope_m_per_V, target_intercept_m (d_ref),
 // and for w in {sine, triangle}: width_open_w, width_ff_w (fractions), rms_open_w_m, rms_ff_w_m,
 // stroke_open_w_m.
+#include <span>
 #include <string>
 
 #include "piezobench/ident/hysteresis.hpp"
@@ -50,8 +51,24 @@ struct TrackingSummary {
 // not one.
 TrackingSummary tracking_summary(const io::TimeSeries& record);
 
-// The figures of one waveform, from the samples [begin, end) of a tracking record's columns (the
-// target line from its settings).
-TrackingFigures tracking_figures(const io::TimeSeries& record, Eigen::Index begin, Eigen::Index end);
+// Where a tracking record's figures are read and against which line: the samples [begin, end) of
+// each waveform (its last `periods` - 1 periods) and the target d_ref = target_slope c +
+// target_intercept.
+struct TrackingLayout {
+  Eigen::Index sine_begin = 0, sine_end = 0, triangle_begin = 0, triangle_end = 0;
+  double target_slope = 0.0;      // m/V
+  double target_intercept = 0.0;  // m
+  double amplitude = 0.0;         // V
+};
+// From the record's sample rate and settings ramp_s, periods, frequency_Hz, amplitude_V,
+// target_slope_m_per_V, target_intercept_m. InputError (source: the record's) naming a missing
+// setting or windows beyond the record.
+TrackingLayout tracking_layout(const io::TimeSeries& record);
+
+// The figures of one waveform from the command c (V) and the displacements without and with the
+// feedforward (m), sample by sample, against the target line. InputError for mismatched sizes or
+// fewer than 2 samples.
+TrackingFigures tracking_figures(std::span<const double> c, std::span<const double> de_open, std::span<const double> de_ff,
+                                 double target_slope, double target_intercept);
 
 }  // namespace piezobench::bench

@@ -28,10 +28,13 @@ namespace piezobench::campaign {
 // The experiments a unit can have (keys of a [[units]] entry).
 // kStiffnessOpen: the stiffness test with every stack open (actuators disconnected from the
 // amplifier, no resistor on the sensor: k_oc, report section 2.2); kFrfNoResistor: u -> Vs without
-// the resistor across the sensor stack (report section 2.5, Figure 2.7).
-enum class Experiment { kFlatness, kCapacitance, kStroke, kHysteresis, kStiffness, kStiffnessOpen, kFrf, kFrfNoResistor, kIff, kHammer };
+// the resistor across the sensor stack (report section 2.5, Figure 2.7); kTracking: the tracking
+// experiment's record (`measure tracking`, bench/tracking.hpp: d_e against the command without and
+// with the inverse hysteresis feedforward).
+enum class Experiment { kFlatness, kCapacitance, kStroke, kHysteresis, kStiffness, kStiffnessOpen, kFrf, kFrfNoResistor, kIff, kHammer,
+                        kTracking };
 // "flatness", "capacitance", "stroke", "hysteresis", "stiffness", "stiffness_open_circuit", "frf",
-// "frf_without_resistor", "iff", "hammer".
+// "frf_without_resistor", "iff", "hammer", "tracking".
 std::string to_string(Experiment e);
 Experiment experiment_from_string(const std::string& name, const std::string& source = "");  // InputError
 const std::vector<Experiment>& all_experiments();
@@ -40,7 +43,8 @@ const std::vector<Experiment>& all_experiments();
 // channel names (bench/experiments.hpp), which are also the role names:
 //   flatness x, y, z [interface]; capacitance C_sensor, C_actuator; stroke Va, de;
 //   hysteresis Va, de; stiffness and stiffness_open_circuit de [added_mass]; frf u, de, Vs;
-//   frf_without_resistor u, Vs; iff u_prime, de; hammer F, v.
+//   frf_without_resistor u, Vs; iff u_prime, de; hammer F, v; tracking c, de_open, de_ff (and the
+//   record's settings: bench/tracking.hpp's tracking_layout).
 // Optional roles are used when their channel is in the file (or when mapped explicitly, in which
 // case the channel must be there).
 const std::vector<std::string>& required_roles(Experiment e);
@@ -62,7 +66,7 @@ struct UnitSpec {
   int id = 0;
   std::string name;     // "APA 1" unless given
   std::string key;      // "units[0]"
-  std::optional<FileSpec> flatness, capacitance, stroke, stiffness, stiffness_open, frf, frf_no_resistor, hammer;
+  std::optional<FileSpec> flatness, capacitance, stroke, stiffness, stiffness_open, frf, frf_no_resistor, hammer, tracking;
   std::vector<FileSpec> hysteresis, iff;
   // LCR readings typed into the campaign instead of a file (F): capacitance_uF = {sensor, actuator}.
   std::optional<double> capacitance_sensor, capacitance_actuator;

@@ -6,7 +6,9 @@
 //
 //   DIR/data/unitN_<experiment>.mat   flatness, capacitance, stroke, stiffness, frf-noise, hammer,
 //                                     hysteresis_<A>V (one per amplitude), and for the IFF unit
-//                                     iff_g<G> (one per gain)
+//                                     iff_g<G> (one per gain), and for the tracking unit tracking
+//                                     (bench/tracking.hpp, the feedforward being the PI model of
+//                                     its largest hysteresis record, as the campaign identifies it)
 //   DIR/data/truth.json               {seed, units: [bench::truth_json of every unit]}
 //   DIR/superelement/                 the APA300ML super element shipped in the binary (docs/apa300ml.md):
 //                                     apa300ml_K.mtx, apa300ml_M.mtx, apa300ml_dofs.txt, apa300ml.toml
@@ -30,6 +32,7 @@ struct DemoOptions {
   std::vector<double> hysteresis_amplitudes = {4.0, 20.0, 40.0, 80.0};  // V around 65 V
   std::vector<double> iff_gains = {30e3, 60e3, 120e3, 240e3};            // controller gains g (optimum ~2.7e5)
   int iff_unit = 1;                                                      // the unit with IFF records
+  int tracking_unit = 1;                                                 // the unit with a tracking record (0: none)
   int threads = 0;                                                       // 0 = all cores
   Log log;                                                               // progress (under a lock)
   void validate() const;                                                 // InputError (source "demo")

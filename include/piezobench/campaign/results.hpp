@@ -15,6 +15,7 @@
 
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/apa/two_dof.hpp"
+#include "piezobench/bench/tracking.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/dsp/frf.hpp"
@@ -90,6 +91,21 @@ struct HysteresisModelFit {
   RecordProvenance provenance;
   Curve loop;                  // x Va [V], y d_e [m]: the record's loop (thinned)
   Curve model_loop;            // x Va [V], y d_e [m]: the model's prediction of it (thinned)
+};
+
+// The tracking experiment's record (`measure tracking`; the demo runs it on one unit with that
+// unit's hysteresis_model as the feedforward): d_e against the command without and with the
+// inverse hysteresis feedforward, the figures recomputed from the record's samples
+// (bench::tracking_layout, bench::tracking_figures: width = peak-to-peak deviation from the best
+// line / stroke; rms error against the record's target line).
+struct TrackingAnalysis {
+  bench::TrackingFigures sine, triangle;
+  double amplitude = 0.0;        // V
+  std::string feedforward;       // the record's: "identified" (from its open run) or "given"
+  double clamped_samples = 0.0;  // of the compensated command, at the stack range
+  RecordProvenance provenance;
+  // x c [V], y d_e [m] over each waveform's window (thinned): without and with the feedforward.
+  Curve sine_open, sine_ff, triangle_open, triangle_ff;
 };
 
 struct StiffnessAnalysis {
@@ -217,6 +233,7 @@ struct UnitAnalysis {
   std::optional<StrokeAnalysis> stroke_analysis;
   std::vector<HysteresisLoop> hysteresis;  // by amplitude
   std::optional<HysteresisModelFit> hysteresis_model;  // from the largest amplitude
+  std::optional<TrackingAnalysis> tracking;
   std::optional<StiffnessAnalysis> stiffness_analysis;       // stacks on the amplifier and the resistor
   std::optional<StiffnessAnalysis> stiffness_open_analysis;  // every stack open (k_oc)
   std::optional<FrfAnalysis> frf_analysis;
