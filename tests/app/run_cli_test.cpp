@@ -135,7 +135,7 @@ capacitance_uF = { sensor = 5.10, actuator = 10.03 }
   EXPECT_TRUE(near(ua["frf"]["resonance_Hz"].get<double>(), ub["frf"]["resonance_Hz"].get<double>(), 1e-9));
   EXPECT_TRUE(near(ua["stiffness_N_per_um"]["k1"].get<double>(), ub["stiffness_N_per_um"]["k1"].get<double>(), 1e-12));
   EXPECT_EQ(ua["frf"]["provenance"]["channels"]["de"], "encoder");
-  EXPECT_EQ(ua["not_measured"].size(), 6u);  // flatness, hysteresis, stiffness_open_circuit, frf_without_resistor, iff, hammer
+  EXPECT_EQ(ua["not_measured"].size(), 7u);  // flatness, hysteresis, stiffness_open_circuit, frf_without_resistor, iff, hammer, tracking
 }
 
 // A second run on a --out another run holds is refused with exit 3 and leaves the folder alone.
