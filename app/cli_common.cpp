@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 
 namespace piezobench::app {
 
@@ -25,7 +26,7 @@ std::vector<std::string> split_list(const std::string& text, const std::string& 
     const auto first = item.find_first_not_of(" \t");
     const auto last = item.find_last_not_of(" \t");
     item = first == std::string::npos ? std::string() : item.substr(first, last - first + 1);
-    if (item.empty()) throw InputError("", option, "a comma-separated list with no empty item", "'" + text + "'");
+    if (item.empty()) throw UsageError(option, "a comma-separated list with no empty item", "'" + text + "'");
     items.push_back(item);
     start = end + 1;
   }
@@ -38,7 +39,7 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
     double value = 0.0;
     const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
     if (ec != std::errc() || ptr != item.data() + item.size() || !std::isfinite(value)) {
-      throw InputError("", option, "a comma-separated list of finite numbers", "'" + item + "' in '" + text + "'");
+      throw UsageError(option, "a comma-separated list of finite numbers", "'" + item + "' in '" + text + "'");
     }
     values.push_back(value);
   }

@@ -11,6 +11,7 @@
 
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/plant_fit.hpp"
@@ -150,7 +151,7 @@ struct FitOptions {
 // `model tune`; a bound given alone keeps the other one open.
 dsp::Frf select_band(const dsp::Frf& frf, FitOptions o) {
   if (o.fmin < 0.0 || (o.fmax > 0.0 && o.fmax <= o.fmin)) {
-    throw InputError("", "--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
+    throw UsageError("--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
   }
   if (o.fmin == 0.0 && o.fmax == 0.0) {
     const dsp::FrequencyBand excited = dsp::excited_band(frf, 0.5);
@@ -341,7 +342,7 @@ struct IffPlantOptions {
 
 int run_fit_iff_plant(const IffPlantOptions& o) {
   if (o.fmin < 0.0 || (o.fmax > 0.0 && o.fmax <= o.fmin)) {
-    throw InputError("", "--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
+    throw UsageError("--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
   }
   const dsp::Frf frf = io::read_frf(o.file);
   const auto i = static_cast<std::size_t>(frf.output_index(o.output));

@@ -9,6 +9,7 @@
 #include "cli_common.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/lti/analysis.hpp"
@@ -78,7 +79,7 @@ double hz(lti::Complex pole) { return lti::pole_info(pole).natural_frequency / k
 
 int run_rlocus(const RlocusOptions& o) {
   if (!(std::isfinite(o.delay) && o.delay >= 0.0)) {
-    throw InputError("", "--delay", "a delay >= 0 s", std::to_string(o.delay));
+    throw UsageError("--delay", "a delay >= 0 s", std::to_string(o.delay));
   }
   const LoadedSystem plant = load_plant(o);
   const LoadedSystem controller = load_controller(o);

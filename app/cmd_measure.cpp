@@ -15,6 +15,7 @@
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/bench/truth.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/rt/comedi_backend.hpp"
@@ -42,12 +43,12 @@ nlohmann::json settings_json(const io::TimeSeries& ts) {
 }
 
 // "experiment options: amplitude: expected ..., found ..." -> "--amplitude: expected ..., found ...":
-// the message names the command-line option the user typed.
-InputError as_option_error(const InputError& e) {
+// the message names the command-line option the user typed, and the exit code is a usage error's.
+[[noreturn]] void throw_as_option_error(const InputError& e) {
   const std::string prefix = "experiment options: ";
   const std::string what = e.what();
-  if (what.rfind(prefix, 0) != 0) return e;
-  return InputError("--" + what.substr(prefix.size()));
+  if (what.rfind(prefix, 0) != 0) throw e;
+  throw UsageError("--" + what.substr(prefix.size()));
 }
 
 nlohmann::json timing_json(const rt::TimingSummary& s) { return {{"p50", s.p50}, {"p99", s.p99}, {"max", s.max}, {"count", s.count}}; }
@@ -72,23 +73,28 @@ void set_feedforward(bench::ExperimentOptions& options, const std::string& file)
 }
 
 int run_measurement(const MeasureRequest& r) {
-  const bench::Experiment experiment = bench::experiment_from_string(r.experiment);
+  bench::Experiment experiment{};
+  try {
+    experiment = bench::experiment_from_string(r.experiment);
+  } catch (const InputError& e) {
+    throw UsageError(e.what());  // "experiment: expected one of stroke, ..., found 'frf'"
+  }
   bench::ExperimentOptions eo = r.options;
   try {
     eo.validate(experiment);
   } catch (const InputError& e) {
-    throw as_option_error(e);
+    throw_as_option_error(e);
   }
   const bool hardware = r.bench && r.bench->hardware();
   bench::UnitTruth unit;
   if (hardware) {
-    if (r.unit < 1) throw InputError("", "--unit", "the number of the unit under test (>= 1)", std::to_string(r.unit));
+    if (r.unit < 1) throw UsageError("--unit", "the number of the unit under test (>= 1)", std::to_string(r.unit));
     unit.id = r.unit;  // a real unit: only its number is known
   } else {
     try {
       unit = bench::batch_unit(r.unit, r.seed);
     } catch (const InputError& e) {
-      throw InputError("--" + std::string(e.what()));  // "--unit: expected a unit of the batch, 1 to 7, ..."
+      throw UsageError("--" + std::string(e.what()));  // "--unit: expected a unit of the batch, 1 to 7, ..."
     }
   }
   const std::string out = r.out.empty() ? fmt::format("{}-unit{}.mat", r.experiment, r.unit) : r.out;
@@ -109,11 +115,11 @@ int run_measurement(const MeasureRequest& r) {
     try {
       ts = bench::simulate(experiment, unit, eo, r.seed, long_run ? progress : bench::Progress{});
     } catch (const InputError& e) {
-      throw as_option_error(e);
+      throw_as_option_error(e);
     }
   } else {
     if (!bench::runs_on_bench(experiment)) {
-      throw InputError("", "experiment",
+      throw UsageError("experiment",
                        "an experiment that runs on the bench's I/O (stroke, hysteresis, stiffness, frf-noise, frf-sweep, "
                        "iff, tracking); record " + r.experiment + " with its own instruments and give the file to `piezobench run`",
                        "'" + r.experiment + "'");
@@ -131,7 +137,7 @@ int run_measurement(const MeasureRequest& r) {
     try {
       ts = bench::run_experiment(experiment, *runner, unit, eo, r.seed);
     } catch (const InputError& e) {
-      throw as_option_error(e);
+      throw_as_option_error(e);
     }
   }
   io::write_timeseries(ts, out);
@@ -279,7 +285,7 @@ int run_serve(const ServeCli& o) {
     throw InputError("--" + std::string(e.what()));
   }
   if (!(std::isfinite(o.idle_timeout) && o.idle_timeout > 0.0)) {
-    throw InputError("", "--idle-timeout", "a time > 0 s", fmt::format("{:g}", o.idle_timeout));
+    throw UsageError("--idle-timeout", "a time > 0 s", fmt::format("{:g}", o.idle_timeout));
   }
   rt::UdpServerOptions so;
   so.address = o.udp;

@@ -17,6 +17,7 @@
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/lti/freqresp.hpp"
@@ -50,9 +51,9 @@ struct TwoDofCommand {
 };
 
 int run_two_dof(const TwoDofCommand& o) {
-  if (!(std::isfinite(o.fmin) && o.fmin > 0.0)) throw InputError("", "--fmin", "a frequency > 0 Hz", fmt::format("{}", o.fmin));
+  if (!(std::isfinite(o.fmin) && o.fmin > 0.0)) throw UsageError("--fmin", "a frequency > 0 Hz", fmt::format("{}", o.fmin));
   if (!(std::isfinite(o.fmax) && o.fmax > o.fmin)) {
-    throw InputError("", "--fmax", fmt::format("a frequency above --fmin = {} Hz", o.fmin), fmt::format("{}", o.fmax));
+    throw UsageError("--fmax", fmt::format("a frequency above --fmin = {} Hz", o.fmin), fmt::format("{}", o.fmax));
   }
   const apa::TwoDofParams p = o.params_file.empty() ? apa::TwoDofParams{} : apa::read_two_dof_params(o.params_file);
   o.bench.validate(kCommandLine);

@@ -10,6 +10,7 @@
 #include "measure_common.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/json.hpp"
@@ -59,9 +60,9 @@ nlohmann::json summary(const rt::TimingSummary& s, bool percentiles = true) {
 
 int run_rt(const RtOptions& o) {
   if (o.controller != "iff" && o.controller != "off") {
-    throw InputError("", "--controller", "iff or off", "'" + o.controller + "'");
+    throw UsageError("--controller", "iff or off", "'" + o.controller + "'");
   }
-  if (!(std::isfinite(o.rate) && o.rate > 0.0)) throw InputError("", "--rate", "a rate > 0 Hz", std::to_string(o.rate));
+  if (!(std::isfinite(o.rate) && o.rate > 0.0)) throw UsageError("--rate", "a rate > 0 Hz", std::to_string(o.rate));
   o.limits.validate();
   std::unique_ptr<rt::Backend> backend;
   nlohmann::json source;
@@ -70,10 +71,10 @@ int run_rt(const RtOptions& o) {
   const bool bench_file = o.bench.size() > 5 && o.bench.substr(o.bench.size() - 5) == ".toml";
   if (bench_file) {
     // A bench file: its backend, rate and limits (a hardware backend never starts without them).
-    if (!o.replay.empty()) throw InputError("", "--replay", "only with --bench replay", "'" + o.replay + "'");
+    if (!o.replay.empty()) throw UsageError("--replay", "only with --bench replay", "'" + o.replay + "'");
     const rt::BenchDescription desc = rt::read_bench_file(o.bench);
     if (o.limits_given) {
-      throw InputError("", "--va-min/--va-max/--slew-rate/--watchdog/--ramp",
+      throw UsageError("--va-min/--va-max/--slew-rate/--watchdog/--ramp",
                        "no limit options with a bench file (its [limits] apply)", "limit options");
     }
     if (o.rate_given && std::abs(o.rate - desc.sample_rate) > 1e-9 * desc.sample_rate) {
@@ -81,13 +82,13 @@ int run_rt(const RtOptions& o) {
     }
     limits = desc.limits;
     if (desc.backend == "comedi" && !o.realtime) {
-      throw InputError("", "--realtime", "true with a card (its I/O is paced by the loop)", "false");
+      throw UsageError("--realtime", "true with a card (its I/O is paced by the loop)", "false");
     }
     backend = make_backend(desc);
     source = {{"bench", desc.backend}, {"bench_file", o.bench}};
     if (!desc.hardware()) source.update({{"unit", desc.unit}, {"seed", desc.seed}});
   } else if (o.bench == "virtual") {
-    if (!o.replay.empty()) throw InputError("", "--replay", "only with --bench replay", "'" + o.replay + "'");
+    if (!o.replay.empty()) throw UsageError("--replay", "only with --bench replay", "'" + o.replay + "'");
     bench::BenchOptions bo;
     bo.sample_rate = o.rate;
     bo.va_min = o.limits.va_min;
@@ -96,12 +97,12 @@ int run_rt(const RtOptions& o) {
     try {
       bo.hysteresis_law = bench::hysteresis_law_from_string(o.hysteresis_law);
     } catch (const InputError&) {
-      throw InputError("", "--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
+      throw UsageError("--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
     }
     backend = std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(o.unit, o.seed), bo, o.seed);
     source = {{"bench", "virtual"}, {"unit", o.unit}, {"seed", o.seed}};
   } else if (o.bench == "replay") {
-    if (o.replay.empty()) throw InputError("", "--replay", "a recorded file (.mat or .csv with de and Vs)", "nothing");
+    if (o.replay.empty()) throw UsageError("--replay", "a recorded file (.mat or .csv with de and Vs)", "nothing");
     auto replay = std::make_unique<rt::ReplayBackend>(std::filesystem::path(o.replay));
     if (o.rate_given && std::abs(o.rate - replay->sample_rate()) > 1e-6 * replay->sample_rate()) {
       throw InputError(o.replay, "--rate", "the record's sample rate " + std::to_string(replay->sample_rate()) + " Hz",
@@ -110,7 +111,7 @@ int run_rt(const RtOptions& o) {
     source = {{"bench", "replay"}, {"file", o.replay}, {"samples", replay->samples()}};
     backend = std::move(replay);
   } else {
-    throw InputError("", "--bench", "virtual, replay or a bench file (.toml)", "'" + o.bench + "'");
+    throw UsageError("--bench", "virtual, replay or a bench file (.toml)", "'" + o.bench + "'");
   }
 
   rt::LoopOptions lo;
@@ -133,7 +134,7 @@ int run_rt(const RtOptions& o) {
   lo.on_warning = [](const std::string& w) { log_line("warning: " + w); };
   if (o.excitation == "noise") {
     const std::vector<double> band = parse_number_list(o.band, "--band");
-    if (band.size() != 2) throw InputError("", "--band", "two frequencies LO,HI in Hz", "'" + o.band + "'");
+    if (band.size() != 2) throw UsageError("--band", "two frequencies LO,HI in Hz", "'" + o.band + "'");
     dsp::NoiseOptions no;
     no.sample_rate = backend->sample_rate();
     const double cycles = std::max(2.0, std::round(o.duration * no.sample_rate));
@@ -149,7 +150,7 @@ int run_rt(const RtOptions& o) {
     lo.log_settings["amplitude_rms"] = o.amplitude;
   } else if (o.excitation == "sine") {
     if (!(std::isfinite(o.frequency) && o.frequency > 0.0 && o.frequency < 0.5 * backend->sample_rate())) {
-      throw InputError("", "--frequency", "a frequency in (0, rate / 2) Hz", fmt::format("{:g}", o.frequency));
+      throw UsageError("--frequency", "a frequency in (0, rate / 2) Hz", fmt::format("{:g}", o.frequency));
     }
     // One period (rounded to whole samples), played cyclically.
     const auto n = static_cast<Eigen::Index>(std::max(2.0, std::round(backend->sample_rate() / o.frequency)));
@@ -161,7 +162,7 @@ int run_rt(const RtOptions& o) {
     lo.log_settings["offset"] = o.offset;
     lo.log_settings["frequency_Hz"] = backend->sample_rate() / static_cast<double>(n);
   } else if (o.excitation != "none") {
-    throw InputError("", "--excitation", "none, noise or sine", "'" + o.excitation + "'");
+    throw UsageError("--excitation", "none, noise or sine", "'" + o.excitation + "'");
   }
   if (!o.feedforward.empty()) {
     lo.feedforward = io::read_hysteresis_model(o.feedforward);
@@ -274,7 +275,7 @@ int run_rt(const RtOptions& o) {
 bool parse_bool(const std::string& text, const std::string& option) {
   if (text == "true" || text == "1" || text == "yes" || text == "on") return true;
   if (text == "false" || text == "0" || text == "no" || text == "off") return false;
-  throw InputError("", option, "true or false", "'" + text + "'");
+  throw UsageError(option, "true or false", "'" + text + "'");
 }
 
 }  // namespace

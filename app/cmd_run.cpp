@@ -189,7 +189,7 @@ int run_merge(const MergeOptions& o) {
 }
 
 int run_run(const RunOptions& o) {
-  if (o.threads < 0) throw InputError("", "--threads", "0 (all cores) or more", std::to_string(o.threads));
+  if (o.threads < 0) throw UsageError("--threads", "0 (all cores) or more", std::to_string(o.threads));
   if (o.list_units) return list_units(o);
   const io::OutputLock lock(o.out);  // a second run on the same --out is refused (exit 3)
   if (!o.part.empty() || !o.units.empty()) return run_part(o);
@@ -197,7 +197,7 @@ int run_run(const RunOptions& o) {
 }
 
 int run_demo(const DemoCli& o) {
-  if (o.threads < 0) throw InputError("", "--threads", "0 (all cores) or more", std::to_string(o.threads));
+  if (o.threads < 0) throw UsageError("--threads", "0 (all cores) or more", std::to_string(o.threads));
   const io::OutputLock lock(o.out);
   const auto t0 = std::chrono::steady_clock::now();
   campaign::DemoOptions d;
@@ -207,7 +207,7 @@ int run_demo(const DemoCli& o) {
   if (!o.units.empty()) {
     d.units.clear();
     for (const double u : parse_number_list(o.units, "--units")) {
-      if (u != std::floor(u) || u < 1 || u > 7) throw InputError("", "--units", "unit numbers 1..7", fmt::format("{}", u));
+      if (u != std::floor(u) || u < 1 || u > 7) throw UsageError("--units", "unit numbers 1..7", fmt::format("{}", u));
       d.units.push_back(static_cast<int>(u));
     }
     if (std::find(d.units.begin(), d.units.end(), d.iff_unit) == d.units.end()) d.iff_unit = d.units.front();

@@ -4,6 +4,7 @@
 
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "measure_common.hpp"
 
 namespace piezobench::app {
@@ -43,7 +44,7 @@ int run_simulate(const SimulateOptions& o) {
   try {
     r.options.bench.hysteresis_law = bench::hysteresis_law_from_string(o.hysteresis_law);
   } catch (const InputError&) {
-    throw InputError("", "--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
+    throw UsageError("--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
   }
   set_feedforward(r.options, o.feedforward);
   r.unit = o.unit;

@@ -13,6 +13,7 @@
 
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/usage_error.hpp"
 #include "piezobench/fem/from_step.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
@@ -43,7 +44,7 @@ struct SuperElementCli {
 fem::SuperElementSetup setup_of(const SuperElementCli& o) {
   fem::SuperElementSetup s;
   if (o.format != "auto" && !fem::super_element_format_from_string(o.format)) {
-    throw InputError("", "--format", "auto, ansys, calculix or matrix-market", "'" + o.format + "'");
+    throw UsageError("--format", "auto, ansys, calculix or matrix-market", "'" + o.format + "'");
   }
   s.format = o.format;
   s.k_file = o.k_file;
@@ -69,9 +70,9 @@ fem::SuperElementSetup setup_of(const SuperElementCli& o) {
 }
 
 int run_superelement(const SuperElementCli& o) {
-  if (!(std::isfinite(o.fmin) && o.fmin > 0.0)) throw InputError("", "--fmin", "a frequency > 0 Hz", fmt::format("{}", o.fmin));
+  if (!(std::isfinite(o.fmin) && o.fmin > 0.0)) throw UsageError("--fmin", "a frequency > 0 Hz", fmt::format("{}", o.fmin));
   if (!(std::isfinite(o.fmax) && o.fmax > o.fmin)) {
-    throw InputError("", "--fmax", fmt::format("a frequency > --fmin ({} Hz)", o.fmin), fmt::format("{}", o.fmax));
+    throw UsageError("--fmax", fmt::format("a frequency > --fmin ({} Hz)", o.fmin), fmt::format("{}", o.fmax));
   }
   const fem::SuperElementSetup setup = setup_of(o);
   const fem::SuperElementFormat format = setup.resolved_format();
@@ -178,7 +179,7 @@ fem::FromStepOptions from_step_options(const FromStepCli& c) {
   } else if (preset == "none") {
     o.materials["body"] = fem::FromStepOptions::apa95ml().materials.at("body");
   } else {
-    throw InputError("", "--preset", "auto, apa95ml, apa95ml-beam, apa300ml or none", "'" + c.preset + "'");
+    throw UsageError("--preset", "auto, apa95ml, apa95ml-beam, apa300ml or none", "'" + c.preset + "'");
   }
   if (!c.regions.empty()) {
     o.regions.clear();
@@ -193,7 +194,7 @@ fem::FromStepOptions from_step_options(const FromStepCli& c) {
   for (const std::string& t : c.materials) {
     const auto colon = t.find(':');
     if (colon == std::string::npos || colon == 0) {
-      throw InputError("", "--material", "REGION:E,nu,rho (REGION: body or a --region name; SI units)", "'" + t + "'");
+      throw UsageError("--material", "REGION:E,nu,rho (REGION: body or a --region name; SI units)", "'" + t + "'");
     }
     o.materials[t.substr(0, colon)] = fem::Material::parse(t.substr(colon + 1), "--material " + t.substr(0, colon));
   }
@@ -207,9 +208,9 @@ fem::FromStepOptions from_step_options(const FromStepCli& c) {
   for (const std::string& t : c.stacks) o.stacks.push_back(fem::StackSpec::parse(t, "--stack"));
   for (const std::string& t : c.geo_parameters) {
     const auto eq = t.find('=');
-    if (eq == std::string::npos || eq == 0) throw InputError("", "--geo-parameter", "NAME=VALUE (a DefineConstant of the .geo)", "'" + t + "'");
+    if (eq == std::string::npos || eq == 0) throw UsageError("--geo-parameter", "NAME=VALUE (a DefineConstant of the .geo)", "'" + t + "'");
     const std::vector<double> v = parse_number_list(t.substr(eq + 1), "--geo-parameter " + t.substr(0, eq));
-    if (v.size() != 1) throw InputError("", "--geo-parameter", "NAME=VALUE (one number)", "'" + t + "'");
+    if (v.size() != 1) throw UsageError("--geo-parameter", "NAME=VALUE (one number)", "'" + t + "'");
     o.geo_parameters[t.substr(0, eq)] = v.front();
   }
   if (!c.axial.empty()) {

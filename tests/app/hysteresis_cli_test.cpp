@@ -64,7 +64,7 @@ TEST(HysteresisCli, BadInputIsRefused) {
   const test::CliRun r1 = run_cli("simulate tracking --feedforward " + bad);
   EXPECT_EQ(r1.exit_code, 3);
   EXPECT_NE(r1.err.find("gain_m_per_V"), std::string::npos) << r1.err;
-  EXPECT_EQ(run_cli("simulate tracking --hysteresis-law preisach").exit_code, 3);
+  EXPECT_EQ(run_cli("simulate tracking --hysteresis-law preisach").exit_code, 2);
   EXPECT_EQ(run_cli("hysteresis fit /nonexistent.mat").exit_code, 3);
   EXPECT_EQ(run_cli("hysteresis fit x.mat --operators 0").exit_code, 2);
   const std::string mat = (dir.path() / "h.mat").string();

@@ -40,7 +40,7 @@ TEST(MeasureCli, RefusesWhatABenchCannotMeasure) {
       "[bench]\nbackend = \"udp\"\nsample_rate_Hz = 10000\n[udp]\naddress = \"127.0.0.1:9\"\n[amplifier]\ngain_V_per_V = 20\n"
       "[limits]\nva_min_V = -20\nva_max_V = 150\nslew_rate_V_per_s = 1e5\n");
   test::CliRun r = run_cli("measure hammer --bench " + udp + " --out " + (dir.path() / "h.mat").string());
-  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(test::contains(r.err, "its own instruments")) << r.err;
   // A bench file without limits: refused before anything is opened.
   const std::string nolimits = test::write_text_file(

@@ -124,21 +124,21 @@ TEST(RtCli, ReplaysARecordedFile) {
 
 TEST(RtCli, BadInputIsReported) {
   test::TempDir dir;
-  auto expect3 = [](const std::string& args, const std::string& needle) {
+  auto expect = [](int code, const std::string& args, const std::string& needle) {
     const test::CliRun r = run_cli(args);
-    EXPECT_EQ(r.exit_code, 3) << args << "\n" << r.err;
+    EXPECT_EQ(r.exit_code, code) << args << "\n" << r.err;
     EXPECT_TRUE(test::contains(r.err, needle)) << args << "\n" << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   };
-  expect3("rt --bench hardware --gain 1 --json", "--bench");
-  expect3("rt --bench replay --gain 1 --json", "--replay");
-  expect3("rt --bench virtual --gain 1 --controller pid --json", "--controller");
-  expect3("rt --bench virtual --gain 1 --realtime maybe --json", "--realtime");
-  expect3("rt --bench virtual --gain 1 --duration 0 --json", "duration");
-  expect3("rt --bench virtual --gain 1 --va-min 200 --json", "va_max");
-  expect3("rt --bench virtual --gain 1 --unit 12 --json", "unit");
+  expect(2, "rt --bench hardware --gain 1 --json", "--bench");
+  expect(2, "rt --bench replay --gain 1 --json", "--replay");
+  expect(2, "rt --bench virtual --gain 1 --controller pid --json", "--controller");
+  expect(2, "rt --bench virtual --gain 1 --realtime maybe --json", "--realtime");
+  expect(3, "rt --bench virtual --gain 1 --duration 0 --json", "duration");
+  expect(3, "rt --bench virtual --gain 1 --va-min 200 --json", "va_max");
+  expect(3, "rt --bench virtual --gain 1 --unit 12 --json", "unit");
   const std::string csv = test::write_text_file(dir, "rec.csv", "# sample_rate_Hz: 10000\nde,V\n0,1\n0,2\n");
-  expect3("rt --bench replay --replay " + csv + " --gain 1 --json", "Vs");
+  expect(3, "rt --bench replay --replay " + csv + " --gain 1 --json", "Vs");
   EXPECT_EQ(run_cli("rt --bench virtual --json").exit_code, 2);  // --gain is required
 }
 

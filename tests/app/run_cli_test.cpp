@@ -185,7 +185,7 @@ TEST(RunCli, BadInputNamesFileAndKeyAndWritesNothing) {
   }
   // A bad command line is exit 2.
   EXPECT_EQ(run_cli("run").exit_code, 2);
-  EXPECT_EQ(run_cli("demo --units 9 --out " + dir.path().string()).exit_code, 3);
+  EXPECT_EQ(run_cli("demo --units 9 --out " + dir.path().string()).exit_code, 2);
 }
 
 }  // namespace

@@ -72,20 +72,20 @@ TEST(SimulateCli, RefusesBadInput) {
   test::TempDir dir;
   const std::string out = " --out " + (dir.path() / "x.mat").string();
   test::CliRun r = run_cli("simulate frf" + out);
-  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(test::contains(r.err, "frf-noise")) << r.err;  // the known names are listed
   r = run_cli("simulate stroke --unit 9" + out);
-  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(test::contains(r.err, "1 to 7")) << r.err;
   r = run_cli("simulate frf-noise --duration -5" + out);
-  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(test::contains(r.err, "--duration")) << r.err;
   r = run_cli("simulate hysteresis --amplitude 90" + out);
-  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(test::contains(r.err, "--amplitude")) << r.err;
   EXPECT_TRUE(test::contains(r.err, "85 V")) << r.err;  // the limit is named
   r = run_cli("simulate stroke --amplitude 10" + out);
-  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.exit_code, 2);
   r = run_cli("simulate frf-noise --duration abc" + out);
   EXPECT_EQ(r.exit_code, 2);
   r = run_cli("simulate frf-noise --duration 1 --out " + (dir.path() / "missing" / "x.mat").string());
