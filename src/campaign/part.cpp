@@ -263,8 +263,14 @@ template <class V> void fields(V& v, metrology::StaticStiffnessOptions& s) {
   v("loaded_s", s.loaded_s); v("after_s", s.after_s); v("t_on", s.t_on); v("t_off", s.t_off);
   v("min_time_constant", s.min_time_constant); v("max_time_constant", s.max_time_constant);
 }
+template <class V> void fields(V& v, ident::CreepFit& s) {
+  v("time_constants", s.time_constants); v("coefficients", s.coefficients); v("gain", s.gain); v("offset", s.offset);
+  v("creep_per_decade", s.creep_per_decade); v("rms_residual", s.rms_residual); v("relative_residual", s.relative_residual);
+  v("quality", s.quality);
+}
 template <class V> void fields(V& v, StiffnessAnalysis& s) {
   v("result", s.result); v("options", s.options); v("mass_log", s.mass_log); v("provenance", s.provenance); v("de", s.de); v("fit", s.fit);
+  v("creep", s.creep);
 }
 template <class V> void fields(V& v, VectorFitSummary& s) { v("order", s.order); v("relative_rms_error", s.relative_rms_error); v("converged", s.converged); }
 template <class V> void fields(V& v, NmpEvidence::Zero& s) {

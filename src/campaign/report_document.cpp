@@ -695,7 +695,7 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
 bool has_stiffness(const UnitAnalysis& u) { return u.k1 || u.k_resonance || u.k_oc; }
 
 std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitCurves>& units) {
-  json traces = json::array(), rows = json::array();
+  json traces = json::array(), rows = json::array(), creep_rows = json::array();
   for (const auto& u : units) {
     for (const bool open : {false, true}) {
       const std::optional<StiffnessCurves>& s = open ? u.stiffness_open : u.stiffness;
@@ -710,6 +710,16 @@ std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitC
                       io::to_json(r.k_resonance, 1e-6),
                       r.stiffness_analysis ? json(r.stiffness_analysis->result.creep_on * 1e6) : json(nullptr)});
     }
+    for (const bool open : {false, true}) {
+      const std::optional<StiffnessAnalysis>& a = open ? r.stiffness_open_analysis : r.stiffness_analysis;
+      if (!a || !a->creep) continue;
+      const ident::CreepFit& k = *a->creep;
+      creep_rows.push_back(json::array({u.name() + (open ? ", stacks open" : ""), fmt::format("{:.3g}", fmt::join(k.time_constants, ", ")),
+                                        fmt::format("{:.3g}", fmt::join(k.coefficients, ", ")), fmt::format("{:.3g}", -1e-6 / k.gain),
+                                        fmt::format("{:.2f}", 100.0 * k.creep_per_decade),
+                                        fmt::format("{:.3g} ({:.2f} %)", k.rms_residual * 1e6, 100.0 * k.relative_residual),
+                                        core::to_string(k.quality.verdict)}));
+    }
   }
   if (traces.empty() && rows.empty()) return std::nullopt;
   json figs = json::array();
@@ -717,14 +727,23 @@ std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitC
     figs.push_back(figure("stiffness", "Fig. 2.4: d_e during the added-mass test", "Time [s]", false,
                           json::array({panel("d_e [um]", false, traces)})));
   }
+  json tables = json::array({table("Stiffness per unit [N/um]",
+                                   {"unit", "k1", "k2", "k_sc", "k_oc", "from the resonance", "creep under load [um/decade]"}, rows)});
+  if (!creep_rows.empty()) {
+    tables.push_back(table("Creep, Prony series (ident::fit_creep: d_e = offset + gain (F + sum c_j F_j), F the weight, F_j its "
+                           "first-order lags of time constant tau_j)",
+                           {"record", "tau_j [s]", "c_j", "instantaneous stiffness [N/um]", "creep [% per decade]",
+                            "rms residual [um] (of the range)", "fit"},
+                           creep_rows, "The model `hysteresis creep` fits (docs/hysteresis.md); a poor fit says the record's creep is not a "
+                                       "sum of these exponentials."));
+  }
   return json{{"id", "stiffness"},
               {"title", "Static stiffness (report 2.2)"},
               {"text", fmt::format("Added mass {:g} kg put on and taken off; dashed: the fitted logarithmic creep model. k_sc: the stacks "
                                    "short-circuited (actuators on the amplifier, sensor on the resistor), which is k1; k_oc: the same test "
                                    "with every stack open (report: about 2.3 and 1.7 N/um).",
                                    c.bench.added_mass)},
-              {"tables", json::array({table("Stiffness per unit [N/um]",
-                                            {"unit", "k1", "k2", "k_sc", "k_oc", "from the resonance", "creep under load [um/decade]"}, rows)})},
+              {"tables", tables},
               {"figures", figs}};
 }
 

@@ -95,10 +95,23 @@ json tracking(const TrackingAnalysis& t) {
           {"sine", figures(t.sine)},         {"triangle", figures(t.triangle)},     {"provenance", provenance(t.provenance)}};
 }
 
+// The Prony creep of a stiffness record (input N, output m).
+json creep(const ident::CreepFit& c) {
+  return {{"time_constants_s", c.time_constants},
+          {"coefficients", c.coefficients},
+          {"compliance_um_per_N", num(c.gain * 1e6)},
+          {"instantaneous_stiffness_N_per_um", num(c.gain != 0.0 ? -1e-6 / c.gain : 0.0)},
+          {"creep_per_decade", num(c.creep_per_decade)},
+          {"rms_residual_um", num(c.rms_residual * 1e6)},
+          {"relative_residual", num(c.relative_residual)},
+          {"quality", core::to_string(c.quality.verdict)},
+          {"quality_problems", c.quality.problems}};
+}
+
 json stiffness(const StiffnessAnalysis& a) {
   const auto& s = a.result;
   const auto& o = a.options;
-  return {{"k1_N_per_um", s.k1 * 1e-6},
+  json j = {{"k1_N_per_um", s.k1 * 1e-6},
           {"k2_N_per_um", s.k2 * 1e-6},
           {"t_on_s", s.t_on},
           {"t_off_s", s.t_off},
@@ -113,6 +126,8 @@ json stiffness(const StiffnessAnalysis& a) {
           {"gravity_m_per_s2", o.gravity},
           {"mass_log", a.mass_log},
           {"provenance", provenance(a.provenance)}};
+  if (a.creep) j["creep_prony"] = creep(*a.creep);
+  return j;
 }
 
 json vector_fit(const VectorFitSummary& v) {

@@ -355,7 +355,7 @@ std::vector<HysteresisLoop> hysteresis(const Campaign& c, const std::vector<Reco
 
 // The added-mass test (report section 2.2): with the stacks on the amplifier and the resistor (k1,
 // k2; k_sc = k1) or with every stack open (k_oc); the same readings and creep fit either way.
-StiffnessAnalysis stiffness(const Campaign& c, const Record& r) {
+StiffnessAnalysis stiffness(const Campaign& c, const Record& r, UnitAnalysis& u, const std::string& what) {
   const VectorXd t = r.time();
   const VectorXd de = r.channel("de");
   const VectorXd mass = r.has("added_mass") ? r.channel("added_mass") : VectorXd();
@@ -365,6 +365,19 @@ StiffnessAnalysis stiffness(const Campaign& c, const Record& r) {
   out.result = metrology::static_stiffness(t, de, mass, out.options, c.file.string() + ": " + r.spec.key);
   out.mass_log = r.has("added_mass");
   out.provenance = provenance(r, {"de", "added_mass"});
+  // The Prony creep of the record (ident::fit_creep, as `hysteresis creep`): the weight carried (N)
+  // in, d_e out; without a mass log, the weight as a step over [t_on, t_off).
+  VectorXd weight(de.size());
+  for (Index k = 0; k < de.size(); ++k) {
+    const double m = out.mass_log ? mass(k) : (t(k) >= out.result.t_on && t(k) < out.result.t_off ? out.options.added_mass : 0.0);
+    weight(k) = m * out.options.gravity;
+  }
+  try {
+    out.creep = ident::fit_creep({weight.data(), static_cast<std::size_t>(weight.size())}, {de.data(), static_cast<std::size_t>(de.size())},
+                                 r.ts.sample_rate);
+  } catch (const NumericalError& e) {
+    record_failure(u, what + ": creep fit", e);
+  }
   const std::vector<double> tt = thin(t);
   out.de = {tt, thin(de)};
   out.fit = {tt, thin(out.result.fit)};
@@ -729,7 +742,7 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   if (spec.stiffness) {
     say("static stiffness", *spec.stiffness);
     try {
-      u.stiffness_analysis = stiffness(c, load_record(c, *spec.stiffness, Experiment::kStiffness));
+      u.stiffness_analysis = stiffness(c, load_record(c, *spec.stiffness, Experiment::kStiffness), u, "static stiffness");
       u.k1 = u.stiffness_analysis->result.k1;
       u.k2 = u.stiffness_analysis->result.k2;
     } catch (const NumericalError& e) {
@@ -739,7 +752,8 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   if (spec.stiffness_open) {
     say("static stiffness, stacks open", *spec.stiffness_open);
     try {
-      u.stiffness_open_analysis = stiffness(c, load_record(c, *spec.stiffness_open, Experiment::kStiffnessOpen));
+      u.stiffness_open_analysis = stiffness(c, load_record(c, *spec.stiffness_open, Experiment::kStiffnessOpen), u,
+                                            "static stiffness, stacks open");
       u.k_oc = u.stiffness_open_analysis->result.k1;
     } catch (const NumericalError& e) {
       record_failure(u, "static stiffness, stacks open", e);

@@ -126,6 +126,13 @@ TEST(UnitAnalysis, EveryAnalysisOnKnownRecords) {
   EXPECT_TRUE(near(u.hysteresis[0].result.relative_width, std::sin(0.03), 1e-3));  // sorted by amplitude
   EXPECT_TRUE(near(u.hysteresis[1].result.relative_width, std::sin(0.1), 1e-4));
   EXPECT_TRUE(near(*u.k1, 1.9e6, 1e-9));
+  // The Prony creep of the same record (no creep in it): instantaneous stiffness k, coefficients 0.
+  ASSERT_TRUE(u.stiffness_analysis->creep);
+  const ident::CreepFit& creep = *u.stiffness_analysis->creep;
+  EXPECT_TRUE(near(-1.0 / creep.gain, 1.9e6, 1e-9));
+  for (const double cj : creep.coefficients) EXPECT_NEAR(cj, 0.0, 1e-9);
+  EXPECT_LT(creep.relative_residual, 1e-9);
+  EXPECT_EQ(creep.quality.verdict, core::FitVerdict::kGood);
   EXPECT_TRUE(near(*u.k2, 1.9e6, 1e-9));
   EXPECT_TRUE(near(*u.flatness, 4e-6, 1e-6));  // minimum zone of the saddle = least squares = 2 d
   EXPECT_DOUBLE_EQ(*u.capacitance_sensor, 5e-6);

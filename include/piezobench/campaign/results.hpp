@@ -115,6 +115,10 @@ struct StiffnessAnalysis {
   RecordProvenance provenance;
   Curve de;   // x t [s], y d_e [m] (thinned)
   Curve fit;  // x t [s], y creep model [m] (thinned)
+  // The Prony-series creep of the record (ident::fit_creep, docs/hysteresis.md): the weight carried
+  // (N: the mass log, or added_mass over [t_on, t_off), times gravity) in, d_e (m) out; its gain is
+  // the instantaneous compliance (m/N, < 0), its residual and verdict say how well it fits.
+  std::optional<ident::CreepFit> creep;
 };
 
 // A vector fit's summary (ident/vector_fitting.hpp).
