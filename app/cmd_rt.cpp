@@ -200,6 +200,13 @@ int run_rt(const RtOptions& o) {
                 {"memory_locked", r.memory_locked},
                 {"cycles", r.cycles},
                 {"overruns", r.overruns},
+                {"overrun_causes", {{"late_wakeup", r.overruns_late_wakeup}, {"long_step", r.overruns_long_step}}},
+                {"host",
+                 {{"overruns_late_wakeup", r.overruns_late_wakeup},
+                  {"skipped_deadlines", r.skipped_deadlines},
+                  {"wait_ms", r.host_wait_ms >= 0.0 ? nlohmann::json(r.host_wait_ms) : nlohmann::json(nullptr)},
+                  {"preemptions", r.host_preemptions >= 0 ? nlohmann::json(r.host_preemptions) : nlohmann::json(nullptr)}}},
+                {"code", {{"overruns_long_step", r.overruns_long_step}, {"step_time_us", summary(r.step_time_us)}}},
                 {"skipped_deadlines", r.skipped_deadlines},
                 {"wind_down_cycles", r.wind_down_cycles},
                 {"period_jitter_us", r.realtime ? summary(r.period_jitter_us) : nlohmann::json(nullptr)},
@@ -245,6 +252,14 @@ int run_rt(const RtOptions& o) {
   fmt::print("real-time loop: {} backend, {:g} Hz, {} ({}SCHED_FIFO, {}mlockall)\n", r.backend, r.sample_rate,
              r.realtime ? "real time" : "lockstep", r.sched_fifo ? "" : "no ", r.memory_locked ? "" : "no ");
   fmt::print("cycles {}   overruns {}   skipped deadlines {}\n", r.cycles, r.overruns, r.skipped_deadlines);
+  if (r.realtime) {
+    // What the shared machine costs, then what this program costs (docs/realtime.md).
+    fmt::print("host: {} overruns from late wake-ups, {} skipped deadlines", r.overruns_late_wakeup, r.skipped_deadlines);
+    if (r.host_wait_ms >= 0.0) fmt::print(", loop thread waited {:.2f} ms for a core", r.host_wait_ms);
+    if (r.host_preemptions >= 0) fmt::print(", preempted {} times", r.host_preemptions);
+    fmt::print("\ncode: {} overruns from long steps, step time p50 {:.2f} us, max {:.2f} us of the {:.0f} us period\n",
+               r.overruns_long_step, r.step_time_us.p50, r.step_time_us.max, 1e6 / r.sample_rate);
+  }
   fmt::print("{:<16}{:>10}{:>10}{:>10}{:>10}   [us]\n", "", "p50", "p99", "p99.9", "max");
   auto row = [](const char* name, const rt::TimingSummary& s) {
     fmt::print("{:<16}{:>10.2f}{:>10.2f}{:>10.2f}{:>10.2f}\n", name, s.p50, s.p99, s.p999, s.max);

@@ -4,12 +4,14 @@
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <thread>
 
 #include "piezobench/core/error.hpp"
@@ -207,7 +209,14 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
 
   const std::int64_t end_ns = monotonic_ns();
   step_time_.add(static_cast<double>(end_ns - start_ns));
-  if (timed && end_ns > deadline_ns + period_ns_) ++overruns_;
+  if (timed && end_ns > deadline_ns + period_ns_) {
+    ++overruns_;
+    if (wake_ns - deadline_ns >= end_ns - wake_ns) {
+      ++overruns_late_wakeup_;
+    } else {
+      ++overruns_long_step_;
+    }
+  }
   last_end_ns_ = end_ns;
 
   if (logger_) {
@@ -251,6 +260,8 @@ LoopReport Loop::finish() {
   rep.realtime = options_.realtime;
   rep.cycles = cycle_;
   rep.overruns = overruns_;
+  rep.overruns_late_wakeup = overruns_late_wakeup_;
+  rep.overruns_long_step = overruns_long_step_;
   rep.skipped_deadlines = skipped_;
   rep.wind_down_cycles = wind_down_;
   rep.period_jitter_us = jitter_.summary_us();
@@ -301,6 +312,22 @@ void prefault_stack() {
   asm volatile("" : : "r"(buffer) : "memory");
 }
 
+// What the host has taken from the calling thread so far: run-queue wait (ns, from
+// /proc/thread-self/schedstat) and involuntary context switches; -1 each when not available.
+struct HostShare {
+  std::int64_t wait_ns = -1;
+  std::int64_t preemptions = -1;
+};
+HostShare host_share() {
+  HostShare h;
+  std::ifstream in("/proc/thread-self/schedstat");
+  std::int64_t cpu_ns = 0, wait_ns = 0;
+  if (in >> cpu_ns >> wait_ns) h.wait_ns = wait_ns;
+  rusage ru{};
+  if (getrusage(RUSAGE_THREAD, &ru) == 0) h.preemptions = ru.ru_nivcsw;
+  return h;
+}
+
 std::string errno_text(int err) {
   return std::string(err == EPERM ? "EPERM" : err == ENOMEM ? "ENOMEM" : err == EAGAIN ? "EAGAIN" : "errno " + std::to_string(err)) +
          ", " + std::strerror(err);
@@ -316,6 +343,7 @@ LoopReport run_loop(Backend& backend, const LoopOptions& options, io::TimeSeries
     if (options.on_warning) options.on_warning(w);
   };
   bool memory_locked = false, fifo = false;
+  std::int64_t host_wait_ns = -1, host_preemptions = -1;  // set by the loop thread (real time)
   loop.start();
   if (!options.realtime) {
     while (loop.cycle()) {
@@ -350,6 +378,7 @@ LoopReport run_loop(Backend& backend, const LoopOptions& options, io::TimeSeries
       // kernel ignores the slack for SCHED_FIFO threads anyway).
       prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
       prefault_stack();
+      const HostShare host_before = host_share();
       std::int64_t deadline = monotonic_ns() + 1'000'000;  // first cycle 1 ms from now
       for (;;) {
         if (host_clock) sleep_until_ns(deadline);
@@ -365,6 +394,9 @@ LoopReport run_loop(Backend& backend, const LoopOptions& options, io::TimeSeries
           loop.add_skipped(static_cast<std::uint64_t>(missed));
         }
       }
+      const HostShare host_after = host_share();
+      if (host_before.wait_ns >= 0 && host_after.wait_ns >= 0) host_wait_ns = host_after.wait_ns - host_before.wait_ns;
+      if (host_before.preemptions >= 0 && host_after.preemptions >= 0) host_preemptions = host_after.preemptions - host_before.preemptions;
       done.store(true, std::memory_order_release);
     });
     // Watchdog: the loop must complete a cycle within watchdog_timeout.
@@ -392,6 +424,8 @@ LoopReport run_loop(Backend& backend, const LoopOptions& options, io::TimeSeries
   }
   LoopReport report = loop.finish();
   report.sched_fifo = fifo;
+  report.host_wait_ms = host_wait_ns >= 0 ? static_cast<double>(host_wait_ns) * 1e-6 : -1.0;
+  report.host_preemptions = host_preemptions;
   report.memory_locked = memory_locked;
   warnings.insert(warnings.end(), report.warnings.begin(), report.warnings.end());
   report.warnings = warnings;

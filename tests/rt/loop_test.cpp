@@ -386,6 +386,8 @@ TEST(RunLoop, RealTimeRunReportsTimingAndPrivileges) {
   EXPECT_LE(rep.step_time_us.p50, rep.step_time_us.max);
   EXPECT_LE(rep.period_jitter_us.p99, rep.period_jitter_us.p999 + 1e-12);
   EXPECT_LE(rep.overruns, rep.cycles);
+  EXPECT_EQ(rep.overruns_late_wakeup + rep.overruns_long_step, rep.overruns);
+  EXPECT_GE(rep.host_wait_ms, -1.0);
   auto warned = [&](const std::string& what) {
     for (const auto& w : rep.warnings) {
       if (test::contains(w, what)) return true;
@@ -395,6 +397,26 @@ TEST(RunLoop, RealTimeRunReportsTimingAndPrivileges) {
   EXPECT_TRUE(rep.sched_fifo || warned("SCHED_FIFO"));
   EXPECT_TRUE(rep.memory_locked || warned("mlockall"));
   EXPECT_EQ(printed.size(), rep.warnings.size());
+}
+
+// An overrun is charged to the larger of its parts: a wake-up 900 us after its deadline (then a
+// step of ~100 us) is the host's late wake-up; a wake-up 10 us late followed by 140 us until the
+// end of the cycle is a long step. Wake-up and deadline times are given, the end is the clock's.
+TEST(Loop, OverrunsAreChargedToTheLateWakeUpOrTheLongStep) {
+  FakeBackend backend(discrete_plant(), kFs);
+  LoopOptions o;
+  o.duration = 1.0;
+  o.limits.watchdog_timeout = 10.0;
+  Loop loop(backend, o);
+  loop.start();
+  const std::int64_t now = monotonic_ns();
+  ASSERT_TRUE(loop.cycle(now - 1'000'000, now - 100'000));  // late by 900 us, step >= 100 us
+  const std::int64_t later = monotonic_ns();
+  ASSERT_TRUE(loop.cycle(later - 150'000, later - 140'000));  // late by 10 us, step >= 140 us
+  const LoopReport rep = loop.finish();
+  EXPECT_EQ(rep.overruns, 2u);
+  EXPECT_EQ(rep.overruns_late_wakeup, 1u);
+  EXPECT_EQ(rep.overruns_long_step, 1u);
 }
 
 TEST(Loop, OptionsAreValidated) {

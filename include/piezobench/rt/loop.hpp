@@ -100,6 +100,16 @@ struct LoopReport {
   bool memory_locked = false;       // mlockall obtained
   std::uint64_t cycles = 0;
   std::uint64_t overruns = 0;       // cycles that ended after the next deadline
+  // The overruns by cause (real time; they add up to `overruns`): each is charged to the larger of
+  // its two parts, the wake-up's lateness (deadline -> wake-up: the host's timer and scheduler) or
+  // the step (wake-up -> end: the code's execution time, plus any preemption inside it).
+  std::uint64_t overruns_late_wakeup = 0;
+  std::uint64_t overruns_long_step = 0;
+  // What the shared host took from the loop thread during the cycles (Linux; -1 when unknown, and
+  // in lockstep mode): time runnable but waiting for a core (schedstat run delay) and involuntary
+  // context switches (preemptions by other threads).
+  double host_wait_ms = -1.0;
+  std::int64_t host_preemptions = -1;
   std::uint64_t skipped_deadlines = 0;
   std::uint64_t wind_down_cycles = 0;  // extra cycles that brought the output to the safe value
   TimingSummary period_jitter_us;   // |actual period - T| between consecutive wake-ups
@@ -151,8 +161,7 @@ class Loop {
   [[nodiscard]] const SafetyGuard& guard() const noexcept { return guard_; }
   [[nodiscard]] const control::DiscreteIff& controller() const noexcept { return iff_; }
 
-  // Used by run_loop(): overruns, skipped deadlines and the watchdog.
-  void add_overrun() noexcept { ++overruns_; }
+  // Used by run_loop(): skipped deadlines and the watchdog.
   void add_skipped(std::uint64_t n) noexcept { skipped_ += n; }
   void watchdog_trip() noexcept;
   [[nodiscard]] std::uint64_t heartbeat() const noexcept;
@@ -171,7 +180,7 @@ class Loop {
   std::unique_ptr<Shared> shared_;  // atomics shared with the watchdog thread
   TimingHistogram jitter_, latency_, step_time_;
   std::uint64_t cycle_ = 0;
-  std::uint64_t overruns_ = 0, skipped_ = 0, wind_down_ = 0;
+  std::uint64_t overruns_ = 0, overruns_late_wakeup_ = 0, overruns_long_step_ = 0, skipped_ = 0, wind_down_ = 0;
   std::uint64_t controller_nonfinite_seen_ = 0;
   std::int64_t last_wake_ns_ = 0;
   std::int64_t last_end_ns_ = 0;
