@@ -15,6 +15,7 @@
 #include "piezobench/control/discrete_iff.hpp"
 #include "piezobench/control/hysteresis_feedforward.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/memory.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/lti/discretize.hpp"
 #include "piezobench/core/units.hpp"
@@ -177,6 +178,8 @@ io::TimeSeries stroke(BenchRunner& runner, const UnitTruth& unit, const Experime
 io::TimeSeries open_loop_record(Eigen::MatrixXd&& y, double fs, bool with_vs) {
   io::TimeSeries ts = with_vs ? make_record({"u", "Va", "de", "Vs"}, {"V", "V", "m", "V"}, 0, fs, false)
                               : make_record({"u", "Va", "de"}, {"V", "V", "m"}, 0, fs, false);
+  ts.t.resize(y.rows());
+  core::advise_huge_pages(ts.t.data(), static_cast<std::size_t>(y.rows()) * sizeof(double));
   ts.t = Eigen::VectorXd::LinSpaced(y.rows(), 0.0, static_cast<double>(y.rows() - 1) / fs);
   if (with_vs) {
     ts.data = std::move(y);  // a 100 s record is 32 MB: moved, not copied
@@ -564,6 +567,7 @@ void VirtualRunner::open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eige
   VirtualBench& b = bench(seed);
   const Eigen::Index n = u.size();
   out.resize(n, 4);
+  core::advise_huge_pages(out.data(), static_cast<std::size_t>(out.size()) * sizeof(double));
   out.col(0) = u;
   const Progressor p{progress, n};
   constexpr Eigen::Index kBlock = 4096;

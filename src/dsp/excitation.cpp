@@ -10,6 +10,7 @@
 #include "dsp/fft.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
+#include "piezobench/core/memory.hpp"
 
 namespace piezobench::dsp {
 
@@ -71,6 +72,8 @@ void fit_to_bounds(const Eigen::VectorXd& c, const Eigen::VectorXd& v, const Vol
   if (bounds.policy == BoundsPolicy::kClip) s = 1.0;
   out.scale = s;
   out.scaled = s < 1.0;
+  out.u.resize(c.size());
+  core::advise_huge_pages(out.u.data(), static_cast<std::size_t>(out.u.size()) * sizeof(double));
   out.u = c + s * v;
   out.clipped = 0;
   for (Index k = 0; k < out.u.size(); ++k) {
@@ -164,6 +167,7 @@ Excitation band_limited_noise(const NoiseOptions& options, const VoltageBounds& 
   }
   detail::RealInverseFft(n).execute(spectrum.data(), samples.data());
   Eigen::VectorXd v(n);
+  core::advise_huge_pages(v.data(), static_cast<std::size_t>(n) * sizeof(double));
   for (Index i = 0; i < n; ++i) v(i) = samples[i] / static_cast<double>(n);
   // Exactly the requested rms (the mean is zero: no DC line).
   const double rms = std::sqrt(v.squaredNorm() / static_cast<double>(n));
@@ -175,7 +179,10 @@ Excitation band_limited_noise(const NoiseOptions& options, const VoltageBounds& 
   out.seed = options.seed;
   out.lines_Hz.resize(2);
   out.lines_Hz << static_cast<double>(first) * df, static_cast<double>(last) * df;
-  fit_to_bounds(Eigen::VectorXd::Constant(n, options.offset), v, bounds, "offset", out);
+  Eigen::VectorXd level(n);
+  core::advise_huge_pages(level.data(), static_cast<std::size_t>(n) * sizeof(double));
+  level.setConstant(options.offset);
+  fit_to_bounds(level, v, bounds, "offset", out);
   return out;
 }
 

@@ -8,6 +8,8 @@
 #include <new>
 #include <utility>
 
+#include "piezobench/core/memory.hpp"
+
 namespace piezobench::dsp::detail {
 namespace {
 
@@ -64,6 +66,7 @@ FftwBuffer<T>::FftwBuffer(Eigen::Index n) : size_(n) {
   void* p = fftw_malloc(sizeof(T) * static_cast<std::size_t>(n > 0 ? n : 1));
   if (p == nullptr) throw std::bad_alloc();
   data_.reset(static_cast<T*>(p));
+  core::advise_huge_pages(p, sizeof(T) * static_cast<std::size_t>(n > 0 ? n : 1));
   for (Eigen::Index i = 0; i < n; ++i) new (data_.get() + i) T{};
 }
 

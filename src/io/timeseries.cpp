@@ -1,9 +1,5 @@
 #include "piezobench/io/timeseries.hpp"
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -19,6 +15,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
+#include "piezobench/core/memory.hpp"
 #include "piezobench/core/text.hpp"
 #include "piezobench/io/units.hpp"
 
@@ -57,18 +54,10 @@ bool all_finite(const double* x, Eigen::Index n) {
 }
 
 // Records reach 10^7 samples per channel: their buffers are allocated once, filled straight from
-// the file and faulted in 2 MiB at a time where the kernel allows it (transparent huge pages in
-// "madvise" mode), which halves the cost of reading a large file (first-touch page faults were
-// half of it). Only the whole 2 MiB pages inside the buffer are advised; a hint, never an error.
-void advise_huge_pages([[maybe_unused]] double* data, [[maybe_unused]] Eigen::Index count) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kHuge = std::uintptr_t{1} << 21;
-  const auto begin = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t end = begin + static_cast<std::uintptr_t>(count) * sizeof(double);
-  const std::uintptr_t first = (begin + kHuge - 1) & ~(kHuge - 1);
-  const std::uintptr_t last = end & ~(kHuge - 1);
-  if (last > first) (void)::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-#endif
+// the file and faulted in 2 MiB at a time where the kernel allows it (core::advise_huge_pages),
+// which halves the cost of reading a large file (first-touch page faults were half of it).
+void advise_huge_pages(double* data, Eigen::Index count) {
+  core::advise_huge_pages(data, static_cast<std::size_t>(count) * sizeof(double));
 }
 
 // The checks of sample_rate_from_time (finite, strictly increasing, uniform) over

@@ -1,0 +1,32 @@
+#include "piezobench/core/memory.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace piezobench::core {
+namespace {
+
+// A hint only: nothing happens to the data, null and small buffers are ignored, and a buffer of
+// several huge pages at any alignment stays readable and writable.
+TEST(Memory, AdvisingHugePagesKeepsTheData) {
+  advise_huge_pages(nullptr, 0);
+  advise_huge_pages(nullptr, std::size_t{1} << 30);
+  double small[4] = {1.0, 2.0, 3.0, 4.0};
+  advise_huge_pages(small, sizeof small);
+  EXPECT_EQ(small[3], 4.0);
+  for (const std::size_t offset : {0u, 1u, 511u}) {
+    std::vector<double> big((std::size_t{3} << 20) + offset);  // 24 MB: at least 10 whole 2 MiB pages
+    for (std::size_t i = 0; i < big.size(); i += 4096) big[i] = static_cast<double>(i);
+    advise_huge_pages(big.data() + offset, (big.size() - offset) * sizeof(double));
+    double sum = 0.0;
+    for (std::size_t i = 0; i < big.size(); i += 4096) sum += big[i] - static_cast<double>(i);
+    EXPECT_EQ(sum, 0.0);
+    big.back() = 7.0;
+    EXPECT_EQ(big.back(), 7.0);
+  }
+}
+
+}  // namespace
+}  // namespace piezobench::core
