@@ -7,6 +7,7 @@
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/least_squares.hpp"
+#include "piezobench/core/memory.hpp"
 #include "piezobench/core/minimize.hpp"
 #include "piezobench/core/nnls.hpp"
 #include "piezobench/core/text.hpp"
