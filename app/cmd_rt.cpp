@@ -10,6 +10,7 @@
 #include "measure_common.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
@@ -156,7 +157,7 @@ int run_rt(const RtOptions& o) {
     const auto n = static_cast<Eigen::Index>(std::max(2.0, std::round(backend->sample_rate() / o.frequency)));
     lo.excitation.resize(n);
     for (Eigen::Index k = 0; k < n; ++k) {
-      lo.excitation(k) = o.offset + o.amplitude * std::sin(2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
+      lo.excitation(k) = o.offset + o.amplitude * std::sin(kTwoPi * static_cast<double>(k) / static_cast<double>(n));
     }
     lo.log_settings["amplitude"] = o.amplitude;
     lo.log_settings["offset"] = o.offset;

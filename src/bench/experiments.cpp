@@ -378,7 +378,7 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
       w = 0.5 - 0.5 * std::cos(std::numbers::pi * t / ramp);
       v = offset * w;
     } else if (k < n_ramp + n_wave) {
-      v = offset + amplitude * std::sin(2.0 * std::numbers::pi * frequency * (t - ramp));
+      v = offset + amplitude * std::sin(kTwoPi * frequency * (t - ramp));
     } else if (k < n_ramp + 2 * n_wave) {
       // Triangle from the offset upwards: 0 -> 1 -> -1 -> 0 per period.
       double phase = frequency * (t - ramp) - periods;

@@ -41,7 +41,6 @@ lti::StateSpace channel(const lti::StateSpace& sys, lti::Index output) {
 nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
   const VirtualBench bench(unit, options, 0);
   const lti::StateSpace sys = bench.linear_model();
-  const double two_pi = kTwoPi;
   nlohmann::json j;
   j["id"] = unit.id;
   j["defective"] = unit.defective;
@@ -57,9 +56,9 @@ nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
     j["model_2dof"] = nullptr;
   }
   j["capacitance_uF"] = {{"sensor", unit.capacitance_sensor * 1e6}, {"actuator", unit.capacitance_actuator * 1e6}};
-  j["hpf_corner_Hz"] = 1.0 / (two_pi * options.sensor_shunt_resistance() * unit.capacitance_sensor);
-  j["hpf_corner_with_resistor_Hz"] = 1.0 / (two_pi * options.hpf_resistance * unit.capacitance_sensor);
-  j["hpf_corner_without_resistor_Hz"] = 1.0 / (two_pi * options.adc_input_resistance * unit.capacitance_sensor);
+  j["hpf_corner_Hz"] = 1.0 / (kTwoPi * options.sensor_shunt_resistance() * unit.capacitance_sensor);
+  j["hpf_corner_with_resistor_Hz"] = 1.0 / (kTwoPi * options.hpf_resistance * unit.capacitance_sensor);
+  j["hpf_corner_without_resistor_Hz"] = 1.0 / (kTwoPi * options.adc_input_resistance * unit.capacitance_sensor);
 
   // Resonance: the lowest lightly damped complex pole pair (the 2-DoF model has one; a super
   // element's modes all have the same modal damping, and the suspended mass's is the lowest).
@@ -69,7 +68,7 @@ nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
   for (const auto& pi : poles) {
     if (pi.pole.imag() > 0.0 && pi.damping < 0.2 && pi.natural_frequency < res.natural_frequency) res = pi;
   }
-  j["resonance_Hz"] = res.natural_frequency / two_pi;
+  j["resonance_Hz"] = res.natural_frequency / kTwoPi;
   j["resonance_damping"] = res.damping;
   // Anti-resonance: the lowest complex zero pair of u -> Vs. (The analysis of sampled files by
   // scripts/analysis/check_simulate.py finds it within 0.0005 in damping.)
@@ -81,10 +80,10 @@ nlohmann::json truth_json(const UnitTruth& unit, const BenchOptions& options) {
     if (zi.natural_frequency < anti.natural_frequency) anti = zi;
   }
   if (std::isfinite(anti.natural_frequency)) {
-    j["antiresonance_Hz"] = anti.natural_frequency / two_pi;
+    j["antiresonance_Hz"] = anti.natural_frequency / kTwoPi;
     j["antiresonance_damping"] = anti.damping;
     j["zero_is_nonminimum_phase"] = anti.damping < 0.0;
-    j["nmp_zero"] = {{"frequency_Hz", anti.natural_frequency / two_pi}, {"damping", anti.damping}};
+    j["nmp_zero"] = {{"frequency_Hz", anti.natural_frequency / kTwoPi}, {"damping", anti.damping}};
   } else {
     j["antiresonance_Hz"] = nullptr;
     j["antiresonance_damping"] = nullptr;

@@ -8,7 +8,6 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
-#include <numbers>
 #include <set>
 
 #include "piezobench/core/file.hpp"
@@ -362,7 +361,7 @@ CraigBamptonResult craig_bampton(const SparseModel& model, const std::vector<Int
     if (it != model.coordinates.end()) se.coordinates[node] = it->second;
   }
   se.source = model.source + " (Craig-Bampton: " + std::to_string(nb) + " interface DOF, " + std::to_string(nm) + " modes)";
-  out.fixed_interface_Hz = lambda.unaryExpr([](double l) { return std::copysign(std::sqrt(std::abs(l)), l) / (2 * std::numbers::pi); });
+  out.fixed_interface_Hz = lambda.unaryExpr([](double l) { return eigenvalue_Hz(l); });
   try {
     se.validate();
   } catch (const InputError& e) {

@@ -4,12 +4,12 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <set>
 
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::fem {
@@ -247,7 +247,7 @@ StructuralModel assemble(const SuperElement& se, const ModelOptions& options) {
       const Modes m = modes(out.K, out.M);
       Eigen::VectorXd two_zeta_w(f);
       for (Index i = 0; i < f; ++i) {
-        two_zeta_w(i) = 2.0 * options.damping.zeta * 2.0 * std::numbers::pi * std::max(0.0, m.frequencies_Hz(i));
+        two_zeta_w(i) = 2.0 * options.damping.zeta * kTwoPi * std::max(0.0, m.frequencies_Hz(i));
       }
       const Eigen::MatrixXd MPhi = out.M * m.shapes;
       out.C = MPhi * two_zeta_w.asDiagonal() * MPhi.transpose();
@@ -265,8 +265,7 @@ Modes modes(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M) {
                          "eigensolver did not converge", false);
   }
   Modes out;
-  out.frequencies_Hz = es.eigenvalues().unaryExpr(
-      [](double l) { return std::copysign(std::sqrt(std::abs(l)), l) / (2 * std::numbers::pi); });
+  out.frequencies_Hz = es.eigenvalues().unaryExpr([](double l) { return eigenvalue_Hz(l); });
   out.shapes = es.eigenvectors();
   return out;
 }
@@ -306,7 +305,7 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
     Eigen::MatrixXcd h = T * lu.solve(F);
     if (!h.allFinite()) {
       throw NumericalError("frequency_response (dense LU of K - w^2 M + j w C)",
-                           "the dynamic stiffness is singular at " + format_number(w / (2 * std::numbers::pi), 17) +
+                           "the dynamic stiffness is singular at " + format_number(w / kTwoPi, 17) +
                                " Hz (an undamped resonance, or a free body at 0 Hz)",
                            true);
     }
@@ -331,7 +330,7 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
     if (!(modal_c.cwiseAbs().maxCoeff() <= kModalCouplingTolerance * c.cwiseAbs().maxCoeff())) return frequency_response(model, omega);
   }
   const Eigen::VectorXd lambda = modes.frequencies_Hz.unaryExpr([](double hz) {
-    const double w = 2 * std::numbers::pi * hz;
+    const double w = kTwoPi * hz;
     return std::copysign(w * w, hz);
   });
   const Eigen::MatrixXcd t_phi = (model.T * phi).cast<std::complex<double>>();
@@ -346,7 +345,7 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
     Eigen::MatrixXcd h = t_phi * inv.asDiagonal() * phi_f;
     if (!h.allFinite()) {
       throw NumericalError("frequency_response (modal superposition)",
-                           "the dynamic stiffness is singular at " + format_number(w / (2 * std::numbers::pi), 17) +
+                           "the dynamic stiffness is singular at " + format_number(w / kTwoPi, 17) +
                                " Hz (an undamped resonance, or a free body at 0 Hz)",
                            true);
     }

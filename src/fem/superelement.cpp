@@ -4,12 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <numbers>
 #include <set>
 
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/fem/matrix_io.hpp"
 
@@ -17,10 +17,6 @@ namespace piezobench::fem {
 namespace {
 
 using text::quote;
-
-double signed_Hz(double lambda) {
-  return std::copysign(std::sqrt(std::abs(lambda)), lambda) / (2 * std::numbers::pi);
-}
 
 std::string list_nodes(const std::vector<long>& nodes) {
   std::string s;
@@ -591,13 +587,13 @@ RigidBodyCheck check_rigid_body_modes(const SuperElement& se, double relative_th
   out.lowest_modes_Hz.resize(6);
   out.rigid_fraction.resize(6);
   for (Index k = 0; k < 6; ++k) {
-    out.lowest_modes_Hz(k) = signed_Hz(es.eigenvalues()(k));
+    out.lowest_modes_Hz(k) = eigenvalue_Hz(es.eigenvalues()(k));
     // M-orthogonal projection of the (mass-normalized) mode on span(R): its squared M-norm.
     const Eigen::VectorXd b = MR.transpose() * es.eigenvectors().col(k);
     const Eigen::VectorXd c = rmr.solve(b);
     out.rigid_fraction(k) = b.dot(c);
   }
-  out.first_flexible_Hz = signed_Hz(es.eigenvalues()(6));
+  out.first_flexible_Hz = eigenvalue_Hz(es.eigenvalues()(6));
   out.free_free = (out.rigid_fraction.array() > 0.9).all();
   const double worst = out.lowest_modes_Hz.cwiseAbs().maxCoeff();
   out.spoiled = out.free_free && worst > relative_threshold * std::abs(out.first_flexible_Hz);
@@ -617,5 +613,7 @@ RigidBodyCheck check_rigid_body_modes(const SuperElement& se, double relative_th
   }
   return out;
 }
+
+double eigenvalue_Hz(double lambda) { return std::copysign(std::sqrt(std::abs(lambda)), lambda) / kTwoPi; }
 
 }  // namespace piezobench::fem

@@ -21,6 +21,10 @@
 
 namespace piezobench::fem {
 
+// The frequency [Hz] of an eigenvalue lambda = w^2 of K phi = w^2 M phi, signed:
+// sign(lambda) sqrt|lambda| / 2 pi, so a negative value flags a negative eigenvalue.
+[[nodiscard]] double eigenvalue_Hz(double lambda);
+
 using Index = Eigen::Index;
 
 // A nodal direction: translations x, y, z and rotations about x, y, z (CalculiX directions 1..6,
