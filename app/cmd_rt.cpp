@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <memory>
-#include <numbers>
 
 #include "cli_common.hpp"
 #include "measure_common.hpp"
