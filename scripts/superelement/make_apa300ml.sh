@@ -13,7 +13,7 @@
 set -eu
 PB=${1:-build/app/piezobench}
 MESH=${MESH:-1.5}
-MODES=${MODES:-20}
+MODES=${MODES:-40}
 DEST=data/superelement/apa300ml
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
