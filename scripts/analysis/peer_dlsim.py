@@ -8,6 +8,7 @@ the peer does less work than the C++ bench.
 
 Usage: /usr/bin/python3 scripts/analysis/peer_dlsim.py [samples]
 """
+import os
 import sys
 import time
 
@@ -15,36 +16,11 @@ import numpy as np
 import scipy
 import scipy.signal
 
-m, k1, c1, ke, ce, ka, ca, ga, gs = 5.7, 0.38e6, 5.0, 5e6, 100.0, 2.5e6, 50.0, -2.58, 0.46e6
-G, wa, R, C_lcr, Ca, Rg, waa = 20.0, 2 * np.pi * 5000, 80.6e3, 4.95e-6, 9.87e-6, 0.16, 2 * np.pi * 1000
-K = ke + ka * k1 / (ka + k1)
-Cb = C_lcr * K / (K + gs * gs * C_lcr)
-alpha = gs * Cb
-kesc = ke - gs * alpha
-kappa = -Rg * Ca
-den = ca + ce
-# states Va, x, v, xn, V, y (Vs at the ADC); input u
-A = np.zeros((6, 6))
-B = np.zeros((6, 1))
-A[0, 0] = -wa
-B[0, 0] = wa * G
-A[1, 2] = 1.0
-xnd = np.array([ga, kesc, ce, -(ka + kesc), alpha, 0.0]) / den
-T = np.array([0.0, kesc, ce, -kesc, alpha, 0.0]) - ce * xnd
-A[2, :] = -T / m
-A[2, 1] -= k1 / m
-A[2, 2] -= c1 / m
-A[3, :] = xnd
-A[4, :] = -gs * xnd
-A[4, 2] += gs
-A[4, 4] -= 1.0 / (R * Cb)
-A[5, 4] = waa
-A[5, 0] = -waa * kappa * wa
-A[5, 5] = -waa
-B[5, 0] = waa * kappa * wa * G
-C = np.zeros((2, 6))
-C[0, 1] = 1.0
-C[1, 5] = 1.0
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_linear_model import linear_bench  # noqa: E402
+
+A, B, rows = linear_bench()
+C = np.vstack([rows["de"], rows["Vs"]])
 D = np.zeros((2, 1))
 
 n = int(sys.argv[1]) if len(sys.argv) > 1 else 1_000_000
