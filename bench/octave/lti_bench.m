@@ -58,6 +58,11 @@ function p = nearest_pole (ps, target)
   [~, j] = min (abs (ps - target));
   p = ps(j);
 endfunction
+## -damping of the branch pole nearest `target` at gain g (one eig per evaluation).
+function v = minus_damping (aL, bL, cL, g, target)
+  p = nearest_pole (eig (aL - g * bL * cL), target);
+  v = real (p) / abs (p);
+endfunction
 function [gopt, zopt] = max_damping (aL, bL, cL, start)
   ggrid = logspace (0, 7, 2001);
   branch = start; zb = zeros (size (ggrid)); bp = zeros (size (ggrid));
@@ -66,7 +71,7 @@ function [gopt, zopt] = max_damping (aL, bL, cL, start)
     bp(k) = branch; zb(k) = -real (branch) / abs (branch);
   endfor
   [~, kb] = max (zb);
-  f = @(lg) real (nearest_pole (eig (aL - 10^lg * bL * cL), bp(kb))) / abs (nearest_pole (eig (aL - 10^lg * bL * cL), bp(kb)));
+  f = @(lg) minus_damping (aL, bL, cL, 10^lg, bp(kb));
   [lg, fo] = fminbnd (f, log10 (ggrid(kb - 1)), log10 (ggrid(kb + 1)), optimset ("TolX", 1e-10));
   gopt = 10^lg; zopt = -fo;
 endfunction
