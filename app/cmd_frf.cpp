@@ -73,9 +73,10 @@ int run_frf(const FrfOptions& o) {
   read.delimiter = io::csv_delimiter_from_string(o.delimiter);
   read.decimal = io::csv_decimal_from_string(o.decimal);
   if (!o.json) log_line("reading " + o.file);
-  const io::TimeSeries ts = io::read_timeseries(o.file, read);
+  // One pass over the samples: a large v5 record is used in place from the file's mapping.
+  const io::TimeSeriesView ts = io::read_timeseries_view(o.file, read);
   // The settings `run` uses for a record (dsp::welch_options_for_record), then the options given.
-  dsp::WelchOptions welch = dsp::welch_options_for_record(ts.samples(), ts.sample_rate, o.resolution, "--resolution");
+  dsp::WelchOptions welch = dsp::welch_options_for_record(ts.samples, ts.sample_rate, o.resolution, "--resolution");
   welch.window = dsp::window_type_from_string(o.window);
   if (o.nfft > 0) welch.nfft = o.nfft;
   welch.overlap = o.overlap;
@@ -85,11 +86,11 @@ int run_frf(const FrfOptions& o) {
 
   std::vector<dsp::Channel> outputs;
   for (std::size_t i = 1; i < read.channels.size(); ++i) {
-    outputs.push_back({read.channels[i], {ts.data.col(static_cast<Eigen::Index>(i)).data(), static_cast<std::size_t>(ts.samples())}});
+    outputs.push_back({read.channels[i], {ts.columns[i], static_cast<std::size_t>(ts.samples)}});
   }
-  const dsp::Channel input{o.input, {ts.data.col(0).data(), static_cast<std::size_t>(ts.samples())}};
+  const dsp::Channel input{o.input, {ts.columns[0], static_cast<std::size_t>(ts.samples)}};
   if (!o.json) {
-    log_line(fmt::format("{} samples at {:g} Hz, nfft {} ({:.4g} Hz bins), {} outputs", ts.samples(), ts.sample_rate, welch.nfft,
+    log_line(fmt::format("{} samples at {:g} Hz, nfft {} ({:.4g} Hz bins), {} outputs", ts.samples, ts.sample_rate, welch.nfft,
                          ts.sample_rate / static_cast<double>(welch.nfft), outputs.size()));
   }
   const dsp::FrfEstimate estimate = dsp::estimate_frf(input, outputs, ts.sample_rate, welch, o.file);

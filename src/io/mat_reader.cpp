@@ -14,6 +14,7 @@
 #include <mutex>
 
 #include "io/mat_file.hpp"
+#include "io/mapped_file.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/text.hpp"
 
@@ -139,6 +140,15 @@ int element_size(std::uint32_t type) {
   }
 }
 
+// A top-level variable of a v5 file, and where its data lie when it is a real double array stored
+// as doubles in the file's own bytes (uncompressed, native byte order): what map_double_vector
+// may use in place. count 0: anything else.
+struct PlainVector {
+  std::string name;
+  unsigned long long offset = 0;  // file offset of the first element
+  unsigned long long count = 0;
+};
+
 struct Tag {
   std::uint32_t type = 0;
   unsigned long long bytes = 0;
@@ -150,7 +160,15 @@ struct Tag {
 // bytes present cannot back, before matio allocates anything for it.
 class V5Checker {
  public:
-  V5Checker(ByteSource& src, bool swap, std::string source) : src_(src), swap_(swap), source_(std::move(source)) {}
+  // `base`: the file offset of the source's first byte when it reads the file itself (lets
+  // plain() locate data); kNotInFile for an inflated stream.
+  static constexpr unsigned long long kNotInFile = ~0ull;
+  V5Checker(ByteSource& src, bool swap, std::string source, unsigned long long base = kNotInFile)
+      : src_(src), swap_(swap), source_(std::move(source)), base_(base) {}
+
+  // After the check of a top-level variable: its name, and where its data lie when it is a real
+  // double array stored as doubles in the file's own bytes (see PlainVector).
+  [[nodiscard]] const PlainVector& plain() const { return plain_; }
 
   // The whole element: tag (miMATRIX) then its contents.
   void check_element(const std::string& path) {
@@ -207,6 +225,7 @@ class V5Checker {
     } else {
       skip(padded(name_tag.bytes), path + " (name)");
     }
+    if (depth == 0) plain_.name = name;
     if (depth == 0 && !name.empty()) path = text::quote(name);
     const std::string what = path + " (declared " + shape + ")";
 
@@ -231,7 +250,14 @@ class V5Checker {
       const unsigned long long children = fields == 0 || count == 0 ? 0 : (count > (1ull << 50) / fields ? (1ull << 50) : count * fields);
       check_children(children, end, depth, path, what);
     } else if (cls == 4 || (cls >= 6 && cls <= 15)) {  // char and numeric classes
-      check_data(count, end, path + " (real part)", what);
+      const Tag real = check_data(count, end, path + " (real part)", what);
+      constexpr std::uint32_t kMiDouble = 9;
+      constexpr unsigned kDoubleClass = 6, kLogicalFlag = 0x200u;
+      if (depth == 0 && base_ != kNotInFile && !swap_ && cls == kDoubleClass && !complex && (flag_word & kLogicalFlag) == 0 &&
+          real.type == kMiDouble && !real.small && count > 0 && real.bytes == count * 8) {
+        plain_.offset = base_ + data_position_;
+        plain_.count = count;
+      }
       if (complex) check_data(count, end, path + " (imaginary part)", what);
     }
     // Anything else (sparse, object, function, opaque) is never read by piezobench: skipped.
@@ -258,8 +284,10 @@ class V5Checker {
     }
   }
 
-  void check_data(unsigned long long count, unsigned long long end, const std::string& field, const std::string& what) {
+  // Checks one data element and returns its tag (data_position_: where its data start).
+  Tag check_data(unsigned long long count, unsigned long long end, const std::string& field, const std::string& what) {
     const Tag tag = read_tag(field);
+    data_position_ = src_.position();
     const int size = element_size(tag.type);
     if (size == 0) fail(field, "a numeric or character data type", "type " + std::to_string(tag.type));
     const unsigned long long left = end - std::min(end, src_.position());
@@ -269,6 +297,7 @@ class V5Checker {
            bytes_text(tag.bytes) + " of data");
     }
     if (!tag.small) skip(padded(tag.bytes), field);
+    return tag;
   }
 
   Tag read_tag(const std::string& where) {
@@ -329,7 +358,14 @@ class V5Checker {
   ByteSource& src_;
   bool swap_;
   std::string source_;
+  unsigned long long base_;
+  unsigned long long data_position_ = 0;
+  PlainVector plain_;
 };
+
+void keep_first(std::vector<PlainVector>& vars, const PlainVector& v) {
+  if (std::none_of(vars.begin(), vars.end(), [&](const PlainVector& q) { return q.name == v.name; })) vars.push_back(v);
+}
 
 // The first bytes decide whether the file is a MAT file at all: a v5/v7 file has a 128-byte
 // header with the version 0x0100 and an endian indicator "IM"/"MI" at bytes 126..127; a v7.3 file
@@ -338,8 +374,9 @@ class V5Checker {
 // For v5, every top-level element is then checked against the file (see V5Checker): matio stops
 // at the first variable it cannot read and reports the ones before it as if the file ended there,
 // and allocates what a variable's header declares.
-// Returns true for a v7.3 (HDF5) file.
-bool check_mat_file(const fs::path& file) {
+// Returns true for a v7.3 (HDF5) file. For v5, `plain` receives the top-level variables (the first
+// of each name, the one matio finds) and where the data of those that can be used in place lie.
+bool check_mat_file(const fs::path& file, std::vector<PlainVector>& plain) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string(), "file", "a readable file", "cannot open it");
   char header[128] = {};
@@ -396,13 +433,15 @@ bool check_mat_file(const fs::path& file) {
     }
     if (type == kMiMatrix) {
       FileSource src(in, pos + 8, nbytes);
-      V5Checker check(src, swap, file.string());
+      V5Checker check(src, swap, file.string(), pos + 8);
       check.check_matrix(nbytes, 0, std::to_string(index) + " (at byte " + std::to_string(pos) + ")");
+      keep_first(plain, check.plain());
     } else if (type == kMiCompressed) {
       const auto limit = static_cast<unsigned long long>(kMaxInflation * static_cast<double>(nbytes)) + 4096;
       InflateSource src(in, pos + 8, nbytes, limit);
       V5Checker check(src, swap, file.string());
       check.check_element(std::to_string(index) + " (compressed, at byte " + std::to_string(pos) + ")");
+      keep_first(plain, check.plain());
     }
     pos = next;
   }
@@ -413,12 +452,25 @@ bool check_mat_file(const fs::path& file) {
 
 class Mat5Input final : public MatInput {
  public:
-  Mat5Input(fs::path file, MatioPtr mat) : MatInput(std::move(file)), mat_(std::move(mat)) {}
+  Mat5Input(fs::path file, MatioPtr mat, std::vector<PlainVector> plain)
+      : MatInput(std::move(file)), mat_(std::move(mat)), plain_(std::move(plain)) {}
   [[nodiscard]] bool v73() const override { return false; }
   [[nodiscard]] mat_t* mat() const { return mat_.get(); }
+  [[nodiscard]] const std::vector<PlainVector>& plain() const { return plain_; }
+  // The file mapped once, on first use (nullptr when it cannot be mapped).
+  [[nodiscard]] const std::shared_ptr<const MappedFile>& mapping() const {
+    if (!mapped_) {
+      mapping_ = MappedFile::open(file());
+      mapped_ = true;
+    }
+    return mapping_;
+  }
 
  private:
   MatioPtr mat_;
+  std::vector<PlainVector> plain_;
+  mutable std::shared_ptr<const MappedFile> mapping_;
+  mutable bool mapped_ = false;
 };
 
 // ---- v7.3 through HDF5 ----------------------------------------------------------------------
@@ -868,13 +920,14 @@ MatFilePtr open_mat_for_reading(const fs::path& file) {
   std::error_code ec;
   if (!fs::exists(file, ec)) throw InputError(file.string(), "file", "an existing file", "no such file");
   if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "a regular file", "a directory");
-  if (check_mat_file(file)) return std::make_unique<Mat73Input>(file);
+  std::vector<PlainVector> plain;
+  if (check_mat_file(file, plain)) return std::make_unique<Mat73Input>(file);
   (void)take_matio_message();
   MatioPtr mat(Mat_Open(file.c_str(), MAT_ACC_RDONLY));
   if (!mat) {
     throw InputError(file.string(), "file", "a MAT file (v5, v7 or v7.3)", with_matio_reason("matio cannot open it"));
   }
-  return std::make_unique<Mat5Input>(file, std::move(mat));
+  return std::make_unique<Mat5Input>(file, std::move(mat), std::move(plain));
 }
 
 std::vector<MatVarInfo> list_mat_variables(MatInput* in, const fs::path& file) {
@@ -980,6 +1033,20 @@ std::optional<double> read_double_element(MatInput* in, const std::string& name,
   (void)take_matio_message();
   if (!ok) return std::nullopt;
   return value;
+}
+
+std::optional<MappedDoubles> map_double_vector(MatInput* in, const std::string& name, std::size_t count) {
+  const Mat5Input* v5 = as_v5(in);
+  if (v5 == nullptr || count == 0) return std::nullopt;
+  const auto& plain = v5->plain();
+  const auto it = std::find_if(plain.begin(), plain.end(), [&](const PlainVector& p) { return p.name == name; });
+  if (it == plain.end() || it->count != count) return std::nullopt;
+  const std::shared_ptr<const MappedFile>& file = v5->mapping();
+  if (!file) return std::nullopt;
+  // The mapping is of the file as it is now: a file that changed since it was checked is refused.
+  const double* data = file->doubles(static_cast<std::size_t>(it->offset), count);
+  if (data == nullptr) return std::nullopt;
+  return MappedDoubles{data, file};
 }
 
 }  // namespace piezobench::io::detail

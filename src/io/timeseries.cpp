@@ -12,6 +12,7 @@
 
 #include "io/csv_table.hpp"
 #include "io/mat_file.hpp"
+#include "io/mapped_file.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
@@ -104,7 +105,7 @@ bool time_samples_ok(const double* t, Eigen::Index n, Eigen::Index first, Eigen:
 
 // Strictly increasing and uniform within tol sample periods; returns the sample rate in Hz.
 // `prechecked`: the reader has verified all of it in its own pass (time_samples_ok).
-double sample_rate_from_time(const std::string& source, const Eigen::VectorXd& t, double tol, bool prechecked) {
+double sample_rate_from_time(const std::string& source, const Eigen::Ref<const Eigen::VectorXd>& t, double tol, bool prechecked) {
   if (prechecked) return 1.0 / ((t(t.size() - 1) - t(0)) / static_cast<double>(t.size() - 1));
   check_finite(source, kTime, t);
   const Eigen::Index n = t.size();
@@ -134,7 +135,7 @@ bool agree(double a, double b, double tol) { return std::abs(a - b) <= tol * std
 
 // Sample rate from, in order of precedence for the value returned: an explicit fs, the file's own
 // `fs`, the time vector. Every pair that is present must agree.
-double resolve_sample_rate(const std::string& source, const Eigen::VectorXd& t, double fs_option,
+double resolve_sample_rate(const std::string& source, const Eigen::Ref<const Eigen::VectorXd>& t, double fs_option,
                            std::optional<double> fs_file, double tol, bool t_prechecked = false) {
   std::optional<double> fs_time;
   if (t.size() >= 2) fs_time = sample_rate_from_time(source, t, tol, t_prechecked);
@@ -227,27 +228,39 @@ double time_unit_factor(const std::string& unit, const std::string& source, cons
   return u.to_si;
 }
 
-// Samples in SI units: each channel's unit (from the file, else ReadOptions::units) is converted
-// with the unit table and replaced by its SI symbol; a unit the table does not know is an
-// InputError naming the channel and the units known. Units stay "" where nothing says one.
-void convert_to_si(TimeSeries& ts, const ReadOptions& options) {
-  if (ts.units.empty()) ts.units.assign(ts.names.size(), "");
-  for (size_t j = 0; j < ts.names.size(); ++j) {
-    std::string& unit = ts.units[j];
-    const auto given = options.units.find(ts.names[j]);
+// SI units: each channel's unit (from the file, else ReadOptions::units) is looked up in the unit
+// table and replaced by its SI symbol; a unit the table does not know is an InputError naming the
+// channel and the units known. Units stay "" where nothing says one (all "": `units` is cleared).
+// Returns the factor from each channel's unit to SI.
+std::vector<double> to_si_units(const std::string& source, const std::vector<std::string>& names,
+                                std::vector<std::string>& units, const ReadOptions& options) {
+  if (units.empty()) units.assign(names.size(), "");
+  std::vector<double> factors(names.size(), 1.0);
+  for (size_t j = 0; j < names.size(); ++j) {
+    std::string& unit = units[j];
+    const auto given = options.units.find(names[j]);
     if (given != options.units.end()) {
       if (!unit.empty() && unit != given->second) {
-        throw InputError(ts.source, "channel " + ts.names[j], "the unit given for it (" + given->second + ")",
+        throw InputError(source, "channel " + names[j], "the unit given for it (" + given->second + ")",
                          "unit " + quote(unit) + " in the file");
       }
       unit = given->second;
     }
     if (unit.empty()) continue;
-    const Unit u = unit_from_string(unit, ts.source, "channel " + ts.names[j]);
-    if (u.to_si != 1.0) ts.data.col(static_cast<Eigen::Index>(j)) *= u.to_si;
+    const Unit u = unit_from_string(unit, source, "channel " + names[j]);
+    factors[j] = u.to_si;
     unit = u.si_symbol;
   }
-  if (std::all_of(ts.units.begin(), ts.units.end(), [](const std::string& u) { return u.empty(); })) ts.units.clear();
+  if (std::all_of(units.begin(), units.end(), [](const std::string& u) { return u.empty(); })) units.clear();
+  return factors;
+}
+
+// Samples in SI units (see to_si_units).
+void convert_to_si(TimeSeries& ts, const ReadOptions& options) {
+  const std::vector<double> factors = to_si_units(ts.source, ts.names, ts.units, options);
+  for (size_t j = 0; j < factors.size(); ++j) {
+    if (factors[j] != 1.0) ts.data.col(static_cast<Eigen::Index>(j)) *= factors[j];
+  }
 }
 
 std::vector<std::string> available_names(const std::vector<std::string>& names) {
@@ -527,9 +540,11 @@ std::map<std::string, Setting> read_struct_settings(const matvar_t& var, const s
   return out;
 }
 
-}  // namespace
-
-TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options) {
+// read_timeseries_mat, and read_timeseries_view's use of a MAT file: with `view`, a time vector and
+// channels stored as plain doubles (detail::map_double_vector) are checked in place in the file's
+// mapping; when every channel is (top level, SI units), `view` gets them (view->mapped) and the
+// TimeSeries returned is empty.
+TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeriesView* view) {
   options.validate();
   const std::string source = file.string();
   detail::MatFilePtr mat = detail::open_mat_for_reading(file);
@@ -582,6 +597,7 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
   // time_samples_ok); anything else through matio's copy and the full checks.
   Eigen::Index t_length = -1;
   bool t_prechecked = false;
+  std::optional<detail::MappedDoubles> t_mapped;  // the time vector in the mapping (view only)
   // `t` or `time` in any case (MATLAB scripts write `time`, `Time`).
   std::string t_name;
   matvar_t* t_in_group = nullptr;
@@ -604,12 +620,22 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
     size_t count = 1;
     for (size_t d : t_info->dims) count *= d;
     const auto n = static_cast<Eigen::Index>(count);
-    const std::optional<double> t_last =
+    if (view != nullptr && n >= 2 && n == lengths.front()) t_mapped = detail::map_double_vector(mat.get(), t_name, count);
+    const std::optional<double> t_last = t_mapped ? std::nullopt :
         n >= 2 && n == lengths.front() && is_numeric_vector(*t_info) && t_info->class_type == MAT_C_DOUBLE
             ? detail::read_double_element(mat.get(), t_name, n, n - 1)
             : std::nullopt;
     bool read = false;
-    if (t_last) {
+    if (t_mapped) {
+      const double* t = t_mapped->data;
+      const double dt = (t[n - 1] - t[0]) / static_cast<double>(n - 1);  // as sample_rate_from_time
+      bool ok = true;
+      for (Eigen::Index first = 0; first < n && ok; first += kReadChunk) {
+        ok = time_samples_ok(t, n, first, std::min(kReadChunk, n - first), dt, options.time_tolerance);
+      }
+      t_prechecked = ok;
+      read = true;
+    } else if (t_last) {
       ts.t.resize(n);
       advise_huge_pages(ts.t.data(), n);
       bool ok = true;
@@ -625,7 +651,7 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
       detail::MatVarPtr tv = detail::read_mat_variable(mat.get(), file, t_name);
       ts.t = detail::to_real_vector(*tv, source, t_name);
     }
-    t_length = ts.t.size();
+    t_length = t_mapped ? n : ts.t.size();
   }
   check_lengths(source, names, lengths, t_length);
 
@@ -652,9 +678,50 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
     const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; });
     return layout.group.empty() && info != vars.end() ? info->unit : std::string();
   };
-  if (ts.t.size() > 0) {
+  if (ts.t.size() > 0 || t_mapped) {
     const double factor = time_unit_factor(unit_of(t_name), source, std::string(kUnits) + "." + t_name);
-    if (factor != 1.0) ts.t *= factor;
+    if (t_mapped && factor != 1.0) {
+      ts.t = Eigen::Map<const Eigen::VectorXd>(t_mapped->data, t_length) * factor;
+      t_mapped.reset();
+    } else if (factor != 1.0) {
+      ts.t *= factor;
+    }
+  }
+  // The time vector where it is: in the mapping or in ts.t.
+  const Eigen::Map<const Eigen::VectorXd> t_samples(t_mapped ? t_mapped->data : ts.t.data(), t_mapped ? t_length : ts.t.size());
+
+  // In place: every channel a plain double vector at the top level, in SI units already.
+  if (view != nullptr && !layout.group_var) {
+    std::vector<std::string> units;
+    for (const std::string& name : names) units.push_back(unit_of(name));
+    const std::vector<double> factors = to_si_units(source, names, units, options);
+    std::vector<detail::MappedDoubles> mapped;
+    if (std::all_of(factors.begin(), factors.end(), [](double f) { return f == 1.0; })) {
+      for (const std::string& name : names) {
+        std::optional<detail::MappedDoubles> m = detail::map_double_vector(mat.get(), name, static_cast<size_t>(lengths.front()));
+        if (!m) break;
+        mapped.push_back(std::move(*m));
+      }
+    }
+    if (mapped.size() == names.size()) {
+      const Eigen::Index n = lengths.front();
+      for (size_t j = 0; j < names.size(); ++j) {
+        bool finite = true;
+        for (Eigen::Index first = 0; first < n && finite; first += kReadChunk) {
+          finite = all_finite(mapped[j].data + first, std::min(kReadChunk, n - first));
+        }
+        if (!finite) check_finite(source, names[j], Eigen::Map<const Eigen::VectorXd>(mapped[j].data, n));
+        view->columns.push_back(mapped[j].data);
+      }
+      view->sample_rate = resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, t_prechecked);
+      view->names = names;
+      view->units = std::move(units);
+      view->samples = n;
+      view->source = source;
+      view->storage = mapped.front().file;
+      view->mapped = true;
+      return ts;
+    }
   }
 
   ts.names = names;
@@ -679,7 +746,7 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
     }
     if (!finite) check_finite(source, field, ts.data.col(col));
   }
-  ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_file, options.time_tolerance, t_prechecked);
+  ts.sample_rate = resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, t_prechecked);
   ts.units.assign(names.size(), "");
   for (size_t j = 0; j < names.size(); ++j) ts.units[j] = unit_of(names[j]);
   convert_to_si(ts, options);
@@ -690,6 +757,40 @@ TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options)
   // The samples were checked above (finite channels, and t by resolve_sample_rate).
   validate_series(ts, /*samples=*/false);
   return ts;
+}
+
+}  // namespace
+
+TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options) { return read_mat(file, options, nullptr); }
+
+TimeSeriesView read_timeseries_view(const fs::path& file, const ReadOptions& options) {
+  TimeSeriesView view;
+  TimeSeries ts = text::to_lower(file.extension().string()) == ".mat" ? read_mat(file, options, &view) : read_timeseries(file, options);
+  if (view.mapped) return view;
+  auto owned = std::make_shared<TimeSeries>(std::move(ts));
+  view.names = owned->names;
+  for (Eigen::Index j = 0; j < owned->channels(); ++j) view.columns.push_back(owned->data.col(j).data());
+  view.samples = owned->samples();
+  view.sample_rate = owned->sample_rate;
+  view.units = owned->units;
+  view.source = owned->source;
+  view.storage = std::move(owned);
+  return view;
+}
+
+Eigen::Index TimeSeriesView::index(const std::string& name) const {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) throw_unknown_channel(source, name, names);
+  return static_cast<Eigen::Index>(it - names.begin());
+}
+
+Eigen::Map<const Eigen::VectorXd> TimeSeriesView::channel(const std::string& name) const {
+  return {columns[static_cast<size_t>(index(name))], samples};
+}
+
+std::string TimeSeriesView::unit(const std::string& name) const {
+  const Eigen::Index j = index(name);
+  return units.empty() ? std::string() : units[static_cast<size_t>(j)];
 }
 
 TimeSeries read_timeseries_csv(const fs::path& file, const ReadOptions& options) {

@@ -526,6 +526,103 @@ TEST(TimeSeriesValidation, TruncatedAndCorruptMatFilesAreInputErrors) {
   EXPECT_TRUE(contains(input_error([&] { (void)read_timeseries(file); }), "MAT file"));
 }
 
+// ---- read_timeseries_view: in place from the file's mapping, same checks and results ----------
+
+// The view of `file` holds what read_timeseries gives, bit for bit; `mapped` says whether it used
+// the file in place.
+void expect_view_matches(const fs::path& file, const ReadOptions& options, bool mapped) {
+  SCOPED_TRACE(file.string());
+  const TimeSeries ts = read_timeseries(file, options);
+  const TimeSeriesView view = read_timeseries_view(file, options);
+  EXPECT_EQ(view.mapped, mapped);
+  EXPECT_EQ(view.names, ts.names);
+  EXPECT_EQ(view.units, ts.units);
+  EXPECT_EQ(view.sample_rate, ts.sample_rate);
+  EXPECT_EQ(view.source, ts.source);
+  ASSERT_EQ(view.samples, ts.samples());
+  ASSERT_EQ(view.columns.size(), ts.names.size());
+  for (const std::string& name : ts.names) {
+    EXPECT_EQ(view.channel(name), ts.channel(name)) << name;
+    EXPECT_EQ(view.unit(name), ts.unit(name)) << name;
+  }
+  EXPECT_TRUE(contains(input_error([&] { (void)view.channel("nope"); }), "nope"));
+}
+
+TEST(TimeSeriesView, UncompressedDoublesAreUsedInPlaceAnythingElseIsRead) {
+  TempDir dir;
+  expect_view_matches(test::fixture_path("io/scipy_two_outputs.mat"), {}, true);   // scipy, v5
+  expect_view_matches(test::fixture_path("io/scipy_compressed.mat"), {}, false);   // zlib
+  expect_view_matches(test::fixture_path("io/scipy_struct.mat"), {}, false);       // channels in a struct
+  ReadOptions ab;
+  ab.channels = {"a", "b"};
+  expect_view_matches(test::fixture_path("io/scipy_types.mat"), ab, false);        // integer classes
+  const fs::path v5 = dir.path() / "v5.mat", v73 = dir.path() / "v73.mat", csv = dir.path() / "r.csv";
+  write_timeseries_mat(sample_series(3000), v5);
+  write_timeseries_mat(sample_series(3000), v73, {.version = MatVersion::kV73});
+  write_timeseries_csv(sample_series(300), csv);
+  expect_view_matches(v5, {}, true);
+  ReadOptions vs_u;
+  vs_u.channels = {"Vs", "u"};
+  expect_view_matches(v5, vs_u, true);
+  expect_view_matches(v73, {}, false);
+  expect_view_matches(csv, {}, false);
+  // A channel in mV is converted to V: read, not used in place.
+  TimeSeries mv = sample_series(3000);
+  mv.units = {"mV", "m", "V"};
+  const fs::path mv_file = dir.path() / "mv.mat";
+  write_timeseries_mat(mv, mv_file);
+  expect_view_matches(mv_file, {}, false);
+  // Row vectors (1xN) and a time vector in ms.
+  const Eigen::VectorXd t = large_time(), a = large_channel(0.0), r = large_channel(2.0);
+  const fs::path rows = dir.path() / "rows.mat";
+  write_raw_mat(rows, {{"t", t}, {"a", a}});
+  expect_view_matches(rows, {}, true);
+  const fs::path wrong_length = dir.path() / "short_t.mat";
+  write_raw_mat(wrong_length, {{"t", t.head(kLarge - 1)}, {"a", a}});
+  EXPECT_EQ(input_error([&] { (void)read_timeseries_view(wrong_length); }),
+            input_error([&] { (void)read_timeseries(wrong_length); }));
+}
+
+TEST(TimeSeriesView, BadSamplesAndDamagedFilesGiveTheReadersMessages) {
+  TempDir dir;
+  const Eigen::VectorXd t = large_time(), a = large_channel(0.0), b = large_channel(1.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const fs::path file = dir.path() / "bad.mat";
+  const auto same_message = [&](const std::vector<std::pair<std::string, Eigen::VectorXd>>& vars) {
+    write_raw_mat(file, vars);
+    const std::string want = input_error([&] { (void)read_timeseries(file); });
+    EXPECT_EQ(input_error([&] { (void)read_timeseries_view(file); }), want);
+  };
+  for (const Eigen::Index k : {Eigen::Index{0}, kPiece - 1, kPiece, kLarge - 1}) {
+    SCOPED_TRACE(k);
+    Eigen::VectorXd bad = b;
+    bad(k) = k % 2 == 0 ? nan : -inf;
+    same_message({{"t", t}, {"a", a}, {"b", bad}});
+    Eigen::VectorXd bad_t = t;
+    bad_t(k) = nan;
+    same_message({{"t", bad_t}, {"a", a}});
+    if (k > 0 && k < kLarge - 1) {
+      bad_t = t;
+      bad_t(k) += 1e-3 / kLargeFs;  // jitter
+      same_message({{"t", bad_t}, {"a", a}});
+      bad_t = t;
+      bad_t(k) = bad_t(k - 1);  // repeat
+      same_message({{"t", bad_t}, {"a", a}});
+    }
+  }
+  // Truncated anywhere, or a data element that declares more than the variable holds: the checks
+  // made when the file is opened refuse it before anything is mapped.
+  write_raw_mat(file, {{"t", t}, {"a", a}, {"b", b}});
+  const std::string content = test::read_text(file);
+  for (const double fraction : {0.0, 0.01, 0.3, 0.6, 0.999}) {
+    const auto size = static_cast<size_t>(fraction * static_cast<double>(content.size()));
+    SCOPED_TRACE("truncated to " + std::to_string(size));
+    const fs::path cut = dir.path() / "cut.mat";
+    write_text(cut, content.substr(0, size));
+    EXPECT_EQ(input_error([&] { (void)read_timeseries_view(cut); }), input_error([&] { (void)read_timeseries(cut); }));
+  }
+}
+
 // ---- writers --------------------------------------------------------------------------------
 
 TEST(TimeSeriesWrite, InvalidDataWritesNothing) {

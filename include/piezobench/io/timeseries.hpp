@@ -36,6 +36,7 @@
 #include <Eigen/Dense>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <variant>
 #include <vector>
@@ -109,6 +110,27 @@ struct MatWriteOptions {
 [[nodiscard]] TimeSeries read_timeseries(const std::filesystem::path& file, const ReadOptions& options = {});
 [[nodiscard]] TimeSeries read_timeseries_mat(const std::filesystem::path& file, const ReadOptions& options = {});
 [[nodiscard]] TimeSeries read_timeseries_csv(const std::filesystem::path& file, const ReadOptions& options = {});
+
+// A record read for one pass over its samples (what `piezobench frf` needs): the same checks and
+// results as read_timeseries, but the channels of a v5 MAT file stored as uncompressed doubles in
+// SI units are used in place from a read-only mapping of the file (no copy into fresh memory);
+// anything else is read by read_timeseries and kept in `storage`. The time vector, when the file
+// has one, is checked and gives the sample rate; the view does not keep it, nor the settings.
+struct TimeSeriesView {
+  std::vector<std::string> names;                // as TimeSeries::names
+  std::vector<const double*> columns;            // columns[j]: samples() values of channel names[j]
+  Eigen::Index samples = 0;
+  double sample_rate = 0.0;                      // Hz
+  std::vector<std::string> units;                // as TimeSeries::units
+  std::string source;
+  std::shared_ptr<const void> storage;           // owns what `columns` point to
+  bool mapped = false;                           // true when the columns point into the file's mapping
+
+  [[nodiscard]] Eigen::Index index(const std::string& name) const;  // as TimeSeries::index
+  [[nodiscard]] Eigen::Map<const Eigen::VectorXd> channel(const std::string& name) const;
+  [[nodiscard]] std::string unit(const std::string& name) const;
+};
+[[nodiscard]] TimeSeriesView read_timeseries_view(const std::filesystem::path& file, const ReadOptions& options = {});
 
 // Writes `ts` (validated first) as .mat or CSV (format from the extension). Channel names must be
 // MATLAB identifiers (letter, then letters, digits, '_'; at most 63 characters) other than the
