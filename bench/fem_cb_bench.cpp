@@ -19,6 +19,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
@@ -36,6 +37,18 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 // Processor time of the process (all threads), s: on a shared machine it says more than wall time.
 double cpu_seconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+
+// Resident memory now and its peak so far, MB (Linux /proc/self/status VmRSS, VmHWM; 0 elsewhere):
+// printed at each stage, they say where the peak memory goes.
+std::pair<double, double> memory_mb() {
+  std::ifstream in("/proc/self/status");
+  double rss = 0.0, hwm = 0.0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) rss = std::atof(line.c_str() + 6) / 1024.0;
+    if (line.rfind("VmHWM:", 0) == 0) hwm = std::atof(line.c_str() + 6) / 1024.0;
+  }
+  return {rss, hwm};
+}
 
 int run(int argc, char** argv) {
   if (argc < 2) {
@@ -76,8 +89,9 @@ int run(int argc, char** argv) {
                                                           fs::path(stem.string() + ".dof"));
   const double t_read = seconds_since(t0);
   const double c_read = cpu_seconds() - c0;
-  std::printf("read: %lld DOF, K %lld nonzeros, %.2f s (CPU %.2f s)\n", static_cast<long long>(model.size()),
-              static_cast<long long>(model.K.nonZeros()), t_read, c_read);
+  std::printf("read: %lld DOF, K %lld nonzeros, M %lld nonzeros, %.2f s (CPU %.2f s), memory %.0f MB (peak %.0f MB)\n",
+              static_cast<long long>(model.size()), static_cast<long long>(model.K.nonZeros()),
+              static_cast<long long>(model.M.nonZeros()), t_read, c_read, memory_mb().first, memory_mb().second);
 
   fem::CraigBamptonOptions o;
   o.modes = modes;
@@ -87,7 +101,9 @@ int run(int argc, char** argv) {
   o.progress = [&](const std::string& step, double) {
     if (step.rfind("fixed-interface modes (", 0) == 0 || step == last) return;
     last = step;
-    std::fprintf(stderr, "  %7.2f s (CPU %7.2f s)  %s\n", seconds_since(t1), cpu_seconds() - c1, step.c_str());
+    const auto [rss, hwm] = memory_mb();
+    std::fprintf(stderr, "  %7.2f s (CPU %7.2f s)  memory %6.0f MB (peak %6.0f MB)  %s\n", seconds_since(t1), cpu_seconds() - c1, rss,
+                 hwm, step.c_str());
   };
   const fem::CraigBamptonResult r = fem::craig_bampton(model, interface, o);
   const double t_cb = seconds_since(t1);
