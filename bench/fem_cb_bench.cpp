@@ -85,7 +85,7 @@ int run(int argc, char** argv) {
 
   const auto t0 = std::chrono::steady_clock::now();
   const double c0 = cpu_seconds();
-  const fem::SparseModel model = fem::read_calculix_model(fs::path(stem.string() + ".sti"), fs::path(stem.string() + ".mas"),
+  fem::SparseModel model = fem::read_calculix_model(fs::path(stem.string() + ".sti"), fs::path(stem.string() + ".mas"),
                                                           fs::path(stem.string() + ".dof"));
   const double t_read = seconds_since(t0);
   const double c_read = cpu_seconds() - c0;
@@ -105,7 +105,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "  %7.2f s (CPU %7.2f s)  memory %6.0f MB (peak %6.0f MB)  %s\n", seconds_since(t1), cpu_seconds() - c1, rss,
                  hwm, step.c_str());
   };
-  const fem::CraigBamptonResult r = fem::craig_bampton(model, interface, o);
+  const fem::CraigBamptonResult r = fem::craig_bampton(std::move(model), interface, o);
   const double t_cb = seconds_since(t1);
   const double c_cb = cpu_seconds() - c1;
   std::printf("craig_bampton: %lld interface DOF, %lld interior DOF, %d modes, %.2f s (CPU %.2f s; factor %lld entries, %lld "

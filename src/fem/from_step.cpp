@@ -758,7 +758,7 @@ FromStepResult superelement_from_step(const fs::path& step_file, const FromStepO
   t0 = std::chrono::steady_clock::now();
   last_step.clear();
   cb.progress = progress;
-  r.reduction = craig_bampton(model, interface, cb);
+  r.reduction = craig_bampton(std::move(model), interface, cb);  // K and M freed once split
   model = SparseModel{};  // free the large matrices
   r.reduced = std::move(r.reduction.reduced);
   r.reduction.reduced = SuperElement{};
