@@ -20,6 +20,7 @@ struct FitOptions {
   double fs = 0.0;
   int operators = 10;
   double threshold_range = 0.0;
+  int dead_zones = 0;
   std::string creep_tau;
   double max_residual = 0.02;
   std::string out;
@@ -36,7 +37,10 @@ nlohmann::json model_json(const ident::HysteresisModel& m) {
           {"thresholds_V", m.hysteresis.thresholds},
           {"weights", m.hysteresis.weights},
           {"creep_time_constants_s", m.creep_time_constants},
-          {"creep_coefficients", m.creep_coefficients}};
+          {"creep_coefficients", m.creep_coefficients},
+          {"output_x_V", m.output.x},
+          {"output_y_V", m.output.y},
+          {"output_slopes", {m.output.slope_below, m.output.slope_above}}};
 }
 
 io::TimeSeries read_pair(const std::string& file, const std::string& input, const std::string& output, double fs, bool quiet) {
@@ -51,6 +55,7 @@ int run_fit(const FitOptions& o) {
   ident::HysteresisFitOptions fo;
   fo.operators = o.operators;
   fo.threshold_range = o.threshold_range;
+  fo.dead_zones = o.dead_zones;
   if (!o.creep_tau.empty()) fo.creep_time_constants = parse_number_list(o.creep_tau, "--creep-tau");
   fo.max_relative_residual = o.max_residual;
   fo.validate();
@@ -79,9 +84,13 @@ int run_fit(const FitOptions& o) {
   } else {
     const ident::HysteresisModel& m = fit.model;
     fmt::print("Prandtl-Ishlinskii model of {} -> {} ({} samples)\n", o.input, o.output, fit.samples);
-    fmt::print("  d_e = {:.6g} m + {:.6g} m/V * (H[Va] + creep)\n", m.offset, m.gain);
+    fmt::print("  d_e = {:.6g} m + {:.6g} m/V * {}(H[Va] + creep)\n", m.offset, m.gain, m.output.identity() ? "" : "S");
     fmt::print("  thresholds (V): {:.4g}\n", fmt::join(m.hysteresis.thresholds, ", "));
     fmt::print("  weights:        {:.4g}\n", fmt::join(m.hysteresis.weights, ", "));
+    if (!m.output.identity()) {
+      fmt::print("  S (dead-zone superposition, knots V -> V): x {:.4g}; y {:.4g}; end slopes {:.4g}, {:.4g}\n", fmt::join(m.output.x, ", "),
+                 fmt::join(m.output.y, ", "), m.output.slope_below, m.output.slope_above);
+    }
     if (!m.creep_time_constants.empty()) {
       fmt::print("  creep: time constants (s) {:.4g}; coefficients {:.4g}\n", fmt::join(m.creep_time_constants, ", "),
                  fmt::join(m.creep_coefficients, ", "));
@@ -142,6 +151,10 @@ void add_hysteresis_commands(CLI::App& app, Action& action) {
   fit->add_option("--output", o->output, "channel of the displacement, m")->capture_default_str();
   fit->add_option("--fs", o->fs, "sample rate, Hz (default: from the file)");
   fit->add_option("--operators", o->operators, "play operators")->check(CLI::Range(1, 200))->capture_default_str();
+  fit->add_option("--dead-zones", o->dead_zones,
+                  "Kuhnen's modified PI for asymmetric loops: dead zones on each side of the output map S (0: plain PI)")
+      ->check(CLI::Range(0, 50))
+      ->capture_default_str();
   fit->add_option("--threshold-range", o->threshold_range, "largest threshold range R, V (thresholds (i - 1/2) R / n; default: half the range of Va)");
   fit->add_option("--creep-tau", o->creep_tau, "comma-separated creep time constants, s (default: no creep states)");
   fit->add_option("--max-residual", o->max_residual, "largest rms residual / stroke of a good fit")->capture_default_str();

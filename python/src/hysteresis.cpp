@@ -33,6 +33,11 @@ py::object model_result(const HysteresisModel& m) {
   d["reference_intercept"] = m.reference_intercept;
   d["input_min"] = m.input_min;
   d["input_max"] = m.input_max;
+  // Kuhnen's output map S (empty knots: the plain PI model).
+  d["output_x"] = numbers(m.output.x);
+  d["output_y"] = numbers(m.output.y);
+  d["output_slope_below"] = m.output.slope_below;
+  d["output_slope_above"] = m.output.slope_above;
   return result("HysteresisModel", d);
 }
 
@@ -61,6 +66,10 @@ HysteresisModel model_arg(py::handle obj, const std::string& source) {
   if (d.contains("reference_intercept")) m.reference_intercept = number_arg(d["reference_intercept"], source, "model.reference_intercept");
   if (d.contains("input_min")) m.input_min = number_arg(d["input_min"], source, "model.input_min");
   if (d.contains("input_max")) m.input_max = number_arg(d["input_max"], source, "model.input_max");
+  if (d.contains("output_x")) m.output.x = vector_of(d["output_x"], source, "model.output_x");
+  if (d.contains("output_y")) m.output.y = vector_of(d["output_y"], source, "model.output_y");
+  if (d.contains("output_slope_below")) m.output.slope_below = number_arg(d["output_slope_below"], source, "model.output_slope_below");
+  if (d.contains("output_slope_above")) m.output.slope_above = number_arg(d["output_slope_above"], source, "model.output_slope_above");
   m.validate(source);
   return m;
 }
@@ -89,6 +98,8 @@ const Options<ident::HysteresisFitOptions>& fit_options() {
         .add("threshold_range", &ident::HysteresisFitOptions::threshold_range,
              "V, R: thresholds (i - 1/2) R / n; 0 = half the range of Va")
         .add("creep_time_constants", &ident::HysteresisFitOptions::creep_time_constants, "s; empty = no creep states")
+        .add("dead_zones", &ident::HysteresisFitOptions::dead_zones,
+             "Kuhnen's modified PI (asymmetric loops): dead zones per side of the output map S; 0 = plain PI")
         .add("max_relative_residual", &ident::HysteresisFitOptions::max_relative_residual, "rms residual / stroke of a good fit");
     return o;
   }();

@@ -83,3 +83,18 @@ def test_tracking_on_the_bouc_wen_bench():
     with pytest.raises(pb.InputError) as e:
         bench.simulate("tracking", hysteresis_law="preisach")
     assert e.value.field == "hysteresis_law"
+
+
+def test_modified_prandtl_ishlinskii_fits_an_asymmetric_loop_and_its_feedforward_linearizes_it():
+    # A PI loop seen through an asymmetric smooth output (not a dead-zone superposition).
+    va = _record()
+    r = (np.arange(10) + 0.5) * 8.0
+    x = ident.prandtl_ishlinskii(va, r, np.full(10, 0.06))
+    de = -1e-6 * (x + 0.006 * x**2)
+    plain = ident.fit_hysteresis(va, de, 1000.0)
+    mod = ident.fit_hysteresis(va, de, 1000.0, dead_zones=4)
+    assert plain.quality == "poor" and mod.quality == "good"
+    assert len(mod.model.output_x) == 9
+    d = ident.predict_hysteresis(mod.model, control.hysteresis_feedforward(mod.model, va, 1000.0), 1000.0)
+    m = mod.model
+    np.testing.assert_allclose(d, m.offset + m.gain * (m.reference_slope * va + m.reference_intercept), atol=1e-12)

@@ -231,8 +231,11 @@ template <class V> void fields(V& v, HysteresisLoop& s) { v("result", s.result);
 template <class V> void fields(V& v, ident::PrandtlIshlinskii& s) {
   v("linear_weight", s.linear_weight); v("thresholds", s.thresholds); v("weights", s.weights);
 }
+template <class V> void fields(V& v, ident::DeadZoneSuperposition& s) {
+  v("x", s.x); v("y", s.y); v("slope_below", s.slope_below); v("slope_above", s.slope_above);
+}
 template <class V> void fields(V& v, ident::HysteresisModel& s) {
-  v("hysteresis", s.hysteresis); v("creep_time_constants", s.creep_time_constants); v("creep_coefficients", s.creep_coefficients);
+  v("hysteresis", s.hysteresis); v("output", s.output); v("creep_time_constants", s.creep_time_constants); v("creep_coefficients", s.creep_coefficients);
   v("gain", s.gain); v("offset", s.offset); v("reference_slope", s.reference_slope); v("reference_intercept", s.reference_intercept);
   v("input_min", s.input_min); v("input_max", s.input_max);
 }

@@ -8,7 +8,7 @@
 namespace piezobench::control {
 
 HysteresisFeedforward::HysteresisFeedforward(const ident::HysteresisModel& model, double sample_rate)
-    : model_(model), inverse_((model.validate(), ident::inverse(model.hysteresis))) {
+    : model_(model), inverse_((model.validate(), ident::inverse(model.hysteresis))), output_inverse_(ident::inverse(model.output)) {
   if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) {
     throw InputError("hysteresis feedforward", "sample_rate", "a rate > 0 Hz", std::to_string(sample_rate));
   }
@@ -24,7 +24,7 @@ void HysteresisFeedforward::reset() noexcept {
 
 double HysteresisFeedforward::at_rest(double c) const {
   ident::PrandtlIshlinskiiOperator fresh(inverse_.model());
-  return fresh.step(model_.reference_slope * c + model_.reference_intercept);
+  return fresh.step(output_inverse_(model_.reference_slope * c + model_.reference_intercept));
 }
 
 std::vector<double> apply_feedforward(const ident::HysteresisModel& model, double sample_rate, const std::vector<double>& command) {

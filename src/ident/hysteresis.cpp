@@ -181,9 +181,32 @@ Eigen::MatrixXd creep_states(std::span<const double> v, std::span<const double> 
 
 // ---- HysteresisModel ----
 
+void DeadZoneSuperposition::validate(const std::string& source) const {
+  const std::string s = source.empty() ? "dead-zone superposition" : source;
+  if (x.size() != y.size()) throw InputError(s, "y", fmt::format("{} values (one per knot)", x.size()), std::to_string(y.size()));
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    require_finite(x[k], s, fmt::format("x[{}]", k));
+    require_finite(y[k], s, fmt::format("y[{}]", k));
+    if (k > 0 && !(x[k] > x[k - 1])) throw InputError(s, fmt::format("x[{}]", k), "knots strictly increasing", num(x[k]));
+    if (k > 0 && !(y[k] > y[k - 1])) {
+      throw InputError(s, fmt::format("y[{}]", k), "values strictly increasing (an invertible map)", num(y[k]));
+    }
+  }
+  for (const auto& [name, v] : {std::pair<const char*, double>{"slope_below", slope_below}, {"slope_above", slope_above}}) {
+    require_finite(v, s, name);
+    if (!(v > 0.0)) throw InputError(s, name, "a slope > 0 (an invertible map)", num(v));
+  }
+}
+
+DeadZoneSuperposition inverse(const DeadZoneSuperposition& s) {
+  s.validate();
+  return {s.y, s.x, 1.0 / s.slope_below, 1.0 / s.slope_above};
+}
+
 void HysteresisModel::validate(const std::string& source) const {
   const std::string s = source.empty() ? "hysteresis model" : source;
   hysteresis.validate(s);
+  output.validate(s + ": output");
   if (hysteresis.linear_weight != 1.0) throw InputError(s, "linear_weight", "1 (H in effective volts)", num(hysteresis.linear_weight));
   if (creep_time_constants.size() != creep_coefficients.size()) {
     throw InputError(s, "creep_coefficients", fmt::format("{} coefficients (one per time constant)", creep_time_constants.size()),
@@ -213,7 +236,7 @@ std::vector<double> HysteresisModel::predict(std::span<const double> v, double s
     const Eigen::VectorXd fc = f * c;
     for (std::size_t k = 0; k < y.size(); ++k) y[k] += fc(static_cast<Eigen::Index>(k));
   }
-  for (double& x : y) x = offset + gain * x;
+  for (double& x : y) x = offset + gain * output(x);
   return y;
 }
 
@@ -229,10 +252,126 @@ void HysteresisFitOptions::validate() const {
     const double tau = creep_time_constants[j];
     if (!(std::isfinite(tau) && tau > 0.0)) throw InputError(s, fmt::format("creep_time_constants[{}]", j), "a time > 0 s", num(tau));
   }
+  if (dead_zones < 0 || dead_zones > 50) throw InputError(s, "dead_zones", "an integer in 0..50", std::to_string(dead_zones));
   if (!(std::isfinite(max_relative_residual) && max_relative_residual > 0.0)) {
     throw InputError(s, "max_relative_residual", "a fraction > 0", num(max_relative_residual));
   }
 }
+
+namespace {
+
+// Kuhnen's modified PI (HysteresisFitOptions::dead_zones > 0): the linear equation-error fit of
+// (H, T = S^-1) on the displacement u = sign d_e - centre, then S = t_0 T^-1(z + b).
+void fit_modified(std::span<const double> va, std::span<const double> de, double sample_rate, const HysteresisFitOptions& o,
+                  const std::vector<double>& r, HysteresisModel& model) {
+  const std::string method = "modified Prandtl-Ishlinskii identification";
+  const auto rows = static_cast<Eigen::Index>(va.size());
+  const int n = static_cast<int>(r.size()), k = o.dead_zones;
+  const auto m = static_cast<Eigen::Index>(o.creep_time_constants.size());
+  const Eigen::VectorXd v = view(va), d = view(de);
+  const double cov = (v.array() - v.mean()).matrix().dot((d.array() - d.mean()).matrix());
+  if (!(std::abs(cov) > 0.0)) throw NumericalError(method, "the output does not follow the input (no slope)", false);
+  const double sign = cov > 0.0 ? 1.0 : -1.0;
+  const Eigen::VectorXd y = sign * d;
+  const double centre = 0.5 * (y.maxCoeff() + y.minCoeff()), half = 0.5 * (y.maxCoeff() - y.minCoeff());
+  const Eigen::VectorXd u = y.array() - centre;
+  // Dead-zone thresholds of T, sorted: -k..-1 below the centre, 0, 1..k above.
+  std::vector<double> e;
+  for (int j = -k; j <= k; ++j) e.push_back(half * j / (k + 1));
+  const auto nz = static_cast<Eigen::Index>(e.size());
+  // Va = T(u) - sum w_i P_i - sum c_j F_j - b; unknowns (t, w, c) >= 0, b free.
+  Eigen::MatrixXd a(rows, nz + n + m + 1);
+  for (Eigen::Index j = 0; j < nz; ++j) {
+    const double ej = e[static_cast<std::size_t>(j)];
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      a(i, j) = ej > 0.0 ? std::max(u(i) - ej, 0.0) : ej < 0.0 ? std::min(u(i) - ej, 0.0) : u(i);
+    }
+  }
+  a.middleCols(nz, n) = -play_outputs(va, r);
+  if (m > 0) a.middleCols(nz + n, m) = -creep_states(va, o.creep_time_constants, sample_rate);
+  a.col(a.cols() - 1).setConstant(-1.0);
+  std::vector<bool> free(static_cast<std::size_t>(a.cols()), false);
+  free.back() = true;
+  Eigen::VectorXd scale(a.cols());
+  for (Eigen::Index j = 0; j < a.cols(); ++j) {
+    const double c = a.col(j).norm();
+    scale(j) = c > 0.0 ? 1.0 / c : 1.0;
+    a.col(j) *= scale(j);
+  }
+  const NnlsResult res = nnls(a, v, free);
+  if (!res.converged) throw NumericalError(method, "the constrained least-squares problem did not converge", false);
+  const Eigen::VectorXd x = res.x.cwiseProduct(scale);
+  const double t0 = x(k);
+  if (!(t0 > 1e-9 * x.head(nz).cwiseAbs().maxCoeff())) {
+    throw NumericalError(method, "the central weight of S^-1 came out 0: the map would not be invertible (d_e does not follow Va?)", true);
+  }
+  model.hysteresis.linear_weight = 1.0;
+  model.hysteresis.thresholds = r;
+  model.hysteresis.weights.assign(static_cast<std::size_t>(n), 0.0);
+  for (int i = 0; i < n; ++i) model.hysteresis.weights[static_cast<std::size_t>(i)] = x(nz + i);
+  model.creep_time_constants = o.creep_time_constants;
+  model.creep_coefficients.assign(static_cast<std::size_t>(m), 0.0);
+  for (Eigen::Index j = 0; j < m; ++j) model.creep_coefficients[static_cast<std::size_t>(j)] = x(nz + n + j);
+  const double b = x(x.size() - 1);
+  // T at its knots; S(z) = t0 T^-1(z + b): knots T(e_j) - b -> t0 e_j.
+  const auto t_of = [&](double uu) {
+    double sum = 0.0;
+    for (Eigen::Index j = 0; j < nz; ++j) {
+      const double ej = e[static_cast<std::size_t>(j)];
+      sum += x(j) * (ej > 0.0 ? std::max(uu - ej, 0.0) : ej < 0.0 ? std::min(uu - ej, 0.0) : uu);
+    }
+    return sum;
+  };
+  double below = 0.0, above = 0.0;
+  for (Eigen::Index j = 0; j < nz; ++j) {
+    const double ej = e[static_cast<std::size_t>(j)];
+    if (ej <= 0.0) below += x(j);
+    if (ej >= 0.0) above += x(j);
+  }
+  model.output.x.clear();
+  model.output.y.clear();
+  for (const double ej : e) {
+    model.output.x.push_back(t_of(ej) - b);
+    model.output.y.push_back(t0 * ej);
+  }
+  model.output.slope_below = t0 / below;
+  model.output.slope_above = t0 / above;
+  model.gain = sign / t0;
+  model.offset = sign * centre;
+}
+
+// The modified PI fit with its reference line, residual (d_e's, output error) and verdict.
+HysteresisFit finish_fit(std::span<const double> va, std::span<const double> de, double sample_rate, const HysteresisFitOptions& o,
+                         const std::vector<double>& r) {
+  HysteresisFit out;
+  HysteresisModel& model = out.model;
+  fit_modified(va, de, sample_rate, o, r, model);
+  model.input_min = *std::min_element(va.begin(), va.end());
+  model.input_max = *std::max_element(va.begin(), va.end());
+  model.validate("hysteresis fit");
+  // Effective voltage S(H + creep) of the record and its best line against Va.
+  const std::vector<double> predicted = model.predict(va, sample_rate);
+  std::vector<double> eff(predicted.size());
+  for (std::size_t i = 0; i < eff.size(); ++i) eff[i] = (predicted[i] - model.offset) / model.gain;
+  const LoopMetrics line = loop_metrics(va, eff);
+  model.reference_slope = line.slope;
+  model.reference_intercept = line.intercept;
+  model.validate("hysteresis fit");
+  double sum = 0.0;
+  for (std::size_t i = 0; i < de.size(); ++i) sum += (predicted[i] - de[i]) * (predicted[i] - de[i]);
+  out.samples = va.size();
+  out.stroke = range(de);
+  out.rms_residual = std::sqrt(sum / static_cast<double>(de.size()));
+  out.relative_residual = out.stroke > 0.0 ? out.rms_residual / out.stroke : 0.0;
+  if (!(out.relative_residual <= o.max_relative_residual)) {
+    out.quality.add_problem(fmt::format("d_e: rms residual {:.3g} % of the stroke (limit {:.3g} %)", 100.0 * out.relative_residual,
+                                        100.0 * o.max_relative_residual));
+    out.quality.advise("more operators or dead zones, creep states (a drifting record), or a record starting at rest");
+  }
+  return out;
+}
+
+}  // namespace
 
 HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double> de, double sample_rate,
                              const HysteresisFitOptions& options) {
@@ -248,6 +387,7 @@ HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double>
   const auto m = static_cast<Eigen::Index>(options.creep_time_constants.size());
   const auto rows = static_cast<Eigen::Index>(va.size());
 
+  if (options.dead_zones > 0) return finish_fit(va, de, sample_rate, options, r);
   Eigen::MatrixXd columns(rows, 1 + n + m);
   columns.col(0) = view(va);
   columns.middleCols(1, n) = play_outputs(va, r);
@@ -291,7 +431,8 @@ HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double>
     out.quality.add_problem(fmt::format("d_e: rms residual {:.3g} % of the stroke (limit {:.3g} %)", 100.0 * out.relative_residual,
                                         100.0 * options.max_relative_residual));
     out.quality.advise("more operators, creep states (a drifting record), or a record starting at rest; loops asymmetric "
-                       "about their centre are beyond a Prandtl-Ishlinskii operator");
+                       "about their centre are beyond a Prandtl-Ishlinskii operator: try the modified one (dead_zones, "
+                       "--dead-zones)");
   }
   return out;
 }

@@ -76,7 +76,8 @@ class Reader {
 std::string hysteresis_model_toml(const ident::HysteresisModel& m, const ident::HysteresisFit* fit, const std::string& source) {
   m.validate();
   std::string s;
-  s += "# Hysteresis and creep of an actuator: d_e = offset + gain (H[Va] + sum_j c_j F_j[Va]) (piezobench hysteresis fit)\n";
+  s += "# Hysteresis and creep of an actuator: d_e = offset + gain S(H[Va] + sum_j c_j F_j[Va]) (piezobench hysteresis fit;\n"
+       "# S the identity unless [output] gives the modified PI's dead-zone superposition by its knots)\n";
   s += fmt::format("format = \"{}\"\n", kFormat);
   s += fmt::format("gain_m_per_V = {:.17g}\n", m.gain);
   s += fmt::format("offset_m = {:.17g}\n", m.offset);
@@ -91,6 +92,12 @@ std::string hysteresis_model_toml(const ident::HysteresisModel& m, const ident::
     s += "\n[creep]\n";
     s += "time_constants_s = " + list(m.creep_time_constants) + "\n";
     s += "coefficients = " + list(m.creep_coefficients) + "\n";
+  }
+  if (!m.output.identity()) {
+    s += "\n[output]\n";
+    s += "x_V = " + list(m.output.x) + "\n";
+    s += "y_V = " + list(m.output.y) + "\n";
+    s += fmt::format("slope_below = {:.17g}\nslope_above = {:.17g}\n", m.output.slope_below, m.output.slope_above);
   }
   if (fit != nullptr) {
     s += "\n[fit]\n";
@@ -117,7 +124,7 @@ ident::HysteresisModel parse_hysteresis_model(const std::string& text, const std
   const toml::table table = parse_toml(text, source);
   const Reader top(table, source, "");
   top.only({"format", "gain_m_per_V", "offset_m", "reference_slope", "reference_intercept_V", "input_min_V", "input_max_V",
-            "hysteresis", "creep", "fit"});
+            "hysteresis", "creep", "output", "fit"});
   const toml::node& format = top.node("format");
   if (format.value<std::string>() != std::string(kFormat)) {
     throw InputError(source, "format", std::string("\"") + kFormat + "\"",
@@ -140,6 +147,14 @@ ident::HysteresisModel parse_hysteresis_model(const std::string& text, const std
     cr.only({"time_constants_s", "coefficients"});
     m.creep_time_constants = cr.numbers("time_constants_s");
     m.creep_coefficients = cr.numbers("coefficients");
+  }
+  if (const toml::table* o = top.table("output", false)) {
+    const Reader orr(*o, source, "output.");
+    orr.only({"x_V", "y_V", "slope_below", "slope_above"});
+    m.output.x = orr.numbers("x_V");
+    m.output.y = orr.numbers("y_V");
+    m.output.slope_below = orr.number("slope_below");
+    m.output.slope_above = orr.number("slope_above");
   }
   (void)top.table("fit", false);  // informative; only its type is checked
   m.validate(source);

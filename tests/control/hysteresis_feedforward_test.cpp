@@ -11,8 +11,9 @@
 namespace piezobench::control {
 namespace {
 
-ident::HysteresisModel model(bool creep) {
+ident::HysteresisModel model(bool creep, bool modified = false) {
   ident::HysteresisModel m;
+  if (modified) m.output = {{-60.0, -10.0, 0.0, 30.0, 70.0}, {-45.0, -9.0, 0.0, 25.0, 50.0}, 0.5, 0.4};  // Kuhnen's S
   m.hysteresis = {1.0, {5.0, 15.0, 25.0, 35.0, 45.0}, {0.1, 0.25, 0.15, 0.1, 0.05}};
   if (creep) {
     m.creep_time_constants = {0.2, 2.0};
@@ -27,8 +28,8 @@ ident::HysteresisModel model(bool creep) {
 
 // The model driven by the feedforward is the reference line, exactly (creep included).
 TEST(HysteresisFeedforward, LinearizesItsModel) {
-  for (bool creep : {false, true}) {
-    const ident::HysteresisModel m = model(creep);
+  for (const auto& [creep, modified] : {std::pair{false, false}, {true, false}, {false, true}, {true, true}}) {
+    const ident::HysteresisModel m = model(creep, modified);
     const double fs = 1000.0;
     std::vector<double> c;
     for (int k = 0; k < 5000; ++k) {
@@ -45,7 +46,7 @@ TEST(HysteresisFeedforward, LinearizesItsModel) {
 }
 
 TEST(HysteresisFeedforward, StepAllocatesNothingAndHoldsOnNonFinite) {
-  HysteresisFeedforward ff(model(true), 10e3);
+  HysteresisFeedforward ff(model(true, true), 10e3);
   test::AllocationCounter count;
   double last = 0.0;
   for (int k = 0; k < 10000; ++k) last = ff.step(30.0 * std::sin(0.001 * k));

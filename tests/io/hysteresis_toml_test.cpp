@@ -37,6 +37,15 @@ TEST(HysteresisToml, RoundTripsExactly) {
   EXPECT_EQ(back.reference_slope, m.reference_slope);
   EXPECT_EQ(back.reference_intercept, m.reference_intercept);
   EXPECT_EQ(back.input_max, m.input_max);
+  EXPECT_TRUE(back.output.identity());
+  // Kuhnen's modified PI: its output map S round-trips too.
+  ident::HysteresisModel mod = model();
+  mod.output = {{-40.0, 0.0, 25.0}, {-30.0, 0.0, 20.0}, 0.6, 0.7};
+  const ident::HysteresisModel mb = parse_hysteresis_model(hysteresis_model_toml(mod), "mod.toml");
+  EXPECT_EQ(mb.output.x, mod.output.x);
+  EXPECT_EQ(mb.output.y, mod.output.y);
+  EXPECT_EQ(mb.output.slope_below, 0.6);
+  EXPECT_EQ(mb.output.slope_above, 0.7);
 }
 
 // A file written by hand (as a user would), without creep or fit sections.

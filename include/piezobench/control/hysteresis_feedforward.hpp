@@ -3,8 +3,9 @@
 // stage in front of the amplifier that makes the stroke proportional to the command.
 //
 // For a command c (V at the stacks, "linear volts") it applies the stack voltage
-//     Va = H^-1[ reference_slope c + reference_intercept - sum_j c_j F_j ],
-// H^-1 the exact inverse of the model's Prandtl-Ishlinskii operator (a PI operator again) and F_j
+//     Va = H^-1[ S^-1(reference_slope c + reference_intercept) - sum_j c_j F_j ],
+// H^-1 the exact inverse of the model's Prandtl-Ishlinskii operator (a PI operator again), S^-1 that
+// of its output dead-zone superposition (the modified PI; identity otherwise) and F_j
 // the model's creep states driven by the Va it has applied (strictly causal, so the creep is
 // cancelled exactly for the model). If the model were the actuator, d_e = offset + gain
 // (reference_slope c + reference_intercept): a straight line through the identification record's
@@ -30,7 +31,7 @@ class HysteresisFeedforward {
   // The stack voltage (V) for the command c (V). A non-finite c gives the last output.
   double step(double c) noexcept {
     if (!std::isfinite(c)) return last_;
-    double z = model_.reference_slope * c + model_.reference_intercept;
+    double z = output_inverse_(model_.reference_slope * c + model_.reference_intercept);
     const std::size_t m = creep_.size();
     for (std::size_t j = 0; j < m; ++j) z -= model_.creep_coefficients[j] * creep_[j];
     const double v = inverse_.step(z);
@@ -47,6 +48,7 @@ class HysteresisFeedforward {
  private:
   ident::HysteresisModel model_;
   ident::PrandtlIshlinskiiOperator inverse_;
+  ident::DeadZoneSuperposition output_inverse_;  // S^-1 (identity for the plain PI model)
   std::vector<double> alpha_, creep_;
   double last_ = 0.0;
 };

@@ -85,9 +85,40 @@ Eigen::MatrixXd play_outputs(std::span<const double> v, std::span<const double> 
 // The creep states F_j[v] (see the file comment) from rest: v.size() x time_constants.size().
 Eigen::MatrixXd creep_states(std::span<const double> v, std::span<const double> time_constants, double sample_rate);
 
-// An identified actuator: d_e = offset + gain (H[Va] + sum_j c_j F_j[Va]).
+// The static output nonlinearity of Kuhnen's modified PI operator (Kuhnen 2003, section 3): a
+// superposition of one-sided dead-zone operators, S(z) = sum_j s_j D_{d_j}(z) with
+// D_d(z) = max(z - d, 0) (d > 0), z (d = 0), min(z - d, 0) (d < 0), which draws loops asymmetric
+// about their centre (S[H[v]]: the ascending and descending branches bent differently). A
+// superposition of dead zones is a continuous piecewise-linear function; it is stored as its knots
+// (x_k, y_k) and end slopes, and is invertible when every piece rises. Its inverse is again one
+// (knots swapped, slopes inverted): exact, analytic. Empty knots: the identity.
+struct DeadZoneSuperposition {
+  std::vector<double> x;      // knots (input unit), strictly increasing
+  std::vector<double> y;      // S(x_k) (output unit), strictly increasing
+  double slope_below = 1.0;   // slope left of x.front(), > 0
+  double slope_above = 1.0;   // slope right of x.back(), > 0
+  [[nodiscard]] bool identity() const noexcept { return x.empty(); }
+  // InputError (source `source`, default "dead-zone superposition") naming the field.
+  void validate(const std::string& source = "") const;
+  // S(z); no allocation (a linear search over the knots).
+  [[nodiscard]] double operator()(double z) const noexcept {
+    const std::size_t n = x.size();
+    if (n == 0) return z;
+    if (z <= x[0]) return y[0] + slope_below * (z - x[0]);
+    if (z >= x[n - 1]) return y[n - 1] + slope_above * (z - x[n - 1]);
+    std::size_t k = 1;
+    while (x[k] < z) ++k;
+    return y[k - 1] + (y[k] - y[k - 1]) * (z - x[k - 1]) / (x[k] - x[k - 1]);
+  }
+};
+// The exact inverse (validates: InputError).
+DeadZoneSuperposition inverse(const DeadZoneSuperposition& s);
+
+// An identified actuator: d_e = offset + gain S(H[Va] + sum_j c_j F_j[Va]) (S the identity for the
+// plain PI model, a dead-zone superposition for Kuhnen's modified PI).
 struct HysteresisModel {
   PrandtlIshlinskii hysteresis;                 // V -> effective V, linear_weight 1
+  DeadZoneSuperposition output;                 // effective V -> effective V (empty: identity)
   std::vector<double> creep_time_constants;     // tau_j, s
   std::vector<double> creep_coefficients;       // c_j (relative to the effective voltage), >= 0
   double gain = 0.0;                            // m per effective V (< 0 for the APA: it shortens)
@@ -110,6 +141,12 @@ struct HysteresisFitOptions {
   double threshold_range = 0.0;               // V, R: thresholds (i - 1/2) R / n, i = 1..n; 0 = half
                                               // the range of Va (a larger threshold never turns)
   std::vector<double> creep_time_constants;   // s, > 0; empty: no creep states
+  // Kuhnen's modified PI (asymmetric loops): > 0 identifies S too, with this many dead zones on
+  // each side of the displacement's centre (thresholds (j/(k+1)) of its half range, weights >= 0:
+  // S saturates towards both ends). The fit is then Kuhnen's linear one in (H, S^-1): Va = S^-1[d]
+  // - sum w_i P_i[Va] - creep - b by sign-constrained least squares; its residual is d_e's. 0 (default):
+  // the plain PI model. 0..50.
+  int dead_zones = 0;
   double max_relative_residual = 0.02;        // the verdict: rms residual / stroke above it is poor
   void validate() const;                      // InputError (source "hysteresis fit options")
 };
