@@ -3,5 +3,6 @@
 #include "piezobench/dsp/detrend.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/dsp/window.hpp"

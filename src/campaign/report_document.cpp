@@ -12,6 +12,7 @@
 #include "piezobench/apa/two_dof.hpp"
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
 
@@ -35,18 +36,9 @@ json values(const std::vector<double>& x, double scale = 1.0) {
 
 // Phases in degrees, unwrapped along the list (no 360 deg jumps between neighbours).
 json unwrapped_degrees(const std::vector<std::complex<double>>& h) {
-  json out = json::array();
-  double prev = 0.0, offset = 0.0;
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    const double p = std::arg(h[i]) * 180.0 / std::numbers::pi;
-    if (i > 0) {
-      while (p + offset - prev > 180.0) offset -= 360.0;
-      while (p + offset - prev < -180.0) offset += 360.0;
-    }
-    prev = p + offset;
-    out.push_back(prev);
-  }
-  return out;
+  std::vector<double> deg;
+  for (const auto& v : h) deg.push_back(std::arg(v) * 180.0 / std::numbers::pi);
+  return dsp::unwrap_phase(std::move(deg), 360.0);
 }
 
 // Indices of a frequency grid thinned to ~`points` log-spaced values inside [fmin, fmax].

@@ -7,13 +7,13 @@
 #include <functional>
 #include <utility>
 #include <limits>
-#include <numbers>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/dsp/unwrap.hpp"
 
 namespace piezobench::ident {
 
@@ -210,22 +210,12 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
         }
       }
       if (use_k.size() >= 3) {
-        std::vector<double> x, y;
-        double prev = 0.0, unwrap = 0.0;
-        for (std::size_t i = 0; i < use_k.size(); ++i) {
-          const double ph = std::arg(d(use_k[i]) / model(start, w(use_k[i])));
-          if (i == 0) {
-            unwrap = ph;
-          } else {
-            double step = ph - prev;
-            while (step > std::numbers::pi) step -= kTwoPi;
-            while (step < -std::numbers::pi) step += kTwoPi;
-            unwrap += step;
-          }
-          prev = ph;
-          x.push_back(w(use_k[i]));
-          y.push_back(unwrap);
+        std::vector<double> x, phase;
+        for (const Index k : use_k) {
+          x.push_back(w(k));
+          phase.push_back(std::arg(d(k) / model(start, w(k))));
         }
+        const std::vector<double> y = dsp::unwrap_phase(phase);
         double mx = 0.0, my = 0.0;
         for (std::size_t i = 0; i < x.size(); ++i) {
           mx += x[i];
@@ -384,24 +374,14 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
     std::sort(mag.begin(), mag.end());
     start.static_gain = (sum_re >= 0.0 ? 1.0 : -1.0) * mag[mag.size() / 2];
     if (options.fit_delay) {
-      std::vector<double> x, y;
-      double prev = 0.0, unwrap = 0.0;
+      std::vector<double> x, phase;
       for (Index k = 0; k < w.size(); ++k) {
         if (w(k) <= 1.5 * start.natural_frequency) continue;
-        const double ph = std::arg(d(k) / second_order(start, w(k)));
-        if (x.empty()) {
-          unwrap = ph;
-        } else {
-          double step = ph - prev;
-          while (step > std::numbers::pi) step -= kTwoPi;
-          while (step < -std::numbers::pi) step += kTwoPi;
-          unwrap += step;
-        }
-        prev = ph;
         x.push_back(w(k));
-        y.push_back(unwrap);
+        phase.push_back(std::arg(d(k) / second_order(start, w(k))));
       }
       if (x.size() >= 3) {
+        const std::vector<double> y = dsp::unwrap_phase(phase);
         double mx = 0.0, my = 0.0, sxy = 0.0, sxx = 0.0;
         for (std::size_t i = 0; i < x.size(); ++i) {
           mx += x[i] / static_cast<double>(x.size());
