@@ -79,7 +79,8 @@ struct CreepRows {
   std::vector<double> s_on, d_on;          // rows in [t_on, t_off): t - t_on, de
   std::vector<double> s_on2, s_off, d_off;  // rows from t_off: t - t_on, t - t_off, de
   // de is taken about its mean over the rows (added back to the offset d0): b'b - b'A x then
-  // cancels far less, and the grid's sums of squares stay good to ~1e-12 instead of ~1e-8.
+  // cancels far less. On the demo's records the creep times picked from these sums agree with
+  // those picked from exact residual sums to 1e-8; without the centring they differed by more.
   double mean = 0.0;
   double n = 0.0, sum_d = 0.0, sum_dd = 0.0, sum_d_on = 0.0, sum_d_off = 0.0;
 };
