@@ -643,7 +643,7 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
   if (!model_rows.empty()) {
     tables.push_back(table("Hysteresis model (Prandtl-Ishlinskii, largest loop; thresholds (i - 1/2) R / n)",
                            {"unit", "amplitude [V]", "gain [um/V]", "weights", "rms residual [um] (of the stroke)",
-                            "width: record / model", "fit"},
+                            "width (steady loop, from the best line): record / model", "fit"},
                            model_rows));
   }
   // The tracking experiment (bench/tracking.hpp): d_e against the command without and with the

@@ -295,17 +295,20 @@ StrokeAnalysis stroke(const Campaign& c, const Record& r) {
   return out;
 }
 
-// The PI model of the largest-amplitude record (it starts at rest, as the identification needs).
-HysteresisModelFit hysteresis_model(const Record& r, double amplitude) {
+// The PI model of the largest-amplitude record (it starts at rest, as the identification needs:
+// the fit takes the whole record). The widths are those of the steady loop `loop` analysed (between
+// its first and last maxima): the ramp from rest and back would add the virgin curve.
+HysteresisModelFit hysteresis_model(const Record& r, const metrology::HysteresisResult& loop) {
   const VectorXd va = r.channel("Va"), de = r.channel("de");
   const std::span<const double> v(va.data(), static_cast<std::size_t>(va.size())), d(de.data(), static_cast<std::size_t>(de.size()));
   HysteresisModelFit out;
   out.fit = ident::fit_hysteresis(v, d, r.ts.sample_rate);
-  out.amplitude = amplitude;
+  out.amplitude = loop.amplitude;
   out.provenance = provenance(r, {"Va", "de"});
   const std::vector<double> predicted = out.fit.model.predict(v, r.ts.sample_rate);
-  out.width = ident::loop_metrics(v, d).width;
-  out.model_width = ident::loop_metrics(v, predicted).width;
+  const auto steady = [&](std::span<const double> x) { return x.subspan(static_cast<std::size_t>(loop.first_sample), static_cast<std::size_t>(loop.samples)); };
+  out.width = ident::loop_metrics(steady(v), steady(d)).width;
+  out.model_width = ident::loop_metrics(steady(v), steady(predicted)).width;
   out.loop = {thin(va, 1200), thin(de, 1200)};
   out.model_loop = {out.loop.x, thin(Eigen::Map<const VectorXd>(predicted.data(), va.size()), 1200)};
   return out;
@@ -348,8 +351,6 @@ std::vector<HysteresisLoop> hysteresis(const Campaign& c, const std::vector<Reco
               thin(de.segment(h.result.first_sample, h.result.samples), 1200)};
     out.push_back(std::move(h));
   }
-  std::stable_sort(out.begin(), out.end(),
-                   [](const HysteresisLoop& a, const HysteresisLoop& b) { return a.result.amplitude < b.result.amplitude; });
   return out;
 }
 
@@ -721,7 +722,7 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
       say("hysteresis", f);
       records.push_back(load_record(c, f, Experiment::kHysteresis));
     }
-    u.hysteresis = hysteresis(c, records);
+    u.hysteresis = hysteresis(c, records);  // in the records' order
     std::size_t largest = 0;
     for (std::size_t i = 1; i < records.size(); ++i) {
       if (records[i].channel("Va").maxCoeff() - records[i].channel("Va").minCoeff() >
@@ -730,10 +731,12 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
       }
     }
     try {
-      u.hysteresis_model = hysteresis_model(records[largest], u.hysteresis.empty() ? 0.0 : u.hysteresis.back().result.amplitude);
+      u.hysteresis_model = hysteresis_model(records[largest], u.hysteresis[largest].result);
     } catch (const NumericalError& e) {
       record_failure(u, "hysteresis model", e);
     }
+    std::stable_sort(u.hysteresis.begin(), u.hysteresis.end(),
+                     [](const HysteresisLoop& a, const HysteresisLoop& b) { return a.result.amplitude < b.result.amplitude; });
   }
   if (spec.tracking) {
     say("tracking without and with the hysteresis feedforward", *spec.tracking);

@@ -85,8 +85,9 @@ struct HysteresisLoop {
 struct HysteresisModelFit {
   ident::HysteresisFit fit;
   double amplitude = 0.0;      // V, of the record it comes from
-  double width = 0.0;          // hysteresis width of that record (ident::loop_metrics: peak-to-peak
-                               // deviation from the best line / stroke)
+  double width = 0.0;          // hysteresis width of that record's steady loop (ident::loop_metrics:
+                               // peak-to-peak deviation from the best line / stroke, over the samples
+                               // its HysteresisLoop analysed: the ramps from and back to rest left out)
   double model_width = 0.0;    // the same figure for the model's prediction of the record
   RecordProvenance provenance;
   Curve loop;                  // x Va [V], y d_e [m]: the record's loop (thinned)
