@@ -205,6 +205,7 @@ int run_measurement(const MeasureRequest& r) {
       runs.push_back({{"cycles", lr.cycles},
                       {"overruns", lr.overruns},
                       {"skipped_deadlines", lr.skipped_deadlines},
+                      {"feedforward", lr.feedforward},
                       {"clamped_samples", lr.clamped_samples},
                       {"slew_limited_samples", lr.slew_limited_samples},
                       {"stale_sensor_samples", lr.stale_sensor_samples},

@@ -369,8 +369,9 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
   const auto n_ramp = static_cast<Eigen::Index>(std::llround(ramp * fs));
   const auto n_wave = static_cast<Eigen::Index>(std::llround(periods / frequency * fs));
   const Eigen::Index n = 2 * n_ramp + 2 * n_wave;
-  // Command (V at the stacks) and the blend of the feedforward over the ramps.
-  std::vector<double> c(static_cast<std::size_t>(n)), blend(static_cast<std::size_t>(n), 1.0);
+  // Command (V at the stacks) and the weight of the feedforward: the raised-cosine ramps' w.
+  std::vector<double> c(static_cast<std::size_t>(n));
+  Eigen::VectorXd weight = Eigen::VectorXd::Ones(n);
   for (Eigen::Index k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) / fs;
     double v = 0.0, w = 1.0;
@@ -390,7 +391,7 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
       v = offset * w;
     }
     c[static_cast<std::size_t>(k)] = v;
-    blend[static_cast<std::size_t>(k)] = w;
+    weight(k) = w;
   }
   auto progress_part = [&](double from, double span) -> Progress {
     if (!progress) return {};
@@ -415,18 +416,10 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
   } else {
     model = *o.feedforward;
   }
-  const std::vector<double> ff = control::apply_feedforward(model, fs, c);
-  std::uint64_t clamped = 0;
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    double va = c[kk] + blend[kk] * (ff[kk] - c[kk]);
-    if (va < b.va_min || va > b.va_max) {
-      va = std::clamp(va, b.va_min, b.va_max);
-      ++clamped;
-    }
-    u(k) = va / b.amplifier_gain;
-  }
-  runner.open_loop(u, detail::derive_seed(seed, stream(Experiment::kTracking, 1)), comp, progress_part(0.5, 0.5));
+  // The compensated run: the same command through the runner's live feedforward stage, blended in
+  // and out over the ramps (the run starts and ends at 0 V).
+  const std::uint64_t clamped = runner.open_loop_feedforward(u, weight, model, detail::derive_seed(seed, stream(Experiment::kTracking, 1)),
+                                                             comp, progress_part(0.5, 0.5));
 
   io::TimeSeries ts = make_record({"c", "Va_open", "de_open", "Va_ff", "de_ff"}, {"V", "V", "m", "V", "m"}, n, fs, true);
   ts.data.col(0) = Eigen::Map<const Eigen::VectorXd>(c.data(), n);
@@ -587,6 +580,26 @@ void VirtualRunner::open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eige
     p(k);
   }
   p.done();
+}
+
+std::uint64_t VirtualRunner::open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
+                                                   std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) {
+  if (w.size() != u_prime.size()) {
+    throw InputError("virtual bench", "feedforward weight", fmt::format("{} samples (the command's)", u_prime.size()), std::to_string(w.size()));
+  }
+  // The stage sample by sample (causal: what it gives at k depends on u'[0..k] only, as in the loop),
+  // then the real-time target's clamp; the virtual bench has no feedback to wait for.
+  control::HysteresisFeedforward ff(model, options_.sample_rate);
+  const double amp = options_.amplifier_gain, u_min = options_.va_min / amp, u_max = options_.va_max / amp;
+  Eigen::VectorXd u(u_prime.size());
+  std::uint64_t clamped = 0;
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    const double v = u_prime(k) + w(k) * (ff.step(u_prime(k) * amp) / amp - u_prime(k));
+    u(k) = std::clamp(v, u_min, u_max);
+    if (u(k) != v) ++clamped;
+  }
+  open_loop(u, seed, out, progress);
+  return clamped;
 }
 
 std::uint64_t VirtualRunner::iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,

@@ -1,5 +1,7 @@
 #include "piezobench/rt/loop.hpp"
 
+#include <fmt/format.h>
+
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
@@ -35,6 +37,18 @@ void LoopOptions::validate() const {
   for (Eigen::Index i = 0; i < excitation.size(); ++i) {
     if (!std::isfinite(excitation(i))) {
       throw InputError(source, "excitation", "finite samples", "NaN or Inf at sample " + std::to_string(i));
+    }
+  }
+  if (feedforward_weight.size() > 0) {
+    if (!feedforward) throw InputError(source, "feedforward_weight", "none without a feedforward", std::to_string(feedforward_weight.size()) + " samples");
+    if (feedforward_weight.size() != excitation.size()) {
+      throw InputError(source, "feedforward_weight", fmt::format("{} samples (the excitation's)", excitation.size()),
+                       std::to_string(feedforward_weight.size()));
+    }
+    for (Eigen::Index i = 0; i < feedforward_weight.size(); ++i) {
+      if (!(feedforward_weight(i) >= 0.0 && feedforward_weight(i) <= 1.0)) {
+        throw InputError(source, "feedforward_weight", "weights in [0, 1]", fmt::format("{} at sample {}", feedforward_weight(i), i));
+      }
     }
   }
   if (log_ring_capacity < 2) throw InputError(source, "log_ring_capacity", "at least 2", std::to_string(log_ring_capacity));
@@ -168,12 +182,15 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
   if (ramp_out_cycles_ > 0) {
     r = std::min(r, static_cast<double>(total_cycles_ - 1 - cycle_) / static_cast<double>(ramp_out_cycles_));
   }
-  const double u_prime =
-      options_.excitation.size() > 0
-          ? options_.excitation(static_cast<Eigen::Index>(cycle_ % static_cast<std::uint64_t>(options_.excitation.size())))
-          : 0.0;
-  // The feedforward's share of the request (V at the DAC): u' through the inverse hysteresis.
-  const double u_ff = feedforward_ ? feedforward_->step(u_prime * amp) / amp : u_prime;
+  const auto played = static_cast<Eigen::Index>(options_.excitation.size() > 0 ? cycle_ % static_cast<std::uint64_t>(options_.excitation.size()) : 0);
+  const double u_prime = options_.excitation.size() > 0 ? options_.excitation(played) : 0.0;
+  // The feedforward's share of the request (V at the DAC): u' through the inverse hysteresis,
+  // weighted.
+  double u_ff = u_prime;
+  if (feedforward_) {
+    const double w = options_.feedforward_weight.size() > 0 ? options_.feedforward_weight(played) : 1.0;
+    u_ff = u_prime + w * (feedforward_->step(u_prime * amp) / amp - u_prime);
+  }
 
   double y = 0.0;
   double request = u_safe;

@@ -191,11 +191,23 @@ void copy_columns(const io::TimeSeries& log, Eigen::Index n, Eigen::MatrixXd& ou
 }  // namespace
 
 void BackendRunner::open_loop(const Eigen::VectorXd& u, std::uint64_t, Eigen::MatrixXd& out, const bench::Progress& progress) {
+  open_run({}, u, out, progress);
+}
+
+std::uint64_t BackendRunner::open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
+                                                   std::uint64_t, Eigen::MatrixXd& out, const bench::Progress& progress) {
   LoopOptions lo;
+  lo.feedforward = model;
+  lo.feedforward_weight = w;
+  open_run(std::move(lo), u_prime, out, progress);
+  return report_.runs.back().clamped_samples;
+}
+
+void BackendRunner::open_run(LoopOptions lo, const Eigen::VectorXd& u_prime, Eigen::MatrixXd& out, const bench::Progress& progress) {
   lo.controller = false;
-  lo.excitation = u;
-  lo.duration = static_cast<double>(u.size()) / backend_.sample_rate();
-  copy_columns(run(lo, nullptr), u.size(), out);
+  lo.excitation = u_prime;
+  lo.duration = static_cast<double>(u_prime.size()) / backend_.sample_rate();
+  copy_columns(run(std::move(lo), nullptr), u_prime.size(), out);
   if (progress) progress(1.0);
 }
 

@@ -271,6 +271,40 @@ TEST(Loop, FeedforwardStaysWithinTheLimits) {
   }
 }
 
+// The feedforward's weight w per cycle: u = u' + w (stage - u'), the stage stepping on every u'
+// (its memory follows the whole command, blended or not): w = 0 gives u', w = 1 the stage's output.
+TEST(Loop, FeedforwardWeightBlendsTheStageInAndOut) {
+  ident::HysteresisModel m;
+  m.hysteresis = {1.0, {10.0, 30.0, 50.0}, {0.2, 0.3, 0.2}};
+  m.gain = -1.6e-6;
+  m.reference_slope = 1.3;
+  m.reference_intercept = 4.0;
+  FakeBackend backend(discrete_plant(), kFs);
+  LoopOptions o = lockstep_options(0.1);
+  o.controller = false;
+  o.feedforward = m;
+  o.limits.ramp_in = o.limits.ramp_out = 0.0;
+  const Eigen::Index n = 1000;
+  o.excitation.resize(n);
+  o.feedforward_weight.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    o.excitation(k) = 2.5 - 2.5 * std::cos(2 * M_PI * 3.0 * static_cast<double>(k) / static_cast<double>(n));  // 0..100 V
+    o.feedforward_weight(k) = std::min(1.0, static_cast<double>(k) / 300.0);
+  }
+  Loop loop(backend, o);
+  run_all(loop);
+  const LoopReport rep = loop.finish();
+  EXPECT_EQ(rep.clamped_samples + rep.slew_limited_samples, 0u);
+  control::HysteresisFeedforward ff(m, kFs);
+  const auto u = loop.log().channel("u");
+  ASSERT_EQ(u.size(), n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double stage = ff.step(20.0 * o.excitation(k)) / 20.0;
+    ASSERT_NEAR(u(k), o.excitation(k) + o.feedforward_weight(k) * (stage - o.excitation(k)), 1e-12) << k;
+  }
+  EXPECT_NEAR(u(0), o.excitation(0), 1e-12);
+}
+
 // A NaN sample: safe state at that cycle, output to the safe value at the slew limit, controller
 // reset, the log stays finite and flags the sample.
 TEST(Loop, NonFiniteSensorSampleEntersTheSafeState) {
@@ -432,6 +466,14 @@ TEST(Loop, OptionsAreValidated) {
   bad([](LoopOptions& o) { o.excitation = Eigen::VectorXd::Constant(3, std::nan("")); }, "excitation");
   bad([](LoopOptions& o) { o.limits.va_max = -100.0; }, "va_max");
   bad([](LoopOptions& o) { o.discrete.prewarp = 1e6; }, "prewarp");
+  bad([](LoopOptions& o) { o.excitation = Eigen::VectorXd::Ones(4); o.feedforward_weight = Eigen::VectorXd::Ones(4); }, "feedforward_weight");
+  ident::HysteresisModel m;
+  m.hysteresis = {1.0, {10.0}, {0.2}};
+  m.gain = -1.6e-6;
+  bad([&](LoopOptions& o) { o.feedforward = m; o.excitation = Eigen::VectorXd::Ones(4); o.feedforward_weight = Eigen::VectorXd::Ones(3); },
+      "feedforward_weight");
+  bad([&](LoopOptions& o) { o.feedforward = m; o.excitation = Eigen::VectorXd::Ones(2); o.feedforward_weight = Eigen::Vector2d(0.5, 1.5); },
+      "feedforward_weight");
 }
 
 }  // namespace

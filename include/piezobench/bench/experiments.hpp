@@ -107,6 +107,14 @@ class BenchRunner {
   virtual ~BenchRunner() = default;
   // Open loop with the DAC commands u (V): out is n x 4, columns u (applied), Va, de, Vs.
   virtual void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) = 0;
+  // Open loop through the inverse hysteresis feedforward of `model` (control::HysteresisFeedforward),
+  // live: each command u'[k] (V at the DAC) is read as c = amplifier_gain u'[k] and the stage's
+  // stack voltage / amplifier_gain is applied with the weight w[k] in [0, 1]
+  // (u'[k] + w[k] (stage - u'[k]): blended in and out), then clamped to the stack range (a real-time
+  // loop also slew-limits it: rt::LoopOptions::feedforward, feedforward_weight). w has u's size. out
+  // as open_loop's (column u: what was applied). Returns the number of clamped samples.
+  virtual std::uint64_t open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
+                                              std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) = 0;
   // IFF closed loop u = u' + g K0 Vs (report's controller, control::DiscreteIff), u clamped to the
   // stack range: out is n x 4, columns u, Va, de, Vs. Returns the number of clamped samples.
   virtual std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
@@ -129,6 +137,10 @@ class VirtualRunner final : public BenchRunner {
   VirtualRunner(const UnitTruth& unit, const BenchOptions& options);
   ~VirtualRunner() override;
   void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) override;
+  // The loop's stages without its timing: the feedforward, then the clamp (the slew limit never
+  // acts on the tracking commands at the default 1e5 V/s).
+  std::uint64_t open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
+                                      std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) override;
   std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
                     const Progress& progress) override;
   std::vector<double> hold(Eigen::Index n, const std::vector<OperatorStep>& steps, std::uint64_t seed, Eigen::MatrixXd& out,

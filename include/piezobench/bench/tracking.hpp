@@ -7,10 +7,12 @@
 // (va_min + va_max) / 2, `periods` periods of a 1 Hz sine of the amplitude, the same number of
 // periods of a 1 Hz triangle of the same amplitude, and a 1 s ramp back to 0 V. It runs twice:
 //  1. open: Va = c (no compensation);
-//  2. compensated: Va = feedforward(c), the model being the one given or else the one identified
-//     from run 1 (ident::fit_hysteresis on its Va, de). It is blended in over the two ramps (the
-//     run starts and ends at 0 V) and clamped to [va_min, va_max] (the clamped samples are counted;
-//     on a real bench the real-time loop's safety layer limits it too).
+//  2. compensated: the same command through the runner's LIVE feedforward stage
+//     (BenchRunner::open_loop_feedforward: on a real-time backend the loop's own stage,
+//     rt::LoopOptions::feedforward, before its clamp and slew limit), the model being the one given
+//     or else the one identified from run 1 (ident::fit_hysteresis on its Va, de). It is blended in
+//     and out over the two ramps (the stage's weight: the run starts and ends at 0 V); the samples
+//     clamped to [va_min, va_max] are counted.
 // For each waveform (the last `periods` - 1 periods of it) and run: the hysteresis width (peak-to-peak
 // deviation of d_e from its best straight line against c, over the stroke; ident::loop_metrics)
 // and the rms tracking error against the target d_ref = offset + gain (reference_slope c +

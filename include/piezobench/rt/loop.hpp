@@ -18,7 +18,8 @@
 //  - Feedforward (LoopOptions::feedforward, control/hysteresis_feedforward.hpp): u' is read as a
 //    linear command c = amplifier_gain u' (V at the stacks) and replaced by the stack voltage the
 //    inverse of the identified hysteresis and creep asks for, divided by the amplifier gain. It sits
-//    before the ramps, the clamp and the slew limit, so the limits hold whatever it asks for. No allocation, no lock, no I/O other than the
+//    before the ramps, the clamp and the slew limit, so the limits hold whatever it asks for; an
+//    optional weight per cycle (feedforward_weight) blends it in and out. No allocation, no lock, no I/O other than the
 //    backend's (tests/rt/loop_test.cpp counts allocations around cycle()).
 //  - Ramps: over ramp_in seconds at the start and ramp_out seconds at the end of the run a factor
 //    r goes 0 -> 1 (-> 0); the controller's gain is r g (bumpless: the gain acts at the sections'
@@ -71,6 +72,10 @@ struct LoopOptions {
   Eigen::VectorXd excitation;  // u' (V at the DAC), played cyclically from cycle 0; empty = 0
   // Inverse hysteresis feedforward on u' (see above); unset = none. Validated by the Loop.
   std::optional<ident::HysteresisModel> feedforward;
+  // Its weight w per cycle in [0, 1], played with the excitation (same length): the stage's share
+  // u' + w (u_ff - u') of the request, to blend it in and out without a step (a run that starts and
+  // ends at rest); the stage itself steps on every u'. Empty = 1.
+  Eigen::VectorXd feedforward_weight;
   // Signal log: kept in memory when `keep_log` (Loop::log()) and/or written to `log_file`.
   std::optional<std::filesystem::path> log_file;
   bool keep_log = false;

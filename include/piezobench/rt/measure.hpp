@@ -60,6 +60,9 @@ class BackendRunner final : public bench::BenchRunner {
   // entered its safe state (interrupted, stale input, watchdog, non-finite sensor): a record
   // that is not the experiment's is never returned.
   void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const bench::Progress& progress) override;
+  // The loop's own feedforward stage (LoopOptions::feedforward), before its clamp and slew limit.
+  std::uint64_t open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
+                                      std::uint64_t seed, Eigen::MatrixXd& out, const bench::Progress& progress) override;
   std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
                     const bench::Progress& progress) override;
   std::vector<double> hold(Eigen::Index n, const std::vector<bench::OperatorStep>& steps, std::uint64_t seed,
@@ -72,6 +75,7 @@ class BackendRunner final : public bench::BenchRunner {
 
  private:
   io::TimeSeries run(LoopOptions lo, const std::vector<bench::OperatorStep>* steps);
+  void open_run(LoopOptions lo, const Eigen::VectorXd& u_prime, Eigen::MatrixXd& out, const bench::Progress& progress);
   Backend& backend_;
   MeasureOptions options_;
   MeasureReport report_;
