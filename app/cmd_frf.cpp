@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <utility>
 #include <optional>
 #include <vector>
 
@@ -49,7 +50,7 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
   for (std::size_t i = 0; i < frf.outputs.size(); ++i) {
     nlohmann::json o = {{"H", io::to_json(frf.H[i])}};
     if (i < frf.coherence.size() && frf.coherence[i].size() > 0) o["coherence"] = io::to_json(frf.coherence[i]);
-    outputs[frf.outputs[i]] = o;
+    outputs[frf.outputs[i]] = std::move(o);
   }
   const auto& p = frf.provenance;
   return {{"source", p.source},
@@ -62,7 +63,7 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
           {"estimator", p.estimator},
           {"averages", p.averages},
           {"sample_rate_Hz", p.sample_rate},
-          {"outputs", outputs}};
+          {"outputs", std::move(outputs)}};
 }
 
 int run_frf(const FrfOptions& o) {
@@ -73,8 +74,9 @@ int run_frf(const FrfOptions& o) {
   read.delimiter = io::csv_delimiter_from_string(o.delimiter);
   read.decimal = io::csv_decimal_from_string(o.decimal);
   if (!o.json) log_line("reading " + o.file);
-  // One pass over the samples: a large v5 record is used in place from the file's mapping.
-  const io::TimeSeriesView ts = io::read_timeseries_view(o.file, read);
+  // One pass over the samples: a large v5 record is used in place from the file's mapping, its
+  // channels checked for NaN/Inf by the estimate's own pass (dsp::estimate_frf).
+  const io::TimeSeriesView ts = io::read_timeseries_view(o.file, read, io::FiniteCheck::kCaller);
   // The settings `run` uses for a record (dsp::welch_options_for_record), then the options given.
   dsp::WelchOptions welch = dsp::welch_options_for_record(ts.samples, ts.sample_rate, o.resolution, "--resolution");
   welch.window = dsp::window_type_from_string(o.window);
@@ -107,7 +109,7 @@ int run_frf(const FrfOptions& o) {
       const std::string num = ts.unit(name), den = ts.unit(o.input);
       units[name] = (num.empty() ? "1" : num) + "/" + (den.empty() ? "1" : den);
     }
-    document["H_units"] = units;
+    document["H_units"] = std::move(units);
     print_json(document);
     return 0;
   }

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <numbers>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include "dsp/fft.hpp"
 #include "piezobench/core/error.hpp"
@@ -49,8 +51,10 @@ double rise(double t, double ramp) {
   return 0.5 - 0.5 * std::cos(kPi * t / ramp);
 }
 
-// u = c + s v with the policy of `bounds`; fills u, scaled, scale, clipped.
-void fit_to_bounds(const Eigen::VectorXd& c, const Eigen::VectorXd& v, const VoltageBounds& bounds,
+// u = c + s v with the policy of `bounds`; fills u, scaled, scale, clipped. `c` may be an
+// expression (a constant level costs no vector); v's storage becomes u.
+template <typename Level>
+void fit_to_bounds(const Eigen::MatrixBase<Level>& c, Eigen::VectorXd&& v, const VoltageBounds& bounds,
                    const std::string& level_field, Excitation& out) {
   bounds.validate();
   for (Index k = 0; k < c.size(); ++k) {
@@ -72,9 +76,8 @@ void fit_to_bounds(const Eigen::VectorXd& c, const Eigen::VectorXd& v, const Vol
   if (bounds.policy == BoundsPolicy::kClip) s = 1.0;
   out.scale = s;
   out.scaled = s < 1.0;
-  out.u.resize(c.size());
-  core::advise_huge_pages(out.u.data(), static_cast<std::size_t>(out.u.size()) * sizeof(double));
-  out.u = c + s * v;
+  v = c + s * v;  // coefficient-wise: in place is safe
+  out.u = std::move(v);
   out.clipped = 0;
   for (Index k = 0; k < out.u.size(); ++k) {
     // For kScale the clamp only removes round-off of the product above; for kClip it is the policy.
@@ -155,16 +158,18 @@ Excitation band_limited_noise(const NoiseOptions& options, const VoltageBounds& 
   const auto last = std::min(static_cast<Index>(std::floor(options.f_high / df)), n / 2);
 
   // White noise -> spectrum -> band -> signal in two FFTW buffers, no Eigen copies in between
-  // (a 100 s record is 1 M samples; the numbers are those of detail::rfft and irfft).
+  // (a 100 s record is 1 M samples; the numbers are those of detail::rfft and irfft). The two
+  // plans are made on another thread while the samples are drawn.
+  std::future<void> plans = detail::plan_in_background(n);
   std::mt19937_64 rng(options.seed);
-  detail::FftwBuffer<double> samples(n);
+  detail::FftwBuffer<double> samples(n, detail::BufferInit::kNone);
   fill_gaussian(rng, samples.data(), n);
+  plans.get();
   const detail::RealForwardFft forward(n);
-  detail::FftwBuffer<std::complex<double>> spectrum(forward.bins());
+  detail::FftwBuffer<std::complex<double>> spectrum(forward.bins(), detail::BufferInit::kNone);
   forward.execute(samples.data(), spectrum.data());
-  for (Index k = 0; k < forward.bins(); ++k) {
-    if (k < first || k > last) spectrum[k] = 0.0;
-  }
+  std::fill(spectrum.data(), spectrum.data() + first, std::complex<double>(0.0));
+  std::fill(spectrum.data() + last + 1, spectrum.data() + forward.bins(), std::complex<double>(0.0));
   detail::RealInverseFft(n).execute(spectrum.data(), samples.data());
   Eigen::VectorXd v(n);
   core::advise_huge_pages(v.data(), static_cast<std::size_t>(n) * sizeof(double));
@@ -179,10 +184,7 @@ Excitation band_limited_noise(const NoiseOptions& options, const VoltageBounds& 
   out.seed = options.seed;
   out.lines_Hz.resize(2);
   out.lines_Hz << static_cast<double>(first) * df, static_cast<double>(last) * df;
-  Eigen::VectorXd level(n);
-  core::advise_huge_pages(level.data(), static_cast<std::size_t>(n) * sizeof(double));
-  level.setConstant(options.offset);
-  fit_to_bounds(level, v, bounds, "offset", out);
+  fit_to_bounds(Eigen::VectorXd::Constant(n, options.offset), std::move(v), bounds, "offset", out);
   return out;
 }
 
@@ -261,7 +263,8 @@ Excitation multisine(const MultisineOptions& options, const VoltageBounds& bound
     power += 0.5 * a * a;
   }
   const Eigen::VectorXd period = detail::irfft(spectrum, n) * (options.rms / std::sqrt(power));
-  Eigen::VectorXd v(n * options.periods);
+  Eigen::VectorXd v(n * options.periods);  // becomes u
+  core::advise_huge_pages(v.data(), static_cast<std::size_t>(v.size()) * sizeof(double));
   for (Index p = 0; p < options.periods; ++p) v.segment(p * n, n) = period;
 
   Excitation out;
@@ -269,7 +272,7 @@ Excitation multisine(const MultisineOptions& options, const VoltageBounds& bound
   out.kind = "multisine-" + to_string(options.phases);
   out.seed = options.phases == MultisinePhases::kRandom ? options.seed : 0;
   out.lines_Hz = Eigen::Map<const Eigen::VectorXd>(options.lines_Hz.data(), lines);
-  fit_to_bounds(Eigen::VectorXd::Constant(v.size(), options.offset), v, bounds, "offset", out);
+  fit_to_bounds(Eigen::VectorXd::Constant(v.size(), options.offset), std::move(v), bounds, "offset", out);
   return out;
 }
 
@@ -304,7 +307,8 @@ Excitation sine_sweep(const SweepOptions& options, const VoltageBounds& bounds) 
   const double T = options.duration;
   const double f0 = options.f_start;
   const double f1 = options.f_end;
-  Eigen::VectorXd v(n);
+  Eigen::VectorXd v(n);  // becomes u
+  core::advise_huge_pages(v.data(), static_cast<std::size_t>(n) * sizeof(double));
   for (Index k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) / options.sample_rate;
     double phase = 0.0;
@@ -320,7 +324,7 @@ Excitation sine_sweep(const SweepOptions& options, const VoltageBounds& bounds) 
   Excitation out;
   out.sample_rate = options.sample_rate;
   out.kind = "sweep-" + to_string(options.type);
-  fit_to_bounds(Eigen::VectorXd::Constant(n, options.offset), v, bounds, "offset", out);
+  fit_to_bounds(Eigen::VectorXd::Constant(n, options.offset), std::move(v), bounds, "offset", out);
   return out;
 }
 
@@ -362,7 +366,7 @@ Excitation offset_sine(const OffsetSineOptions& options, const VoltageBounds& bo
   out.sample_rate = options.sample_rate;
   out.kind = "offset-sine";
   out.lines_Hz = Eigen::VectorXd::Constant(1, options.frequency);
-  fit_to_bounds(c, v, bounds, "rest", out);
+  fit_to_bounds(c, std::move(v), bounds, "rest", out);
   return out;
 }
 
@@ -403,7 +407,7 @@ Excitation steps(const StepOptions& options, const VoltageBounds& bounds) {
   Excitation out;
   out.sample_rate = options.sample_rate;
   out.kind = "steps";
-  const Eigen::VectorXd c = Eigen::VectorXd::Constant(n, options.rest);
+  const auto c = Eigen::VectorXd::Constant(n, options.rest);
   fit_to_bounds(c, stair - c, bounds, "rest", out);
   return out;
 }

@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <complex>
 #include <cstddef>
+#include <future>
 #include <memory>
 
 namespace piezobench::dsp::detail {
@@ -15,12 +16,16 @@ struct FftwFree {
   void operator()(void* p) const;
 };
 
-// An fftw_malloc'ed array of n elements (zero-initialized).
+// kNone: for a buffer that is written whole before it is read (a transform's output, samples
+// drawn into it): no pass over fresh pages.
+enum class BufferInit { kZero, kNone };
+
+// An fftw_malloc'ed array of n elements (zero-initialized unless BufferInit::kNone).
 template <typename T>
 class FftwBuffer {
  public:
   FftwBuffer() = default;
-  explicit FftwBuffer(Eigen::Index n);
+  explicit FftwBuffer(Eigen::Index n, BufferInit init = BufferInit::kZero);
   [[nodiscard]] T* data() { return data_.get(); }
   [[nodiscard]] const T* data() const { return data_.get(); }
   [[nodiscard]] Eigen::Index size() const { return size_; }
@@ -59,6 +64,11 @@ class RealInverseFft {
   Eigen::Index n_;
   const void* plan_;
 };
+
+// Makes (or finds) the forward and the inverse plan of length n on another thread, for a caller
+// with other work to do meanwhile: a 1 M-point plan costs milliseconds (its twiddle factors).
+// get() on the result waits for both and rethrows a planning failure.
+[[nodiscard]] std::future<void> plan_in_background(Eigen::Index n);
 
 // Convenience on Eigen vectors (copies into aligned buffers): full one-sided spectrum of x, and
 // the real signal of length n from its one-sided spectrum (normalized by 1/n, i.e. numpy irfft).

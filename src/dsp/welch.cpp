@@ -31,10 +31,11 @@ void check_channel(const Channel& ch, Index expected_length, const std::string& 
                      std::to_string(n));
   }
   for (Index i = 0; i < n; ++i) {
-    if (!std::isfinite(ch.samples[static_cast<std::size_t>(i)])) {
+    const double x = ch.samples[static_cast<std::size_t>(i)];
+    if (!std::isfinite(x)) {
       throw InputError(source, ch.name, "finite samples",
-                       std::string(std::isnan(ch.samples[static_cast<std::size_t>(i)]) ? "NaN" : "Inf") +
-                           " at sample " + std::to_string(i) + " (0-based)");
+                       std::string(std::isnan(x) ? "NaN" : x > 0 ? "Inf" : "-Inf") + " at sample " + std::to_string(i) +
+                           " (0-based)");
     }
   }
 }

@@ -35,9 +35,16 @@ constexpr const char* kChannelOrder = "channels";  // comma-separated names, in 
 // for the checks that follow each piece to find it in the L2 cache.
 constexpr Eigen::Index kReadChunk = Eigen::Index{1} << 15;
 
+// True when every sample is finite: x * 0 is 0 for a finite x and NaN for NaN and +-Inf, and
+// Eigen's sum runs on vectors (the caller finds the bad sample with check_finite only when there
+// is one).
+bool all_finite(const double* x, Eigen::Index n) {
+  return (Eigen::Map<const Eigen::ArrayXd>(x, n) * 0.0).sum() == 0.0;
+}
+
 // NaN/Inf check with the channel and the first bad sample in the message.
 void check_finite(const std::string& source, const std::string& channel, const Eigen::Ref<const Eigen::VectorXd>& v) {
-  if (v.allFinite()) return;
+  if (all_finite(v.data(), v.size())) return;
   for (Eigen::Index k = 0; k < v.size(); ++k) {
     if (!std::isfinite(v(k))) {
       throw InputError(source, channel, "finite samples",
@@ -45,13 +52,6 @@ void check_finite(const std::string& source, const std::string& channel, const E
                            " at sample " + std::to_string(k));
     }
   }
-}
-
-// True when every sample is finite: x * 0 is 0 for a finite x and NaN for NaN and +-Inf, and
-// Eigen's sum runs on vectors (the caller finds the bad sample with check_finite only when there
-// is one).
-bool all_finite(const double* x, Eigen::Index n) {
-  return (Eigen::Map<const Eigen::ArrayXd>(x, n) * 0.0).sum() == 0.0;
 }
 
 // Records reach 10^7 samples per channel: their buffers are allocated once, filled straight from
@@ -544,7 +544,8 @@ std::map<std::string, Setting> read_struct_settings(const matvar_t& var, const s
 // channels stored as plain doubles (detail::map_double_vector) are checked in place in the file's
 // mapping; when every channel is (top level, SI units), `view` gets them (view->mapped) and the
 // TimeSeries returned is empty.
-TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeriesView* view) {
+TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeriesView* view,
+                    FiniteCheck finite_check = FiniteCheck::kReader) {
   options.validate();
   const std::string source = file.string();
   detail::MatFilePtr mat = detail::open_mat_for_reading(file);
@@ -707,7 +708,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
       const Eigen::Index n = lengths.front();
       for (size_t j = 0; j < names.size(); ++j) {
         bool finite = true;
-        for (Eigen::Index first = 0; first < n && finite; first += kReadChunk) {
+        for (Eigen::Index first = 0; first < n && finite && finite_check == FiniteCheck::kReader; first += kReadChunk) {
           finite = all_finite(mapped[j].data + first, std::min(kReadChunk, n - first));
         }
         if (!finite) check_finite(source, names[j], Eigen::Map<const Eigen::VectorXd>(mapped[j].data, n));
@@ -763,9 +764,10 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
 
 TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options) { return read_mat(file, options, nullptr); }
 
-TimeSeriesView read_timeseries_view(const fs::path& file, const ReadOptions& options) {
+TimeSeriesView read_timeseries_view(const fs::path& file, const ReadOptions& options, FiniteCheck finite) {
   TimeSeriesView view;
-  TimeSeries ts = text::to_lower(file.extension().string()) == ".mat" ? read_mat(file, options, &view) : read_timeseries(file, options);
+  TimeSeries ts = text::to_lower(file.extension().string()) == ".mat" ? read_mat(file, options, &view, finite)
+                                                                      : read_timeseries(file, options);
   if (view.mapped) return view;
   auto owned = std::make_shared<TimeSeries>(std::move(ts));
   view.names = owned->names;

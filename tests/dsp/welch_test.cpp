@@ -365,7 +365,7 @@ TEST(WelchErrors, NonFiniteSamplesAfterTheLastSegmentAreReported) {
   EXPECT_EQ(r.error("y2"), "rec.mat: y2: expected finite samples, found NaN at sample 195000 (0-based)");
   r.y2(LongRecord::kCovered) = 0.0;
   r.y1(LongRecord::kN - 1) = -std::numeric_limits<double>::infinity();  // the very last sample
-  EXPECT_EQ(r.error("y1"), "rec.mat: y1: expected finite samples, found Inf at sample 199999 (0-based)");
+  EXPECT_EQ(r.error("y1"), "rec.mat: y1: expected finite samples, found -Inf at sample 199999 (0-based)");
   r.u(LongRecord::kN - 2) = nan;  // the input is reported first
   EXPECT_EQ(r.error("u"), "rec.mat: u: expected finite samples, found NaN at sample 199998 (0-based)");
   // welch_psd (no outputs) checks its tail as well.
@@ -396,7 +396,7 @@ TEST(WelchErrors, NonFiniteSamplesInsideSegmentsNameTheChannelInputFirst) {
       alone(&LongRecord::y1, "y1", 150000, nan, "NaN");
       alone(&LongRecord::u, "u", 194999, nan, "NaN");  // the last sample of the last segment
       // Sample 0 is in one segment only, where the periodic Hann window is exactly 0.
-      alone(&LongRecord::u, "u", 0, -inf, "Inf");
+      alone(&LongRecord::u, "u", 0, -inf, "-Inf");  // the sign kept, as the readers do
       alone(&LongRecord::y1, "y1", 0, nan, "NaN");
       // Several bad channels: the input first, then the outputs in order, whatever the indices.
       r.y2(1000) = inf;

@@ -116,6 +116,10 @@ struct MatWriteOptions {
 // SI units are used in place from a read-only mapping of the file (no copy into fresh memory);
 // anything else is read by read_timeseries and kept in `storage`. The time vector, when the file
 // has one, is checked and gives the sample rate; the view does not keep it, nor the settings.
+// FiniteCheck::kCaller leaves NaN/Inf in the mapped channels to the caller, which must check them
+// on its own pass (dsp::estimate_frf does, through its sums, and names the channel and sample):
+// one pass over the record less. A record read into memory is checked as it arrives in any case.
+enum class FiniteCheck { kReader, kCaller };
 struct TimeSeriesView {
   std::vector<std::string> names;                // as TimeSeries::names
   std::vector<const double*> columns;            // columns[j]: samples() values of channel names[j]
@@ -130,7 +134,8 @@ struct TimeSeriesView {
   [[nodiscard]] Eigen::Map<const Eigen::VectorXd> channel(const std::string& name) const;
   [[nodiscard]] std::string unit(const std::string& name) const;
 };
-[[nodiscard]] TimeSeriesView read_timeseries_view(const std::filesystem::path& file, const ReadOptions& options = {});
+[[nodiscard]] TimeSeriesView read_timeseries_view(const std::filesystem::path& file, const ReadOptions& options = {},
+                                                  FiniteCheck finite = FiniteCheck::kReader);
 
 // Writes `ts` (validated first) as .mat or CSV (format from the extension). Channel names must be
 // MATLAB identifiers (letter, then letters, digits, '_'; at most 63 characters) other than the
