@@ -623,6 +623,28 @@ TEST(TimeSeriesView, BadSamplesAndDamagedFilesGiveTheReadersMessages) {
   }
 }
 
+TEST(TimeSeriesView, FiniteCheckByTheCallerLeavesMappedChannelsAloneButNotTheTimeVector) {
+  TempDir dir;
+  const Eigen::VectorXd t = large_time(), a = large_channel(0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const fs::path file = dir.path() / "caller.mat";
+  Eigen::VectorXd bad = a;
+  bad(kPiece + 3) = nan;
+  write_raw_mat(file, {{"t", t}, {"a", bad}});
+  // The reader would refuse it; with kCaller the channel is given as it is, in place.
+  EXPECT_NE(input_error([&] { (void)read_timeseries_view(file); }), "");
+  const TimeSeriesView view = read_timeseries_view(file, {}, FiniteCheck::kCaller);
+  ASSERT_TRUE(view.mapped);
+  EXPECT_TRUE(std::isnan(view.channel("a")(kPiece + 3)));
+  EXPECT_EQ(view.channel("a")(kPiece + 2), a(kPiece + 2));
+  // The time vector gives the sample rate: it is checked whoever checks the channels.
+  Eigen::VectorXd bad_t = t;
+  bad_t(kPiece) = nan;
+  write_raw_mat(file, {{"t", bad_t}, {"a", a}});
+  EXPECT_EQ(input_error([&] { (void)read_timeseries_view(file, {}, FiniteCheck::kCaller); }),
+            input_error([&] { (void)read_timeseries(file); }));
+}
+
 // ---- writers --------------------------------------------------------------------------------
 
 TEST(TimeSeriesWrite, InvalidDataWritesNothing) {
