@@ -51,9 +51,25 @@ nlohmann::json settings_json(const io::TimeSeries& ts) {
   throw UsageError("--" + what.substr(prefix.size()));
 }
 
-nlohmann::json timing_json(const rt::TimingSummary& s) { return {{"p50", s.p50}, {"p99", s.p99}, {"max", s.max}, {"count", s.count}}; }
-
 }  // namespace
+
+nlohmann::json timing_json(const rt::TimingSummary& s) {
+  return {{"p50", s.p50}, {"p99", s.p99}, {"p999", s.p999}, {"max", s.max}, {"mean", s.mean}, {"count", s.count}};
+}
+
+nlohmann::json loop_timing_json(const rt::LoopReport& r) {
+  const auto known = [](auto value) { return value >= 0 ? nlohmann::json(value) : nlohmann::json(nullptr); };
+  return {{"overruns", r.overruns},
+          {"overrun_causes", {{"late_wakeup", r.overruns_late_wakeup}, {"long_step", r.overruns_long_step}}},
+          {"host",
+           {{"overruns_late_wakeup", r.overruns_late_wakeup},
+            {"skipped_deadlines", r.skipped_deadlines},
+            {"wait_ms", known(r.host_wait_ms)},
+            {"preemptions", known(r.host_preemptions)}}},
+          {"code", {{"overruns_long_step", r.overruns_long_step}, {"step_time_us", timing_json(r.step_time_us)}}},
+          {"skipped_deadlines", r.skipped_deadlines},
+          {"step_time_us", timing_json(r.step_time_us)}};
+}
 
 const std::atomic<bool>* stop_on_sigint() {
   g_stop.store(false);
@@ -202,18 +218,17 @@ int run_measurement(const MeasureRequest& r) {
                  {"stale_inputs", io.timeouts}, {"errors", io.errors}, {"round_trip_us", timing_json(io.round_trip_us)}};
     nlohmann::json runs = nlohmann::json::array();
     for (const rt::LoopReport& lr : rep.runs) {
-      runs.push_back({{"cycles", lr.cycles},
-                      {"overruns", lr.overruns},
-                      {"skipped_deadlines", lr.skipped_deadlines},
-                      {"feedforward", lr.feedforward},
-                      {"clamped_samples", lr.clamped_samples},
-                      {"slew_limited_samples", lr.slew_limited_samples},
-                      {"stale_sensor_samples", lr.stale_sensor_samples},
-                      {"safe_state_reason", lr.safe_state_reason},
-                      {"sched_fifo", lr.sched_fifo},
-                      {"memory_locked", lr.memory_locked},
-                      {"step_time_us", timing_json(lr.step_time_us)},
-                      {"warnings", lr.warnings}});
+      nlohmann::json run = loop_timing_json(lr);
+      run.update({{"cycles", lr.cycles},
+                  {"feedforward", lr.feedforward},
+                  {"clamped_samples", lr.clamped_samples},
+                  {"slew_limited_samples", lr.slew_limited_samples},
+                  {"stale_sensor_samples", lr.stale_sensor_samples},
+                  {"safe_state_reason", lr.safe_state_reason},
+                  {"sched_fifo", lr.sched_fifo},
+                  {"memory_locked", lr.memory_locked},
+                  {"warnings", lr.warnings}});
+      runs.push_back(std::move(run));
     }
     doc["runs"] = runs;
     nlohmann::json steps = nlohmann::json::array();

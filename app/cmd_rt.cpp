@@ -49,15 +49,6 @@ struct RtOptions {
   bool json = false;
 };
 
-nlohmann::json summary(const rt::TimingSummary& s, bool percentiles = true) {
-  nlohmann::json j = {{"p50", s.p50}, {"max", s.max}, {"mean", s.mean}, {"count", s.count}};
-  if (percentiles) {
-    j["p99"] = s.p99;
-    j["p999"] = s.p999;
-  }
-  return j;
-}
-
 int run_rt(const RtOptions& o) {
   if (o.controller != "iff" && o.controller != "off") {
     throw UsageError("--controller", "iff or off", "'" + o.controller + "'");
@@ -190,7 +181,8 @@ int run_rt(const RtOptions& o) {
                {"y_rms_V", rms(log.channel("y"))}};
   }
   if (o.json) {
-    print_json({{"source", source},
+    nlohmann::json doc = loop_timing_json(r);
+    doc.update({{"source", source},
                 {"controller", o.controller},
                 {"gain", o.gain},
                 {"rate_Hz", r.sample_rate},
@@ -199,19 +191,9 @@ int run_rt(const RtOptions& o) {
                 {"sched_fifo", r.sched_fifo},
                 {"memory_locked", r.memory_locked},
                 {"cycles", r.cycles},
-                {"overruns", r.overruns},
-                {"overrun_causes", {{"late_wakeup", r.overruns_late_wakeup}, {"long_step", r.overruns_long_step}}},
-                {"host",
-                 {{"overruns_late_wakeup", r.overruns_late_wakeup},
-                  {"skipped_deadlines", r.skipped_deadlines},
-                  {"wait_ms", r.host_wait_ms >= 0.0 ? nlohmann::json(r.host_wait_ms) : nlohmann::json(nullptr)},
-                  {"preemptions", r.host_preemptions >= 0 ? nlohmann::json(r.host_preemptions) : nlohmann::json(nullptr)}}},
-                {"code", {{"overruns_long_step", r.overruns_long_step}, {"step_time_us", summary(r.step_time_us)}}},
-                {"skipped_deadlines", r.skipped_deadlines},
                 {"wind_down_cycles", r.wind_down_cycles},
-                {"period_jitter_us", r.realtime ? summary(r.period_jitter_us) : nlohmann::json(nullptr)},
-                {"wake_latency_us", r.realtime ? summary(r.wake_latency_us) : nlohmann::json(nullptr)},
-                {"step_time_us", summary(r.step_time_us)},
+                {"period_jitter_us", r.realtime ? timing_json(r.period_jitter_us) : nlohmann::json(nullptr)},
+                {"wake_latency_us", r.realtime ? timing_json(r.wake_latency_us) : nlohmann::json(nullptr)},
                 {"clamped_samples", r.clamped_samples},
                 {"slew_limited_samples", r.slew_limited_samples},
                 {"safe_state_events", r.safe_state_events},
@@ -230,7 +212,7 @@ int run_rt(const RtOptions& o) {
                   {"late", r.io.late},
                   {"stale_inputs", r.io.timeouts},
                   {"errors", r.io.errors},
-                  {"round_trip_us", summary(r.io.round_trip_us)}}},
+                  {"round_trip_us", timing_json(r.io.round_trip_us)}}},
                 {"max_va_cmd_step_V", r.max_va_cmd_step},
                 {"limits",
                  {{"actuator", limits.actuator},
@@ -247,6 +229,7 @@ int run_rt(const RtOptions& o) {
                 {"dropped_log_samples", r.dropped_log_samples},
                 {"signals", signals},
                 {"warnings", r.warnings}});
+    print_json(doc);
     return 0;
   }
   fmt::print("real-time loop: {} backend, {:g} Hz, {} ({}SCHED_FIFO, {}mlockall)\n", r.backend, r.sample_rate,

@@ -5,11 +5,13 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/rt/backend.hpp"
 #include "piezobench/rt/bench_file.hpp"
+#include "piezobench/rt/loop.hpp"
 
 namespace piezobench::app {
 
@@ -31,6 +33,13 @@ struct MeasureRequest {
 void set_feedforward(bench::ExperimentOptions& options, const std::string& file);
 // Runs the experiment, writes the record, prints the summary (or the JSON document).
 int run_measurement(const MeasureRequest& request);
+
+// The timing report of one loop run as JSON, the same in `rt --json` and in each run of
+// `measure --json`: overruns and their causes, what the shared host took (late wake-ups, skipped
+// deadlines, wait for a core, preemptions) apart from what the code took (long steps, step time).
+nlohmann::json loop_timing_json(const rt::LoopReport& report);
+// p50, p99, p999, max, mean and count of a timing summary.
+nlohmann::json timing_json(const rt::TimingSummary& summary);
 
 // The backend a bench file names (virtual: the batch unit of its [virtual] table). InputError when
 // the device cannot be used.

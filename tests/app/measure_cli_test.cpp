@@ -4,8 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <complex>
+#include <cstdint>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/io/timeseries.hpp"
@@ -140,6 +144,22 @@ TEST(MeasureCli, TwoProcessesOverLoopbackMatchTheInProcessBench) {
   EXPECT_EQ(mj["io"]["lost"], 0) << m.out;
   EXPECT_EQ(mj["samples"], 40000);
   EXPECT_EQ(mj["settings"]["backend"], "udp");
+  // Each loop run carries rt's timing report (one serializer): the same fields, causes adding up.
+  ASSERT_EQ(mj["runs"].size(), 1U) << m.out;
+  const nlohmann::json& run = mj["runs"][0];
+  for (const char* key : {"overruns", "overrun_causes", "host", "code", "skipped_deadlines", "step_time_us"}) {
+    EXPECT_TRUE(run.contains(key)) << key << " missing in " << run.dump();
+    EXPECT_TRUE(j.contains(key)) << key << " missing in rt's " << rt.out;
+  }
+  for (const auto& [name, part] : {std::pair{"host", j["host"]}, {"code", j["code"]}}) {
+    std::vector<std::string> rt_keys, run_keys;
+    for (const auto& item : part.items()) rt_keys.push_back(item.key());
+    for (const auto& item : run[name].items()) run_keys.push_back(item.key());
+    EXPECT_EQ(run_keys, rt_keys) << name;
+  }
+  EXPECT_EQ(run["overrun_causes"]["late_wakeup"].get<std::uint64_t>() + run["overrun_causes"]["long_step"].get<std::uint64_t>(),
+            run["overruns"].get<std::uint64_t>());
+  EXPECT_EQ(run["code"]["step_time_us"], run["step_time_us"]);
   ASSERT_EQ(run_cli("simulate frf-noise --unit 1 --seed 1 --duration 4 --out " + sim_mat).exit_code, 0);
   const std::string served = server.finish();
   EXPECT_EQ(nlohmann::json::parse(served)["sessions"], 2) << served;
