@@ -2,7 +2,7 @@
 // hysteresis, creep and noise (target <= 20 ns per 100 us sample: 5,000 times real time), of the
 // APA95ML super-element bench (target 200 times real time), and a whole frf-noise record of
 // 100 s (1 M samples) in memory. The peer is scipy.signal.dlsim / lfilter on the same linear
-// 2-DoF bench (bench/sim/peer_dlsim.py), run in the same session; docs/performance.md has the
+// 2-DoF bench (scripts/analysis/peer_dlsim.py), run in the same session; docs/performance.md has the
 // figures and the commands.
 #include <benchmark/benchmark.h>
 
