@@ -85,7 +85,7 @@ int run_superelement(const SuperElementCli& o) {
   const fem::Modes modes = fem::modes(model);
 
   const Eigen::VectorXd hz = lti::logspace(std::log10(o.fmin), std::log10(o.fmax), o.points);
-  std::vector<Eigen::MatrixXcd> H;
+  lti::FrequencyResponse H;
   if (model.F.cols() > 0 && model.T.rows() > 0) {
     if (!o.json) log_line(fmt::format("frequency response at {} points on {} DOF", o.points, model.size()));
     H = fem::frequency_response(model, modes, kTwoPi * hz);  // modal superposition
@@ -99,9 +99,7 @@ int run_superelement(const SuperElementCli& o) {
         channels.push_back({{"output", model.output_names[static_cast<std::size_t>(out)]},
                             {"input", model.input_names[static_cast<std::size_t>(in)]},
                             {"units", "m/N"}});
-        Eigen::VectorXcd v(hz.size());
-        for (Index k = 0; k < hz.size(); ++k) v(k) = H[static_cast<std::size_t>(k)](out, in);
-        h.push_back(io::to_json(v));
+        h.push_back(io::to_json(H.channel(out, in)));
       }
     }
     nlohmann::json nodes = nlohmann::json::array();
@@ -120,7 +118,7 @@ int run_superelement(const SuperElementCli& o) {
                 {"fixed_nodes", options.fixed_nodes},
                 {"damping", o.damping},
                 {"modes_Hz", io::to_json(modes.frequencies_Hz)},
-                {"freq_Hz", H.empty() ? nlohmann::json::array() : io::to_json(hz)},
+                {"freq_Hz", H.H.empty() ? nlohmann::json::array() : io::to_json(hz)},
                 {"channels", channels},
                 {"H", h},
                 {"warnings", se.warnings}});
@@ -132,11 +130,11 @@ int run_superelement(const SuperElementCli& o) {
   fmt::print("first {} modes [Hz]:", shown);
   for (Index i = 0; i < shown; ++i) fmt::print(" {:.5g}", modes.frequencies_Hz(i));
   fmt::print("\n");
-  for (Index out = 0; out < model.T.rows() && !H.empty(); ++out) {
+  for (Index out = 0; out < model.T.rows() && !H.H.empty(); ++out) {
     for (Index in = 0; in < model.F.cols(); ++in) {
       fmt::print("{} <- {}: |H| at {:.4g} Hz = {:.4g} m/N, at {:.4g} Hz = {:.4g} m/N\n",
                  model.output_names[static_cast<std::size_t>(out)], model.input_names[static_cast<std::size_t>(in)],
-                 hz(0), std::abs(H.front()(out, in)), hz(hz.size() - 1), std::abs(H.back()(out, in)));
+                 hz(0), std::abs(H.H.front()(out, in)), hz(hz.size() - 1), std::abs(H.H.back()(out, in)));
     }
   }
   for (const std::string& w : se.warnings) fmt::print("warning: {}\n", w);

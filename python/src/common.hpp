@@ -31,6 +31,7 @@ namespace piezobench::lti {
 struct StateSpace;
 struct RootLocusOptions;
 struct RootLocus;
+struct FrequencyResponse;
 }
 namespace piezobench::dsp {
 struct Frf;
@@ -326,6 +327,10 @@ void reject_leftovers(const py::dict& kwargs, const std::string& source, const s
 
 // A system given as lti.StateSpace, lti.TransferFunction or lti.Zpk, as a state space (lti.cpp).
 lti::StateSpace state_space_arg(py::handle obj, const std::string& source, const std::string& field);
+
+// A frequency response as a complex128 array (len(omega), outputs, inputs); with squeeze_siso a
+// single-input single-output response is 1-D (lti.cpp; lti.freqresp squeezes, fem's does not).
+py::array response_array(const lti::FrequencyResponse& r, bool squeeze_siso);
 
 // Keyword tables shared by several modules (defined in lti.cpp and dsp.cpp).
 template <class T>

@@ -180,13 +180,8 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
           [](const StructuralModel& s, py::object omega) {
             auto w = to_vector(omega, "fem.StructuralModel.frequency_response", "omega");
             auto h = without_gil([&] { return frequency_response(s, w); });
-            const py::ssize_t n = w.size(), p = s.T.rows(), q = s.F.cols();
-            py::array_t<Complex> out({n, p, q});
-            auto a = out.mutable_unchecked<3>();
-            for (py::ssize_t k = 0; k < n; ++k)
-              for (py::ssize_t i = 0; i < p; ++i)
-                for (py::ssize_t j = 0; j < q; ++j) a(k, i, j) = h[static_cast<std::size_t>(k)](i, j);
-            return out;
+            if (w.size() == 0) return py::array(py::array_t<Complex>({py::ssize_t{0}, py::ssize_t{s.T.rows()}, py::ssize_t{s.F.cols()}}));
+            return response_array(h, false);
           },
           arg("omega"), "T (K - w^2 M + j w C)^-1 F at every omega (rad/s): (len(omega), outputs, inputs).");
 

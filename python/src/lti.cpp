@@ -40,16 +40,14 @@ const Options<DiscretizeOptions>& discretize_options() {
   return t;
 }
 
-py::array response_array(const FrequencyResponse& r) {
+}  // namespace
+
+py::array response_array(const FrequencyResponse& r, bool squeeze_siso) {
   // omega.size() x outputs x inputs, complex128; SISO: 1-D.
   const Index n = r.omega.size();
   if (n == 0) return to_numpy(Eigen::VectorXcd());
   const Index p = r.H[0].rows(), q = r.H[0].cols();
-  if (p == 1 && q == 1) {
-    Eigen::VectorXcd h(n);
-    for (Index k = 0; k < n; ++k) h(k) = r.H[k](0, 0);
-    return to_numpy(std::move(h));
-  }
+  if (squeeze_siso && p == 1 && q == 1) return to_numpy(r.channel(0, 0));
   py::array_t<Complex> out({n, p, q});
   auto a = out.mutable_unchecked<3>();
   for (Index k = 0; k < n; ++k)
@@ -57,6 +55,8 @@ py::array response_array(const FrequencyResponse& r) {
       for (Index j = 0; j < q; ++j) a(k, i, j) = r.H[k](i, j);
   return out;
 }
+
+namespace {
 
 py::object time_response(TimeResponse&& r) {
   py::dict d;
@@ -193,7 +193,7 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
         }
         auto s = state_space_arg(sys, "lti.freqresp", "sys");
         auto r = without_gil([&] { return FrequencyResponseEvaluator(s).response(w, threads); });
-        return response_array(r);
+        return response_array(r, true);
       },
       arg("sys"), arg("omega"), arg("threads") = 1,
       R"(H(j omega) at every omega (rad/s), delays exact. SISO: a 1-D complex array; MIMO state space:

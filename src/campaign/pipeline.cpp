@@ -424,7 +424,7 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
     ga.push_back(std::abs(fit.ga));
     gs.push_back(std::abs(fit.gs));
     if (u.resonance_Hz) measured_res.push_back(*u.resonance_Hz);
-    if (!out.figure) out.figure = SuperElementComparison::Response{u.id, u.name, fit.freq_Hz, fit.de, fit.vs};
+    if (!out.figure) out.figure = SuperElementComparison::Response{u.id, u.name, fit.model};
   }
   if (!out.units.empty()) {
     out.ga = median(ga);

@@ -819,14 +819,14 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
   if (s && !s->failed && s->figure) {
     // Figure 4.2: the tuned model thinned as the unit's measured FRF (unit_curves).
     const SuperElementComparison::Response& m = *s->figure;
-    const VectorXd& f = m.freq_Hz;
+    const VectorXd& f = m.model.freq_Hz;
     json fm = json::array();
     std::vector<std::complex<double>> de, vs;
     if (f.size() > 1) {
       for (const Index k : log_indices(f, std::max(0.5, f(1)), std::min(2.0 * r.campaign.analysis.fmax_Hz, f(f.size() - 1)))) {
         fm.push_back(f(k));
-        de.push_back(m.de(k));
-        vs.push_back(m.vs(k));
+        de.push_back(m.model.H[0](k));
+        vs.push_back(m.model.H[1](k));
       }
     }
     const Bode se_de = model_lines(fm, de, 1e6), se_vs = model_lines(fm, vs, 1.0);

@@ -25,7 +25,7 @@ double median(std::vector<double> v) {
 // The model's u -> [d_e, e_s] per newton of actuator force at `hz`, by modal superposition on
 // the model's modes (its damping is modal, so this is the dense solution to round-off without a
 // complex LU per frequency: the fit evaluates ~1,000 frequencies per unit).
-std::vector<Eigen::MatrixXcd> response(const fem::StructuralModel& model, const fem::Modes& modes, const Eigen::VectorXd& hz) {
+lti::FrequencyResponse response(const fem::StructuralModel& model, const fem::Modes& modes, const Eigen::VectorXd& hz) {
   return fem::frequency_response(model, modes, kTwoPi * hz);
 }
 
@@ -74,16 +74,16 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
   const Eigen::Index n = 800;
   const Eigen::VectorXd grid = Eigen::VectorXd::LinSpaced(n, std::log10(std::max(1.0, f(0))), std::log10(std::max(2.0, f(f.size() - 1))))
                                    .unaryExpr([](double x) { return std::pow(10.0, x); });
-  const std::vector<Eigen::MatrixXcd> hg = response(model, modes, grid);
+  const lti::FrequencyResponse hg = response(model, modes, grid);
+  const Eigen::VectorXd grid_de = hg.channel(0, 0).cwiseAbs(), grid_s = hg.channel(1, 0).cwiseAbs();
   Eigen::Index peak = 0;
   for (Eigen::Index k = 1; k < n; ++k) {
-    if (std::abs(hg[static_cast<std::size_t>(k)](0, 0)) > std::abs(hg[static_cast<std::size_t>(peak)](0, 0))) peak = k;
+    if (grid_de(k) > grid_de(peak)) peak = k;
   }
   r.resonance_Hz = grid(peak);
   Eigen::Index dip = -1;
   for (Eigen::Index k = 1; k + 1 < peak; ++k) {
-    const double a = std::abs(hg[static_cast<std::size_t>(k)](1, 0));
-    if (a < std::abs(hg[static_cast<std::size_t>(k - 1)](1, 0)) && a < std::abs(hg[static_cast<std::size_t>(k + 1)](1, 0))) dip = k;
+    if (grid_s(k) < grid_s(k - 1) && grid_s(k) < grid_s(k + 1)) dip = k;
   }
   r.antiresonance_Hz = dip >= 0 ? grid(dip) : 0.0;
 
@@ -104,13 +104,13 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
   }
   Eigen::VectorXd fb(static_cast<Eigen::Index>(band.size()));
   for (std::size_t i = 0; i < band.size(); ++i) fb(static_cast<Eigen::Index>(i)) = f(band[i]);
-  const std::vector<Eigen::MatrixXcd> hb = response(model, modes, fb);
+  const lti::FrequencyResponse hb = response(model, modes, fb);
   std::vector<double> ga_ratio, gs_ratio, de_phase, vs_phase;
   for (std::size_t i = 0; i < band.size(); ++i) {
     const std::complex<double> m_de = measured.H[static_cast<std::size_t>(ide)](band[i]);
     const std::complex<double> m_vs = measured.H[static_cast<std::size_t>(ivs)](band[i]);
-    const std::complex<double> h_de = options.amplifier_gain * hb[i](0, 0);
-    const std::complex<double> h_s = options.amplifier_gain * hb[i](1, 0);
+    const std::complex<double> h_de = options.amplifier_gain * hb.H[i](0, 0);
+    const std::complex<double> h_s = options.amplifier_gain * hb.H[i](1, 0);
     ga_ratio.push_back(std::abs(m_de) / std::abs(h_de));
     de_phase.push_back(std::cos(std::arg(m_de / h_de)));
     gs_ratio.push_back(std::abs(m_vs) / std::abs(h_s));  // divided by |ga| below
@@ -124,18 +124,19 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
   }
 
   // The tuned model at the measured frequencies, and its error up to twice the resonance.
-  Eigen::Index last = f.size();
-  r.freq_Hz = f.head(last);
-  const std::vector<Eigen::MatrixXcd> h = response(model, modes, r.freq_Hz);
-  r.de.resize(last);
-  r.vs.resize(last);
+  // (On the measured grid itself: freq_Hz is f, not f converted to rad/s and back.)
+  const lti::FrequencyResponse h = response(model, modes, f);
+  r.model.freq_Hz = f;
+  r.model.input = "u";
+  r.model.outputs = {"de", "Vs"};
+  r.model.H = {options.amplifier_gain * r.ga * h.channel(0, 0), options.amplifier_gain * r.ga * r.gs * h.channel(1, 0)};
+  r.model.provenance.source = "super element " + setup.source + " on the bench, ga and gs tuned";
+  const Eigen::VectorXcd &de = r.model.H[0], &vs = r.model.H[1];
   std::vector<double> e_de, e_vs;
-  for (Eigen::Index k = 0; k < last; ++k) {
-    r.de(k) = options.amplifier_gain * r.ga * h[static_cast<std::size_t>(k)](0, 0);
-    r.vs(k) = options.amplifier_gain * r.ga * r.gs * h[static_cast<std::size_t>(k)](1, 0);
+  for (Eigen::Index k = 0; k < f.size(); ++k) {
     if (f(k) >= r.band_lo_Hz && f(k) <= 2.0 * r.resonance_Hz) {
-      e_de.push_back(std::abs(20.0 * std::log10(std::abs(r.de(k)) / std::abs(measured.H[static_cast<std::size_t>(ide)](k)))));
-      e_vs.push_back(std::abs(20.0 * std::log10(std::abs(r.vs(k)) / std::abs(measured.H[static_cast<std::size_t>(ivs)](k)))));
+      e_de.push_back(std::abs(20.0 * std::log10(std::abs(de(k)) / std::abs(measured.H[static_cast<std::size_t>(ide)](k)))));
+      e_vs.push_back(std::abs(20.0 * std::log10(std::abs(vs(k)) / std::abs(measured.H[static_cast<std::size_t>(ivs)](k)))));
     }
   }
   r.de_error_dB = e_de.empty() ? 0.0 : median(e_de);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::dsp {
 
@@ -89,6 +90,51 @@ void Frf::validate(const std::string& source) const {
       }
     }
   }
+}
+
+lti::FrequencyResponse to_frequency_response(const Frf& frf) {
+  frf.validate();
+  const Index n = frf.freq_Hz.size();
+  const auto outputs = static_cast<Index>(frf.H.size());
+  lti::FrequencyResponse r;
+  r.omega = kTwoPi * frf.freq_Hz;
+  r.H.assign(static_cast<std::size_t>(n), lti::CMatrix(outputs, 1));
+  for (Index k = 0; k < n; ++k) {
+    for (Index i = 0; i < outputs; ++i) r.H[static_cast<std::size_t>(k)](i, 0) = frf.H[static_cast<std::size_t>(i)](k);
+  }
+  return r;
+}
+
+Frf to_frf(const lti::FrequencyResponse& response, const std::string& input_name, const std::vector<std::string>& output_names,
+           Index input) {
+  const std::string src = "frequency response";
+  const Index n = response.omega.size();
+  if (response.H.size() != static_cast<std::size_t>(n)) {
+    throw InputError(src, "H", std::to_string(n) + " matrices (one per frequency)", std::to_string(response.H.size()));
+  }
+  const auto outputs = static_cast<Index>(output_names.size());
+  for (Index k = 0; k < n; ++k) {
+    const lti::CMatrix& h = response.H[static_cast<std::size_t>(k)];
+    if (h.rows() != outputs) {
+      throw InputError(src, "outputs", std::to_string(h.rows()) + " names (one per output of the response)",
+                       std::to_string(outputs) + " at index " + std::to_string(k));
+    }
+    if (input < 0 || input >= h.cols()) {
+      throw InputError(src, "input", "an input index below " + std::to_string(h.cols()), std::to_string(input));
+    }
+  }
+  Frf frf;
+  frf.freq_Hz = response.omega / kTwoPi;
+  frf.input = input_name;
+  frf.outputs = output_names;
+  frf.provenance.source = src;
+  for (Index i = 0; i < outputs; ++i) {
+    Eigen::VectorXcd h(n);
+    for (Index k = 0; k < n; ++k) h(k) = response.H[static_cast<std::size_t>(k)](i, input);
+    frf.H.push_back(std::move(h));
+  }
+  frf.validate(src);
+  return frf;
 }
 
 FrequencyBand excited_band(const Frf& frf, double min_coherence) {

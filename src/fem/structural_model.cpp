@@ -290,8 +290,10 @@ lti::StateSpace to_state_space(const StructuralModel& model) {
   return lti::StateSpace(std::move(A), std::move(B), std::move(C), Eigen::MatrixXd::Zero(no, ni));
 }
 
-std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, const Eigen::VectorXd& omega) {
-  std::vector<Eigen::MatrixXcd> H;
+lti::FrequencyResponse frequency_response(const StructuralModel& model, const Eigen::VectorXd& omega) {
+  lti::FrequencyResponse r;
+  r.omega = omega;
+  std::vector<Eigen::MatrixXcd>& H = r.H;
   H.reserve(static_cast<std::size_t>(omega.size()));
   const Eigen::MatrixXcd F = model.F.cast<std::complex<double>>();
   const Eigen::MatrixXcd T = model.T.cast<std::complex<double>>();
@@ -311,10 +313,10 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
     }
     H.push_back(std::move(h));
   }
-  return H;
+  return r;
 }
 
-std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, const Modes& modes, const Eigen::VectorXd& omega) {
+lti::FrequencyResponse frequency_response(const StructuralModel& model, const Modes& modes, const Eigen::VectorXd& omega) {
   const Index f = model.size();
   if (modes.shapes.rows() != f || modes.shapes.cols() != f || modes.frequencies_Hz.size() != f) {
     throw InputError("", "modes", "all " + std::to_string(f) + " modes of the model",
@@ -335,7 +337,9 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
   });
   const Eigen::MatrixXcd t_phi = (model.T * phi).cast<std::complex<double>>();
   const Eigen::MatrixXcd phi_f = (phi.transpose() * model.F).cast<std::complex<double>>();
-  std::vector<Eigen::MatrixXcd> H;
+  lti::FrequencyResponse r;
+  r.omega = omega;
+  std::vector<Eigen::MatrixXcd>& H = r.H;
   H.reserve(static_cast<std::size_t>(omega.size()));
   Eigen::VectorXcd inv(f);
   for (Index k = 0; k < omega.size(); ++k) {
@@ -351,7 +355,7 @@ std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, c
     }
     H.push_back(std::move(h));
   }
-  return H;
+  return r;
 }
 
 }  // namespace piezobench::fem

@@ -117,7 +117,7 @@ TEST(SuperElementPlant, MatchesTheFullStructuralModel) {
   const Eigen::VectorXd two_zeta_w = 2.0 * 0.01 * 2 * kPi * modes.frequencies_Hz;
   full.C = mphi * two_zeta_w.asDiagonal() * mphi.transpose();
   const Eigen::VectorXd hz = lti::logspace(0, 3.3, 60);
-  const std::vector<Eigen::MatrixXcd> h = fem::frequency_response(full, 2 * kPi * hz);
+  const std::vector<Eigen::MatrixXcd> h = fem::frequency_response(full, 2 * kPi * hz).H;
   // Plant: from the extra actuator force (N) to d_e, and from the force on the mass to d_e.
   const lti::StateSpace force(plant.A, plant.B.rightCols(2), plant.C.row(kOutDe), plant.D.block(kOutDe, 1, 1, 2));
   const lti::FrequencyResponse r = lti::freqresp(force, 2 * kPi * hz);

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::dsp {
 namespace {
@@ -123,6 +124,82 @@ TEST(ExcitedBand, FromTheCoherenceOfTheBestOutputIgnoringDipsAndIsolatedBins) {
     EXPECT_EQ(e.field(), "coherence");
     EXPECT_NE(std::string(e.what()).find("check the input and output channels"), std::string::npos) << e.what();
   }
+}
+
+// A mass-spring-damper m x'' + c x' + k x = F with outputs [x, x'] and a second input that only
+// moves the velocity output: H_x = 1 / (k - m w^2 + j c w), H_v = j w H_x.
+lti::StateSpace two_output_plant() {
+  const double m = 2.0, k = 8.0e4, c = 40.0;
+  lti::StateSpace s;
+  s.A = (lti::Matrix(2, 2) << 0.0, 1.0, -k / m, -c / m).finished();
+  s.B = (lti::Matrix(2, 2) << 0.0, 0.0, 1.0 / m, 0.0).finished();
+  s.C = lti::Matrix::Identity(2, 2);
+  s.D = (lti::Matrix(2, 2) << 0.0, 0.0, 0.0, 3.0).finished();
+  return s;
+}
+
+TEST(FrfConversion, ModelResponseToFrfIsHzNamedAndPerOutput) {
+  const double m = 2.0, k = 8.0e4, c = 40.0;
+  const Eigen::VectorXd f_Hz = Eigen::VectorXd::LinSpaced(50, 1.0, 100.0);
+  const lti::FrequencyResponse r = lti::freqresp(two_output_plant(), kTwoPi * f_Hz);
+  const Frf frf = to_frf(r, "F", {"x", "v"});
+  EXPECT_EQ(frf.input, "F");
+  ASSERT_EQ(frf.outputs.size(), 2U);
+  EXPECT_EQ(frf.outputs[1], "v");
+  EXPECT_TRUE(frf.coherence.empty());
+  ASSERT_EQ(frf.freq_Hz.size(), 50);
+  for (Eigen::Index i = 0; i < 50; ++i) {
+    EXPECT_NEAR(frf.freq_Hz(i), f_Hz(i), 1e-13 * f_Hz(i));
+    const double w = kTwoPi * f_Hz(i);
+    const std::complex<double> hx = 1.0 / std::complex<double>(k - m * w * w, c * w);
+    EXPECT_LT(std::abs(frf.H[0](i) - hx), 1e-12 * std::abs(hx));
+    EXPECT_LT(std::abs(frf.H[1](i) - std::complex<double>(0.0, w) * hx), 1e-12 * std::abs(w * hx));
+  }
+  // The second input: only the feedthrough to v.
+  const Frf second = to_frf(r, "G", {"x", "v"}, 1);
+  EXPECT_EQ(second.H[0](7), std::complex<double>(0.0, 0.0));
+  EXPECT_EQ(second.H[1](7), std::complex<double>(3.0, 0.0));
+}
+
+TEST(FrfConversion, FrfToResponseAndBackIsTheSame) {
+  const Frf f = two_outputs();
+  const lti::FrequencyResponse r = to_frequency_response(f);
+  ASSERT_EQ(r.omega.size(), 5);
+  ASSERT_EQ(r.H.size(), 5U);
+  for (Eigen::Index k = 0; k < 5; ++k) {
+    EXPECT_DOUBLE_EQ(r.omega(k), kTwoPi * f.freq_Hz(k));
+    ASSERT_EQ(r.H[static_cast<std::size_t>(k)].rows(), 2);
+    ASSERT_EQ(r.H[static_cast<std::size_t>(k)].cols(), 1);
+  }
+  EXPECT_EQ(r.channel(0, 0), f.H[0]);
+  EXPECT_EQ(r.channel(1, 0), f.H[1]);
+  const Frf back = to_frf(r, f.input, f.outputs);
+  for (Eigen::Index k = 0; k < 5; ++k) EXPECT_DOUBLE_EQ(back.freq_Hz(k), f.freq_Hz(k));
+  EXPECT_EQ(back.H[0], f.H[0]);
+  EXPECT_EQ(back.H[1], f.H[1]);
+}
+
+TEST(FrfConversion, RefusesNamesSizesAndGridsThatDoNotFit) {
+  const lti::FrequencyResponse r = lti::freqresp(two_output_plant(), Eigen::VectorXd::LinSpaced(4, 1.0, 4.0));
+  const auto field_of = [](auto&& call) {
+    try {
+      call();
+    } catch (const InputError& e) {
+      return e.field();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(field_of([&] { (void)to_frf(r, "F", {"x"}); }), "outputs");
+  EXPECT_EQ(field_of([&] { (void)to_frf(r, "F", {"x", "v"}, 2); }), "input");
+  EXPECT_EQ(field_of([&] { (void)to_frf(r, "F", {"x", "x"}); }), "outputs");
+  lti::FrequencyResponse bad = r;
+  bad.omega(2) = bad.omega(1);  // not increasing
+  EXPECT_EQ(field_of([&] { (void)to_frf(bad, "F", {"x", "v"}); }), "freq_Hz");
+  bad.H.pop_back();
+  EXPECT_EQ(field_of([&] { (void)to_frf(bad, "F", {"x", "v"}); }), "H");
+  Frf f = two_outputs();
+  f.H[1].resize(3);
+  EXPECT_THROW((void)to_frequency_response(f), InputError);
 }
 
 }  // namespace

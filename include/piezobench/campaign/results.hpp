@@ -354,13 +354,12 @@ struct SuperElementComparison {
   std::optional<double> resonance_Hz;           // the first unit's tuned model
   std::optional<double> measured_resonance_Hz;  // median of the units'
   std::vector<std::string> warnings;
-  // Figure 4.2: the first tuned unit's model at the measured frequencies (up to the band's end).
+  // Figure 4.2: the first tuned unit's model at its measured frequencies (SuperElementFit::model:
+  // outputs "de", m/V, and "Vs", V/V).
   struct Response {
     int unit = 0;
     std::string name;
-    Eigen::VectorXd freq_Hz;
-    Eigen::VectorXcd de;  // u -> d_e, m/V
-    Eigen::VectorXcd vs;  // u -> V_s, V/V
+    dsp::Frf model;
   };
   std::optional<Response> figure;
   std::optional<std::string> failed;

@@ -40,8 +40,9 @@ struct SuperElementFit {
   double antiresonance_Hz = 0.0;   // dip of the model's u -> V_s below the resonance (0: none)
   double de_error_dB = 0.0;        // median |20 log10 model/measured| of u -> d_e, band_lo .. 2 x resonance
   double vs_error_dB = 0.0;        // same for u -> V_s
-  Eigen::VectorXd freq_Hz;         // the measured frequencies up to the measured band's end
-  Eigen::VectorXcd de, vs;         // the tuned model there: u -> d_e (m/V), u -> V_s (V/V)
+  // The tuned model at the measured frequencies: input "u", outputs "de" (u -> d_e, m/V) and "Vs"
+  // (u -> V_s, V/V), no coherence.
+  dsp::Frf model;
 };
 
 // The bench model (see above). InputError when the setup has no force or fewer than two outputs,

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/lti/freqresp.hpp"
+
 namespace piezobench::dsp {
 
 // How an FRF was estimated (empty / zero where it does not apply, e.g. an FRF read from a file
@@ -34,6 +36,21 @@ struct Frf {
   // frequency or a coherence outside [0, 1] (1e-9 of round-off admitted).
   void validate(const std::string& source = "") const;
 };
+
+// The two FRF layouts and their converters. dsp::Frf is what is measured, read and written: Hz, one
+// input, named outputs, one vector per output (H[i](k)), coherence and provenance.
+// lti::FrequencyResponse is what a model gives: rad/s, one outputs x inputs matrix per frequency
+// (H[k](i, j)), no names. Only these two convert into each other: omega = 2 pi freq_Hz.
+//
+// The FRF as a single-input lti::FrequencyResponse: omega = 2 pi freq_Hz (rad/s), H[k] is
+// outputs x 1 at omega[k]. Names, coherence and provenance are dropped. Validates the FRF first.
+[[nodiscard]] lti::FrequencyResponse to_frequency_response(const Frf& frf);
+// Input `input` of a model's response as a dsp::Frf: freq_Hz = omega / (2 pi), H[i](k) =
+// response.H[k](i, input), named `input_name` and `output_names` (one per output), no coherence.
+// InputError (source "frequency response") for names that do not match the outputs, an input out of
+// range, inconsistent sizes or a grid Frf::validate refuses (negative, non-increasing, non-finite).
+[[nodiscard]] Frf to_frf(const lti::FrequencyResponse& response, const std::string& input_name,
+                         const std::vector<std::string>& output_names, Eigen::Index input = 0);
 
 // The band an FRF's input excited, read from the coherence: its lowest and highest frequency > 0
 // where the coherence of the best output (the largest coherence of the outputs whose coherence is

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "piezobench/fem/superelement.hpp"
+#include "piezobench/lti/freqresp.hpp"
 #include "piezobench/lti/state_space.hpp"
 
 namespace piezobench::fem {
@@ -110,10 +111,10 @@ struct Modes {
 [[nodiscard]] lti::StateSpace to_state_space(const StructuralModel& model);
 
 // H(j w) = T (K - w^2 M + j w C)^-1 F at every omega (rad/s), by a dense complex LU per
-// frequency (partial pivoting; O(f^3) each). H[k] is outputs x inputs. NumericalError when the
-// dynamic stiffness is singular (an undamped resonance hit exactly).
-[[nodiscard]] std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model,
-                                                               const Eigen::VectorXd& omega);
+// frequency (partial pivoting; O(f^3) each). H[k] is outputs x inputs (m/N) at omega[k], as for
+// lti::freqresp (dsp::to_frf names it). NumericalError when the dynamic stiffness is singular (an
+// undamped resonance hit exactly).
+[[nodiscard]] lti::FrequencyResponse frequency_response(const StructuralModel& model, const Eigen::VectorXd& omega);
 
 // The same H(j w) by modal superposition on `modes` (all f modes of the model, as modes(model)
 // returns them): H = T Phi diag(1 / (w_i^2 - w^2 + j w c_i)) Phi^T F with c = diag(Phi^T C Phi).
@@ -126,7 +127,7 @@ struct Modes {
 // mode) keeps fewer digits than the dense LU's. InputError when `modes` is not the model's full
 // set; NumericalError as above.
 inline constexpr double kModalCouplingTolerance = 1e-8;
-[[nodiscard]] std::vector<Eigen::MatrixXcd> frequency_response(const StructuralModel& model, const Modes& modes,
-                                                               const Eigen::VectorXd& omega);
+[[nodiscard]] lti::FrequencyResponse frequency_response(const StructuralModel& model, const Modes& modes,
+                                                        const Eigen::VectorXd& omega);
 
 }  // namespace piezobench::fem
