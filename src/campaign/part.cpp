@@ -280,7 +280,7 @@ template <class V> void fields(V& v, NmpEvidence::Zero& s) {
   v("phase_verdict", s.phase_verdict); v("phase_change_deg", s.phase_change_deg); v("fitted_zero", s.fitted_zero);
   v("fitted_zero_nonminimum_phase", s.fitted_zero_nonminimum_phase);
 }
-template <class V> void fields(V& v, NmpEvidence& s) { v("zero", s.zero); v("iff_plant_fit_xz", s.iff_plant_fit_xz); v("verdict_from", s.verdict_from); }
+template <class V> void fields(V& v, NmpEvidence& s) { v("zero", s.zero); v("iff_plant_fit_xz", s.iff_plant_fit_xz); v("verdict_from", s.verdict_from); v("verdict_reason", s.verdict_reason); }
 template <class V> void fields(V& v, HighPassCorner& s) {
   v("first_order_fit_Hz", s.first_order_fit_Hz); v("first_order_fit_points", s.first_order_fit_points); v("r_c_Hz", s.r_c_Hz);
   v("iff_plant_fit_Hz", s.iff_plant_fit_Hz); v("iff_plant_fit_error", s.iff_plant_fit_error); v("method", s.method); v("corner_Hz", s.corner_Hz);

@@ -359,11 +359,12 @@ json nmp_section(const std::vector<UnitCurves>& units) {
     mag.push_back(trace(u.name(), z.f, z.abs, u.name(), false, "lines+markers"));
     coh.push_back(trace(u.name(), z.f, z.coh, u.name(), false, "lines+markers"));
     phase.push_back(trace(u.name(), z.f, z.phase, u.name(), false, "lines+markers"));
-    json row = {u.name(), nullptr, nullptr, nullptr, nullptr, nullptr};
+    json row = {u.name(), nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
     if (const auto& f = u.result->frf_analysis) {
       row = {u.name(), io::to_json(f->antiresonance_Hz), io::to_json(f->antiresonance_damping),
              f->nmp.zero ? json(f->nmp.zero->phase_change_deg) : json(nullptr),
-             f->nmp.zero ? json(ident::to_string(f->nmp.zero->phase_verdict)) : json(nullptr), f->nmp.verdict_from};
+             f->nmp.zero ? json(ident::to_string(f->nmp.zero->phase_verdict)) : json(nullptr), f->nmp.verdict_from,
+             f->nmp.verdict_reason};
     }
     rows.push_back(row);
   }
@@ -372,7 +373,7 @@ json nmp_section(const std::vector<UnitCurves>& units) {
                    "a non-minimum-phase one lowers it by 180 deg; the coherence says whether the data there can be trusted."},
           {"tables", json::array({table("Verdict per unit",
                                         {"unit", "anti-resonance [Hz]", "zero damping", "phase change [deg]", "verdict of the phase",
-                                         "verdict from"},
+                                         "verdict from", "why"},
                                         rows)})},
           {"figures", json::array({figure("nmp-zoom", "Fig. 2.6: u -> Vs at the anti-resonance", "Frequency [Hz]", false,
                                           json::array({panel("|H| [V/V]", true, mag), panel("Coherence", false, coh),

@@ -193,6 +193,7 @@ json frf(const FrfAnalysis& f) {
   }
   if (f.nmp.iff_plant_fit_xz) nmp["iff_plant_fit_xz"] = *f.nmp.iff_plant_fit_xz;
   nmp["verdict_from"] = f.nmp.verdict_from;
+  nmp["verdict_reason"] = f.nmp.verdict_reason;
   out["nmp_evidence"] = nmp;
   if (f.antiresonance_vector_fit_Hz) {
     out["antiresonance_vector_fit_Hz"] = *f.antiresonance_vector_fit_Hz;

@@ -457,7 +457,7 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   }
   // u -> Vs: anti-resonance and the NMP verdict.
   std::optional<double> anti_w, anti_z;
-  std::optional<bool> nmp_phase, nmp_model;
+  std::optional<ident::AntiResonance> zero;
   try {
     const ident::FrfFeatures f = ident::frf_features(vs.omega, vs.h, fo);
     const Index pk = peak_index(vs, 0.0);
@@ -470,8 +470,7 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     if (z) {
       anti_w = z->natural_frequency;
       anti_z = z->damping;
-      nmp_model = z->nonminimum_phase_model;
-      if (z->phase_verdict != ident::PhaseVerdict::kUndetermined) nmp_phase = z->phase_verdict == ident::PhaseVerdict::kNonMinimumPhase;
+      zero = *z;
       out.nmp.zero = NmpEvidence::Zero{z->phase_verdict, z->phase_change_deg, z->root, z->nonminimum_phase_model};
     }
     out.static_gain_vs = f.static_gain;
@@ -520,12 +519,12 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     hpf.corner_Hz = hpf.first_order_fit_Hz;
   }
 
-  // The verdict: the phase of the data when it decides, else the fitted models (VF zero, then the
-  // sign of xz in the IFF fit).
-  std::optional<bool> verdict = nmp_phase;
-  if (!verdict && u.iff_plant) verdict = u.iff_plant->zero_is_nonminimum_phase();
-  if (!verdict) verdict = nmp_model;
-  out.nmp.verdict_from = nmp_phase ? "phase" : (u.iff_plant ? "iff-plant-fit" : (nmp_model ? "fitted-zero" : "none"));
+  // The verdict: the phase of the data when it decides unambiguously, else the sign of xz in the
+  // IFF plant fit, else the ambiguous phase, else the vector fit's zero (ident::zero_phase_verdict).
+  const ident::ZeroPhaseVerdict zv = ident::zero_phase_verdict(zero ? &*zero : nullptr, u.iff_plant ? &*u.iff_plant : nullptr);
+  const std::optional<bool> verdict = zv.nonminimum_phase;
+  out.nmp.verdict_from = zv.from;
+  out.nmp.verdict_reason = zv.reason;
   // Static gain, resonance and its damping: from the mass-spring-damper fit of u -> d_e with its
   // delay (else the vector fit, else the IFF plant fit). Anti-resonance: from the IFF plant fit,
   // whose zero pair is exactly the model's (the order-N vector fit spreads the narrow notch over

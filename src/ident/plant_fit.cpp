@@ -101,6 +101,46 @@ lti::TransferFunction IffPlantFit::transfer_function() const { return control::i
 
 CVector IffPlantFit::response(const Vector& omega) const { return control::iff_plant_response(*this, omega); }
 
+ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit* plant, double ambiguity_deg) {
+  ZeroPhaseVerdict v;
+  const auto kind = [](bool nmp) { return std::string(nmp ? "non-minimum-phase" : "minimum-phase"); };
+  std::string phase;  // what the phase says, for the reason
+  bool ambiguous = false;
+  if (zero) {
+    const double change = zero->phase_change_deg;
+    ambiguous = std::abs(std::abs(change) - 180.0) <= ambiguity_deg;
+    if (zero->phase_verdict == PhaseVerdict::kUndetermined) {
+      phase = fmt::format("phase change {:.1f} deg undetermined", change);
+    } else if (ambiguous) {
+      phase = fmt::format("phase change {:.1f} deg ambiguous (within {:g} deg of +-180 deg)", change, ambiguity_deg);
+    } else {
+      v.nonminimum_phase = zero->phase_verdict == PhaseVerdict::kNonMinimumPhase;
+      v.from = "phase";
+      v.reason = fmt::format("phase change {:.1f} deg across the anti-resonance: {}", change, kind(*v.nonminimum_phase));
+      return v;
+    }
+  } else {
+    phase = "no anti-resonance in the data's fit";
+  }
+  if (plant) {
+    v.nonminimum_phase = plant->zero_is_nonminimum_phase();
+    v.from = "iff-plant-fit";
+    v.reason = fmt::format("{}; plant fit zero xz = {:.3g} {} 0", phase, plant->xz, plant->xz < 0.0 ? "<" : ">=");
+  } else if (zero && zero->phase_verdict != PhaseVerdict::kUndetermined) {
+    v.nonminimum_phase = zero->phase_verdict == PhaseVerdict::kNonMinimumPhase;
+    v.from = "phase";
+    v.reason = fmt::format("{}, no plant fit to decide: {} as counted", phase, kind(*v.nonminimum_phase));
+  } else if (zero) {
+    v.nonminimum_phase = zero->nonminimum_phase_model;
+    v.from = "fitted-zero";
+    v.reason = fmt::format("{}, no plant fit; vector fit zero Re = {:.3g} rad/s", phase, zero->root.real());
+  } else {
+    v.from = "none";
+    v.reason = phase + ", no plant fit";
+  }
+  return v;
+}
+
 IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
                           const std::string& source) {
   options.validate();

@@ -140,6 +140,7 @@ struct NmpEvidence {
   std::optional<Zero> zero;              // the vector fit's zero nearest the dip
   std::optional<double> iff_plant_fit_xz;
   std::string verdict_from;              // "phase", "iff-plant-fit", "fitted-zero" or "none"
+  std::string verdict_reason;            // why (ident::ZeroPhaseVerdict::reason)
 };
 
 // The resistor high-pass of the force sensor's read-out.

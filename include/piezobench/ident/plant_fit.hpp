@@ -26,6 +26,7 @@
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/least_squares.hpp"
+#include "piezobench/ident/features.hpp"
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 
@@ -63,6 +64,31 @@ struct IffPlantFit : control::IffPlantParams {
   // G(j omega) at every omega (rad/s): control::iff_plant_response(*this, omega).
   [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
 };
+
+// Is the zero pair of u -> Vs at the anti-resonance non-minimum-phase (report sections 2.3, 2.4)?
+// Three pieces of evidence, in this order of trust:
+//  1. the data's phase change across the anti-resonance (AntiResonance::phase_change_deg, the sum of
+//     the phase steps between neighbouring lines): +180 deg for a minimum-phase zero pair, -180 deg
+//     for a mirrored one. When the dip is narrower than the line spacing, one step through it is
+//     itself about 180 deg, and whether it counts as +180 or -180 is decided by the noise: a change
+//     within `ambiguity_deg` of +-180 deg is ambiguous (a unit's -178 deg became +182 deg with
+//     another noise realization);
+//  2. the eq. 2.3 plant fit (fit_iff_plant): xz < 0 is a non-minimum-phase zero. It fits the whole
+//     band with the delay, so it does not depend on the few lines through the dip;
+//  3. the vector fit's zero (AntiResonance::nonminimum_phase_model): least trusted, a rational model
+//     without a delay absorbs the delay's phase into its zeros (it calls a mirrored zero with a
+//     delay minimum-phase).
+// The phase decides when it gives a verdict outside the ambiguity; else the plant fit; else the
+// ambiguous phase; else the fitted zero.
+struct ZeroPhaseVerdict {
+  std::optional<bool> nonminimum_phase;  // nullopt: no evidence
+  std::string from;    // "phase", "iff-plant-fit", "fitted-zero" or "none"
+  std::string reason;  // e.g. "phase change -178.3 deg ambiguous (within 20 deg of +-180 deg); plant fit zero xz = -0.0047 < 0"
+};
+inline constexpr double kPhaseAmbiguityDeg = 20.0;
+// zero: the anti-resonance found in the data (nullptr: none); plant: the eq. 2.3 fit (nullptr: none).
+[[nodiscard]] ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit* plant,
+                                                  double ambiguity_deg = kPhaseAmbiguityDeg);
 
 // omega: rad/s, increasing; h: u -> Vs (V/V); coherence: empty or same size. InputError (source)
 // for sizes that differ, non-finite data, fewer than 12 usable points or no resonance above an
