@@ -63,8 +63,10 @@ void fit_to_bounds(const Eigen::MatrixBase<Level>& c, Eigen::VectorXd&& v, const
                        format_number(c(k), 10) + " V");
     }
   }
+  // Most signals lie inside: one vectorized pass shows it, and then u = c + v needs no clamp.
+  const bool inside = c.size() > 0 && (c + v).maxCoeff() <= bounds.max && (c + v).minCoeff() >= bounds.min;
   double s = 1.0;
-  for (Index k = 0; k < c.size(); ++k) {
+  for (Index k = 0; k < c.size() && !inside; ++k) {
     if (v(k) > 0.0 && c(k) + v(k) > bounds.max) s = std::min(s, (bounds.max - c(k)) / v(k));
     if (v(k) < 0.0 && c(k) + v(k) < bounds.min) s = std::min(s, (bounds.min - c(k)) / v(k));
   }
@@ -79,7 +81,7 @@ void fit_to_bounds(const Eigen::MatrixBase<Level>& c, Eigen::VectorXd&& v, const
   v = c + s * v;  // coefficient-wise: in place is safe
   out.u = std::move(v);
   out.clipped = 0;
-  for (Index k = 0; k < out.u.size(); ++k) {
+  for (Index k = 0; k < out.u.size() && !inside; ++k) {
     // For kScale the clamp only removes round-off of the product above; for kClip it is the policy.
     const double clamped = std::clamp(out.u(k), bounds.min, bounds.max);
     if (clamped != out.u(k)) {
