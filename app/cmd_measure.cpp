@@ -88,6 +88,14 @@ void set_feedforward(bench::ExperimentOptions& options, const std::string& file)
   if (!file.empty()) options.feedforward = io::read_hysteresis_model(file);
 }
 
+bench::HysteresisLaw hysteresis_law_option(const std::string& name) {
+  try {
+    return bench::hysteresis_law_from_string(name);
+  } catch (const InputError&) {
+    throw UsageError("--hysteresis-law", bench::kHysteresisLaws, "'" + name + "'");
+  }
+}
+
 int run_measurement(const MeasureRequest& r) {
   bench::Experiment experiment{};
   try {
@@ -251,6 +259,8 @@ struct MeasureCli {
   CLI::Option *amplitude_option = nullptr, *duration_option = nullptr, *gain_option = nullptr, *seed_option = nullptr,
               *unit_option = nullptr;
   std::string feedforward;
+  std::string hysteresis_law = "prandtl-ishlinskii";  // virtual bench
+  CLI::Option* hysteresis_law_option = nullptr;
   bool realtime = false, json = false, open_circuit = false, no_resistor = false;
 };
 
@@ -264,6 +274,11 @@ int run_measure(const MeasureCli& o) {
   if (o.gain_option->count() > 0) r.options.gain = o.gain;
   r.options.bench.actuator_open_circuit = o.open_circuit;
   r.options.bench.hpf_resistor = !o.no_resistor;
+  r.options.bench.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
+  if (desc.hardware() && o.hysteresis_law_option->count() > 0) {
+    throw UsageError("--hysteresis-law", "the virtual bench (a bench file with backend \"virtual\"; for `bench serve`, its own option)",
+                     "backend " + desc.backend);
+  }
   set_feedforward(r.options, o.feedforward);
   r.unit = o.unit_option->count() > 0 || desc.hardware() ? o.unit : desc.unit;
   r.seed = o.seed_option->count() > 0 || desc.hardware() ? o.seed : desc.seed;
@@ -288,12 +303,14 @@ struct ServeCli {
   int sessions = 0;
   double idle_timeout = 60.0;
   std::uint64_t drop_every = 0;
+  std::string hysteresis_law = "prandtl-ishlinskii";
   bool json = false;
 };
 
 int run_serve(const ServeCli& o) {
   bench::BenchOptions bo;
   bo.sample_rate = o.rate;
+  bo.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
   bench::UnitTruth unit;
   try {
     unit = bench::batch_unit(o.unit, o.seed);
@@ -353,6 +370,7 @@ void add_measure_commands(CLI::App& app, Action& action) {
   m->add_flag("--open-circuit", o->open_circuit,
               "actuator stacks disconnected from the amplifier (stiffness k_oc; a real bench asks the operator first)");
   m->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (a real bench asks the operator first)");
+  o->hysteresis_law_option = m->add_option("--hysteresis-law", o->hysteresis_law, kHysteresisLawHelp)->capture_default_str();
   m->add_flag("--realtime", o->realtime, "SCHED_FIFO priority and locked memory for the loop (a message when not permitted)");
   m->add_option("--log", o->log, "also write the loop's raw log (every cycle, with safety flags) to this file");
   m->add_flag("--json", o->json, "print one JSON document (file, settings, I/O counts) on stdout");
@@ -372,6 +390,7 @@ void add_measure_commands(CLI::App& app, Action& action) {
   serve->add_option("--idle-timeout", s->idle_timeout, "exit after this long without a datagram, s")->capture_default_str();
   serve->add_option("--drop-every", s->drop_every, "testing: leave every N-th io request unanswered (0: none)")
       ->capture_default_str();
+  serve->add_option("--hysteresis-law", s->hysteresis_law, kHysteresisLawHelp)->capture_default_str();
   serve->add_flag("--json", s->json, "print the session counts as JSON at the end");
   serve->callback([s, &action] { action = [s] { return run_serve(*s); }; });
 }

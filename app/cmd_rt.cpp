@@ -85,11 +85,7 @@ int run_rt(const RtOptions& o) {
     bo.va_min = o.limits.va_min;
     bo.va_max = o.limits.va_max;
     bo.amplifier_gain = o.limits.amplifier_gain;
-    try {
-      bo.hysteresis_law = bench::hysteresis_law_from_string(o.hysteresis_law);
-    } catch (const InputError&) {
-      throw UsageError("--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
-    }
+    bo.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
     backend = std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(o.unit, o.seed), bo, o.seed);
     source = {{"bench", "virtual"}, {"unit", o.unit}, {"seed", o.seed}};
   } else if (o.bench == "replay") {
@@ -299,7 +295,7 @@ void add_rt_commands(CLI::App& app, Action& action) {
   rt->add_option("--amplitude", o->amplitude, "noise rms or sine amplitude, V at the DAC")->capture_default_str();
   rt->add_option("--frequency", o->frequency, "sine frequency, Hz (a whole number of samples per period)")->capture_default_str();
   rt->add_option("--offset", o->offset, "sine offset, V at the DAC")->capture_default_str();
-  rt->add_option("--hysteresis-law", o->hysteresis_law, "virtual bench: prandtl-ishlinskii or bouc-wen")->capture_default_str();
+  rt->add_option("--hysteresis-law", o->hysteresis_law, kHysteresisLawHelp)->capture_default_str();
   rt->add_option("--feedforward", o->feedforward,
                  "hysteresis model (TOML, `hysteresis fit`): u' passes through its inverse before the safety clamp")
       ->check(CLI::ExistingFile);

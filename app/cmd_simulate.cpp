@@ -41,11 +41,7 @@ int run_simulate(const SimulateOptions& o) {
   r.options.bench.hpf_resistor = !o.no_resistor;
   r.options.bench.actuator_open_circuit = o.open_circuit;
   if (!o.superelement.empty()) r.options.bench.superelement = o.superelement;
-  try {
-    r.options.bench.hysteresis_law = bench::hysteresis_law_from_string(o.hysteresis_law);
-  } catch (const InputError&) {
-    throw UsageError("--hysteresis-law", "prandtl-ishlinskii or bouc-wen", "'" + o.hysteresis_law + "'");
-  }
+  r.options.bench.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
   set_feedforward(r.options, o.feedforward);
   r.unit = o.unit;
   r.seed = o.seed;
@@ -74,8 +70,7 @@ void add_simulate_commands(CLI::App& app, Action& action) {
   sim->add_flag("--no-nmp-zero", o->no_nmp_zero, "a minimum-phase anti-resonance on u -> Vs");
   sim->add_flag("--no-hysteresis", o->no_hysteresis, "no hysteresis of the stacks");
   sim->add_flag("--no-creep", o->no_creep, "no creep of the stacks");
-  sim->add_option("--hysteresis-law", o->hysteresis_law,
-                  "law of the stacks' hysteresis: prandtl-ishlinskii (play operators) or bouc-wen (docs/virtual-bench.md)")
+  sim->add_option("--hysteresis-law", o->hysteresis_law, kHysteresisLawHelp)
       ->capture_default_str();
   sim->add_option("--feedforward", o->feedforward,
                   "tracking: the hysteresis model (TOML, `hysteresis fit`) of the compensated run (default: identified from the open run)")

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "piezobench/bench/experiments.hpp"
+#include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/rt/backend.hpp"
 #include "piezobench/rt/bench_file.hpp"
 #include "piezobench/rt/loop.hpp"
@@ -31,6 +32,12 @@ struct MeasureRequest {
 // --feedforward MODEL.toml of simulate and measure: the tracking experiment's model (InputError
 // naming the file; a model for another experiment is refused by ExperimentOptions::validate).
 void set_feedforward(bench::ExperimentOptions& options, const std::string& file);
+// --hysteresis-law NAME of simulate, rt, measure and bench serve (the virtual bench's law;
+// docs/virtual-bench.md): UsageError naming the option and the laws.
+bench::HysteresisLaw hysteresis_law_option(const std::string& name);
+inline constexpr const char* kHysteresisLawHelp =
+    "virtual bench: law of the stacks' hysteresis, prandtl-ishlinskii (play operators), bouc-wen or bouc-wen-asymmetric "
+    "(docs/virtual-bench.md)";
 // Runs the experiment, writes the record, prints the summary (or the JSON document).
 int run_measurement(const MeasureRequest& request);
 

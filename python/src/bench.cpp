@@ -37,7 +37,7 @@ const Options<BenchOptions>& bench_options() {
         .add("nonminimum_phase_zero", &BenchOptions::nonminimum_phase_zero, "the lightly damped NMP zero on u -> Vs")
         .add("hysteresis", &BenchOptions::hysteresis, "hysteresis of the stacks")
         .add_enum("hysteresis_law", &BenchOptions::hysteresis_law, &bench::to_string, &hysteresis_law_from_string,
-                  "\"prandtl-ishlinskii\" or \"bouc-wen\"")
+                  "\"prandtl-ishlinskii\", \"bouc-wen\" or \"bouc-wen-asymmetric\"")
         .add("creep", &BenchOptions::creep, "creep of the stacks")
         .add("noise", &BenchOptions::noise, "measurement noise (quantization stays)")
         .add("superelement", &BenchOptions::superelement, "TOML file of a super element replacing the 2-DoF model");

@@ -191,6 +191,7 @@ void bind_hysteresis(py::module_& ident_m, py::module_& control_m, py::module_& 
         d["stroke"] = m.stroke;
         d["width"] = m.width;
         d["rms_deviation"] = m.rms_deviation;
+        d["asymmetry"] = m.asymmetry;
         return result("LoopMetrics", d);
       },
       arg("command"), arg("output"),

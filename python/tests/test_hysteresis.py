@@ -85,6 +85,19 @@ def test_tracking_on_the_bouc_wen_bench():
     assert e.value.field == "hysteresis_law"
 
 
+def test_the_asymmetric_bench_law_bends_the_loop():
+    # The bench's third law: its 80 V loop is asymmetric, the two symmetric laws' are not.
+    def asymmetry(law):
+        ts = bench.simulate("hysteresis", unit=1, seed=1, amplitude=80.0, hysteresis_law=law)
+        va, de = ts.channel("Va"), ts.channel("de")
+        fs = ts.sample_rate
+        steady = slice(int(1.25 * fs), int(3.25 * fs))  # from the first to the last maximum of Va
+        return ident.loop_metrics(va[steady], de[steady]).asymmetry
+
+    assert asymmetry("bouc-wen-asymmetric") > 0.015
+    assert asymmetry("bouc-wen") < 0.002
+
+
 def test_modified_prandtl_ishlinskii_fits_an_asymmetric_loop_and_its_feedforward_linearizes_it():
     # A PI loop seen through an asymmetric smooth output (not a dead-zone superposition).
     va = _record()

@@ -104,7 +104,10 @@ class Hysteresis {
   Hysteresis() = default;
   Hysteresis(PlayHysteresis play) : play_(play), bouc_wen_(false) {}            // NOLINT(google-explicit-constructor)
   Hysteresis(BoucWenHysteresis bw) : bw_(bw), bouc_wen_(true) {}                // NOLINT(google-explicit-constructor)
-  double update(double v) noexcept { return bouc_wen_ ? bw_.update(v) : play_.update(v); }
+  // Bouc-Wen plus quadratic v^2 (1/V) on the effective voltage: loops asymmetric about their centre.
+  Hysteresis(BoucWenHysteresis bw, double quadratic) : bw_(bw), quadratic_(quadratic), bouc_wen_(true) {}
+  // Va_eff - v (V) after advancing to the voltage v.
+  double update(double v) noexcept { return (bouc_wen_ ? bw_.update(v) : play_.update(v)) + quadratic_ * v * v; }
   void reset() noexcept {
     play_.reset();
     bw_.reset();
@@ -113,6 +116,7 @@ class Hysteresis {
  private:
   PlayHysteresis play_;
   BoucWenHysteresis bw_;
+  double quadratic_ = 0.0;
   bool bouc_wen_ = false;
 };
 

@@ -50,12 +50,20 @@ constexpr std::size_t kMaxConfigs = 4;
 
 }  // namespace
 
-std::string to_string(HysteresisLaw law) { return law == HysteresisLaw::kBoucWen ? "bouc-wen" : "prandtl-ishlinskii"; }
+std::string to_string(HysteresisLaw law) {
+  switch (law) {
+    case HysteresisLaw::kBoucWen: return "bouc-wen";
+    case HysteresisLaw::kBoucWenAsymmetric: return "bouc-wen-asymmetric";
+    case HysteresisLaw::kPrandtlIshlinskii: break;
+  }
+  return "prandtl-ishlinskii";
+}
 
 HysteresisLaw hysteresis_law_from_string(const std::string& name) {
   if (name == "prandtl-ishlinskii") return HysteresisLaw::kPrandtlIshlinskii;
   if (name == "bouc-wen") return HysteresisLaw::kBoucWen;
-  throw InputError("", "hysteresis_law", "prandtl-ishlinskii or bouc-wen", "'" + name + "'");
+  if (name == "bouc-wen-asymmetric") return HysteresisLaw::kBoucWenAsymmetric;
+  throw InputError("", "hysteresis_law", kHysteresisLaws, "'" + name + "'");
 }
 
 void UnitTruth::validate() const {
@@ -371,9 +379,13 @@ VirtualBench::VirtualBench(const UnitTruth& unit, const BenchOptions& options, s
   }
   s.use_hysteresis = options.hysteresis && unit.hysteresis_scale > 0.0;
   s.use_creep = options.creep && (unit.creep_coefficient > 0.0 || unit.load_creep_coefficient > 0.0);
-  s.d.hysteresis = options.hysteresis_law == HysteresisLaw::kBoucWen
-                       ? detail::Hysteresis(detail::BoucWenHysteresis::bench_default(unit.hysteresis_scale))
-                       : detail::Hysteresis(detail::PlayHysteresis::bench_default(unit.hysteresis_scale));
+  switch (options.hysteresis_law) {
+    case HysteresisLaw::kBoucWen: s.d.hysteresis = detail::BoucWenHysteresis::bench_default(unit.hysteresis_scale); break;
+    case HysteresisLaw::kBoucWenAsymmetric:
+      s.d.hysteresis = detail::Hysteresis(detail::BoucWenHysteresis::bench_default(unit.hysteresis_scale), kAsymmetricQuadratic * unit.hysteresis_scale);
+      break;
+    case HysteresisLaw::kPrandtlIshlinskii: s.d.hysteresis = detail::PlayHysteresis::bench_default(unit.hysteresis_scale); break;
+  }
   // The super element has no stack extension to drive the load creep: voltage creep only there.
   s.d.creep = detail::Creep(unit.creep_coefficient, s.superelement() ? 0.0 : unit.load_creep_coefficient, s.ts);
 

@@ -628,23 +628,35 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
     const ident::HysteresisModel& m = h.fit.model;
     json weights = json::array();
     for (const double w : m.hysteresis.weights) weights.push_back(fmt::format("{:.3g}", w));
-    model_rows.push_back(json::array({u.name(), fmt::format("{:.3g}", h.amplitude), fmt::format("{:.3g}", m.gain * 1e6),
+    const bool modified = !m.output.identity();
+    const ident::HysteresisFit* plain = modified ? (h.alternative ? &*h.alternative : nullptr) : &h.fit;
+    const ident::HysteresisFit* kuhnen = modified ? &h.fit : (h.alternative ? &*h.alternative : nullptr);
+    const auto residual = [](const ident::HysteresisFit* f) {
+      return f == nullptr ? std::string("not fitted") : fmt::format("{:.2f} % ({})", 100.0 * f->relative_residual, core::to_string(f->quality.verdict));
+    };
+    model_rows.push_back(json::array({u.name(), modified ? "modified PI" : "PI", fmt::format("{:.2f} %", 100.0 * h.asymmetry),
+                                      fmt::format("{:.3g}", h.amplitude), fmt::format("{:.3g}", m.gain * 1e6),
                                       fmt::format("{}", fmt::join(weights, " ")),
                                       fmt::format("{:.3g} ({:.2f} %)", h.fit.rms_residual * 1e6, 100.0 * h.fit.relative_residual),
+                                      residual(plain) + " / " + residual(kuhnen),
                                       fmt::format("{:.1f} % / {:.1f} %", 100.0 * h.width, 100.0 * h.model_width),
                                       core::to_string(h.fit.quality.verdict)}));
     const XY& p = *u.hysteresis_model_record;
     figs.push_back(figure(fmt::format("hysteresis-model-{}", u.result->id), u.name() + ": hysteresis model against the record", "Va [V]", false,
                           json::array({panel("d_e [um]", false,
                                              json::array({trace("record", p.x, p.y, "record"),
-                                                          trace("Prandtl-Ishlinskii model", p.x, u.hysteresis_model_um, "model")}))}),
+                                                          trace(m.output.identity() ? "Prandtl-Ishlinskii model" : "modified Prandtl-Ishlinskii model",
+                                                                p.x, u.hysteresis_model_um, "model")}))}),
                           "The model's inverse is the feedforward of `rt --feedforward` and `measure tracking` "
                           "(docs/hysteresis.md)."));
   }
   if (!model_rows.empty()) {
-    tables.push_back(table("Hysteresis model (Prandtl-Ishlinskii, largest loop; thresholds (i - 1/2) R / n)",
-                           {"unit", "amplitude [V]", "gain [um/V]", "weights", "rms residual [um] (of the stroke)",
-                            "width (steady loop, from the best line): record / model", "fit"},
+    tables.push_back(table(fmt::format("Hysteresis model of the largest loop (Prandtl-Ishlinskii, thresholds (i - 1/2) R / n; Kuhnen's "
+                                       "modified PI, {} dead zones per side, fitted too when the loop's asymmetry exceeds {:.0f} % "
+                                       "of the stroke, kept when better)",
+                                       kCampaignDeadZones, 100.0 * kHysteresisAsymmetryLimit),
+                           {"unit", "model", "loop asymmetry", "amplitude [V]", "gain [um/V]", "weights", "rms residual [um] (of the stroke)",
+                            "residual: PI / modified PI", "width (steady loop, from the best line): record / model", "fit"},
                            model_rows));
   }
   // The tracking experiment (bench/tracking.hpp): d_e against the command without and with the

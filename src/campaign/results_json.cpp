@@ -65,9 +65,26 @@ json hysteresis(const std::vector<HysteresisLoop>& loops) {
   return list;
 }
 
+std::string hysteresis_model_name(const ident::HysteresisModel& m) {
+  return m.output.identity() ? "prandtl-ishlinskii" : "modified-prandtl-ishlinskii";
+}
+
 json hysteresis_model(const HysteresisModelFit& h) {
   const ident::HysteresisModel& m = h.fit.model;
-  json j = {{"amplitude_V", h.amplitude},
+  // Every model fitted (the chosen first), with its residual and verdict.
+  json candidates = json::array();
+  for (const ident::HysteresisFit* f : {&h.fit, h.alternative ? &*h.alternative : nullptr}) {
+    if (f == nullptr) continue;
+    candidates.push_back({{"model", hysteresis_model_name(f->model)},
+                          {"chosen", f == &h.fit},
+                          {"rms_residual_um", f->rms_residual * 1e6},
+                          {"relative_residual", f->relative_residual},
+                          {"quality", core::to_string(f->quality.verdict)}});
+  }
+  json j = {{"model", hysteresis_model_name(m)},
+            {"loop_asymmetry", h.asymmetry},
+            {"candidates", candidates},
+            {"amplitude_V", h.amplitude},
             {"operators", m.hysteresis.thresholds.size()},
             {"thresholds_V", m.hysteresis.thresholds},
             {"weights", m.hysteresis.weights},
@@ -82,6 +99,9 @@ json hysteresis_model(const HysteresisModelFit& h) {
             {"quality", core::to_string(h.fit.quality.verdict)},
             {"quality_problems", h.fit.quality.problems},
             {"provenance", provenance(h.provenance)}};
+  if (!m.output.identity()) {
+    j["output_map"] = {{"x_V", m.output.x}, {"y_V", m.output.y}, {"slope_below", m.output.slope_below}, {"slope_above", m.output.slope_above}};
+  }
   return j;
 }
 

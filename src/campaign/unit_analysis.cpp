@@ -295,19 +295,32 @@ StrokeAnalysis stroke(const Campaign& c, const Record& r) {
   return out;
 }
 
-// The PI model of the largest-amplitude record (it starts at rest, as the identification needs:
-// the fit takes the whole record). The widths are those of the steady loop `loop` analysed (between
-// its first and last maxima): the ramp from rest and back would add the virgin curve.
+// The hysteresis model of the largest-amplitude record (it starts at rest, as the identification
+// needs: the fit takes the whole record): the plain PI and, when the steady loop is asymmetric,
+// Kuhnen's modified PI too, the better one kept (HysteresisModelFit::fit). The widths and the
+// asymmetry are those of the steady loop `loop` analysed (between its first and last maxima): the
+// ramp from rest and back would add the virgin curve.
 HysteresisModelFit hysteresis_model(const Record& r, const metrology::HysteresisResult& loop) {
   const VectorXd va = r.channel("Va"), de = r.channel("de");
   const std::span<const double> v(va.data(), static_cast<std::size_t>(va.size())), d(de.data(), static_cast<std::size_t>(de.size()));
+  const auto steady = [&](std::span<const double> x) { return x.subspan(static_cast<std::size_t>(loop.first_sample), static_cast<std::size_t>(loop.samples)); };
   HysteresisModelFit out;
+  const ident::LoopMetrics record = ident::loop_metrics(steady(v), steady(d));
+  out.width = record.width;
+  out.asymmetry = record.asymmetry;
   out.fit = ident::fit_hysteresis(v, d, r.ts.sample_rate);
+  if (out.asymmetry > kHysteresisAsymmetryLimit) {
+    ident::HysteresisFitOptions o;
+    o.dead_zones = kCampaignDeadZones;
+    ident::HysteresisFit modified = ident::fit_hysteresis(v, d, r.ts.sample_rate, o);
+    const bool better = modified.quality.poor() != out.fit.quality.poor() ? out.fit.quality.poor()
+                                                                          : modified.relative_residual < out.fit.relative_residual;
+    if (better) std::swap(modified, out.fit);
+    out.alternative = std::move(modified);
+  }
   out.amplitude = loop.amplitude;
   out.provenance = provenance(r, {"Va", "de"});
   const std::vector<double> predicted = out.fit.model.predict(v, r.ts.sample_rate);
-  const auto steady = [&](std::span<const double> x) { return x.subspan(static_cast<std::size_t>(loop.first_sample), static_cast<std::size_t>(loop.samples)); };
-  out.width = ident::loop_metrics(steady(v), steady(d)).width;
   out.model_width = ident::loop_metrics(steady(v), steady(predicted)).width;
   out.loop = {thin(va, 1200), thin(de, 1200)};
   out.model_loop = {out.loop.x, thin(Eigen::Map<const VectorXd>(predicted.data(), va.size()), 1200)};

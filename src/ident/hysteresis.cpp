@@ -503,6 +503,14 @@ LoopMetrics loop_metrics(std::span<const double> command, std::span<const double
   m.stroke = y.maxCoeff() - y.minCoeff();
   m.width = m.stroke > 0.0 ? (dev.maxCoeff() - dev.minCoeff()) / m.stroke : 0.0;
   m.rms_deviation = std::sqrt(dev.square().mean());
+  const double mid = 0.5 * (c.maxCoeff() + c.minCoeff()), half = 0.5 * (c.maxCoeff() - c.minCoeff());
+  Eigen::MatrixXd basis(c.size(), 4);
+  basis.col(0).setOnes();
+  basis.col(1) = (c.array() - mid) / half;
+  basis.col(2) = basis.col(1).array().square();
+  basis.col(3) = basis.col(2).array() * basis.col(1).array();
+  const Eigen::VectorXd cubic = basis.colPivHouseholderQr().solve((y.array() - ym).matrix());
+  m.asymmetry = m.stroke > 0.0 ? std::abs(cubic(2)) / m.stroke : 0.0;
   return m;
 }
 

@@ -35,6 +35,16 @@ TEST(MeasureCli, OnTheVirtualBenchItWritesWhatSimulateWrites) {
   EXPECT_EQ(x.settings, y.settings);
   EXPECT_EQ((x.data - y.data).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 10000);
+  // With the asymmetric Bouc-Wen law, selected the same way on both.
+  const std::string c = (dir.path() / "sim-asym.mat").string(), d = (dir.path() / "measure-asym.mat").string();
+  ASSERT_EQ(run_cli("simulate hysteresis --hysteresis-law bouc-wen-asymmetric --unit 2 --out " + c).exit_code, 0);
+  const test::CliRun ra =
+      run_cli("measure hysteresis --bench " + kExamples + "bench-virtual.toml --hysteresis-law bouc-wen-asymmetric --unit 2 --out " + d);
+  ASSERT_EQ(ra.exit_code, 0) << ra.err;
+  const io::TimeSeries p = io::read_timeseries(c), q = io::read_timeseries(d);
+  EXPECT_EQ(std::get<std::string>(q.settings.at("hysteresis_law")), "bouc-wen-asymmetric");
+  EXPECT_EQ(p.settings, q.settings);
+  EXPECT_EQ((p.data - q.data).cwiseAbs().maxCoeff(), 0.0);
 }
 
 TEST(MeasureCli, RefusesWhatABenchCannotMeasure) {
@@ -46,6 +56,13 @@ TEST(MeasureCli, RefusesWhatABenchCannotMeasure) {
   test::CliRun r = run_cli("measure hammer --bench " + udp + " --out " + (dir.path() / "h.mat").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(test::contains(r.err, "its own instruments")) << r.err;
+  // The virtual bench's hysteresis law is for the virtual bench.
+  r = run_cli("measure hysteresis --bench " + udp + " --hysteresis-law bouc-wen --out " + (dir.path() / "h.mat").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(test::contains(r.err, "--hysteresis-law")) << r.err;
+  r = run_cli("measure hysteresis --bench " + kExamples + "bench-virtual.toml --hysteresis-law preisach");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(test::contains(r.err, "bouc-wen-asymmetric")) << r.err;
   // A bench file without limits: refused before anything is opened.
   const std::string nolimits = test::write_text_file(
       dir, "nolimits.toml", "[bench]\nbackend = \"udp\"\nsample_rate_Hz = 10000\n[udp]\naddress = \"127.0.0.1:9\"\n[amplifier]\ngain_V_per_V = 20\n");

@@ -1,7 +1,9 @@
 #include "piezobench/campaign/unit_analysis.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 
 #include "piezobench/bench/experiments.hpp"
@@ -187,6 +189,50 @@ TEST(UnitAnalysis, HysteresisModelWidthsAreOverTheSteadyLoop) {
   EXPECT_NEAR(m.model_width, m.width, 0.01);
   EXPECT_GT(m.width, 0.17);
   EXPECT_LT(m.width, 0.23);
+}
+
+// The campaign's model choice on the bench's three hysteresis laws at 80 V: symmetric loops (PI and
+// Bouc-Wen) keep the plain PI (the modified one is not fitted); the asymmetric Bouc-Wen law's loop
+// is bent (asymmetry above the limit), the modified PI is fitted too and kept, with a smaller
+// residual. results.json says which and gives both residuals.
+TEST(UnitAnalysis, HysteresisModelIsTheModifiedPiWhenTheLoopIsAsymmetric) {
+  const Files f;
+  for (const bench::HysteresisLaw law : {bench::HysteresisLaw::kPrandtlIshlinskii, bench::HysteresisLaw::kBoucWen, bench::HysteresisLaw::kBoucWenAsymmetric}) {
+    SCOPED_TRACE(bench::to_string(law));
+    bench::ExperimentOptions o;
+    o.amplitude = 80.0;
+    o.bench.hysteresis_law = law;
+    io::write_timeseries(bench::simulate(bench::Experiment::kHysteresis, bench::batch_unit(1, 1), o, 1), f.dir.path() / "h80.mat");
+    const Campaign c = f.campaign("hysteresis = [\"h80.mat\"]\n");
+    const UnitAnalysis u = analyze_unit(c, c.units[0]);
+    ASSERT_TRUE(u.hysteresis_model);
+    const HysteresisModelFit& m = *u.hysteresis_model;
+    const nlohmann::json j = unit_json(u)["hysteresis_model"];
+    std::printf("%-20s loop asymmetry %.2f %% of the stroke; plain PI %.3f %%%s; chosen %s\n", bench::to_string(law).c_str(),
+                100.0 * m.asymmetry, 100.0 * (m.fit.model.output.identity() ? m.fit : *m.alternative).relative_residual,
+                m.alternative ? fmt::format(", modified PI {:.3f} %", 100.0 * (m.fit.model.output.identity() ? *m.alternative : m.fit).relative_residual).c_str() : "",
+                j["model"].get<std::string>().c_str());
+    if (law != bench::HysteresisLaw::kBoucWenAsymmetric) {
+      EXPECT_LT(m.asymmetry, kHysteresisAsymmetryLimit / 2);
+      EXPECT_FALSE(m.alternative);
+      EXPECT_EQ(j["model"], "prandtl-ishlinskii");
+      EXPECT_EQ(j["candidates"].size(), 1u);
+      continue;
+    }
+    EXPECT_GT(m.asymmetry, 2 * kHysteresisAsymmetryLimit);
+    ASSERT_TRUE(m.alternative);
+    EXPECT_FALSE(m.fit.model.output.identity());
+    EXPECT_TRUE(m.alternative->model.output.identity());
+    EXPECT_LT(m.fit.relative_residual, m.alternative->relative_residual);
+    EXPECT_FALSE(m.fit.quality.poor());
+    EXPECT_EQ(j["model"], "modified-prandtl-ishlinskii");
+    ASSERT_EQ(j["candidates"].size(), 2u);
+    EXPECT_EQ(j["candidates"][0]["model"], "modified-prandtl-ishlinskii");
+    EXPECT_TRUE(j["candidates"][0]["chosen"].get<bool>());
+    EXPECT_EQ(j["candidates"][1]["model"], "prandtl-ishlinskii");
+    EXPECT_DOUBLE_EQ(j["candidates"][1]["relative_residual"].get<double>(), m.alternative->relative_residual);
+    EXPECT_TRUE(j.contains("output_map"));
+  }
 }
 
 TEST(UnitAnalysis, ExperimentsNotListedAreNotMeasured) {

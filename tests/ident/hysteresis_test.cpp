@@ -298,6 +298,32 @@ TEST(LoopMetrics, EllipseHasTheAnalyticWidth) {
   EXPECT_NEAR(m.width, e / std::sqrt(1.0 + e * e), 1e-6);
   EXPECT_NEAR(m.rms_deviation, 2.0 * e / std::sqrt(2.0), 1e-9);
   EXPECT_THROW(loop_metrics(std::vector<double>(5, 1.0), std::vector<double>(5, 2.0)), InputError);
+  EXPECT_LT(m.asymmetry, 1e-12);  // an ellipse is point-symmetric about its centre
+}
+
+// The asymmetry: 0 for the loops a PI operator draws (point-symmetric about their centre), the x^2
+// coefficient over the stroke for a bent loop: y = x + b x^2 + 0.05 cos on x = sin (mid-range 0,
+// half-range 1) over whole periods has the cubic fit x + b x^2 (cos is orthogonal to 1, x, x^2, x^3).
+TEST(LoopMetrics, AsymmetryIsTheBendOfTheLoop) {
+  const double b = 0.1;
+  std::vector<double> c, y, pi_c, pi_y;
+  PrandtlIshlinskiiOperator h(PrandtlIshlinskii{1.0, {5.0, 15.0, 25.0}, {0.3, 0.2, 0.4}});
+  for (int k = 0; k < 50000; ++k) {
+    const double s = std::sin(2.0 * std::numbers::pi * k / 10000.0);
+    c.push_back(s);
+    y.push_back(s + b * s * s + 0.05 * std::cos(2.0 * std::numbers::pi * k / 10000.0));
+    const double v = 40.0 + 30.0 * s;
+    const double out = h.step(v);
+    if (k >= 10000) {  // whole periods after the first
+      pi_c.push_back(v);
+      pi_y.push_back(out);
+    }
+  }
+  const LoopMetrics bent = loop_metrics(c, y);
+  EXPECT_NEAR(bent.asymmetry * bent.stroke, b, 1e-9);  // the cos (the loop's opening) is orthogonal to the cubic
+  const LoopMetrics pi = loop_metrics(pi_c, pi_y);
+  EXPECT_GT(pi.width, 0.1);
+  EXPECT_LT(pi.asymmetry, 1e-6);
 }
 
 }  // namespace

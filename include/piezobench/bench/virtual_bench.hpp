@@ -37,7 +37,8 @@
 //    exceeds the small-signal gain, as the report found (250 um against 17 um/V x 8.5 V/V). A
 //    second law, Bouc-Wen (BenchOptions::hysteresis_law), is there for the tests of the
 //    hysteresis identification and compensation (ident/hysteresis.hpp), which must not meet the
-//    family they identify.
+//    family they identify; with a quadratic term on the effective voltage ("bouc-wen-asymmetric")
+//    its loops are asymmetric about their centre (the modified PI's case).
 //  - Creep: three first-order creep states (5, 50, 500 s) on the actuator stacks, driven by the
 //    voltage-induced free stroke (creep_coefficient) and by the stacks' elastic strain under load
 //    (load_creep_coefficient), so a constant load keeps compressing the APA (Figure 2.4, k1 < k2).
@@ -103,7 +104,11 @@ UnitTruth batch_unit(int id, std::uint64_t seed);
 enum class HysteresisLaw {
   kPrandtlIshlinskii,  // "prandtl-ishlinskii": 8 play operators, thresholds 10..80 V (the default)
   kBoucWen,            // "bouc-wen": Bouc-Wen, a = 1 x hysteresis_scale, beta = 0.02 /V
+  kBoucWenAsymmetric,  // "bouc-wen-asymmetric": the same plus kAsymmetricQuadratic x hysteresis_scale
+                       // x Va^2 on the effective voltage: loops asymmetric about their centre
 };
+inline constexpr double kAsymmetricQuadratic = 1e-3;  // 1/V
+inline constexpr const char* kHysteresisLaws = "prandtl-ishlinskii, bouc-wen or bouc-wen-asymmetric";
 std::string to_string(HysteresisLaw law);
 HysteresisLaw hysteresis_law_from_string(const std::string& name);  // InputError (field "hysteresis_law")
 

@@ -196,6 +196,11 @@ struct LoopMetrics {
   double stroke = 0.0;                  // max - min of the output
   double width = 0.0;                   // (max - min of output - line) / stroke
   double rms_deviation = 0.0;           // rms of output - line (output unit)
+  // |a2| / stroke, a2 the x^2 coefficient of the least-squares cubic of the output in
+  // x = (command - its mid-range) / its half-range: 0 for a loop point-symmetric about its centre
+  // (what a PI operator draws for a symmetric command, over whole periods), the height of the
+  // loop's bend otherwise (Kuhnen's modified PI's case).
+  double asymmetry = 0.0;
 };
 // InputError for mismatched sizes, fewer than 2 samples, or a command that does not move.
 LoopMetrics loop_metrics(std::span<const double> command, std::span<const double> output);
