@@ -215,7 +215,7 @@ struct ZeroReport {
   lti::Complex zero;
   bool lightly_damped = false;            // |damping| < 0.2
   std::optional<bool> nonminimum_phase;   // for a lightly damped pair: the data's phase, else the model's
-  std::string evidence;                   // "phase of the data (-178 deg)" or "fitted zero"
+  std::string evidence;                   // ident::zero_phase_verdict's reason, or "fitted zero"
 };
 
 std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const dsp::Frf& band, Eigen::Index i,
@@ -243,8 +243,11 @@ std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const 
       rep.evidence = "fitted zero";
       for (const auto& a : anti) {
         if (std::abs(a.natural_frequency / std::abs(z) - 1.0) < 0.05 && a.phase_verdict != ident::PhaseVerdict::kUndetermined) {
-          rep.nonminimum_phase = a.phase_verdict == ident::PhaseVerdict::kNonMinimumPhase;
-          rep.evidence = fmt::format("phase of the data ({:+.0f} deg across it)", a.phase_change_deg);
+          // The phase as counted; the reason says when it is within the ambiguity of +-180 deg
+          // (no plant fit here: `fit iff-plant`'s xz decides for u -> Vs).
+          const ident::ZeroPhaseVerdict v = ident::zero_phase_verdict(&a, nullptr);
+          rep.nonminimum_phase = v.nonminimum_phase;
+          rep.evidence = v.reason;
         }
       }
     }
@@ -322,7 +325,7 @@ int run_fit(const FitOptions& o) {
       fmt::print("  {:>12.6g} {:+12.6g}j  {:>10.5g} Hz  damping {:+.5f}", z.real(), z.imag(), std::abs(z) / kTwoPi,
                  std::abs(z) > 0 ? -z.real() / std::abs(z) : 0.0);
       if (rep.nonminimum_phase) {
-        fmt::print("  lightly damped, {} (from the {})", *rep.nonminimum_phase ? "NON-minimum phase" : "minimum phase", rep.evidence);
+        fmt::print("  lightly damped, {} ({})", *rep.nonminimum_phase ? "NON-minimum phase" : "minimum phase", rep.evidence);
       }
       fmt::print("\n");
     }
