@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 #include <new>
+#include <system_error>
 #include <type_traits>
 #include <utility>
 
@@ -97,10 +98,19 @@ void RealInverseFft::execute(std::complex<double>* in, double* out) const {
 }
 
 std::future<void> plan_in_background(Eigen::Index n) {
-  return std::async(std::launch::async, [n] {
+  const auto plan = [n] {
     (void)PlanCache::instance().forward(n);
     (void)PlanCache::instance().inverse(n);
-  });
+  };
+  // A short transform plans in microseconds: no thread for it (nor when none can be started).
+  constexpr Eigen::Index kWorthAThread = Eigen::Index{1} << 16;
+  if (n >= kWorthAThread) {
+    try {
+      return std::async(std::launch::async, plan);
+    } catch (const std::system_error&) {
+    }
+  }
+  return std::async(std::launch::deferred, plan);
 }
 
 Eigen::VectorXcd rfft(const Eigen::VectorXd& x) {

@@ -67,7 +67,8 @@ class RealInverseFft {
 
 // Makes (or finds) the forward and the inverse plan of length n on another thread, for a caller
 // with other work to do meanwhile: a 1 M-point plan costs milliseconds (its twiddle factors).
-// get() on the result waits for both and rethrows a planning failure.
+// get() on the result waits for both and rethrows a planning failure. Short lengths (or no thread
+// to be had) are planned by get() itself.
 [[nodiscard]] std::future<void> plan_in_background(Eigen::Index n);
 
 // Convenience on Eigen vectors (copies into aligned buffers): full one-sided spectrum of x, and

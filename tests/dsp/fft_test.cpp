@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <future>
 #include <numbers>
 #include <random>
 #include <thread>
@@ -58,6 +60,23 @@ TEST(Fft, PlansAreSharedAndUsableFromSeveralThreads) {
     for (std::size_t t = 0; t < results.size(); ++t) threads.emplace_back([&, t] { results[t] = rfft(x); });
   }
   for (const auto& r : results) EXPECT_EQ(r, expected);
+}
+
+TEST(Fft, PlansMadeInTheBackgroundGiveTheSameTransforms) {
+  // The same numbers whichever thread made the plan, short (planned by get()) or long (a thread).
+  for (const Index n : {Index{720}, Index{3} << 16}) {
+    SCOPED_TRACE(n);
+    Eigen::VectorXd x(n);
+    for (Index i = 0; i < n; ++i) x(i) = std::sin(0.37 * static_cast<double>(i)) + 1e-3 * static_cast<double>(i % 7);
+    std::future<void> plans = plan_in_background(n);
+    // Meanwhile another thread uses the other plans (the planner is serialized by the cache).
+    const Eigen::VectorXcd other = rfft(Eigen::VectorXd::LinSpaced(64, 0.0, 1.0));
+    plans.get();
+    const Eigen::VectorXcd X = rfft(x);
+    EXPECT_NEAR(std::abs(X(0) - x.sum()), 0.0, 1e-9 * x.cwiseAbs().sum());
+    EXPECT_TRUE(test::all_near(irfft(X, n), x, test::Tolerance{0, 1e-12}));
+    EXPECT_EQ(other, rfft(Eigen::VectorXd::LinSpaced(64, 0.0, 1.0)));
+  }
 }
 
 }  // namespace
