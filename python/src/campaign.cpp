@@ -104,7 +104,7 @@ void bind_result_classes(py::module_& m) {
     c.def_readonly("zero", &NmpEvidence::zero, "campaign.NmpZero or None")
         .def_readonly("iff_plant_fit_xz", &NmpEvidence::iff_plant_fit_xz, "xz of the IFF plant fit (< 0: non-minimum phase)")
         .def_readonly("verdict_from", &NmpEvidence::verdict_from, "\"phase\", \"iff-plant-fit\", \"fitted-zero\" or \"none\"")
-        .def_readonly("verdict_reason", &NmpEvidence::verdict_reason, "why the verdict is what it is (ident.zero_phase_verdict)");
+        .def_readonly("verdict_reason", &NmpEvidence::verdict_reason, "why: which evidence decided and what it said, e.g. an ambiguous phase change and the plant fit's xz");
     typed(c);
   }
   {

@@ -37,6 +37,8 @@ def test_demo_campaign_results_agree_with_the_truth(demo):
     assert unit.resonance_Hz == pytest.approx(truth["resonance_Hz"], rel=0.01)
     assert unit.antiresonance_Hz == pytest.approx(truth["antiresonance_Hz"], rel=0.01)
     assert unit.frf_analysis.zero_is_nonminimum_phase == truth["zero_is_nonminimum_phase"]
+    nmp = unit.frf_analysis.nmp  # which evidence decided, and why (ident::zero_phase_verdict)
+    assert nmp.verdict_from in ("phase", "iff-plant-fit") and nmp.verdict_reason.startswith("phase change ")
     assert unit.k1 * 1e-6 == pytest.approx(truth["stiffness_N_per_um"]["k1"], rel=0.05)
     # The IFF plant of the unit is an ident.IffPlantFit with its verdict, as ident.fit_iff_plant returns.
     assert isinstance(unit.iff_plant, ident.IffPlantFit) and unit.iff_plant.quality.verdict == "good"
