@@ -594,7 +594,7 @@ std::uint64_t VirtualRunner::open_loop_feedforward(const Eigen::VectorXd& u_prim
   Eigen::VectorXd u(u_prime.size());
   std::uint64_t clamped = 0;
   for (Eigen::Index k = 0; k < u.size(); ++k) {
-    const double v = u_prime(k) + w(k) * (ff.step(u_prime(k) * amp) / amp - u_prime(k));
+    const double v = ff.step(u_prime(k) * amp, w(k)) / amp;
     u(k) = std::clamp(v, u_min, u_max);
     if (u(k) != v) ++clamped;
   }

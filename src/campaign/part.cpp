@@ -244,7 +244,7 @@ template <class V> void fields(V& v, ident::HysteresisFit& s) {
   v("samples", s.samples); v("quality", s.quality);
 }
 template <class V> void fields(V& v, HysteresisModelFit& s) {
-  v("fit", s.fit); v("alternative", s.alternative); v("asymmetry", s.asymmetry);
+  v("fit", s.fit); v("alternative", s.alternative); v("alternative_error", s.alternative_error); v("asymmetry", s.asymmetry);
   v("amplitude", s.amplitude); v("width", s.width); v("model_width", s.model_width); v("provenance", s.provenance);
   v("loop", s.loop); v("model_loop", s.model_loop);
 }

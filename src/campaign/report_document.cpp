@@ -631,8 +631,9 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
     const bool modified = !m.output.identity();
     const ident::HysteresisFit* plain = modified ? (h.alternative ? &*h.alternative : nullptr) : &h.fit;
     const ident::HysteresisFit* kuhnen = modified ? &h.fit : (h.alternative ? &*h.alternative : nullptr);
-    const auto residual = [](const ident::HysteresisFit* f) {
-      return f == nullptr ? std::string("not fitted") : fmt::format("{:.2f} % ({})", 100.0 * f->relative_residual, core::to_string(f->quality.verdict));
+    const auto residual = [&](const ident::HysteresisFit* f) {
+      if (f != nullptr) return fmt::format("{:.2f} % ({})", 100.0 * f->relative_residual, core::to_string(f->quality.verdict));
+      return f == kuhnen && !h.alternative_error.empty() ? "failed: " + h.alternative_error : std::string("not fitted");
     };
     model_rows.push_back(json::array({u.name(), modified ? "modified PI" : "PI", fmt::format("{:.2f} %", 100.0 * h.asymmetry),
                                       fmt::format("{:.3g}", h.amplitude), fmt::format("{:.3g}", m.gain * 1e6),

@@ -81,6 +81,7 @@ json hysteresis_model(const HysteresisModelFit& h) {
                           {"relative_residual", f->relative_residual},
                           {"quality", core::to_string(f->quality.verdict)}});
   }
+  if (!h.alternative_error.empty()) candidates.push_back({{"model", "modified-prandtl-ishlinskii"}, {"chosen", false}, {"error", h.alternative_error}});
   json j = {{"model", hysteresis_model_name(m)},
             {"loop_asymmetry", h.asymmetry},
             {"candidates", candidates},

@@ -312,11 +312,15 @@ HysteresisModelFit hysteresis_model(const Record& r, const metrology::Hysteresis
   if (out.asymmetry > kHysteresisAsymmetryLimit) {
     ident::HysteresisFitOptions o;
     o.dead_zones = kCampaignDeadZones;
-    ident::HysteresisFit modified = ident::fit_hysteresis(v, d, r.ts.sample_rate, o);
-    const bool better = modified.quality.poor() != out.fit.quality.poor() ? out.fit.quality.poor()
-                                                                          : modified.relative_residual < out.fit.relative_residual;
-    if (better) std::swap(modified, out.fit);
-    out.alternative = std::move(modified);
+    try {
+      ident::HysteresisFit modified = ident::fit_hysteresis(v, d, r.ts.sample_rate, o);
+      const bool better = modified.quality.poor() != out.fit.quality.poor() ? out.fit.quality.poor()
+                                                                            : modified.relative_residual < out.fit.relative_residual;
+      if (better) std::swap(modified, out.fit);
+      out.alternative = std::move(modified);
+    } catch (const NumericalError& e) {
+      out.alternative_error = e.what();  // the plain PI stays; results.json and the report say why
+    }
   }
   out.amplitude = loop.amplitude;
   out.provenance = provenance(r, {"Va", "de"});

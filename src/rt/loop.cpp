@@ -189,7 +189,7 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
   double u_ff = u_prime;
   if (feedforward_) {
     const double w = options_.feedforward_weight.size() > 0 ? options_.feedforward_weight(played) : 1.0;
-    u_ff = u_prime + w * (feedforward_->step(u_prime * amp) / amp - u_prime);
+    u_ff = feedforward_->step(u_prime * amp, w) / amp;
   }
 
   double y = 0.0;

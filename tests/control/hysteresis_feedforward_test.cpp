@@ -57,6 +57,17 @@ TEST(HysteresisFeedforward, StepAllocatesNothingAndHoldsOnNonFinite) {
   EXPECT_DOUBLE_EQ(ff.step(0.0), ff.at_rest(0.0));
 }
 
+// The weighted step: c + w (stage - c), the stage stepping whatever w is (its memory follows the
+// whole command): w = 0 gives c, w = 1 the stage's output, as an unweighted twin fed the same c.
+TEST(HysteresisFeedforward, WeightedStepBlendsTheStage) {
+  HysteresisFeedforward a(model(true, true), 10e3), b(model(true, true), 10e3);
+  for (int k = 0; k < 3000; ++k) {
+    const double c = 40.0 + 30.0 * std::sin(0.003 * k), w = k < 1000 ? 0.0 : k < 2000 ? 0.25 : 1.0;
+    const double stage = b.step(c);
+    ASSERT_NEAR(a.step(c, w), c + w * (stage - c), 1e-12) << k;
+  }
+}
+
 TEST(HysteresisFeedforward, RefusesBadSettings) {
   EXPECT_THROW(HysteresisFeedforward(model(false), 0.0), InputError);
   ident::HysteresisModel m = model(false);

@@ -299,7 +299,7 @@ TEST(Loop, FeedforwardWeightBlendsTheStageInAndOut) {
   const auto u = loop.log().channel("u");
   ASSERT_EQ(u.size(), n);
   for (Eigen::Index k = 0; k < n; ++k) {
-    const double stage = ff.step(20.0 * o.excitation(k)) / 20.0;
+    const double stage = ff.step(20.0 * o.excitation(k)) / 20.0;  // the stage alone, then blended by hand
     ASSERT_NEAR(u(k), o.excitation(k) + o.feedforward_weight(k) * (stage - o.excitation(k)), 1e-12) << k;
   }
   EXPECT_NEAR(u(0), o.excitation(0), 1e-12);

@@ -80,8 +80,6 @@ struct HysteresisLoop {
   Curve loop;  // x Va [V], y d_e [m], the part of the record analysed (thinned)
 };
 
-// The Prandtl-Ishlinskii hysteresis model identified from the unit's largest-amplitude hysteresis
-// record (ident::fit_hysteresis, docs/hysteresis.md): what `hysteresis fit` gives for that file.
 // The asymmetry of the steady loop (ident::LoopMetrics::asymmetry) above which the campaign fits
 // Kuhnen's modified PI besides the plain one: 1 % of the stroke (at 80 V the bench's symmetric laws
 // give 0.02-0.03 %, its asymmetric Bouc-Wen law 2.2 %).
@@ -89,12 +87,16 @@ inline constexpr double kHysteresisAsymmetryLimit = 0.01;
 // The dead zones per side of the modified PI the campaign fits (ident::HysteresisFitOptions).
 inline constexpr int kCampaignDeadZones = 4;
 
+// The hysteresis model identified from the unit's largest-amplitude hysteresis record
+// (ident::fit_hysteresis, docs/hysteresis.md): what `hysteresis fit` (with `--dead-zones 4` for the
+// modified PI) gives for that file.
 struct HysteresisModelFit {
   // The chosen model's fit: the plain PI, or Kuhnen's modified PI (fit.model.output not the
   // identity) when the loop is asymmetric and the modified fit is better: a good verdict where the
   // plain one is poor, or the same verdict and a smaller residual.
   ident::HysteresisFit fit;
   std::optional<ident::HysteresisFit> alternative;  // the candidate not chosen (only when both were fitted)
+  std::string alternative_error;  // why the modified PI, asked for, could not be fitted (NumericalError); else empty
   double asymmetry = 0.0;      // of the record's steady loop (ident::LoopMetrics::asymmetry)
   double amplitude = 0.0;      // V, of the record it comes from
   double width = 0.0;          // hysteresis width of that record's steady loop (ident::loop_metrics:

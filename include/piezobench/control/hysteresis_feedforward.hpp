@@ -39,6 +39,9 @@ class HysteresisFeedforward {
     last_ = v;
     return v;
   }
+  // The stage blended in with the weight w in [0, 1]: c + w (step(c) - c) (V). The stage steps on c
+  // whatever w is, so its memory follows the whole command (rt::LoopOptions::feedforward_weight).
+  double step(double c, double w) noexcept { return c + w * (step(c) - c); }
   // Back to rest (the model's initial state).
   void reset() noexcept;
   [[nodiscard]] const ident::HysteresisModel& model() const noexcept { return model_; }
