@@ -13,7 +13,7 @@
 namespace piezobench::app {
 namespace {
 
-struct FitOptions {
+struct HysteresisFitArgs {
   std::string file;
   std::string input = "Va";
   std::string output = "de";
@@ -51,7 +51,7 @@ io::TimeSeries read_pair(const std::string& file, const std::string& input, cons
   return io::read_timeseries(file, read);
 }
 
-int run_fit(const FitOptions& o) {
+int run_hysteresis_fit(const HysteresisFitArgs& o) {
   ident::HysteresisFitOptions fo;
   fo.operators = o.operators;
   fo.threshold_range = o.threshold_range;
@@ -144,7 +144,7 @@ int run_creep(const CreepOptions& o) {
 void add_hysteresis_commands(CLI::App& app, Action& action) {
   CLI::App* h = app.add_subcommand("hysteresis", "Hysteresis and creep of the stacks: identification for the inverse feedforward");
   h->require_subcommand(1);
-  auto o = std::make_shared<FitOptions>();
+  auto o = std::make_shared<HysteresisFitArgs>();
   CLI::App* fit = h->add_subcommand("fit", "Prandtl-Ishlinskii model (+ creep) of a Va -> d_e record, written as TOML (rt --feedforward)");
   fit->add_option("file", o->file, "time-series file (.mat, .csv) with the stack voltage and the displacement")->required();
   fit->add_option("--input", o->input, "channel of the stack voltage, V")->capture_default_str();
@@ -160,7 +160,7 @@ void add_hysteresis_commands(CLI::App& app, Action& action) {
   fit->add_option("--max-residual", o->max_residual, "largest rms residual / stroke of a good fit")->capture_default_str();
   fit->add_option("-o,--out", o->out, "write the model (TOML)");
   fit->add_flag("--json", o->json, "print one JSON document on stdout");
-  fit->callback([o, &action] { action = [o] { return run_fit(*o); }; });
+  fit->callback([o, &action] { action = [o] { return run_hysteresis_fit(*o); }; });
 
   auto c = std::make_shared<CreepOptions>();
   CLI::App* creep = h->add_subcommand("creep", "Prony-series creep of a step record (the stiffness test: added_mass -> de)");

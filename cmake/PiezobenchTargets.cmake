@@ -32,6 +32,30 @@ if(PIEZOBENCH_FUZZ)
   target_link_options(piezobench_options INTERFACE ${PIEZOBENCH_FUZZ_SANITIZE})
 endif()
 
+# Build time (docs/performance.md, "Build time"): CI builds everything cold, twice. Each module,
+# test program, the app and the Python module compile their sources in unity batches (one compiler
+# run parses Eigen, GoogleTest and the project headers once for several files and instantiates
+# their templates once), and the test programs share one precompiled header of the third-party
+# headers they all include. -DPIEZOBENCH_UNITY_BUILD=OFF -DPIEZOBENCH_PCH=OFF compile every file
+# alone (to check that a file includes what it uses).
+option(PIEZOBENCH_UNITY_BUILD "Compile the sources of each target in unity batches" ON)
+# ccache caches no compile that uses a precompiled header unless it is configured for them
+# (sloppiness pch_defines,time_macros): with ccache as the compiler launcher the default is OFF.
+if(CMAKE_CXX_COMPILER_LAUNCHER MATCHES "ccache")
+  set(_pb_pch_default OFF)
+else()
+  set(_pb_pch_default ON)
+endif()
+option(PIEZOBENCH_PCH "Precompile the third-party headers of the test programs once" ${_pb_pch_default})
+set(PIEZOBENCH_UNITY_BATCH_SIZE 4 CACHE STRING "Source files per unity batch")
+
+# piezobench_unity_build(<target>)
+function(piezobench_unity_build target)
+  if(PIEZOBENCH_UNITY_BUILD)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE ${PIEZOBENCH_UNITY_BATCH_SIZE})
+  endif()
+endfunction()
+
 # piezobench_add_module(NAME <name> SOURCES <files...> [DEPS <targets...>])
 # Declares the library piezobench_<name> with the alias piezobench::<name>. Its public headers live
 # in include/piezobench/<name>/; its sources and private headers in src/<name>/.
@@ -48,6 +72,7 @@ function(piezobench_add_module)
   target_link_libraries(${target} PUBLIC "$<BUILD_INTERFACE:piezobench::options>" ${ARG_DEPS})
   target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON EXPORT_NAME ${ARG_NAME})
+  piezobench_unity_build(${target})
   set_property(GLOBAL APPEND PROPERTY PIEZOBENCH_MODULES ${target})
   install(TARGETS ${target} EXPORT piezobenchTargets ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}")
 endfunction()
@@ -88,5 +113,9 @@ function(piezobench_add_test)
     PIEZOBENCH_FIXTURE_DIR="${PROJECT_SOURCE_DIR}/tests/fixtures"
     PIEZOBENCH_SHARED_DATA_DIR="${PIEZOBENCH_SHARED_DATA_DIR}"
     PIEZOBENCH_BINARY="$<TARGET_FILE:piezobench>")
+  piezobench_unity_build(${ARG_NAME})
+  if(TARGET piezobench_test_pch)
+    target_precompile_headers(${ARG_NAME} REUSE_FROM piezobench_test_pch)
+  endif()
   gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
 endfunction()

@@ -13,8 +13,10 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -22,6 +24,7 @@
 #include <unistd.h>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 
 // Tests that need the external data (the Ansys APA95ML export in ../shared/data next to the
 // repository; CMake option PIEZOBENCH_SHARED_DATA_DIR) call this first: without the data the test
@@ -135,6 +138,24 @@ template <typename F>
 void expect_input_error(F&& f, const std::vector<std::string>& needles) {
   const std::string what = input_error(std::forward<F>(f));
   for (const auto& needle : needles) EXPECT_TRUE(contains(what, needle)) << "'" << needle << "' not in: " << what;
+}
+
+// n angular frequencies [rad/s], log-spaced from f_lo to f_hi [Hz] (both included).
+inline Eigen::VectorXd log_grid(double f_lo, double f_hi, Eigen::Index n) {
+  Eigen::VectorXd w(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    w(k) = kTwoPi * f_lo * std::pow(f_hi / f_lo, static_cast<double>(k) / static_cast<double>(n - 1));
+  }
+  return w;
+}
+
+// n samples of zero-mean Gaussian noise of standard deviation rms, from a fixed seed.
+inline Eigen::VectorXd gaussian_noise(Eigen::Index n, double rms, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> d(0.0, rms);
+  Eigen::VectorXd v(n);
+  for (Eigen::Index i = 0; i < n; ++i) v(i) = d(rng);
+  return v;
 }
 
 // Writes `text` to `path` (test input files).

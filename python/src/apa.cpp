@@ -27,7 +27,7 @@ const Options<TwoDofParams>& params_options() {
   return t;
 }
 
-const Options<TwoDofBench>& bench_options() {
+const Options<TwoDofBench>& two_dof_bench_options() {
   static const Options<TwoDofBench> t = [] {
     Options<TwoDofBench> o("TwoDofBench");
     o.add("amplifier_gain", &TwoDofBench::amplifier_gain, "V/V, Va = G u")
@@ -60,7 +60,7 @@ const Options<TuningOptions>& tuning_options() {
   static const Options<TuningOptions> t = [] {
     Options<TuningOptions> o("TuningOptions");
     o.add("mass", &TuningOptions::mass, "kg, the known moving mass")
-        .add_nested("bench", &TuningOptions::bench, bench_options(),
+        .add_nested("bench", &TuningOptions::bench, two_dof_bench_options(),
                     "measurement chain removed before fitting (apa.two_dof_bench keywords; masses 0)")
         .add("fmin_Hz", &TuningOptions::fmin_Hz, "Hz, band used; 0 = from the lowest point")
         .add("fmax_Hz", &TuningOptions::fmax_Hz, "Hz; 0 = to the highest point")
@@ -80,20 +80,20 @@ const Options<TuningOptions>& tuning_options() {
 std::pair<TwoDofParams, TwoDofBench> model_kwargs(const py::kwargs& kw, const std::string& source) {
   py::dict d = kwargs_dict(kw);
   auto p = params_options().take(d, source);
-  auto b = bench_options().take(d, source);
-  reject_leftovers(d, source, params_options().names() + ", " + bench_options().names());
+  auto b = two_dof_bench_options().take(d, source);
+  reject_leftovers(d, source, params_options().names() + ", " + two_dof_bench_options().names());
   return {p, b};
 }
 
 const std::string& model_doc() {
   static const std::string s = "\nKeywords (TwoDofParams, Table 3.1):\n" + params_options().doc() +
-                               "Keywords (TwoDofBench):\n" + bench_options().doc();
+                               "Keywords (TwoDofBench):\n" + two_dof_bench_options().doc();
   return s;
 }
 
 }  // namespace
 
-py::dict two_dof_bench_dict(const TwoDofBench& b) { return bench_options().to_dict(b); }
+py::dict two_dof_bench_dict(const TwoDofBench& b) { return two_dof_bench_options().to_dict(b); }
 
 py::object tuning_result(const TwoDofTuning& r) {
   py::dict feat;

@@ -78,7 +78,7 @@ struct Writer {
   template <class T> void operator()(const char* key, const T& v) { out[key] = encode(v); }
 };
 
-struct Reader {
+struct PartReader {
   const json& in;
   Where where;
   template <class T> void operator()(const char* key, T& v) {
@@ -194,7 +194,7 @@ template <class T> void decode(const json& j, T& v, const Where& w) {
     }
   } else {
     if (!j.is_object()) bad(w, "an object", j);
-    Reader r{j, w};
+    PartReader r{j, w};
     fields(r, v);
   }
 }
@@ -471,7 +471,7 @@ CampaignPart read_part(const fs::path& path) {
                      doc.is_object() && doc.contains("format") ? doc["format"].dump() : "no format key");
   }
   int version = 0;
-  Reader r{doc, top};
+  PartReader r{doc, top};
   r("format_version", version);
   if (version != kPartFormatVersion) throw InputError(name, "format_version", std::to_string(kPartFormatVersion), std::to_string(version));
   CampaignPart p;

@@ -13,6 +13,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/memory.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace piezobench::dsp {
 
@@ -20,7 +21,6 @@ using Eigen::Index;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 const std::string kSource = "excitation";
 
 void require(bool ok, const std::string& field, const std::string& expected, const std::string& found) {

@@ -21,7 +21,7 @@
 namespace piezobench::fem {
 namespace {
 
-const char* const kSource = "Craig-Bampton";
+const char* const kCraigBamptonSource = "Craig-Bampton";
 // CHOLMOD supernodal Cholesky; the subclass only exposes the factor's size.
 class Factor : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
  public:
@@ -158,18 +158,18 @@ Partition partition(const SparseModel& model, const std::vector<InterfacePoint>&
   std::vector<char> retained(static_cast<std::size_t>(model.size()), 0);
   const auto keep = [&](Index row, DofLabel label, const std::string& field) {
     if (retained[static_cast<std::size_t>(row)] != 0) {
-      throw InputError(kSource, field, "interface points that share no DOF", "DOF " + model.dofs[static_cast<std::size_t>(row)].to_string() + " twice");
+      throw InputError(kCraigBamptonSource, field, "interface points that share no DOF", "DOF " + model.dofs[static_cast<std::size_t>(row)].to_string() + " twice");
     }
     retained[static_cast<std::size_t>(row)] = 1;
     p.boundary.push_back(row);
     p.labels.push_back(label);
   };
-  if (interface.empty()) throw InputError(kSource, "interface", "at least one interface point", "none");
+  if (interface.empty()) throw InputError(kCraigBamptonSource, "interface", "at least one interface point", "none");
   std::set<long> names;
   for (std::size_t k = 0; k < interface.size(); ++k) {
     const InterfacePoint& ip = interface[k];
     const std::string field = "interface[" + std::to_string(k) + "]";
-    if (!names.insert(ip.node).second) throw InputError(kSource, field, "each interface node once", "node " + std::to_string(ip.node) + " again");
+    if (!names.insert(ip.node).second) throw InputError(kCraigBamptonSource, field, "each interface node once", "node " + std::to_string(ip.node) + " again");
     p.point_nodes.push_back(ip.node);
     if (ip.rot_node < 0) {
       bool any = false;
@@ -197,7 +197,7 @@ Partition partition(const SparseModel& model, const std::vector<InterfacePoint>&
                          "node " + std::to_string(ip.rot_node) + " lacks direction " + std::to_string(d));
       }
       if (names.count(ip.rot_node) != 0) {
-        throw InputError(kSource, field, "a ROT NODE that is not an interface node", "node " + std::to_string(ip.rot_node));
+        throw InputError(kCraigBamptonSource, field, "a ROT NODE that is not an interface node", "node " + std::to_string(ip.rot_node));
       }
       keep(*r, DofLabel::nodal(ip.node, static_cast<Direction>(d + 3)), field);
     }
@@ -311,9 +311,9 @@ CraigBamptonResult reduce(const SparseModel& model, SparseModel* release, const 
   const auto ni = static_cast<Index>(p.interior.size());
   const auto nb = static_cast<Index>(p.boundary.size());
   const Index nm = options.modes;
-  if (ni == 0) throw InputError(kSource, "interface", "fewer retained DOF than the model has", "every DOF retained");
+  if (ni == 0) throw InputError(kCraigBamptonSource, "interface", "fewer retained DOF than the model has", "every DOF retained");
   if (nm >= ni) {
-    throw InputError(kSource, "modes", "fewer modes than interior DOF (" + std::to_string(ni) + ")", std::to_string(nm));
+    throw InputError(kCraigBamptonSource, "modes", "fewer modes than interior DOF (" + std::to_string(ni) + ")", std::to_string(nm));
   }
   CraigBamptonResult out;
   out.interior_dofs = ni;

@@ -23,9 +23,9 @@ std::string list(const std::vector<double>& v) {
   return s + "]";
 }
 
-class Reader {
+class ModelTableReader {
  public:
-  Reader(const toml::table& table, std::string source, std::string prefix)
+  ModelTableReader(const toml::table& table, std::string source, std::string prefix)
       : table_(table), source_(std::move(source)), prefix_(std::move(prefix)) {}
 
   void only(const std::set<std::string>& keys) const {
@@ -122,7 +122,7 @@ void write_hysteresis_model(const std::filesystem::path& path, const ident::Hyst
 
 ident::HysteresisModel parse_hysteresis_model(const std::string& text, const std::string& source) {
   const toml::table table = parse_toml(text, source);
-  const Reader top(table, source, "");
+  const ModelTableReader top(table, source, "");
   top.only({"format", "gain_m_per_V", "offset_m", "reference_slope", "reference_intercept_V", "input_min_V", "input_max_V",
             "hysteresis", "creep", "output", "fit"});
   const toml::node& format = top.node("format");
@@ -137,19 +137,19 @@ ident::HysteresisModel parse_hysteresis_model(const std::string& text, const std
   m.reference_intercept = top.number("reference_intercept_V");
   m.input_min = top.number("input_min_V");
   m.input_max = top.number("input_max_V");
-  const Reader h(*top.table("hysteresis", true), source, "hysteresis.");
+  const ModelTableReader h(*top.table("hysteresis", true), source, "hysteresis.");
   h.only({"thresholds_V", "weights"});
   m.hysteresis.linear_weight = 1.0;
   m.hysteresis.thresholds = h.numbers("thresholds_V");
   m.hysteresis.weights = h.numbers("weights");
   if (const toml::table* c = top.table("creep", false)) {
-    const Reader cr(*c, source, "creep.");
+    const ModelTableReader cr(*c, source, "creep.");
     cr.only({"time_constants_s", "coefficients"});
     m.creep_time_constants = cr.numbers("time_constants_s");
     m.creep_coefficients = cr.numbers("coefficients");
   }
   if (const toml::table* o = top.table("output", false)) {
-    const Reader orr(*o, source, "output.");
+    const ModelTableReader orr(*o, source, "output.");
     orr.only({"x_V", "y_V", "slope_below", "slope_above"});
     m.output.x = orr.numbers("x_V");
     m.output.y = orr.numbers("y_V");

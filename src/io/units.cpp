@@ -21,7 +21,7 @@ struct Entry {
 
 // The one unit table (see units.hpp). Micro: ASCII "u", the micro sign U+00B5 and the Greek
 // letter mu U+03BC, as spreadsheets and DAQ software write all three.
-constexpr std::array kUnits = {
+constexpr std::array kUnitTable = {
     Entry{"nm", Quantity::kLength, 1e-9, "m", true},
     Entry{"um", Quantity::kLength, 1e-6, "m", true},
     Entry{"\xC2\xB5m", Quantity::kLength, 1e-6, "m", false},
@@ -99,7 +99,7 @@ std::string to_string(Quantity q) {
 
 std::optional<Unit> find_unit(std::string_view symbol) {
   symbol = text::trim(symbol);
-  for (const Entry& e : kUnits) {
+  for (const Entry& e : kUnitTable) {
     if (symbol == e.symbol) return Unit{e.symbol, e.quantity, e.to_si, e.si};
   }
   return std::nullopt;
@@ -107,7 +107,7 @@ std::optional<Unit> find_unit(std::string_view symbol) {
 
 std::string known_units() {
   std::string out;
-  for (const Entry& e : kUnits) {
+  for (const Entry& e : kUnitTable) {
     if (!e.listed) continue;
     if (!out.empty()) out += ", ";
     out += e.symbol;

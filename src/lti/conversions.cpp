@@ -11,6 +11,7 @@
 #include "lti/check.hpp"
 #include "lti/spectral.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/lti/interconnect.hpp"
 
 namespace piezobench::lti {
@@ -45,7 +46,6 @@ Complex gain_point(const CVector& p, const CVector& z) {
     std::nth_element(mags.begin(), mags.begin() + static_cast<std::ptrdiff_t>(mags.size() / 2), mags.end());
     r = mags[mags.size() / 2];
   }
-  constexpr double kPi = 3.14159265358979323846;
   Complex best(r, 0.0);
   double best_score = -1.0;
   for (const double radius : {1.0, 0.5, 2.0, 0.25, 4.0}) {

@@ -10,7 +10,7 @@
 namespace piezobench::rt {
 
 namespace {
-const std::string kSource = "actuator limits";
+const std::string kLimitsSource = "actuator limits";
 }
 
 std::string to_string(Fault fault) {
@@ -34,27 +34,27 @@ std::string to_string(Fault fault) {
 }
 
 void ActuatorLimits::validate() const {
-  detail::require_positive(amplifier_gain, "amplifier_gain", kSource);
-  detail::require_finite(va_min, "va_min", kSource);
-  detail::require_finite(va_max, "va_max", kSource);
+  detail::require_positive(amplifier_gain, "amplifier_gain", kLimitsSource);
+  detail::require_finite(va_min, "va_min", kLimitsSource);
+  detail::require_finite(va_max, "va_max", kLimitsSource);
   if (!(va_min < va_max)) {
-    throw InputError(kSource, "va_max", "a value above va_min = " + format_number(va_min) + " V", format_number(va_max));
+    throw InputError(kLimitsSource, "va_max", "a value above va_min = " + format_number(va_min) + " V", format_number(va_max));
   }
   if (!(std::isfinite(va_safe) && va_safe >= va_min && va_safe <= va_max)) {
-    throw InputError(kSource, "va_safe", "a voltage in [" + format_number(va_min) + ", " + format_number(va_max) + "] V",
+    throw InputError(kLimitsSource, "va_safe", "a voltage in [" + format_number(va_min) + ", " + format_number(va_max) + "] V",
                      format_number(va_safe));
   }
-  detail::require_positive(slew_rate, "slew_rate", kSource);
-  detail::require_nonnegative(ramp_in, "ramp_in", kSource);
-  detail::require_nonnegative(ramp_out, "ramp_out", kSource);
-  if (stale_cycles < 0) throw InputError(kSource, "stale_cycles", "an integer >= 0", std::to_string(stale_cycles));
-  detail::require_positive(watchdog_timeout, "watchdog_timeout", kSource);
-  detail::require_positive(saturation_time, "saturation_time", kSource);
+  detail::require_positive(slew_rate, "slew_rate", kLimitsSource);
+  detail::require_nonnegative(ramp_in, "ramp_in", kLimitsSource);
+  detail::require_nonnegative(ramp_out, "ramp_out", kLimitsSource);
+  if (stale_cycles < 0) throw InputError(kLimitsSource, "stale_cycles", "an integer >= 0", std::to_string(stale_cycles));
+  detail::require_positive(watchdog_timeout, "watchdog_timeout", kLimitsSource);
+  detail::require_positive(saturation_time, "saturation_time", kLimitsSource);
 }
 
 SafetyGuard::SafetyGuard(const ActuatorLimits& limits, double sample_rate) : limits_(limits) {
   limits.validate();
-  detail::require_positive(sample_rate, "sample_rate", kSource);
+  detail::require_positive(sample_rate, "sample_rate", kLimitsSource);
   u_min_ = limits.u_min();
   u_max_ = limits.u_max();
   u_safe_ = limits.u_safe();

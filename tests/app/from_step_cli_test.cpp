@@ -20,7 +20,7 @@ const std::string kStep = (fs::path(PIEZOBENCH_SHARED_DATA_DIR) / "apa95ml-ansys
 // The issue's acceptance for the reduced model against ccx on the full mesh.
 constexpr double kAgainstCcx = 2e-3;
 
-const auto run = test::run_cli;
+using test::run_cli;
 
 long node_of(const nlohmann::json& doc, const std::string& name) {
   for (const auto& p : doc["remote_points"]) {
@@ -34,7 +34,7 @@ TEST(FromStepCli, CoarseChainWritesASuperElementThatTheImporterReads) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
   test::TempDir dir;
   const fs::path out = dir.path() / "apa";
-  const test::CliRun r = run("superelement from-step " + kStep + " --mesh-size 8 --order 1 --modes 10 --verify --json --out " +
+  const test::CliRun r = run_cli("superelement from-step " + kStep + " --mesh-size 8 --order 1 --modes 10 --verify --json --out " +
                              out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json doc = nlohmann::json::parse(r.out);  // exactly one JSON document
@@ -66,7 +66,7 @@ TEST(FromStepCli, CoarseChainWritesASuperElementThatTheImporterReads) {
                             doc["super_element"]["dof_list"].get<std::string>();
   const long bottom = node_of(doc, "bottom"), top = node_of(doc, "top");
   const long a = node_of(doc, "stack_a"), b = node_of(doc, "stack_b");
-  const test::CliRun se = run("superelement " + files + " --fix " + std::to_string(bottom) + " --force " + std::to_string(a) + ":" +
+  const test::CliRun se = run_cli("superelement " + files + " --fix " + std::to_string(bottom) + " --force " + std::to_string(a) + ":" +
                               std::to_string(b) + ":x --output " + std::to_string(top) + ":y --fmin 1 --fmax 100 --points 3 --json");
   ASSERT_EQ(se.exit_code, 0) << se.err;
   const nlohmann::json sj = nlohmann::json::parse(se.out);
@@ -85,16 +85,16 @@ TEST(FromStepCli, CoarseChainWritesASuperElementThatTheImporterReads) {
 
 TEST(FromStepCli, TextOutputHelpAndUsage) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys/APA95ML.step");
-  const test::CliRun h = run("superelement from-step --help");
+  const test::CliRun h = run_cli("superelement from-step --help");
   EXPECT_EQ(h.exit_code, 0);
   for (const char* option : {"--mesh-size", "--modes", "--material", "--remote-point", "--verify", "--keep-temp", "--out"}) {
     EXPECT_TRUE(test::contains(h.out, option)) << option;
   }
-  EXPECT_EQ(run("superelement from-step").exit_code, 2);  // STEP_FILE missing
-  EXPECT_EQ(run("superelement").exit_code, 2);            // the importer's files missing
+  EXPECT_EQ(run_cli("superelement from-step").exit_code, 2);  // STEP_FILE missing
+  EXPECT_EQ(run_cli("superelement").exit_code, 2);            // the importer's files missing
 
   test::TempDir dir;
-  const test::CliRun r = run("superelement from-step " + kStep + " --mesh-size 8 --order 1 --modes 6 --remote-point top:y=max " +
+  const test::CliRun r = run_cli("superelement from-step " + kStep + " --mesh-size 8 --order 1 --modes 6 --remote-point top:y=max " +
                              "--remote-point bottom:y=min --out " + (dir.path() / "o").string() + " --keep-temp --stem apa");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(test::contains(r.out, "modes with bottom clamped [Hz]:")) << r.out;
@@ -127,7 +127,7 @@ TEST(FromStepCli, BadInputExitsWithThreeAndSaysWhat) {
       {kStep + out + " --clamp middle", {"--clamp", "middle"}},
   };
   for (const Case& c : cases) {
-    const test::CliRun r = run("superelement from-step " + c.args + " --json");
+    const test::CliRun r = run_cli("superelement from-step " + c.args + " --json");
     EXPECT_EQ(r.exit_code, c.exit_code) << c.args << "\n" << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
     for (const auto& needle : c.needles) EXPECT_TRUE(test::contains(r.err, needle)) << c.args << "\n" << r.err;

@@ -22,24 +22,24 @@ using Complex = std::complex<double>;
 using test::near;
 
 using Outcome = test::CliRun;
-const auto run = test::run_cli;
+using test::run_cli;
 
 Complex cx(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>()}; }
 
 TEST(ModelCli, Help) {
-  const Outcome h = run("--help");
+  const Outcome h = run_cli("--help");
   EXPECT_EQ(h.exit_code, 0);
   EXPECT_NE(h.out.find("model"), std::string::npos);
   EXPECT_NE(h.out.find("piezo"), std::string::npos);
   for (const char* cmd : {"model 2dof --help", "model tune --help", "piezo --help"}) {
-    EXPECT_EQ(run(cmd).exit_code, 0) << cmd;
+    EXPECT_EQ(run_cli(cmd).exit_code, 0) << cmd;
   }
-  EXPECT_EQ(run("model").exit_code, 2);
-  EXPECT_EQ(run("model tune --json").exit_code, 2);  // --frf is required
+  EXPECT_EQ(run_cli("model").exit_code, 2);
+  EXPECT_EQ(run_cli("model tune --json").exit_code, 2);  // --frf is required
 }
 
 TEST(ModelCli, TwoDofJsonHasTheReferenceNumbers) {
-  const Outcome r = run("model 2dof --json");
+  const Outcome r = run_cli("model 2dof --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   // REFERENCE.md derived checks, within 0.5 % (issue 4).
@@ -65,7 +65,7 @@ TEST(ModelCli, TwoDofJsonHasTheReferenceNumbers) {
 TEST(ModelCli, TwoDofOptionsAndParamsFile) {
   test::TempDir dir;
   const std::string params = test::write_text_file(dir, "p.toml", "m = 5.7\nk1 = 0.5e6\nga = -3\n");
-  const Outcome r = run("model 2dof --json --params " + params + " --fmin 10 --fmax 1000 --points 11 --amplifier-gain 10");
+  const Outcome r = run_cli("model 2dof --json --params " + params + " --fmin 10 --fmax 1000 --points 11 --amplifier-gain 10");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(near(j["antiresonance_Hz"].get<double>(), std::sqrt(0.5e6 / 5.7) / kTwoPi, 1e-9));
@@ -75,20 +75,20 @@ TEST(ModelCli, TwoDofOptionsAndParamsFile) {
   EXPECT_EQ(j["params"]["k1"].get<double>(), 0.5e6);
 
   // High-pass and delay: one more pole at -1/(R C), Vs blocked at DC, |H| unchanged by the delay.
-  const Outcome h = run("model 2dof --json --hpf-r 80.6e3 --hpf-c 5e-6 --delay 200e-6 --points 5");
+  const Outcome h = run_cli("model 2dof --json --hpf-r 80.6e3 --hpf-c 5e-6 --delay 200e-6 --points 5");
   ASSERT_EQ(h.exit_code, 0) << h.err;
   const auto jh = nlohmann::json::parse(h.out);
   EXPECT_EQ(jh["poles"].size(), 4U);
   EXPECT_EQ(jh["static_gain_Vs_V_per_V"].get<double>(), 0.0);
   EXPECT_TRUE(near(jh["static_gain_Vs_before_hpf_V_per_V"].get<double>(), 0.588, 0.005));
   EXPECT_TRUE(near(jh["bench"]["hpf_corner_Hz"].get<double>(), 0.395, 0.002));
-  const Outcome plain = run("model 2dof --json --points 5");
+  const Outcome plain = run_cli("model 2dof --json --points 5");
   const auto jp = nlohmann::json::parse(plain.out);
   for (std::size_t k = 0; k < 5; ++k) {
     EXPECT_TRUE(near(std::abs(cx(jh["H_de"][k])), std::abs(cx(jp["H_de"][k])), 1e-12));
   }
 
-  const Outcome text = run("model 2dof");
+  const Outcome text = run_cli("model 2dof");
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("resonance"), std::string::npos);
   EXPECT_NE(text.out.find("-16.81"), std::string::npos) << text.out;
@@ -107,16 +107,16 @@ TEST(ModelCli, BadParamsExitWithThreeAndNameTheKey) {
   };
   for (const auto& c : cases) {
     const std::string f = test::write_text_file(dir, "bad.toml", c.text);
-    const Outcome r = run("model 2dof --json --params " + f);
+    const Outcome r = run_cli("model 2dof --json --params " + f);
     EXPECT_EQ(r.exit_code, 3) << c.text << r.err;
     EXPECT_NE(r.err.find(f + ": " + c.needle), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
-  EXPECT_EQ(run("model 2dof --fmin 0").exit_code, 2);  // the command line is at fault
-  EXPECT_EQ(run("model 2dof --fmin 100 --fmax 10").exit_code, 2);
-  EXPECT_EQ(run("model 2dof --hpf-r 1e3").exit_code, 3);
-  EXPECT_EQ(run("model 2dof --amplifier-gain 0").exit_code, 3);
-  EXPECT_EQ(run("model 2dof --points 1").exit_code, 2);
+  EXPECT_EQ(run_cli("model 2dof --fmin 0").exit_code, 2);  // the command line is at fault
+  EXPECT_EQ(run_cli("model 2dof --fmin 100 --fmax 10").exit_code, 2);
+  EXPECT_EQ(run_cli("model 2dof --hpf-r 1e3").exit_code, 3);
+  EXPECT_EQ(run_cli("model 2dof --amplifier-gain 0").exit_code, 3);
+  EXPECT_EQ(run_cli("model 2dof --points 1").exit_code, 2);
 }
 
 // FRF CSV of a 2-DoF actuator (direct solve of the dynamic stiffness), input u through 20 V/V,
@@ -147,7 +147,7 @@ TEST(ModelCli, TuneRecoversTheParameters) {
   test::TempDir dir;
   const double k1 = 0.42e6, ke = 5.6e6, ka = 2.8e6, ce = 90.0, ca = 55.0, ga = -2.9, gs = 0.5e6;
   const std::string f = test::write_text_file(dir, "frf.csv", frf_csv(k1, ke, ka, ce, ca, ga, gs, 0.01));
-  const Outcome r = run("model tune --frf " + f + " --mass 5.7 --json");
+  const Outcome r = run_cli("model tune --frf " + f + " --mass 5.7 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const auto& p = j["model_2dof"];
@@ -170,11 +170,11 @@ TEST(ModelCli, TuneRecoversTheParameters) {
   EXPECT_EQ(j["quality"], "good");
 
   // The amplifier gain scales ga: data through 20 V/V read as 10 V/V give twice the force per volt.
-  const Outcome half = run("model tune --frf " + f + " --amplifier-gain 10 --json");
+  const Outcome half = run_cli("model tune --frf " + f + " --amplifier-gain 10 --json");
   ASSERT_EQ(half.exit_code, 0) << half.err;
   EXPECT_TRUE(near(nlohmann::json::parse(half.out)["model_2dof"]["ga"].get<double>(), 2.0 * ga, 0.02));
 
-  const Outcome text = run("model tune --frf " + f);
+  const Outcome text = run_cli("model tune --frf " + f);
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("converged"), std::string::npos) << text.out;
 }
@@ -182,13 +182,13 @@ TEST(ModelCli, TuneRecoversTheParameters) {
 TEST(ModelCli, TuneBadInputExitsWithThree) {
   test::TempDir dir;
   const std::string no_vs = test::write_text_file(dir, "novs.csv", "freq_Hz,re_de,im_de\n1,1,0\n2,1,0\n");
-  const Outcome r = run("model tune --frf " + no_vs + " --json");
+  const Outcome r = run_cli("model tune --frf " + no_vs + " --json");
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("Vs"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
   const std::string good = test::write_text_file(dir, "frf.csv", frf_csv(0.4e6, 5e6, 2.5e6, 100, 50, -2.5, 0.46e6, 0.0));
-  EXPECT_EQ(run("model tune --frf " + good + " --mass -1").exit_code, 3);
-  EXPECT_EQ(run("model tune --frf " + good + " --fmin 500 --fmax 501").exit_code, 3);
+  EXPECT_EQ(run_cli("model tune --frf " + good + " --mass -1").exit_code, 3);
+  EXPECT_EQ(run_cli("model tune --frf " + good + " --fmin 500 --fmax 501").exit_code, 3);
 }
 
 // Issue 12: a Welch FRF made by a lab's scipy script (coherence columns, whole band, the bench's
@@ -197,7 +197,7 @@ TEST(ModelCli, TuneBadInputExitsWithThree) {
 TEST(ModelCli, TuneOnAScipyWelchFrfWithOnlyTheMass) {
   const std::string f = test::fixture_path("ident/two_dof_welch_frf.csv").string();
   const auto truth = nlohmann::json::parse(test::read_text(test::fixture_path("ident/two_dof_welch_truth.json")));
-  const Outcome r = run("model tune --frf " + f + " --mass 5.7 --json");
+  const Outcome r = run_cli("model tune --frf " + f + " --mass 5.7 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const auto& p = j["model_2dof"];
@@ -214,7 +214,7 @@ TEST(ModelCli, PoorTuningWarnsAndExitsWithSix) {
   const std::string f = test::fixture_path("ident/two_dof_welch_frf.csv").string();
   // A delay given on the command line replaces the fitted one: 2 ms instead of 0.25 ms leaves no
   // model that fits.
-  const Outcome r = run("model tune --frf " + f + " --mass 5.7 --delay 0.002 --json");
+  const Outcome r = run_cli("model tune --frf " + f + " --mass 5.7 --delay 0.002 --json");
   EXPECT_EQ(r.exit_code, 6) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["quality"], "poor");
@@ -224,26 +224,26 @@ TEST(ModelCli, PoorTuningWarnsAndExitsWithSix) {
 }
 
 TEST(ModelCli, PiezoTable41) {
-  const Outcome r = run("piezo --json");
+  const Outcome r = run_cli("piezo --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(near(j["ga_N_per_V"].get<double>(), 26.11, 0.002));
   EXPECT_TRUE(near(j["gs_V_per_m"].get<double>(), 5.06e6, 0.002));
   EXPECT_TRUE(near(j["ka_N_per_m"].get<double>(), 2.4e8, 1e-12));
   // Explicit values: the same Table 4.1 spelled out.
-  const Outcome e = run("piezo --json --d33 680e-12 --eps-t 4.0e-8 --s-d 21e-12 --c-e 48e9 --length 0.02 --area 1e-4 --layers 160");
+  const Outcome e = run_cli("piezo --json --d33 680e-12 --eps-t 4.0e-8 --s-d 21e-12 --c-e 48e9 --length 0.02 --area 1e-4 --layers 160");
   ASSERT_EQ(e.exit_code, 0) << e.err;
   EXPECT_EQ(nlohmann::json::parse(e.out)["ga_N_per_V"].get<double>(), j["ga_N_per_V"].get<double>());
-  const Outcome text = run("piezo");
+  const Outcome text = run_cli("piezo");
   ASSERT_EQ(text.exit_code, 0);
   EXPECT_NE(text.out.find("26.11"), std::string::npos) << text.out;
 
   for (const char* bad : {"--layers 0", "--layers 160.5", "--d33 -1", "--area 0"}) {
-    const Outcome b = run(std::string("piezo --json ") + bad);
+    const Outcome b = run_cli(std::string("piezo --json ") + bad);
     EXPECT_EQ(b.exit_code, 3) << bad << b.err;
     EXPECT_TRUE(b.out.empty());
   }
-  EXPECT_NE(run("piezo --layers 160.5").err.find("layers"), std::string::npos);
+  EXPECT_NE(run_cli("piezo --layers 160.5").err.find("layers"), std::string::npos);
 }
 
 }  // namespace

@@ -26,7 +26,7 @@ const std::string kFiles = (kDir / "piezo_amplified_K.txt").string() + " " + (kD
 const std::string kCheck = " --fix 76429 --force 76430:76440:x --output 76423:y";
 
 using Outcome = test::CliRun;
-const auto run = test::run_cli;
+using test::run_cli;
 
 std::vector<std::complex<double>> channel(const nlohmann::json& j, std::size_t index) {
   std::vector<std::complex<double>> h;
@@ -85,7 +85,7 @@ std::vector<std::complex<double>> independent(const std::vector<double>& hz, dou
 
 TEST(SuperElementCli, TenKilogramsMatchAnIndependentDenseSolution) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
-  const Outcome r = run("superelement " + kFiles + kCheck + " --mass 76423:10 --fmin 10 --fmax 10000 --points 120 --json");
+  const Outcome r = run_cli("superelement " + kFiles + kCheck + " --mass 76423:10 --fmin 10 --fmax 10000 --points 120 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"modes_Hz", "freq_Hz", "H", "warnings", "channels"}) EXPECT_TRUE(j.contains(key)) << key;
@@ -115,7 +115,7 @@ TEST(SuperElementCli, TenKilogramsMatchAnIndependentDenseSolution) {
 
 TEST(SuperElementCli, MedianErrorAgainstAnsysIsUnderOneDecibel) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
-  const Outcome r = run("superelement " + kFiles + kCheck + " --fmin 1009 --fmax 10000 --points 1000 --json");
+  const Outcome r = run_cli("superelement " + kFiles + kCheck + " --fmin 1009 --fmax 10000 --points 1000 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const auto hz = j["freq_Hz"].get<std::vector<double>>();
@@ -147,14 +147,14 @@ TEST(SuperElementCli, MedianErrorAgainstAnsysIsUnderOneDecibel) {
 
 TEST(SuperElementCli, TextOutputAndHelp) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
-  const Outcome r = run("superelement " + kFiles + kCheck + " --points 20");
+  const Outcome r = run_cli("superelement " + kFiles + kCheck + " --points 20");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("modes [Hz]"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
-  const Outcome h = run("superelement --help");
+  const Outcome h = run_cli("superelement --help");
   EXPECT_EQ(h.exit_code, 0);
   EXPECT_NE(h.out.find("--force"), std::string::npos);
-  EXPECT_EQ(run("superelement").exit_code, 2);  // positional files missing
+  EXPECT_EQ(run_cli("superelement").exit_code, 2);  // positional files missing
 }
 
 TEST(SuperElementCli, BadInputExitsWithThreeAndSaysWhat) {
@@ -191,7 +191,7 @@ TEST(SuperElementCli, BadInputExitsWithThreeAndSaysWhat) {
       {kFiles + " --damping modal", {"--damping"}},
   };
   for (const Case& c : cases) {
-    const Outcome r = run("superelement " + c.args + " --json");
+    const Outcome r = run_cli("superelement " + c.args + " --json");
     EXPECT_EQ(r.exit_code, 3) << c.args << "\n" << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
     for (const auto& needle : c.needles) EXPECT_NE(r.err.find(needle), std::string::npos) << c.args << "\n" << r.err;

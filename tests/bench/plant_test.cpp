@@ -11,6 +11,7 @@
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/discretize.hpp"
 #include "piezobench/lti/freqresp.hpp"
+#include "piezobench/core/units.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::bench::detail {
@@ -18,7 +19,6 @@ namespace {
 
 using test::near;
 using Complex = std::complex<double>;
-constexpr double kPi = std::numbers::pi;
 
 Electrics report_electrics(double ground_resistance) {
   Electrics e;

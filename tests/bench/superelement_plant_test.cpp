@@ -10,13 +10,13 @@
 
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/freqresp.hpp"
+#include "piezobench/core/units.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::bench::detail {
 namespace {
 
 using test::near;
-constexpr double kPi = std::numbers::pi;
 
 const std::string kData = std::string(PIEZOBENCH_SHARED_DATA_DIR) + "/apa95ml-ansys/";
 

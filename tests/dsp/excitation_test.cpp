@@ -9,6 +9,7 @@
 
 #include "dsp/fft.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::dsp {
@@ -17,7 +18,6 @@ namespace {
 using Eigen::Index;
 using Eigen::VectorXd;
 using test::near;
-constexpr double kPi = std::numbers::pi;
 
 double rms(const VectorXd& x) { return std::sqrt(x.squaredNorm() / static_cast<double>(x.size())); }
 

@@ -12,6 +12,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "test_util.hpp"
+#include "fem_test_data.hpp"
 
 namespace piezobench::fem {
 namespace {
@@ -19,7 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Accuracy of the comparison with ccx, from the issue: 0.2 %.
-constexpr double kAgainstCcx = 2e-3;
+using test_data::kAgainstCcx;
 
 struct Fixture {
   SparseModel model;

@@ -20,6 +20,7 @@
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/fem/superelement.hpp"
 #include "test_util.hpp"
+#include "fem_test_data.hpp"
 
 namespace piezobench::fem {
 namespace {
@@ -28,7 +29,7 @@ namespace fs = std::filesystem;
 
 const fs::path kStep = fs::path(PIEZOBENCH_SHARED_DATA_DIR) / "apa95ml-ansys" / "APA95ML.step";
 // The acceptance for the reduced model against ccx on the full mesh.
-constexpr double kAgainstCcx = 2e-3;
+using test_data::kAgainstCcx;
 
 // Sets an environment variable for the scope and restores it.
 class ScopedEnv {

@@ -16,16 +16,17 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/freqresp.hpp"
+#include "piezobench/core/units.hpp"
 #include "test_util.hpp"
+#include "fem_test_data.hpp"
 
 namespace piezobench::fem {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = std::numbers::pi;
-const fs::path kAnsysDir = fs::path(PIEZOBENCH_SHARED_DATA_DIR) / "apa95ml-ansys";
+using test_data::kAnsysDir;
 
-SuperElement apa95ml() {
+SuperElement apa95ml_superelement() {
   return read_ansys_super_element(kAnsysDir / "piezo_amplified_K.txt", kAnsysDir / "piezo_amplified_M.txt",
                                   kAnsysDir / "piezo_amplified.txt");
 }
@@ -149,7 +150,7 @@ TEST(StructuralModel, ParsesTheCommandLineForms) {
 
 TEST(StructuralModel, UnknownNodesAreInputErrors) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
-  const SuperElement se = apa95ml();
+  const SuperElement se = apa95ml_superelement();
   ModelOptions o = check_options(0);
   o.fixed_nodes = {12345};
   try {
@@ -175,7 +176,7 @@ TEST(StructuralModel, UnknownNodesAreInputErrors) {
 // 1e-6 relative away from resonances.
 TEST(StructuralModel, MatchesAnIndependentDenseSolutionWithTenKilograms) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
-  const StructuralModel model = assemble(apa95ml(), check_options(10.0));
+  const StructuralModel model = assemble(apa95ml_superelement(), check_options(10.0));
   ASSERT_EQ(model.size(), 102);
   const Eigen::VectorXd hz = lti::logspace(0.0, 4.0, 250);
   Eigen::VectorXd modes_Hz;
@@ -201,7 +202,7 @@ TEST(StructuralModel, MatchesAnIndependentDenseSolutionWithTenKilograms) {
 // Without the mass: the median magnitude error against Ansys's harmonic response over 1-10 kHz.
 TEST(StructuralModel, FollowsTheAnsysHarmonicResponse) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
-  const StructuralModel model = assemble(apa95ml(), check_options(0.0));
+  const StructuralModel model = assemble(apa95ml_superelement(), check_options(0.0));
   std::ifstream in(kAnsysDir / "FEA-Response-Top.txt");
   std::string line;
   std::getline(in, line);
@@ -231,7 +232,7 @@ TEST(StructuralModel, StateSpaceAgreesWithTheDirectResponse) {
     ModelOptions o = check_options(10.0);
     o.damping = Damping::parse(damping, "--damping");
     o.outputs.push_back(DisplacementOutput::parse("76430:76440:x", "o"));  // the stack elongation
-    const StructuralModel model = assemble(apa95ml(), o);
+    const StructuralModel model = assemble(apa95ml_superelement(), o);
     const lti::StateSpace ss = to_state_space(model);
     ASSERT_EQ(ss.states(), 2 * 102);
     ASSERT_EQ(ss.inputs(), 1);
@@ -250,7 +251,7 @@ TEST(StructuralModel, ModalDampingGivesTheRequestedDampingRatio) {
   PIEZOBENCH_SKIP_WITHOUT_SHARED_DATA("apa95ml-ansys");
   ModelOptions o = check_options(10.0);
   o.damping = Damping::parse("modal:0.02", "--damping");
-  const StructuralModel model = assemble(apa95ml(), o);
+  const StructuralModel model = assemble(apa95ml_superelement(), o);
   const Modes m = modes(model);
   // Phi^T C Phi = diag(2 zeta w_i).
   const Eigen::MatrixXd modal_c = m.shapes.transpose() * model.C * m.shapes;

@@ -12,13 +12,14 @@
 
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
+#include "fem_test_data.hpp"
 
 namespace piezobench::fem {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kAnsysDir = fs::path(PIEZOBENCH_SHARED_DATA_DIR) / "apa95ml-ansys";
+using test_data::kAnsysDir;
 const fs::path kK = kAnsysDir / "piezo_amplified_K.txt";
 const fs::path kM = kAnsysDir / "piezo_amplified_M.txt";
 const fs::path kMasters = kAnsysDir / "piezo_amplified.txt";

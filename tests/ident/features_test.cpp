@@ -66,13 +66,7 @@ struct TwoDof {
   double static_gain_vs() const { return -amplifier * ga * gs * k1 / den(0.0).real(); }
 };
 
-Vector log_grid(double f_lo, double f_hi, Index n) {
-  Vector w(n);
-  for (Index k = 0; k < n; ++k) {
-    w(k) = kTwoPi * f_lo * std::pow(f_hi / f_lo, static_cast<double>(k) / static_cast<double>(n - 1));
-  }
-  return w;
-}
+using test::log_grid;
 
 template <typename F>
 CVector response(const Vector& omega, F&& f) {

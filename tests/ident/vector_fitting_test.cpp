@@ -64,13 +64,7 @@ Model six_pole_model() {
   return m;
 }
 
-Vector log_grid(double f_lo, double f_hi, Index n) {
-  Vector w(n);
-  for (Index k = 0; k < n; ++k) {
-    w(k) = kTwoPi * f_lo * std::pow(f_hi / f_lo, static_cast<double>(k) / static_cast<double>(n - 1));
-  }
-  return w;
-}
+using test::log_grid;
 
 CMatrix add_relative_noise(const CMatrix& h, double level, unsigned seed) {
   std::mt19937_64 rng(seed);

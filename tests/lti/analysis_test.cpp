@@ -10,6 +10,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
+#include "piezobench/core/units.hpp"
 #include "lti/lti_test_util.hpp"
 #include "test_util.hpp"
 
@@ -22,7 +23,6 @@ using test::kRoundoff;
 using test::near;
 using test::Tolerance;
 
-constexpr double kPi = 3.14159265358979323846;
 
 using test::concat;
 using test::pair;

@@ -7,6 +7,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/analysis.hpp"
+#include "piezobench/core/units.hpp"
 #include "lti/lti_test_util.hpp"
 #include "test_util.hpp"
 
@@ -19,7 +20,6 @@ using test::kRoundoff;
 using test::near;
 using test::Tolerance;
 
-constexpr double kPi = 3.14159265358979323846;
 
 using test::cvec;
 using test::pair;

@@ -8,6 +8,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/freqresp.hpp"
+#include "piezobench/core/units.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::lti {
@@ -17,7 +18,6 @@ using test::all_near;
 using test::kRoundoff;
 using test::near;
 using test::Tolerance;
-constexpr double kPi = std::numbers::pi;
 
 Matrix m1(double v) { return Matrix::Constant(1, 1, v); }
 

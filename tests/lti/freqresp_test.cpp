@@ -12,6 +12,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
+#include "piezobench/core/units.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::lti {
@@ -24,7 +25,6 @@ using test::Tolerance;
 
 using LComplex = std::complex<long double>;
 using LCMatrix = Eigen::Matrix<LComplex, Eigen::Dynamic, Eigen::Dynamic>;
-constexpr double kPi = std::numbers::pi;
 
 // Independent reference: C (sI - A)^-1 B + D by a dense LU in long double (64-bit mantissa), from the
 // very same double entries, so that its own error (~cond * 5e-20) is far below the tolerance.
@@ -52,7 +52,7 @@ CMatrix long_double_response(const StateSpace& sys, Complex s) {
 }
 
 // Random orthogonal matrix (QR of a Gaussian matrix), fixed seed.
-Matrix random_orthogonal(Index n, unsigned seed) {
+Matrix random_orthogonal_by_rows(Index n, unsigned seed) {
   std::mt19937 gen(seed);
   std::normal_distribution<double> dist;
   Matrix g(n, n);
@@ -100,7 +100,7 @@ Modal modal_system(int modes, double w_lo, double w_hi, double zeta, unsigned se
     md.r.push_back(Complex(c(0, i), c(0, i + 1)) * Complex(b(i, 0), -b(i + 1, 0)) / 2.0);
     md.wn.push_back(wn);
   }
-  const Matrix q = random_orthogonal(n, seed + 1);
+  const Matrix q = random_orthogonal_by_rows(n, seed + 1);
   Vector scale(n);
   for (Index i = 0; i < n; ++i) scale(i) = std::pow(10.0, 3.0 * uni(gen));
   const Matrix t = q * scale.asDiagonal();

@@ -20,7 +20,7 @@ using test::near;
 using test::Tolerance;
 
 // H(s) = D + C (sI - A)^-1 B by a dense solve (independent of the library).
-CMatrix evaluate(const StateSpace& sys, Complex s) {
+CMatrix evaluate_matrix(const StateSpace& sys, Complex s) {
   const CMatrix m = s * CMatrix::Identity(sys.states(), sys.states()) - sys.A.cast<Complex>();
   return sys.D.cast<Complex>() + sys.C.cast<Complex>() * m.partialPivLu().solve(sys.B.cast<Complex>());
 }
@@ -51,7 +51,7 @@ TEST(Series, ProductOfTransferFunctions) {
   const StateSpace g2 = tf({2.0, 1.0}, {1.0, 3.0});
   const StateSpace s = series(g1, g2);
   for (const Complex p : kPoints) {
-    EXPECT_TRUE(near(evaluate(s, p)(0, 0), evaluate(g2, p)(0, 0) * evaluate(g1, p)(0, 0), Tolerance{kRoundoff, 0.0}));
+    EXPECT_TRUE(near(evaluate_matrix(s, p)(0, 0), evaluate_matrix(g2, p)(0, 0) * evaluate_matrix(g1, p)(0, 0), Tolerance{kRoundoff, 0.0}));
   }
 }
 
@@ -67,7 +67,7 @@ TEST(Series, MimoOrderIsSecondTimesFirst) {
   ASSERT_EQ(s.inputs(), 2);
   ASSERT_EQ(s.outputs(), 2);
   for (const Complex p : kPoints) {
-    EXPECT_TRUE(all_near(evaluate(s, p), evaluate(k, p) * evaluate(g, p), Tolerance{kRoundoff, 1e-14}));
+    EXPECT_TRUE(all_near(evaluate_matrix(s, p), evaluate_matrix(k, p) * evaluate_matrix(g, p), Tolerance{kRoundoff, 1e-14}));
   }
   EXPECT_THROW(series(g, g), InputError);  // 3 outputs into 2 inputs
 }
@@ -107,7 +107,7 @@ TEST(Parallel, SumOfTransferFunctions) {
   const StateSpace g = mimo_plant();
   const StateSpace gg = parallel(g, scale(g, -3.0));
   for (const Complex s : kPoints) {
-    EXPECT_TRUE(all_near(evaluate(gg, s), -2.0 * evaluate(g, s), Tolerance{kRoundoff, 1e-14}));
+    EXPECT_TRUE(all_near(evaluate_matrix(gg, s), -2.0 * evaluate_matrix(g, s), Tolerance{kRoundoff, 1e-14}));
   }
   EXPECT_THROW(parallel(g, tf({1.0}, {1.0, 1.0})), InputError);
 }
@@ -132,9 +132,9 @@ TEST(Append, BlockDiagonalWithDelays) {
   EXPECT_EQ(s.channel_delay(0, 0), 0.3);
   EXPECT_EQ(s.channel_delay(1, 1), 0.0);
   for (const Complex p : kPoints) {
-    const CMatrix h = evaluate(s, p);
-    EXPECT_TRUE(near(h(0, 0), evaluate(a, p)(0, 0), Tolerance{kRoundoff, 0.0}));
-    EXPECT_TRUE(all_near(h.bottomRightCorner(3, 2), evaluate(g, p), Tolerance{kRoundoff, 1e-14}));
+    const CMatrix h = evaluate_matrix(s, p);
+    EXPECT_TRUE(near(h(0, 0), evaluate_matrix(a, p)(0, 0), Tolerance{kRoundoff, 0.0}));
+    EXPECT_TRUE(all_near(h.bottomRightCorner(3, 2), evaluate_matrix(g, p), Tolerance{kRoundoff, 1e-14}));
     EXPECT_TRUE(all_near(h.topRightCorner(1, 2), CMatrix::Zero(1, 2), Tolerance{0.0, 0.0}));
     EXPECT_TRUE(all_near(h.bottomLeftCorner(3, 1), CMatrix::Zero(3, 1), Tolerance{0.0, 0.0}));
   }
@@ -148,8 +148,8 @@ TEST(Select, ReordersChannels) {
   ASSERT_EQ(s.inputs(), 1);
   EXPECT_EQ(s.channel_delay(0, 0), 0.3);
   for (const Complex p : kPoints) {
-    const CMatrix h = evaluate(g, p);
-    const CMatrix hs = evaluate(s, p);
+    const CMatrix h = evaluate_matrix(g, p);
+    const CMatrix hs = evaluate_matrix(s, p);
     EXPECT_TRUE(near(hs(0, 0), h(2, 1), Tolerance{kRoundoff, 0.0}));
     EXPECT_TRUE(near(hs(1, 0), h(0, 1), Tolerance{kRoundoff, 0.0}));
   }
@@ -164,7 +164,7 @@ TEST(Select, ReordersChannels) {
 TEST(Scale, OutputsScaled) {
   const StateSpace g = mimo_plant();
   const StateSpace s = scale(g, 2.5);
-  EXPECT_TRUE(all_near(evaluate(s, kPoints[1]), 2.5 * evaluate(g, kPoints[1]), Tolerance{kRoundoff, 0.0}));
+  EXPECT_TRUE(all_near(evaluate_matrix(s, kPoints[1]), 2.5 * evaluate_matrix(g, kPoints[1]), Tolerance{kRoundoff, 0.0}));
   EXPECT_THROW(scale(g, std::nan("")), InputError);
 }
 
@@ -189,9 +189,9 @@ TEST(Feedback, IffLoopOfTheReportMatchesFormula) {
   const StateSpace k = tf({-2.0, -1.0}, {1.0, 20.0});
   const StateSpace cl = feedback(g, k);
   for (const Complex s : kPoints) {
-    const Complex gs = evaluate(g, s)(0, 0);
-    const Complex ks = evaluate(k, s)(0, 0);
-    EXPECT_TRUE(near(evaluate(cl, s)(0, 0), gs / (1.0 + gs * ks), Tolerance{kRoundoff, 0.0}));
+    const Complex gs = evaluate_matrix(g, s)(0, 0);
+    const Complex ks = evaluate_matrix(k, s)(0, 0);
+    EXPECT_TRUE(near(evaluate_matrix(cl, s)(0, 0), gs / (1.0 + gs * ks), Tolerance{kRoundoff, 0.0}));
   }
 }
 
@@ -217,11 +217,11 @@ TEST(Feedback, MimoSubsetOfChannels) {
     ASSERT_EQ(cl.inputs(), 2);
     ASSERT_EQ(cl.outputs(), 3);
     for (const Complex s : kPoints) {
-      const CMatrix gs = evaluate(g, s);
-      const CMatrix ks = evaluate(k, s);
+      const CMatrix gs = evaluate_matrix(g, s);
+      const CMatrix ks = evaluate_matrix(k, s);
       const CMatrix expected =
           (CMatrix::Identity(3, 3) - sg * gs * e.cast<Complex>() * ks * f.cast<Complex>()).partialPivLu().solve(gs);
-      EXPECT_TRUE(all_near(evaluate(cl, s), expected, Tolerance{1e-12, 1e-14}));
+      EXPECT_TRUE(all_near(evaluate_matrix(cl, s), expected, Tolerance{1e-12, 1e-14}));
     }
   }
 }

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::lti {
@@ -15,7 +16,6 @@ namespace {
 
 using test::near;
 using test::Tolerance;
-constexpr double kPi = std::numbers::pi;
 
 // SISO building blocks written out by hand (independent of lti::conversions).
 // num/den in descending powers, same degree or lower numerator, den monic.

@@ -38,13 +38,6 @@ lti::StateSpace discrete_plant() {
   return lti::StateSpace(a, b, c, lti::Matrix::Zero(1, 1), g.sample_time);
 }
 
-Eigen::VectorXd noise(Eigen::Index n, double rms, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> d(0.0, rms);
-  Eigen::VectorXd v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v(i) = d(rng);
-  return v;
-}
 
 LoopOptions lockstep_options(double duration) {
   LoopOptions o;
@@ -70,7 +63,7 @@ TEST(Loop, ClosedLoopEqualsTheDiscreteInterconnection) {
   o.gain = 1.5e5;
   o.limits.ramp_in = 0.0;
   o.limits.ramp_out = 0.0;
-  o.excitation = noise(3000, 0.05, 11);
+  o.excitation = test::gaussian_noise(3000, 0.05, 11);
   Loop loop(backend, o);
   EXPECT_GE(run_all(loop), 3000u);  // + the wind-down cycle (no ramp out here)
   const LoopReport rep = loop.finish();
@@ -109,7 +102,7 @@ TEST(Loop, CycleAllocatesNothing) {
   o.gain = 2.8e5;
   o.limits.ramp_in = 0.01;
   o.limits.ramp_out = 0.01;
-  o.excitation = noise(1000, 2.0, 5);  // large: clamps and slew limits too
+  o.excitation = test::gaussian_noise(1000, 2.0, 5);  // large: clamps and slew limits too
   o.realtime = true;                   // the real-time path (push, timing), paced by the test
   ident::HysteresisModel m;            // with the inverse hysteresis feedforward and its creep states
   m.hysteresis = {1.0, {10.0, 30.0}, {0.2, 0.3}};

@@ -12,7 +12,7 @@
 namespace piezobench::rt {
 namespace {
 
-io::TimeSeries record(Eigen::Index n, double fs = 10e3) {
+io::TimeSeries sine_record(Eigen::Index n, double fs = 10e3) {
   io::TimeSeries ts;
   ts.names = {"u", "de", "Vs"};
   ts.data.resize(n, 3);
@@ -27,7 +27,7 @@ io::TimeSeries record(Eigen::Index n, double fs = 10e3) {
 }
 
 TEST(ReplayBackend, ReturnsTheRecordRowByRow) {
-  const io::TimeSeries ts = record(5);
+  const io::TimeSeries ts = sine_record(5);
   ReplayBackend b(ts);
   EXPECT_EQ(b.name(), "replay");
   EXPECT_EQ(b.sample_rate(), 10e3);
@@ -48,11 +48,11 @@ TEST(ReplayBackend, ReturnsTheRecordRowByRow) {
 }
 
 TEST(ReplayBackend, MissingChannelsAndBadRecords) {
-  io::TimeSeries ts = record(5);
+  io::TimeSeries ts = sine_record(5);
   ts.names = {"u", "d", "Vs"};
   const std::string what = test::input_error([&] { ReplayBackend b(ts); });
   EXPECT_TRUE(test::contains(what, "de")) << what;
-  ts = record(5);
+  ts = sine_record(5);
   ts.data(2, 2) = std::nan("");
   test::input_error([&] { ReplayBackend b(ts); });
   test::TempDir dir;
@@ -64,7 +64,7 @@ TEST(ReplayBackend, MissingChannelsAndBadRecords) {
 TEST(ReplayBackend, LoopReplaysTheControllerOnRecordedData) {
   test::TempDir dir;
   const auto file = dir.path() / "rec.mat";
-  io::write_timeseries(record(4000), file);
+  io::write_timeseries(sine_record(4000), file);
   ReplayBackend b(file);
   LoopOptions o;
   o.realtime = false;
@@ -81,7 +81,7 @@ TEST(ReplayBackend, LoopReplaysTheControllerOnRecordedData) {
   EXPECT_EQ(rep.dropped_log_samples, 0u);
   EXPECT_EQ(rep.logged_samples, 4000u);
   control::DiscreteIff iff({}, {}, 2.8e5);
-  const io::TimeSeries rec = record(4000);
+  const io::TimeSeries rec = sine_record(4000);
   ASSERT_EQ(log.samples(), 4000);
   for (Eigen::Index k = 0; k < 4000; ++k) {
     const double y = iff.step(rec.data(k, 2));

@@ -11,13 +11,6 @@
 namespace piezobench::rt {
 namespace {
 
-Eigen::VectorXd noise(Eigen::Index n, double rms, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> d(0.0, rms);
-  Eigen::VectorXd v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v(i) = d(rng);
-  return v;
-}
 
 TEST(VirtualBenchBackend, SteppedInLockstep) {
   const bench::UnitTruth unit = bench::batch_unit(1, 1);
@@ -57,7 +50,7 @@ TEST(VirtualBenchBackend, LogHoldsTheCommandsAndTheBenchMeasurements) {
   o.duration = 0.3;
   o.gain = 2.8e5;
   o.keep_log = true;
-  o.excitation = noise(3000, 0.05, 3);
+  o.excitation = test::gaussian_noise(3000, 0.05, 3);
   io::TimeSeries log;
   const LoopReport rep = run_loop(b, o, &log);
   ASSERT_EQ(log.samples(), 3000);
@@ -87,7 +80,7 @@ TEST(VirtualBenchBackend, SaturatedLoopKeepsTheMeasuredVoltageInRange) {
   o.duration = 0.3;
   o.gain = 1e8;
   o.keep_log = true;
-  o.excitation = noise(3000, 5.0, 8);
+  o.excitation = test::gaussian_noise(3000, 5.0, 8);
   io::TimeSeries log;
   const LoopReport rep = run_loop(b, o, &log);
   EXPECT_GT(rep.clamped_samples, 0u);
