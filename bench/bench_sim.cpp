@@ -37,12 +37,10 @@ void report(benchmark::State& state, std::size_t steps_per_iteration, double sam
                                                     benchmark::Counter::kIsRate);
 }
 
-// range(0): 1 = everything on (the bench's default); 0 = hysteresis, creep and noise off.
-void BM_TwoDofBenchStep(benchmark::State& state) {
-  BenchOptions options;  // hysteresis, creep, noise, delay, NMP zero: all on
-  if (state.range(0) == 0) options.hysteresis = options.creep = options.noise = false;
+// Unit 1's bench with these options, one VirtualBench::step() per sample of an n-sample command.
+void step_samples(benchmark::State& state, const BenchOptions& options, std::size_t n) {
   VirtualBench bench(piezobench::bench::batch_unit(1, 1), options, 1);
-  const std::vector<double> u = command(1 << 16);
+  const std::vector<double> u = command(n);
   for (auto _ : state) {
     double sum = 0.0;
     for (const double v : u) {
@@ -52,6 +50,13 @@ void BM_TwoDofBenchStep(benchmark::State& state) {
     benchmark::DoNotOptimize(sum);
   }
   report(state, u.size(), options.sample_rate);
+}
+
+// range(0): 1 = everything on (the bench's default); 0 = hysteresis, creep and noise off.
+void BM_TwoDofBenchStep(benchmark::State& state) {
+  BenchOptions options;  // hysteresis, creep, noise, delay, NMP zero: all on
+  if (state.range(0) == 0) options.hysteresis = options.creep = options.noise = false;
+  step_samples(state, options, 1 << 16);
 }
 BENCHMARK(BM_TwoDofBenchStep)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
@@ -86,17 +91,7 @@ std::filesystem::path apa95ml_toml() {
 void BM_SuperElementBenchStep(benchmark::State& state) {
   BenchOptions options;
   options.superelement = apa95ml_toml();
-  VirtualBench bench(piezobench::bench::batch_unit(1, 1), options, 1);
-  const std::vector<double> u = command(1 << 14);
-  for (auto _ : state) {
-    double sum = 0.0;
-    for (const double v : u) {
-      const auto m = bench.step(v);
-      sum += m.de + m.vs;
-    }
-    benchmark::DoNotOptimize(sum);
-  }
-  report(state, u.size(), options.sample_rate);
+  step_samples(state, options, 1 << 14);
 }
 BENCHMARK(BM_SuperElementBenchStep)->Unit(benchmark::kMillisecond);
 

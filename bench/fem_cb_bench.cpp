@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "program_main.hpp"
 #include "piezobench/fem/craig_bampton.hpp"
 #include "piezobench/fem/matrix_io.hpp"
 
@@ -31,9 +32,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace piezobench;
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using bench_program::seconds_since;
 
 // Processor time of the process (all threads), s: on a shared machine it says more than wall time.
 double cpu_seconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
@@ -133,14 +132,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const piezobench::Error& e) {
-    std::fprintf(stderr, "fem_cb_bench: %s\n", e.what());
-    return static_cast<int>(e.exit_code());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "fem_cb_bench: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return piezobench::bench_program::guarded_main("fem_cb_bench", run, argc, argv); }

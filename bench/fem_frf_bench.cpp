@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "program_main.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
 #include "piezobench/lti/freqresp.hpp"
@@ -26,9 +27,7 @@ namespace {
 
 using namespace piezobench;
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using bench_program::seconds_since;
 
 int run(int argc, char** argv) {
   if (argc < 2) {
@@ -85,14 +84,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const piezobench::Error& e) {
-    std::fprintf(stderr, "fem_frf_bench: %s\n", e.what());
-    return static_cast<int>(e.exit_code());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "fem_frf_bench: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return piezobench::bench_program::guarded_main("fem_frf_bench", run, argc, argv); }

@@ -13,21 +13,21 @@
 #include <stdexcept>
 #include <string>
 
+#include "piezobench/control/iff.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/freqresp.hpp"
-#include "piezobench/lti/interconnect.hpp"
 #include "piezobench/lti/rlocus.hpp"
 #include "piezobench/lti/state_space.hpp"
-#include "piezobench/lti/transfer_function.hpp"
+#include "piezobench/core/units.hpp"
 
 namespace {
 
+using piezobench::kTwoPi;
 using piezobench::lti::Complex;
 using piezobench::lti::Index;
 using piezobench::lti::Matrix;
 using piezobench::lti::StateSpace;
 using piezobench::lti::Vector;
-constexpr double kPi = std::numbers::pi;
 
 // Format of bench/data/ss100.txt (written by bench/octave/make_ss100.m): "states inputs outputs",
 // then the rows of A, B, C, D.
@@ -59,36 +59,21 @@ const StateSpace& system100() {
 }
 
 Vector frequencies() {
-  return piezobench::lti::logspace(std::log10(2 * kPi * 1.0), std::log10(2 * kPi * 1e4), 10000);
+  return piezobench::lti::logspace(std::log10(kTwoPi * 1.0), std::log10(kTwoPi * 1e4), 10000);
 }
 
-// L = -K0 G, the open loop of the report's IFF loop (1 + g L = 0), as in the fixture script.
+// L = -K0 G, the open loop of the report's IFF loop (1 + g L = 0): the plant of eq. 2.3 and the
+// controller of eq. 2.4 at the report's values (control/iff.hpp), as in the fixture script.
 StateSpace iff_loop() {
-  const double g0 = 0.64;
-  const double wz = 2 * kPi * 42.7;
-  const double xz = 0.004;
-  const double wp = 2 * kPi * 95.2;
-  const double xp = 0.02;
-  const double w_hpf = 2 * kPi * 0.4;
-  // G = g0 (s^2/wz^2 + 2 xz s/wz + 1) s / ((s^2/wp^2 + 2 xp s/wp + 1)(s + w_hpf))
-  Vector g_num(4);
-  g_num << g0 / (wz * wz), g0 * 2 * xz / wz, g0, 0.0;
-  Vector g_den(4);
-  g_den << 1 / (wp * wp), 2 * xp / wp + w_hpf / (wp * wp), 1 + 2 * xp * w_hpf / wp, w_hpf;
-  const StateSpace g = piezobench::lti::to_state_space(piezobench::lti::TransferFunction(g_num, g_den));
-  // K0 = -10 s / ((s + 2 pi 2)(s + 2 pi 20)(s + 2 pi 2000))
-  Eigen::VectorXcd k_zeros(1);
-  k_zeros << Complex(0.0, 0.0);
-  Eigen::VectorXcd k_poles(3);
-  k_poles << Complex(-2 * kPi * 2, 0.0), Complex(-2 * kPi * 20, 0.0), Complex(-2 * kPi * 2000, 0.0);
-  const StateSpace k0 = piezobench::lti::to_state_space(piezobench::lti::Zpk(k_zeros, k_poles, -10.0));
-  return piezobench::lti::series(g, piezobench::lti::scale(k0, -1.0));
+  namespace control = piezobench::control;
+  return control::iff_open_loop(piezobench::lti::to_state_space(control::iff_plant()),
+                                piezobench::lti::to_state_space(control::iff_controller()));
 }
 
+// The plant's resonance pole, where the optimized branch starts.
 Complex resonance_pole() {
-  const double wp = 2 * kPi * 95.2;
-  const double xp = 0.02;
-  return {-xp * wp, wp * std::sqrt(1 - xp * xp)};
+  const piezobench::control::IffPlantParams p;
+  return {-p.xp * p.wp, p.wp * std::sqrt(1 - p.xp * p.xp)};
 }
 
 // (a) one call: Hessenberg reduction + 10,000 frequencies, one thread.

@@ -41,6 +41,13 @@ py::object model_result(const HysteresisModel& m) {
   return result("HysteresisModel", d);
 }
 
+// The quality verdict of a fit as the result's quality, quality_problems and advice fields.
+void put_quality(py::dict& d, const core::FitQuality& q) {
+  d["quality"] = core::to_string(q.verdict);
+  d["quality_problems"] = q.problems;
+  d["advice"] = q.advice;
+}
+
 // A HysteresisModel result (or a dict with its fields; creep_*, reference_*, input_* optional).
 HysteresisModel model_arg(py::handle obj, const std::string& source) {
   py::dict d;
@@ -124,9 +131,7 @@ void bind_hysteresis(py::module_& ident_m, py::module_& control_m, py::module_& 
         d["relative_residual"] = f.relative_residual;
         d["stroke"] = f.stroke;
         d["samples"] = f.samples;
-        d["quality"] = core::to_string(f.quality.verdict);
-        d["quality_problems"] = f.quality.problems;
-        d["advice"] = f.quality.advice;
+        put_quality(d, f.quality);
         return result("HysteresisFit", d);
       },
       arg("va"), arg("de"), arg("sample_rate"),
@@ -152,9 +157,7 @@ void bind_hysteresis(py::module_& ident_m, py::module_& control_m, py::module_& 
         d["creep_per_decade"] = c.creep_per_decade;
         d["rms_residual"] = c.rms_residual;
         d["relative_residual"] = c.relative_residual;
-        d["quality"] = core::to_string(c.quality.verdict);
-        d["quality_problems"] = c.quality.problems;
-        d["advice"] = c.quality.advice;
+        put_quality(d, c.quality);
         return result("CreepFit", d);
       },
       arg("input"), arg("output"), arg("sample_rate"), arg("time_constants") = py::none(), arg("max_relative_residual") = 0.05,

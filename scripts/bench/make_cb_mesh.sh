@@ -49,60 +49,29 @@ echo "make_cb_mesh: gmsh, ${size} mm, C3D10" >&2
 /usr/bin/time -f "gmsh: %e s wall, %M kB peak" gmsh -3 cb.geo -format inp -o gmsh.inp > gmsh.log 2>&1 || { tail -20 gmsh.log >&2; exit 4; }
 tail -n 1 gmsh.log >&2
 
-/usr/bin/python3 - <<'PY'
-nodes, blocks, mode, cur = {}, {}, None, None
-for line in open('gmsh.inp'):
-    s = line.strip()
-    if s.startswith('*'):
-        u = s.upper().replace(' ', '')
-        if u.startswith('*NODE'):
-            mode = 'node'
-        elif u.startswith('*ELEMENT') and 'TYPE=C3D10' in u:
-            mode, cur = 'elem', u.split('ELSET=')[1]
-            blocks[cur] = []
-        else:
-            mode = None
-        continue
-    if not s:
-        continue
-    if mode == 'node':
-        p = s.split(',')
-        nodes[int(p[0])] = [float(v) * 1e-3 for v in p[1:4]]  # mm -> m
-    elif mode == 'elem':
-        blocks[cur].append([int(v) for v in s.split(',') if v.strip()])
-used = sorted({n for es in blocks.values() for e in es for n in e[1:]})
+PYTHONPATH="$repo/scripts/fem" /usr/bin/python3 - <<'PY'
+from ccx_mesh import read_gmsh_inp, rigid_bodies, used_nodes, write_nodes, write_remote_points
+nodes, blocks = read_gmsh_inp('gmsh.inp', 'C3D10')
+used = used_nodes(blocks)
 ys = [nodes[n][1] for n in used]
 tol = 1e-9
 faces = {'TOP': [n for n in used if abs(nodes[n][1] - max(ys)) < tol],
          'BOTTOM': [n for n in used if abs(nodes[n][1] - min(ys)) < tol]}
 def in_stack(e):  # the block volume: corner nodes inside |x| <= 34.7793, |y| <= 10 mm
     return all(abs(nodes[n][0]) <= 0.0347793 + 1e-9 and abs(nodes[n][1]) <= 0.010 + 1e-9 for n in e[1:5])
-top = max(used)
 with open('mesh.inp', 'w') as f:
-    f.write('** APA95ML.step meshed by gmsh (C3D10), metres; scripts/bench/make_cb_mesh.sh\n*NODE, NSET=NALL\n')
-    for n in used:
-        f.write('%d, %.12g, %.12g, %.12g\n' % (n, *nodes[n]))
+    f.write('** APA95ML.step meshed by gmsh (C3D10), metres; scripts/bench/make_cb_mesh.sh\n')
+    write_nodes(f, nodes, used)
     for name, es in blocks.items():
         region = 'STACK' if all(in_stack(e) for e in es) else 'SHELL'
         f.write('*ELEMENT, TYPE=C3D10, ELSET=%s\n' % region)
         for e in es:
             f.write(', '.join(map(str, e)) + '\n')
-    refs = {}
-    for k, (name, ids) in enumerate(faces.items()):
-        f.write('*NSET, NSET=%s\n' % name)
-        for i in range(0, len(ids), 10):
-            f.write(', '.join(map(str, ids[i:i + 10])) + '\n')
-        c = [sum(nodes[n][d] for n in ids) / len(ids) for d in range(3)]
-        refs[name] = (top + 1 + 2 * k, top + 2 + 2 * k, c)
-    f.write('*NODE, NSET=REMOTE\n')
-    for name, (ref, rot, c) in refs.items():
-        f.write('%d, %.12g, %.12g, %.12g\n%d, %.12g, %.12g, %.12g\n' % (ref, *c, rot, *c))
+    refs = write_remote_points(f, nodes, faces, max(used) + 1)
 common = ['*INCLUDE, INPUT=mesh.inp',
           '*MATERIAL, NAME=STEEL', '*ELASTIC', '1.9e11, 0.3', '*DENSITY', '7800.',
           '*MATERIAL, NAME=PZT', '*ELASTIC', '4.8e10, 0.31', '*DENSITY', '7800.',
-          '*SOLID SECTION, ELSET=SHELL, MATERIAL=STEEL', '*SOLID SECTION, ELSET=STACK, MATERIAL=PZT']
-for name, (ref, rot, c) in refs.items():
-    common.append('*RIGID BODY, NSET=%s, REF NODE=%d, ROT NODE=%d' % (name, ref, rot))
+          '*SOLID SECTION, ELSET=SHELL, MATERIAL=STEEL', '*SOLID SECTION, ELSET=STACK, MATERIAL=PZT'] + rigid_bodies(refs)
 with open('cb_dump.inp', 'w') as f:
     f.write('\n'.join(common + ['*STEP', '*FREQUENCY, SOLVER=MATRIXSTORAGE', '10', '*END STEP']) + '\n')
 bc = []

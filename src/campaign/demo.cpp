@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <exception>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -18,6 +17,7 @@
 #include "piezobench/bench/truth.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/parallel.hpp"
 #include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/timeseries.hpp"
@@ -115,60 +115,40 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
   // Simulate and write in parallel.
   std::mutex log_mutex;
   std::map<std::string, io::TimeSeries> small;  // settings needed for the campaign (stiffness)
-  std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
-  std::atomic<bool> stop{false};
-  std::vector<std::exception_ptr> errors(jobs.size());
   const auto start = std::chrono::steady_clock::now();
-  auto worker = [&] {
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= jobs.size() || stop.load()) return;
-      const Job& j = jobs[i];
-      try {
-        bench::ExperimentOptions eo;
-        eo.bench = bench_options;
-        eo.bench.actuator_open_circuit = j.open_circuit;
-        eo.bench.hpf_resistor = !(j.no_resistor || j.open_circuit);
-        eo.amplitude = j.amplitude;
-        eo.gain = j.gain;
-        eo.duration = j.duration;
-        const io::TimeSeries ts = bench::simulate(j.experiment, truths.at(j.unit), eo, options.seed);
-        io::write_timeseries(ts, dir / j.file);
-        if (!j.tracking_file.empty()) {
-          // The tracking experiment with the unit's hysteresis model as the campaign identifies it
-          // (the same fit of the same record: campaign hysteresis_model).
-          bench::ExperimentOptions to;
-          to.bench = bench_options;
-          const Eigen::VectorXd va = ts.channel("Va"), de = ts.channel("de");
-          to.feedforward = ident::fit_hysteresis({va.data(), static_cast<std::size_t>(va.size())},
-                                                 {de.data(), static_cast<std::size_t>(de.size())}, ts.sample_rate)
-                               .model;
-          io::write_timeseries(bench::simulate(bench::Experiment::kTracking, truths.at(j.unit), to, options.seed), dir / j.tracking_file);
-        }
-        const std::lock_guard<std::mutex> lock(log_mutex);
-        if (j.experiment == bench::Experiment::kStiffness) {
-          io::TimeSeries head;
-          head.settings = ts.settings;
-          small[j.file] = head;
-        }
-        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        say(fmt::format("simulated {:>2}/{} {} ({:.1f} s)", ++done, jobs.size(), j.file, elapsed));
-      } catch (...) {
-        errors[i] = std::current_exception();
-        stop = true;
-      }
+  const int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  core::parallel_for(jobs.size(), threads, [&](std::size_t i) {
+    const Job& j = jobs[i];
+    bench::ExperimentOptions eo;
+    eo.bench = bench_options;
+    eo.bench.actuator_open_circuit = j.open_circuit;
+    eo.bench.hpf_resistor = !(j.no_resistor || j.open_circuit);
+    eo.amplitude = j.amplitude;
+    eo.gain = j.gain;
+    eo.duration = j.duration;
+    const io::TimeSeries ts = bench::simulate(j.experiment, truths.at(j.unit), eo, options.seed);
+    io::write_timeseries(ts, dir / j.file);
+    if (!j.tracking_file.empty()) {
+      // The tracking experiment with the unit's hysteresis model as the campaign identifies it
+      // (the same fit of the same record: campaign hysteresis_model).
+      bench::ExperimentOptions to;
+      to.bench = bench_options;
+      const Eigen::VectorXd va = ts.channel("Va"), de = ts.channel("de");
+      to.feedforward = ident::fit_hysteresis({va.data(), static_cast<std::size_t>(va.size())},
+                                             {de.data(), static_cast<std::size_t>(de.size())}, ts.sample_rate)
+                           .model;
+      io::write_timeseries(bench::simulate(bench::Experiment::kTracking, truths.at(j.unit), to, options.seed), dir / j.tracking_file);
     }
-  };
-  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min<int>(threads, static_cast<int>(jobs.size()));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  for (const auto& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
+    const std::lock_guard<std::mutex> lock(log_mutex);
+    if (j.experiment == bench::Experiment::kStiffness) {
+      io::TimeSeries head;
+      head.settings = ts.settings;
+      small[j.file] = head;
+    }
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    say(fmt::format("simulated {:>2}/{} {} ({:.1f} s)", ++done, jobs.size(), j.file, elapsed));
+  });
 
   DemoFiles files;
   for (const Job& j : jobs) {

@@ -3,10 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <mutex>
 #include <numbers>
 #include <stdexcept>
@@ -18,6 +16,8 @@
 #include "piezobench/campaign/superelement_fit.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/parallel.hpp"
+#include "piezobench/core/statistics.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
@@ -71,11 +71,7 @@ const std::map<std::string, std::string>& rejecting_outliers() {
   return m;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using core::median;
 
 struct BatchOutput {
   BatchAnalysis batch;
@@ -465,32 +461,13 @@ std::vector<UnitAnalysis> analyze_units(const Campaign& c, const std::vector<std
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   threads = std::max(1, std::min<int>(threads, static_cast<int>(n)));
   std::vector<UnitAnalysis> units(n);
-  std::vector<std::exception_ptr> errors(n);
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> stop{false};
-  auto worker = [&] {
-    for (;;) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= n || stop.load()) return;
-      const UnitSpec& spec = c.units[indices[i]];
-      try {
-        units[i] = analyze_unit(c, spec, log);
-        log(fmt::format("{}: done ({} of the experiments not measured, {} analyses failed)", spec.name,
-                        units[i].not_measured.size(), units[i].failed.size()));
-      } catch (...) {
-        errors[i] = std::current_exception();
-        stop = true;
-      }
-    }
-  };
   log(fmt::format("analysing {} units on {} threads", n, threads));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  for (const auto& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
+  core::parallel_for(n, threads, [&](std::size_t i) {
+    const UnitSpec& spec = c.units[indices[i]];
+    units[i] = analyze_unit(c, spec, log);
+    log(fmt::format("{}: done ({} of the experiments not measured, {} analyses failed)", spec.name,
+                    units[i].not_measured.size(), units[i].failed.size()));
+  });
   return units;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/statistics.hpp"
 #include "piezobench/core/units.hpp"
 
 namespace piezobench::campaign {
@@ -16,11 +17,7 @@ namespace {
 
 const char* const kSource = "superelement fit";
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using core::median;
 
 // The model's u -> [d_e, e_s] per newton of actuator force at `hz`, by modal superposition on
 // the model's modes (its damping is modal, so this is the dense solution to round-off without a

@@ -9,6 +9,7 @@
 #include "metrology/check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
+#include "piezobench/core/statistics.hpp"
 
 namespace piezobench::metrology {
 
@@ -51,13 +52,7 @@ void OutlierOptions::validate() const {
   }
 }
 
-namespace {
-double median(std::vector<double> v) {
-  const std::size_t n = v.size();
-  std::sort(v.begin(), v.end());
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-}  // namespace
+using core::median;
 
 OutlierAnalysis robust_outliers(const std::vector<double>& values, const OutlierOptions& options,
                                 const std::string& source, const std::string& field) {
