@@ -1,7 +1,8 @@
 #pragma once
 // The core module: errors (InputError, NumericalError, UsageError), shared constants, the one
 // Levenberg-Marquardt, the one golden-section search, fit-quality verdicts and sign-constrained
-// linear least squares, text helpers and whole-file input/output shared by the readers.
+// linear least squares, the median, a runner of independent jobs on a few threads, text helpers
+// and whole-file input/output shared by the readers.
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/fit_quality.hpp"
@@ -10,6 +11,8 @@
 #include "piezobench/core/memory.hpp"
 #include "piezobench/core/minimize.hpp"
 #include "piezobench/core/nnls.hpp"
+#include "piezobench/core/parallel.hpp"
+#include "piezobench/core/statistics.hpp"
 #include "piezobench/core/text.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"
