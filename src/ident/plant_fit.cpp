@@ -7,6 +7,7 @@
 #include <functional>
 #include <utility>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
@@ -37,6 +38,26 @@ void IffPlantFitOptions::validate() const {
 }
 
 namespace {
+
+// The delay a phase falling linearly with omega implies (a start value of both fits): minus the
+// least-squares slope (a straight line with an intercept) of the unwrapped phase (rad) against
+// omega (rad/s), clamped to [0, 0.1] s; nullopt when omega does not vary.
+std::optional<double> delay_from_phase(const std::vector<double>& omega, const std::vector<double>& phase) {
+  const std::vector<double> y = dsp::unwrap_phase(phase);
+  const auto n = static_cast<double>(omega.size());
+  double mx = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < omega.size(); ++i) {
+    mx += omega[i] / n;
+    my += y[i] / n;
+  }
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < omega.size(); ++i) {
+    sxy += (omega[i] - mx) * (y[i] - my);
+    sxx += (omega[i] - mx) * (omega[i] - mx);
+  }
+  if (!(sxx > 0.0)) return std::nullopt;
+  return std::clamp(-sxy / sxx, 0.0, 0.1);
+}
 
 Complex model(const IffPlantFit& p, double w) { return control::iff_plant_response(p, w); }
 
@@ -255,20 +276,7 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
           x.push_back(w(k));
           phase.push_back(std::arg(d(k) / model(start, w(k))));
         }
-        const std::vector<double> y = dsp::unwrap_phase(phase);
-        double mx = 0.0, my = 0.0;
-        for (std::size_t i = 0; i < x.size(); ++i) {
-          mx += x[i];
-          my += y[i];
-        }
-        mx /= static_cast<double>(x.size());
-        my /= static_cast<double>(x.size());
-        double sxy = 0.0, sxx = 0.0;
-        for (std::size_t i = 0; i < x.size(); ++i) {
-          sxy += (x[i] - mx) * (y[i] - my);
-          sxx += (x[i] - mx) * (x[i] - mx);
-        }
-        if (sxx > 0.0) start.delay = std::clamp(-sxy / sxx, 0.0, 0.1);
+        if (const auto delay = delay_from_phase(x, phase)) start.delay = *delay;
       }
     }
   }
@@ -421,17 +429,7 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
         phase.push_back(std::arg(d(k) / second_order(start, w(k))));
       }
       if (x.size() >= 3) {
-        const std::vector<double> y = dsp::unwrap_phase(phase);
-        double mx = 0.0, my = 0.0, sxy = 0.0, sxx = 0.0;
-        for (std::size_t i = 0; i < x.size(); ++i) {
-          mx += x[i] / static_cast<double>(x.size());
-          my += y[i] / static_cast<double>(x.size());
-        }
-        for (std::size_t i = 0; i < x.size(); ++i) {
-          sxy += (x[i] - mx) * (y[i] - my);
-          sxx += (x[i] - mx) * (x[i] - mx);
-        }
-        if (sxx > 0.0) start.delay = std::clamp(-sxy / sxx, 0.0, 0.1);
+        if (const auto delay = delay_from_phase(x, phase)) start.delay = *delay;
       }
     }
   }
