@@ -59,6 +59,34 @@ std::optional<double> delay_from_phase(const std::vector<double>& omega, const s
   return std::clamp(-sxy / sxx, 0.0, 0.1);
 }
 
+// Points of the band with finite data and enough coherence.
+void select_band(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
+                 const std::string& source, Vector& w, CVector& d) {
+  if (omega.size() != h.size()) {
+    throw InputError(source, "H", fmt::format("{} values (one per frequency)", omega.size()), std::to_string(h.size()));
+  }
+  if (coherence.size() != 0 && coherence.size() != h.size()) {
+    throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
+  }
+  const double wmin = kTwoPi * options.fmin_Hz;
+  const double wmax = options.fmax_Hz > 0.0 ? kTwoPi * options.fmax_Hz : std::numeric_limits<double>::infinity();
+  std::vector<Index> use;
+  for (Index k = 0; k < omega.size(); ++k) {
+    if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
+      throw InputError(source, "H", "finite values", fmt::format("a non-finite value at point {}", k));
+    }
+    if (omega(k) <= 0.0 || omega(k) < wmin || omega(k) > wmax || h(k) == Complex(0.0)) continue;
+    if (coherence.size() > 0 && coherence(k) < options.min_coherence) continue;
+    use.push_back(k);
+  }
+  w.resize(static_cast<Index>(use.size()));
+  d.resize(static_cast<Index>(use.size()));
+  for (std::size_t i = 0; i < use.size(); ++i) {
+    w(static_cast<Index>(i)) = omega(use[i]);
+    d(static_cast<Index>(i)) = h(use[i]);
+  }
+}
+
 Complex model(const IffPlantFit& p, double w) { return control::iff_plant_response(p, w); }
 
 // Scaled parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, log w_hpf, delay / 100 us.
@@ -165,30 +193,10 @@ ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit
 IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
                           const std::string& source) {
   options.validate();
-  if (omega.size() != h.size()) {
-    throw InputError(source, "H", fmt::format("{} values (one per frequency)", omega.size()), std::to_string(h.size()));
-  }
-  if (coherence.size() != 0 && coherence.size() != h.size()) {
-    throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
-  }
-  std::vector<Index> use;
-  const double wmin = kTwoPi * options.fmin_Hz;
-  const double wmax = options.fmax_Hz > 0.0 ? kTwoPi * options.fmax_Hz : std::numeric_limits<double>::infinity();
-  for (Index k = 0; k < omega.size(); ++k) {
-    if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
-      throw InputError(source, "H", "finite values", fmt::format("a non-finite value at point {}", k));
-    }
-    if (omega(k) <= 0.0 || omega(k) < wmin || omega(k) > wmax || h(k) == Complex(0.0)) continue;
-    if (coherence.size() > 0 && coherence(k) < options.min_coherence) continue;
-    use.push_back(k);
-  }
-  if (use.size() < 12) throw InputError(source, "H", "at least 12 usable points in the band", std::to_string(use.size()));
-  Vector w(static_cast<Index>(use.size()));
-  CVector d(static_cast<Index>(use.size()));
-  for (std::size_t i = 0; i < use.size(); ++i) {
-    w(static_cast<Index>(i)) = omega(use[i]);
-    d(static_cast<Index>(i)) = h(use[i]);
-  }
+  Vector w;
+  CVector d;
+  select_band(omega, h, coherence, options, source, w, d);
+  if (w.size() < 12) throw InputError(source, "H", "at least 12 usable points in the band", std::to_string(w.size()));
   // Starting values.
   const double w_hpf_band = kTwoPi * options.hpf_fmax_Hz;
   Index peak = -1;
@@ -342,34 +350,6 @@ Complex second_order(const DelayedSecondOrderFit& p, double w) {
   const Complex s(0.0, w);
   const double wn = p.natural_frequency;
   return p.static_gain * wn * wn / (s * s + 2.0 * p.damping * wn * s + wn * wn) * std::exp(-s * p.delay);
-}
-
-// Points of the band with finite data and enough coherence.
-void select_band(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
-                 const std::string& source, Vector& w, CVector& d) {
-  if (omega.size() != h.size()) {
-    throw InputError(source, "H", fmt::format("{} values (one per frequency)", omega.size()), std::to_string(h.size()));
-  }
-  if (coherence.size() != 0 && coherence.size() != h.size()) {
-    throw InputError(source, "coherence", fmt::format("{} values or none", h.size()), std::to_string(coherence.size()));
-  }
-  const double wmin = kTwoPi * options.fmin_Hz;
-  const double wmax = options.fmax_Hz > 0.0 ? kTwoPi * options.fmax_Hz : std::numeric_limits<double>::infinity();
-  std::vector<Index> use;
-  for (Index k = 0; k < omega.size(); ++k) {
-    if (!std::isfinite(omega(k)) || !std::isfinite(h(k).real()) || !std::isfinite(h(k).imag())) {
-      throw InputError(source, "H", "finite values", fmt::format("a non-finite value at point {}", k));
-    }
-    if (omega(k) <= 0.0 || omega(k) < wmin || omega(k) > wmax || h(k) == Complex(0.0)) continue;
-    if (coherence.size() > 0 && coherence(k) < options.min_coherence) continue;
-    use.push_back(k);
-  }
-  w.resize(static_cast<Index>(use.size()));
-  d.resize(static_cast<Index>(use.size()));
-  for (std::size_t i = 0; i < use.size(); ++i) {
-    w(static_cast<Index>(i)) = omega(use[i]);
-    d(static_cast<Index>(i)) = h(use[i]);
-  }
 }
 
 }  // namespace
