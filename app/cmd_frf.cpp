@@ -164,35 +164,15 @@ dsp::Frf select_band(const dsp::Frf& frf, FitOptions o) {
       if (!o.json) log_line(fmt::format("band {:.4g} to {:.4g} Hz: where the coherence is at least 0.5 (--fmin/--fmax to choose)", o.fmin, o.fmax));
     }
   }
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index k = 0; k < frf.freq_Hz.size(); ++k) {
-    if (frf.freq_Hz(k) >= o.fmin && (o.fmax <= 0.0 || frf.freq_Hz(k) <= o.fmax)) keep.push_back(k);
+  dsp::BandSelection selection;
+  selection.fmin_Hz = o.fmin;
+  selection.fmax_Hz = o.fmax;
+  if (!o.outputs.empty()) {
+    for (const auto& name : split_list(o.outputs, "--output")) selection.outputs.push_back(frf.output_index(name));
   }
-  if (keep.empty()) {
+  dsp::Frf band = dsp::select_band(frf, selection);
+  if (band.freq_Hz.size() == 0) {
     throw InputError(o.file, "freq_Hz", fmt::format("frequencies inside [{:g}, {:g}] Hz", o.fmin, o.fmax), "none");
-  }
-  std::vector<Eigen::Index> outs;
-  if (o.outputs.empty()) {
-    for (std::size_t i = 0; i < frf.outputs.size(); ++i) outs.push_back(static_cast<Eigen::Index>(i));
-  } else {
-    for (const auto& name : split_list(o.outputs, "--output")) outs.push_back(frf.output_index(name));
-  }
-  dsp::Frf band;
-  band.input = frf.input;
-  band.provenance = frf.provenance;
-  band.freq_Hz.resize(static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t k = 0; k < keep.size(); ++k) band.freq_Hz(static_cast<Eigen::Index>(k)) = frf.freq_Hz(keep[k]);
-  for (const Eigen::Index i : outs) {
-    const auto ui = static_cast<std::size_t>(i);
-    band.outputs.push_back(frf.outputs[ui]);
-    Eigen::VectorXcd h(band.freq_Hz.size());
-    for (std::size_t k = 0; k < keep.size(); ++k) h(static_cast<Eigen::Index>(k)) = frf.H[ui](keep[k]);
-    band.H.push_back(h);
-    if (ui < frf.coherence.size() && frf.coherence[ui].size() > 0) {
-      Eigen::VectorXd c(band.freq_Hz.size());
-      for (std::size_t k = 0; k < keep.size(); ++k) c(static_cast<Eigen::Index>(k)) = frf.coherence[ui](keep[k]);
-      band.coherence.push_back(c);
-    }
   }
   return band;
 }

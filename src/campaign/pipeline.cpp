@@ -345,13 +345,13 @@ IffStudy iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units) {
     if (branch.re_im.x.size() > 1) out.branches.push_back(std::move(branch));
   }
   const auto points = [&](const lti::CVector& v) {
-    Curve c;
+    Curve curve;
     for (const auto z : v) {
       if (!inside(z)) continue;
-      c.x.push_back(z.real());
-      c.y.push_back(z.imag());
+      curve.x.push_back(z.real());
+      curve.y.push_back(z.imag());
     }
-    return c;
+    return curve;
   };
   out.open_loop_poles = points(lti::poles(loop));
   out.open_loop_zeros = points(lti::zeros(loop));

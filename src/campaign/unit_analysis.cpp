@@ -181,25 +181,17 @@ struct Band {
 };
 
 Band band(const dsp::Frf& frf, Index output, double fmin, double fmax, double min_coherence = 0.0) {
-  std::vector<Index> keep;
-  for (Index k = 0; k < frf.freq_Hz.size(); ++k) {
-    const double f = frf.freq_Hz(k);
-    if (f <= 0.0 || f < fmin || (fmax > 0.0 && f > fmax)) continue;
-    const auto& coh = frf.coherence[static_cast<std::size_t>(output)];
-    if (coh.size() > 0 && coh(k) < min_coherence) continue;
-    keep.push_back(k);
-  }
+  dsp::BandSelection selection;
+  selection.fmin_Hz = fmin;
+  selection.fmax_Hz = fmax;
+  selection.exclude_dc = true;
+  selection.min_coherence = min_coherence;
+  selection.outputs = {output};
+  dsp::Frf part = dsp::select_band(frf, selection);
   Band b;
-  b.omega.resize(static_cast<Index>(keep.size()));
-  b.h.resize(static_cast<Index>(keep.size()));
-  b.coherence.resize(static_cast<Index>(keep.size()));
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    const auto j = static_cast<Index>(i);
-    b.omega(j) = kTwoPi * frf.freq_Hz(keep[i]);
-    b.h(j) = frf.H[static_cast<std::size_t>(output)](keep[i]);
-    const auto& coh = frf.coherence[static_cast<std::size_t>(output)];
-    b.coherence(j) = coh.size() > 0 ? coh(keep[i]) : 1.0;
-  }
+  b.omega = kTwoPi * part.freq_Hz;
+  b.h = std::move(part.H[0]);
+  b.coherence = part.coherence.empty() ? VectorXd::Ones(b.omega.size()) : std::move(part.coherence[0]);
   return b;
 }
 
@@ -455,15 +447,15 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   // The resistor high-pass: its corner is 1 / (2 pi R C_sensor) (report section 2.5) when the
   // capacitance is measured; the FRF below a few Hz is dominated by the stacks' creep and
   // hysteresis, so the corner fitted to it is a cross-check only.
-  const std::optional<double> w_rc = u.capacitance_sensor ? std::optional<double>(1.0 / (c.bench.hpf_resistance * *u.capacitance_sensor))
-                                                          : std::nullopt;
+  // rad/s; 0 when the capacitance is not measured.
+  const double w_rc = u.capacitance_sensor ? 1.0 / (c.bench.hpf_resistance * *u.capacitance_sensor) : 0.0;
   const std::string fit_source = c.file.string() + ": " + r.spec.key;
   ident::ActuatorPlantOptions po;
   po.fmin_Hz = a.fmin_Hz;
   po.fmax_Hz = a.fmax_Hz;
-  po.iff_fmin_Hz = w_rc ? a.fmin_Hz : 0.0;
+  po.iff_fmin_Hz = w_rc > 0.0 ? a.fmin_Hz : 0.0;
   po.hpf_fmax_Hz = a.hpf_fmax_Hz;
-  po.fixed_w_hpf = w_rc.value_or(0.0);
+  po.fixed_w_hpf = w_rc;
   po.min_coherence = 0.5;
   const ident::ActuatorPlants plants =
       ident::fit_actuator_plants(kTwoPi * frf.freq_Hz, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1], po, fit_source);
@@ -503,18 +495,18 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     hpf.first_order_fit_Hz = h.corner_Hz();
     hpf.first_order_fit_points = static_cast<long>(low.omega.size());
   }
-  if (w_rc) hpf.r_c_Hz = *w_rc / kTwoPi;
+  if (w_rc > 0.0) hpf.r_c_Hz = w_rc / kTwoPi;
   const VectorXd& coh = frf.coherence[1];
   if (plants.vs) {
     u.iff_plant = *plants.vs;
     out.iff_plant = u.iff_plant;
     out.iff_plant_fmin_Hz = plants.vs_options.fmin_Hz;
     out.iff_plant_fmax_Hz = plants.vs_options.fmax_Hz;
-    out.iff_plant_w_hpf_measured = w_rc.has_value();
+    out.iff_plant_w_hpf_measured = w_rc > 0.0;
     out.nmp.iff_plant_fit_xz = u.iff_plant->xz;
-    if (!w_rc) hpf.iff_plant_fit_Hz = u.iff_plant->w_hpf / kTwoPi;
+    if (w_rc <= 0.0) hpf.iff_plant_fit_Hz = u.iff_plant->w_hpf / kTwoPi;
   }
-  if (w_rc) {
+  if (w_rc > 0.0) {
     // Cross-check: the corner fitted with the rest of eq. 2.3 down to the lowest frequencies.
     try {
       ident::IffPlantFitOptions free;
@@ -527,7 +519,7 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
       hpf.iff_plant_fit_error = e.what();
     }
   }
-  hpf.method = w_rc ? "1/(2 pi R C_sensor), R from [bench], C_sensor measured" : "IFF plant fit (eq. 2.3) down to the lowest frequency";
+  hpf.method = w_rc > 0.0 ? "1/(2 pi R C_sensor), R from [bench], C_sensor measured" : "IFF plant fit (eq. 2.3) down to the lowest frequency";
   if (u.capacitance_sensor) {
     hpf.corner_Hz = 1.0 / (kTwoPi * c.bench.hpf_resistance * *u.capacitance_sensor);
   } else if (hpf.iff_plant_fit_Hz) {

@@ -137,6 +137,43 @@ Frf to_frf(const lti::FrequencyResponse& response, const std::string& input_name
   return frf;
 }
 
+Frf select_band(const Frf& frf, const BandSelection& selection) {
+  std::vector<Index> outs = selection.outputs;
+  if (outs.empty()) {
+    for (std::size_t i = 0; i < frf.outputs.size(); ++i) outs.push_back(static_cast<Index>(i));
+  }
+  for (const Index i : outs) {
+    if (i < 0 || static_cast<std::size_t>(i) >= frf.H.size()) {
+      throw InputError(frf.provenance.source, "output", fmt::format("an output index below {}", frf.H.size()), std::to_string(i));
+    }
+  }
+  // The coherence is known for every output or for none (Frf::validate).
+  const auto known_coherence = [&](Index i) -> const Eigen::VectorXd* {
+    return frf.coherence.empty() ? nullptr : &frf.coherence[static_cast<std::size_t>(i)];
+  };
+  std::vector<Index> keep;
+  for (Index k = 0; k < frf.freq_Hz.size(); ++k) {
+    const double f = frf.freq_Hz(k);
+    if (f < selection.fmin_Hz || (selection.fmax_Hz > 0.0 && f > selection.fmax_Hz) || (selection.exclude_dc && f <= 0.0)) continue;
+    const bool coherent = std::all_of(outs.begin(), outs.end(), [&](Index i) {
+      const Eigen::VectorXd* c = known_coherence(i);
+      return c == nullptr || (*c)(k) >= selection.min_coherence;
+    });
+    if (coherent) keep.push_back(k);
+  }
+  Frf band;
+  band.input = frf.input;
+  band.provenance = frf.provenance;
+  band.freq_Hz = frf.freq_Hz(keep);
+  for (const Index i : outs) {
+    const auto ui = static_cast<std::size_t>(i);
+    band.outputs.push_back(frf.outputs[ui]);
+    band.H.emplace_back(frf.H[ui](keep));
+    if (const Eigen::VectorXd* c = known_coherence(i)) band.coherence.emplace_back((*c)(keep));
+  }
+  return band;
+}
+
 FrequencyBand excited_band(const Frf& frf, double min_coherence) {
   frf.validate();
   const Index n = frf.freq_Hz.size();

@@ -126,6 +126,64 @@ TEST(ExcitedBand, FromTheCoherenceOfTheBestOutputIgnoringDipsAndIsolatedBins) {
   }
 }
 
+TEST(SelectBand, KeepsTheLinesOutputsAndCoherenceAskedFor) {
+  // 0 .. 5 Hz in 1 Hz lines; output 1's coherence is low at 3 Hz, output 0's at 5 Hz.
+  Frf f;
+  f.freq_Hz = Eigen::VectorXd::LinSpaced(6, 0.0, 5.0);
+  f.input = std::string("u");
+  f.outputs = {"a", "b"};
+  f.H = {Eigen::VectorXcd::LinSpaced(6, 10.0, 15.0), Eigen::VectorXcd::LinSpaced(6, 20.0, 25.0)};
+  Eigen::VectorXd cb = Eigen::VectorXd::Constant(6, 0.9);
+  cb(3) = 0.2;
+  Eigen::VectorXd ca = Eigen::VectorXd::Ones(6);
+  ca(5) = 0.1;
+  f.coherence = {ca, cb};
+  f.provenance.source = "run.mat";
+
+  // Inclusive bounds, the 0 Hz line kept when fmin is 0 and not excluded, every output.
+  BandSelection s;
+  s.fmax_Hz = 2.0;
+  Frf all = select_band(f, s);
+  ASSERT_EQ(all.freq_Hz.size(), 3);
+  EXPECT_EQ(all.freq_Hz(0), 0.0);
+  EXPECT_EQ(all.outputs, f.outputs);
+  EXPECT_EQ(all.H[1](2), std::complex<double>(22.0, 0.0));
+  ASSERT_EQ(all.coherence.size(), 2U);
+  EXPECT_EQ(all.coherence[1](2), 0.9);
+  EXPECT_EQ(all.provenance.source, "run.mat");
+  EXPECT_NO_THROW(all.validate());
+
+  // One output, no DC, no upper bound, and its low-coherence line dropped.
+  s = BandSelection{};
+  s.exclude_dc = true;
+  s.min_coherence = 0.5;
+  s.outputs = {1};
+  const Frf b = select_band(f, s);
+  ASSERT_EQ(b.freq_Hz.size(), 4);
+  EXPECT_EQ(b.freq_Hz(0), 1.0);
+  EXPECT_EQ(b.freq_Hz(2), 4.0);
+  EXPECT_EQ(b.outputs, std::vector<std::string>{"b"});
+  EXPECT_EQ(b.H[0](2), std::complex<double>(24.0, 0.0));
+  // Both outputs: a line goes when either output's coherence is low.
+  s.outputs = {};
+  EXPECT_EQ(select_band(f, s).freq_Hz.size(), 3);
+  // Without coherence nothing is filtered by it, and the band has none either.
+  Frf no_coherence = f;
+  no_coherence.coherence.clear();
+  const Frf nc = select_band(no_coherence, s);
+  EXPECT_EQ(nc.freq_Hz.size(), 5);
+  EXPECT_TRUE(nc.coherence.empty());
+  EXPECT_NO_THROW(nc.validate());
+
+  // Nothing inside: no line (the caller decides); an output that does not exist: InputError.
+  s = BandSelection{};
+  s.fmin_Hz = 7.0;
+  EXPECT_EQ(select_band(f, s).freq_Hz.size(), 0);
+  s.fmin_Hz = 0.0;
+  s.outputs = {2};
+  EXPECT_THROW((void)select_band(f, s), InputError);
+}
+
 // A mass-spring-damper m x'' + c x' + k x = F with outputs [x, x'] and a second input that only
 // moves the velocity output: H_x = 1 / (k - m w^2 + j c w), H_v = j w H_x.
 lti::StateSpace two_output_plant() {

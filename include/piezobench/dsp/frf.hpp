@@ -27,7 +27,7 @@ struct Frf {
   std::string input;                       // input channel name
   std::vector<std::string> outputs;        // output channel names
   std::vector<Eigen::VectorXcd> H;         // H[i](k): output i / input at freq_Hz(k)
-  std::vector<Eigen::VectorXd> coherence;  // same layout as H, in [0, 1]; empty vector = unknown
+  std::vector<Eigen::VectorXd> coherence;  // same layout as H, in [0, 1]; empty (no vector at all) = unknown
   FrfProvenance provenance;
 
   // Index of the named output; throws InputError (field "output", expected one of the names).
@@ -51,6 +51,19 @@ struct Frf {
 // range, inconsistent sizes or a grid Frf::validate refuses (negative, non-increasing, non-finite).
 [[nodiscard]] Frf to_frf(const lti::FrequencyResponse& response, const std::string& input_name,
                          const std::vector<std::string>& output_names, Eigen::Index input = 0);
+
+// The part of an FRF a fit or a summary uses: the lines with fmin_Hz <= f <= fmax_Hz, of the
+// outputs listed, with their coherence (if known). A line is dropped where the coherence of a kept
+// output is below min_coherence. The result has no line when none qualifies (the caller decides whether
+// that is an error); InputError for an output index out of range.
+struct BandSelection {
+  double fmin_Hz = 0.0;               // Hz
+  double fmax_Hz = 0.0;               // Hz; <= 0: no upper bound
+  bool exclude_dc = false;            // drop the 0 Hz line even when fmin_Hz is 0
+  double min_coherence = 0.0;         // in [0, 1]
+  std::vector<Eigen::Index> outputs;  // indices into Frf::outputs; empty: all, in order
+};
+[[nodiscard]] Frf select_band(const Frf& frf, const BandSelection& selection);
 
 // The band an FRF's input excited, read from the coherence: its lowest and highest frequency > 0
 // where the coherence of the best output (the largest coherence of the outputs whose coherence is
