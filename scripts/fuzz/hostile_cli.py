@@ -2,7 +2,8 @@
 """Runs the piezobench CLI over the regression corpus of hostile files (fuzz/regression/) and checks
 the contract of issue 21: every run ends with exit 2, 3 or 4 (0 for a file named valid_*, any of
 0, 2, 3, 4 for heavy_*) within 20 s of CPU time and under 1 GB of address space, never a signal, a
-sanitizer report or exit 1 ("internal error"), and its output does not depend on MALLOC_PERTURB_.
+sanitizer report of its own process (a forked HDF5 reader's is the child's: src/io/isolated.hpp)
+or exit 1 ("internal error"), and its output does not depend on MALLOC_PERTURB_.
 
 usage: hostile_cli.py PIEZOBENCH_BINARY [--corpus DIR] [--timeout S] [--memory-mb MB]
 Exit status 0 when every case holds; the failures are listed otherwise. Under a sanitizer build the
@@ -11,6 +12,7 @@ sanitizer reports count.
 """
 import argparse
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -76,11 +78,32 @@ def run(binary, args, timeout, memory_mb, perturb, cwd):
             resource.setrlimit(resource.RLIMIT_AS, (memory_mb << 20, memory_mb << 20))
     env = dict(os.environ, MALLOC_PERTURB_=str(perturb))
     t0 = time.monotonic()
-    try:
-        p = subprocess.run([binary] + args, capture_output=True, timeout=6 * timeout, preexec_fn=limits, env=env, cwd=cwd)
-    except subprocess.TimeoutExpired:
-        return None, b"", b"", time.monotonic() - t0
-    return p.returncode, p.stdout, p.stderr, time.monotonic() - t0
+    with subprocess.Popen([binary] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=limits, env=env,
+                          cwd=cwd) as p:
+        try:
+            out, err = p.communicate(timeout=6 * timeout)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.communicate()
+            return None, b"", b"", time.monotonic() - t0
+    return p.returncode, out, own_reports(err, p.pid), time.monotonic() - t0
+
+
+def own_reports(err, pid):
+    """stderr without the sanitizer reports of other processes. A MAT v7.3 file is read by a forked
+    child (src/io/isolated.hpp) whose fault inside Debian's HDF5 the CLI reports as exit 3; what
+    ASan prints in that child (from '==CHILD==ERROR: AddressSanitizer' to '==CHILD==ABORTING') is
+    the child's. Reports of the CLI's own process, and every UBSan 'runtime error:', still count."""
+    kept, foreign = [], None
+    for line in err.splitlines(keepends=True):
+        m = re.match(rb"==(\d+)==ERROR:", line)
+        if foreign is None and m and int(m.group(1)) != pid:
+            foreign = m.group(1)
+        if foreign is None:
+            kept.append(line)
+        elif line.startswith(b"==" + foreign + b"==ABORTING"):
+            foreign = None
+    return b"".join(kept)
 
 
 def check(binary, name, args, allowed, timeout, memory_mb, cwd, failures, deterministic=True):

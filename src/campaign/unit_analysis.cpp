@@ -21,6 +21,8 @@
 #include "piezobench/metrology/stiffness.hpp"
 #include "piezobench/metrology/stroke.hpp"
 
+#include "io/mat_file.hpp"
+
 namespace piezobench::campaign {
 
 namespace fs = std::filesystem;
@@ -44,30 +46,25 @@ VectorXd Record::time() const {
 namespace {
 
 // LCR readings are one sample per channel, which the time-series readers refuse in a .mat file
-// (a record has 2 samples or more): read them as real numeric scalars or vectors through matio.
+// (a record has 2 samples or more): read them as real numeric scalars or vectors.
 // Returns false when the file is not a .mat file or lacks a channel (the reader's message is then
 // the one to show).
 bool read_readings_mat(const fs::path& file, const std::vector<std::string>& channels, io::TimeSeries& out) {
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
   if (ext != ".mat") return false;
-  mat_t* mat = Mat_Open(file.c_str(), MAT_ACC_RDONLY);
-  if (mat == nullptr) return false;
+  // io's bounded MAT reader (a v7.3 file is read by an isolated child, never by HDF5 here).
+  const io::detail::MatFilePtr mat = io::detail::open_mat_for_reading(file);
+  const std::vector<io::detail::MatVarInfo> vars = io::detail::list_mat_variables(mat.get(), file);
   std::vector<VectorXd> values;
-  bool ok = true;
   for (const auto& name : channels) {
-    matvar_t* v = Mat_VarRead(mat, name.c_str());
-    ok = v != nullptr && v->class_type == MAT_C_DOUBLE && !v->isComplex && v->data != nullptr && v->rank == 2 &&
-         (v->dims[0] == 1 || v->dims[1] == 1) && v->dims[0] * v->dims[1] >= 1;
-    if (ok) {
-      const auto n = static_cast<Index>(v->dims[0] * v->dims[1]);
-      values.push_back(Eigen::Map<const VectorXd>(static_cast<const double*>(v->data), n));
-    }
-    if (v != nullptr) Mat_VarFree(v);
-    if (!ok) break;
+    if (std::none_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; })) return false;
+    const io::detail::MatVarPtr v = io::detail::read_mat_variable(mat.get(), file, name);
+    const bool ok = v->class_type == MAT_C_DOUBLE && v->isComplex == 0 && v->data != nullptr && v->rank == 2 &&
+                    (v->dims[0] == 1 || v->dims[1] == 1) && v->dims[0] * v->dims[1] >= 1;
+    if (!ok) return false;
+    values.push_back(io::detail::to_real_vector(*v, file.string(), name));
   }
-  Mat_Close(mat);
-  if (!ok) return false;
   const Index n = values.front().size();
   if (std::any_of(values.begin(), values.end(), [&](const VectorXd& v) { return v.size() != n; })) return false;
   out.names = channels;

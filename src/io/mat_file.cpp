@@ -1,21 +1,17 @@
 #include "io/mat_file.hpp"
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "io/isolated.hpp"
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <complex>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <mutex>
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
-#include "piezobench/core/text.hpp"
 
 namespace piezobench::io::detail {
 namespace fs = std::filesystem;
@@ -314,76 +310,38 @@ std::vector<std::string> create_and_fill(const fs::path& temp, const fs::path& f
   return writer.written();
 }
 
-// HDF5 keeps a file it failed to flush (disk full, file size limit) in its global table and
-// crashes on it when the process exits. A v7.3 file is therefore written by a forked child: a
-// failure there cannot leave state behind in this process. The child reports an error message
-// through a pipe and exits without running exit handlers.
-std::vector<std::string> create_and_fill_isolated(const fs::path& temp, const fs::path& file, bool compress,
-                                                  const std::function<void(MatWriter&)>& fill) {
-  int fds[2];
-  if (::pipe(fds) != 0) {
-    const int err = errno;
-    throw InputError(file.string(), "output file", "a pipe for the writer process", std::string(std::strerror(err)));
-  }
-  std::fflush(nullptr);  // buffered output must not be written twice
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    const int err = errno;
-    ::close(fds[0]);
-    ::close(fds[1]);
-    throw InputError(file.string(), "output file", "a writer process", "fork failed (" + std::string(std::strerror(err)) + ")");
-  }
-  if (pid == 0) {
-    ::close(fds[0]);
-    int code = 0;
-    std::string message;
-    try {
-      const std::vector<std::string> names = create_and_fill(temp, file, true, compress, fill);
-      message = "\n" + text::join(names, "\n");  // leading newline: success
-    } catch (const std::exception& e) {
-      message = e.what();
-      code = 1;
-    } catch (...) {
-      message = "unknown error";
-      code = 1;
+}  // namespace
+
+namespace {
+
+// Re-opens the written file and checks that every written variable reads back (matio does not
+// report every failed fwrite: disk full, file size limit). A long real column of an uncompressed
+// v5 file is proven by reading its last element (its header and its end are in the file, and v5
+// stores it contiguously) instead of all of it: a 100 s record is 40 MB.
+void check_written(const fs::path& temp, const fs::path& file, bool v73, bool compress, const std::vector<std::string>& written) {
+  MatioPtr check(Mat_Open(temp.c_str(), MAT_ACC_RDONLY));
+  if (!check) throw InputError(file.string(), "output file", "a complete write", with_matio_reason("the written file does not open"));
+  for (const std::string& name : written) {
+    const auto incomplete = [&] {
+      return InputError(file.string(), name, "a variable written completely", with_matio_reason("it does not read back"));
+    };
+    if (!v73 && !compress) {
+      MatVarPtr info(Mat_VarReadInfo(check.get(), name.c_str()));
+      if (!info) throw incomplete();
+      const size_t n = info->class_type == MAT_C_DOUBLE && info->isComplex == 0 ? element_count(*info) : 0;
+      if (n > 4096) {
+        double last = 0.0;
+        int start = static_cast<int>(n - 1), stride = 1, edge = 1;
+        if (n - 1 > static_cast<size_t>(std::numeric_limits<int>::max()) ||
+            Mat_VarReadDataLinear(check.get(), info.get(), &last, start, stride, edge) != 0) {
+          throw incomplete();
+        }
+        continue;
+      }
     }
-    size_t done = 0;
-    while (done < message.size()) {
-      const ssize_t w = ::write(fds[1], message.data() + done, message.size() - done);
-      if (w <= 0) break;
-      done += static_cast<size_t>(w);
-    }
-    ::close(fds[1]);
-    ::_exit(code);
+    MatVarPtr var(Mat_VarRead(check.get(), name.c_str()));
+    if (!var || (var->class_type != MAT_C_STRUCT && element_count(*var) > 0 && var->data == nullptr)) throw incomplete();
   }
-  ::close(fds[1]);
-  std::string message;
-  char buf[4096];
-  for (;;) {
-    const ssize_t r = ::read(fds[0], buf, sizeof buf);
-    if (r > 0) {
-      message.append(buf, static_cast<size_t>(r));
-    } else if (r == 0 || errno != EINTR) {
-      break;
-    }
-  }
-  ::close(fds[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && !message.empty() && message.front() == '\n') {
-    std::vector<std::string> names;
-    for (std::string_view n : text::split(std::string_view(message).substr(1), '\n')) {
-      if (!n.empty()) names.emplace_back(n);
-    }
-    return names;
-  }
-  if (WIFSIGNALED(status)) {
-    throw InputError(file.string(), "output file", "a complete write",
-                     "the v7.3 writer process died (signal " + std::to_string(WTERMSIG(status)) + ")");
-  }
-  // The child's InputError message already names the file.
-  throw InputError(message.empty() ? file.string() + ": output file: the v7.3 writer failed" : message);
 }
 
 }  // namespace
@@ -391,36 +349,21 @@ std::vector<std::string> create_and_fill_isolated(const fs::path& temp, const fs
 void write_mat_atomically(const fs::path& file, bool v73, bool compress, const std::function<void(MatWriter&)>& fill) {
   install_matio_logger();
   AtomicFile out(file);
-  const std::vector<std::string> written =
-      v73 ? create_and_fill_isolated(out.temp_path(), file, compress, fill) : create_and_fill(out.temp_path(), file, false, compress, fill);
-  // matio does not report every failed fwrite (disk full, file size limit); reading the variables
-  // back proves the file complete before it gets its name. A long real column of an uncompressed
-  // v5 file is proven by reading its last element (its header and its end are in the file, and v5
-  // stores it contiguously) instead of all of it: a 100 s record is 40 MB.
-  {
-    MatioPtr check(Mat_Open(out.temp_path().c_str(), MAT_ACC_RDONLY));
-    if (!check) throw InputError(file.string(), "output file", "a complete write", with_matio_reason("the written file does not open"));
-    for (const std::string& name : written) {
-      const auto incomplete = [&] {
-        return InputError(file.string(), name, "a variable written completely", with_matio_reason("it does not read back"));
-      };
-      if (!v73 && !compress) {
-        MatVarPtr info(Mat_VarReadInfo(check.get(), name.c_str()));
-        if (!info) throw incomplete();
-        const size_t n = info->class_type == MAT_C_DOUBLE && info->isComplex == 0 ? element_count(*info) : 0;
-        if (n > 4096) {
-          double last = 0.0;
-          int start = static_cast<int>(n - 1), stride = 1, edge = 1;
-          if (n - 1 > static_cast<size_t>(std::numeric_limits<int>::max()) ||
-              Mat_VarReadDataLinear(check.get(), info.get(), &last, start, stride, edge) != 0) {
-            throw incomplete();
-          }
-          continue;
-        }
-      }
-      MatVarPtr var(Mat_VarRead(check.get(), name.c_str()));
-      if (!var || (var->class_type != MAT_C_STRUCT && element_count(*var) > 0 && var->data == nullptr)) throw incomplete();
-    }
+  if (v73) {
+    // HDF5 keeps a file it failed to flush (disk full, file size limit) in its global table and
+    // crashes on it when the process exits: a v7.3 file is written and checked by an isolated
+    // child (io/isolated.hpp), which also keeps this process free of HDF5 altogether.
+    IsolatedOptions isolated;
+    isolated.source = file.string();
+    isolated.field = "output file";
+    isolated.expected = "a complete write";
+    isolated.failure = "the v7.3 writer process failed";
+    run_isolated(
+        isolated,
+        [&](IsolatedOut&) { check_written(out.temp_path(), file, true, compress, create_and_fill(out.temp_path(), file, true, compress, fill)); },
+        [](IsolatedIn&) {});
+  } else {
+    check_written(out.temp_path(), file, false, compress, create_and_fill(out.temp_path(), file, false, compress, fill));
   }
   out.commit();
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Private MAT-file layer of io: thin RAII wrappers around matio, the bounded reader (v5/v7 through
-// matio, v7.3 through HDF5: mat_reader.cpp) and the atomic writer (the v7.3 writer runs in a forked
-// child so that a crash inside HDF5 cannot take the program down: mat_file.cpp).
+// matio, v7.3 through HDF5: mat_reader.cpp) and the atomic writer (mat_file.cpp). Every call into
+// HDF5 (reading and writing v7.3) runs in a forked child (io/isolated.hpp) so that a fault inside
+// the library on a hostile file cannot take the program down: this process never calls HDF5.
 #include <matio.h>
 
 #include <Eigen/Dense>
@@ -49,7 +50,9 @@ void install_matio_logger();
 //         hdf5storage, and reads flagged-empty datasets as dimensions): an uncompressed dataset
 //         must have the bytes its dimensions need allocated in the file; a filtered (deflated)
 //         one may declare at most kMaxInflation times its stored bytes. Every HDF5 return value is
-//         checked; a failed read is an InputError, never data.
+//         checked; a failed read is an InputError, never data. Every operation runs in an
+//         isolated child (open and list, each variable, each vector): a child that crashes or
+//         exits is an InputError naming the file ("the HDF5 library failed on it (signal 11)").
 inline constexpr double kMaxInflation = 1100.0;
 
 // An open MAT file (v5/v7 through matio, v7.3 through HDF5).

@@ -11,8 +11,8 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
-#include <mutex>
 
+#include "io/isolated.hpp"
 #include "io/mat_file.hpp"
 #include "io/mapped_file.hpp"
 #include "piezobench/core/error.hpp"
@@ -475,12 +475,6 @@ class Mat5Input final : public MatInput {
 
 // ---- v7.3 through HDF5 ----------------------------------------------------------------------
 
-// HDF5 (serial build) is not thread-safe: every HDF5 call of a reader runs under this lock.
-std::recursive_mutex& hdf5_mutex() {
-  static std::recursive_mutex m;
-  return m;
-}
-
 class H5Id {
  public:
   H5Id() = default;
@@ -510,24 +504,24 @@ class H5Id {
   herr_t (*close_)(hid_t) = nullptr;
 };
 
-class Mat73Input final : public MatInput {
+// An HDF5 file open for reading. Only ever inside an isolated child (io/isolated.hpp): this
+// process never calls HDF5, so a fault of the library on a corrupt file stays in the child.
+class H5File {
  public:
-  explicit Mat73Input(fs::path f) : MatInput(std::move(f)), lock_(hdf5_mutex()) {
-    static std::once_flag once;
-    std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });  // errors become InputErrors
+  explicit H5File(fs::path f) : file_(std::move(f)) {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become InputErrors
     std::error_code ec;
-    file_size_ = fs::file_size(file(), ec);
+    file_size_ = fs::file_size(file_, ec);
     if (ec) throw InputError(source(), "file", "a readable file", "cannot determine its size");
-    h5_ = H5Id(H5Fopen(file().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    h5_ = H5Id(H5Fopen(file_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
     if (!h5_.valid()) throw InputError(source(), "file", "a MAT v7.3 (HDF5) file HDF5 can open", "HDF5 cannot open it (corrupt?)");
   }
-  [[nodiscard]] bool v73() const override { return true; }
-  [[nodiscard]] std::string source() const { return file().string(); }
+  [[nodiscard]] std::string source() const { return file_.string(); }
   [[nodiscard]] hid_t root() const { return h5_.get(); }
   [[nodiscard]] unsigned long long file_size() const { return file_size_; }
 
  private:
-  std::unique_lock<std::recursive_mutex> lock_;
+  fs::path file_;
   H5Id h5_;
   unsigned long long file_size_ = 0;
 };
@@ -619,7 +613,7 @@ bool is_complex_type(hid_t type) {
   return H5Tget_member_index(type, "real") >= 0 && H5Tget_member_index(type, "imag") >= 0;
 }
 
-H5Var open_h5_var(const Mat73Input& in, hid_t parent, const std::string& name, const std::string& field) {
+H5Var open_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field) {
   const std::string source = in.source();
   H5Var v;
   if (H5Lexists(parent, name.c_str(), H5P_DEFAULT) <= 0) {
@@ -690,7 +684,7 @@ size_t product(const std::vector<size_t>& dims) {
 
 // The data of a dataset must be in the file: uncompressed, the bytes the dimensions need;
 // filtered (deflate), at most kMaxInflation times the stored bytes once inflated.
-void check_h5_storage(const Mat73Input& in, const H5Var& v, const std::string& field) {
+void check_h5_storage(const H5File& in, const H5Var& v, const std::string& field) {
   const std::string source = in.source();
   const size_t n = product(v.dims);
   if (n == 0 || v.empty_flag) return;
@@ -722,9 +716,9 @@ MatVarPtr checked_create(MatVarPtr var, const std::string& source, const std::st
   return var;
 }
 
-MatVarPtr read_h5_var(const Mat73Input& in, hid_t parent, const std::string& name, const std::string& field, int depth);
+MatVarPtr read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth);
 
-MatVarPtr read_h5_struct(const Mat73Input& in, const H5Var& v, const std::string& name, const std::string& field, int depth) {
+MatVarPtr read_h5_struct(const H5File& in, const H5Var& v, const std::string& name, const std::string& field, int depth) {
   const std::string source = in.source();
   if (depth > 16) throw InputError(source, field, "structs nested at most 16 deep", "deeper nesting");
   std::vector<std::string> names;
@@ -753,7 +747,7 @@ MatVarPtr read_h5_struct(const Mat73Input& in, const H5Var& v, const std::string
   return var;
 }
 
-MatVarPtr read_h5_var(const Mat73Input& in, hid_t parent, const std::string& name, const std::string& field, int depth) {
+MatVarPtr read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth) {
   const std::string source = in.source();
   const H5Var v = open_h5_var(in, parent, name, field);
   if (v.group) {
@@ -828,7 +822,7 @@ MatVarPtr read_h5_var(const Mat73Input& in, hid_t parent, const std::string& nam
   return var;
 }
 
-std::vector<std::string> h5_top_level_names(const Mat73Input& in) {
+std::vector<std::string> h5_top_level_names(const H5File& in) {
   std::vector<std::string> names;
   hsize_t idx = 0;
   const auto collect = [](hid_t, const char* link, const H5L_info_t*, void* data) -> herr_t {
@@ -847,7 +841,7 @@ std::vector<std::string> h5_top_level_names(const Mat73Input& in) {
 
 // The dataset of a real double vector of exactly `count` elements (class double or none), or an
 // invalid H5Var.
-std::optional<H5Var> plain_h5_vector(const Mat73Input& in, const std::string& name, Eigen::Index count) {
+std::optional<H5Var> plain_h5_vector(const H5File& in, const std::string& name, Eigen::Index count) {
   if (count <= 0 || H5Lexists(in.root(), name.c_str(), H5P_DEFAULT) <= 0) return std::nullopt;
   H5Var v = open_h5_var(in, in.root(), name, name);
   if (v.group || v.empty_flag || v.complex || v.cls != MAT_C_DOUBLE || static_cast<Eigen::Index>(product(v.dims)) != count ||
@@ -862,7 +856,7 @@ std::optional<H5Var> plain_h5_vector(const Mat73Input& in, const std::string& na
 
 // Elements [first, first + count) of a vector dataset into out (a hyperslab along its one
 // non-singleton dimension).
-void read_h5_part(const Mat73Input& in, const H5Var& v, const std::string& name, Eigen::Index first, Eigen::Index count, double* out) {
+void read_h5_part(const H5File& in, const H5Var& v, const std::string& name, Eigen::Index first, Eigen::Index count, double* out) {
   const H5Id space(H5Dget_space(v.obj.get()), H5Sclose);
   const int rank = space.valid() ? H5Sget_simple_extent_ndims(space.get()) : -1;
   if (rank < 0 || rank > 32) throw InputError(in.source(), name, "a readable dataset", "HDF5 cannot read its shape");
@@ -887,6 +881,199 @@ void read_h5_part(const Mat73Input& in, const H5Var& v, const std::string& name,
     throw InputError(in.source(), name, "data HDF5 can read", "the read failed (corrupt or truncated file)");
   }
 }
+
+// ---- v7.3: the parent's side ----------------------------------------------------------------
+//
+// Every operation on a v7.3 file forks a child that opens the file with HDF5, does the one
+// operation and sends its result back (io/isolated.hpp); the parent keeps only the file's name
+// and its list of variables. The parent checks what it receives as it would a file: bounded
+// names, ranks, nesting and sizes (a child whose memory HDF5 corrupted may send anything).
+
+IsolatedOptions isolated_options(const std::string& source) {
+  IsolatedOptions o;
+  o.source = source;
+  o.expected = "a MAT v7.3 (HDF5) file the HDF5 library can read";
+  o.failure = "the HDF5 library failed on it";
+  return o;
+}
+
+// A variable (1x1 struct with its fields, char, numeric, complex; others as their header only).
+void put_var(IsolatedOut& out, const matvar_t& var) {
+  out.put_string(var.name != nullptr ? var.name : "");
+  for (std::uint64_t v : {static_cast<std::uint64_t>(var.class_type), static_cast<std::uint64_t>(var.data_type),
+                          static_cast<std::uint64_t>(var.isComplex != 0), static_cast<std::uint64_t>(var.isLogical != 0),
+                          static_cast<std::uint64_t>(std::max(var.rank, 0))}) {
+    out.put_u64(v);
+  }
+  for (int i = 0; i < var.rank; ++i) out.put_u64(var.dims[i]);
+  if (var.class_type == MAT_C_STRUCT) {
+    const unsigned fields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
+    char* const* names = Mat_VarGetStructFieldnames(&var);
+    out.put_u64(fields);
+    for (unsigned i = 0; i < fields; ++i) {
+      out.put_string(names[i]);
+      put_var(out, *Mat_VarGetStructFieldByIndex(const_cast<matvar_t*>(&var), i, 0));
+    }
+    return;
+  }
+  const size_t bytes = element_count(var) * Mat_SizeOf(var.data_type);
+  if (var.data == nullptr || bytes == 0) {
+    out.put_u64(0);
+  } else if (var.isComplex != 0) {
+    const auto* split = static_cast<const mat_complex_split_t*>(var.data);
+    out.put_u64(2);
+    out.put_u64(bytes);
+    out.put(split->Re, bytes);
+    out.put(split->Im, bytes);
+  } else {
+    out.put_u64(1);
+    out.put_u64(bytes);
+    out.put(var.data, bytes);
+  }
+}
+
+// The variable put_var sent; `limit`: the most bytes of data a variable of the file may hold.
+MatVarPtr get_var(IsolatedIn& in, const std::string& source, const std::string& field, double limit, int depth) {
+  if (depth > 17) in.malformed("structs nested deeper than the reader reads");
+  const std::string name = in.get_string(4096);
+  const std::uint64_t cls = in.get_u64(), type = in.get_u64(), complex = in.get_u64(), logical = in.get_u64(), rank = in.get_u64();
+  if (cls > MAT_C_OPAQUE || type > MAT_T_FUNCTION || complex > 1 || logical > 1 || rank > 32) in.malformed("a variable header out of range");
+  std::vector<size_t> dims(rank);
+  for (size_t& d : dims) d = in.get_u64();
+  const auto c = static_cast<matio_classes>(cls);
+  const auto t = static_cast<matio_types>(type);
+  const int r = static_cast<int>(rank);
+  if (c == MAT_C_STRUCT) {
+    const std::uint64_t n = in.get_u64();
+    if (n > 4096) in.malformed(std::to_string(n) + " struct fields");
+    std::vector<std::string> names;
+    std::vector<MatVarPtr> fields;
+    for (std::uint64_t i = 0; i < n; ++i) {
+      names.push_back(in.get_string(4096));
+      fields.push_back(get_var(in, source, field + "." + names.back(), limit, depth + 1));
+    }
+    std::vector<const char*> cnames;
+    for (const auto& f : names) cnames.push_back(f.c_str());
+    cnames.push_back(nullptr);
+    size_t one[2] = {1, 1};
+    MatVarPtr var = checked_create(MatVarPtr(Mat_VarCreateStruct2(name.c_str(), 2, one, cnames.data())), source, field);
+    for (std::uint64_t i = 0; i < n; ++i) {
+      MatVarPtr replaced(Mat_VarSetStructFieldByName(var.get(), names[i].c_str(), 0, fields[i].get()));
+      (void)fields[i].release();
+    }
+    return var;
+  }
+  const std::uint64_t kind = in.get_u64();
+  if (kind == 0) {
+    const bool header_only = !is_numeric_class(c) && c != MAT_C_CHAR;
+    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), c, t, r, dims.data(), nullptr, header_only ? MAT_F_DONT_COPY_DATA : 0)),
+                          source, field);
+  }
+  const std::uint64_t bytes = in.get_u64();
+  std::uint64_t count = 1;
+  for (size_t d : dims) count = d == 0 || count == 0 ? 0 : (count > (1ull << 50) / d ? (1ull << 50) : count * d);
+  if (kind > 2 || Mat_SizeOf(t) == 0 || bytes != count * Mat_SizeOf(t) || static_cast<double>(bytes) > limit) {
+    in.malformed("data of " + std::to_string(bytes) + " bytes for " + shape_text(dims));
+  }
+  if (kind == 2) {
+    std::vector<char> re(bytes), im(bytes);
+    in.get(re.data(), bytes);
+    in.get(im.data(), bytes);
+    mat_complex_split_t split{re.data(), im.data()};
+    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), c, t, r, dims.data(), &split, MAT_F_COMPLEX)), source, field);
+  }
+  void* data = std::malloc(bytes);
+  if (data == nullptr) throw InputError(source, field, "memory for " + bytes_text(bytes), "allocation failed");
+  try {
+    in.get(data, bytes);
+  } catch (...) {
+    std::free(data);
+    throw;
+  }
+  MatVarPtr var(Mat_VarCreate(name.c_str(), c, t, r, dims.data(), data, MAT_F_DONT_COPY_DATA));
+  if (!var) {
+    std::free(data);
+    throw InputError(source, field, "a variable matio can hold", "Mat_VarCreate failed");
+  }
+  var->mem_conserve = 0;  // the variable frees `data`
+  if (logical != 0) var->isLogical = 1;
+  return var;
+}
+
+// A v7.3 file in this process: its name and what the child that opened it listed.
+class Mat73Input final : public MatInput {
+ public:
+  explicit Mat73Input(fs::path f) : MatInput(std::move(f)) {
+    std::error_code ec;
+    const auto size = fs::file_size(file(), ec);
+    if (ec) throw InputError(source(), "file", "a readable file", "cannot determine its size");
+    // Doubles from 1-byte integers (8x) of a deflated dataset (kMaxInflation x), see check_h5_storage.
+    limit_ = 8.0 * kMaxInflation * static_cast<double>(size) + 4096.0;
+    run(
+        [&](IsolatedOut& out) {
+          H5File h5(file());
+          std::vector<MatVarInfo> list;
+          try {
+            for (const std::string& name : h5_top_level_names(h5)) {
+              const H5Var v = open_h5_var(h5, h5.root(), name, name);
+              // Readers size their buffers from this list: the declared size is checked here, first.
+              if (!v.group && (is_numeric_class(v.cls) || v.cls == MAT_C_CHAR)) check_h5_storage(h5, v, name);
+              list.push_back({name, v.cls, v.complex, v.dims, read_string_attribute(v.obj.get(), "units", h5.source(), name)});
+            }
+          } catch (const InputError& e) {
+            // Reported by list_mat_variables, as when the file was read in this process.
+            out.put_u64(1);
+            out.put_string(e.what());
+            return;
+          }
+          out.put_u64(0);
+          out.put_u64(list.size());
+          for (const MatVarInfo& v : list) {
+            out.put_string(v.name);
+            out.put_u64(static_cast<std::uint64_t>(v.class_type));
+            out.put_u64(v.is_complex ? 1 : 0);
+            out.put_u64(v.dims.size());
+            for (size_t d : v.dims) out.put_u64(d);
+            out.put_string(v.unit);
+          }
+        },
+        [&](IsolatedIn& in) {
+          if (in.get_u64() != 0) {
+            list_error_ = in.get_string();
+            return;
+          }
+          const std::uint64_t n = in.get_u64();
+          if (n > (1u << 20)) in.malformed(std::to_string(n) + " variables");
+          for (std::uint64_t i = 0; i < n; ++i) {
+            MatVarInfo v;
+            v.name = in.get_string(4096);
+            const std::uint64_t cls = in.get_u64(), complex = in.get_u64(), rank = in.get_u64();
+            if (cls > MAT_C_OPAQUE || complex > 1 || rank > 32) in.malformed("a variable header out of range");
+            v.class_type = static_cast<matio_classes>(cls);
+            v.is_complex = complex != 0;
+            for (std::uint64_t d = 0; d < rank; ++d) v.dims.push_back(in.get_u64());
+            v.unit = in.get_string(4096);
+            list_.push_back(std::move(v));
+          }
+        });
+  }
+  [[nodiscard]] bool v73() const override { return true; }
+  [[nodiscard]] std::string source() const { return file().string(); }
+  [[nodiscard]] double limit() const { return limit_; }
+  [[nodiscard]] const std::vector<MatVarInfo>& list() const {
+    if (!list_error_.empty()) throw InputError(list_error_);
+    return list_;
+  }
+  // Runs `child` (given the file open in HDF5) isolated, `parent` on its answer.
+  void run(const std::function<void(IsolatedOut&)>& child, const std::function<void(IsolatedIn&)>& parent) const {
+    run_isolated(isolated_options(source()), child, parent);
+  }
+
+ private:
+  std::vector<MatVarInfo> list_;
+  std::string list_error_;
+  double limit_ = 0.0;
+};
 
 // ---- matio fast path (v5) -------------------------------------------------------------------
 
@@ -913,6 +1100,33 @@ bool read_v5_part(mat_t* mat, matvar_t* info, Eigen::Index first, Eigen::Index c
 const Mat5Input* as_v5(const MatInput* in) { return in->v73() ? nullptr : static_cast<const Mat5Input*>(in); }
 const Mat73Input* as_v73(const MatInput* in) { return in->v73() ? static_cast<const Mat73Input*>(in) : nullptr; }
 
+// A plain double vector of exactly `count` elements, its elements [first, first + count) sent by
+// the child in pieces of `chunk`, each handed to `take` (false: the variable is something else).
+bool read_h5_vector(const Mat73Input& in, const std::string& name, Eigen::Index count, Eigen::Index first, Eigen::Index length,
+                    Eigen::Index chunk, const std::function<void(Eigen::Index first, Eigen::Index count, IsolatedIn&)>& take) {
+  bool plain = false;
+  const fs::path file = in.file();
+  in.run(
+      [&](IsolatedOut& out) {
+        H5File h5(file);
+        const std::optional<H5Var> v = plain_h5_vector(h5, name, count);
+        out.put_u64(v ? 1 : 0);
+        if (!v) return;
+        std::vector<double> piece(static_cast<size_t>(std::min(chunk, length)));
+        for (Eigen::Index at = first; at < first + length; at += chunk) {
+          const Eigen::Index n = std::min(chunk, first + length - at);
+          read_h5_part(h5, *v, name, at, n, piece.data());
+          out.put(piece.data(), static_cast<size_t>(n) * sizeof(double));
+        }
+      },
+      [&](IsolatedIn& answer) {
+        plain = answer.get_u64() != 0;
+        if (!plain) return;
+        for (Eigen::Index at = first; at < first + length; at += chunk) take(at, std::min(chunk, first + length - at), answer);
+      });
+  return plain;
+}
+
 }  // namespace
 
 MatFilePtr open_mat_for_reading(const fs::path& file) {
@@ -932,15 +1146,7 @@ MatFilePtr open_mat_for_reading(const fs::path& file) {
 
 std::vector<MatVarInfo> list_mat_variables(MatInput* in, const fs::path& file) {
   std::vector<MatVarInfo> out;
-  if (const Mat73Input* h5 = as_v73(in)) {
-    for (const std::string& name : h5_top_level_names(*h5)) {
-      const H5Var v = open_h5_var(*h5, h5->root(), name, name);
-      // Readers size their buffers from this list: the declared size is checked here, first.
-      if (!v.group && (is_numeric_class(v.cls) || v.cls == MAT_C_CHAR)) check_h5_storage(*h5, v, name);
-      out.push_back({name, v.cls, v.complex, v.dims, read_string_attribute(v.obj.get(), "units", h5->source(), name)});
-    }
-    return out;
-  }
+  if (const Mat73Input* h5 = as_v73(in)) return h5->list();
   mat_t* mat = as_v5(in)->mat();
   if (Mat_Rewind(mat) != 0) throw InputError(file.string(), "file", "a readable MAT file", with_matio_reason("cannot rewind"));
   // A corrupt file can make matio loop on garbage; a real file never holds this many variables.
@@ -966,7 +1172,16 @@ std::vector<MatVarInfo> list_mat_variables(MatInput* in, const fs::path& file) {
 }
 
 MatVarPtr read_mat_variable(MatInput* in, const fs::path& file, const std::string& name) {
-  if (const Mat73Input* h5 = as_v73(in)) return read_h5_var(*h5, h5->root(), name, name, 0);
+  if (const Mat73Input* h5 = as_v73(in)) {
+    MatVarPtr var;
+    h5->run(
+        [&](IsolatedOut& out) {
+          H5File f(file);
+          put_var(out, *read_h5_var(f, f.root(), name, name, 0));
+        },
+        [&](IsolatedIn& answer) { var = get_var(answer, file.string(), name, h5->limit(), 0); });
+    return var;
+  }
   mat_t* mat = as_v5(in)->mat();
   (void)take_matio_message();
   MatVarPtr info(Mat_VarReadInfo(mat, name.c_str()));
@@ -993,14 +1208,11 @@ bool read_double_vector_into(MatInput* in, const std::string& name, Eigen::Ref<E
   const Eigen::Index n = out.size();
   const Eigen::Index step = chunk > 0 ? chunk : n;
   if (const Mat73Input* h5 = as_v73(in)) {
-    const std::optional<H5Var> v = plain_h5_vector(*h5, name, n);
-    if (!v) return false;
-    for (Eigen::Index first = 0; first < n; first += step) {
-      const Eigen::Index count = std::min(step, n - first);
-      read_h5_part(*h5, *v, name, first, count, out.data() + first);
+    // Each piece lands in `out` as it arrives, and is looked at before the next one is read.
+    return read_h5_vector(*h5, name, n, 0, n, step, [&](Eigen::Index first, Eigen::Index count, IsolatedIn& answer) {
+      answer.get(out.data() + first, static_cast<size_t>(count) * sizeof(double));
       if (on_chunk) on_chunk(first, count);
-    }
-    return true;
+    });
   }
   mat_t* mat = as_v5(in)->mat();
   const MatVarPtr info = plain_double_vector_info(mat, name, n);
@@ -1021,9 +1233,9 @@ std::optional<double> read_double_element(MatInput* in, const std::string& name,
   if (index < 0 || index >= count) return std::nullopt;
   double value = 0.0;
   if (const Mat73Input* h5 = as_v73(in)) {
-    const std::optional<H5Var> v = plain_h5_vector(*h5, name, count);
-    if (!v) return std::nullopt;
-    read_h5_part(*h5, *v, name, index, 1, &value);
+    const bool plain = read_h5_vector(*h5, name, count, index, 1, 1,
+                                      [&](Eigen::Index, Eigen::Index, IsolatedIn& answer) { answer.get(&value, sizeof value); });
+    if (!plain) return std::nullopt;
     return value;
   }
   mat_t* mat = as_v5(in)->mat();

@@ -124,5 +124,79 @@ TEST(MatReaderHostile, EveryHostileFileIsAnInputErrorThroughEveryReader) {
   }
 }
 
+// ---- v7.3 through the isolated child (isolated.cpp) ----------------------------------------
+
+// A 16 MB vector comes back from the child intact, both in pieces into place (the timeseries
+// fast path) and as one whole variable.
+TEST(MatReaderV73, TwoMillionDoublesRoundTripThroughTheChild) {
+  test::TempDir dir;
+  const fs::path file = dir.path() / "big73.mat";
+  constexpr Eigen::Index n = 2'000'000;
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(n, -1.0, 1.0).array().sin() * 3.0;
+  detail::write_mat_atomically(file, /*v73=*/true, false, [&](detail::MatWriter& w) { w.write(detail::make_real_column("de", x)); });
+  const detail::MatFilePtr mat = detail::open_mat_for_reading(file);
+  const std::vector<detail::MatVarInfo> vars = detail::list_mat_variables(mat.get(), file);
+  ASSERT_EQ(vars.size(), 1u);
+  EXPECT_EQ(vars[0].name, "de");
+  EXPECT_EQ(vars[0].dims, (std::vector<size_t>{static_cast<size_t>(n), 1}));
+
+  Eigen::VectorXd into(n);
+  Eigen::Index pieces = 0, covered = 0;
+  ASSERT_TRUE(detail::read_double_vector_into(mat.get(), "de", into, 1 << 17, [&](Eigen::Index first, Eigen::Index count) {
+    EXPECT_EQ(first, covered);
+    covered += count;
+    ++pieces;
+  }));
+  EXPECT_EQ(covered, n);
+  EXPECT_EQ(pieces, (n + (1 << 17) - 1) / (1 << 17));
+  EXPECT_TRUE(into == x);
+  EXPECT_EQ(detail::read_double_element(mat.get(), "de", n, n - 1), x(n - 1));
+
+  const detail::MatVarPtr whole = detail::read_mat_variable(mat.get(), file, "de");
+  EXPECT_TRUE(detail::to_real_vector(*whole, file.string(), "de") == x);
+}
+
+// Every kind of variable the child sends (struct, char, complex, scalar) arrives as it was written.
+TEST(MatReaderV73, StructsTextAndComplexDataComeBackFromTheChild) {
+  test::TempDir dir;
+  const fs::path file = dir.path() / "kinds73.mat";
+  Eigen::VectorXcd h(3);
+  h << std::complex<double>(1.0, -2.0), std::complex<double>(0.5, 0.25), std::complex<double>(-3.0, 4.0);
+  detail::write_mat_atomically(file, /*v73=*/true, false, [&](detail::MatWriter& w) {
+    std::vector<std::pair<std::string, detail::MatVarPtr>> fields;
+    fields.emplace_back("name", detail::make_text("name", "APA300ML"));
+    fields.emplace_back("k", detail::make_scalar("k", 1.75e6));
+    w.write(detail::make_struct("settings", std::move(fields)));
+    w.write(detail::make_complex_column("H", h));
+    w.write(detail::make_text("input", "u"));
+  });
+  const detail::MatFilePtr mat = detail::open_mat_for_reading(file);
+  const detail::MatVarPtr s = detail::read_mat_variable(mat.get(), file, "settings");
+  ASSERT_EQ(s->class_type, MAT_C_STRUCT);
+  matvar_t* name = Mat_VarGetStructFieldByName(s.get(), "name", 0);
+  matvar_t* k = Mat_VarGetStructFieldByName(s.get(), "k", 0);
+  ASSERT_NE(name, nullptr);
+  ASSERT_NE(k, nullptr);
+  EXPECT_EQ(detail::to_text(*name, file.string(), "name"), "APA300ML");
+  EXPECT_EQ(detail::to_real_vector(*k, file.string(), "k")(0), 1.75e6);
+  EXPECT_TRUE(detail::to_complex_vector(*detail::read_mat_variable(mat.get(), file, "H"), file.string(), "H") == h);
+  EXPECT_EQ(detail::to_text(*detail::read_mat_variable(mat.get(), file, "input"), file.string(), "input"), "u");
+  // A variable the file lacks: the child's InputError, as it was.
+  expect_input_error([&] { (void)detail::read_mat_variable(mat.get(), file, "missing"); },
+                     {"kinds73.mat", "missing", "none of that name"});
+}
+
+// Files on which Debian's HDF5 1.10.8 itself over-reads a heap buffer (under H5Aexists) or leaks
+// (found by fuzz_mat_frf and fuzz_mat_timeseries; replayed from fuzz/regression/): read in the
+// isolated child, they end as an InputError naming the file through every reader.
+TEST(MatReaderV73, FilesHdf5ItselfFailsOnAreInputErrors) {
+  for (const char* name : {"mat_frf/hdf5_attr_overread.mat", "mat_timeseries/hdf5_leak.mat"}) {
+    const fs::path file = fs::path(PIEZOBENCH_SOURCE_DIR) / "fuzz" / "regression" / name;
+    SCOPED_TRACE(name);
+    expect_refused([&] { (void)read_timeseries(file); }, {file.filename().string()});
+    expect_refused([&] { (void)read_frf(file); }, {file.filename().string()});
+  }
+}
+
 }  // namespace
 }  // namespace piezobench::io
