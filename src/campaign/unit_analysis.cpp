@@ -59,11 +59,11 @@ bool read_readings_mat(const fs::path& file, const std::vector<std::string>& cha
   std::vector<VectorXd> values;
   for (const auto& name : channels) {
     if (std::none_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; })) return false;
-    const io::detail::MatVarPtr v = io::detail::read_mat_variable(mat.get(), file, name);
-    const bool ok = v->class_type == MAT_C_DOUBLE && v->isComplex == 0 && v->data != nullptr && v->rank == 2 &&
-                    (v->dims[0] == 1 || v->dims[1] == 1) && v->dims[0] * v->dims[1] >= 1;
+    const io::detail::MatValue v = io::detail::read_mat_variable(mat.get(), file, name);
+    const bool ok = v.class_type == MAT_C_DOUBLE && !v.is_complex && v.has_data && v.dims.size() == 2 &&
+                    (v.dims[0] == 1 || v.dims[1] == 1) && v.count() >= 1;
     if (!ok) return false;
-    values.push_back(io::detail::to_real_vector(*v, file.string(), name));
+    values.push_back(io::detail::to_real_vector(v, file.string(), name));
   }
   const Index n = values.front().size();
   if (std::any_of(values.begin(), values.end(), [&](const VectorXd& v) { return v.size() != n; })) return false;

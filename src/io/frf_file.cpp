@@ -195,8 +195,8 @@ dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) {
 namespace {
 constexpr const char* kFreq = "freq_Hz";
 
-std::vector<std::pair<std::string, detail::MatVarPtr>> provenance_fields(const dsp::FrfProvenance& p) {
-  std::vector<std::pair<std::string, detail::MatVarPtr>> f;
+std::vector<std::pair<std::string, detail::MatValue>> provenance_fields(const dsp::FrfProvenance& p) {
+  std::vector<std::pair<std::string, detail::MatValue>> f;
   f.emplace_back("source", detail::make_text("source", p.source));
   f.emplace_back("estimator", detail::make_text("estimator", p.estimator));
   f.emplace_back("window", detail::make_text("window", p.window));
@@ -240,10 +240,10 @@ dsp::Frf read_frf_mat(const fs::path& file) {
     throw InputError(source, kFreq, "a frequency vector in Hz", "no such variable (variables: " + text::join(names) + ")");
   }
   dsp::Frf frf;
-  frf.freq_Hz = detail::to_real_vector(*detail::read_mat_variable(mat.get(), file, kFreq), source, kFreq);
-  if (has("input")) frf.input = detail::to_text(*detail::read_mat_variable(mat.get(), file, "input"), source, "input");
+  frf.freq_Hz = detail::to_real_vector(detail::read_mat_variable(mat.get(), file, kFreq), source, kFreq);
+  if (has("input")) frf.input = detail::to_text(detail::read_mat_variable(mat.get(), file, "input"), source, "input");
   if (has("outputs")) {
-    const std::string list = detail::to_text(*detail::read_mat_variable(mat.get(), file, "outputs"), source, "outputs");
+    const std::string list = detail::to_text(detail::read_mat_variable(mat.get(), file, "outputs"), source, "outputs");
     for (std::string_view part : text::split(list, ',')) {
       if (!text::trim(part).empty()) frf.outputs.emplace_back(text::trim(part));
     }
@@ -257,7 +257,7 @@ dsp::Frf read_frf_mat(const fs::path& file) {
   for (const std::string& o : frf.outputs) {
     const std::string hname = "H_" + o;
     if (!has(hname)) throw InputError(source, hname, "the FRF of output " + o + " (listed in outputs)", "no such variable");
-    frf.H.push_back(detail::to_complex_vector(*detail::read_mat_variable(mat.get(), file, hname), source, hname));
+    frf.H.push_back(detail::to_complex_vector(detail::read_mat_variable(mat.get(), file, hname), source, hname));
     if (has("coh_" + o)) ++with_coh;
   }
   if (with_coh != 0 && with_coh != frf.outputs.size()) {
@@ -266,18 +266,18 @@ dsp::Frf read_frf_mat(const fs::path& file) {
   }
   if (with_coh != 0) {
     for (const std::string& o : frf.outputs) {
-      frf.coherence.push_back(detail::to_real_vector(*detail::read_mat_variable(mat.get(), file, "coh_" + o), source, "coh_" + o));
+      frf.coherence.push_back(detail::to_real_vector(detail::read_mat_variable(mat.get(), file, "coh_" + o), source, "coh_" + o));
     }
   }
   if (has("provenance")) {
-    detail::MatVarPtr p = detail::read_mat_variable(mat.get(), file, "provenance");
-    if (p->class_type == MAT_C_STRUCT && detail::element_count(*p) == 1) {
+    const detail::MatValue p = detail::read_mat_variable(mat.get(), file, "provenance");
+    if (p.class_type == MAT_C_STRUCT && p.count() == 1) {
       const auto text = [&](const char* field) {
-        matvar_t* f = Mat_VarGetStructFieldByName(p.get(), field, 0);
+        const detail::MatValue* f = p.field(field);
         return f != nullptr ? detail::to_text(*f, source, std::string("provenance.") + field) : std::string();
       };
       const auto number = [&](const char* field) {
-        matvar_t* f = Mat_VarGetStructFieldByName(p.get(), field, 0);
+        const detail::MatValue* f = p.field(field);
         if (f == nullptr) return 0.0;
         const Eigen::VectorXd v = detail::to_real_vector(*f, source, std::string("provenance.") + field);
         if (v.size() != 1 || !std::isfinite(v(0))) {

@@ -128,8 +128,8 @@ class InflateSource final : public ByteSource {
   bool failed_ = false, ready_ = false, exceeded_ = false;
 };
 
-// v5 data types and classes (MAT-file format, tables 1-2 and 1-3).
-constexpr std::uint32_t kMiMatrix = 14, kMiCompressed = 15;
+// v5 data types and classes (MAT-file format, tables 1-2 and 1-3): the one place a v5 file is parsed
+// (checked, listed and, for a plain file, read).
 int element_size(std::uint32_t type) {
   switch (type) {
     case 1: case 2: case 16: return 1;     // int8, uint8, utf8
@@ -140,13 +140,17 @@ int element_size(std::uint32_t type) {
   }
 }
 
-// A top-level variable of a v5 file, and where its data lie when it is a real double array stored
-// as doubles in the file's own bytes (uncompressed, native byte order): what map_double_vector
-// may use in place. count 0: anything else.
-struct PlainVector {
+// A top-level variable of a v5 file: its header, where its element lies (uncompressed: what the own
+// reader decodes), and where its data lie when it is a real double array stored as doubles in the
+// file's own bytes (uncompressed, native byte order): what map_double_vector may use in place.
+struct V5Variable {
   std::string name;
-  unsigned long long offset = 0;  // file offset of the first element
-  unsigned long long count = 0;
+  matio_classes class_type = MAT_C_EMPTY;
+  bool is_complex = false;
+  std::vector<size_t> dims;
+  unsigned long long element = 0, bytes = 0;  // file offset and size of the element's contents (0: compressed)
+  unsigned long long offset = 0;              // file offset of the first double
+  unsigned long long count = 0;               // its number of doubles (0: not a plain double array)
 };
 
 struct Tag {
@@ -157,7 +161,8 @@ struct Tag {
 };
 
 // Walks one variable (a miMATRIX element, recursively) and refuses any declared size that the
-// bytes present cannot back, before matio allocates anything for it.
+// bytes present cannot back, before anything is allocated for it. Given a MatValue, the same walk
+// also reads the variable into it (native byte order only: the own reader's files).
 class V5Checker {
  public:
   // `base`: the file offset of the source's first byte when it reads the file itself (lets
@@ -166,9 +171,9 @@ class V5Checker {
   V5Checker(ByteSource& src, bool swap, std::string source, unsigned long long base = kNotInFile)
       : src_(src), swap_(swap), source_(std::move(source)), base_(base) {}
 
-  // After the check of a top-level variable: its name, and where its data lie when it is a real
-  // double array stored as doubles in the file's own bytes (see PlainVector).
-  [[nodiscard]] const PlainVector& plain() const { return plain_; }
+  // After the check of a top-level variable: its header, and where its data lie when it is a real
+  // double array stored as doubles in the file's own bytes (see V5Variable).
+  [[nodiscard]] const V5Variable& plain() const { return plain_; }
 
   // The whole element: tag (miMATRIX) then its contents.
   void check_element(const std::string& path) {
@@ -177,10 +182,15 @@ class V5Checker {
     check_matrix(tag.bytes, 0, path);
   }
 
-  // Contents of a miMATRIX element of `bytes` bytes, starting at the source's position.
-  void check_matrix(unsigned long long bytes, int depth, std::string path) {
+  // Contents of a miMATRIX element of `bytes` bytes, starting at the source's position; read into
+  // `out` when given.
+  void check_matrix(unsigned long long bytes, int depth, std::string path, MatValue* out = nullptr) {
     if (depth > 32) fail(path, "structs or cells nested at most 32 deep", "deeper nesting");
-    if (bytes == 0) return;  // an empty cell element
+    if (out != nullptr && swap_) fail(path, "a file in this machine's byte order", "the other one");
+    if (bytes == 0) {  // an empty cell element
+      if (out != nullptr) *out = MatValue("", MAT_C_EMPTY, {0, 0});
+      return;
+    }
     const unsigned long long end = src_.position() + bytes;
     const Tag flags = read_tag(path + " (array flags)");
     std::uint32_t flag_word = 0;
@@ -214,6 +224,7 @@ class V5Checker {
       count = d == 0 || count == 0 ? 0 : (count > (1ull << 50) / d ? (1ull << 50) : count * d);
     }
     const std::string shape = shape_text(dims);
+    const matio_classes class_type = cls <= 17 ? static_cast<matio_classes>(cls) : MAT_C_EMPTY;
     const Tag name_tag = read_tag(path + " (name)");
     std::string name;
     if (name_tag.small) {
@@ -225,12 +236,20 @@ class V5Checker {
     } else {
       skip(padded(name_tag.bytes), path + " (name)");
     }
-    if (depth == 0) plain_.name = name;
+    if (depth == 0) {
+      plain_.name = name;
+      plain_.class_type = class_type;
+      plain_.is_complex = complex;
+      plain_.dims.assign(dims.begin(), dims.end());
+    }
+    if (out != nullptr) {
+      *out = MatValue(name, class_type, std::vector<size_t>(dims.begin(), dims.end()), complex, (flag_word & 0x200u) != 0);
+    }
     if (depth == 0 && !name.empty()) path = text::quote(name);
     const std::string what = path + " (declared " + shape + ")";
 
     if (cls == 1) {  // cell: one matrix element per cell
-      check_children(count, end, depth, path, what);
+      check_children(count, end, depth, path, what, out);
     } else if (cls == 2) {  // struct: field name length, names, then fields x elements
       const Tag len_tag = read_tag(path + " (field name length)");
       std::uint32_t len = 0;
@@ -245,20 +264,37 @@ class V5Checker {
       }
       len = fix(len);
       const Tag names_tag = read_tag(path + " (field names)");
-      if (!names_tag.small) skip(padded(names_tag.bytes), path + " (field names)");
       const unsigned long long fields = len == 0 ? 0 : names_tag.bytes / len;
+      if (out != nullptr) {
+        const unsigned long long left = end - std::min(end, src_.position());
+        if (!names_tag.small && names_tag.bytes > left) {
+          fail(path + " (field names)", "names inside the variable", bytes_text(names_tag.bytes) + " declared, " + bytes_text(left) + " left");
+        }
+        std::string names(names_tag.bytes, '\0');
+        read_payload(names_tag, reinterpret_cast<unsigned char*>(names.data()), path + " (field names)");
+        for (unsigned long long f = 0; f < fields; ++f) {
+          const std::string_view field(names.data() + f * len, len);
+          out->field_names.emplace_back(field.substr(0, std::min(field.size(), field.find('\0'))));
+        }
+      } else if (!names_tag.small) {
+        skip(padded(names_tag.bytes), path + " (field names)");
+      }
       const unsigned long long children = fields == 0 || count == 0 ? 0 : (count > (1ull << 50) / fields ? (1ull << 50) : count * fields);
-      check_children(children, end, depth, path, what);
+      check_children(children, end, depth, path, what, out);
+      if (out != nullptr) {
+        for (size_t i = 0; i < out->items.size(); ++i) out->items[i].name = out->field_names[i % out->field_names.size()];
+      }
     } else if (cls == 4 || (cls >= 6 && cls <= 15)) {  // char and numeric classes
-      const Tag real = check_data(count, end, path + " (real part)", what);
-      constexpr std::uint32_t kMiDouble = 9;
+      const Tag real = check_data(count, end, path + " (real part)", what, out, false);
       constexpr unsigned kDoubleClass = 6, kLogicalFlag = 0x200u;
       if (depth == 0 && base_ != kNotInFile && !swap_ && cls == kDoubleClass && !complex && (flag_word & kLogicalFlag) == 0 &&
           real.type == kMiDouble && !real.small && count > 0 && real.bytes == count * 8) {
         plain_.offset = base_ + data_position_;
         plain_.count = count;
       }
-      if (complex) check_data(count, end, path + " (imaginary part)", what);
+      if (complex) check_data(count, end, path + " (imaginary part)", what, out, true);
+    } else if (out != nullptr) {
+      out->has_data = false;
     }
     // Anything else (sparse, object, function, opaque) is never read by piezobench: skipped.
     if (src_.position() > end) fail(path, "sub-elements inside the variable's " + bytes_text(bytes), "more");
@@ -266,7 +302,8 @@ class V5Checker {
   }
 
  private:
-  void check_children(unsigned long long n, unsigned long long end, int depth, const std::string& path, const std::string& what) {
+  void check_children(unsigned long long n, unsigned long long end, int depth, const std::string& path, const std::string& what,
+                      MatValue* out) {
     // Each child is at least an 8-byte tag.
     if (n > (end - std::min(end, src_.position())) / 8) {
       fail(what, std::to_string(n) + " elements (8 bytes each at least)",
@@ -280,12 +317,15 @@ class V5Checker {
         fail(child, "a size inside its parent", bytes_text(tag.bytes) + " declared, " +
                                                    bytes_text(end - std::min(end, src_.position())) + " left");
       }
-      check_matrix(tag.bytes, depth + 1, child);
+      if (out != nullptr) out->items.emplace_back();
+      check_matrix(tag.bytes, depth + 1, child, out != nullptr ? &out->items.back() : nullptr);
     }
   }
 
-  // Checks one data element and returns its tag (data_position_: where its data start).
-  Tag check_data(unsigned long long count, unsigned long long end, const std::string& field, const std::string& what) {
+  // Checks one data element and returns its tag (data_position_: where its data start); reads its
+  // first `count` values into `out` (the imaginary part when `imaginary`) when given.
+  Tag check_data(unsigned long long count, unsigned long long end, const std::string& field, const std::string& what, MatValue* out,
+                 bool imaginary) {
     const Tag tag = read_tag(field);
     data_position_ = src_.position();
     const int size = element_size(tag.type);
@@ -296,8 +336,42 @@ class V5Checker {
       fail(what, std::to_string(count) + " elements of " + bytes_text(static_cast<unsigned long long>(size)),
            bytes_text(tag.bytes) + " of data");
     }
-    if (!tag.small) skip(padded(tag.bytes), field);
+    if (out != nullptr) {
+      read_values(tag, count, field, *out, imaginary);
+    } else if (!tag.small) {
+      skip(padded(tag.bytes), field);
+    }
     return tag;
+  }
+
+  // The data of a checked element (at least `count` values) into `out`, and past its padding.
+  void read_values(const Tag& tag, unsigned long long count, const std::string& field, MatValue& out, bool imaginary) {
+    const auto size = static_cast<unsigned long long>(element_size(tag.type));
+    std::vector<double>& values = imaginary ? out.im : out.re;
+    if (tag.type == kMiDouble && out.class_type != MAT_C_CHAR && !tag.small) {
+      values.resize(count);  // doubles: straight into place
+      need(values.data(), count * 8, field);
+    } else {
+      std::vector<unsigned char> raw;
+      const unsigned char* bytes = tag.payload;  // a small element holds at most 4 bytes: count * size <= 4
+      if (!tag.small) {
+        raw.resize(count * size);
+        need(raw.data(), raw.size(), field);
+        bytes = raw.data();
+      }
+      if (out.class_type == MAT_C_CHAR && size == 1) {
+        out.text.assign(reinterpret_cast<const char*>(bytes), count);  // UTF-8 (or 8-bit) as it is
+      } else {
+        values.resize(count);
+        if (!numbers_to_doubles(tag.type, bytes, count, values.data())) fail(field, "numbers or characters", "type " + std::to_string(tag.type));
+        if (out.class_type == MAT_C_CHAR) {
+          // UTF-16/32 code units; piezobench names are ASCII.
+          for (double c : values) out.text += c >= 0.0 && c < 128.0 ? static_cast<char>(c) : '?';
+          values.clear();
+        }
+      }
+    }
+    if (!tag.small) skip(padded(tag.bytes) - count * size, field);
   }
 
   Tag read_tag(const std::string& where) {
@@ -360,12 +434,8 @@ class V5Checker {
   std::string source_;
   unsigned long long base_;
   unsigned long long data_position_ = 0;
-  PlainVector plain_;
+  V5Variable plain_;
 };
-
-void keep_first(std::vector<PlainVector>& vars, const PlainVector& v) {
-  if (std::none_of(vars.begin(), vars.end(), [&](const PlainVector& q) { return q.name == v.name; })) vars.push_back(v);
-}
 
 // The first bytes decide whether the file is a MAT file at all: a v5/v7 file has a 128-byte
 // header with the version 0x0100 and an endian indicator "IM"/"MI" at bytes 126..127; a v7.3 file
@@ -374,9 +444,10 @@ void keep_first(std::vector<PlainVector>& vars, const PlainVector& v) {
 // For v5, every top-level element is then checked against the file (see V5Checker): matio stops
 // at the first variable it cannot read and reports the ones before it as if the file ended there,
 // and allocates what a variable's header declares.
-// Returns true for a v7.3 (HDF5) file. For v5, `plain` receives the top-level variables (the first
-// of each name, the one matio finds) and where the data of those that can be used in place lie.
-bool check_mat_file(const fs::path& file, std::vector<PlainVector>& plain) {
+// Returns true for a v7.3 (HDF5) file. For v5, `vars` receives the top-level variables in file
+// order (for a name given twice, the first is the one matio reads) and `own` whether the own reader
+// reads the file: this machine's byte order, and every top-level element an uncompressed matrix.
+bool check_mat_file(const fs::path& file, std::vector<V5Variable>& vars, bool& own) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string(), "file", "a readable file", "cannot open it");
   char header[128] = {};
@@ -401,6 +472,7 @@ bool check_mat_file(const fs::path& file, std::vector<PlainVector>& plain) {
   in.seekg(0, std::ios::end);
   const auto size = static_cast<unsigned long long>(in.tellg());
   const bool swap = (little != (std::endian::native == std::endian::little));
+  own = !swap;
   const auto u32 = [&](const unsigned char* p) {
     std::uint32_t v;
     std::memcpy(&v, p, 4);
@@ -420,6 +492,7 @@ bool check_mat_file(const fs::path& file, std::vector<PlainVector>& plain) {
     in.read(reinterpret_cast<char*>(tag), 8);
     const std::uint32_t type = u32(tag);
     if ((type >> 16) != 0) {  // small data element: type and size share the first 4 bytes
+      own = false;
       pos += 8;
       continue;
     }
@@ -435,28 +508,58 @@ bool check_mat_file(const fs::path& file, std::vector<PlainVector>& plain) {
       FileSource src(in, pos + 8, nbytes);
       V5Checker check(src, swap, file.string(), pos + 8);
       check.check_matrix(nbytes, 0, std::to_string(index) + " (at byte " + std::to_string(pos) + ")");
-      keep_first(plain, check.plain());
+      vars.push_back(check.plain());
+      vars.back().element = pos + 8;
+      vars.back().bytes = nbytes;
     } else if (type == kMiCompressed) {
+      own = false;
       const auto limit = static_cast<unsigned long long>(kMaxInflation * static_cast<double>(nbytes)) + 4096;
       InflateSource src(in, pos + 8, nbytes, limit);
       V5Checker check(src, swap, file.string());
       check.check_element(std::to_string(index) + " (compressed, at byte " + std::to_string(pos) + ")");
-      keep_first(plain, check.plain());
+      vars.push_back(check.plain());
+    } else {
+      own = false;
     }
     pos = next;
   }
   return false;
 }
 
-// ---- v5/v7 through matio --------------------------------------------------------------------
+// ---- v5/v7: the own reader (plain files) or matio ---------------------------------------------
 
 class Mat5Input final : public MatInput {
  public:
-  Mat5Input(fs::path file, MatioPtr mat, std::vector<PlainVector> plain)
-      : MatInput(std::move(file)), mat_(std::move(mat)), plain_(std::move(plain)) {}
+  // `mat`: matio's handle, or null when the own reader reads the file.
+  Mat5Input(fs::path file, MatioPtr mat, std::vector<V5Variable> vars)
+      : MatInput(std::move(file)), mat_(std::move(mat)), vars_(std::move(vars)) {}
   [[nodiscard]] bool v73() const override { return false; }
   [[nodiscard]] mat_t* mat() const { return mat_.get(); }
-  [[nodiscard]] const std::vector<PlainVector>& plain() const { return plain_; }
+  [[nodiscard]] const std::vector<V5Variable>& vars() const { return vars_; }
+  // The first variable of that name, or null.
+  [[nodiscard]] const V5Variable* find(const std::string& name) const {
+    const auto it = std::find_if(vars_.begin(), vars_.end(), [&](const V5Variable& v) { return v.name == name; });
+    return it == vars_.end() ? nullptr : &*it;
+  }
+  // The bytes [offset, offset + n) of the file into out; InputError when they cannot be read.
+  void read_at(unsigned long long offset, void* out, unsigned long long n) const {
+    if (!in_.is_open()) in_.open(file(), std::ios::binary);
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(offset));
+    in_.read(static_cast<char*>(out), static_cast<std::streamsize>(n));
+    if (!in_ || static_cast<unsigned long long>(in_.gcount()) != n) {
+      throw InputError(file().string(), "file", "the bytes checked when it was opened", "a read error (the file changed?)");
+    }
+  }
+  // A variable read by the own reader (the walk that checked it, this time reading its data).
+  [[nodiscard]] MatValue decode(const V5Variable& v) const {
+    if (!in_.is_open()) in_.open(file(), std::ios::binary);
+    FileSource src(in_, v.element, v.bytes);
+    V5Checker walk(src, false, file().string(), v.element);
+    MatValue out;
+    walk.check_matrix(v.bytes, 0, text::quote(v.name), &out);
+    return out;
+  }
   // The file mapped once, on first use (nullptr when it cannot be mapped).
   [[nodiscard]] const std::shared_ptr<const MappedFile>& mapping() const {
     if (!mapped_) {
@@ -468,7 +571,8 @@ class Mat5Input final : public MatInput {
 
  private:
   MatioPtr mat_;
-  std::vector<PlainVector> plain_;
+  std::vector<V5Variable> vars_;
+  mutable std::ifstream in_;
   mutable std::shared_ptr<const MappedFile> mapping_;
   mutable bool mapped_ = false;
 };
@@ -1127,26 +1231,72 @@ bool read_h5_vector(const Mat73Input& in, const std::string& name, Eigen::Index 
   return plain;
 }
 
+// The own reader's plain double vector of exactly `count` elements, or null.
+const V5Variable* own_plain_vector(const Mat5Input& in, const std::string& name, Eigen::Index count) {
+  const V5Variable* v = in.find(name);
+  return v != nullptr && count > 0 && v->count == static_cast<unsigned long long>(count) &&
+                 std::count_if(v->dims.begin(), v->dims.end(), [](size_t d) { return d != 1; }) <= 1
+             ? v
+             : nullptr;
+}
+
 }  // namespace
 
+bool numbers_to_doubles(std::uint32_t type, const void* data, size_t n, double* out) {
+  const auto* raw = static_cast<const unsigned char*>(data);
+  const auto convert = [&](auto zero) {
+    using T = decltype(zero);
+    for (size_t i = 0; i < n; ++i) {
+      T v;
+      std::memcpy(&v, raw + i * sizeof(T), sizeof(T));
+      out[i] = static_cast<double>(v);
+    }
+    return true;
+  };
+  switch (type) {
+    case 1: return convert(std::int8_t{});
+    case 2: case 16: return convert(std::uint8_t{});   // uint8, utf8
+    case 3: return convert(std::int16_t{});
+    case 4: case 17: return convert(std::uint16_t{});  // uint16, utf16
+    case 5: return convert(std::int32_t{});
+    case 6: case 18: return convert(std::uint32_t{});  // uint32, utf32
+    case 7: return convert(float{});
+    case 9: std::memcpy(out, data, n * sizeof(double)); return true;
+    case 12: return convert(std::int64_t{});
+    case 13: return convert(std::uint64_t{});
+    default: return false;
+  }
+}
+
 MatFilePtr open_mat_for_reading(const fs::path& file) {
-  install_matio_logger();
   std::error_code ec;
   if (!fs::exists(file, ec)) throw InputError(file.string(), "file", "an existing file", "no such file");
   if (fs::is_directory(file, ec)) throw InputError(file.string(), "file", "a regular file", "a directory");
-  std::vector<PlainVector> plain;
-  if (check_mat_file(file, plain)) return std::make_unique<Mat73Input>(file);
+  std::vector<V5Variable> vars;
+  bool own = false;
+  if (check_mat_file(file, vars, own)) return std::make_unique<Mat73Input>(file);
+  if (own) return std::make_unique<Mat5Input>(file, nullptr, std::move(vars));
+  install_matio_logger();
   (void)take_matio_message();
   MatioPtr mat(Mat_Open(file.c_str(), MAT_ACC_RDONLY));
   if (!mat) {
     throw InputError(file.string(), "file", "a MAT file (v5, v7 or v7.3)", with_matio_reason("matio cannot open it"));
   }
-  return std::make_unique<Mat5Input>(file, std::move(mat), std::move(plain));
+  return std::make_unique<Mat5Input>(file, std::move(mat), std::move(vars));
+}
+
+bool read_without_matio(const MatInput* in) {
+  const Mat5Input* v5 = as_v5(in);
+  return v5 != nullptr && v5->mat() == nullptr;
 }
 
 std::vector<MatVarInfo> list_mat_variables(MatInput* in, const fs::path& file) {
   std::vector<MatVarInfo> out;
   if (const Mat73Input* h5 = as_v73(in)) return h5->list();
+  if (read_without_matio(in)) {
+    for (const V5Variable& v : as_v5(in)->vars()) out.push_back({v.name, v.class_type, v.is_complex, v.dims, ""});
+    return out;
+  }
   mat_t* mat = as_v5(in)->mat();
   if (Mat_Rewind(mat) != 0) throw InputError(file.string(), "file", "a readable MAT file", with_matio_reason("cannot rewind"));
   // A corrupt file can make matio loop on garbage; a real file never holds this many variables.
@@ -1171,7 +1321,7 @@ std::vector<MatVarInfo> list_mat_variables(MatInput* in, const fs::path& file) {
   return out;
 }
 
-MatVarPtr read_mat_variable(MatInput* in, const fs::path& file, const std::string& name) {
+MatValue read_mat_variable(MatInput* in, const fs::path& file, const std::string& name) {
   if (const Mat73Input* h5 = as_v73(in)) {
     MatVarPtr var;
     h5->run(
@@ -1180,7 +1330,12 @@ MatVarPtr read_mat_variable(MatInput* in, const fs::path& file, const std::strin
           put_var(out, *read_h5_var(f, f.root(), name, name, 0));
         },
         [&](IsolatedIn& answer) { var = get_var(answer, file.string(), name, h5->limit(), 0); });
-    return var;
+    return from_matvar(*var, file.string());
+  }
+  if (read_without_matio(in)) {
+    const V5Variable* v = as_v5(in)->find(name);
+    if (v == nullptr) throw InputError(file.string(), name, "a variable of the file", "none of that name");
+    return as_v5(in)->decode(*v);
   }
   mat_t* mat = as_v5(in)->mat();
   (void)take_matio_message();
@@ -1189,7 +1344,9 @@ MatVarPtr read_mat_variable(MatInput* in, const fs::path& file, const std::strin
     throw InputError(file.string(), name, "a readable variable", with_matio_reason("matio cannot read it (missing or corrupt)"));
   }
   const matio_classes c = info->class_type;
-  if (!is_numeric_class(c) && c != MAT_C_CHAR && c != MAT_C_STRUCT && c != MAT_C_CELL && c != MAT_C_EMPTY) return info;
+  if (!is_numeric_class(c) && c != MAT_C_CHAR && c != MAT_C_STRUCT && c != MAT_C_CELL && c != MAT_C_EMPTY) {
+    return from_matvar(*info, file.string());
+  }
   MatVarPtr var(Mat_VarRead(mat, name.c_str()));
   if (!var) {
     throw InputError(file.string(), name, "a readable variable", with_matio_reason("matio cannot read it (missing or corrupt)"));
@@ -1199,7 +1356,7 @@ MatVarPtr read_mat_variable(MatInput* in, const fs::path& file, const std::strin
       element_count(*var) > 0 && var->data == nullptr) {
     throw InputError(file.string(), name, "a complete variable", with_matio_reason("its data cannot be read (truncated file?)"));
   }
-  return var;
+  return from_matvar(*var, file.string());
 }
 
 bool read_double_vector_into(MatInput* in, const std::string& name, Eigen::Ref<Eigen::VectorXd> out, Eigen::Index chunk,
@@ -1213,6 +1370,16 @@ bool read_double_vector_into(MatInput* in, const std::string& name, Eigen::Ref<E
       answer.get(out.data() + first, static_cast<size_t>(count) * sizeof(double));
       if (on_chunk) on_chunk(first, count);
     });
+  }
+  if (read_without_matio(in)) {
+    const V5Variable* v = own_plain_vector(*as_v5(in), name, n);
+    if (v == nullptr) return false;
+    for (Eigen::Index first = 0; first < n; first += step) {
+      const Eigen::Index count = std::min(step, n - first);
+      as_v5(in)->read_at(v->offset + 8 * static_cast<unsigned long long>(first), out.data() + first, 8 * static_cast<unsigned long long>(count));
+      if (on_chunk) on_chunk(first, count);
+    }
+    return true;
   }
   mat_t* mat = as_v5(in)->mat();
   const MatVarPtr info = plain_double_vector_info(mat, name, n);
@@ -1238,6 +1405,12 @@ std::optional<double> read_double_element(MatInput* in, const std::string& name,
     if (!plain) return std::nullopt;
     return value;
   }
+  if (read_without_matio(in)) {
+    const V5Variable* v = own_plain_vector(*as_v5(in), name, count);
+    if (v == nullptr) return std::nullopt;
+    as_v5(in)->read_at(v->offset + 8 * static_cast<unsigned long long>(index), &value, 8);
+    return value;
+  }
   mat_t* mat = as_v5(in)->mat();
   const MatVarPtr info = plain_double_vector_info(mat, name, count);
   if (!info) return std::nullopt;
@@ -1250,9 +1423,8 @@ std::optional<double> read_double_element(MatInput* in, const std::string& name,
 std::optional<MappedDoubles> map_double_vector(MatInput* in, const std::string& name, std::size_t count) {
   const Mat5Input* v5 = as_v5(in);
   if (v5 == nullptr || count == 0) return std::nullopt;
-  const auto& plain = v5->plain();
-  const auto it = std::find_if(plain.begin(), plain.end(), [&](const PlainVector& p) { return p.name == name; });
-  if (it == plain.end() || it->count != count) return std::nullopt;
+  const V5Variable* it = v5->find(name);
+  if (it == nullptr || it->count != count) return std::nullopt;
   const std::shared_ptr<const MappedFile>& file = v5->mapping();
   if (!file) return std::nullopt;
   // The mapping is of the file as it is now: a file that changed since it was checked is refused.

@@ -14,7 +14,9 @@
 
 namespace piezobench::io {
 
-using detail::MatVarPtr;
+using detail::make_logical;
+using detail::make_matrix;
+using detail::MatValue;
 using json = nlohmann::json;
 
 void MatStructOptions::validate() const {
@@ -69,25 +71,9 @@ std::optional<double> as_number(const json& v) {
   return std::nullopt;
 }
 
-MatVarPtr checked(matvar_t* var, const std::string& name) {
-  if (var == nullptr) throw InputError("", name, "a variable matio can create", "Mat_VarCreate failed");
-  return MatVarPtr(var);
-}
+MatValue build(const json& v, const std::string& name);
 
-MatVarPtr make_matrix(const std::string& name, std::size_t rows, std::size_t cols, std::vector<double> data) {
-  size_t dims[2] = {rows, cols};
-  return checked(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, data.empty() ? nullptr : data.data(), 0), name);
-}
-
-MatVarPtr make_logical(const std::string& name, const std::vector<unsigned char>& values) {
-  size_t dims[2] = {1, values.size()};
-  std::vector<unsigned char> copy = values;
-  return checked(Mat_VarCreate(name.c_str(), MAT_C_UINT8, MAT_T_UINT8, 2, dims, copy.data(), MAT_F_LOGICAL), name);
-}
-
-MatVarPtr build(const json& v, const std::string& name);
-
-MatVarPtr build_struct_array(const std::vector<const json*>& objects, const std::string& name) {
+MatValue build_struct_array(const std::vector<const json*>& objects, const std::string& name) {
   // The union of the keys (a JSON object keeps its keys sorted).
   json ordered = json::object();
   for (const json* o : objects) {
@@ -99,36 +85,25 @@ MatVarPtr build_struct_array(const std::vector<const json*>& objects, const std:
     std::size_t i = 0;
     for (const auto& item : ordered.items()) field_of[item.key()] = names[i++];
   }
-  std::vector<const char*> c_names;
-  for (const auto& n : names) c_names.push_back(n.c_str());
-  c_names.push_back(nullptr);
-  size_t dims[2] = {1, objects.size()};
-  MatVarPtr var = checked(Mat_VarCreateStruct2(name.c_str(), 2, dims, c_names.data()), name);
+  MatValue var(name, MAT_C_STRUCT, {1, objects.size()});
+  var.field_names = names;
   for (std::size_t i = 0; i < objects.size(); ++i) {
     for (const auto& item : ordered.items()) {
       const std::string& field = field_of[item.key()];
       const json* value = objects[i]->contains(item.key()) ? &(*objects[i])[item.key()] : &item.value();  // null -> []
-      MatVarPtr f = build(*value, field);
-      if (Mat_VarSetStructFieldByName(var.get(), field.c_str(), i, f.get()) != nullptr) {
-        throw InputError("", field, "a struct field matio can set", "a previous value");
-      }
-      (void)f.release();  // owned by the struct now
+      var.items.push_back(build(*value, field));
     }
   }
   return var;
 }
 
-MatVarPtr build_cell(const json& array, const std::string& name) {
-  size_t dims[2] = {1, array.size()};
-  MatVarPtr var = checked(Mat_VarCreate(name.c_str(), MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0), name);
-  for (std::size_t i = 0; i < array.size(); ++i) {
-    MatVarPtr cell = build(array[i], name);
-    (void)Mat_VarSetCell(var.get(), static_cast<int>(i), cell.release());
-  }
+MatValue build_cell(const json& array, const std::string& name) {
+  MatValue var(name, MAT_C_CELL, {1, array.size()});
+  for (const json& item : array) var.items.push_back(build(item, name));
   return var;
 }
 
-MatVarPtr build_array(const json& a, const std::string& name) {
+MatValue build_array(const json& a, const std::string& name) {
   if (a.empty()) return make_matrix(name, 0, 0, {});
   // Numbers (with non-finite stand-ins), not all of them stand-ins.
   {
@@ -175,14 +150,10 @@ MatVarPtr build_array(const json& a, const std::string& name) {
   return build_cell(a, name);
 }
 
-MatVarPtr build(const json& v, const std::string& name) {
+MatValue build(const json& v, const std::string& name) {
   switch (v.type()) {
     case json::value_t::object: {
-      if (v.empty()) {
-        size_t dims[2] = {1, 1};
-        const char* none[] = {nullptr};
-        return checked(Mat_VarCreateStruct2(name.c_str(), 2, dims, none), name);
-      }
+      if (v.empty()) return MatValue(name, MAT_C_STRUCT, {1, 1});
       return build_struct_array({&v}, name);
     }
     case json::value_t::array: return build_array(v, name);
@@ -203,7 +174,7 @@ void write_json_as_mat(const json& document, const std::filesystem::path& file, 
   if (!document.is_object()) {
     throw InputError(file.string(), "document", "a JSON object", std::string("a JSON ") + document.type_name());
   }
-  std::vector<MatVarPtr> vars;
+  std::vector<MatValue> vars;
   try {
     if (!options.variable.empty()) {
       vars.push_back(build(document, options.variable));

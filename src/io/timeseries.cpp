@@ -171,16 +171,6 @@ bool is_rate_name(const std::string& name) {
   return l == "fs" || l == "sample_rate" || l == "sample_rate_hz" || l == "samplerate" || l == "sampling_rate";
 }
 
-std::vector<std::string> struct_field_names(const matvar_t& var) {
-  std::vector<std::string> out;
-  const unsigned nfields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
-  char* const* names = Mat_VarGetStructFieldnames(&var);
-  for (unsigned i = 0; i < nfields && names != nullptr; ++i) {
-    if (names[i] != nullptr) out.emplace_back(names[i]);
-  }
-  return out;
-}
-
 // A sample rate written as text: "fs: 10000", "Fs = 10 kHz", "sample_rate_Hz: 10000",
 // "sample rate [Hz]: 1000" (keys in any case; Hz unless a frequency unit follows). nullopt when the
 // text is not about the sample rate; InputError (source, field) when its value is not a rate.
@@ -421,7 +411,7 @@ namespace {
 struct MatLayout {
   std::vector<std::string> channels;  // numeric vectors (excluding t and fs)
   std::string group;                  // "" = top level
-  detail::MatVarPtr group_var;        // the struct, read with data, when group is set
+  std::optional<detail::MatValue> group_var;  // the struct, read with data, when group is set
 };
 
 bool is_numeric_vector(const detail::MatVarInfo& v) {
@@ -435,27 +425,21 @@ bool is_numeric_vector(const detail::MatVarInfo& v) {
   return non_singleton <= 1 && count > 1;
 }
 
-std::vector<std::string> struct_channels(const matvar_t& var) {
+std::vector<std::string> struct_channels(const detail::MatValue& var) {
   std::vector<std::string> out;
-  const unsigned nfields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
-  char* const* names = Mat_VarGetStructFieldnames(&var);
-  for (unsigned i = 0; i < nfields && names != nullptr; ++i) {
-    if (names[i] == nullptr || is_time_name(names[i])) continue;
-    matvar_t* field = Mat_VarGetStructFieldByIndex(const_cast<matvar_t*>(&var), i, 0);
+  for (const std::string& name : var.field_names) {
+    if (is_time_name(name)) continue;
+    const detail::MatValue* field = var.field(name);
     if (field == nullptr) continue;
-    detail::MatVarInfo info;
-    info.class_type = field->class_type;
-    info.is_complex = field->isComplex != 0;
-    if (field->dims != nullptr) info.dims.assign(field->dims, field->dims + std::max(field->rank, 0));
-    if (is_numeric_vector(info)) out.emplace_back(names[i]);
+    if (is_numeric_vector({name, field->class_type, field->is_complex, field->dims, ""})) out.push_back(name);
   }
   return out;
 }
 
-detail::MatVarPtr read_group(detail::MatInput* mat, const fs::path& file, const std::string& group) {
-  detail::MatVarPtr var = detail::read_mat_variable(mat, file, group);
-  if (var->class_type != MAT_C_STRUCT || detail::element_count(*var) != 1) {
-    throw InputError(file.string(), group, "a 1x1 struct holding the channels", detail::describe(*var));
+detail::MatValue read_group(detail::MatInput* mat, const fs::path& file, const std::string& group) {
+  detail::MatValue var = detail::read_mat_variable(mat, file, group);
+  if (var.class_type != MAT_C_STRUCT || var.count() != 1) {
+    throw InputError(file.string(), group, "a 1x1 struct holding the channels", detail::describe(var));
   }
   return var;
 }
@@ -485,7 +469,7 @@ MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOpti
   // Files written by piezobench list their channels in order (HDF5 lists variables by name).
   const auto order_var = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return v.name == kChannelOrder; });
   if (order_var != vars.end() && order_var->class_type == MAT_C_CHAR) {
-    const std::string list = detail::to_text(*detail::read_mat_variable(mat, file, kChannelOrder), file.string(), kChannelOrder);
+    const std::string list = detail::to_text(detail::read_mat_variable(mat, file, kChannelOrder), file.string(), kChannelOrder);
     std::vector<std::string> ordered;
     for (std::string_view part : text::split(list, ',')) ordered.emplace_back(text::trim(part));
     std::vector<std::string> sorted_listed = ordered, sorted_found = layout.channels;
@@ -502,8 +486,8 @@ MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOpti
           return std::find(layout.channels.begin(), layout.channels.end(), c) != layout.channels.end();
         });
     if (layout.channels.empty() || (!options.channels.empty() && !top_level_has_requested)) {
-      detail::MatVarPtr candidate = read_group(mat, file, structs.front());
-      std::vector<std::string> fields = struct_channels(*candidate);
+      detail::MatValue candidate = read_group(mat, file, structs.front());
+      std::vector<std::string> fields = struct_channels(candidate);
       const bool fits = options.channels.empty()
                             ? !fields.empty()
                             : std::all_of(options.channels.begin(), options.channels.end(), [&](const std::string& c) {
@@ -520,20 +504,17 @@ MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOpti
 }
 
 // Text fields of a struct (units) or text/scalar fields (settings); other fields are ignored.
-std::map<std::string, Setting> read_struct_settings(const matvar_t& var, const std::string& source, const std::string& field) {
+std::map<std::string, Setting> read_struct_settings(const detail::MatValue& var, const std::string& source, const std::string& field) {
   std::map<std::string, Setting> out;
-  if (var.class_type != MAT_C_STRUCT || detail::element_count(var) != 1) {
+  if (var.class_type != MAT_C_STRUCT || var.count() != 1) {
     throw InputError(source, field, "a 1x1 struct", detail::describe(var));
   }
-  const unsigned nfields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
-  char* const* names = Mat_VarGetStructFieldnames(&var);
-  for (unsigned i = 0; i < nfields && names != nullptr; ++i) {
-    matvar_t* f = Mat_VarGetStructFieldByIndex(const_cast<matvar_t*>(&var), i, 0);
-    if (f == nullptr || names[i] == nullptr) continue;
-    const std::string name = names[i];
+  for (const std::string& name : var.field_names) {
+    const detail::MatValue* f = var.field(name);
+    if (f == nullptr) continue;
     if (f->class_type == MAT_C_CHAR) {
       out[name] = detail::to_text(*f, source, field + "." + name);
-    } else if (detail::is_numeric_class(f->class_type) && f->isComplex == 0 && detail::element_count(*f) == 1) {
+    } else if (detail::is_numeric_class(f->class_type) && !f->is_complex && f->count() == 1) {
       out[name] = detail::to_real_vector(*f, source, field + "." + name)(0);
     }
   }
@@ -557,13 +538,13 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
   if (!options.channels.empty()) {
     for (const std::string& c : options.channels) {
       if (std::find(layout.channels.begin(), layout.channels.end(), c) != layout.channels.end()) continue;
-      matvar_t* found = nullptr;
-      detail::MatVarPtr top;
+      const detail::MatValue* found = nullptr;
+      std::optional<detail::MatValue> top;
       if (layout.group_var) {
-        found = Mat_VarGetStructFieldByName(layout.group_var.get(), c.c_str(), 0);
+        found = layout.group_var->field(c);
       } else if (std::any_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == c; })) {
         top = detail::read_mat_variable(mat.get(), file, c);
-        found = top.get();
+        found = &*top;
       }
       if (found != nullptr) {
         const std::string field = layout.group.empty() ? c : layout.group + "." + c;
@@ -577,12 +558,12 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
   // Lengths come from the variables' headers, so the matrix is allocated once and every channel
   // is copied straight into its column (records reach 10^7 samples: no second copy).
   const auto field_of = [&](const std::string& name) {
-    return layout.group_var ? Mat_VarGetStructFieldByName(layout.group_var.get(), name.c_str(), 0) : nullptr;
+    return layout.group_var ? layout.group_var->field(name) : nullptr;
   };
   std::vector<Eigen::Index> lengths;
   for (const std::string& name : names) {
     if (layout.group_var) {
-      lengths.push_back(static_cast<Eigen::Index>(detail::element_count(*field_of(name))));
+      lengths.push_back(static_cast<Eigen::Index>(field_of(name)->count()));
     } else {
       const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; });
       size_t count = 1;
@@ -601,9 +582,9 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
   std::optional<detail::MappedDoubles> t_mapped;  // the time vector in the mapping (view only)
   // `t` or `time` in any case (MATLAB scripts write `time`, `Time`).
   std::string t_name;
-  matvar_t* t_in_group = nullptr;
+  const detail::MatValue* t_in_group = nullptr;
   if (layout.group_var) {
-    for (const std::string& f : struct_field_names(*layout.group_var)) {
+    for (const std::string& f : layout.group_var->field_names) {
       if (is_time_name(f)) {
         t_name = f;
         t_in_group = field_of(f);
@@ -649,8 +630,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
       t_prechecked = read && ok && ts.t(n - 1) == *t_last;
     }
     if (!read) {
-      detail::MatVarPtr tv = detail::read_mat_variable(mat.get(), file, t_name);
-      ts.t = detail::to_real_vector(*tv, source, t_name);
+      ts.t = detail::to_real_vector(detail::read_mat_variable(mat.get(), file, t_name), source, t_name);
     }
     t_length = t_mapped ? n : ts.t.size();
   }
@@ -660,17 +640,17 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
   std::optional<double> fs_file;
   const auto fs_info = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return is_rate_name(v.name); });
   if (fs_info != vars.end()) {
-    detail::MatVarPtr fv = detail::read_mat_variable(mat.get(), file, fs_info->name);
-    const Eigen::VectorXd f = detail::to_real_vector(*fv, source, fs_info->name);
-    if (f.size() != 1) throw InputError(source, fs_info->name, "a scalar sample rate in Hz", detail::describe(*fv));
+    const detail::MatValue fv = detail::read_mat_variable(mat.get(), file, fs_info->name);
+    const Eigen::VectorXd f = detail::to_real_vector(fv, source, fs_info->name);
+    if (f.size() != 1) throw InputError(source, fs_info->name, "a scalar sample rate in Hz", detail::describe(fv));
     fs_file = f(0);
   }
 
   // Units: the `units` struct of the file (one char field per channel, and the time vector's).
   std::map<std::string, Setting> file_units;
   if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kUnits; })) {
-    detail::MatVarPtr uv = detail::read_mat_variable(mat.get(), file, kUnits);
-    if (uv->class_type == MAT_C_STRUCT) file_units = read_struct_settings(*uv, source, kUnits);
+    const detail::MatValue uv = detail::read_mat_variable(mat.get(), file, kUnits);
+    if (uv.class_type == MAT_C_STRUCT) file_units = read_struct_settings(uv, source, kUnits);
   }
   // A field of `units`, else (v7.3) the dataset's own `units` attribute.
   const auto unit_of = [&](const std::string& name) {
@@ -741,8 +721,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
                                                 [&](Eigen::Index first, Eigen::Index count) {
                                                   finite = finite && all_finite(ts.data.col(col).data() + first, count);
                                                 })) {
-      const detail::MatVarPtr v = detail::read_mat_variable(mat.get(), file, names[j]);
-      detail::copy_real_vector(*v, source, field, ts.data.col(col));
+      detail::copy_real_vector(detail::read_mat_variable(mat.get(), file, names[j]), source, field, ts.data.col(col));
       finite = all_finite(ts.data.col(col).data(), ts.data.rows());
     }
     if (!finite) check_finite(source, field, ts.data.col(col));
@@ -752,8 +731,8 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
   for (size_t j = 0; j < names.size(); ++j) ts.units[j] = unit_of(names[j]);
   convert_to_si(ts, options);
   if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kSettings; })) {
-    detail::MatVarPtr sv = detail::read_mat_variable(mat.get(), file, kSettings);
-    if (sv->class_type == MAT_C_STRUCT) ts.settings = read_struct_settings(*sv, source, kSettings);
+    const detail::MatValue sv = detail::read_mat_variable(mat.get(), file, kSettings);
+    if (sv.class_type == MAT_C_STRUCT) ts.settings = read_struct_settings(sv, source, kSettings);
   }
   // The samples were checked above (finite channels, and t by resolve_sample_rate).
   validate_series(ts, /*samples=*/false);
@@ -910,7 +889,7 @@ void write_timeseries_mat(const TimeSeries& ts, const fs::path& file, const MatW
     }
     w.write(detail::make_scalar(kFs, ts.sample_rate));
     w.write(detail::make_text(kChannelOrder, text::join(ts.names, ",")));
-    std::vector<std::pair<std::string, detail::MatVarPtr>> unit_fields;
+    std::vector<std::pair<std::string, detail::MatValue>> unit_fields;
     if (ts.t.size() > 0) unit_fields.emplace_back(kTime, detail::make_text(kTime, "s"));
     for (size_t j = 0; j < ts.units.size(); ++j) {
       if (!ts.units[j].empty()) unit_fields.emplace_back(ts.names[j], detail::make_text(ts.names[j], ts.units[j]));
@@ -918,7 +897,7 @@ void write_timeseries_mat(const TimeSeries& ts, const fs::path& file, const MatW
     if (!ts.units.empty()) unit_fields.emplace_back(kFs, detail::make_text(kFs, "Hz"));
     if (!unit_fields.empty() && !ts.units.empty()) w.write(detail::make_struct(kUnits, std::move(unit_fields)));
     if (!ts.settings.empty()) {
-      std::vector<std::pair<std::string, detail::MatVarPtr>> fields;
+      std::vector<std::pair<std::string, detail::MatValue>> fields;
       for (const auto& [key, value] : ts.settings) {
         if (std::holds_alternative<double>(value)) {
           fields.emplace_back(key, detail::make_scalar(key, std::get<double>(value)));

@@ -152,8 +152,8 @@ TEST(MatReaderV73, TwoMillionDoublesRoundTripThroughTheChild) {
   EXPECT_TRUE(into == x);
   EXPECT_EQ(detail::read_double_element(mat.get(), "de", n, n - 1), x(n - 1));
 
-  const detail::MatVarPtr whole = detail::read_mat_variable(mat.get(), file, "de");
-  EXPECT_TRUE(detail::to_real_vector(*whole, file.string(), "de") == x);
+  const detail::MatValue whole = detail::read_mat_variable(mat.get(), file, "de");
+  EXPECT_TRUE(detail::to_real_vector(whole, file.string(), "de") == x);
 }
 
 // Every kind of variable the child sends (struct, char, complex, scalar) arrives as it was written.
@@ -163,7 +163,7 @@ TEST(MatReaderV73, StructsTextAndComplexDataComeBackFromTheChild) {
   Eigen::VectorXcd h(3);
   h << std::complex<double>(1.0, -2.0), std::complex<double>(0.5, 0.25), std::complex<double>(-3.0, 4.0);
   detail::write_mat_atomically(file, /*v73=*/true, false, [&](detail::MatWriter& w) {
-    std::vector<std::pair<std::string, detail::MatVarPtr>> fields;
+    std::vector<std::pair<std::string, detail::MatValue>> fields;
     fields.emplace_back("name", detail::make_text("name", "APA300ML"));
     fields.emplace_back("k", detail::make_scalar("k", 1.75e6));
     w.write(detail::make_struct("settings", std::move(fields)));
@@ -171,16 +171,16 @@ TEST(MatReaderV73, StructsTextAndComplexDataComeBackFromTheChild) {
     w.write(detail::make_text("input", "u"));
   });
   const detail::MatFilePtr mat = detail::open_mat_for_reading(file);
-  const detail::MatVarPtr s = detail::read_mat_variable(mat.get(), file, "settings");
-  ASSERT_EQ(s->class_type, MAT_C_STRUCT);
-  matvar_t* name = Mat_VarGetStructFieldByName(s.get(), "name", 0);
-  matvar_t* k = Mat_VarGetStructFieldByName(s.get(), "k", 0);
+  const detail::MatValue s = detail::read_mat_variable(mat.get(), file, "settings");
+  ASSERT_EQ(s.class_type, MAT_C_STRUCT);
+  const detail::MatValue* name = s.field("name");
+  const detail::MatValue* k = s.field("k");
   ASSERT_NE(name, nullptr);
   ASSERT_NE(k, nullptr);
   EXPECT_EQ(detail::to_text(*name, file.string(), "name"), "APA300ML");
   EXPECT_EQ(detail::to_real_vector(*k, file.string(), "k")(0), 1.75e6);
-  EXPECT_TRUE(detail::to_complex_vector(*detail::read_mat_variable(mat.get(), file, "H"), file.string(), "H") == h);
-  EXPECT_EQ(detail::to_text(*detail::read_mat_variable(mat.get(), file, "input"), file.string(), "input"), "u");
+  EXPECT_TRUE(detail::to_complex_vector(detail::read_mat_variable(mat.get(), file, "H"), file.string(), "H") == h);
+  EXPECT_EQ(detail::to_text(detail::read_mat_variable(mat.get(), file, "input"), file.string(), "input"), "u");
   // A variable the file lacks: the child's InputError, as it was.
   expect_input_error([&] { (void)detail::read_mat_variable(mat.get(), file, "missing"); },
                      {"kinds73.mat", "missing", "none of that name"});

@@ -112,6 +112,16 @@ TEST(MatStruct, NestedStructsReadBackV5) {
   check_file(file);
 }
 
+// Uncompressed: written by piezobench's own v5 encoder, read by matio.
+TEST(MatStruct, NestedStructsReadBackV5Uncompressed) {
+  test::TempDir dir;
+  const auto file = dir.path() / "results_plain.mat";
+  MatStructOptions o;
+  o.compress = false;
+  write_json_as_mat(document(), file, o);
+  check_file(file);
+}
+
 TEST(MatStruct, NestedStructsReadBackV73) {
   test::TempDir dir;
   const auto file = dir.path() / "results73.mat";

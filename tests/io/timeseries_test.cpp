@@ -430,11 +430,8 @@ TEST(TimeSeriesLargeMat, NanOrInfInTimeNamesTAndTheSample) {
 }
 
 // A 1xN variable (MATLAB's row vector), as written by `x = x.'; save`.
-detail::MatVarPtr make_real_row(const std::string& name, const Eigen::VectorXd& v) {
-  size_t dims[2] = {1, static_cast<size_t>(v.size())};
-  detail::MatVarPtr var(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, const_cast<double*>(v.data()), 0));
-  if (!var) throw std::runtime_error("Mat_VarCreate failed for " + name);
-  return var;
+detail::MatValue make_real_row(const std::string& name, const Eigen::VectorXd& v) {
+  return detail::make_matrix(name, 1, static_cast<size_t>(v.size()), std::vector<double>(v.data(), v.data() + v.size()));
 }
 
 TEST(TimeSeriesLargeMat, RowVectorsAreReadExactlyAcrossPieces) {
