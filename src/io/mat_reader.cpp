@@ -270,7 +270,7 @@ class V5Checker {
         if (!names_tag.small && names_tag.bytes > left) {
           fail(path + " (field names)", "names inside the variable", bytes_text(names_tag.bytes) + " declared, " + bytes_text(left) + " left");
         }
-        std::string names(names_tag.bytes, '\0');
+        std::string names(std::max<unsigned long long>(names_tag.bytes, 4), '\0');  // a small element copies 4 bytes
         read_payload(names_tag, reinterpret_cast<unsigned char*>(names.data()), path + " (field names)");
         for (unsigned long long f = 0; f < fields; ++f) {
           const std::string_view field(names.data() + f * len, len);

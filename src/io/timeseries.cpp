@@ -576,7 +576,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
   ts.source = source;
   // The time vector: inside the group if it has one, else at the top level. A plain double vector
   // as long as the channels is read straight into place (and checked chunk by chunk, see
-  // time_samples_ok); anything else through matio's copy and the full checks.
+  // time_samples_ok); anything else through a copy and the full checks.
   Eigen::Index t_length = -1;
   bool t_prechecked = false;
   std::optional<detail::MappedDoubles> t_mapped;  // the time vector in the mapping (view only)

@@ -1,7 +1,7 @@
 #pragma once
 // Sampled measurement records (time series) and the files they live in.
 //
-// Readers: MATLAB .mat (v5/v7 and v7.3, through matio) and CSV with a header row. Writers: .mat
+// Readers: MATLAB .mat (v5/v7 and v7.3, docs/formats.md) and CSV with a header row. Writers: .mat
 // (v5 by default, v7.3 on request) and CSV. Every reader validates what it returns and throws
 // InputError naming the file, the field or channel, what was expected and what was found: unknown
 // channel (the message lists the available ones), lengths that differ, NaN/Inf (channel and sample
