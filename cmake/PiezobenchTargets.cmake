@@ -96,8 +96,7 @@ function(piezobench_install_package)
     "${PROJECT_BINARY_DIR}/piezobenchConfig.cmake" INSTALL_DESTINATION "${config_dir}")
   write_basic_package_version_file("${PROJECT_BINARY_DIR}/piezobenchConfigVersion.cmake" COMPATIBILITY SameMinorVersion)
   install(FILES "${PROJECT_BINARY_DIR}/piezobenchConfig.cmake" "${PROJECT_BINARY_DIR}/piezobenchConfigVersion.cmake"
-                "${PROJECT_SOURCE_DIR}/cmake/FindFFTW3.cmake" "${PROJECT_SOURCE_DIR}/cmake/FindMatio.cmake"
-                "${PROJECT_SOURCE_DIR}/cmake/FindCHOLMOD.cmake" "${PROJECT_SOURCE_DIR}/cmake/FindHdf5Serial.cmake"
+                "${PROJECT_SOURCE_DIR}/cmake/FindFFTW3.cmake"
           DESTINATION "${config_dir}")
 endfunction()
 

@@ -2,7 +2,7 @@
 // The core module: errors (InputError, NumericalError, UsageError), shared constants, the one
 // Levenberg-Marquardt, the one golden-section search, fit-quality verdicts and sign-constrained
 // linear least squares, the median, a runner of independent jobs on a few threads, text helpers
-// and whole-file input/output shared by the readers.
+// whole-file input/output shared by the readers, and shared libraries loaded on first use.
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/fit_quality.hpp"
@@ -12,6 +12,7 @@
 #include "piezobench/core/minimize.hpp"
 #include "piezobench/core/nnls.hpp"
 #include "piezobench/core/parallel.hpp"
+#include "piezobench/core/shared_library.hpp"
 #include "piezobench/core/statistics.hpp"
 #include "piezobench/core/text.hpp"
 #include "piezobench/core/units.hpp"

@@ -1,0 +1,17 @@
+# piezobench_read_soname(<var> <library file>)
+# Sets <var> to the SONAME recorded in a shared library (objdump -p): the name under which the
+# program loads the libraries it opens on first use (include/piezobench/core/shared_library.hpp).
+function(piezobench_read_soname var library)
+  set(objdump "${CMAKE_OBJDUMP}")
+  if(NOT objdump)
+    find_program(PIEZOBENCH_OBJDUMP NAMES objdump llvm-objdump REQUIRED)
+    set(objdump "${PIEZOBENCH_OBJDUMP}")
+  endif()
+  get_filename_component(real "${library}" REALPATH)
+  execute_process(COMMAND "${objdump}" -p "${real}" OUTPUT_VARIABLE out RESULT_VARIABLE rc ERROR_VARIABLE err)
+  string(REGEX MATCH "SONAME[ \t]+([^ \t\r\n]+)" match "${out}")
+  if(NOT rc EQUAL 0 OR NOT CMAKE_MATCH_1)
+    message(FATAL_ERROR "cannot read the SONAME of ${library} (${objdump} -p: ${rc} ${err})")
+  endif()
+  set(${var} "${CMAKE_MATCH_1}" PARENT_SCOPE)
+endfunction()
