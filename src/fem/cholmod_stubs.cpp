@@ -22,14 +22,18 @@
 
 namespace {
 
+piezobench::core::SharedLibrary& library() {
+  static piezobench::core::SharedLibrary loaded(PIEZOBENCH_CHOLMOD_SONAME,
+                                                "the sparse Cholesky factorization of Craig-Bampton (CHOLMOD)");
+  return loaded;
+}
+
 struct Functions {
   PIEZOBENCH_CHOLMOD_FUNCTIONS(PIEZOBENCH_STUB_MEMBER)
 };
 
 const Functions& functions() {
   static const Functions resolved = [] {
-    static piezobench::core::SharedLibrary library(PIEZOBENCH_CHOLMOD_SONAME,
-                                                   "the sparse Cholesky factorization of Craig-Bampton (CHOLMOD)");
     Functions table;
     PIEZOBENCH_CHOLMOD_FUNCTIONS(PIEZOBENCH_STUB_RESOLVE)
     return table;

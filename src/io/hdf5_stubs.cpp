@@ -9,6 +9,7 @@
 // The soname is the one the build found (PIEZOBENCH_HDF5_SONAME, src/io/CMakeLists.txt).
 #include <hdf5.h>
 
+#include "io/isolated.hpp"
 #include "piezobench/core/shared_library.hpp"
 
 #define PIEZOBENCH_HDF5_FUNCTIONS(X)                                                                             \
@@ -73,11 +74,16 @@
   extern "C" {                                \
   __attribute__((visibility("hidden"))) hid_t name = H5I_INVALID_HID; \
   }
-#define PIEZOBENCH_HDF5_COPY_VARIABLE(name) name = *static_cast<const hid_t*>(library.symbol(#name));
+#define PIEZOBENCH_HDF5_COPY_VARIABLE(name) name = *static_cast<const hid_t*>(library().symbol(#name));
 
 PIEZOBENCH_HDF5_VARIABLES(PIEZOBENCH_HDF5_DEFINE_VARIABLE)
 
 namespace {
+
+piezobench::core::SharedLibrary& library() {
+  static piezobench::core::SharedLibrary hdf5(PIEZOBENCH_HDF5_SONAME, "reading and writing MAT v7.3 files (HDF5)");
+  return hdf5;
+}
 
 struct Functions {
   PIEZOBENCH_HDF5_FUNCTIONS(PIEZOBENCH_STUB_MEMBER)
@@ -85,10 +91,9 @@ struct Functions {
 
 const Functions& functions() {
   static const Functions resolved = [] {
-    static piezobench::core::SharedLibrary library(PIEZOBENCH_HDF5_SONAME, "reading MAT v7.3 files (HDF5)");
     Functions table;
     PIEZOBENCH_HDF5_FUNCTIONS(PIEZOBENCH_STUB_RESOLVE)
-    if (table.H5open() < 0) throw piezobench::core::SharedLibraryError(library.soname() + ": H5open failed");
+    if (table.H5open() < 0) throw piezobench::core::SharedLibraryError(library().soname() + ": H5open failed");
     PIEZOBENCH_HDF5_VARIABLES(PIEZOBENCH_HDF5_COPY_VARIABLE)
     return table;
   }();
@@ -98,3 +103,5 @@ const Functions& functions() {
 }  // namespace
 
 PIEZOBENCH_HDF5_FUNCTIONS(PIEZOBENCH_STUB_DEFINE)
+
+void piezobench::io::detail::map_hdf5_library() { (void)library().symbol("H5open"); }

@@ -246,6 +246,7 @@ void run_isolated(const IsolatedOptions& options, const std::function<void(Isola
     const int err = errno;
     throw fail("no pipe for the isolated process (" + std::string(std::strerror(err)) + ")");
   }
+  map_hdf5_library();
   std::fflush(nullptr);  // buffered output must not be written twice
   const pid_t pid = ::fork();
   if (pid < 0) {

@@ -85,4 +85,9 @@ struct IsolatedOptions {
 void run_isolated(const IsolatedOptions& options, const std::function<void(IsolatedOut&)>& child,
                   const std::function<void(IsolatedIn&)>& parent);
 
+// Maps the HDF5 library into this process without initializing it (src/io/hdf5_stubs.cpp; HDF5 is
+// loaded on first use), so that the children inherit the mapping instead of each loading HDF5 and
+// its 40 dependencies again. run_isolated calls it before it forks.
+void map_hdf5_library();
+
 }  // namespace piezobench::io::detail

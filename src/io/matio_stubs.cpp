@@ -41,13 +41,17 @@
 
 namespace {
 
+piezobench::core::SharedLibrary& library() {
+  static piezobench::core::SharedLibrary loaded(PIEZOBENCH_MATIO_SONAME, "reading and writing MAT files (matio)");
+  return loaded;
+}
+
 struct Functions {
   PIEZOBENCH_MATIO_FUNCTIONS(PIEZOBENCH_STUB_MEMBER)
 };
 
 const Functions& functions() {
   static const Functions resolved = [] {
-    static piezobench::core::SharedLibrary library(PIEZOBENCH_MATIO_SONAME, "reading and writing MAT files (matio)");
     Functions table;
     PIEZOBENCH_MATIO_FUNCTIONS(PIEZOBENCH_STUB_RESOLVE)
     return table;

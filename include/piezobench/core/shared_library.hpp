@@ -60,12 +60,12 @@ class SharedLibrary {
 // returns a struct of the real functions, resolved all at once on the first call (so that a missing
 // symbol is reported at the first use, and a later call, e.g. from a destructor, cannot throw).
 //   struct Functions { FUNCTIONS(PIEZOBENCH_STUB_MEMBER) };                   the table
-//   FUNCTIONS(PIEZOBENCH_STUB_RESOLVE)            fills `Functions table` from `SharedLibrary library`
+//   FUNCTIONS(PIEZOBENCH_STUB_RESOLVE)            fills `Functions table` from `SharedLibrary& library()`
 //   FUNCTIONS(PIEZOBENCH_STUB_DEFINE)             the C functions themselves (at global scope)
 // The stubs are hidden: a program that links the real library too keeps the library's own
 // functions for every other caller, and the library cannot bind its internal calls to a stub.
 #define PIEZOBENCH_STUB_MEMBER(ret, name, params, args) decltype(&::name) name = nullptr;
-#define PIEZOBENCH_STUB_RESOLVE(ret, name, params, args) table.name = library.function<decltype(&::name)>(#name);
+#define PIEZOBENCH_STUB_RESOLVE(ret, name, params, args) table.name = library().function<decltype(&::name)>(#name);
 #define PIEZOBENCH_STUB_DEFINE(ret, name, params, args) \
   extern "C" __attribute__((visibility("hidden"))) ret name params { return functions().name args; }
 
