@@ -125,6 +125,67 @@ bool is_vector_shape(const MatValue& var) {
 std::string name_of(const MatValue& var, const std::string& field) { return field.empty() ? var.name : field; }
 }  // namespace
 
+std::u16string utf16_from_utf8(std::string_view text) {
+  std::u16string out;
+  for (size_t i = 0; i < text.size();) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    const int more = b < 0x80 ? 0 : (b >> 5) == 0x6 ? 1 : (b >> 4) == 0xE ? 2 : (b >> 3) == 0x1E ? 3 : -1;
+    char32_t c = more == 0 ? b : more == 1 ? (b & 0x1Fu) : more == 2 ? (b & 0x0Fu) : (b & 0x07u);
+    bool ok = more >= 0 && i + static_cast<size_t>(std::max(more, 0)) < text.size();
+    for (int k = 1; ok && k <= more; ++k) {
+      const auto next = static_cast<unsigned char>(text[i + static_cast<size_t>(k)]);
+      ok = (next >> 6) == 0x2;
+      c = (c << 6) | (next & 0x3Fu);
+    }
+    static constexpr char32_t kMin[4] = {0, 0x80, 0x800, 0x10000};
+    if (!ok || c < kMin[std::max(more, 0)] || c > 0x10FFFF || (c >= 0xD800 && c <= 0xDFFF)) {
+      out += u'\uFFFD';
+      ++i;
+      continue;
+    }
+    if (c >= 0x10000) {
+      out += static_cast<char16_t>(0xD800 + ((c - 0x10000) >> 10));
+      out += static_cast<char16_t>(0xDC00 + ((c - 0x10000) & 0x3FF));
+    } else {
+      out += static_cast<char16_t>(c);
+    }
+    i += static_cast<size_t>(more) + 1;
+  }
+  return out;
+}
+
+std::string utf8_from_units(const double* units, size_t n) {
+  std::string out;
+  const auto put = [&](char32_t c) {
+    if (c < 0x80) {
+      out += static_cast<char>(c);
+    } else if (c < 0x800) {
+      out += static_cast<char>(0xC0 | (c >> 6));
+      out += static_cast<char>(0x80 | (c & 0x3F));
+    } else if (c < 0x10000) {
+      out += static_cast<char>(0xE0 | (c >> 12));
+      out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
+      out += static_cast<char>(0x80 | (c & 0x3F));
+    } else {
+      out += static_cast<char>(0xF0 | (c >> 18));
+      out += static_cast<char>(0x80 | ((c >> 12) & 0x3F));
+      out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
+      out += static_cast<char>(0x80 | (c & 0x3F));
+    }
+  };
+  for (size_t i = 0; i < n; ++i) {
+    const double u = units[i];
+    const auto c = u >= 0.0 && u <= 0x10FFFF ? static_cast<char32_t>(u) : char32_t{0xFFFD};
+    if (c >= 0xD800 && c <= 0xDBFF && i + 1 < n && units[i + 1] >= 0xDC00 && units[i + 1] <= 0xDFFF) {
+      put(0x10000 + ((c - 0xD800) << 10) + (static_cast<char32_t>(units[i + 1]) - 0xDC00));
+      ++i;
+    } else {
+      put(c >= 0xD800 && c <= 0xDFFF ? char32_t{0xFFFD} : c);
+    }
+  }
+  return out;
+}
+
 size_t MatValue::count() const {
   if (dims.empty()) return 0;
   size_t n = 1;
@@ -201,7 +262,7 @@ Eigen::VectorXcd to_complex_vector(const MatValue& var, const std::string& sourc
 std::string to_text(const MatValue& var, const std::string& source, const std::string& field) {
   const std::string f = name_of(var, field);
   if (var.class_type == MAT_C_EMPTY || var.count() == 0) return "";
-  if (var.class_type != MAT_C_CHAR || !is_vector_shape(var) || !var.has_data || var.text.size() != var.count()) {
+  if (var.class_type != MAT_C_CHAR || !is_vector_shape(var) || !var.has_data) {
     throw InputError(source, f, "a char row", describe(var));
   }
   return var.text;
@@ -245,14 +306,15 @@ MatValue from_matvar(const matvar_t& var, const std::string& source) {
         case MAT_T_UINT16:
         case MAT_T_UTF16:
         case MAT_T_INT16: {
-          // MATLAB stores char as UTF-16 code units; piezobench names are ASCII.
+          // MATLAB stores char as UTF-16 code units.
           const auto* p = static_cast<const mat_uint16_t*>(var.data);
-          for (size_t i = 0; i < n; ++i) out.text += p[i] < 128 ? static_cast<char>(p[i]) : '?';
+          const std::vector<double> units(p, p + n);
+          out.text = utf8_from_units(units.data(), n);
           break;
         }
         case MAT_T_UINT8:
         case MAT_T_INT8:
-        case MAT_T_UTF8: out.text.assign(static_cast<const char*>(var.data), n); break;
+        case MAT_T_UTF8: out.text.assign(static_cast<const char*>(var.data), std::max(n, var.nbytes)); break;
         default:
           throw InputError(source, out.name, "a char row", std::string("char data of matio type ") + std::to_string(var.data_type));
       }
@@ -310,7 +372,7 @@ MatValue make_complex_column(const std::string& name, const Eigen::VectorXcd& v)
 MatValue make_scalar(const std::string& name, double v) { return make_matrix(name, 1, 1, {v}); }
 
 MatValue make_text(const std::string& name, const std::string& text) {
-  MatValue out(name, MAT_C_CHAR, {1, text.size()});
+  MatValue out(name, MAT_C_CHAR, {1, utf16_from_utf8(text).size()});
   out.text = text;
   return out;
 }
@@ -371,9 +433,10 @@ MatVarPtr to_matvar(const MatValue& v) {
       return var;
     }
     case MAT_C_CHAR: {
-      std::string copy = v.text;
+      std::u16string units = utf16_from_utf8(v.text);
+      if (units.size() != n) throw InputError(v.name, "", std::to_string(n) + " characters", std::to_string(units.size()));
       return created(
-          Mat_VarCreate(v.name.c_str(), MAT_C_CHAR, MAT_T_UTF8, rank, dims.data(), copy.empty() ? nullptr : copy.data(), 0), v.name);
+          Mat_VarCreate(v.name.c_str(), MAT_C_CHAR, MAT_T_UINT16, rank, dims.data(), units.empty() ? nullptr : units.data(), 0), v.name);
     }
     default: break;
   }
@@ -450,8 +513,11 @@ class V5Encoder {
       if (v.items.size() != n) fail(name, std::to_string(n) + " cells", std::to_string(v.items.size()));
       for (const MatValue& item : v.items) matrix(item, "");
     } else if (v.class_type == MAT_C_CHAR) {
-      if (v.text.size() != n) fail(name, std::to_string(n) + " characters", std::to_string(v.text.size()));
-      element(kMiUtf8, v.text.data(), n);
+      // UTF-8 (miUTF8) with the dimensions counting characters (UTF-16 code units), as scipy writes
+      // char; MATLAB and Octave read it so.
+      const size_t units = utf16_from_utf8(v.text).size();
+      if (units != n) fail(name, std::to_string(n) + " characters", std::to_string(units));
+      element(kMiUtf8, v.text.data(), v.text.size());
     } else if (v.is_logical) {
       if (v.re.size() != n) fail(name, std::to_string(n) + " values", std::to_string(v.re.size()));
       std::string bytes(n, '\0');

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -45,11 +46,19 @@ void install_matio_logger();
 
 // ---- the v5 format (MathWorks, "MAT-File Format", Level 5) -----------------------------------
 // Data types (table 1-1): matio's matio_types use the same numbers.
-inline constexpr std::uint32_t kMiInt8 = 1, kMiUint8 = 2, kMiInt32 = 5, kMiUint32 = 6, kMiDouble = 9, kMiMatrix = 14,
-                               kMiCompressed = 15, kMiUtf8 = 16;
+inline constexpr std::uint32_t kMiInt8 = 1, kMiUint8 = 2, kMiUint16 = 4, kMiInt32 = 5, kMiUint32 = 6, kMiDouble = 9,
+                               kMiMatrix = 14, kMiCompressed = 15,
+                               kMiUtf8 = 16;
 // n values of v5 data type `type` (native byte order, any alignment) as double; false for a type
 // that holds no numbers. Character types count as their code units (mat_reader.cpp).
 bool numbers_to_doubles(std::uint32_t type, const void* data, size_t n, double* out);
+
+// MATLAB's char data are UTF-16 code units, piezobench's strings UTF-8 (mat_file.cpp). A byte that
+// is not valid UTF-8 becomes U+FFFD.
+[[nodiscard]] std::u16string utf16_from_utf8(std::string_view text);
+// Code units as UTF-8: UTF-16 (surrogate pairs joined; an unpaired one becomes U+FFFD), values
+// above 0xFFFF taken as code points (UTF-32 data).
+[[nodiscard]] std::string utf8_from_units(const double* units, size_t n);
 
 // ---- a MAT variable in piezobench's memory --------------------------------------------------
 
@@ -67,7 +76,7 @@ struct MatValue {
   std::vector<size_t> dims;                 // MATLAB order, at least 2 once built
   std::vector<double> re, im;               // numeric (and logical) data, column-major
   const double* view = nullptr;             // writers only: real data borrowed instead of `re`
-  std::string text;                         // char data (code units above 127 read as '?')
+  std::string text;                         // char data, UTF-8 (dims count UTF-16 code units)
   std::vector<std::string> field_names;     // struct
   // struct: element e's field f at items[e * field_names.size() + f]; cell: the cells
   std::vector<MatValue> items;

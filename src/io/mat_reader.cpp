@@ -352,23 +352,27 @@ class V5Checker {
       values.resize(count);  // doubles: straight into place
       need(values.data(), count * 8, field);
     } else {
+      // Characters in 8-bit units are UTF-8: all the element's bytes (the dimensions count
+      // characters), else `count` values.
+      const bool utf8 = out.class_type == MAT_C_CHAR && size == 1;
+      const unsigned long long take = utf8 ? tag.bytes : count * size;
       std::vector<unsigned char> raw;
-      const unsigned char* bytes = tag.payload;  // a small element holds at most 4 bytes: count * size <= 4
+      const unsigned char* bytes = tag.payload;  // a small element holds at most 4 bytes
       if (!tag.small) {
-        raw.resize(count * size);
+        raw.resize(take);
         need(raw.data(), raw.size(), field);
         bytes = raw.data();
       }
-      if (out.class_type == MAT_C_CHAR && size == 1) {
-        out.text.assign(reinterpret_cast<const char*>(bytes), count);  // UTF-8 (or 8-bit) as it is
-      } else {
-        values.resize(count);
-        if (!numbers_to_doubles(tag.type, bytes, count, values.data())) fail(field, "numbers or characters", "type " + std::to_string(tag.type));
-        if (out.class_type == MAT_C_CHAR) {
-          // UTF-16/32 code units; piezobench names are ASCII.
-          for (double c : values) out.text += c >= 0.0 && c < 128.0 ? static_cast<char>(c) : '?';
-          values.clear();
-        }
+      if (utf8) {
+        out.text.assign(reinterpret_cast<const char*>(bytes), take);
+        if (!tag.small) skip(padded(tag.bytes) - take, field);
+        return;
+      }
+      values.resize(count);
+      if (!numbers_to_doubles(tag.type, bytes, count, values.data())) fail(field, "numbers or characters", "type " + std::to_string(tag.type));
+      if (out.class_type == MAT_C_CHAR) {
+        out.text = utf8_from_units(values.data(), values.size());  // UTF-16/32 code units
+        values.clear();
       }
     }
     if (!tag.small) skip(padded(tag.bytes) - count * size, field);

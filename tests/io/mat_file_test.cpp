@@ -30,6 +30,22 @@ TEST(MatlabIdentifier, FollowsMatlabRules) {
   EXPECT_TRUE(is_matlab_identifier(std::string(63, 'a')));
 }
 
+TEST(MatText, Utf8AndUtf16RoundTrip) {
+  const std::string text = "a\u00b5\u20ac\U0001F600z";
+  const std::u16string units = utf16_from_utf8(text);
+  EXPECT_EQ(units, u"a\u00b5\u20ac\U0001F600z");
+  EXPECT_EQ(units.size(), 6u);  // the emoji is a surrogate pair
+  const std::vector<double> d(units.begin(), units.end());
+  EXPECT_EQ(utf8_from_units(d.data(), d.size()), text);
+  // UTF-32 data hold code points; invalid bytes and unpaired surrogates become U+FFFD.
+  const double code_point = 0x1F600;
+  EXPECT_EQ(utf8_from_units(&code_point, 1), "\U0001F600");
+  EXPECT_EQ(utf16_from_utf8("x\xff\xc3"), u"x\uFFFD\uFFFD");
+  const double lone = 0xD800;
+  EXPECT_EQ(utf8_from_units(&lone, 1), "\uFFFD");
+  EXPECT_EQ(make_text("t", "\u00b5m").dims, (std::vector<size_t>{1, 2}));
+}
+
 // Every layout the writers of piezobench produce: real columns and matrices (with values that a
 // conversion would change), complex columns, scalars, text (also empty), logical rows, [], nested
 // structs, a struct array and a cell.
@@ -43,6 +59,7 @@ std::vector<MatValue> layouts(const Eigen::VectorXd& column) {
   v.push_back(make_scalar("s", 42.0));
   v.push_back(make_text("txt", "hello, world"));
   v.push_back(make_text("abc", ""));
+  v.push_back(make_text("unit", "\u00b5m, \u00dc \u2192 \u221e"));  // UTF-8 in, UTF-16 in the file
   v.push_back(make_logical("flags", {1, 0, 1}));
   v.push_back(make_matrix("e", 0, 0, {}));
   v.push_back(make_struct("st", {{"a", make_scalar("", 1.0)},
