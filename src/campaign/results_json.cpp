@@ -260,7 +260,7 @@ json damped_plants(const std::vector<DampedPlant>& plants) {
                       {"order", d.identified_order},
                       {"relative_rms_error", d.identified->fit.relative_rms_error},
                       {"band_Hz", {d.fmin_Hz, d.fmax_Hz}},
-                      {"method", "vector fitting, the dominant pole pair (largest |r|/|Re p|) in the band; delay of d_e removed"}};
+                      {"method", "vector fitting, the dominant pole pair (the largest contribution to the data) in the band; delay of d_e removed"}};
     }
     if (d.second_order) {
       entry["second_order_fit"] = {{"frequency_Hz", d.second_order->natural_frequency / kTwoPi},

@@ -32,7 +32,18 @@ DominantPole dominant_pole(const Vector& omega, const CVector& h, const Dominant
     const Complex p = d.fit.poles(k);
     const double w = std::abs(p);
     if (p.imag() <= 0.0 || w < lo || w > hi) continue;
-    const double peak = d.fit.residues.col(k).cwiseAbs().sum() / std::max(std::abs(p.real()), 1e-300);
+    // The pair's contribution r/(s - p) + conj(r)/(s - conj(p)) at its largest on the data's
+    // frequencies (the header says why not |r| / |Re p|).
+    double peak = 0.0;
+    for (Index i = 0; i < omega.size(); ++i) {
+      const Complex s(0.0, omega(i));
+      double sum = 0.0;
+      for (Index o = 0; o < d.fit.residues.rows(); ++o) {
+        const Complex r = d.fit.residues(o, k);
+        sum += std::abs(r / (s - p) + std::conj(r) / (s - std::conj(p)));
+      }
+      peak = std::max(peak, sum);
+    }
     if (peak > best) {
       best = peak;
       d.pole = p;

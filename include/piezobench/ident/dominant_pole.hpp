@@ -3,9 +3,12 @@
 // damped plant u' -> d_e under Integral Force Feedback).
 //
 // Method: a vector fit of `fit.order` poles over the data, then, of its complex pairs whose natural
-// frequency lies in [omega_min, omega_max], the one with the largest peak contribution
-// |r| / |Re p| (summed over outputs): the resonance dominates the response, while a pair the fit
-// adds for a small feature or for noise contributes orders of magnitude less. Unlike the report's
+// frequency lies in [omega_min, omega_max], the one whose contribution r/(s - p) + conj(r)/(s -
+// conj(p)) is the largest on the data's frequencies (summed over outputs): the resonance dominates
+// the response, while a pair the fit adds for a small feature or for noise contributes much less.
+// (Not |r| / |Re p|, the pair's peak on a continuous axis: unbounded for a pair the fit puts on the
+// imaginary axis with a tiny residue between two lines, and large for a damping near 1, where the
+// pair has no peak; both happened on the demo's damped plants, depending on the noise.) Unlike the report's
 // second-order fit, this stays on the closed loop's pole once the controller's own poles have moved
 // into the band (large gains), where a second-order model misplaces it by 10 to 50 %.
 #include "piezobench/ident/vector_fitting.hpp"
@@ -28,7 +31,7 @@ struct DominantPole {
   Complex pole;                    // rad/s, Im > 0
   double natural_frequency = 0.0;  // |pole|, rad/s
   double damping = 0.0;            // -Re pole / |pole|
-  double peak = 0.0;               // its peak contribution |r| / |Re p|, data units
+  double peak = 0.0;               // its largest contribution on the data's frequencies, data units
   VectorFittingResult fit;         // the model it comes from (its relative_rms_error is the fit's error)
   [[nodiscard]] double frequency_Hz() const;
 };
