@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <future>
 #include <limits>
 #include <numbers>
@@ -32,16 +33,12 @@ void require_rate(double fs) { require(std::isfinite(fs) && fs > 0.0, "sample_ra
 // Uniform in [0, 1) with 53 random bits (the top bits of one mt19937_64 draw).
 double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
-// Standard normal pairs by Box-Muller, written out so that the numbers do not depend on the
-// standard library's normal_distribution.
-void fill_gaussian(std::mt19937_64& rng, double* x, Index n) {
-  for (Index i = 0; i < n; i += 2) {
-    const double u1 = 1.0 - uniform01(rng);  // (0, 1]: log is finite
-    const double u2 = uniform01(rng);
-    const double r = std::sqrt(-2.0 * std::log(u1));
-    x[i] = r * std::cos(2.0 * kPi * u2);
-    if (i + 1 < n) x[i + 1] = r * std::sin(2.0 * kPi * u2);
-  }
+// One standard normal pair (x, y) by Box-Muller, written out so that the numbers do not depend on
+// the standard library's normal_distribution: x + i y is a circular complex Gaussian.
+std::complex<double> gaussian_pair(std::mt19937_64& rng) {
+  const double u1 = 1.0 - uniform01(rng);  // (0, 1]: log is finite
+  const double u2 = uniform01(rng);
+  return std::polar(std::sqrt(-2.0 * std::log(u1)), 2.0 * kPi * u2);
 }
 
 // Raised-cosine rise from 0 at t = 0 to 1 at t = ramp (1 beyond; 1 everywhere if ramp == 0).
@@ -159,26 +156,28 @@ Excitation band_limited_noise(const NoiseOptions& options, const VoltageBounds& 
   const auto first = static_cast<Index>(std::max(1.0, std::ceil(options.f_low / df)));
   const auto last = std::min(static_cast<Index>(std::floor(options.f_high / df)), n / 2);
 
-  // White noise -> spectrum -> band -> signal in two FFTW buffers, no Eigen copies in between
-  // (a 100 s record is 1 M samples; the numbers are those of detail::rfft and irfft). The two
-  // plans are made on another thread while the samples are drawn.
-  std::future<void> plans = detail::plan_in_background(n);
+  // The band's DFT lines are drawn directly, as the DFT of white Gaussian noise has them: on each
+  // line 0 < k < n/2 independent real and imaginary parts of equal variance (n/2 for unit white
+  // noise), on the Nyquist line k = n/2 (n even) a real part of twice that variance; then one
+  // inverse transform. The common factor sqrt(n/2) is left out: the rms is set exactly below.
+  // The inverse plan is made on another thread while the lines are drawn.
+  std::future<void> plan = detail::plan_in_background(n, detail::PlanDirections::kInverse);
   std::mt19937_64 rng(options.seed);
-  detail::FftwBuffer<double> samples(n, detail::BufferInit::kNone);
-  fill_gaussian(rng, samples.data(), n);
-  plans.get();
-  const detail::RealForwardFft forward(n);
-  detail::FftwBuffer<std::complex<double>> spectrum(forward.bins(), detail::BufferInit::kNone);
-  forward.execute(samples.data(), spectrum.data());
+  const Index bins = n / 2 + 1;
+  detail::FftwBuffer<std::complex<double>> spectrum(bins, detail::BufferInit::kNone);
   std::fill(spectrum.data(), spectrum.data() + first, std::complex<double>(0.0));
-  std::fill(spectrum.data() + last + 1, spectrum.data() + forward.bins(), std::complex<double>(0.0));
+  for (Index k = first; k <= last; ++k) spectrum[k] = gaussian_pair(rng);
+  std::fill(spectrum.data() + last + 1, spectrum.data() + bins, std::complex<double>(0.0));
+  if (n % 2 == 0 && last == n / 2) spectrum[last] = std::sqrt(2.0) * spectrum[last].real();
+  plan.get();
+  detail::FftwBuffer<double> samples(n, detail::BufferInit::kNone);
   detail::RealInverseFft(n).execute(spectrum.data(), samples.data());
+  // Exactly the requested rms (the mean is zero: no DC line).
+  const Eigen::Map<const Eigen::VectorXd> raw(samples.data(), n);
+  const double raw_rms = std::sqrt(raw.squaredNorm() / static_cast<double>(n));
   Eigen::VectorXd v(n);
   core::advise_huge_pages(v.data(), static_cast<std::size_t>(n) * sizeof(double));
-  for (Index i = 0; i < n; ++i) v(i) = samples[i] / static_cast<double>(n);
-  // Exactly the requested rms (the mean is zero: no DC line).
-  const double rms = std::sqrt(v.squaredNorm() / static_cast<double>(n));
-  if (rms > 0.0) v *= options.rms / rms;
+  v = (raw_rms > 0.0 ? options.rms / raw_rms : 1.0) * raw;
 
   Excitation out;
   out.sample_rate = options.sample_rate;

@@ -97,10 +97,10 @@ void RealInverseFft::execute(std::complex<double>* in, double* out) const {
                        out);
 }
 
-std::future<void> plan_in_background(Eigen::Index n) {
-  const auto plan = [n] {
-    (void)PlanCache::instance().forward(n);
-    (void)PlanCache::instance().inverse(n);
+std::future<void> plan_in_background(Eigen::Index n, PlanDirections directions) {
+  const auto plan = [n, directions] {
+    if (directions != PlanDirections::kInverse) (void)PlanCache::instance().forward(n);
+    if (directions != PlanDirections::kForward) (void)PlanCache::instance().inverse(n);
   };
   // A short transform plans in microseconds: no thread for it (nor when none can be started).
   constexpr Eigen::Index kWorthAThread = Eigen::Index{1} << 16;

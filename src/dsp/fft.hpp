@@ -65,11 +65,12 @@ class RealInverseFft {
   const void* plan_;
 };
 
-// Makes (or finds) the forward and the inverse plan of length n on another thread, for a caller
-// with other work to do meanwhile: a 1 M-point plan costs milliseconds (its twiddle factors).
-// get() on the result waits for both and rethrows a planning failure. Short lengths (or no thread
-// to be had) are planned by get() itself.
-[[nodiscard]] std::future<void> plan_in_background(Eigen::Index n);
+// Makes (or finds) the plans of length n in `directions` on another thread, for a caller with
+// other work to do meanwhile: a 1 M-point plan costs milliseconds (its twiddle factors). get() on
+// the result waits for them and rethrows a planning failure. Short lengths (or no thread to be
+// had) are planned by get() itself.
+enum class PlanDirections { kForward, kInverse, kBoth };
+[[nodiscard]] std::future<void> plan_in_background(Eigen::Index n, PlanDirections directions = PlanDirections::kBoth);
 
 // Convenience on Eigen vectors (copies into aligned buffers): full one-sided spectrum of x, and
 // the real signal of length n from its one-sided spectrum (normalized by 1/n, i.e. numpy irfft).

@@ -66,6 +66,87 @@ TEST(Noise, ReproducibleFromTheSeed) {
   EXPECT_EQ(a.seed, 42U);
 }
 
+// The generator draws the band's DFT lines as white Gaussian noise's DFT has them. A long record
+// then shows white noise's statistics: Gaussian samples (skewness 0, kurtosis 3), equal mean power
+// in every part of the band, nothing outside it, exactly the rms, the offset as mean.
+TEST(Noise, LongRecordIsGaussianAndWhiteInsideTheBand) {
+  NoiseOptions o;
+  o.sample_rate = 1000.0;
+  o.samples = Index{1} << 18;  // lines 1000 / 2^18 Hz apart
+  o.f_low = 50.0;
+  o.f_high = 450.0;
+  o.rms = 0.3;
+  o.offset = 1.0;
+  o.seed = 7;
+  const Excitation e = band_limited_noise(o, VoltageBounds{-10.0, 10.0});
+  const VectorXd v = e.u.array() - 1.0;
+  EXPECT_TRUE(near(rms(v), 0.3, test::kRoundoff));
+  EXPECT_NEAR(e.u.mean(), 1.0, 1e-13);
+  // Moments: with ~2e5 nearly independent samples the standard errors are sqrt(6/N) = 0.005 and
+  // sqrt(24/N) = 0.01; the bounds are 6 to 8 of them (a uniform draw would give kurtosis 1.8).
+  const double m2 = v.array().square().mean();
+  const double skew = v.array().cube().mean() / std::pow(m2, 1.5);
+  const double kurt = v.array().square().square().mean() / (m2 * m2);
+  EXPECT_NEAR(skew, 0.0, 0.04);
+  EXPECT_NEAR(kurt, 3.0, 0.06);
+  // 1 sigma holds 68.27 % of the samples, 2 sigma 95.45 %.
+  const double sigma = std::sqrt(m2);
+  EXPECT_NEAR((v.array().abs() < sigma).cast<double>().mean(), 0.6827, 0.01);
+  EXPECT_NEAR((v.array().abs() < 2.0 * sigma).cast<double>().mean(), 0.9545, 0.005);
+  // Spectrum: zero outside the lines [50, 450] Hz, the same mean power in each quarter of the band
+  // (each mean is over ~26,000 exponentially distributed line powers: 0.6 % standard error).
+  const Eigen::VectorXd power = detail::rfft(v).cwiseAbs2();
+  const double hz = static_cast<double>(o.samples) / o.sample_rate;  // lines per Hz
+  const auto first = static_cast<Index>(std::ceil(50.0 * hz)), last = static_cast<Index>(std::floor(450.0 * hz));
+  const double in_band = power.segment(first, last - first + 1).mean();
+  EXPECT_LT(power.head(first).maxCoeff(), 1e-24 * in_band);
+  EXPECT_LT(power.tail(power.size() - last - 1).maxCoeff(), 1e-24 * in_band);
+  const Index quarter = (last - first + 1) / 4;
+  for (Index q = 0; q < 4; ++q) {
+    EXPECT_NEAR(power.segment(first + q * quarter, quarter).mean() / in_band, 1.0, 0.03) << "quarter " << q;
+  }
+}
+
+// The Nyquist line of an even record is real and carries, on average, the power of any other line
+// (white noise's DFT: X(n/2) = sum (-1)^j x_j has variance n, as E|X_k|^2 does). Averaged over many
+// seeds of a short record; an odd record has no Nyquist line and its last line is complex.
+TEST(Noise, NyquistLineCarriesTheSameMeanPower) {
+  for (const Index n : {Index{64}, Index{63}}) {
+    SCOPED_TRACE(n);
+    NoiseOptions o;
+    o.sample_rate = static_cast<double>(n);  // 1 Hz lines
+    o.samples = n;
+    o.f_low = 1.0;
+    o.f_high = 0.5 * o.sample_rate;
+    o.rms = 1.0;
+    const Index bins = n / 2 + 1;
+    VectorXd mean_power = VectorXd::Zero(bins);
+    const int seeds = 4000;
+    for (int s = 1; s <= seeds; ++s) {
+      o.seed = static_cast<std::uint64_t>(s);
+      mean_power += detail::rfft(band_limited_noise(o, VoltageBounds{-100.0, 100.0}).u).cwiseAbs2() / seeds;
+    }
+    EXPECT_LT(mean_power(0), 1e-20);  // DC: the offset (0) only
+    const double interior = mean_power.segment(1, bins - 2).mean();
+    // chi-square with 1 degree of freedom averaged over 4000 draws: 2.2 % standard error.
+    EXPECT_NEAR(mean_power(bins - 1) / interior, 1.0, 0.1);
+  }
+}
+
+TEST(Noise, SeedsGiveDifferentSignalsOfTheSameStatistics) {
+  NoiseOptions o = noise_options();
+  const VoltageBounds b{-10.0, 10.0};
+  const VectorXd ua = band_limited_noise(o, b).u;
+  const VectorXd a = ua.array() - 2.0;
+  o.seed = 43;
+  const VectorXd c = band_limited_noise(o, b).u.array() - 2.0;
+  EXPECT_TRUE(near(rms(c), rms(a), test::kRoundoff));
+  // Independent draws: the normalized correlation of the two records is of order 1/sqrt(lines).
+  EXPECT_LT(std::abs(a.dot(c)) / (a.norm() * c.norm()), 0.2);
+  o.seed = 42;
+  EXPECT_EQ(band_limited_noise(o, b).u, ua);
+}
+
 TEST(Noise, ScaledIntoTheBoundsAndReported) {
   NoiseOptions o = noise_options();
   o.rms = 3.0;

@@ -42,9 +42,12 @@ struct Excitation {
   std::uint64_t seed = 0;        // random signals: the seed used
 };
 
-// Gaussian noise shaped in the frequency domain: white spectrum kept on the DFT lines inside
-// [f_low, f_high] (DC excluded: it is the offset), so the signal is periodic with period
-// `samples`. The varying part has standard deviation `rms` before any scaling.
+// Gaussian noise made in the frequency domain: the DFT lines inside [f_low, f_high] (DC excluded:
+// it is the offset; the Nyquist line allowed) are drawn as a white Gaussian sequence's DFT has
+// them (independent real and imaginary parts of equal variance; a real Nyquist line of twice
+// that), every other line is zero, and one inverse FFT gives the signal: Gaussian, periodic with
+// period `samples`, its power exactly on the band's lines. The varying part has standard deviation
+// (rms) exactly `rms` before any scaling.
 struct NoiseOptions {
   double sample_rate = 10e3;   // Hz, > 0
   Eigen::Index samples = 0;    // >= 2
