@@ -1,5 +1,6 @@
 #include "io/isolated.hpp"
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -246,6 +247,9 @@ void run_isolated(const IsolatedOptions& options, const std::function<void(Isola
     const int err = errno;
     throw fail("no pipe for the isolated process (" + std::string(std::strerror(err)) + ")");
   }
+  // 1 MiB instead of 64 KiB (when the system allows it): a 48 MB channel crosses in 50 wake-ups of
+  // the parent rather than 750 (on a loaded machine each can wait for a time slice).
+  (void)::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);
   map_hdf5_library();
   std::fflush(nullptr);  // buffered output must not be written twice
   const pid_t pid = ::fork();
