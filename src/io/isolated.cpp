@@ -96,11 +96,6 @@ void IsolatedOut::put_string(const std::string& s) {
   put(s.data(), s.size());
 }
 
-void IsolatedOut::put_strings(const std::vector<std::string>& list) {
-  put_u64(list.size());
-  for (const std::string& s : list) put_string(s);
-}
-
 // The child: default actions for the crash signals (a sanitizer's or libFuzzer's handler would
 // report the parent's input as a crash of its own), the work, its answer, _exit.
 void run_child(int fd, const std::function<void(IsolatedOut&)>& child) {
@@ -219,15 +214,6 @@ std::string IsolatedIn::get_string(std::size_t max_bytes) {
   std::string s(n, '\0');
   get(s.data(), n);
   return s;
-}
-
-std::vector<std::string> IsolatedIn::get_strings(std::size_t max_count) {
-  const std::uint64_t n = get_u64();
-  if (n > max_count) malformed(std::to_string(n) + " strings");
-  std::vector<std::string> out;
-  out.reserve(n);
-  for (std::uint64_t i = 0; i < n; ++i) out.push_back(get_string());
-  return out;
 }
 
 void IsolatedIn::malformed(const std::string& what) { throw Malformed{what}; }

@@ -26,7 +26,6 @@ class IsolatedOut {
   void put(const void* data, std::size_t bytes);
   void put_u64(std::uint64_t v) { put(&v, sizeof v); }
   void put_string(const std::string& s);
-  void put_strings(const std::vector<std::string>& list);
   // Sends what is buffered (called by run_isolated before the end frame).
   void flush();
 
@@ -48,8 +47,6 @@ class IsolatedIn {
   [[nodiscard]] std::uint64_t get_u64();
   // A length-prefixed string of at most max_bytes (longer: a malformed answer).
   [[nodiscard]] std::string get_string(std::size_t max_bytes = 1 << 20);
-  // At most max_count strings.
-  [[nodiscard]] std::vector<std::string> get_strings(std::size_t max_count = 1 << 20);
   // Throws a malformed-answer error (the parent's own checks of what it received).
   [[noreturn]] static void malformed(const std::string& what);
   // True when the child has ended its answer (its end frame read); false if data remain.

@@ -53,11 +53,13 @@ TEST(Isolated, SmallPiecesAreGatheredAndReadBackInOrder) {
   run_isolated(
       options(),
       [](IsolatedOut& out) {
-        std::vector<std::string> names;
-        for (int i = 0; i < 20000; ++i) names.push_back("channel_" + std::to_string(i));
-        out.put_strings(names);
+        out.put_u64(20000);
+        for (int i = 0; i < 20000; ++i) out.put_string("channel_" + std::to_string(i));
       },
-      [&](IsolatedIn& in) { got = in.get_strings(); });
+      [&](IsolatedIn& in) {
+        const std::uint64_t n = in.get_u64();
+        for (std::uint64_t i = 0; i < n; ++i) got.push_back(in.get_string());
+      });
   ASSERT_EQ(got.size(), 20000u);
   EXPECT_EQ(got.front(), "channel_0");
   EXPECT_EQ(got.back(), "channel_19999");
