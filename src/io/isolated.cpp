@@ -228,6 +228,7 @@ bool IsolatedIn::at_end() {
 void run_isolated(const IsolatedOptions& options, const std::function<void(IsolatedOut&)>& child,
                   const std::function<void(IsolatedIn&)>& parent) {
   const auto fail = [&](const std::string& found) { return InputError(options.source, options.field, options.expected, found); };
+  map_hdf5_library();  // before the pipe: a missing library leaves nothing open
   int fds[2];
   if (::pipe(fds) != 0) {
     const int err = errno;
@@ -236,7 +237,6 @@ void run_isolated(const IsolatedOptions& options, const std::function<void(Isola
   // 1 MiB instead of 64 KiB (when the system allows it): a 48 MB channel crosses in 50 wake-ups of
   // the parent rather than 750 (on a loaded machine each can wait for a time slice).
   (void)::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);
-  map_hdf5_library();
   std::fflush(nullptr);  // buffered output must not be written twice
   const pid_t pid = ::fork();
   if (pid < 0) {

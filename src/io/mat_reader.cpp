@@ -1005,107 +1005,60 @@ IsolatedOptions isolated_options(const std::string& source) {
   return o;
 }
 
-// A variable (1x1 struct with its fields, char, numeric, complex; others as their header only).
-void put_var(IsolatedOut& out, const matvar_t& var) {
-  out.put_string(var.name != nullptr ? var.name : "");
-  for (std::uint64_t v : {static_cast<std::uint64_t>(var.class_type), static_cast<std::uint64_t>(var.data_type),
-                          static_cast<std::uint64_t>(var.isComplex != 0), static_cast<std::uint64_t>(var.isLogical != 0),
-                          static_cast<std::uint64_t>(std::max(var.rank, 0))}) {
-    out.put_u64(v);
+// A variable as the reader returns it (MatValue: numeric and char data, struct fields and cells
+// recursively), sent by the child.
+void put_value(IsolatedOut& out, const MatValue& v) {
+  out.put_string(v.name);
+  for (std::uint64_t x : {static_cast<std::uint64_t>(v.class_type), static_cast<std::uint64_t>(v.is_complex),
+                          static_cast<std::uint64_t>(v.is_logical), static_cast<std::uint64_t>(v.has_data),
+                          static_cast<std::uint64_t>(v.dims.size())}) {
+    out.put_u64(x);
   }
-  for (int i = 0; i < var.rank; ++i) out.put_u64(var.dims[i]);
-  if (var.class_type == MAT_C_STRUCT) {
-    const unsigned fields = Mat_VarGetNumberOfFields(const_cast<matvar_t*>(&var));
-    char* const* names = Mat_VarGetStructFieldnames(&var);
-    out.put_u64(fields);
-    for (unsigned i = 0; i < fields; ++i) {
-      out.put_string(names[i]);
-      put_var(out, *Mat_VarGetStructFieldByIndex(const_cast<matvar_t*>(&var), i, 0));
-    }
-    return;
+  for (size_t d : v.dims) out.put_u64(d);
+  for (const std::vector<double>* part : {&v.re, &v.im}) {
+    out.put_u64(part->size());
+    out.put(part->data(), part->size() * sizeof(double));
   }
-  const size_t bytes = element_count(var) * Mat_SizeOf(var.data_type);
-  if (var.data == nullptr || bytes == 0) {
-    out.put_u64(0);
-  } else if (var.isComplex != 0) {
-    const auto* split = static_cast<const mat_complex_split_t*>(var.data);
-    out.put_u64(2);
-    out.put_u64(bytes);
-    out.put(split->Re, bytes);
-    out.put(split->Im, bytes);
-  } else {
-    out.put_u64(1);
-    out.put_u64(bytes);
-    out.put(var.data, bytes);
-  }
+  out.put_string(v.text);
+  out.put_u64(v.field_names.size());
+  for (const std::string& f : v.field_names) out.put_string(f);
+  out.put_u64(v.items.size());
+  for (const MatValue& item : v.items) put_value(out, item);
 }
 
-// The variable put_var sent; `limit`: the most bytes of data a variable of the file may hold.
-MatVarPtr get_var(IsolatedIn& in, const std::string& source, const std::string& field, double limit, int depth) {
-  if (depth > 17) in.malformed("structs nested deeper than the reader reads");
-  const std::string name = in.get_string(4096);
-  const std::uint64_t cls = in.get_u64(), type = in.get_u64(), complex = in.get_u64(), logical = in.get_u64(), rank = in.get_u64();
-  if (cls > MAT_C_OPAQUE || type > MAT_T_FUNCTION || complex > 1 || logical > 1 || rank > 32) in.malformed("a variable header out of range");
-  std::vector<size_t> dims(rank);
-  for (size_t& d : dims) d = in.get_u64();
-  const auto c = static_cast<matio_classes>(cls);
-  const auto t = static_cast<matio_types>(type);
-  const int r = static_cast<int>(rank);
-  if (c == MAT_C_STRUCT) {
+// The MatValue put_value sent. `budget`: the bytes of data and the items the answer may still
+// hold (a variable of the file cannot hold more: 8 x kMaxInflation x its size), spent as they come.
+MatValue get_value(IsolatedIn& in, double& budget, int depth) {
+  if (depth > 17) in.malformed("values nested deeper than the reader reads");
+  MatValue v;
+  v.name = in.get_string(4096);
+  const std::uint64_t cls = in.get_u64(), complex = in.get_u64(), logical = in.get_u64(), has_data = in.get_u64(),
+                      rank = in.get_u64();
+  if (cls > MAT_C_OPAQUE || complex > 1 || logical > 1 || has_data > 1 || rank > 32) in.malformed("a variable header out of range");
+  v.class_type = static_cast<matio_classes>(cls);
+  v.is_complex = complex != 0;
+  v.is_logical = logical != 0;
+  v.has_data = has_data != 0;
+  for (std::uint64_t d = 0; d < rank; ++d) v.dims.push_back(in.get_u64());
+  const auto spend = [&](double bytes) {
+    if (bytes > budget) in.malformed("more data than the file can hold");
+    budget -= bytes;
+  };
+  for (std::vector<double>* part : {&v.re, &v.im}) {
     const std::uint64_t n = in.get_u64();
-    if (n > 4096) in.malformed(std::to_string(n) + " struct fields");
-    std::vector<std::string> names;
-    std::vector<MatVarPtr> fields;
-    for (std::uint64_t i = 0; i < n; ++i) {
-      names.push_back(in.get_string(4096));
-      fields.push_back(get_var(in, source, field + "." + names.back(), limit, depth + 1));
-    }
-    std::vector<const char*> cnames;
-    for (const auto& f : names) cnames.push_back(f.c_str());
-    cnames.push_back(nullptr);
-    size_t one[2] = {1, 1};
-    MatVarPtr var = checked_create(MatVarPtr(Mat_VarCreateStruct2(name.c_str(), 2, one, cnames.data())), source, field);
-    for (std::uint64_t i = 0; i < n; ++i) {
-      MatVarPtr replaced(Mat_VarSetStructFieldByName(var.get(), names[i].c_str(), 0, fields[i].get()));
-      (void)fields[i].release();
-    }
-    return var;
+    spend(8.0 * static_cast<double>(n));
+    part->resize(n);
+    in.get(part->data(), n * sizeof(double));
   }
-  const std::uint64_t kind = in.get_u64();
-  if (kind == 0) {
-    const bool header_only = !is_numeric_class(c) && c != MAT_C_CHAR;
-    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), c, t, r, dims.data(), nullptr, header_only ? MAT_F_DONT_COPY_DATA : 0)),
-                          source, field);
-  }
-  const std::uint64_t bytes = in.get_u64();
-  std::uint64_t count = 1;
-  for (size_t d : dims) count = d == 0 || count == 0 ? 0 : (count > (1ull << 50) / d ? (1ull << 50) : count * d);
-  if (kind > 2 || Mat_SizeOf(t) == 0 || bytes != count * Mat_SizeOf(t) || static_cast<double>(bytes) > limit) {
-    in.malformed("data of " + std::to_string(bytes) + " bytes for " + shape_text(dims));
-  }
-  if (kind == 2) {
-    std::vector<char> re(bytes), im(bytes);
-    in.get(re.data(), bytes);
-    in.get(im.data(), bytes);
-    mat_complex_split_t split{re.data(), im.data()};
-    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), c, t, r, dims.data(), &split, MAT_F_COMPLEX)), source, field);
-  }
-  void* data = std::malloc(bytes);
-  if (data == nullptr) throw InputError(source, field, "memory for " + bytes_text(bytes), "allocation failed");
-  try {
-    in.get(data, bytes);
-  } catch (...) {
-    std::free(data);
-    throw;
-  }
-  MatVarPtr var(Mat_VarCreate(name.c_str(), c, t, r, dims.data(), data, MAT_F_DONT_COPY_DATA));
-  if (!var) {
-    std::free(data);
-    throw InputError(source, field, "a variable matio can hold", "Mat_VarCreate failed");
-  }
-  var->mem_conserve = 0;  // the variable frees `data`
-  if (logical != 0) var->isLogical = 1;
-  return var;
+  v.text = in.get_string(static_cast<std::size_t>(std::min(budget, 1e15)));
+  spend(static_cast<double>(v.text.size()));
+  const std::uint64_t fields = in.get_u64();
+  if (fields > 4096) in.malformed(std::to_string(fields) + " struct fields");
+  for (std::uint64_t f = 0; f < fields; ++f) v.field_names.push_back(in.get_string(4096));
+  const std::uint64_t items = in.get_u64();
+  spend(64.0 * static_cast<double>(items));
+  for (std::uint64_t i = 0; i < items; ++i) v.items.push_back(get_value(in, budget, depth + 1));
+  return v;
 }
 
 // A v7.3 file in this process: its name and what the child that opened it listed.
@@ -1327,14 +1280,17 @@ std::vector<MatVarInfo> list_mat_variables(MatInput* in, const fs::path& file) {
 
 MatValue read_mat_variable(MatInput* in, const fs::path& file, const std::string& name) {
   if (const Mat73Input* h5 = as_v73(in)) {
-    MatVarPtr var;
+    MatValue value;
     h5->run(
         [&](IsolatedOut& out) {
           H5File f(file);
-          put_var(out, *read_h5_var(f, f.root(), name, name, 0));
+          put_value(out, from_matvar(*read_h5_var(f, f.root(), name, name, 0), file.string()));
         },
-        [&](IsolatedIn& answer) { var = get_var(answer, file.string(), name, h5->limit(), 0); });
-    return from_matvar(*var, file.string());
+        [&](IsolatedIn& answer) {
+          double budget = h5->limit();
+          value = get_value(answer, budget, 0);
+        });
+    return value;
   }
   if (read_without_matio(in)) {
     const V5Variable* v = as_v5(in)->find(name);
