@@ -819,14 +819,9 @@ void check_h5_storage(const H5File& in, const H5Var& v, const std::string& field
   }
 }
 
-MatVarPtr checked_create(MatVarPtr var, const std::string& source, const std::string& field) {
-  if (!var) throw InputError(source, field, "a variable matio can hold", "Mat_VarCreate failed");
-  return var;
-}
+MatValue read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth);
 
-MatVarPtr read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth);
-
-MatVarPtr read_h5_struct(const H5File& in, const H5Var& v, const std::string& name, const std::string& field, int depth) {
+MatValue read_h5_struct(const H5File& in, const H5Var& v, const std::string& name, const std::string& field, int depth) {
   const std::string source = in.source();
   if (depth > 16) throw InputError(source, field, "structs nested at most 16 deep", "deeper nesting");
   std::vector<std::string> names;
@@ -841,21 +836,18 @@ MatVarPtr read_h5_struct(const H5File& in, const H5Var& v, const std::string& na
     throw InputError(source, field, "a readable struct", "HDF5 cannot list its fields");
   }
   if (names.size() > 4096) throw InputError(source, field, "a struct of at most 4096 fields", "more");
-  std::vector<const char*> cnames;
-  for (const auto& n : names) cnames.push_back(n.c_str());
-  cnames.push_back(nullptr);
-  size_t dims[2] = {1, 1};
-  MatVarPtr var = checked_create(MatVarPtr(Mat_VarCreateStruct2(name.c_str(), 2, dims, cnames.data())), source, field);
+  MatValue out(name, MAT_C_STRUCT, {1, 1});
+  out.field_names = names;
   for (const auto& n : names) {
-    MatVarPtr f = read_h5_var(in, v.obj.get(), n, field + "." + n, depth + 1);
-    // The struct owns the new field from here; it returns the one it replaces (none: names are unique).
-    MatVarPtr replaced(Mat_VarSetStructFieldByName(var.get(), n.c_str(), 0, f.get()));
-    (void)f.release();
+    out.items.push_back(read_h5_var(in, v.obj.get(), n, field + "." + n, depth + 1));
+    out.items.back().name = n;
   }
-  return var;
+  return out;
 }
 
-MatVarPtr read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth) {
+// A variable of the file as the reader returns it (numeric classes as doubles), straight from
+// HDF5 (no matio).
+MatValue read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth) {
   const std::string source = in.source();
   const H5Var v = open_h5_var(in, parent, name, field);
   if (v.group) {
@@ -863,32 +855,27 @@ MatVarPtr read_h5_var(const H5File& in, hid_t parent, const std::string& name, c
     return read_h5_struct(in, v, name, field, depth);
   }
   const size_t n = product(v.dims);
-  std::vector<size_t> dims = v.dims;
-  const bool numeric = is_numeric_class(v.cls);
-  if (!numeric && v.cls != MAT_C_CHAR) {
+  if (!is_numeric_class(v.cls) && v.cls != MAT_C_CHAR) {
     // Classes piezobench never reads (cell, object, function handle): the header only.
-    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), v.cls, MAT_T_UNKNOWN, static_cast<int>(dims.size()), dims.data(),
-                                                  nullptr, MAT_F_DONT_COPY_DATA)),
-                          source, field);
+    MatValue out(name, v.cls, v.dims);
+    out.has_data = v.cls == MAT_C_CELL && n == 0;  // an empty cell is complete
+    return out;
   }
   check_h5_storage(in, v, field);
-  if (n == 0 || v.empty_flag) {
-    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), v.cls == MAT_C_CHAR ? MAT_C_CHAR : MAT_C_DOUBLE,
-                                                  v.cls == MAT_C_CHAR ? MAT_T_UINT16 : MAT_T_DOUBLE, static_cast<int>(dims.size()),
-                                                  dims.data(), nullptr, 0)),
-                          source, field);
-  }
+  if (n == 0 || v.empty_flag) return MatValue(name, v.cls == MAT_C_CHAR ? MAT_C_CHAR : MAT_C_DOUBLE, v.dims);
   const auto fail_read = [&] { throw InputError(source, field, "data HDF5 can read", "the read failed (corrupt or truncated file)"); };
   if (v.cls == MAT_C_CHAR) {
-    std::vector<std::uint16_t> text(n);
+    std::vector<std::uint16_t> units(n);
     const H5Id ftype(H5Dget_type(v.obj.get()), H5Tclose);
     if (!ftype.valid() || H5Tget_class(ftype.get()) != H5T_INTEGER) {
       throw InputError(source, field, "char data as 16-bit code units", "another HDF5 type");
     }
-    if (H5Dread(v.obj.get(), H5T_NATIVE_UINT16, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()) < 0) fail_read();
-    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), MAT_C_CHAR, MAT_T_UINT16, static_cast<int>(dims.size()), dims.data(),
-                                                  text.data(), 0)),
-                          source, field);
+    if (H5Dread(v.obj.get(), H5T_NATIVE_UINT16, H5S_ALL, H5S_ALL, H5P_DEFAULT, units.data()) < 0) fail_read();
+    MatValue out(name, MAT_C_CHAR, v.dims);
+    out.text.reserve(n);
+    // MATLAB stores char as UTF-16 code units; piezobench names are ASCII.
+    for (std::uint16_t u : units) out.text += u < 128 ? static_cast<char>(u) : '?';
+    return out;
   }
   if (v.complex) {
     const H5Id mem(H5Tcreate(H5T_COMPOUND, 2 * sizeof(double)), H5Tclose);
@@ -898,36 +885,23 @@ MatVarPtr read_h5_var(const H5File& in, hid_t parent, const std::string& name, c
     }
     std::vector<double> both(2 * n);
     if (H5Dread(v.obj.get(), mem.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, both.data()) < 0) fail_read();
-    std::vector<double> re(n), im(n);
+    MatValue out(name, MAT_C_DOUBLE, v.dims, /*complex=*/true);
+    out.re.resize(n);
+    out.im.resize(n);
     for (size_t i = 0; i < n; ++i) {
-      re[i] = both[2 * i];
-      im[i] = both[2 * i + 1];
+      out.re[i] = both[2 * i];
+      out.im[i] = both[2 * i + 1];
     }
-    mat_complex_split_t split{re.data(), im.data()};
-    return checked_create(MatVarPtr(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, static_cast<int>(dims.size()), dims.data(),
-                                                  &split, MAT_F_COMPLEX)),
-                          source, field);
+    return out;
   }
   const H5Id ftype(H5Dget_type(v.obj.get()), H5Tclose);
   if (!ftype.valid() || (H5Tget_class(ftype.get()) != H5T_FLOAT && H5Tget_class(ftype.get()) != H5T_INTEGER)) {
     throw InputError(source, field, "numeric data (integer or floating point)", "another HDF5 type");
   }
-  // Read as double straight into a buffer the variable then owns (no second copy).
-  auto* data = static_cast<double*>(std::malloc(n * sizeof(double)));
-  if (data == nullptr) throw InputError(source, field, "memory for " + std::to_string(n) + " samples", "allocation failed");
-  if (H5Dread(v.obj.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
-    std::free(data);
-    fail_read();
-  }
-  MatVarPtr var(Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, static_cast<int>(dims.size()), dims.data(), data,
-                              MAT_F_DONT_COPY_DATA));
-  if (!var) {
-    std::free(data);
-    throw InputError(source, field, "a variable matio can hold", "Mat_VarCreate failed");
-  }
-  var->mem_conserve = 0;  // the variable frees `data`
-  if (v.logical) var->isLogical = 1;
-  return var;
+  MatValue out(name, MAT_C_DOUBLE, v.dims, /*complex=*/false, v.logical);
+  out.re.resize(n);  // read as double straight into place
+  if (H5Dread(v.obj.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.re.data()) < 0) fail_read();
+  return out;
 }
 
 std::vector<std::string> h5_top_level_names(const H5File& in) {
@@ -1284,7 +1258,7 @@ MatValue read_mat_variable(MatInput* in, const fs::path& file, const std::string
     h5->run(
         [&](IsolatedOut& out) {
           H5File f(file);
-          put_value(out, from_matvar(*read_h5_var(f, f.root(), name, name, 0), file.string()));
+          put_value(out, read_h5_var(f, f.root(), name, name, 0));
         },
         [&](IsolatedIn& answer) {
           double budget = h5->limit();
