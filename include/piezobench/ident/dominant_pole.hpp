@@ -8,9 +8,10 @@
 // the response, while a pair the fit adds for a small feature or for noise contributes much less.
 // (Not |r| / |Re p|, the pair's peak on a continuous axis: unbounded for a pair the fit puts on the
 // imaginary axis with a tiny residue between two lines, and large for a damping near 1, where the
-// pair has no peak; both happened on the demo's damped plants, depending on the noise.) Unlike the report's
-// second-order fit, this stays on the closed loop's pole once the controller's own poles have moved
-// into the band (large gains), where a second-order model misplaces it by 10 to 50 %.
+// pair has no peak; both happened on the demo's damped plants, depending on the noise.) Unlike
+// the report's second-order fit, this stays on the closed loop's pole once the controller's own
+// poles have moved into the band (large gains), where a second-order model misplaces it by 10 to
+// 50 %.
 #include "piezobench/ident/vector_fitting.hpp"
 
 namespace piezobench::ident {

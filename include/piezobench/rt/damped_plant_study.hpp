@@ -24,9 +24,9 @@
 // [fit_fmin, fit_fmax]: of its complex pairs with a natural frequency in [resonance_fmin,
 // resonance_fmax], the one whose contribution is the largest on the data's frequencies
 // (ident::dominant_pole: the resonance dominates the response; a spurious pair that the fit adds
-// for a small feature contributes much less). The report fitted second-order models (vectfit3, 2 poles); that fit is
-// also made (ident::fit_second_order with vector fitting over [second_order_fmin,
-// second_order_fmax]) and reported, but not checked: once the damping is large, the damped plant
+// for a small feature contributes much less). The report fitted second-order models (vectfit3,
+// 2 poles); that fit is also made (ident::fit_second_order with vector fitting over
+// [second_order_fmin, second_order_fmax]) and reported, but not checked: once the damping is large, the damped plant
 // is no longer second order near the resonance (the controller's poles have moved into the band)
 // and a second-order fit places the pole off the locus by 10-20 %, as in the report's Figure 2.10b.
 #include <cstdint>
