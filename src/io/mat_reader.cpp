@@ -872,9 +872,9 @@ MatValue read_h5_var(const H5File& in, hid_t parent, const std::string& name, co
     }
     if (H5Dread(v.obj.get(), H5T_NATIVE_UINT16, H5S_ALL, H5S_ALL, H5P_DEFAULT, units.data()) < 0) fail_read();
     MatValue out(name, MAT_C_CHAR, v.dims);
-    out.text.reserve(n);
-    // MATLAB stores char as UTF-16 code units; piezobench names are ASCII.
-    for (std::uint16_t u : units) out.text += u < 128 ? static_cast<char>(u) : '?';
+    // MATLAB stores char as UTF-16 code units; the text is UTF-8 (as from_matvar makes it).
+    const std::vector<double> codes(units.begin(), units.end());
+    out.text = utf8_from_units(codes.data(), n);
     return out;
   }
   if (v.complex) {

@@ -169,8 +169,10 @@ TEST(MatReaderV73, StructsTextAndComplexDataComeBackFromTheChild) {
     w.write(detail::make_struct("settings", std::move(fields)));
     w.write(detail::make_complex_column("H", h));
     w.write(detail::make_text("input", "u"));
+    w.write(detail::make_text("unit", "\u00b5m \u00dc \u221e"));  // non-ASCII: UTF-16 units in the file
   });
   const detail::MatFilePtr mat = detail::open_mat_for_reading(file);
+  EXPECT_EQ(detail::to_text(detail::read_mat_variable(mat.get(), file, "unit"), file.string(), "unit"), "\u00b5m \u00dc \u221e");
   const detail::MatValue s = detail::read_mat_variable(mat.get(), file, "settings");
   ASSERT_EQ(s.class_type, MAT_C_STRUCT);
   const detail::MatValue* name = s.field("name");
