@@ -1,8 +1,8 @@
 #pragma once
 // A shared library opened on first use (dlopen) instead of at program start. The dependencies only
 // some commands need (matio and HDF5 for MAT files, CHOLMOD for Craig-Bampton) are reached this
-// way: a command that never calls them never maps them nor pays their relocations (HDF5 and
-// CHOLMOD bring 50 libraries with them; docs/performance.md, "Start-up").
+// way: a command that never calls them never maps them nor pays their relocations (with them the
+// program started with 57 shared libraries, without them 11; docs/performance.md, "Start-up").
 //
 // Each such dependency has one stub file (src/io/matio_stubs.cpp, src/io/hdf5_stubs.cpp,
 // src/fem/cholmod_stubs.cpp) that defines the C functions piezobench calls, with the signatures of
