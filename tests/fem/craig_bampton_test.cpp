@@ -186,22 +186,7 @@ TEST(CraigBampton, KeepingEveryInteriorModeIsExact) {
   // and node n retained: with all n - 2 interior modes the reduction is a change of basis, so
   // the eigenvalues are those of the full model (dense path, interior <= 400).
   const int n = 40;
-  SparseModel chain;
-  std::vector<Eigen::Triplet<double, int>> tk, tm;
-  for (int i = 0; i < n; ++i) {
-    const double k = 1000.0 + 10.0 * i;
-    tk.emplace_back(i, i, 2 * k);
-    if (i + 1 < n) {
-      tk.emplace_back(i, i + 1, -k);
-      tk.emplace_back(i + 1, i, -k);
-    }
-    tm.emplace_back(i, i, 1.0 + 0.01 * i);
-    chain.dofs.push_back(DofLabel::nodal(i + 1, Direction::kX));
-  }
-  chain.K.resize(n, n);
-  chain.M.resize(n, n);
-  chain.K.setFromTriplets(tk.begin(), tk.end());
-  chain.M.setFromTriplets(tm.begin(), tm.end());
+  const SparseModel chain = test_data::spring_chain(n);
   CraigBamptonOptions o;
   o.modes = n - 3;  // all but one interior mode: the highest is dropped
   const CraigBamptonResult r = craig_bampton(chain, {{1, -1}, {n, -1}}, o);

@@ -7,6 +7,7 @@
 #include "piezobench/core/shared_library.hpp"
 #include "piezobench/fem/craig_bampton.hpp"
 #include "piezobench/fem/structural_model.hpp"
+#include "fem_test_data.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::fem {
@@ -20,24 +21,9 @@ TEST(LazyCholmod, LoadedByTheFirstReductionOnly) {
   EXPECT_FALSE(is_shared_object_loaded("libopenblas"));
   EXPECT_FALSE(is_shared_object_loaded("libgfortran"));
 
-  // A chain of n springs and masses (grounded at both ends), nodes 1 and n retained.
+  // A spring-mass chain, nodes 1 and n retained.
   const int n = 30;
-  SparseModel chain;
-  std::vector<Eigen::Triplet<double, int>> tk, tm;
-  for (int i = 0; i < n; ++i) {
-    const double k = 1000.0 + 10.0 * i;
-    tk.emplace_back(i, i, 2 * k);
-    if (i + 1 < n) {
-      tk.emplace_back(i, i + 1, -k);
-      tk.emplace_back(i + 1, i, -k);
-    }
-    tm.emplace_back(i, i, 1.0 + 0.01 * i);
-    chain.dofs.push_back(DofLabel::nodal(i + 1, Direction::kX));
-  }
-  chain.K.resize(n, n);
-  chain.M.resize(n, n);
-  chain.K.setFromTriplets(tk.begin(), tk.end());
-  chain.M.setFromTriplets(tm.begin(), tm.end());
+  const SparseModel chain = test_data::spring_chain(n);
   EXPECT_FALSE(is_shared_object_loaded("libcholmod"));
 
   CraigBamptonOptions o;
