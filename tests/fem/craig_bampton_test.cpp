@@ -199,19 +199,7 @@ TEST(CraigBampton, KeepingEveryInteriorModeIsExact) {
     EXPECT_GE(red.eigenvalues()(i), full.eigenvalues()(i) * (1 - 1e-12));
     EXPECT_TRUE(test::near(red.eigenvalues()(i), full.eigenvalues()(i), 1e-4)) << i;
   }
-  // The static part is exact whatever the number of modes: the static response to interface
-  // forces equals the full model's.
-  const Eigen::MatrixXd Kfull = Eigen::MatrixXd(chain.K);
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
-  f(0) = 1.0;
-  f(n - 1) = -0.5;
-  const Eigen::VectorXd u_full = Kfull.ldlt().solve(f);
-  Eigen::VectorXd fr = Eigen::VectorXd::Zero(r.reduced.size());
-  fr(0) = 1.0;
-  fr(1) = -0.5;
-  const Eigen::VectorXd u_red = r.reduced.K.ldlt().solve(fr);
-  EXPECT_TRUE(test::near(u_red(0), u_full(0), 1e-10));
-  EXPECT_TRUE(test::near(u_red(1), u_full(n - 1), 1e-10));
+  test_data::expect_exact_static_condensation(chain, r);
 }
 
 }  // namespace

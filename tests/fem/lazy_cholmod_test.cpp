@@ -30,18 +30,7 @@ TEST(LazyCholmod, LoadedByTheFirstReductionOnly) {
   o.modes = 4;
   const CraigBamptonResult r = craig_bampton(chain, {{1, -1}, {n, -1}}, o);
   EXPECT_TRUE(is_shared_object_loaded("libcholmod"));
-  // The static part is exact whatever the number of modes: the reduced model's response to
-  // interface forces equals the full model's (dense solve).
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
-  f(0) = 1.0;
-  f(n - 1) = -0.5;
-  const Eigen::VectorXd u_full = Eigen::MatrixXd(chain.K).ldlt().solve(f);
-  Eigen::VectorXd fr = Eigen::VectorXd::Zero(r.reduced.size());
-  fr(0) = 1.0;
-  fr(1) = -0.5;
-  const Eigen::VectorXd u_red = r.reduced.K.ldlt().solve(fr);
-  EXPECT_TRUE(test::near(u_red(0), u_full(0), 1e-10));
-  EXPECT_TRUE(test::near(u_red(1), u_full(n - 1), 1e-10));
+  test_data::expect_exact_static_condensation(chain, r);
 }
 
 }  // namespace
