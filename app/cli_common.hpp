@@ -24,6 +24,7 @@ void add_simulate_commands(CLI::App& app, Action& action);  // simulate
 void add_measure_commands(CLI::App& app, Action& action);  // measure, bench serve
 void add_run_commands(CLI::App& app, Action& action);  // run, merge, demo
 void add_hysteresis_commands(CLI::App& app, Action& action);  // hysteresis fit, hysteresis creep
+void add_qualify_commands(CLI::App& app, Action& action);  // qualify, db
 
 // Prints exactly one JSON document on stdout (round-trip precision for doubles).
 void print_json(const nlohmann::json& document);

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   piezobench::app::add_measure_commands(app, action);
   piezobench::app::add_run_commands(app, action);
   piezobench::app::add_hysteresis_commands(app, action);
+  piezobench::app::add_qualify_commands(app, action);
 
   try {
     app.parse(argc, argv);
