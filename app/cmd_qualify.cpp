@@ -213,20 +213,24 @@ void add_qualify_commands(CLI::App& app, Action& action) {
   auto d = std::make_shared<DbCli>();
   CLI::App* db = app.add_subcommand("db", "The station database: list, show, export (docs/station.md)");
   db->require_subcommand(1);
-  db->add_option("--db", d->db, "station database (SQLite)")->capture_default_str();
+  const auto database = [&d](CLI::App* sub) { sub->add_option("--db", d->db, "station database (SQLite)")->capture_default_str(); };
   CLI::App* list = db->add_subcommand("list", "Qualifications, newest first");
   list->add_option("--batch", d->batch, "only this batch");
   list->add_flag("--json", d->json, "as JSON");
+  database(list);
   list->callback([d, &action] { action = [d] { return run_db_list(*d); }; });
   CLI::App* show = db->add_subcommand("show", "The newest qualification of a unit: tries, measurements, raw files");
   show->add_option("serial", d->serial, "serial number")->required();
   show->add_flag("--json", d->json, "as JSON (with the per-unit results)");
+  database(show);
   show->callback([d, &action] { action = [d] { return run_db_show(*d); }; });
   CLI::App* exp = db->add_subcommand("export", "A campaign file of a batch's qualified units that `piezobench run` accepts");
   exp->add_option("--batch", d->batch, "the batch")->required();
   exp->add_option("--out", d->out, "campaign file to write")->required();
+  database(exp);
   exp->callback([d, &action] { action = [d] { return run_db_export(*d); }; });
   CLI::App* check = db->add_subcommand("check", "PRAGMA integrity_check of the database (prints ok)");
+  database(check);
   check->callback([d, &action] { action = [d] { return run_db_check(*d); }; });
 }
 
