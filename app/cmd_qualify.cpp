@@ -11,6 +11,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/station/certificate.hpp"
 #include "piezobench/station/phase_runner.hpp"
 #include "piezobench/version.hpp"
 
@@ -122,6 +123,7 @@ int run_qualify(const QualifyCli& o) {
     doc["reasons"] = r.reasons;
     doc["analysis_seconds"] = r.analysis_seconds;
     doc["database"] = o.db;
+    doc["certificate"] = r.certificate.string();
     print_json(doc);
   } else {
     print_qualification(*q, store.phase_tries(r.qualification_id));
@@ -181,6 +183,31 @@ int run_db_export(const DbCli& o) {
   return 0;
 }
 
+int run_db_certificate(const DbCli& o) {
+  station::RecordStore store(o.db);
+  const auto q = store.latest_qualification(o.serial);
+  if (!q || q->status != "complete") throw InputError(o.db, "serial", "a unit with a completed qualification", "'" + o.serial + "'");
+  const std::string html = station::certificate_html(*q, store.phase_tries(q->id));
+  const std::string sha = station::sha256_text(html);
+  write_text_atomically(o.out, html);
+  fmt::print("{}: sha256 {} ({} the one stored with qualification {})\n", o.out, sha, sha == q->certificate_sha256 ? "equal to" : "DIFFERENT from",
+             q->id);
+  if (sha != q->certificate_sha256) throw InputError(o.db, "certificate_sha256", q->certificate_sha256, sha);
+  return 0;
+}
+
+int run_db_charts(const DbCli& o) {
+  station::RecordStore store(o.db);
+  const auto charts = station::control_charts(store, o.batch);
+  const std::string title = o.batch.empty() ? "Control charts, every batch" : "Control charts, batch " + o.batch;
+  write_text_atomically(o.out, station::control_charts_html(charts, title));
+  for (const auto& c : charts) {
+    log_line(fmt::format("{}: {} units, mean {:.5g} {}, 3 sigma {:.3g}, {} marginal, {} failed", c.quantity, c.points.size(), c.mean, c.unit,
+                         3 * c.sigma, c.marginal, c.failed));
+  }
+  return 0;
+}
+
 int run_db_check(const DbCli& o) {
   station::RecordStore store(o.db);
   const std::string result = store.integrity_check();
@@ -229,6 +256,16 @@ void add_qualify_commands(CLI::App& app, Action& action) {
   exp->add_option("--out", d->out, "campaign file to write")->required();
   database(exp);
   exp->callback([d, &action] { action = [d] { return run_db_export(*d); }; });
+  CLI::App* cert = db->add_subcommand("certificate", "Regenerate a unit's certificate (HTML) from the database; checks its stored SHA-256");
+  cert->add_option("serial", d->serial, "serial number")->required();
+  cert->add_option("--out", d->out, "HTML file to write")->required();
+  database(cert);
+  cert->callback([d, &action] { action = [d] { return run_db_certificate(*d); }; });
+  CLI::App* charts = db->add_subcommand("charts", "Control charts across units and batches (HTML): values, spec limits, mean +- 3 sigma");
+  charts->add_option("--batch", d->batch, "only this batch (default: every batch)");
+  charts->add_option("--out", d->out, "HTML file to write")->required();
+  database(charts);
+  charts->callback([d, &action] { action = [d] { return run_db_charts(*d); }; });
   CLI::App* check = db->add_subcommand("check", "PRAGMA integrity_check of the database (prints ok)");
   database(check);
   check->callback([d, &action] { action = [d] { return run_db_check(*d); }; });

@@ -13,6 +13,8 @@
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/campaign/unit_analysis.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/file.hpp"
+#include "piezobench/station/certificate.hpp"
 
 namespace piezobench::station {
 
@@ -344,6 +346,13 @@ QualifyResult finish(Context& cx, const std::string& status, QualifyResult r) {
     if (cx.options.observer) cx.options.observer->verdict(cx.options.serial, r.verdict, r.deciding_phase, r.deciding_measurement);
   }
   cx.store.finish_qualification(cx.q);
+  if (status == "complete") {
+    // The certificate from the database's rows (db certificate regenerates the same bytes).
+    const std::string html = certificate_html(*cx.store.qualification(cx.q.id), cx.store.phase_tries(cx.q.id));
+    r.certificate = cx.options.data_dir / cx.options.serial / fmt::format("certificate-q{}.html", cx.q.id);
+    write_text_atomically(r.certificate, html);
+    cx.store.set_certificate(cx.q.id, sha256_text(html));
+  }
   return r;
 }
 

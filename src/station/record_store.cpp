@@ -392,19 +392,19 @@ std::vector<PhaseTryRow> RecordStore::phase_tries(std::int64_t qid) const {
   return out;
 }
 
-std::vector<std::pair<std::string, double>> RecordStore::history(const std::string& measurement, const std::string& batch) const {
+std::vector<HistoryPoint> RecordStore::history(const std::string& measurement, const std::string& batch) const {
   // The latest complete qualification of each unit, then its last complete try's value.
   Statement s(db_,
               "WITH latest AS (SELECT serial, MAX(id) AS qid FROM qualification WHERE status = 'complete' AND (? = '' OR batch = ?) "
               "GROUP BY serial) "
-              "SELECT u.serial, m.value FROM latest l JOIN unit u ON u.serial = l.serial "
+              "SELECT u.serial, u.batch, m.value, m.min, m.max, m.verdict FROM latest l JOIN unit u ON u.serial = l.serial "
               "JOIN phase_try p ON p.qualification_id = l.qid AND p.status = 'complete' "
               "JOIN measurement m ON m.phase_try_id = p.id AND m.name = ? "
               "WHERE m.value IS NOT NULL ORDER BY u.ordinal, p.id",
               file_);
   s.bind(1, batch).bind(2, batch).bind(3, measurement);
-  std::vector<std::pair<std::string, double>> out;
-  while (s.step()) out.emplace_back(s.text(0), *s.real(1));
+  std::vector<HistoryPoint> out;
+  while (s.step()) out.push_back({s.text(0), s.text(1), *s.real(2), s.real(3), s.real(4), s.text(5)});
   return out;
 }
 

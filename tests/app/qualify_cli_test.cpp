@@ -136,6 +136,16 @@ TEST(QualifyCli, TheDemoBatchMatchesRunOnTheExport) {
   EXPECT_TRUE(test::contains(reasons, "capacitance of the sensor stack")) << reasons;
   EXPECT_TRUE(test::contains(reasons, "below the minimum 200.0 um")) << reasons;
   EXPECT_EQ(qualified[3]["accepted"], false);
+  // The certificate regenerated from the database is the one qualify wrote, byte for byte.
+  const std::string db = (f.dir.path() / "st.db").string(), cert = (f.dir.path() / "APA-3.html").string();
+  const auto c = run_cli("db certificate APA-3 --out " + cert + " --db " + db);
+  ASSERT_EQ(c.exit_code, 0) << c.err << c.out;
+  EXPECT_TRUE(test::contains(c.out, "equal to the one stored")) << c.out;
+  EXPECT_EQ(test::read_text(cert), test::read_text(f.dir.path() / "data/APA-3/certificate-q3.html"));
+  const auto charts = run_cli("db charts --batch demo --out " + (f.dir.path() / "charts.html").string() + " --db " + db);
+  ASSERT_EQ(charts.exit_code, 0) << charts.err;
+  EXPECT_TRUE(test::contains(charts.err, "stroke_um: 7 units")) << charts.err;
+  EXPECT_TRUE(test::contains(charts.err, "capacitance_sensor_uF: 7 units")) << charts.err;
 }
 
 TEST(QualifyCli, AnswersWithATypoOrAMissingAnswerAreRefusedBeforeAnythingMoves) {

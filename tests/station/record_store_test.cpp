@@ -86,7 +86,12 @@ TEST(RecordStore, EveryTryIsKeptWithItsMeasurementsAndFiles) {
   EXPECT_EQ(t[0].raw_files[0].bytes, 1234);
   EXPECT_EQ(s.list("B1").size(), 2U);
   EXPECT_EQ(s.list("B2").size(), 0U);
-  EXPECT_EQ(s.history("stroke_um", "B1"), (std::vector<std::pair<std::string, double>>{{"SN2", 250.0}}));
+  const auto h = s.history("stroke_um", "B1");
+  ASSERT_EQ(h.size(), 1U);
+  EXPECT_EQ(h[0].serial, "SN2");
+  EXPECT_DOUBLE_EQ(h[0].value, 250.0);
+  EXPECT_DOUBLE_EQ(*h[0].min, 200.0);
+  EXPECT_EQ(h[0].verdict, "pass");
   EXPECT_EQ(s.integrity_check(), "ok");
 }
 

@@ -16,7 +16,8 @@
 // not measured). After the last phase the whole unit is analysed by the campaign pipeline
 // (run_campaign on the unit's campaign, the one `db export` writes) and the unit's verdict is the
 // worst of its phases' verdicts and the pipeline's acceptance; the deciding phase and measurement
-// are the first with that verdict.
+// are the first with that verdict. The certificate (certificate.hpp) is written next to the raw
+// files and its SHA-256 stored.
 //
 // Resume (options.resume): the newest qualification of the serial, not complete, continues at its
 // first phase without a kept try; a kept phase is never measured again (its raw file's hash is
@@ -164,6 +165,7 @@ struct QualifyResult {
   std::vector<std::string> resumed_phases;  // kept phases of an earlier run, not measured again
   std::optional<campaign::UnitAnalysis> unit;   // the final analysis (status complete)
   double analysis_seconds = 0.0;        // the final analysis
+  std::filesystem::path certificate;    // DATA/SERIAL/certificate-q<ID>.html (status complete)
 };
 
 QualifyResult qualify(const StationFile& station, Instrument& instrument, Operator& op, RecordStore& store,

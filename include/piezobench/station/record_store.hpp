@@ -58,6 +58,14 @@ struct PhaseTryRow {
   std::vector<RawFileRow> raw_files;
 };
 
+// One unit's value of a measurement (RecordStore::history).
+struct HistoryPoint {
+  std::string serial, batch;
+  double value = 0.0;
+  std::optional<double> min, max;
+  std::string verdict;
+};
+
 // The SHA-256 of a file's bytes as lower-case hex (nettle). InputError when it cannot be read.
 std::string sha256_file(const std::filesystem::path& file);
 std::string sha256_text(const std::string& bytes);
@@ -91,9 +99,10 @@ class RecordStore {
   [[nodiscard]] std::vector<QualificationRow> list(const std::string& batch = "", int limit = 1000) const;
   // Every try of a qualification, in order, with measurements and raw files.
   [[nodiscard]] std::vector<PhaseTryRow> phase_tries(std::int64_t qualification_id) const;
-  // History of one measurement across units: (serial, value) of the latest complete qualification
-  // per unit, in the order units were first qualified; batch "" for all.
-  [[nodiscard]] std::vector<std::pair<std::string, double>> history(const std::string& measurement, const std::string& batch = "") const;
+  // History of one measurement across units: the value in the latest complete qualification of
+  // each unit, in the order units were first qualified; batch "" for all (indexed: docs/station.md
+  // has the time on 10,000 units).
+  [[nodiscard]] std::vector<HistoryPoint> history(const std::string& measurement, const std::string& batch = "") const;
   // "ok" when PRAGMA integrity_check finds nothing.
   [[nodiscard]] std::string integrity_check() const;
   [[nodiscard]] const std::filesystem::path& file() const { return file_; }
