@@ -122,6 +122,7 @@ int run_qualify(const QualifyCli& o) {
     doc["resumed_phases"] = r.resumed_phases;
     doc["reasons"] = r.reasons;
     doc["analysis_seconds"] = r.analysis_seconds;
+    doc["analysis_cpu_seconds"] = r.analysis_cpu_seconds;
     doc["database"] = o.db;
     doc["certificate"] = r.certificate.string();
     print_json(doc);

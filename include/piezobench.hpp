@@ -13,4 +13,5 @@
 #include "piezobench/metrology.hpp"
 #include "piezobench/report.hpp"
 #include "piezobench/rt.hpp"
+#include "piezobench/station.hpp"
 #include "piezobench/version.hpp"

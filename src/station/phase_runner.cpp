@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <map>
 #include <sstream>
 
@@ -325,6 +326,13 @@ void decide(const Context& cx, const campaign::UnitAnalysis& ua, QualifyResult& 
   }
 }
 
+// CPU time of the whole process (every thread), s.
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 QualifyResult finish(Context& cx, const std::string& status, QualifyResult r) {
   r.qualification_id = cx.q.id;
   r.status = status;
@@ -332,9 +340,11 @@ QualifyResult finish(Context& cx, const std::string& status, QualifyResult r) {
   cx.q.finished = utc_now();
   if (status == "complete") {
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = process_cpu_seconds();
     const campaign::Campaign c = cx.campaign_of(cx.kept);
     campaign::CampaignResult cr = campaign::run_campaign(c);
     r.analysis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.analysis_cpu_seconds = process_cpu_seconds() - cpu0;
     decide(cx, cr.units.front(), r);
     cx.q.verdict = to_string(r.verdict);
     cx.q.deciding_phase = r.deciding_phase;

@@ -393,16 +393,24 @@ std::vector<PhaseTryRow> RecordStore::phase_tries(std::int64_t qid) const {
 }
 
 std::vector<HistoryPoint> RecordStore::history(const std::string& measurement, const std::string& batch) const {
-  // The latest complete qualification of each unit, then its last complete try's value.
-  Statement s(db_,
-              "WITH latest AS (SELECT serial, MAX(id) AS qid FROM qualification WHERE status = 'complete' AND (? = '' OR batch = ?) "
-              "GROUP BY serial) "
-              "SELECT u.serial, u.batch, m.value, m.min, m.max, m.verdict FROM latest l JOIN unit u ON u.serial = l.serial "
-              "JOIN phase_try p ON p.qualification_id = l.qid AND p.status = 'complete' "
-              "JOIN measurement m ON m.phase_try_id = p.id AND m.name = ? "
-              "WHERE m.value IS NOT NULL ORDER BY u.ordinal, p.id",
-              file_);
-  s.bind(1, batch).bind(2, batch).bind(3, measurement);
+  // The latest complete qualification of each unit, then its complete tries' values. Two plans
+  // (docs/performance.md, 10,000 units): a batch starts from its qualifications (index on batch)
+  // and walks each one's tries; every batch starts from the measurement's rows (index on name),
+  // keeping those of the latest qualifications (an IN list SQLite indexes).
+  const std::string sql =
+      batch.empty()
+          ? "SELECT u.serial, u.batch, m.value, m.min, m.max, m.verdict FROM measurement m "
+            "JOIN phase_try p ON p.id = m.phase_try_id JOIN qualification q ON q.id = p.qualification_id "
+            "JOIN unit u ON u.serial = q.serial WHERE m.name = ?1 AND m.value IS NOT NULL AND p.status = 'complete' "
+            "AND p.qualification_id IN (SELECT MAX(id) FROM qualification WHERE status = 'complete' GROUP BY serial) "
+            "ORDER BY u.ordinal, p.id"
+          : "WITH latest AS (SELECT serial, MAX(id) AS qid FROM qualification WHERE status = 'complete' AND batch = ?2 GROUP BY serial) "
+            "SELECT u.serial, u.batch, m.value, m.min, m.max, m.verdict FROM latest l CROSS JOIN unit u ON u.serial = l.serial "
+            "CROSS JOIN phase_try p ON p.qualification_id = l.qid CROSS JOIN measurement m ON m.phase_try_id = p.id "
+            "WHERE p.status = 'complete' AND m.name = ?1 AND m.value IS NOT NULL ORDER BY u.ordinal, p.id";
+  Statement s(db_, sql, file_);
+  s.bind(1, measurement);
+  if (!batch.empty()) s.bind(2, batch);
   std::vector<HistoryPoint> out;
   while (s.step()) out.push_back({s.text(0), s.text(1), *s.real(2), s.real(3), s.real(4), s.text(5)});
   return out;

@@ -164,7 +164,8 @@ struct QualifyResult {
   std::vector<std::string> reasons;
   std::vector<std::string> resumed_phases;  // kept phases of an earlier run, not measured again
   std::optional<campaign::UnitAnalysis> unit;   // the final analysis (status complete)
-  double analysis_seconds = 0.0;        // the final analysis
+  double analysis_seconds = 0.0;        // the final analysis, wall time
+  double analysis_cpu_seconds = 0.0;    // and CPU time (every thread)
   std::filesystem::path certificate;    // DATA/SERIAL/certificate-q<ID>.html (status complete)
 };
 
