@@ -37,6 +37,8 @@ const Options<VectorFittingOptions>& vf_options() {
         .add("starting_damping", &VectorFittingOptions::starting_damping, "damping of the automatic starting poles")
         .add_enum("weighting", &VectorFittingOptions::weighting, &ident::to_string, &weighting_from_string,
                   "\"unit\", \"inverse-magnitude\" or \"inverse-sqrt-magnitude\"")
+        .add("point_weights", &VectorFittingOptions::point_weights,
+             "one weight per frequency point (e.g. 1/std), multiplying the row weights; empty = none")
         .add("frequency_scale", &VectorFittingOptions::frequency_scale, "rad/s; 0 = the highest omega");
     return o;
   }();

@@ -39,7 +39,10 @@ def test_frf_features_find_the_nmp_zero_of_the_iff_plant():
     s, wz, xz = 1j * w, 2 * np.pi * 42.7, 0.004
     mirror = (1 - 2 * xz * s / wz + s**2 / wz**2) / (1 + 2 * xz * s / wz + s**2 / wz**2)
     h = lti.freqresp(control.iff_plant(), w) * mirror
-    feat = ident.frf_features(w, h, fit={"order": 6})
+    # The data have 3 poles (the mirror's cancel the plant's zeros); order 4 leaves one spare pole.
+    # (With 3 spare poles, where they land is decided by round-off: one pair next to the 95.2 Hz
+    # pole, with a zero that cancels it, hid the resonance with the FMA kernels of vector_fit.)
+    feat = ident.frf_features(w, h, fit={"order": 4})
     assert len(feat.antiresonances) == 1 and len(feat.resonances) == 1
     anti = feat.antiresonances[0]
     assert anti.frequency_Hz == pytest.approx(42.7, rel=1e-4)

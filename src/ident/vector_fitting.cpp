@@ -47,28 +47,35 @@ CVector canonical_poles(const CVector& raw) {
   return out;
 }
 
-// Basis of the partial fractions for canonical poles: 1/(s - p) for a real pole; for a pair,
-// 1/(s - p) + 1/(s - p*) and j/(s - p) - j/(s - p*), so that real coefficients (c', c'') give
-// the residue c' + j c'' on p (Gustavsen & Semlyen 1999, eq. A.3).
-void fill_basis(const CVector& s, const CVector& poles, CMatrix& basis) {
-  // 1/z as conj(z)/|z|^2: the data are well scaled (s is normalized), and this avoids the slow
-  // overflow-safe library division, which dominated the cost of this loop.
-  const auto inv = [](Complex z) {
-    const double n2 = z.real() * z.real() + z.imag() * z.imag();
-    return Complex(z.real() / n2, -z.imag() / n2);
-  };
+// Basis of the partial fractions for canonical poles at s = j w (w: the scaled frequencies): 1/(s - p)
+// for a real pole; for a pair, 1/(s - p) + 1/(s - p*) and j/(s - p) - j/(s - p*), so that real
+// coefficients (c', c'') give the residue c' + j c'' on p (Gustavsen & Semlyen 1999, eq. A.3).
+// Written in real arithmetic: s is imaginary, and GCC's complex product checks every result for
+// NaN (a call to __muldc3), which kept these loops from being vectorized.
+void fill_basis(const Vector& w, const CVector& poles, CMatrix& basis) {
   const Index n = poles.size();
+  const Index ns = w.size();
   for (Index i = 0; i < n; ++i) {
-    const Complex p = poles(i);
-    if (p.imag() == 0.0) {
-      for (Index k = 0; k < s.size(); ++k) basis(k, i) = inv(s(k) - p);
+    const double a = poles(i).real();
+    const double b = poles(i).imag();
+    if (b == 0.0) {
+      // 1/(j w - a) = (-a - j w) / (a^2 + w^2)
+      for (Index k = 0; k < ns; ++k) {
+        const double inv = 1.0 / (a * a + w(k) * w(k));
+        basis(k, i) = Complex(-a * inv, -w(k) * inv);
+      }
     } else {
-      // 1/(s - p) + 1/(s - p*) = 2 (s - Re p) / q and j (1/(s - p) - 1/(s - p*)) = -2 Im p / q with
-      // q = (s - p)(s - p*): one reciprocal per pair instead of two.
-      for (Index k = 0; k < s.size(); ++k) {
-        const Complex r = inv((s(k) - p) * (s(k) - std::conj(p)));
-        basis(k, i) = 2.0 * (s(k) - p.real()) * r;
-        basis(k, i + 1) = -2.0 * p.imag() * r;
+      // 1/(s - p) + 1/(s - p*) = 2 (s - a) / q and j (1/(s - p) - 1/(s - p*)) = -2 b / q with
+      // q = (s - p)(s - p*) = (a^2 + b^2 - w^2) - 2 j a w: one reciprocal per pair.
+      const double m2 = a * a + b * b;
+      for (Index k = 0; k < ns; ++k) {
+        const double qr = m2 - w(k) * w(k);
+        const double qi = -2.0 * a * w(k);
+        const double inv = 1.0 / (qr * qr + qi * qi);
+        const double rr = qr * inv;   // 1/q = (qr - j qi) / |q|^2
+        const double ri = -qi * inv;
+        basis(k, i) = Complex(2.0 * (-a * rr - w(k) * ri), 2.0 * (-a * ri + w(k) * rr));
+        basis(k, i + 1) = Complex(-2.0 * b * rr, -2.0 * b * ri);
       }
       ++i;
     }
@@ -177,7 +184,7 @@ CVector automatic_starting_poles(const Vector& omega, const VectorFittingOptions
   return p;
 }
 
-Matrix make_weights(const CMatrix& data, const Matrix& user, Weighting weighting) {
+Matrix base_weights(const CMatrix& data, const Matrix& user, Weighting weighting) {
   if (user.size() > 0) return user;
   if (weighting == Weighting::kUnit) return Matrix::Ones(data.rows(), 1);
   Matrix w(data.rows(), data.cols());
@@ -198,6 +205,13 @@ Matrix make_weights(const CMatrix& data, const Matrix& user, Weighting weighting
       w(k, i) = weighting == Weighting::kInverseMagnitude ? 1.0 / mag : 1.0 / std::sqrt(mag);
     }
   }
+  return w;
+}
+
+// The row weights: the explicit ones or those of the weighting, times the point weights.
+Matrix make_weights(const CMatrix& data, const Matrix& user, const VectorFittingOptions& o) {
+  Matrix w = base_weights(data, user, o.weighting);
+  if (o.point_weights.size() > 0) w.array().colwise() *= o.point_weights.array();
   return w;
 }
 
@@ -230,6 +244,10 @@ void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights
     }
   }
   if (data.cwiseAbs().maxCoeff() == 0.0) throw InputError(kSource, "data", "a nonzero response", "all zeros");
+  if (o.point_weights.size() > 0 && o.point_weights.size() != ns) {
+    throw InputError(kSource, "point_weights", std::to_string(ns) + " values (one per frequency)",
+                     std::to_string(o.point_weights.size()));
+  }
   if (weights.size() > 0) {
     if (weights.rows() != ns || (weights.cols() != 1 && weights.cols() != data.cols())) {
       throw InputError(kSource, "weights",
@@ -264,34 +282,117 @@ void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights
 // 2N + 2 columns). Eigen's HouseholderQR treats a matrix of fewer than 48 columns as one panel and
 // applies each reflector separately (a matrix-vector product and a rank-1 update per reflector).
 // The kernel below applies the reflectors in panels of kPanel (compact WY form, Q = I - V T V^T):
-// two passes over the trailing columns per panel instead of two per reflector, with the sums over
-// rows in 2-wide vectors (GCC/Clang vector extensions: SSE2 on x86-64, NEON on ARM; the compiler
-// does not vectorize floating-point sums by itself). On the VF benchmark (2000 points, 42
-// columns) the QRs of a relocation take 1.6 times less time than with Eigen's HouseholderQR. It
-// is the same Householder QR (beta = -sign(x) ||x||, as Eigen's), so R agrees with Eigen's to
-// round-off.
+// two passes over the trailing columns per panel instead of two per reflector, two trailing
+// columns per pass (each load of V serves both), with the sums over rows in W-wide vectors (GCC/
+// Clang vector extensions; the compiler does not vectorize floating-point sums by itself). It is
+// compiled three times, for W = 2 (SSE2 on x86-64, NEON on ARM), W = 4 (AVX2 with FMA) and W = 8
+// (AVX-512), and the widest the processor has is chosen once at run time (the build itself stays
+// generic x86-64). It is the same Householder QR (beta = -sign(x) ||x||, as Eigen's), so R agrees
+// with Eigen's to round-off; the variants differ from one another by round-off only (FMA).
+// docs/performance.md ("ident") has the figures.
 
-typedef double Vec2 __attribute__((vector_size(16), aligned(8), may_alias));
-constexpr int kLanes = 2;
+#define PB_KERNEL [[gnu::always_inline]] inline
+
+template <int W>
+struct Lanes {
+  typedef double Vec __attribute__((vector_size(8 * W), aligned(8), may_alias));
+};
+
 constexpr int kPanel = 4;
 
+
 // sum_i x[i] y[i]
-double dot(const double* x, const double* y, Index n) {
-  Vec2 acc0 = {}, acc1 = {};
+template <int W>
+PB_KERNEL double dot(const double* x, const double* y, Index n) {
+  using V = typename Lanes<W>::Vec;
+  V acc0 = {}, acc1 = {};
   Index i = 0;
-  for (; i + 2 * kLanes <= n; i += 2 * kLanes) {
-    acc0 += *reinterpret_cast<const Vec2*>(x + i) * *reinterpret_cast<const Vec2*>(y + i);
-    acc1 += *reinterpret_cast<const Vec2*>(x + i + kLanes) * *reinterpret_cast<const Vec2*>(y + i + kLanes);
+  for (; i + 2 * W <= n; i += 2 * W) {
+    acc0 += *reinterpret_cast<const V*>(x + i) * *reinterpret_cast<const V*>(y + i);
+    acc1 += *reinterpret_cast<const V*>(x + i + W) * *reinterpret_cast<const V*>(y + i + W);
   }
   acc0 += acc1;
-  double sum = acc0[0] + acc0[1];
+  double sum = 0.0;
+  for (int l = 0; l < W; ++l) sum += acc0[l];
   for (; i < n; ++i) sum += x[i] * y[i];
   return sum;
 }
 
+// One panel's block reflector applied to G consecutive trailing columns c[0..G): c -= V (T^T (V^T
+// c)). vcol[q] are V's columns (rows k0 + q + 1 .. bulk - 1 stored below the unit diagonal, rows
+// from `bulk` down stored whole); unused ones (q >= nb) repeat the last with a zero row of T.
+template <int W, int G>
+PB_KERNEL void apply_panel(const double* const* vcol, const double (*t)[kPanel], int nb, Index k0,
+                           Index bulk, Index rows, double* const* c) {
+  using V = typename Lanes<W>::Vec;
+  const Index blen = rows - bulk;
+  double w[G][kPanel] = {};
+  for (int g = 0; g < G; ++g) {
+    for (int q = 0; q < nb; ++q) {
+      double d = c[g][k0 + q];
+      for (Index i = k0 + q + 1; i < bulk; ++i) d += vcol[q][i] * c[g][i];
+      w[g][q] = d;
+    }
+  }
+  {
+    V acc[G][kPanel];
+    for (int g = 0; g < G; ++g) {
+      for (int q = 0; q < kPanel; ++q) acc[g][q] = V{};
+    }
+    Index i = 0;
+    for (; i + W <= blen; i += W) {
+      V v[kPanel];
+      for (int q = 0; q < kPanel; ++q) v[q] = *reinterpret_cast<const V*>(vcol[q] + bulk + i);
+      for (int g = 0; g < G; ++g) {
+        const V x = *reinterpret_cast<const V*>(c[g] + bulk + i);
+        for (int q = 0; q < kPanel; ++q) acc[g][q] += v[q] * x;
+      }
+    }
+    for (int g = 0; g < G; ++g) {
+      double sum[kPanel];
+      for (int q = 0; q < kPanel; ++q) {
+        sum[q] = 0.0;
+        for (int l = 0; l < W; ++l) sum[q] += acc[g][q][l];
+      }
+      for (Index r = i; r < blen; ++r) {
+        for (int q = 0; q < kPanel; ++q) sum[q] += vcol[q][bulk + r] * c[g][bulk + r];
+      }
+      for (int q = 0; q < nb; ++q) w[g][q] += sum[q];
+    }
+  }
+  double tw[G][kPanel] = {};
+  for (int g = 0; g < G; ++g) {
+    for (int q = 0; q < nb; ++q) {
+      for (int p = 0; p <= q; ++p) tw[g][q] += t[p][q] * w[g][p];
+    }
+    for (int q = 0; q < nb; ++q) {
+      c[g][k0 + q] -= tw[g][q];
+      for (Index i = k0 + q + 1; i < bulk; ++i) c[g][i] -= vcol[q][i] * tw[g][q];
+    }
+  }
+  Index i = 0;
+  for (; i + W <= blen; i += W) {
+    V v[kPanel];
+    for (int q = 0; q < kPanel; ++q) v[q] = *reinterpret_cast<const V*>(vcol[q] + bulk + i);
+    for (int g = 0; g < G; ++g) {
+      V u = v[0] * tw[g][0];
+      for (int q = 1; q < kPanel; ++q) u += v[q] * tw[g][q];
+      *reinterpret_cast<V*>(c[g] + bulk + i) -= u;
+    }
+  }
+  for (; i < blen; ++i) {
+    for (int g = 0; g < G; ++g) {
+      double u = 0.0;
+      for (int q = 0; q < kPanel; ++q) u += tw[g][q] * vcol[q][bulk + i];
+      c[g][bulk + i] -= u;
+    }
+  }
+}
+
 // In place on the column-major rows x cols matrix `a` (leading dimension ld): on return its upper
 // triangle (trapezoid if rows < cols) holds R; the entries below it are left undefined.
-void triangularize(double* a, Index rows, Index cols, Index ld) {
+template <int W>
+PB_KERNEL void triangularize_lanes(double* a, Index rows, Index cols, Index ld) {
   const Index kmax = std::min(rows, cols);
   for (Index k0 = 0; k0 < kmax; k0 += kPanel) {
     const int nb = static_cast<int>(std::min<Index>(kPanel, kmax - k0));
@@ -303,7 +404,7 @@ void triangularize(double* a, Index rows, Index cols, Index ld) {
       double* col = a + k * ld;
       double* v = col + k + 1;
       const Index len = rows - k - 1;
-      const double sigma = dot(v, v, len);
+      const double sigma = dot<W>(v, v, len);
       if (sigma == 0.0) continue;  // already triangular in this column: tau = 0
       const double x = col[k];
       const double norm = std::sqrt(x * x + sigma);
@@ -314,7 +415,7 @@ void triangularize(double* a, Index rows, Index cols, Index ld) {
       for (Index i = 0; i < len; ++i) v[i] *= inv;
       for (Index j = k + 1; j < k0 + nb; ++j) {
         double* c = a + j * ld;
-        const double d = tau[q] * (c[k] + dot(v, c + k + 1, len));
+        const double d = tau[q] * (c[k] + dot<W>(v, c + k + 1, len));
         c[k] -= d;
         for (Index i = 0; i < len; ++i) c[k + 1 + i] -= d * v[i];
       }
@@ -334,7 +435,7 @@ void triangularize(double* a, Index rows, Index cols, Index ld) {
       for (int p = 0; p < q; ++p) {
         double d = vcol[p][k0 + q];
         for (Index i = k0 + q + 1; i < bulk; ++i) d += vcol[p][i] * vcol[q][i];
-        vv[p] = d + dot(vcol[p] + bulk, vcol[q] + bulk, blen);
+        vv[p] = d + dot<W>(vcol[p] + bulk, vcol[q] + bulk, blen);
       }
       for (int p = 0; p < q; ++p) {
         double sum = 0.0;
@@ -342,47 +443,45 @@ void triangularize(double* a, Index rows, Index cols, Index ld) {
         t[p][q] = -tau[q] * sum;
       }
     }
-    // Trailing columns: c -= V (T^T (V^T c)).
-    for (Index j = bulk; j < cols; ++j) {
-      double* c = a + j * ld;
-      double w[kPanel] = {};
-      for (int q = 0; q < nb; ++q) {
-        double d = c[k0 + q];
-        for (Index i = k0 + q + 1; i < bulk; ++i) d += vcol[q][i] * c[i];
-        w[q] = d;
-      }
-      {
-        Vec2 acc[kPanel];
-        for (auto& x : acc) x = Vec2{};
-        const double* cb = c + bulk;
-        Index i = 0;
-        for (; i + kLanes <= blen; i += kLanes) {
-          const Vec2 x = *reinterpret_cast<const Vec2*>(cb + i);
-          for (int q = 0; q < kPanel; ++q) acc[q] += *reinterpret_cast<const Vec2*>(vcol[q] + bulk + i) * x;
-        }
-        double sum[kPanel];
-        for (int q = 0; q < kPanel; ++q) sum[q] = acc[q][0] + acc[q][1];
-        for (; i < blen; ++i) {
-          for (int q = 0; q < kPanel; ++q) sum[q] += vcol[q][bulk + i] * cb[i];
-        }
-        for (int q = 0; q < nb; ++q) w[q] += sum[q];
-      }
-      double tw[kPanel] = {};
-      for (int q = 0; q < nb; ++q) {
-        for (int p = 0; p <= q; ++p) tw[q] += t[p][q] * w[p];
-      }
-      for (int q = 0; q < nb; ++q) {
-        c[k0 + q] -= tw[q];
-        for (Index i = k0 + q + 1; i < bulk; ++i) c[i] -= vcol[q][i] * tw[q];
-      }
-      double* cb = c + bulk;
-      for (Index i = 0; i < blen; ++i) {
-        double u = 0.0;
-        for (int q = 0; q < kPanel; ++q) u += tw[q] * vcol[q][bulk + i];
-        cb[i] -= u;
-      }
+    // Trailing columns, two at a time.
+    Index j = bulk;
+    for (; j + 2 <= cols; j += 2) {
+      double* const c[2] = {a + j * ld, a + (j + 1) * ld};
+      apply_panel<W, 2>(vcol, t, nb, k0, bulk, rows, c);
+    }
+    if (j < cols) {
+      double* const c[1] = {a + j * ld};
+      apply_panel<W, 1>(vcol, t, nb, k0, bulk, rows, c);
     }
   }
+}
+
+void triangularize_generic(double* a, Index rows, Index cols, Index ld) { triangularize_lanes<2>(a, rows, cols, ld); }
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+[[gnu::target("avx2,fma")]] void triangularize_avx2(double* a, Index rows, Index cols, Index ld) {
+  triangularize_lanes<4>(a, rows, cols, ld);
+}
+[[gnu::target("avx512f,avx2,fma")]] void triangularize_avx512(double* a, Index rows, Index cols, Index ld) {
+  triangularize_lanes<8>(a, rows, cols, ld);
+}
+#endif
+
+using TriangularizeFn = void (*)(double*, Index, Index, Index);
+
+// The widest variant this processor runs, chosen once.
+TriangularizeFn pick_triangularize() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f")) return triangularize_avx512;
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return triangularize_avx2;
+#endif
+  return triangularize_generic;
+}
+
+void triangularize(double* a, Index rows, Index cols, Index ld) {
+  static const TriangularizeFn fn = pick_triangularize();
+  fn(a, rows, cols, ld);
 }
 
 // The triangular factor R of a tall matrix whose rows are supplied in blocks (a sequential TSQR):
@@ -432,7 +531,7 @@ class Fitter {
          double scale)
       : data_(data), weights_(weights), opts_(o), ns_(omega.size()), nc_(data.cols()), n_(o.order),
         offs_(asymptote_terms(o.asymptote)) {
-    s_ = (kJ * omega / scale).eval();
+    w_ = omega / scale;
     basis_.resize(ns_, n_ + 2);
     wd_.resize(std::min(kBlockPoints, ns_));
     data_max_ = data.cwiseAbs().maxCoeff();
@@ -474,9 +573,9 @@ class Fitter {
 
   // One pole relocation: returns the zeros of sigma (canonical, possibly unstable).
   CVector relocate(const CVector& poles) {
-    fill_basis(s_, poles, basis_);
+    fill_basis(w_, poles, basis_);
     basis_.col(n_).setOnes();
-    basis_.col(n_ + 1) = s_;
+    basis_.col(n_ + 1) = kJ * w_.cast<Complex>();
     CVector relocated;
     if (opts_.relaxed) {
       if (solve_sigma(poles, /*relaxed=*/true, relocated)) return relocated;
@@ -496,9 +595,9 @@ class Fitter {
   // R_A: the same least-squares solution (||A x - b|| and ||R_A x - (Q^T b)_top|| differ by a
   // constant), for a fraction of the cost of pivoting on the tall matrix.
   Matrix identify(const CVector& poles) {
-    fill_basis(s_, poles, basis_);
+    fill_basis(w_, poles, basis_);
     basis_.col(n_).setOnes();
-    basis_.col(n_ + 1) = s_;
+    basis_.col(n_ + 1) = kJ * w_.cast<Complex>();
     const Index cols = n_ + offs_;
     Matrix x(cols, nc_);
     const bool common = weights_.cols() == 1;
@@ -572,9 +671,10 @@ class Fitter {
         for (Index k = 0; k < cnt; ++k) wd_(k) = -w(k0 + k) * data_(k0 + k, i);
         for (Index j = 0; j < nsig; ++j) {
           for (Index k = 0; k < cnt; ++k) {
-            const Complex v = basis_(k0 + k, j) * wd_(k);
-            rows(k, left + j) = v.real();
-            rows(cnt + k, left + j) = v.imag();
+            // basis * wd in real arithmetic (no NaN check per product, see fill_basis)
+            const Complex x = basis_(k0 + k, j), y = wd_(k);
+            rows(k, left + j) = x.real() * y.real() - x.imag() * y.imag();
+            rows(cnt + k, left + j) = x.real() * y.imag() + x.imag() * y.real();
           }
         }
         if (!relaxed) {
@@ -641,7 +741,7 @@ class Fitter {
   const Matrix& weights_;
   const VectorFittingOptions& opts_;
   Index ns_, nc_, n_, offs_;
-  CVector s_;
+  Vector w_;  // omega / scale
   CMatrix basis_;
   CVector wd_;  // -w H of one output over one row block
   TriangularFactor tall_;
@@ -732,6 +832,12 @@ void VectorFittingOptions::validate() const {
     throw InputError(kOptionsSource, "frequency_scale", "finite value >= 0 rad/s (0 = automatic)",
                      format_number(frequency_scale));
   }
+  for (Index k = 0; k < point_weights.size(); ++k) {
+    if (!std::isfinite(point_weights(k)) || point_weights(k) <= 0.0) {
+      throw InputError(kOptionsSource, "point_weights[" + std::to_string(k) + "]", "finite value > 0",
+                       format_number(point_weights(k)));
+    }
+  }
   if (starting_poles.size() > 0) {
     if (starting_poles.size() != order) {
       throw InputError(kOptionsSource, "starting_poles", std::to_string(order) + " poles (= order)",
@@ -765,10 +871,15 @@ CVector VectorFittingResult::evaluate_at(Complex s) const {
   CVector out(outputs());
   for (Index i = 0; i < outputs(); ++i) out(i) = d(i) + s * e(i);
   for (Index n = 0; n < poles.size(); ++n) {
-    // r / z as r conj(z) / |z|^2 (no overflow concern at frequencies where the model is used).
+    // r / z as r conj(z) / |z|^2 (no overflow concern at frequencies where the model is used), the
+    // product in real arithmetic (GCC's complex product checks each result for NaN).
     const Complex z = s - poles(n);
-    const Complex inv = std::conj(z) / std::norm(z);
-    for (Index i = 0; i < outputs(); ++i) out(i) += residues(i, n) * inv;
+    const double n2 = z.real() * z.real() + z.imag() * z.imag();
+    const double zr = z.real() / n2, zi = -z.imag() / n2;
+    for (Index i = 0; i < outputs(); ++i) {
+      const Complex r = residues(i, n);
+      out(i) += Complex(r.real() * zr - r.imag() * zi, r.real() * zi + r.imag() * zr);
+    }
   }
   return out;
 }
@@ -796,7 +907,7 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
                                const VectorFittingOptions& options) {
   options.validate();
   check_input(omega, data, user_weights, options);
-  const Matrix weights = make_weights(data, user_weights, options.weighting);
+  const Matrix weights = make_weights(data, user_weights, options);
   const double scale = options.frequency_scale > 0.0 ? options.frequency_scale : omega(omega.size() - 1);
 
   CVector start = options.starting_poles.size() > 0 ? options.starting_poles

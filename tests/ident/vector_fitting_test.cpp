@@ -236,6 +236,45 @@ TEST(VectorFitting, BadInputIsRejectedWithTheField) {
   EXPECT_EQ(field_of(omega, h, Matrix::Ones(99, 1)), "weights");
   EXPECT_EQ(field_of(omega, h, Matrix::Zero(100, 1)), "weights");
   EXPECT_EQ(field_of(omega, h, Matrix::Ones(100, 1)), "no error");
+  o.point_weights = Vector::Ones(99);
+  EXPECT_EQ(field_of(omega, h, Matrix()), "point_weights");
+}
+
+TEST(VectorFitting, PointWeightsDiscountCorruptedPoints) {
+  // Every 10th point off by 30 %: with unit weights the poles move (by more than 1e-6); with those
+  // points weighted 1e-9 (as 1/std weighs points of huge variance) the fit finds the generating poles.
+  const Model m = six_pole_model();
+  const Vector omega = log_grid(5.0, 1000.0, 800);
+  CMatrix h = m.response(omega);
+  Vector point_weights = Vector::Ones(omega.size());
+  for (Index k = 0; k < omega.size(); k += 10) {
+    h(k, 0) *= 1.3;
+    point_weights(k) = 1e-9;
+  }
+  VectorFittingOptions o;
+  o.order = 6;
+  o.fail_if_not_converged = false;
+  const VectorFittingResult plain = vector_fit(omega, h, o);
+  EXPECT_FALSE(all_near(plain.poles, m.poles, Tolerance{1e-6, 0.0}));
+  o.point_weights = point_weights;
+  const VectorFittingResult weighted = vector_fit(omega, h, o);
+  EXPECT_TRUE(all_near(weighted.poles, m.poles, Tolerance{1e-6, 0.0})) << weighted.brief_report();
+  // The same as the explicit weights argument, and they multiply the weighting's own weights.
+  const VectorFittingResult explicit_weights = vector_fit(omega, h, Matrix(point_weights), [] {
+    VectorFittingOptions x;
+    x.order = 6;
+    x.fail_if_not_converged = false;
+    return x;
+  }());
+  EXPECT_TRUE(all_near(weighted.poles, explicit_weights.poles, Tolerance{1e-12, 0.0}));
+  o.weighting = Weighting::kInverseMagnitude;
+  Matrix combined(omega.size(), 1);
+  for (Index k = 0; k < omega.size(); ++k) combined(k, 0) = point_weights(k) / std::abs(h(k, 0));
+  const VectorFittingResult both = vector_fit(omega, h, o);
+  VectorFittingOptions unit = o;
+  unit.weighting = Weighting::kUnit;
+  unit.point_weights = Vector();
+  EXPECT_TRUE(all_near(both.poles, vector_fit(omega, h, combined, unit).poles, Tolerance{1e-12, 0.0}));
 }
 
 TEST(VectorFitting, OptionsValidateNamesTheField) {
@@ -278,6 +317,13 @@ TEST(VectorFitting, OptionsValidateNamesTheField) {
   o = VectorFittingOptions{};
   o.significance_floor = 1.0;
   EXPECT_EQ(field_of(o), "significance_floor");
+  o = VectorFittingOptions{};
+  o.point_weights = Vector::Ones(5);
+  EXPECT_EQ(field_of(o), "no error");
+  o.point_weights(3) = 0.0;
+  EXPECT_EQ(field_of(o), "point_weights[3]");
+  o.point_weights(3) = std::nan("");
+  EXPECT_EQ(field_of(o), "point_weights[3]");
 }
 
 TEST(VectorFitting, NotSettlingIsANumericalErrorThatMayBeRetried) {

@@ -92,6 +92,11 @@ struct VectorFittingOptions {
   PoleSpacing starting_spacing = PoleSpacing::kLogarithmic;
   double starting_damping = 0.01;
   Weighting weighting = Weighting::kUnit;
+  // Per-frequency-point weights, one per data point (e.g. 1 / the standard deviation of each FRF
+  // point), finite and > 0; empty = none. They multiply the row weights: those of the explicit
+  // weights argument of vector_fit if given, else those of `weighting` (so "output-scale" and
+  // point weights combine). vector_fit checks the length against the data (field "point_weights").
+  Vector point_weights;
   // rad/s; 0 = automatic (highest omega).
   double frequency_scale = 0.0;
 
@@ -135,7 +140,7 @@ struct VectorFittingResult {
 
 // omega: rad/s, strictly increasing, >= 0, finite. data: points x outputs (data(k, i) = f_i(j
 // omega_k)), finite, not all zero. weights: empty (options.weighting is used), points x 1 (common
-// to all outputs) or points x outputs, finite and > 0.
+// to all outputs) or points x outputs, finite and > 0; options.point_weights multiply them.
 // Throws InputError (source "vector fitting") for bad input, including too few data for the
 // order; NumericalError when the relocation system is singular or, with fail_if_not_converged,
 // when the poles do not settle.
