@@ -114,6 +114,7 @@ int run_qualify(const QualifyCli& o) {
   qo.bench_sha256 = station::sha256_file(o.bench);
   qo.software_version = std::string("piezobench ") + kVersion;
   qo.resume = !o.resume.empty();
+  qo.stop = bo.stop;
   qo.log = log_line;
   const station::QualifyResult r = station::qualify(st, instrument, *op, store, qo);
   const auto q = store.qualification(r.qualification_id);

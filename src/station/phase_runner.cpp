@@ -399,6 +399,10 @@ QualifyResult qualify(const StationFile& station, Instrument& instrument, Operat
       if (stops(*kept)) break;
       continue;
     }
+    if (options.stop && options.stop->load()) {
+      cx.say(fmt::format("qualify {}: interrupted before phase {}", options.serial, p.name));
+      return finish(cx, "aborted", std::move(r));
+    }
     const PhaseOutcome o = run_phase(cx, static_cast<int>(i), p);
     if (o == PhaseOutcome::kAborted) return finish(cx, "aborted", std::move(r));
     if (o == PhaseOutcome::kBenchFailed) return finish(cx, "failed", std::move(r));

@@ -173,7 +173,21 @@ TEST(PhaseRunner, AnAbortedQualificationResumesAtTheAbortedPhase) {
   AnswersOperator op = s.answers();
   EXPECT_EQ(qualify(s.st, inst, op, s.store, o).status, "complete");
   EXPECT_EQ(inst.calls["capacitance"], 1);
-  // A raw file changed after it was recorded is refused on resume.
+}
+
+TEST(PhaseRunner, CtrlCBeforeAPhaseAbortsResumably) {
+  Station s;
+  TestInstrument inst(1);
+  AnswersOperator op = s.answers();
+  std::atomic<bool> stop{true};
+  QualifyOptions o = s.options("SN1", 1);
+  o.stop = &stop;
+  EXPECT_EQ(qualify(s.st, inst, op, s.store, o).status, "aborted");
+  EXPECT_TRUE(inst.calls.empty());
+  stop = false;
+  o.resume = true;
+  AnswersOperator op2 = s.answers();
+  EXPECT_EQ(qualify(s.st, inst, op2, s.store, o).status, "complete");
 }
 
 TEST(PhaseRunner, ResumeRefusesARawFileChangedSinceItWasRecorded) {

@@ -152,6 +152,7 @@ struct QualifyOptions {
   std::filesystem::path data_dir;       // raw files under DATA/SERIAL/
   std::string station_sha256, bench_file, bench_sha256, software_version;
   bool resume = false;
+  const std::atomic<bool>* stop = nullptr;  // Ctrl-C: checked before each phase (status aborted)
   Observer* observer = nullptr;
   std::function<void(const std::string&)> log;
 };
