@@ -96,6 +96,10 @@ int run_frf(const FrfOptions& o) {
                          ts.sample_rate / static_cast<double>(welch.nfft), outputs.size()));
   }
   const dsp::FrfEstimate estimate = dsp::estimate_frf(input, outputs, ts.sample_rate, welch, o.file);
+  // The verdict before any output, so that the exit code is the same whatever --json and --out
+  // say: a record whose input excited nothing (no band of coherence >= 0.5) is refused (exit 3)
+  // and no file is written.
+  const dsp::FrequencyBand band = dsp::excited_band(estimate.frf, 0.5);
 
   if (!o.out.empty()) {
     io::write_frf(estimate.frf, o.out);
@@ -118,7 +122,6 @@ int run_frf(const FrfOptions& o) {
              frf.provenance.estimator, frf.input, fmt::join(frf.outputs, ", "), frf.provenance.averages,
              frf.provenance.window, frf.provenance.nfft, frf.freq_Hz.size() > 1 ? frf.freq_Hz(1) - frf.freq_Hz(0) : 0.0);
   // The summary covers the band the input excited (coherence >= 0.5), not the noise around it.
-  const dsp::FrequencyBand band = dsp::excited_band(frf, 0.5);
   fmt::print("excited band (coherence >= 0.5): {:.4g} to {:.4g} Hz\n", band.fmin_Hz, band.fmax_Hz);
   for (std::size_t i = 0; i < frf.outputs.size(); ++i) {
     Eigen::Index peak = -1;

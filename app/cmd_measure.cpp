@@ -14,6 +14,7 @@
 #include "measure_common.hpp"
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/bench/truth.hpp"
+#include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
@@ -21,6 +22,7 @@
 #include "piezobench/rt/comedi_backend.hpp"
 #include "piezobench/rt/measure.hpp"
 #include "piezobench/rt/udp.hpp"
+#include "piezobench/rt/udp_target.hpp"
 #include "piezobench/rt/virtual_backend.hpp"
 
 namespace piezobench::app {
@@ -78,8 +80,21 @@ const std::atomic<bool>* stop_on_sigint() {
   return &g_stop;
 }
 
-std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& b) {
-  if (b.backend == "udp") return std::make_unique<rt::UdpBackend>(b.udp_address, b.sample_rate, b.udp_timeout);
+// The operator's confirmation on stdin that a target's latched safe state may be cleared.
+bool confirm_target_reset(const std::string& target) {
+  log_line("operator: " + target + " is in its latched safe state (a fault of an earlier session); check the bench, then "
+           "press Enter to clear it (the end of the input refuses)");
+  std::string line;
+  return static_cast<bool>(std::getline(std::cin, line));
+}
+
+std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& b, bool reset_target) {
+  if (b.backend == "udp") {
+    rt::UdpBackendOptions o;
+    o.key = b.udp_key;
+    if (reset_target) o.confirm_reset = confirm_target_reset;
+    return std::make_unique<rt::UdpBackend>(b.udp_address, b.sample_rate, b.udp_timeout, o);
+  }
   if (b.backend == "comedi") return std::make_unique<rt::ComediBackend>(b);
   return std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(b.unit, b.seed), rt::bench_options(b), b.seed);
 }
@@ -148,7 +163,7 @@ int run_measurement(const MeasureRequest& r) {
                        "iff, tracking); record " + r.experiment + " with its own instruments and give the file to `piezobench run`",
                        "'" + r.experiment + "'");
     }
-    backend = make_backend(*r.bench);
+    backend = make_backend(*r.bench, r.reset_target);
     rt::MeasureOptions mo;
     mo.bench = *r.bench;
     mo.realtime_priority = r.realtime;
@@ -164,6 +179,7 @@ int run_measurement(const MeasureRequest& r) {
       throw_as_option_error(e);
     }
   }
+  if (!r.serial.empty()) ts.settings["serial"] = r.serial;  // checked by `run` against the campaign's units[].serial
   io::write_timeseries(ts, out);
   std::optional<bench::TrackingSummary> tracking;
   if (experiment == bench::Experiment::kTracking) tracking = bench::tracking_summary(ts);
@@ -223,7 +239,8 @@ int run_measurement(const MeasureRequest& r) {
     doc["bench_file"] = r.bench->source;
     doc["cycles"] = rep.cycles();
     doc["io"] = {{"exchanges", io.exchanges}, {"replies", io.replies}, {"lost", io.lost},       {"late", io.late},
-                 {"stale_inputs", io.timeouts}, {"errors", io.errors}, {"round_trip_us", timing_json(io.round_trip_us)}};
+                 {"stale_inputs", io.timeouts}, {"errors", io.errors}, {"rejected", io.rejected},
+                 {"round_trip_us", timing_json(io.round_trip_us)}};
     nlohmann::json runs = nlohmann::json::array();
     for (const rt::LoopReport& lr : rep.runs) {
       nlohmann::json run = loop_timing_json(lr);
@@ -252,7 +269,7 @@ int run_measurement(const MeasureRequest& r) {
 namespace {
 
 struct MeasureCli {
-  std::string experiment, bench, out, log;
+  std::string experiment, bench, out, log, serial;
   int unit = 1;
   std::uint64_t seed = 1;
   double amplitude = 0.0, duration = 0.0, gain = 0.0;
@@ -261,7 +278,7 @@ struct MeasureCli {
   std::string feedforward;
   std::string hysteresis_law = "prandtl-ishlinskii";  // virtual bench
   CLI::Option* hysteresis_law_option = nullptr;
-  bool realtime = false, json = false, open_circuit = false, no_resistor = false;
+  bool realtime = false, json = false, open_circuit = false, no_resistor = false, reset_target = false;
 };
 
 int run_measure(const MeasureCli& o) {
@@ -286,6 +303,8 @@ int run_measure(const MeasureCli& o) {
   r.json = o.json;
   r.realtime = o.realtime;
   r.log = o.log;
+  r.reset_target = o.reset_target;
+  r.serial = o.serial;
   if (desc.hardware()) {
     r.bench = desc;
   } else if (o.realtime || !o.log.empty()) {
@@ -301,8 +320,9 @@ struct ServeCli {
   std::uint64_t seed = 1;
   double rate = 10e3;
   int sessions = 0;
-  double idle_timeout = 60.0;
+  double idle_timeout = 60.0, session_timeout = 10.0;
   std::uint64_t drop_every = 0;
+  std::string key_file;
   std::string hysteresis_law = "prandtl-ishlinskii";
   bool json = false;
 };
@@ -317,15 +337,17 @@ int run_serve(const ServeCli& o) {
   } catch (const InputError& e) {
     throw InputError("--" + std::string(e.what()));
   }
-  if (!(std::isfinite(o.idle_timeout) && o.idle_timeout > 0.0)) {
-    throw UsageError("--idle-timeout", "a time > 0 s", fmt::format("{:g}", o.idle_timeout));
-  }
+  checked_duration_s(o.idle_timeout, 1e-3, 1e6, NumberOrigin::command_line("--idle-timeout"));
+  checked_duration_s(o.session_timeout, 1e-3, 3600.0, NumberOrigin::command_line("--session-timeout"));
   rt::UdpServerOptions so;
   so.address = o.udp;
   so.sessions = o.sessions;
   so.idle_timeout = o.idle_timeout;
-  so.drop_every = o.drop_every;
+  so.target.session_timeout = o.session_timeout;
+  so.target.drop_every = o.drop_every;
+  if (!o.key_file.empty()) so.target.key = rt::read_udp_key(o.key_file, "--key-file", "key");
   so.stop = stop_on_sigint();
+  so.on_warning = [](const std::string& w) { log_line("warning: " + w); };
   so.on_listening = [&](const std::string& address) {
     // First line on stdout, flushed: a script (or a test) reads the port from it.
     fmt::print("listening on {}\n", address);
@@ -339,10 +361,16 @@ int run_serve(const ServeCli& o) {
                 {"replies", rep.replies},
                 {"dropped", rep.dropped},
                 {"rejected", rep.rejected},
-                {"target_safe", rep.target_safe}});
+                {"refused", rep.refused},
+                {"limited", rep.limited},
+                {"expired", rep.expired},
+                {"target_safe", rep.target_safe},
+                {"safe_reason", rep.safe_reason}});
   } else {
-    fmt::print("served {} sessions: {} io requests, {} replies ({} dropped on purpose), {} datagrams rejected\n",
-               rep.sessions, rep.requests, rep.replies, rep.dropped, rep.rejected);
+    fmt::print("served {} sessions: {} io requests, {} replies ({} dropped on purpose), {} datagrams rejected, {} hellos "
+               "refused (busy), {} commands limited by the target{}\n",
+               rep.sessions, rep.requests, rep.replies, rep.dropped, rep.rejected, rep.refused, rep.limited,
+               rep.target_safe ? "; safe state latched: " + rep.safe_reason : std::string());
   }
   return 0;
 }
@@ -359,6 +387,7 @@ void add_measure_commands(CLI::App& app, Action& action) {
       ->required()
       ->check(CLI::ExistingFile);
   o->unit_option = m->add_option("--unit", o->unit, "number of the unit under test (virtual bench: 1..7 of the batch)");
+  m->add_option("--serial", o->serial, "the unit's serial number, recorded in the file (`run` checks it against the campaign's)");
   o->seed_option = m->add_option("--seed", o->seed, "virtual bench: seed of the batch and of the noise; excitation seed");
   m->add_option("--out", o->out, "output file, .mat (default) or .csv (default: EXPERIMENT-unitN.mat)");
   o->amplitude_option = m->add_option("--amplitude", o->amplitude, "V at the stacks, as for simulate");
@@ -374,6 +403,8 @@ void add_measure_commands(CLI::App& app, Action& action) {
   m->add_flag("--realtime", o->realtime, "SCHED_FIFO priority and locked memory for the loop (a message when not permitted)");
   m->add_option("--log", o->log, "also write the loop's raw log (every cycle, with safety flags) to this file");
   m->add_flag("--json", o->json, "print one JSON document (file, settings, I/O counts) on stdout");
+  m->add_flag("--reset-target", o->reset_target,
+              "udp: a target in its latched safe state is reset once the operator presses Enter (docs/hardware.md \"UDP protocol\")");
   m->callback([o, &action] { action = [o] { return run_measure(*o); }; });
 
   auto s = std::make_shared<ServeCli>();
@@ -390,6 +421,11 @@ void add_measure_commands(CLI::App& app, Action& action) {
   serve->add_option("--idle-timeout", s->idle_timeout, "exit after this long without a datagram, s")->capture_default_str();
   serve->add_option("--drop-every", s->drop_every, "testing: leave every N-th io request unanswered (0: none)")
       ->capture_default_str();
+  serve->add_option("--session-timeout", s->session_timeout,
+                    "s of silence that end a client's session (after its first command: the safe state latches)")
+      ->capture_default_str();
+  serve->add_option("--key-file", s->key_file, "shared key (>= 16 bytes): every datagram carries its HMAC-SHA256 (docs/hardware.md)")
+      ->check(CLI::ExistingFile);
   serve->add_option("--hysteresis-law", s->hysteresis_law, kHysteresisLawHelp)->capture_default_str();
   serve->add_flag("--json", s->json, "print the session counts as JSON at the end");
   serve->callback([s, &action] { action = [s] { return run_serve(*s); }; });

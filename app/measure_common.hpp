@@ -28,6 +28,8 @@ struct MeasureRequest {
   std::optional<rt::BenchDescription> bench;
   bool realtime = false;             // SCHED_FIFO and mlockall
   std::string log;                   // raw loop log
+  bool reset_target = false;
+  std::string serial;                // the unit's serial number when known: recorded (settings.serial)         // --reset-target: clear a UDP target's latched safe state after the operator's Enter
 };
 // --feedforward MODEL.toml of simulate and measure: the tracking experiment's model (InputError
 // naming the file; a model for another experiment is refused by ExperimentOptions::validate).
@@ -49,8 +51,9 @@ nlohmann::json loop_timing_json(const rt::LoopReport& report);
 nlohmann::json timing_json(const rt::TimingSummary& summary);
 
 // The backend a bench file names (virtual: the batch unit of its [virtual] table). InputError when
-// the device cannot be used.
-std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& bench);
+// the device cannot be used. reset_target: a UDP target found in its latched safe state is reset
+// once the operator confirms on stdin (otherwise refused).
+std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& bench, bool reset_target = false);
 
 // Ctrl-C (SIGINT) sets the returned flag instead of killing the process, until the process ends:
 // the loop brings the output to the safe value and the log is written.

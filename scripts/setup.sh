@@ -39,7 +39,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # Data-acquisition cards through Comedi (the `measure` command's comedi backend).
   libcomedi-dev
-  # The station's record store (`qualify`, `db`: SQLite) and the raw files' SHA-256 (nettle).
+  # The station's record store (`qualify`, `db`: SQLite) and the raw files' SHA-256 (nettle; also the
+  # UDP protocol's HMAC-SHA256).
   libsqlite3-dev nettle-dev
   # An optimized BLAS under CHOLMOD (Debian's alternatives select it): the Craig-Bampton reduction
   # of a 150,000-DOF model takes 31 s of CPU with it and 83 s with the reference BLAS.

@@ -3,6 +3,7 @@
 // Levenberg-Marquardt, the one golden-section search, fit-quality verdicts and sign-constrained
 // linear least squares, the median, a runner of independent jobs on a few threads, text helpers
 // whole-file input/output shared by the readers, and shared libraries loaded on first use.
+#include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/fit_quality.hpp"
@@ -15,5 +16,6 @@
 #include "piezobench/core/shared_library.hpp"
 #include "piezobench/core/statistics.hpp"
 #include "piezobench/core/text.hpp"
+#include "piezobench/core/timestamp.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"

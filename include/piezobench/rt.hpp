@@ -12,4 +12,5 @@
 #include "piezobench/rt/spsc_ring.hpp"
 #include "piezobench/rt/timing.hpp"
 #include "piezobench/rt/udp.hpp"
+#include "piezobench/rt/udp_target.hpp"
 #include "piezobench/rt/virtual_backend.hpp"

@@ -38,6 +38,10 @@ def split(path, parts, names, workdir):
     return out
 
 
+# Corpora that are not files the CLI reads: the UDP target's datagrams (fuzz_udp_target replays them).
+NOT_FILES = {"udp_target"}
+
+
 def command(reader, path, workdir):
     """The command line that reads `path` with the reader under test."""
     if reader in ("mat_timeseries", "csv_timeseries"):
@@ -144,6 +148,8 @@ def main():
     with tempfile.TemporaryDirectory(prefix="piezobench-hostile-") as tmp:
         cases = []
         for reader in sorted(os.listdir(a.corpus)):
+            if reader in NOT_FILES:
+                continue
             for f in sorted(os.listdir(os.path.join(a.corpus, reader))):
                 cases.append((reader, f))
         for i, (reader, f) in enumerate(cases):

@@ -14,7 +14,9 @@
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/control/discrete_iff.hpp"
 #include "piezobench/control/hysteresis_feedforward.hpp"
+#include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/timestamp.hpp"
 #include "piezobench/core/memory.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/lti/discretize.hpp"
@@ -52,8 +54,11 @@ bool uses_duration(Experiment e) {
 // The settings every record carries; `runner` adds where it was made (bench experiments).
 void common_settings(io::TimeSeries& ts, Experiment e, const UnitTruth& unit, const BenchOptions& b, std::uint64_t seed,
                      const BenchRunner* runner) {
+  // Provenance (checked by `run` against the campaign): what, which unit, where, when.
   ts.settings["experiment"] = to_string(e);
   ts.settings["unit"] = static_cast<double>(unit.id);
+  ts.settings["bench"] = std::string("virtual");  // a bench runner's describe() names its bench
+  ts.settings["recorded_at"] = utc_timestamp_now();
   // Seeds up to 2^53 are numbers; larger ones would lose digits as doubles, so they are text.
   if (seed <= (std::uint64_t{1} << 53)) {
     ts.settings["seed"] = static_cast<double>(seed);
@@ -742,9 +747,7 @@ void ExperimentOptions::validate() const {
   if (amplitude && !(std::isfinite(*amplitude) && *amplitude > 0.0)) {
     throw InputError(kSource, "amplitude", "an amplitude > 0 V", fmt::format("{:g}", *amplitude));
   }
-  if (duration && !(std::isfinite(*duration) && *duration > 0.0 && *duration <= 1e5)) {
-    throw InputError(kSource, "duration", "a duration in (0, 100000] s", fmt::format("{:g} s", *duration));
-  }
+  if (duration) checked_duration_s(*duration, 1e-3, 1e5, NumberOrigin::file(kSource, "duration"));
   if (gain && !(std::isfinite(*gain) && *gain >= 0.0)) {
     throw InputError(kSource, "gain", "an IFF gain >= 0", fmt::format("{:g}", *gain));
   }

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
 
 #include "piezobench/io/toml_table.hpp"
 #include "piezobench/io/units.hpp"
+#include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
 
@@ -153,12 +155,13 @@ class Reader {
       out = *v;
     }
   }
-  [[nodiscard]] std::optional<long> integer(const std::string& k) const {
+  // An integer in [lo, hi]: a float (even 92233720368547758e07) is refused before any conversion,
+  // an integer outside is refused, not clamped (core/checked_number.hpp).
+  [[nodiscard]] std::optional<long> integer(const std::string& k, long lo, long hi) const {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
-    const auto v = n->value<int64_t>();
-    if (!n->is_integer() || !v) throw InputError(source_, key(k), "an integer", describe_toml(*n));
-    return static_cast<long>(*v);
+    if (!n->is_integer()) throw InputError(source_, key(k), "an integer", describe_toml(*n));
+    return static_cast<long>(checked_integer(n->as_integer()->get(), lo, hi, NumberOrigin::file(source_, key(k))));
   }
   [[nodiscard]] std::string string(const std::string& k, const toml::node& node) const {
     const auto v = node.value<std::string>();
@@ -298,14 +301,14 @@ UnitSpec read_unit(const Context& ctx, const toml::table& t, std::size_t index) 
   UnitSpec u;
   u.key = "units[" + std::to_string(index) + "]";
   const Reader r(t, ctx.source, u.key);
-  std::vector<std::string> known = {"id", "name", "channels", "capacitance_uF"};
+  std::vector<std::string> known = {"id", "name", "serial", "channels", "capacitance_uF"};
   for (const Experiment e : all_experiments()) known.push_back(to_string(e));
   r.only(known);
-  const auto id = r.integer("id");
+  const auto id = r.integer("id", 0, 1000000);
   if (!id) throw InputError(ctx.source, r.key("id"), "the unit's number (id = 1, 2, ...)", "no such key");
-  if (*id < 0 || *id > 1000000) throw InputError(ctx.source, r.key("id"), "an integer in 0..1000000", std::to_string(*id));
   u.id = static_cast<int>(*id);
   u.name = r.string("name").value_or(fmt::format("APA {}", u.id));
+  u.serial = r.string("serial");
   std::map<std::string, std::string> channels;
   std::vector<std::string> explicit_roles;
   if (const toml::table* c = r.table("channels")) {
@@ -412,7 +415,7 @@ void read_analysis(const Reader& r, AnalysisSettings& a) {
       throw InputError(r.source(), r.key("window"), "a window name (hann-periodic, hamming-periodic, ...)", "'" + *w + "'");
     }
   }
-  if (const auto n = r.integer("nfft")) {
+  if (const auto n = r.integer("nfft", 0, 1L << 30)) {
     if (*n != 0 && *n < 16) throw InputError(r.source(), r.key("nfft"), "0 (automatic) or at least 16 samples", std::to_string(*n));
     a.nfft = *n;
   }
@@ -430,14 +433,9 @@ void read_analysis(const Reader& r, AnalysisSettings& a) {
   r.positive("hammer_fmin_Hz", a.hammer_fmin_Hz);
   r.positive("hammer_fmax_Hz", a.hammer_fmax_Hz);
   if (a.hammer_fmax_Hz <= a.hammer_fmin_Hz) throw InputError(r.source(), r.key("hammer_fmax_Hz"), "a frequency above hammer_fmin_Hz", fmt::format("{}", a.hammer_fmax_Hz));
-  if (const auto n = r.integer("fit_order")) {
-    if (*n < 2 || *n > 40) throw InputError(r.source(), r.key("fit_order"), "an order in 2..40", std::to_string(*n));
-    a.fit_order = *n;
-  }
-  if (const auto n = r.integer("iff_unit")) {
-    if (*n < 0) throw InputError(r.source(), r.key("iff_unit"), "a unit id (or 0 = first with IFF data)", std::to_string(*n));
-    a.iff_unit = static_cast<int>(*n);
-  }
+  if (const auto n = r.integer("fit_order", 2, 40)) a.fit_order = *n;
+  // A unit id (ids are 0 .. 1000000) or 0 = the first unit with IFF data.
+  if (const auto n = r.integer("iff_unit", 0, 1000000)) a.iff_unit = static_cast<int>(*n);
   if (const toml::table* c = r.table("iff_controller")) {
     const Reader cr(*c, r.source(), r.key("iff_controller"));
     cr.only({"gain", "hpf_Hz", "lpf_Hz", "robust_Hz"});
@@ -455,10 +453,7 @@ void read_analysis(const Reader& r, AnalysisSettings& a) {
     cr.positive("robust_Hz", hz);
     a.controller.w_robust = kTwoPi * hz;
   }
-  if (const auto n = r.integer("threads")) {
-    if (*n < 0 || *n > 256) throw InputError(r.source(), r.key("threads"), "0 (all cores) .. 256", std::to_string(*n));
-    a.threads = static_cast<int>(*n);
-  }
+  if (const auto n = r.integer("threads", 0, 256)) a.threads = static_cast<int>(*n);  // 0: all cores
 }
 
 CampaignSuperElement read_superelement(const Context& ctx, const Reader& r) {
@@ -488,9 +483,10 @@ CampaignSuperElement read_superelement(const Context& ctx, const Reader& r) {
     const toml::array* a = n->as_array();
     if (!a) throw InputError(ctx.source, r.key("fix"), "an array of node numbers", describe_toml(*n));
     for (std::size_t i = 0; i < a->size(); ++i) {
-      const auto v = (*a)[i].value<int64_t>();
-      if (!(*a)[i].is_integer() || !v) throw InputError(ctx.source, r.key("fix") + "[" + std::to_string(i) + "]", "a node number", describe_toml((*a)[i]));
-      s.model.fixed_nodes.push_back(static_cast<long>(*v));
+      const std::string field = r.key("fix") + "[" + std::to_string(i) + "]";
+      if (!(*a)[i].is_integer()) throw InputError(ctx.source, field, "a node number", describe_toml((*a)[i]));
+      s.model.fixed_nodes.push_back(static_cast<long>(
+          checked_integer((*a)[i].as_integer()->get(), 0, std::numeric_limits<long>::max(), NumberOrigin::file(ctx.source, field))));
     }
   }
   const auto act = r.string("actuator");

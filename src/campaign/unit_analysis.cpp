@@ -7,6 +7,10 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
 
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/bench/tracking.hpp"
@@ -78,7 +82,9 @@ bool read_readings_mat(const fs::path& file, const std::vector<std::string>& cha
 
 }  // namespace
 
-Record load_record(const Campaign& campaign, const FileSpec& spec, Experiment experiment) {
+namespace {
+
+Record read_record(const Campaign& campaign, const FileSpec& spec, Experiment experiment) {
   const std::string source = campaign.file.string();
   io::ReadOptions read;
   read.fs = spec.sample_rate;
@@ -122,6 +128,64 @@ Record load_record(const Campaign& campaign, const FileSpec& spec, Experiment ex
     }
     throw wrap(e);
   }
+  return r;
+}
+
+// The settings.experiment values of the records a campaign experiment takes (bench/experiments.hpp).
+std::vector<std::string> recorded_kinds(Experiment e) {
+  switch (e) {
+    case Experiment::kFlatness: return {"flatness"};
+    case Experiment::kCapacitance: return {"capacitance"};
+    case Experiment::kStroke: return {"stroke"};
+    case Experiment::kHysteresis: return {"hysteresis"};
+    case Experiment::kStiffness:
+    case Experiment::kStiffnessOpen: return {"stiffness"};
+    case Experiment::kFrf:
+    case Experiment::kFrfNoResistor: return {"frf-noise", "frf-sweep"};
+    case Experiment::kIff: return {"iff"};
+    case Experiment::kHammer: return {"hammer"};
+    case Experiment::kTracking: return {"tracking"};
+  }
+  return {};
+}
+
+// What a record says about itself (the settings piezobench's writers record: unit, serial,
+// experiment) against the campaign entry that names it: a record of another unit or another kind
+// is refused, naming both (issue 35: unit 1's files given for unit 3 made the defective unit pass
+// with unit 1's numbers). A record without these settings (another tool's) is taken as given.
+void check_provenance(const Campaign& campaign, const UnitSpec& unit, const FileSpec& spec, Experiment experiment,
+                      const io::TimeSeries& ts) {
+  const std::string source = campaign.file.string();
+  const auto text = [&](const char* key) -> std::optional<std::string> {
+    const auto it = ts.settings.find(key);
+    if (it == ts.settings.end() || !std::holds_alternative<std::string>(it->second)) return std::nullopt;
+    return std::get<std::string>(it->second);
+  };
+  if (const auto it = ts.settings.find("unit"); it != ts.settings.end() && std::holds_alternative<double>(it->second)) {
+    const double recorded = std::get<double>(it->second);
+    if (recorded != static_cast<double>(unit.id)) {
+      throw InputError(source, spec.key, fmt::format("a record of unit {} ({}.id)", unit.id, unit.key),
+                       fmt::format("'{}', a record of unit {:g} (its settings.unit)", spec.given, recorded));
+    }
+  }
+  if (const auto serial = text("serial"); serial && unit.serial && *serial != *unit.serial) {
+    throw InputError(source, spec.key, fmt::format("a record of serial '{}' ({}.serial)", *unit.serial, unit.key),
+                     fmt::format("'{}', a record of serial '{}' (its settings.serial)", spec.given, *serial));
+  }
+  if (const auto kind = text("experiment")) {
+    const std::vector<std::string> kinds = recorded_kinds(experiment);
+    if (std::find(kinds.begin(), kinds.end(), *kind) == kinds.end()) {
+      throw InputError(source, spec.key, fmt::format("a {} record ({})", to_string(experiment), fmt::join(kinds, " or ")),
+                       fmt::format("'{}', a {} record (its settings.experiment)", spec.given, *kind));
+    }
+  }
+}
+
+}  // namespace
+
+Record load_record(const Campaign& campaign, const UnitSpec& unit, const FileSpec& spec, Experiment experiment) {
+  Record r = read_record(campaign, spec, experiment);
+  check_provenance(campaign, unit, spec, experiment, r.ts);
   return r;
 }
 
@@ -257,7 +321,7 @@ FlatnessAnalysis flatness(const Campaign& c, const Record& r) {
 CapacitanceAnalysis capacitance(const Campaign& c, const UnitSpec& spec) {
   CapacitanceAnalysis out;
   if (spec.capacitance) {
-    const Record r = load_record(c, *spec.capacitance, Experiment::kCapacitance);
+    const Record r = load_record(c, spec, *spec.capacitance, Experiment::kCapacitance);
     out.sensor = r.channel("C_sensor").mean();
     out.actuator = r.channel("C_actuator").mean();
     out.provenance = provenance(r, {"C_sensor", "C_actuator"});
@@ -708,7 +772,7 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   }
   if (spec.flatness) {
     say("flatness", *spec.flatness);
-    u.flatness_analysis = flatness(c, load_record(c, *spec.flatness, Experiment::kFlatness));
+    u.flatness_analysis = flatness(c, load_record(c, spec, *spec.flatness, Experiment::kFlatness));
     u.flatness = u.flatness_analysis->flatness;
   }
   if (spec.has(Experiment::kCapacitance)) {
@@ -718,14 +782,14 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   }
   if (spec.stroke) {
     say("stroke", *spec.stroke);
-    u.stroke_analysis = stroke(c, load_record(c, *spec.stroke, Experiment::kStroke));
+    u.stroke_analysis = stroke(c, load_record(c, spec, *spec.stroke, Experiment::kStroke));
     u.stroke = u.stroke_analysis->result.stroke;
   }
   if (!spec.hysteresis.empty()) {
     std::vector<Record> records;
     for (const auto& f : spec.hysteresis) {
       say("hysteresis", f);
-      records.push_back(load_record(c, f, Experiment::kHysteresis));
+      records.push_back(load_record(c, spec, f, Experiment::kHysteresis));
     }
     u.hysteresis = hysteresis(c, records);  // in the records' order
     std::size_t largest = 0;
@@ -745,12 +809,12 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   }
   if (spec.tracking) {
     say("tracking without and with the hysteresis feedforward", *spec.tracking);
-    u.tracking = tracking(load_record(c, *spec.tracking, Experiment::kTracking));
+    u.tracking = tracking(load_record(c, spec, *spec.tracking, Experiment::kTracking));
   }
   if (spec.stiffness) {
     say("static stiffness", *spec.stiffness);
     try {
-      u.stiffness_analysis = stiffness(c, load_record(c, *spec.stiffness, Experiment::kStiffness), u, "static stiffness");
+      u.stiffness_analysis = stiffness(c, load_record(c, spec, *spec.stiffness, Experiment::kStiffness), u, "static stiffness");
       u.k1 = u.stiffness_analysis->result.k1;
       u.k2 = u.stiffness_analysis->result.k2;
     } catch (const NumericalError& e) {
@@ -760,7 +824,7 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   if (spec.stiffness_open) {
     say("static stiffness, stacks open", *spec.stiffness_open);
     try {
-      u.stiffness_open_analysis = stiffness(c, load_record(c, *spec.stiffness_open, Experiment::kStiffnessOpen), u,
+      u.stiffness_open_analysis = stiffness(c, load_record(c, spec, *spec.stiffness_open, Experiment::kStiffnessOpen), u,
                                             "static stiffness, stacks open");
       u.k_oc = u.stiffness_open_analysis->result.k1;
     } catch (const NumericalError& e) {
@@ -770,7 +834,7 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   std::optional<Record> frf_record;
   if (spec.frf) {
     say("FRFs u -> d_e, Vs", *spec.frf);
-    frf_record = load_record(c, *spec.frf, Experiment::kFrf);
+    frf_record = load_record(c, spec, *spec.frf, Experiment::kFrf);
     frf(c, *frf_record, u);
   }
   if (spec.frf_no_resistor) {
@@ -778,7 +842,7 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
     try {
       ResistorComparison rc;
       if (frf_record) rc.with_resistor = low_frequency_vs(c, *frf_record);
-      rc.without_resistor = low_frequency_vs(c, load_record(c, *spec.frf_no_resistor, Experiment::kFrfNoResistor));
+      rc.without_resistor = low_frequency_vs(c, load_record(c, spec, *spec.frf_no_resistor, Experiment::kFrfNoResistor));
       u.resistor = std::move(rc);
     } catch (const NumericalError& e) {
       record_failure(u, "high-pass corner with and without the resistor", e);
@@ -789,13 +853,13 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
     std::vector<Record> records;
     for (const auto& f : spec.iff) {
       say("IFF damped plant", f);
-      records.push_back(load_record(c, f, Experiment::kIff));
+      records.push_back(load_record(c, spec, f, Experiment::kIff));
     }
     u.damped = iff(c, records, u);
   }
   if (spec.hammer) {
     say("hammer test", *spec.hammer);
-    u.flexible_modes = hammer(c, load_record(c, *spec.hammer, Experiment::kHammer), u);
+    u.flexible_modes = hammer(c, load_record(c, spec, *spec.hammer, Experiment::kHammer), u);
   }
   return u;
 }

@@ -140,6 +140,8 @@ Matrix expm(const Matrix& a) {
       {{3, 1.495585217958292e-2}, {5, 2.539398330063230e-1}, {7, 9.504178996162932e-1}, {9, 2.097847961257068e0}}};
   constexpr double kTheta13 = 5.371920351148152e0;
   const double norm1 = a.cwiseAbs().colwise().sum().maxCoeff();
+  // Finite entries can still sum to infinity; the squaring count below must be a finite integer.
+  if (!std::isfinite(norm1)) throw InputError("expm", "a", "entries whose column sums are finite", "an infinite 1-norm");
   for (const auto& [m, theta] : kTheta) {
     if (norm1 <= theta) return pade_exp(a, m);
   }

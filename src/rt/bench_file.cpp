@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <toml++/toml.h>
 #include <vector>
 
+#include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/toml_table.hpp"
+#include "piezobench/rt/udp.hpp"
 
 namespace piezobench::rt {
 
@@ -55,12 +58,18 @@ class Table {
     if (!v) throw InputError(source_, key(k), "a number (" + why + ")", "nothing");
     return *v;
   }
-  [[nodiscard]] std::optional<std::int64_t> integer(const std::string& k) const {
+  // An integer in [lo, hi] (a float is refused before any conversion; core/checked_number.hpp).
+  [[nodiscard]] std::optional<std::int64_t> integer(const std::string& k, std::int64_t lo, std::int64_t hi) const {
     const toml::node* n = get(k);
     if (!n) return std::nullopt;
-    const auto v = n->value<std::int64_t>();
-    if (!n->is_integer() || !v) throw InputError(source_, key(k), "an integer", describe_toml(*n));
-    return *v;
+    if (!n->is_integer()) throw InputError(source_, key(k), "an integer", describe_toml(*n));
+    return checked_integer(n->as_integer()->get(), lo, hi, NumberOrigin::file(source_, key(k)));
+  }
+  // A time in seconds in [min_s, max_s].
+  [[nodiscard]] std::optional<double> duration(const std::string& k, double min_s, double max_s) const {
+    const auto v = number(k);
+    if (!v) return std::nullopt;
+    return checked_duration_s(*v, min_s, max_s, NumberOrigin::file(source_, key(k)));
   }
   [[nodiscard]] std::optional<std::string> string(const std::string& k) const {
     const toml::node* n = get(k);
@@ -89,8 +98,8 @@ SignalChannel read_signal(const Table& t, const std::string& default_device) {
   t.only({"device", "subdevice", "channel", "range", "scale", "unit", "kind", "aref"});
   SignalChannel s;
   s.device = t.string("device").value_or(default_device);
-  s.subdevice = static_cast<int>(t.integer("subdevice").value_or(-1));
-  s.channel = static_cast<int>(t.integer("channel").value_or(-1));
+  s.subdevice = static_cast<int>(t.integer("subdevice", 0, 255).value_or(-1));
+  s.channel = static_cast<int>(t.integer("channel", 0, 65535).value_or(-1));
   if (const auto r = t.range("range")) {
     s.range_min = r->first;
     s.range_max = r->second;
@@ -137,6 +146,7 @@ void BenchDescription::validate() const {
   } catch (const InputError& e) {
     throw e.with_source(source);
   }
+  check_plausible(limits, source);
   if (!(std::isfinite(encoder_resolution) && encoder_resolution > 0.0)) {
     throw InputError(source, "encoder.resolution_m", "a resolution > 0 m", fmt::format("{:g}", encoder_resolution));
   }
@@ -206,7 +216,8 @@ BenchDescription parse_bench_description(const std::string& text, const std::str
                      fmt::format("{:g}", d.limits.amplifier_gain));
   }
   const Table lim = top.table("limits");
-  lim.only({"actuator", "va_min_V", "va_max_V", "va_safe_V", "slew_rate_V_per_s", "ramp_s", "stale_cycles", "watchdog_s"});
+  lim.only({"actuator", "va_min_V", "va_max_V", "va_safe_V", "slew_rate_V_per_s", "ramp_s", "stale_cycles", "stale_budget",
+            "watchdog_s", "de_range_m", "vs_range_V"});
   if (hardware && !lim.present()) throw InputError(source, "limits", "a [limits] table (" + why + ")", "nothing");
   d.limits.actuator = lim.string("actuator").value_or(d.limits.actuator);
   if (hardware) {
@@ -219,9 +230,12 @@ BenchDescription parse_bench_description(const std::string& text, const std::str
     d.limits.slew_rate = lim.number("slew_rate_V_per_s").value_or(d.limits.slew_rate);
   }
   d.limits.va_safe = lim.number("va_safe_V").value_or(d.limits.va_safe);
-  if (const auto r = lim.number("ramp_s")) d.limits.ramp_in = d.limits.ramp_out = *r;
-  if (const auto s = lim.integer("stale_cycles")) d.limits.stale_cycles = static_cast<int>(std::clamp<std::int64_t>(*s, -1, 1000000));
-  d.limits.watchdog_timeout = lim.number("watchdog_s").value_or(d.limits.watchdog_timeout);
+  if (const auto r = lim.duration("ramp_s", 0.0, ActuatorLimits::kMaxTime)) d.limits.ramp_in = d.limits.ramp_out = *r;
+  if (const auto s = lim.integer("stale_cycles", 0, ActuatorLimits::kMaxStaleCycles)) d.limits.stale_cycles = static_cast<int>(*s);
+  d.limits.stale_budget = lim.number("stale_budget").value_or(d.limits.stale_budget);
+  d.limits.watchdog_timeout = lim.duration("watchdog_s", 1e-6, ActuatorLimits::kMaxTime).value_or(d.limits.watchdog_timeout);
+  d.limits.de_range = lim.number("de_range_m").value_or(d.limits.de_range);
+  d.limits.vs_range = lim.number("vs_range_V").value_or(d.limits.vs_range);
 
   const Table enc = top.table("encoder");
   enc.only({"resolution_m"});
@@ -229,14 +243,16 @@ BenchDescription parse_bench_description(const std::string& text, const std::str
 
   const Table virt = top.table("virtual");
   virt.only({"unit", "seed"});
-  d.unit = static_cast<int>(std::clamp<std::int64_t>(virt.integer("unit").value_or(1), -1, 1000));
-  if (const auto s = virt.integer("seed")) {
-    if (*s < 0) throw InputError(source, "virtual.seed", "an integer >= 0", std::to_string(*s));
-    d.seed = static_cast<std::uint64_t>(*s);
-  }
+  d.unit = static_cast<int>(virt.integer("unit", 1, 7).value_or(1));
+  if (const auto s = virt.integer("seed", 0, std::numeric_limits<std::int64_t>::max())) d.seed = static_cast<std::uint64_t>(*s);
   const Table udp = top.table("udp");
-  udp.only({"address", "timeout_s"});
+  udp.only({"address", "timeout_s", "key_file"});
   d.udp_address = udp.string("address").value_or("");
+  if (const auto k = udp.string("key_file")) {
+    std::filesystem::path file(*k);
+    if (file.is_relative()) file = std::filesystem::path(source).parent_path() / file;
+    d.udp_key = read_udp_key(file, source, "udp.key_file");
+  }
   d.udp_timeout = udp.number("timeout_s").value_or(d.udp_timeout);
 
   const Table com = top.table("comedi");

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/timestamp.hpp"
 
 namespace piezobench::rt {
 
@@ -82,6 +83,7 @@ IoStats MeasureReport::io() const {
     s.lost += r.io.lost;
     s.timeouts += r.io.timeouts;
     s.errors += r.io.errors;
+    s.rejected += r.io.rejected;
     s.round_trip_us = r.io.round_trip_us;
   }
   return s;
@@ -171,6 +173,15 @@ io::TimeSeries BackendRunner::run(LoopOptions lo, const std::vector<bench::Opera
         fmt::format("the safe state ({}) at t = {:.4f} s; the output was brought to {:g} V{}", rep.safe_state_reason,
                     static_cast<double>(rep.safe_state_cycle) / rate, lo.limits.va_safe,
                     lo.log_file ? "; the log up to then is in " + lo.log_file->string() : std::string()));
+  }
+  // A held sample repeats the previous one: beyond the budget the record is not the response.
+  const double budget = std::floor(lo.limits.stale_budget * static_cast<double>(rep.cycles));
+  if (static_cast<double>(rep.stale_sensor_samples) > budget) {
+    throw InputError("measure on " + backend_.name(), "stale samples",
+                     fmt::format("at most {:g} held samples ({:g} % of the run's {} cycles, limits.stale_budget)", budget,
+                                 100.0 * lo.limits.stale_budget, rep.cycles),
+                     fmt::format("{}{}", rep.stale_sensor_samples,
+                                 lo.log_file ? "; the log is in " + lo.log_file->string() : std::string()));
   }
   const auto n = static_cast<Eigen::Index>(std::llround(lo.duration * rate));
   if (log.samples() < n) {
@@ -275,6 +286,7 @@ void BackendRunner::describe(io::TimeSeries& ts) const {
   ts.settings["backend"] = backend_.name();
   ts.settings["bench_file"] = b.source;
   if (!b.name.empty()) ts.settings["bench_name"] = b.name;
+  ts.settings["bench"] = b.name.empty() ? b.source : b.name;
   if (b.backend == "udp") ts.settings["udp_address"] = b.udp_address;
   if (b.backend == "comedi") {
     ts.settings["device"] = b.comedi_device;
@@ -287,6 +299,7 @@ void BackendRunner::describe(io::TimeSeries& ts) const {
     ts.settings["slew_limited_samples"] = static_cast<double>(r.slew_limited_samples);
     ts.settings["io_lost"] = static_cast<double>(r.io.lost);
     ts.settings["io_late"] = static_cast<double>(r.io.late);
+    ts.settings["io_rejected"] = static_cast<double>(r.io.rejected);
     ts.settings["stale_samples"] = static_cast<double>(r.stale_sensor_samples);
   }
 }

@@ -9,6 +9,7 @@ namespace piezobench::rt {
 
 void TimingHistogram::add(double ns) noexcept {
   if (!(ns > 0.0)) ns = 0.0;  // also NaN
+  ns = std::min(ns, 1e300);   // +inf: the last bin (its log must convert to an int)
   int bin = 0;
   if (ns > 1.0) {
     bin = static_cast<int>(std::floor(std::log10(ns) * kBinsPerDecade));

@@ -1,6 +1,8 @@
 #include "piezobench/rt/udp.hpp"
 
 #include <arpa/inet.h>
+#include <nettle/hmac.h>
+#include <nettle/memops.h>
 #include <netinet/in.h>
 #include <linux/sockios.h>
 #include <poll.h>
@@ -10,17 +12,24 @@
 
 #include <array>
 #include <bit>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <fstream>
 #include <limits>
+#include <sstream>
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
+#include "rt/udp_socket.hpp"
 #include "rt/util.hpp"
 
 namespace piezobench::rt {
+
+using detail::to_sockaddr;
+using detail::wait_readable;
 
 namespace {
 
@@ -44,28 +53,7 @@ bool check_header(const unsigned char* p, std::size_t size, std::size_t expected
   return size == expected && get(p, 4) == kUdpMagic && get(p + 4, 2) == kUdpVersion;
 }
 
-sockaddr_in to_sockaddr(const UdpAddress& a) {
-  sockaddr_in sa{};
-  sa.sin_family = AF_INET;
-  sa.sin_addr.s_addr = a.host;
-  sa.sin_port = htons(a.port);
-  return sa;
-}
-
 std::string errno_text() { return std::strerror(errno); }
-
-// Waits until fd is readable or the CLOCK_MONOTONIC deadline passes; true when readable.
-bool wait_readable(int fd, std::int64_t deadline_ns) noexcept {
-  for (;;) {
-    const std::int64_t left = deadline_ns - monotonic_ns();
-    if (left <= 0) return false;
-    pollfd p{fd, POLLIN, 0};
-    timespec ts{static_cast<time_t>(left / 1'000'000'000), static_cast<long>(left % 1'000'000'000)};
-    const int r = ppoll(&p, 1, &ts, nullptr);
-    if (r > 0) return true;
-    if (r < 0 && errno != EINTR) return false;
-  }
-}
 
 }  // namespace
 
@@ -74,7 +62,7 @@ void encode(const UdpRequest& r, unsigned char (&out)[kUdpRequestSize]) noexcept
   put(out + 8, r.sequence, 8);
   put_f64(out + 16, r.u);
   put(out + 24, r.flags, 4);
-  put(out + 28, 0, 4);
+  put(out + 28, r.session, 4);
 }
 
 void encode(const UdpReply& r, unsigned char (&out)[kUdpReplySize]) noexcept {
@@ -85,25 +73,30 @@ void encode(const UdpReply& r, unsigned char (&out)[kUdpReplySize]) noexcept {
   put_f64(out + 32, r.vs);
   put_f64(out + 40, r.va);
   put(out + 48, r.status, 4);
-  put(out + 52, 0, 4);
+  put(out + 52, r.session, 4);
 }
 
 std::optional<UdpRequest> decode_request(const unsigned char* p, std::size_t size) noexcept {
   if (!check_header(p, size, kUdpRequestSize)) return std::nullopt;
   const auto type = static_cast<UdpType>(get(p + 6, 2));
-  if (type != UdpType::kHello && type != UdpType::kIo && type != UdpType::kBye && type != UdpType::kSafe) return std::nullopt;
+  if (type != UdpType::kHello && type != UdpType::kIo && type != UdpType::kBye && type != UdpType::kSafe && type != UdpType::kReset) {
+    return std::nullopt;
+  }
   UdpRequest r;
   r.type = type;
   r.sequence = get(p + 8, 8);
   r.u = get_f64(p + 16);
   r.flags = static_cast<std::uint32_t>(get(p + 24, 4));
+  r.session = static_cast<std::uint32_t>(get(p + 28, 4));
   return r;
 }
 
 std::optional<UdpReply> decode_reply(const unsigned char* p, std::size_t size) noexcept {
   if (!check_header(p, size, kUdpReplySize)) return std::nullopt;
   const auto type = static_cast<UdpType>(get(p + 6, 2));
-  if (type != UdpType::kHelloReply && type != UdpType::kIoReply && type != UdpType::kByeReply) return std::nullopt;
+  if (type != UdpType::kHelloReply && type != UdpType::kIoReply && type != UdpType::kByeReply && type != UdpType::kResetReply) {
+    return std::nullopt;
+  }
   UdpReply r;
   r.type = type;
   r.sequence = get(p + 8, 8);
@@ -112,7 +105,47 @@ std::optional<UdpReply> decode_reply(const unsigned char* p, std::size_t size) n
   r.vs = get_f64(p + 32);
   r.va = get_f64(p + 40);
   r.status = static_cast<std::uint32_t>(get(p + 48, 4));
+  r.session = static_cast<std::uint32_t>(get(p + 52, 4));
   return r;
+}
+
+std::string read_udp_key(const std::filesystem::path& file, const std::string& source, const std::string& field) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(source, field, "a readable key file", "'" + file.string() + "': " + errno_text());
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string key = text.str();
+  while (!key.empty() && std::isspace(static_cast<unsigned char>(key.back()))) key.pop_back();
+  if (key.size() < 16 || key.size() > 4096) {
+    throw InputError(source, field, "a key of 16 to 4096 bytes (e.g. `head -c 32 /dev/urandom | base64`)",
+                     std::to_string(key.size()) + " bytes in '" + file.string() + "'");
+  }
+  return key;
+}
+
+namespace {
+// HMAC-SHA256 (nettle) of data[0, n) under key into tag (kUdpTagSize bytes).
+void hmac_sha256(const std::string& key, const unsigned char* data, std::size_t n, unsigned char* tag) noexcept {
+  hmac_sha256_ctx ctx;
+  hmac_sha256_set_key(&ctx, key.size(), reinterpret_cast<const std::uint8_t*>(key.data()));
+  hmac_sha256_update(&ctx, n, data);
+  hmac_sha256_digest(&ctx, kUdpTagSize, tag);
+}
+}  // namespace
+
+std::size_t seal(unsigned char* datagram, std::size_t n, const std::string& key) noexcept {
+  if (key.empty()) return n;
+  hmac_sha256(key, datagram, n, datagram + n);
+  return n + kUdpTagSize;
+}
+
+std::size_t unseal(const unsigned char* datagram, std::size_t n, const std::string& key) noexcept {
+  if (key.empty()) return n;
+  if (n < kUdpTagSize) return 0;
+  const std::size_t payload = n - kUdpTagSize;
+  unsigned char tag[kUdpTagSize];
+  hmac_sha256(key, datagram, payload, tag);
+  return memeql_sec(tag, datagram + payload, kUdpTagSize) != 0 ? payload : 0;  // constant time
 }
 
 std::string UdpAddress::to_string() const {
@@ -122,6 +155,8 @@ std::string UdpAddress::to_string() const {
   inet_ntop(AF_INET, &a, buf, sizeof buf);
   return std::string(buf) + ":" + std::to_string(port);
 }
+
+bool UdpAddress::loopback() const { return (ntohl(host) >> 24) == 127; }
 
 UdpAddress parse_udp_address(const std::string& text, const std::string& source, const std::string& field) {
   const auto colon = text.rfind(':');
@@ -144,14 +179,58 @@ UdpAddress parse_udp_address(const std::string& text, const std::string& source,
 
 // ---------------------------------------------------------------------------------------------
 
-UdpBackend::UdpBackend(const std::string& address, double sample_rate, double timeout)
-    : address_(parse_udp_address(address, "udp backend", "address")), sample_rate_(sample_rate), timeout_(timeout) {
+UdpBackend::UdpBackend(const std::string& address, double sample_rate, double timeout, UdpBackendOptions options)
+    : address_(parse_udp_address(address, "udp backend", "address")),
+      sample_rate_(sample_rate),
+      timeout_(timeout),
+      options_(std::move(options)) {
   detail::require_positive(sample_rate, "sample_rate", "udp backend");
   detail::require_positive(timeout, "timeout", "udp backend");
 }
 
 UdpBackend::~UdpBackend() {
   if (fd_ >= 0) ::close(fd_);
+}
+
+void UdpBackend::send_request(const UdpRequest& r) noexcept {
+  unsigned char out[kUdpRequestSize + kUdpTagSize];
+  encode(r, reinterpret_cast<unsigned char(&)[kUdpRequestSize]>(out));
+  if (::send(fd_, out, seal(out, kUdpRequestSize, options_.key), 0) < 0) ++stats_.errors;
+}
+
+std::optional<UdpReply> UdpBackend::receive_reply() noexcept {
+  unsigned char in[kUdpReplySize + kUdpTagSize + 8];
+  const ssize_t n = ::recv(fd_, in, sizeof in, MSG_DONTWAIT);
+  if (n < 0) return std::nullopt;
+  const std::size_t payload = unseal(in, static_cast<std::size_t>(n), options_.key);
+  auto r = payload > 0 ? decode_reply(in, payload) : std::nullopt;
+  // A reply of another session (an earlier one's late datagram, a forged one): not ours.
+  if (!r || (session_ != 0 && r->session != session_)) {
+    ++stats_.rejected;
+    return std::nullopt;
+  }
+  return r;
+}
+
+// Sends `type` (hello or reset) until its answer comes: 3 tries, 0.5 s each.
+bool UdpBackend::exchange(UdpType type, UdpType answer, UdpReply& reply) {
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    unsigned char out[kUdpRequestSize + kUdpTagSize];
+    encode(UdpRequest{type, 0, type == UdpType::kHello ? sample_rate_ : 0.0, 0, session_},
+           reinterpret_cast<unsigned char(&)[kUdpRequestSize]>(out));
+    if (::send(fd_, out, seal(out, kUdpRequestSize, options_.key), 0) < 0 && errno != ECONNREFUSED) {
+      throw InputError("udp backend", "address", "a reachable target", address_.to_string() + ": " + errno_text());
+    }
+    const std::int64_t deadline = monotonic_ns() + 500'000'000;
+    while (wait_readable(fd_, deadline)) {
+      const auto r = receive_reply();
+      if (!r) continue;  // ECONNREFUSED (nobody listens yet: try again), or not a reply of ours
+      if (r->type != answer) continue;
+      reply = *r;
+      return true;
+    }
+  }
+  return false;
 }
 
 void UdpBackend::start() {
@@ -164,44 +243,56 @@ void UdpBackend::start() {
   }
   stats_ = IoStats{};
   rtt_ = TimingHistogram{};
-  sent_ = answered_ = 0;
-  safe_ = false;
+  sent_ = answered_ = last_sample_ = last_reply_sequence_ = 0;
+  session_ = 0;
+  counter_fault_ = safe_ = false;
   last_ = SensorSample{};
-  // Hello: the target resets and says its rate.
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    unsigned char out[kUdpRequestSize];
-    encode(UdpRequest{UdpType::kHello, 0, sample_rate_, 0}, out);
-    if (::send(fd_, out, sizeof out, 0) < 0 && errno != ECONNREFUSED) {
-      throw InputError("udp backend", "address", "a reachable target", address_.to_string() + ": " + errno_text());
-    }
-    const std::int64_t deadline = monotonic_ns() + 500'000'000;
-    while (wait_readable(fd_, deadline)) {
-      unsigned char in[kUdpReplySize + 8];
-      const ssize_t n = ::recv(fd_, in, sizeof in, MSG_DONTWAIT);
-      if (n < 0) break;  // ECONNREFUSED: nobody listens yet; try again
-      const auto r = decode_reply(in, static_cast<std::size_t>(n));
-      if (!r || r->type != UdpType::kHelloReply) continue;
-      if (std::abs(r->de - sample_rate_) > 1e-9 * sample_rate_) {
-        throw InputError("udp target " + address_.to_string(), "sample rate", format_number(sample_rate_) + " Hz (the bench file's)",
-                         format_number(r->de) + " Hz");
-      }
-      return;
-    }
+  const std::string target = "udp target " + address_.to_string();
+  // Hello: the target opens this host's session (or refuses: busy) and says its rate.
+  UdpReply r;
+  if (!exchange(UdpType::kHello, UdpType::kHelloReply, r)) throw InputError(target, "hello", "an answer within 3 x 0.5 s", "no answer");
+  if ((r.status & kUdpStatusBusy) != 0) {
+    throw InputError(target, "hello", "a target free for this host",
+                     "busy: it serves another host's session (one at a time; docs/hardware.md \"UDP protocol\")");
   }
-  throw InputError("udp target " + address_.to_string(), "hello", "an answer within 3 x 0.5 s", "no answer");
+  if (r.session == 0) throw InputError(target, "hello", "a session id (protocol version 2)", "0");
+  session_ = r.session;
+  // From here on a refusal closes the session it opened (a bye), so the target is free at once.
+  const auto refuse = [this](const InputError& e) {
+    stop();
+    throw e;
+  };
+  if (std::abs(r.de - sample_rate_) > 1e-9 * sample_rate_) {
+    refuse(InputError(target, "sample rate", format_number(sample_rate_) + " Hz (the bench file's)", format_number(r.de) + " Hz"));
+  }
+  if ((r.status & kUdpStatusTargetSafe) == 0) return;
+  // The safe state a fault latched (in this or an earlier session): only this session's reset,
+  // after the operator's confirmation, clears it.
+  if (!options_.confirm_reset || !options_.confirm_reset(target)) {
+    refuse(InputError(target, "safe state",
+                      "a target ready to move (its latched safe state is cleared by `measure --reset-target` after the "
+                      "operator checked the bench)",
+                      "the safe state latched by an earlier fault"));
+  }
+  if (!exchange(UdpType::kReset, UdpType::kResetReply, r) || (r.status & kUdpStatusTargetSafe) != 0) {
+    refuse(InputError(target, "reset", "the target out of its safe state", "no answer or still safe"));
+  }
 }
 
 bool UdpBackend::receive(std::int64_t deadline_ns, std::uint64_t wanted, UdpReply& reply) noexcept {
   for (;;) {
-    unsigned char in[kUdpReplySize + 8];
-    ssize_t n = ::recv(fd_, in, sizeof in, MSG_DONTWAIT);
-    if (n < 0) {
-      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR && errno != ECONNREFUSED) ++stats_.errors;
-      if (!wait_readable(fd_, deadline_ns)) return false;
+    errno = 0;
+    const auto r = receive_reply();
+    if (!r) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR || errno == ECONNREFUSED) {
+        if (!wait_readable(fd_, deadline_ns)) return false;
+      } else if (errno != 0) {
+        ++stats_.errors;
+        if (!wait_readable(fd_, deadline_ns)) return false;
+      }
       continue;
     }
-    const auto r = decode_reply(in, static_cast<std::size_t>(n));
-    if (!r || r->type != UdpType::kIoReply) continue;
+    if (r->type != UdpType::kIoReply) continue;
     if (r->sequence == wanted) {
       reply = *r;
       return true;
@@ -212,9 +303,9 @@ bool UdpBackend::receive(std::int64_t deadline_ns, std::uint64_t wanted, UdpRepl
 }
 
 SensorSample UdpBackend::read() noexcept {
-  if (fd_ < 0 || answered_ == sent_) {
+  if (fd_ < 0 || answered_ == sent_ || counter_fault_) {
     ++stats_.timeouts;
-    return last_;  // nothing outstanding: stale
+    return last_;  // nothing outstanding (or the target broke the protocol): stale
   }
   const std::uint64_t wanted = sent_;
   UdpReply r;
@@ -231,7 +322,17 @@ SensorSample UdpBackend::read() noexcept {
   }
   ++stats_.replies;
   answered_ = wanted;
-  const bool fault = (r.status & (kUdpStatusTargetSafe | kUdpStatusSensorFault)) != 0;
+  // The target steps once per io request of this session: its sample counter advances, by at most
+  // the requests sent since the previous reply (fewer when a request was lost). More, or less
+  // than one, is another host stepping it or a broken target: the safe state.
+  const std::uint64_t requests = wanted - last_reply_sequence_;
+  if (r.sample <= last_sample_ || r.sample - last_sample_ > requests) {
+    counter_fault_ = true;
+    ++stats_.errors;
+  }
+  last_sample_ = r.sample;
+  last_reply_sequence_ = wanted;
+  const bool fault = counter_fault_ || (r.status & (kUdpStatusTargetSafe | kUdpStatusSensorFault)) != 0;
   last_.de = fault ? std::numeric_limits<double>::quiet_NaN() : r.de;
   last_.vs = fault ? std::numeric_limits<double>::quiet_NaN() : r.vs;
   last_.va = r.va;
@@ -241,12 +342,12 @@ SensorSample UdpBackend::read() noexcept {
 
 void UdpBackend::write(double u) noexcept {
   if (fd_ < 0) return;
-  unsigned char out[kUdpRequestSize];
-  encode(UdpRequest{UdpType::kIo, sent_ + 1, u, safe_ ? 1u : 0u}, out);
   timespec now{};
   clock_gettime(CLOCK_REALTIME, &now);
   sent_ns_ = now.tv_sec * 1'000'000'000LL + now.tv_nsec;
-  if (::send(fd_, out, sizeof out, 0) < 0) {
+  unsigned char out[kUdpRequestSize + kUdpTagSize];
+  encode(UdpRequest{UdpType::kIo, sent_ + 1, u, safe_ ? 1u : 0u, session_}, reinterpret_cast<unsigned char(&)[kUdpRequestSize]>(out));
+  if (::send(fd_, out, seal(out, kUdpRequestSize, options_.key), 0) < 0) {
     ++stats_.errors;
     return;
   }
@@ -256,9 +357,7 @@ void UdpBackend::write(double u) noexcept {
 
 void UdpBackend::on_watchdog() noexcept {
   if (fd_ < 0) return;
-  unsigned char out[kUdpRequestSize];
-  encode(UdpRequest{UdpType::kSafe, 0, 0.0, 1u}, out);
-  ::send(fd_, out, sizeof out, 0);
+  send_request(UdpRequest{UdpType::kSafe, 0, 0.0, 1u, session_});
 }
 
 void UdpBackend::stop() noexcept {
@@ -268,10 +367,7 @@ void UdpBackend::stop() noexcept {
   const std::int64_t deadline = monotonic_ns() + std::max<std::int64_t>(static_cast<std::int64_t>(timeout_ * 1e9), 50'000'000);
   std::uint64_t pending = sent_ > answered_ ? sent_ - answered_ : 0;
   while (pending > 0 && wait_readable(fd_, deadline)) {
-    unsigned char in[kUdpReplySize + 8];
-    const ssize_t n = ::recv(fd_, in, sizeof in, MSG_DONTWAIT);
-    if (n < 0) continue;
-    const auto r = decode_reply(in, static_cast<std::size_t>(n));
+    const auto r = receive_reply();
     if (!r || r->type != UdpType::kIoReply) continue;
     if (r->sequence > answered_) {
       ++stats_.replies;
@@ -280,17 +376,17 @@ void UdpBackend::stop() noexcept {
       ++stats_.late;
     }
   }
-  unsigned char out[kUdpRequestSize];
-  encode(UdpRequest{UdpType::kBye, sent_ + 1, 0.0, 0}, out);
-  ::send(fd_, out, sizeof out, 0);
-  const std::int64_t bye_deadline = monotonic_ns() + 100'000'000;
-  while (wait_readable(fd_, bye_deadline)) {
-    unsigned char in[kUdpReplySize + 8];
-    const ssize_t n = ::recv(fd_, in, sizeof in, MSG_DONTWAIT);
-    if (n < 0) continue;
-    const auto r = decode_reply(in, static_cast<std::size_t>(n));
-    if (r && r->type == UdpType::kByeReply) break;
-    if (r && r->type == UdpType::kIoReply) ++stats_.late;
+  // Bye (3 tries): a lost bye would keep the session open on the target until its time-out.
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    send_request(UdpRequest{UdpType::kBye, sent_ + 1, 0.0, 0, session_});
+    const std::int64_t bye_deadline = monotonic_ns() + 100'000'000;
+    bool done = false;
+    while (!done && wait_readable(fd_, bye_deadline)) {
+      const auto r = receive_reply();
+      if (r && r->type == UdpType::kByeReply) done = true;
+      if (r && r->type == UdpType::kIoReply) ++stats_.late;
+    }
+    if (done) break;
   }
   ::close(fd_);
   fd_ = -1;
@@ -302,95 +398,6 @@ IoStats UdpBackend::io_stats() const {
   s.lost = s.exchanges > answered ? s.exchanges - answered : 0;
   s.round_trip_us = rtt_.summary_us();
   return s;
-}
-
-// ---------------------------------------------------------------------------------------------
-
-UdpServerReport serve_udp(const bench::UnitTruth& unit, const bench::BenchOptions& options, std::uint64_t seed,
-                          const UdpServerOptions& server) {
-  const UdpAddress address = parse_udp_address(server.address, "bench serve", "--udp");
-  bench::VirtualBench bench(unit, options, seed);
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw InputError("bench serve", "socket", "a UDP socket", errno_text());
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  sockaddr_in sa = to_sockaddr(address);
-  if (::bind(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) != 0) {
-    throw InputError("bench serve", "--udp", "an address this host can listen on", address.to_string() + ": " + errno_text());
-  }
-  socklen_t len = sizeof sa;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&sa), &len);
-  UdpAddress bound{sa.sin_addr.s_addr, ntohs(sa.sin_port)};
-  if (server.on_listening) server.on_listening(bound.to_string());
-
-  UdpServerReport rep;
-  std::uint64_t sample = 0, io_requests = 0;
-  bool safe = false;
-  std::int64_t last_activity = monotonic_ns();
-  const auto idle_ns = static_cast<std::int64_t>(server.idle_timeout * 1e9);
-  for (;;) {
-    if (server.stop != nullptr && server.stop->load()) break;
-    if (!wait_readable(fd, monotonic_ns() + 100'000'000)) {
-      if (monotonic_ns() - last_activity > idle_ns) break;
-      continue;
-    }
-    unsigned char in[kUdpRequestSize + 8];
-    sockaddr_in from{};
-    socklen_t from_len = sizeof from;
-    const ssize_t n = ::recvfrom(fd, in, sizeof in, 0, reinterpret_cast<sockaddr*>(&from), &from_len);
-    if (n < 0) continue;
-    last_activity = monotonic_ns();
-    const auto req = decode_request(in, static_cast<std::size_t>(n));
-    if (!req) {
-      ++rep.rejected;
-      continue;
-    }
-    UdpReply reply;
-    reply.sequence = req->sequence;
-    switch (req->type) {
-      case UdpType::kHello:
-        bench.reset(seed);
-        sample = 0;
-        io_requests = 0;
-        safe = false;
-        reply.type = UdpType::kHelloReply;
-        reply.de = bench.sample_rate();
-        break;
-      case UdpType::kIo: {
-        ++rep.requests;
-        ++io_requests;
-        const bench::BenchSample s = bench.step(safe ? 0.0 : req->u);
-        reply.type = UdpType::kIoReply;
-        reply.sample = ++sample;
-        reply.de = s.de;
-        reply.vs = s.vs;
-        reply.va = s.va;
-        reply.status = safe ? kUdpStatusTargetSafe : 0u;
-        if (server.drop_every > 0 && io_requests % server.drop_every == 0) {
-          ++rep.dropped;
-          continue;
-        }
-        break;
-      }
-      case UdpType::kSafe:
-        safe = true;
-        rep.target_safe = true;
-        continue;
-      case UdpType::kBye:
-        reply.type = UdpType::kByeReply;
-        ++rep.sessions;
-        break;
-      default:
-        continue;
-    }
-    unsigned char out[kUdpReplySize];
-    encode(reply, out);
-    if (::sendto(fd, out, sizeof out, 0, reinterpret_cast<const sockaddr*>(&from), from_len) >= 0) ++rep.replies;
-    if (req->type == UdpType::kBye && server.sessions > 0 && rep.sessions >= static_cast<std::uint64_t>(server.sessions)) break;
-  }
-  return rep;
 }
 
 }  // namespace piezobench::rt

@@ -2,10 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <complex>
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "run_cli.hpp"
 #include "test_util.hpp"
@@ -249,6 +252,32 @@ TEST(FrfCli, LabFilesGiveScipysH1InSi) {
   EXPECT_EQ(bad.exit_code, 3);
   EXPECT_TRUE(test::contains(bad.err, "tab-separated")) << bad.err;
   EXPECT_EQ(run_cli("frf " + test::fixture_path("io/lab/semicolon_mm.csv").string() + " --input u --output d_e --delimiter pipe").exit_code, 2);
+}
+
+// Issue 35: a record whose input excited nothing (independent noise on u and y: coherence ~0)
+// exited 3 without --json and 0 with it, and with --out the file was written before the exit 3.
+// Now one outcome, one exit code, whatever the output flags; nothing is written.
+TEST(FrfCli, TheExitCodeOfALowCoherenceRecordDoesNotDependOnTheOutputFlags) {
+  test::TempDir dir;
+  std::string csv = "t,u,y\n";
+  std::uint64_t state = 12345;
+  const auto noise = [&state] {  // a 64-bit LCG: two independent-looking sequences
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) * 0x1p-53 - 0.5;
+  };
+  for (int k = 0; k < 8192; ++k) {
+    const double u = noise(), y = noise();
+    csv += std::to_string(k * 1e-3) + "," + std::to_string(u) + "," + std::to_string(y) + "\n";
+  }
+  const std::string record = test::write_text_file(dir, "noise.csv", csv);
+  const std::string out = (dir.path() / "frf.csv").string();
+  for (const std::string& flags : std::vector<std::string>{"", " --json", " --out " + out, " --json --out " + out}) {
+    const test::CliRun r = run_cli("frf " + record + " --input u --output y --nfft 256" + flags);
+    EXPECT_EQ(r.exit_code, 3) << flags << ": " << r.err;
+    EXPECT_TRUE(test::contains(r.err, "the input excites the outputs")) << flags << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << flags << ": " << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out)) << flags;
+  }
 }
 
 }  // namespace

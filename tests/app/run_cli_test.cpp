@@ -115,7 +115,7 @@ title = "assembled"
 [specs]
 stroke_min_um = 200.0
 [[units]]
-id = 11
+id = 1
 frf = { file = "apa1_frf.csv", channels = { u = "dac", de = "encoder", Vs = "force_sensor" } }
 stiffness = { file = "apa1_stiffness.mat", channels = { de = "laser" } }
 stroke = "stroke.mat"
@@ -129,7 +129,7 @@ capacitance_uF = { sensor = 5.10, actuator = 10.03 }
   const json b = json::parse(read_text(d / "results.json"));
   const json& ua = a["units"][0];
   const json& ub = b["units"][0];
-  EXPECT_EQ(ua["id"], 11);
+  EXPECT_EQ(ua["id"], 1);  // unit 1's records: their settings.unit says so, and run checks it
   EXPECT_TRUE(ua["accepted"].get<bool>()) << ua["reasons"].dump();
   // The CSV keeps 17 digits: the same numbers as from the .mat files.
   EXPECT_TRUE(near(ua["frf"]["resonance_Hz"].get<double>(), ub["frf"]["resonance_Hz"].get<double>(), 1e-9));
@@ -139,6 +139,28 @@ capacitance_uF = { sensor = 5.10, actuator = 10.03 }
 }
 
 // A second run on a --out another run holds is refused with exit 3 and leaves the folder alone.
+// Issue 35's reproducers of item 2, through the command: unit 1's files given for unit 3, an FRF
+// record given as a stroke: exit 3 naming both, no results written.
+TEST(RunCli, RecordsOfAnotherUnitOrKindAreRefused) {
+  test::TempDir dir;
+  const auto file = [&dir](const std::string& name) { return (dir.path() / name).string(); };
+  ASSERT_EQ(run_cli("simulate capacitance --unit 1 --out " + file("c1.mat")).exit_code, 0);
+  ASSERT_EQ(run_cli("simulate stroke --unit 1 --out " + file("s1.mat")).exit_code, 0);
+  ASSERT_EQ(run_cli("simulate frf-noise --unit 3 --duration 1 --out " + file("f3.mat")).exit_code, 0);
+  std::ofstream(dir.path() / "swapped.toml") << "[[units]]\nid = 3\ncapacitance = \"c1.mat\"\nstroke = \"s1.mat\"\n";
+  CliRun r = run_cli("run " + file("swapped.toml") + " --out " + file("out1"));
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "expected a record of unit 3 (units[0].id)")) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "a record of unit 1 (its settings.unit)")) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out1" / "results.json"));
+  std::ofstream(dir.path() / "kind.toml") << "[[units]]\nid = 3\nstroke = \"f3.mat\"\n";
+  r = run_cli("run " + file("kind.toml") + " --out " + file("out2"));
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "expected a stroke record (stroke), found '" )) << r.err;
+  EXPECT_TRUE(test::contains(r.err, "a frf-noise record (its settings.experiment)")) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out2" / "results.json"));
+}
+
 TEST(RunCli, BusyOutFolderIsRefused) {
   const fs::path& d = demo_dir();
   TempDir dir;

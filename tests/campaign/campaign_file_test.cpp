@@ -179,6 +179,14 @@ TEST(CampaignFile, BadValues) {
   f.error("[[units]]\nid = 1\ncapacitance = \"data/b_cap.csv\"\ncapacitance_uF = { sensor = 1.0, actuator = 2.0 }\n",
           "units[0].capacitance_uF");
   f.error("[[units]]\nid = 1\ncapacitance_uF = { sensor = 1.0 }\n", "units[0].capacitance_uF.actuator");
+  // Integers beyond their range, or floats where an integer is expected, are refused before any
+  // conversion (issue 35: `id = 92233720368547758e07` was converted to int first, UB).
+  const std::string huge = f.error("[[units]]\nid = 92233720368547758e07\n", "units[0].id");
+  EXPECT_TRUE(contains(huge, "expected an integer, found")) << huge;
+  const std::string big = f.error("[[units]]\nid = 9223372036854775807\n", "units[0].id");
+  EXPECT_TRUE(contains(big, "expected an integer in 0 .. 1000000, found 9223372036854775807")) << big;
+  f.error("[analysis]\niff_unit = 4294967297\n[[units]]\nid = 1\n", "analysis.iff_unit");
+  f.error("[analysis]\nthreads = 1e300\n[[units]]\nid = 1\n", "analysis.threads");
   // TOML syntax: the line is named.
   const std::string syntax = test::input_error([&] { (void)f.parse("[[units]]\nid = = 1\n"); });
   EXPECT_TRUE(contains(syntax, "line 2")) << syntax;

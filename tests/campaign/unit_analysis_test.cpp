@@ -47,6 +47,12 @@ id = 5
   }
 };
 
+// A simulated record of the campaign's unit (id 5): its settings.unit is checked against it.
+io::TimeSeries unit5_record(io::TimeSeries ts) {
+  ts.settings["unit"] = 5.0;
+  return ts;
+}
+
 const char* kAll = R"(
 capacitance_uF = { sensor = 5.0, actuator = 10.0 }
 frf = { file = "frf.mat", channels = { de = "d_enc", Vs = "V_sensor" } }
@@ -177,7 +183,7 @@ TEST(UnitAnalysis, HysteresisModelWidthsAreOverTheSteadyLoop) {
   const Files f;
   bench::ExperimentOptions o;
   o.amplitude = 80.0;
-  io::write_timeseries(bench::simulate(bench::Experiment::kHysteresis, bench::batch_unit(1, 1), o, 1), f.dir.path() / "h80.mat");
+  io::write_timeseries(unit5_record(bench::simulate(bench::Experiment::kHysteresis, bench::batch_unit(1, 1), o, 1)), f.dir.path() / "h80.mat");
   const Campaign c = f.campaign("hysteresis = [\"hyst20.mat\", \"h80.mat\"]\n");
   const UnitAnalysis u = analyze_unit(c, c.units[0]);
   ASSERT_TRUE(u.hysteresis_model);
@@ -202,7 +208,7 @@ TEST(UnitAnalysis, HysteresisModelIsTheModifiedPiWhenTheLoopIsAsymmetric) {
     bench::ExperimentOptions o;
     o.amplitude = 80.0;
     o.bench.hysteresis_law = law;
-    io::write_timeseries(bench::simulate(bench::Experiment::kHysteresis, bench::batch_unit(1, 1), o, 1), f.dir.path() / "h80.mat");
+    io::write_timeseries(unit5_record(bench::simulate(bench::Experiment::kHysteresis, bench::batch_unit(1, 1), o, 1)), f.dir.path() / "h80.mat");
     const Campaign c = f.campaign("hysteresis = [\"h80.mat\"]\n");
     const UnitAnalysis u = analyze_unit(c, c.units[0]);
     ASSERT_TRUE(u.hysteresis_model);
@@ -269,6 +275,36 @@ TEST(UnitAnalysis, MissingChannelNamesCampaignKey) {
   io::write_timeseries(nogain, f.dir.path() / "nogain.mat");
   const Campaign c3 = f.campaign("iff = \"nogain.mat\"\n");
   test::input_error([&] { (void)analyze_unit(c3, c3.units[0]); }, "units[0].iff.gain");
+}
+
+// Issue 35: a record whose own settings name another unit, serial or kind of experiment than the
+// campaign entry that gives it is refused, naming both (unit 1's files given for unit 3 made the
+// defective unit pass with unit 1's numbers; an FRF record given as a stroke was analysed).
+TEST(UnitAnalysis, ARecordOfAnotherUnitSerialOrKindIsRefused) {
+  const Files f;
+  io::TimeSeries stroke = syn::stroke_record(-1.5e-6);
+  stroke.settings["experiment"] = std::string("stroke");
+  stroke.settings["unit"] = 1.0;
+  stroke.settings["serial"] = std::string("APA300ML-0001");
+  io::write_timeseries(stroke, f.dir.path() / "unit1_stroke.mat");
+  const std::string channels = ", channels = { Va = \"V_stack\", de = \"probe\" } }\n";
+  const Campaign other_unit = f.campaign("stroke = { file = \"unit1_stroke.mat\"" + channels);  // the campaign's unit is id 5
+  std::string msg = test::input_error([&] { (void)analyze_unit(other_unit, other_unit.units[0]); }, "units[0].stroke");
+  EXPECT_TRUE(test::contains(msg, "expected a record of unit 5 (units[0].id), found 'unit1_stroke.mat', a record of unit 1 (its settings.unit)"))
+      << msg;
+  stroke.settings["unit"] = 5.0;
+  io::write_timeseries(stroke, f.dir.path() / "unit5_stroke.mat");
+  const Campaign other_serial = f.campaign("serial = \"APA300ML-0005\"\nstroke = { file = \"unit5_stroke.mat\"" + channels);
+  msg = test::input_error([&] { (void)analyze_unit(other_serial, other_serial.units[0]); }, "units[0].stroke");
+  EXPECT_TRUE(test::contains(msg, "serial 'APA300ML-0005'")) << msg;
+  EXPECT_TRUE(test::contains(msg, "serial 'APA300ML-0001'")) << msg;
+  const Campaign same_serial = f.campaign("serial = \"APA300ML-0001\"\nstroke = { file = \"unit5_stroke.mat\"" + channels);
+  EXPECT_NO_THROW((void)analyze_unit(same_serial, same_serial.units[0]));
+  stroke.settings["experiment"] = std::string("frf-noise");
+  io::write_timeseries(stroke, f.dir.path() / "frf_as_stroke.mat");
+  const Campaign other_kind = f.campaign("stroke = { file = \"frf_as_stroke.mat\"" + channels);
+  msg = test::input_error([&] { (void)analyze_unit(other_kind, other_kind.units[0]); }, "units[0].stroke");
+  EXPECT_TRUE(test::contains(msg, "expected a stroke record (stroke), found 'frf_as_stroke.mat', a frf-noise record")) << msg;
 }
 
 // LCR readings of one sample in a .mat file (what the bench writes) and in a CSV file.

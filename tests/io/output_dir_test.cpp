@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <fstream>
 
 #include "piezobench/core/error.hpp"
@@ -68,6 +71,48 @@ TEST(StagedOutputs, CommitRenamesInOrderAndLeavesNoStagingFolder) {
   EXPECT_EQ(written.back(), dir.path() / "b.txt");
   EXPECT_EQ(test::read_text(dir.path() / "a.txt"), "new a");
   EXPECT_EQ(names(dir.path()), (std::vector<std::string>{"a.txt", "b.txt"}));
+}
+
+TEST(OutputLock, ASymbolicLinkIsNeverFollowedAndTheLockFileGoesAtTheEnd) {
+  TempDir dir;
+  const fs::path out = dir.path() / "out";
+  fs::create_directories(out);
+  fs::create_symlink(dir.path() / "victim", out / ".piezobench.lock");
+  const std::string e = test::input_error([&] { const OutputLock lock(out); });
+  EXPECT_TRUE(test::contains(e, "symbolic link")) << e;
+  EXPECT_FALSE(fs::exists(dir.path() / "victim"));  // issue 35: a file was created at the link's target
+  fs::remove(out / ".piezobench.lock");
+  {
+    const OutputLock lock(out);
+    EXPECT_TRUE(fs::is_regular_file(out / ".piezobench.lock"));
+  }
+  EXPECT_FALSE(fs::exists(out / ".piezobench.lock"));
+}
+
+// The pid of a process that has ended (a child that exited; until the kernel recycles it).
+long dead_pid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  return child;
+}
+
+TEST(OutputLock, RemovesWhatDeadRunsLeftAndNothingElse) {
+  TempDir dir;
+  const fs::path out = dir.path() / "out";
+  const long dead = dead_pid();
+  fs::create_directories(out / ("data"));
+  fs::create_directories(out / (".staging-" + std::to_string(dead) + "-0"));
+  std::ofstream(out / (".staging-" + std::to_string(dead) + "-0") / "results.mat") << "partial";
+  std::ofstream(out / "data" / (".unit1_frf.mat.tmp-" + std::to_string(dead) + "-3-0badcafe.mat")) << "partial";
+  std::ofstream(out / (".results.json.tmp-" + std::to_string(dead) + "-0-12345678.json")) << "partial";
+  // Kept: a live process's (pid 1), files that only look alike, the results.
+  fs::create_directories(out / ".staging-1-0");
+  std::ofstream(out / "data" / ".notes.tmp-abc") << "x";
+  std::ofstream(out / "results.json") << "{}";
+  { const OutputLock lock(out); }
+  EXPECT_EQ(names(out), (std::vector<std::string>{".staging-1-0", "data", "results.json"}));
+  EXPECT_EQ(names(out / "data"), (std::vector<std::string>{".notes.tmp-abc"}));
 }
 
 }  // namespace

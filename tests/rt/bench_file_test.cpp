@@ -103,5 +103,31 @@ TEST(BenchFile, TheDocumentedExamplesRead) {
   }
 }
 
+TEST(BenchFile, LimitsArePlausibleForTheNamedActuator) {
+  // Issue 35: limits checked against each other only; now against the APA300ML's datasheet
+  // (-20 .. 150 V) and physical bounds, each refusal naming the key (exit 3).
+  std::string e = error_of(test::replace_once(kComedi, "va_max_V = 150\n", "va_max_V = 1e308\n"));
+  EXPECT_TRUE(test::contains(e, "bench.toml: limits.va_max_V: expected at most 150 V (APA300ML's datasheet)")) << e;
+  e = error_of(test::replace_once(kComedi, "slew_rate_V_per_s = 1e5\n", "slew_rate_V_per_s = 1e308\n"));
+  EXPECT_TRUE(test::contains(e, "limits.slew_rate_V_per_s")) << e;
+  e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nramp_s = 1e300\n"));
+  EXPECT_TRUE(test::contains(e, "limits.ramp_s: expected a duration in [0, 60] s, found 1e+300")) << e;
+  e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nactuator = \"APA3000ML\"\n"));
+  EXPECT_TRUE(test::contains(e, "limits.actuator")) << e;
+}
+
+TEST(BenchFile, IntegersAndDurationsAreRangeCheckedBeforeConversion) {
+  std::string e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nstale_cycles = 9223372036854775807\n"));
+  EXPECT_TRUE(test::contains(e, "bench.toml: limits.stale_cycles: expected an integer in 0 .. 1000, found 9223372036854775807")) << e;
+  e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nwatchdog_s = 1e300\n"));
+  EXPECT_TRUE(test::contains(e, "limits.watchdog_s: expected a duration in [1e-06, 60] s")) << e;
+  e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nstale_cycles = 3.5e20\n"));
+  EXPECT_TRUE(test::contains(e, "limits.stale_cycles: expected an integer")) << e;
+  e = error_of(test::replace_once(kComedi, "subdevice = 0\nchannel = 2", "subdevice = 0\nchannel = 4294967298"));
+  EXPECT_TRUE(test::contains(e, "signals.Vs.channel: expected an integer in 0 .. 65535")) << e;
+  e = error_of("[bench]\nbackend = \"virtual\"\nsample_rate_Hz = 10000\n[virtual]\nunit = 4294967297\n");
+  EXPECT_TRUE(test::contains(e, "virtual.unit: expected an integer in 1 .. 7")) << e;
+}
+
 }  // namespace
 }  // namespace piezobench::rt

@@ -53,7 +53,8 @@ TEST(BackendRunner, OnTheVirtualBenchItWritesTheSimulatedRecord) {
     // The same settings, plus where it was made.
     for (const auto& [key, value] : simulated.settings) {
       if (key == "defective" || key == "noise" || key == "suspended_mass_kg" || key == "hpf_resistance_ohm" || key == "sensor_shunt_ohm" ||
-          key == "model" || key == "delay_s" || key == "nmp_zero" || key == "hysteresis" || key == "creep") {
+          key == "model" || key == "delay_s" || key == "nmp_zero" || key == "hysteresis" || key == "creep" ||
+          key == "recorded_at" || key == "bench") {
         continue;  // what only the simulator knows
       }
       ASSERT_TRUE(measured.settings.count(key)) << key;
@@ -232,6 +233,79 @@ TEST(BackendRunner, ASafetyTripRefusesTheRecordAndKeepsTheLog) {
   }
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "raw.mat"));
   EXPECT_TRUE(runner.report().runs.at(0).interrupted);
+}
+
+// The virtual bench behind a target that lies or stalls (issue 35): from read `from` on, d_e is
+// `de` (a sensor reading no actuator gives), or every `hold_every`-th read repeats the previous
+// sample (a held, stale input).
+class LyingBackend final : public Backend {
+ public:
+  explicit LyingBackend(Backend& inner) : inner_(inner) {}
+  std::uint64_t from = ~0ULL, hold_every = 0;
+  double de = 0.0;
+  [[nodiscard]] std::string name() const override { return "lying"; }
+  [[nodiscard]] double sample_rate() const override { return inner_.sample_rate(); }
+  void start() override { inner_.start(); }
+  SensorSample read() noexcept override {
+    ++reads_;
+    if (hold_every > 0 && reads_ % hold_every == 0) return last_;
+    last_ = inner_.read();
+    if (reads_ >= from) last_.de = de;
+    return last_;
+  }
+  void write(double u) noexcept override { inner_.write(u); }
+  void stop() noexcept override { inner_.stop(); }
+
+ private:
+  Backend& inner_;
+  std::uint64_t reads_ = 0;
+  SensorSample last_;
+};
+
+TEST(BackendRunner, ASensorReadingOutOfRangeEndsTheRunInTheSafeState) {
+  VirtualBenchBackend virt(bench::batch_unit(1, 1), bench::BenchOptions{}, 1);
+  LyingBackend lying(virt);
+  lying.from = 50;
+  lying.de = 1e300;  // metres
+  MeasureOptions mo;
+  mo.bench = virtual_bench(0.0);
+  mo.lockstep = true;
+  BackendRunner runner(lying, mo);
+  Eigen::MatrixXd out;
+  try {
+    runner.open_loop(Eigen::VectorXd::Constant(1000, 1.0), 0, out, {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(test::contains(e.what(), "the safe state (sensor out of range) at t = 0.0049 s")) << e.what();
+  }
+  EXPECT_EQ(out.size(), 0);
+}
+
+TEST(BackendRunner, HeldSamplesBeyondTheBudgetRefuseTheRecord) {
+  // 1 read in 200 held: 0.5 % of the samples, above the 0.1 % budget; each alone is tolerated
+  // (stale_cycles = 3), so the loop itself never trips.
+  VirtualBenchBackend virt(bench::batch_unit(1, 1), bench::BenchOptions{}, 1);
+  LyingBackend lying(virt);
+  lying.hold_every = 200;
+  MeasureOptions mo;
+  mo.bench = virtual_bench(0.0);
+  mo.lockstep = true;
+  BackendRunner runner(lying, mo);
+  Eigen::MatrixXd out;
+  try {
+    runner.open_loop(Eigen::VectorXd::Constant(10000, 1.0), 0, out, {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(test::contains(e.what(), "stale samples: expected at most 10 held samples (0.1 % of the run's 10000 cycles")) << e.what();
+    EXPECT_TRUE(test::contains(e.what(), "found 50")) << e.what();
+  }
+  // Within the budget (1 in 2000: 5 held samples) the record is accepted.
+  VirtualBenchBackend virt2(bench::batch_unit(1, 1), bench::BenchOptions{}, 1);
+  LyingBackend rare(virt2);
+  rare.hold_every = 2000;
+  BackendRunner ok(rare, mo);
+  EXPECT_NO_THROW(ok.open_loop(Eigen::VectorXd::Constant(10000, 1.0), 0, out, {}));
+  EXPECT_EQ(ok.report().runs.at(0).stale_sensor_samples, 5u);
 }
 
 }  // namespace

@@ -38,6 +38,13 @@ TEST(ActuatorLimits, ValidateNamesTheField) {
   bad([](ActuatorLimits& l) { l.stale_cycles = -1; }, "stale_cycles");
   bad([](ActuatorLimits& l) { l.watchdog_timeout = 0.0; }, "watchdog_timeout");
   bad([](ActuatorLimits& l) { l.saturation_time = kNaN; }, "saturation_time");
+  // Times and counts that become nanoseconds or cycles are range-checked, not converted first
+  // (issue 35: a watchdog of 1e300 s tripped at t = 0).
+  bad([](ActuatorLimits& l) { l.watchdog_timeout = 1e300; }, "watchdog_timeout");
+  bad([](ActuatorLimits& l) { l.ramp_in = 1e300; }, "ramp_in");
+  bad([](ActuatorLimits& l) { l.stale_cycles = 1001; }, "stale_cycles");
+  bad([](ActuatorLimits& l) { l.stale_budget = 0.5; }, "stale_budget");
+  bad([](ActuatorLimits& l) { l.de_range = 0.0; }, "de_range");
   const std::string what = test::input_error([] { SafetyGuard g(ActuatorLimits{}, 0.0); }, "sample_rate");
   EXPECT_TRUE(test::contains(what, "actuator limits")) << what;
 }
@@ -164,6 +171,53 @@ TEST(SafetyGuard, DetectsNonFiniteAndStaleSamples) {
   EXPECT_EQ(g.check(s), Fault::kNonFiniteSensor);
   EXPECT_EQ(g.nonfinite_samples(), 2u);
   EXPECT_FALSE(g.safe_state());  // check() reports, trip() decides
+}
+
+TEST(SafetyGuard, AReadingOutsideTheSensorsRangeIsASensorFault) {
+  const ActuatorLimits l;  // d_e within 1 mm, Vs within 100 V
+  SafetyGuard g(l, 10e3);
+  SensorSample s;
+  s.sequence = 1;
+  s.de = 300e-6;  // the APA300ML's full stroke
+  s.vs = 20.0;
+  EXPECT_EQ(g.check(s), Fault::kNone);
+  s.sequence = 2;
+  s.de = 1e300;  // a lying target (issue 35)
+  EXPECT_EQ(g.check(s), Fault::kSensorOutOfRange);
+  s.de = -1.001e-3;
+  EXPECT_EQ(g.check(s), Fault::kSensorOutOfRange);
+  s.de = 0.0;
+  s.vs = -100.5;
+  EXPECT_EQ(g.check(s), Fault::kSensorOutOfRange);
+  EXPECT_EQ(to_string(Fault::kSensorOutOfRange), "sensor out of range");
+}
+
+TEST(ActuatorDatasheet, BoundsTheLimitsOfANamedActuator) {
+  const auto d = actuator_datasheet("APA300ML");
+  ASSERT_TRUE(d);
+  EXPECT_DOUBLE_EQ(d->va_min, -20.0);
+  EXPECT_DOUBLE_EQ(d->va_max, 150.0);
+  EXPECT_NEAR(d->max_slew_rate(), 10.0 / 9.9e-6, 1e-6);  // 1.01e6 V/s: 10 A into 9.9 uF
+  EXPECT_FALSE(actuator_datasheet("APA300M"));
+  EXPECT_NO_THROW(check_plausible(ActuatorLimits{}, "b.toml"));
+  auto refused = [](auto mutate, const std::string& field) {
+    ActuatorLimits l;
+    mutate(l);
+    return test::input_error([&] { check_plausible(l, "b.toml"); }, field);
+  };
+  const std::string e = refused([](ActuatorLimits& l) { l.va_max = 1e308; }, "limits.va_max_V");
+  EXPECT_TRUE(test::contains(e, "at most 150 V (APA300ML's datasheet)")) << e;
+  refused([](ActuatorLimits& l) { l.va_min = -30.0; }, "limits.va_min_V");
+  refused([](ActuatorLimits& l) { l.slew_rate = 1e308; }, "limits.slew_rate_V_per_s");
+  refused([](ActuatorLimits& l) { l.de_range = 1.0; }, "limits.de_range_m");
+  refused([](ActuatorLimits& l) { l.actuator = "APA300M"; }, "limits.actuator");
+  // "custom": the physical bounds of any stack only.
+  ActuatorLimits custom;
+  custom.actuator = "custom";
+  custom.va_max = 500.0;
+  EXPECT_NO_THROW(check_plausible(custom, "b.toml"));
+  custom.va_max = 1e308;
+  test::input_error([&] { check_plausible(custom, "b.toml"); }, "limits.va_max_V");
 }
 
 }  // namespace

@@ -4,6 +4,13 @@
 #include "piezobench/rt/udp.hpp"
 
 #include <gtest/gtest.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
 
 #include <cmath>
 #include <condition_variable>
@@ -13,6 +20,7 @@
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/rt/loop.hpp"
+#include "piezobench/rt/udp_target.hpp"
 #include "piezobench/rt/virtual_backend.hpp"
 #include "test_util.hpp"
 
@@ -23,7 +31,7 @@ TEST(UdpProtocol, EncodesLittleEndianFixedLayouts) {
   unsigned char req[kUdpRequestSize];
   encode(UdpRequest{UdpType::kIo, 0x0102030405060708ULL, 1.5, 1u}, req);
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(req), 4), "PBZ1");
-  EXPECT_EQ(req[4], 1);  // version
+  EXPECT_EQ(req[4], 2);  // version
   EXPECT_EQ(req[6], 3);  // io
   EXPECT_EQ(req[8], 0x08);
   EXPECT_EQ(req[15], 0x01);
@@ -68,7 +76,7 @@ class Server {
   explicit Server(std::uint64_t drop_every = 0, double rate = 10e3) {
     UdpServerOptions o;
     o.address = "127.0.0.1:0";
-    o.drop_every = drop_every;
+    o.target.drop_every = drop_every;
     o.stop = &stop_;
     o.idle_timeout = 30.0;
     o.on_listening = [this](const std::string& a) {
@@ -183,6 +191,77 @@ TEST(UdpBackend, RefusesATargetAtAnotherRateOrNone) {
   }
   UdpBackend nobody("127.0.0.1:9", 10e3, 0.01);  // discard port: nothing answers
   EXPECT_THROW(nobody.start(), InputError);
+}
+
+TEST(UdpBackend, ATargetInItsLatchedSafeStateNeedsTheOperatorsReset) {
+  Server server;
+  {
+    UdpBackend udp(server.address(), 10e3, 0.5);
+    udp.start();
+    udp.write(1.0);
+    (void)udp.read();
+    udp.on_watchdog();  // latched on the target
+    udp.stop();
+  }
+  UdpBackend refused(server.address(), 10e3, 0.5);
+  const std::string e = test::input_error([&] { refused.start(); }, "safe state");
+  EXPECT_TRUE(test::contains(e, "--reset-target")) << e;  // and the refused session was closed (bye)
+  UdpBackendOptions o;
+  std::string asked;
+  o.confirm_reset = [&asked](const std::string& target) {
+    asked = target;
+    return true;  // the operator pressed Enter
+  };
+  UdpBackend confirmed(server.address(), 10e3, 0.5, o);
+  confirmed.start();
+  EXPECT_TRUE(test::contains(asked, server.address())) << asked;
+  confirmed.write(0.5);
+  EXPECT_TRUE(std::isfinite(confirmed.read().de));  // moving again
+  confirmed.stop();
+}
+
+// A target whose sample counter advances by two per request (another host stepping it, or a
+// broken target): the host's check trips the safe state at the first reply.
+TEST(UdpBackend, ASampleCounterThatJumpsIsAFault) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in sa{};
+  sa.sin_family = AF_INET;
+  sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&sa), sizeof sa), 0);
+  socklen_t len = sizeof sa;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&sa), &len);
+  std::atomic<bool> done{false};
+  std::thread liar([&] {
+    while (!done.load()) {
+      pollfd p{fd, POLLIN, 0};
+      if (::poll(&p, 1, 20) <= 0) continue;
+      unsigned char in[64];
+      sockaddr_in from{};
+      socklen_t from_len = sizeof from;
+      const ssize_t n = ::recvfrom(fd, in, sizeof in, 0, reinterpret_cast<sockaddr*>(&from), &from_len);
+      const auto q = decode_request(in, static_cast<std::size_t>(n));
+      if (!q) continue;
+      UdpReply r;
+      r.sequence = q->sequence;
+      r.session = 77;
+      r.type = q->type == UdpType::kHello ? UdpType::kHelloReply : q->type == UdpType::kBye ? UdpType::kByeReply : UdpType::kIoReply;
+      if (q->type == UdpType::kHello) r.de = 10e3;
+      r.sample = 2 * q->sequence;
+      unsigned char out[kUdpReplySize];
+      encode(r, out);
+      ::sendto(fd, out, sizeof out, 0, reinterpret_cast<sockaddr*>(&from), from_len);
+    }
+  });
+  UdpBackend udp("127.0.0.1:" + std::to_string(ntohs(sa.sin_port)), 10e3, 0.5);
+  udp.start();
+  udp.write(0.1);
+  const SensorSample s = udp.read();
+  EXPECT_TRUE(std::isnan(s.de));
+  EXPECT_EQ(udp.io_stats().errors, 1u);
+  udp.stop();
+  done = true;
+  liar.join();
+  ::close(fd);
 }
 
 }  // namespace

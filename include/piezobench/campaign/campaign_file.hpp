@@ -66,6 +66,7 @@ struct UnitSpec {
   int id = 0;
   std::string name;     // "APA 1" unless given
   std::string key;      // "units[0]"
+  std::optional<std::string> serial;  // the unit's serial number, when known (checked against the records')
   std::optional<FileSpec> flatness, capacitance, stroke, stiffness, stiffness_open, frf, frf_no_resistor, hammer, tracking;
   std::vector<FileSpec> hysteresis, iff;
   // LCR readings typed into the campaign instead of a file (F): capacitance_uF = {sensor, actuator}.

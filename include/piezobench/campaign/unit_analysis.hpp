@@ -54,7 +54,10 @@ struct Record {
 // Reads the file of `spec` with the channels its experiment needs (required roles, and optional
 // ones that the file has or that the campaign mapped explicitly). InputError (source = campaign
 // file, field = spec.key) wrapping the reader's message: missing channel, NaN, bad time vector, ...
-Record load_record(const Campaign& campaign, const FileSpec& spec, Experiment experiment);
+// Then checks the record's provenance against `unit`: a record whose settings name another unit
+// (settings.unit), another serial (settings.serial, when both are known) or another kind of
+// experiment (settings.experiment) is an InputError naming both.
+Record load_record(const Campaign& campaign, const UnitSpec& unit, const FileSpec& spec, Experiment experiment);
 
 using Log = std::function<void(const std::string&)>;
 

@@ -50,6 +50,7 @@ struct IoStats {
   std::uint64_t lost = 0;        // never answered (counted when the backend stops)
   std::uint64_t timeouts = 0;    // reads that returned no fresh sample in time (stale inputs)
   std::uint64_t errors = 0;      // device errors (each one also trips the safe state)
+  std::uint64_t rejected = 0;    // datagrams refused (udp: another session's, a tag that does not verify)
   TimingSummary round_trip_us;   // request -> reply (udp) or instruction list (comedi) time
 };
 

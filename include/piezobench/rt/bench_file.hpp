@@ -10,7 +10,8 @@
 //                va_safe_V, ramp_s, stale_cycles, watchdog_s (optional)
 //   [encoder]    resolution_m
 //   [virtual]    unit, seed                       (backend "virtual")
-//   [udp]        address "HOST:PORT", timeout_s   (backend "udp")
+//   [udp]        address "HOST:PORT", timeout_s, key_file (the shared key; relative to the
+//                bench file's folder)   (backend "udp")
 //   [comedi]     device, calibration ("auto" | "soft" | "hard" | "none")   (backend "comedi")
 //   [signals.u] [signals.d_e] [signals.Vs] [signals.Va]  (comedi; Va optional)
 //                device (default comedi.device), subdevice, channel, range = [lo, hi] (V at the
@@ -53,6 +54,7 @@ struct BenchDescription {
   // udp
   std::string udp_address;            // "127.0.0.1:5600"
   double udp_timeout = 2e-3;          // s: a reply later than this is a stale input
+  std::string udp_key;                // the shared key's bytes (udp.key_file), empty: none
   // comedi
   std::string comedi_device = "/dev/comedi0";
   std::string calibration = "auto";

@@ -1,8 +1,9 @@
 #pragma once
 // Safety of the real-time loop's output, configurable per actuator (DESIGN.md "Safety in the
 // real-time loop"). Every cycle the requested DAC command goes through, in this order:
-//   1. sensor check: a non-finite d_e or Vs, or more than `stale_cycles` consecutive reads without
-//      a fresh sample, trips the safe state;
+//   1. sensor check: a non-finite d_e or Vs, one outside the sensor's range (|d_e| > de_range,
+//      |Vs| > vs_range: a reading no actuator of the bench can produce), or more than
+//      `stale_cycles` consecutive reads without a fresh sample, trips the safe state;
 //   2. safe state (latched until the end of the run): the request is replaced by the safe output;
 //   3. clamp to the actuator's range [va_min, va_max] / amplifier_gain (counted: clamped samples);
 //   4. slew-rate limit: |u[k] - u[k-1]| <= slew_rate / amplifier_gain / sample_rate (counted);
@@ -20,6 +21,7 @@
 // The ramp in and out (ramp_in, ramp_out) and the watchdog (watchdog_timeout) are applied by the
 // loop (loop.hpp) with these settings.
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "piezobench/rt/backend.hpp"
@@ -38,16 +40,29 @@ struct ActuatorLimits {
   double slew_rate = 1e5;
   double ramp_in = 0.1;           // s, controller gain and output envelope from 0 to 1 at the start
   double ramp_out = 0.1;          // s, and back to 0 at the end of the run
-  int stale_cycles = 3;           // consecutive stale reads tolerated (>= 0)
+  int stale_cycles = 3;           // consecutive stale reads tolerated (0 .. kMaxStaleCycles)
+  // Held (stale) samples a run may contain, as a fraction of its cycles (0 .. 0.01). `measure`
+  // refuses a record with more (exit 3): a held sample repeats the previous one, so a record with
+  // many of them is not the actuator's response.
+  double stale_budget = 1e-3;
   // s without a completed cycle before the watchdog trips the safe state. The default allows for a
   // host without real-time scheduling (a container); a real target would use a few periods.
   double watchdog_timeout = 20e-3;
   // s of (net) saturated output before the safe state (policy 5 above).
   double saturation_time = 0.1;
+  // The sensors' ranges: a reading beyond is a sensor fault (safe state). d_e, m: 1 mm, three times
+  // the APA300ML's stroke; Vs, V: 100 V, well above what the sensor stack gives at 150 V on the
+  // actuator stacks (a few V with the 80.6 kOhm resistor, tens without).
+  double de_range = 1e-3;
+  double vs_range = 100.0;
+
+  static constexpr int kMaxStaleCycles = 1000;
+  static constexpr double kMaxTime = 60.0;  // s: ramps, watchdog, saturation time
 
   // InputError (source "actuator limits") naming the field: finite values, amplifier_gain > 0,
-  // va_min < va_max, va_safe inside [va_min, va_max], slew_rate > 0, ramps >= 0, stale_cycles >= 0,
-  // watchdog_timeout > 0, saturation_time > 0.
+  // va_min < va_max, va_safe inside [va_min, va_max], slew_rate > 0, ramps in [0, kMaxTime] s,
+  // stale_cycles in 0 .. kMaxStaleCycles, stale_budget in [0, 0.01], watchdog_timeout and
+  // saturation_time in (0, kMaxTime] s, de_range and vs_range > 0.
   void validate() const;
 
   [[nodiscard]] double u_min() const { return va_min / amplifier_gain; }    // V at the DAC
@@ -57,17 +72,36 @@ struct ActuatorLimits {
   [[nodiscard]] double max_step(double sample_rate) const { return slew_rate / amplifier_gain / sample_rate; }
 };
 
+// What a datasheet says an actuator takes; the limits of a bench file must stay inside it.
+struct ActuatorDatasheet {
+  std::string name;
+  double va_min = 0.0, va_max = 0.0;  // V at the stacks
+  double capacitance = 0.0;           // F of the driven stacks: slew_rate x capacitance is the current
+  double max_current = 0.0;           // A, the current the bench's amplifier may drive into them
+  double stroke = 0.0;                // m, the free stroke
+  [[nodiscard]] double max_slew_rate() const { return max_current / capacitance; }  // V/s
+};
+// The datasheet of a known actuator ("APA300ML": -20 .. 150 V, 9.9 uF, 300 um), or nothing.
+std::optional<ActuatorDatasheet> actuator_datasheet(const std::string& name);
+// InputError (source `source`, fields as a bench file names them: limits.va_min_V, ...) unless
+// the limits are plausible: a known actuator's within its datasheet (voltages inside its range,
+// slew rate within max_current / capacitance, de_range within 10 strokes); "custom" within the
+// physical bounds of any piezo stack (|V| <= 1000 V, slew rate <= 1e7 V/s, de_range <= 0.1 m);
+// any other name is refused (a typo must not skip the datasheet).
+void check_plausible(const ActuatorLimits& limits, const std::string& source);
+
 // Why the loop entered its safe state.
 enum class Fault : std::uint8_t {
   kNone,
   kNonFiniteSensor,      // d_e or Vs was NaN or infinite
+  kSensorOutOfRange,     // d_e or Vs beyond the sensor's range (de_range, vs_range)
   kStaleSensor,          // no fresh sample for more than stale_cycles reads
   kWatchdog,             // the loop did not complete a cycle within watchdog_timeout
   kNonFiniteController,  // the controller's output overflowed
   kInterrupted,          // a stop was requested (Ctrl-C)
   kSaturation,           // the output was saturated for saturation_time (policy 5)
 };
-std::string to_string(Fault fault);  // "none", "non-finite sensor", "stale sensor", "watchdog", ...
+std::string to_string(Fault fault);  // "none", "non-finite sensor", "sensor out of range", "stale sensor", ...
 
 // The output stage: sensor checks, safe state, clamp and slew limit, with their counters.
 // Allocates nothing after construction; all member functions but the constructor are noexcept.
@@ -76,8 +110,8 @@ class SafetyGuard {
   // Validates the limits (InputError) and the rate (> 0). The previous output starts at u_safe.
   SafetyGuard(const ActuatorLimits& limits, double sample_rate);
 
-  // Checks one acquisition: kNonFiniteSensor, kStaleSensor (after stale_cycles stale reads in a
-  // row) or kNone. Counts non-finite and stale samples. Does not trip by itself.
+  // Checks one acquisition: kNonFiniteSensor, kSensorOutOfRange, kStaleSensor (after stale_cycles
+  // stale reads in a row) or kNone. Counts non-finite and stale samples. Does not trip by itself.
   Fault check(const SensorSample& sample) noexcept;
   // Enters the (latched) safe state for `fault` at cycle `cycle`; only the first trip is recorded
   // as the reason, every trip while not already safe counts as an event.
