@@ -4,8 +4,14 @@
 #include <cctype>
 #include <charconv>
 #include <filesystem>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <iostream>
+#include <limits>
+
+#include <fmt/format.h>
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
@@ -13,7 +19,8 @@
 namespace piezobench::app {
 
 void print_json(const nlohmann::json& document) {
-  std::cout << document.dump(2) << '\n';
+  // Invalid UTF-8 (a hostile file's channel names quoted in a message) becomes U+FFFD, never a throw.
+  std::cout << document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   std::cout.flush();
 }
 
@@ -91,6 +98,86 @@ CLI::Validator output_extension(const std::vector<std::string>& extensions) {
         return "expected a file name ending in one of " + list + ", found '" + value + "'";
       },
       "FILE (" + list + ")");
+}
+
+CLI::Validator input_file() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        std::error_code ec;
+        const auto status = std::filesystem::status(value, ec);
+        if (!std::filesystem::exists(status)) throw InputError(value, "file", "an existing, readable file", "no such file");
+        if (std::filesystem::is_directory(status)) throw InputError(value, "file", "an existing, readable file", "a folder");
+        std::ifstream in(value, std::ios::binary);
+        if (!in) throw InputError(value, "file", "an existing, readable file", std::string("not readable (") + std::strerror(errno) + ")");
+        return {};
+      },
+      "FILE");
+}
+
+CLI::Validator number_in(double lo, double hi) {
+  const std::string what = std::isinf(hi) ? fmt::format("a number >= {:g}", lo) : fmt::format("a number in [{:g}, {:g}]", lo, hi);
+  return CLI::Validator(
+      [lo, hi, what](std::string& value) -> std::string {
+        double v = 0.0;
+        const char* end = value.data() + value.size();
+        const auto [ptr, ec] = std::from_chars(value.data(), end, v);
+        if (ec != std::errc() || ptr != end || !(v >= lo && v <= hi)) return "expected " + what + ", found '" + value + "'";
+        return {};
+      },
+      std::isinf(hi) ? fmt::format("NUMBER >= {:g}", lo) : fmt::format("NUMBER in [{:g}, {:g}]", lo, hi));
+}
+
+CLI::Validator non_negative() { return number_in(0.0, std::numeric_limits<double>::infinity()); }
+
+CLI::Validator positive() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        double v = 0.0;
+        const char* end = value.data() + value.size();
+        const auto [ptr, ec] = std::from_chars(value.data(), end, v);
+        if (ec != std::errc() || ptr != end || !(v > 0.0) || std::isinf(v)) return "expected a number > 0, found '" + value + "'";
+        return {};
+      },
+      "NUMBER > 0");
+}
+
+namespace {
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string nearest_option(const CLI::App& app, const std::string& unknown) {
+  std::string word = unknown.substr(0, unknown.find('='));
+  while (!word.empty() && word.front() == '-') word.erase(0, 1);
+  if (word.empty()) return {};
+  std::string best;
+  std::size_t best_distance = std::max<std::size_t>(2, word.size() / 3) + 1;
+  for (const CLI::App* a = &app; a != nullptr; a = a->get_parent()) {
+    for (const CLI::Option* o : a->get_options()) {
+      for (const std::string& name : o->get_lnames()) {
+        const std::size_t d = edit_distance(word, name);
+        if (d < best_distance) {
+          best_distance = d;
+          best = "--" + name;
+        }
+      }
+    }
+  }
+  return best;
 }
 
 }  // namespace piezobench::app

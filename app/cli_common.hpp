@@ -26,7 +26,8 @@ void add_run_commands(CLI::App& app, Action& action);  // run, merge, demo
 void add_hysteresis_commands(CLI::App& app, Action& action);  // hysteresis fit, hysteresis creep
 void add_qualify_commands(CLI::App& app, Action& action);  // qualify, db
 
-// Prints exactly one JSON document on stdout (round-trip precision for doubles).
+// Prints exactly one JSON document on stdout (round-trip precision for doubles; invalid UTF-8 in a
+// string replaced by U+FFFD).
 void print_json(const nlohmann::json& document);
 
 // "de, Vs" -> {"de", "Vs"} (items trimmed); InputError naming `option` for an empty item.
@@ -51,5 +52,22 @@ int report_quality(const core::FitQuality& quality);
 
 // A check that an output file's extension is one of `extensions` (lower case, with the dot).
 CLI::Validator output_extension(const std::vector<std::string>& extensions);
+
+// An input file that exists and can be read. Unlike CLI11's ExistingFile (exit 2), a missing or
+// unreadable input file is bad input data, exit 3, in every command (docs/cli.md): the check throws
+// InputError(path, "file", ...), which main() maps like a reader's.
+CLI::Validator input_file();
+
+// A number in [lo, hi] (hi may be infinite: "a number >= lo"); the message prints the limits as
+// people write them ("expected a number in [1000, 1e+15], found 5"), where CLI11's Range prints
+// std::to_string of the double (309 digits for its NonNegativeNumber's upper limit).
+CLI::Validator number_in(double lo, double hi);
+// number_in(0, inf) and a number > 0.
+CLI::Validator non_negative();
+CLI::Validator positive();
+
+// The long option of `app` (a subcommand, with its parents' options) nearest to `unknown` by edit
+// distance, "" when none is near (more than a third of its letters, at least 2, differ).
+std::string nearest_option(const CLI::App& app, const std::string& unknown);
 
 }  // namespace piezobench::app

@@ -197,7 +197,7 @@ std::vector<lti::Complex> output_zeros(const ident::VectorFittingResult& r, Eige
 struct ZeroReport {
   lti::Complex zero;
   bool lightly_damped = false;            // |damping| < 0.2
-  std::optional<bool> nonminimum_phase;   // for a lightly damped pair: the data's phase, else the model's
+  std::optional<bool> nonminimum_phase;   // for a lightly damped pair in the band: the data's phase, else the model's
   std::string evidence;                   // ident::zero_phase_verdict's reason, or "fitted zero"
 };
 
@@ -216,12 +216,17 @@ std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const 
   } catch (const Error&) {
     // no phase evidence: the fitted zero decides
   }
+  const double f_lo = band.freq_Hz.minCoeff(), f_hi = band.freq_Hz.maxCoeff();
   for (const lti::Complex z : output_zeros(r, i)) {
     ZeroReport rep;
     rep.zero = z;
     const double damping = std::abs(z) > 0.0 ? -z.real() / std::abs(z) : 0.0;
     rep.lightly_damped = z.imag() > 0.0 && std::abs(damping) < 0.2;
-    if (rep.lightly_damped) {
+    const double fz = std::abs(z) / kTwoPi;
+    if (rep.lightly_damped && (fz < f_lo || fz > f_hi)) {
+      // No data constrain a zero outside the band: its side of the axis is the fit's guess.
+      rep.evidence = fmt::format("outside the fitted band {:g} to {:g} Hz: phase not determined by the data", f_lo, f_hi);
+    } else if (rep.lightly_damped) {
       rep.nonminimum_phase = z.real() > 0.0;
       rep.evidence = "fitted zero";
       for (const auto& a : anti) {
@@ -301,7 +306,7 @@ int run_fit(const FitOptions& o) {
                std::abs(p) > 0 ? -p.real() / std::abs(p) : 0.0);
   }
   for (std::size_t i = 0; i < band.outputs.size(); ++i) {
-    fmt::print("{}: relative rms error {:.3g}; zeros of the fitted model:{}\n", band.outputs[i],
+    fmt::print("{}: relative rms error {:.3g}; zeros of the fitted model [rad/s], frequency, damping ratio:{}\n", band.outputs[i],
                r.relative_rms_error_per_output(static_cast<Eigen::Index>(i)), zeros[i].empty() ? " none" : "");
     for (const auto& rep : zeros[i]) {
       const lti::Complex z = rep.zero;
@@ -309,6 +314,8 @@ int run_fit(const FitOptions& o) {
                  std::abs(z) > 0 ? -z.real() / std::abs(z) : 0.0);
       if (rep.nonminimum_phase) {
         fmt::print("  lightly damped, {} ({})", *rep.nonminimum_phase ? "NON-minimum phase" : "minimum phase", rep.evidence);
+      } else if (rep.lightly_damped) {
+        fmt::print("  lightly damped, {}", rep.evidence);
       }
       fmt::print("\n");
     }
@@ -392,7 +399,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
 void add_frf_commands(CLI::App& app, Action& action) {
   auto f = std::make_shared<FrfOptions>();
   CLI::App* frf = app.add_subcommand("frf", "FRFs (Welch H1 or H2) and coherence from one input to several outputs of a time-series file");
-  frf->add_option("file", f->file, "time series: .mat (v5 or v7.3) or .csv with a header row")->required()->check(CLI::ExistingFile);
+  frf->add_option("file", f->file, "time series: .mat (v5 or v7.3) or .csv with a header row")->required()->check(input_file());
   frf->add_option("--input", f->input, "input channel name (e.g. u)")->required();
   frf->add_option("--output", f->outputs, "output channel names, comma-separated (e.g. de,Vs)")->required();
   frf->add_option("--fs", f->fs, "sample rate, Hz (needed when the file has no time vector t)");
@@ -404,8 +411,8 @@ void add_frf_commands(CLI::App& app, Action& action) {
       ->check(parsed_by([](const std::string& v) { (void)dsp::window_type_from_string(v); }, "WINDOW"));
   frf->add_option("--nfft", f->nfft, "segment length, samples (0 = as `run`: 1/--resolution seconds, at most a quarter of the record)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  frf->add_option("--resolution", f->resolution, "target bin width when --nfft is 0, Hz")->capture_default_str()->check(CLI::PositiveNumber);
+      ->check(non_negative());
+  frf->add_option("--resolution", f->resolution, "target bin width when --nfft is 0, Hz")->capture_default_str()->check(positive());
   frf->add_option("--overlap", f->overlap, "overlap of segments, fraction of nfft in [0, 1)")->capture_default_str();
   frf->add_option("--detrend", f->detrend, "none, mean or linear (per segment)")
       ->capture_default_str()
@@ -428,8 +435,8 @@ void add_frf_commands(CLI::App& app, Action& action) {
   CLI::App* fit = app.add_subcommand("fit", "Vector fitting (Gustavsen & Semlyen) of an FRF file: common poles, residues, D, zeros per output; "
                                             "`fit iff-plant`: the IFF plant of eq. 2.3");
   fit->require_subcommand(0, 1);
-  fit->add_option("file", v->file, "FRF file: .csv (freq_Hz,re_NAME,im_NAME[,coh_NAME]...), .mat or .uff")->check(CLI::ExistingFile);
-  fit->add_option("--order", v->order, "number of poles")->check(CLI::PositiveNumber);
+  fit->add_option("file", v->file, "FRF file: .csv (freq_Hz,re_NAME,im_NAME[,coh_NAME]...), .mat or .uff")->check(input_file());
+  fit->add_option("--order", v->order, "number of poles")->check(positive());
   fit->add_option("--fmin", v->fmin, "lowest frequency used, Hz (default: the band where the coherence is at least 0.5)");
   fit->add_option("--fmax", v->fmax, "highest frequency used, Hz (0 = all; default: as --fmin)");
   fit->add_option("--output", v->outputs, "outputs to fit, comma-separated (default: all, with common poles)");
@@ -448,14 +455,14 @@ void add_frf_commands(CLI::App& app, Action& action) {
   auto ip = std::make_shared<IffPlantOptions>();
   CLI::App* iff_plant = fit->add_subcommand("iff-plant", "Fit the IFF plant of the report (eq. 2.3 with delay) to u -> Vs; --out writes "
                                                          "the TOML that `iff rlocus --plant` reads");
-  iff_plant->add_option("file", ip->file, "FRF file (.csv, .mat, .uff) with the output")->required()->check(CLI::ExistingFile);
+  iff_plant->add_option("file", ip->file, "FRF file (.csv, .mat, .uff) with the output")->required()->check(input_file());
   iff_plant->add_option("--output", ip->output, "the force-sensor output")->capture_default_str();
   iff_plant->add_option("--fmin", ip->fmin, "lowest frequency used, Hz (default: the band where the coherence is at least --min-coherence)");
   iff_plant->add_option("--fmax", ip->fmax, "highest frequency used, Hz (0 = all)");
-  iff_plant->add_option("--hpf-fmax", ip->hpf_fmax, "points below this start the high-pass corner, Hz")->capture_default_str()->check(CLI::PositiveNumber);
+  iff_plant->add_option("--hpf-fmax", ip->hpf_fmax, "points below this start the high-pass corner, Hz")->capture_default_str()->check(positive());
   iff_plant->add_option("--min-coherence", ip->min_coherence, "leave out frequencies with a lower coherence")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.999));
+      ->check(number_in(0.0, 0.999));
   iff_plant->add_option("--out", ip->out, "write the plant as an LTI TOML file (transfer function with delay)")
       ->check(output_extension({".toml"}));
   iff_plant->add_flag("--json", ip->json, "print one JSON document on stdout");

@@ -5,11 +5,13 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
 
 #include "cli_common.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/lti/analysis.hpp"
@@ -29,6 +31,7 @@ struct RlocusOptions {
   double resonance_Hz = 0.0;
   int max_order = lti::RootLocusOptions{}.max_order;
   double max_work = lti::RootLocusOptions{}.max_work;
+  std::string out;  // the JSON document (with the full table) also written here
   bool json = false;
 };
 
@@ -77,6 +80,22 @@ LoadedSystem load_controller(const RlocusOptions& o) {
 
 double hz(lti::Complex pole) { return lti::pole_info(pole).natural_frequency / kTwoPi; }
 
+// The first gain of the locus at which a closed-loop pole crosses into the right half plane, and
+// that pole; nullopt when the loop is stable at every gain computed. A pole counts as unstable past
+// a relative real part of 1e-9 (the integrator-like poles of the controller sit on the axis at g = 0).
+struct Instability {
+  double gain = 0.0;
+  lti::Complex pole;
+};
+std::optional<Instability> first_unstable_gain(const lti::RootLocus& locus) {
+  for (std::size_t i = 0; i < locus.gains.size(); ++i) {
+    for (const lti::Complex p : locus.poles[i]) {
+      if (p.real() > 1e-9 * std::max(1.0, std::abs(p))) return Instability{locus.gains[i], p};
+    }
+  }
+  return std::nullopt;
+}
+
 int run_rlocus(const RlocusOptions& o) {
   if (!(std::isfinite(o.delay) && o.delay >= 0.0)) {
     throw UsageError("--delay", "a delay >= 0 s", std::to_string(o.delay));
@@ -99,14 +118,17 @@ int run_rlocus(const RlocusOptions& o) {
   if (!o.json) log_line("computing the root locus" + std::string(gains.empty() ? " on an automatic gain grid" : ""));
   const control::IffRootLocus r = control::iff_root_locus(plant.system, controller.system, gains, options);
 
-  if (o.json) {
+  const std::optional<Instability> unstable = first_unstable_gain(r.locus);
+  const double largest = r.locus.gains.empty() ? 0.0 : r.locus.gains.back();
+  if (o.json || !o.out.empty()) {
     nlohmann::json poles = nlohmann::json::array();
     nlohmann::json branch = nlohmann::json::array();
     for (const auto& p : r.locus.poles) {
       poles.push_back(io::to_json(p));
       branch.push_back(io::to_json(p(r.resonance_branch)));
     }
-    print_json({{"convention", "u = u' + g K(s) Vs with Vs = G(s) u; closed-loop poles solve 1 - g K(s) G(s) = 0"},
+    const nlohmann::json document = {
+                {"convention", "u = u' + g K(s) Vs with Vs = G(s) u; closed-loop poles solve 1 - g K(s) G(s) = 0"},
                 {"plant", plant.description},
                 {"controller", controller.description},
                 {"pade_order", (plant.system.has_delay() || controller.system.has_delay()) ? nlohmann::json(o.pade_order) : nlohmann::json(nullptr)},
@@ -117,21 +139,31 @@ int run_rlocus(const RlocusOptions& o) {
                 {"optimal_gain", io::to_json(r.optimum.gain)},
                 {"max_damping", io::to_json(r.optimum.damping)},
                 {"optimal_pole", io::to_json(r.optimum.pole)},
-                {"optimal_frequency_Hz", io::to_json(hz(r.optimum.pole))}});
-    return 0;
+                {"optimal_frequency_Hz", io::to_json(hz(r.optimum.pole))},
+                {"unstable_from_gain", unstable ? io::to_json(unstable->gain) : nlohmann::json(nullptr)},
+                {"unstable_pole", unstable ? io::to_json(unstable->pole) : nlohmann::json(nullptr)},
+                {"largest_gain", io::to_json(largest)}};
+    if (!o.out.empty()) io::write_text_atomically(o.out, document.dump(2) + "\n");
+    if (o.json) {
+      print_json(document);
+      return 0;
+    }
   }
   fmt::print("IFF root locus: u = u' + g K(s) Vs (report Figure 2.9)\n");
   fmt::print("plant: {}, controller: {}\n", plant.description["source"].get<std::string>(),
              controller.description["source"].get<std::string>());
   fmt::print("branch from the resonance pole {:.4g} Hz (damping {:.4g}):\n", hz(r.resonance_pole),
              lti::pole_info(r.resonance_pole).damping);
-  fmt::print("{:>14}  {:>26}  {:>10}  {:>9}\n", "gain g", "pole [rad/s]", "f [Hz]", "damping");
-  for (std::size_t i = 0; i < r.locus.gains.size(); ++i) {
-    const lti::Complex p = r.locus.poles[i](r.resonance_branch);
-    fmt::print("{:>14.6g}  {:>12.6g} {:+12.6g}j  {:>10.4g}  {:>9.4f}\n", r.locus.gains[i], p.real(), p.imag(), hz(p),
-               lti::pole_info(p).damping);
+  // The summary; the full table of gains and poles is in the JSON document (--json, --out).
+  fmt::print("maximum damping: gain g = {:.6g} (a factor on K(s)), damping ratio {:.4f} at {:.4g} Hz, pole {:.6g} {:+.6g}j rad/s\n",
+             r.optimum.gain, r.optimum.damping, hz(r.optimum.pole), r.optimum.pole.real(), r.optimum.pole.imag());
+  if (unstable) {
+    fmt::print("unstable from gain g = {:.6g}: a closed-loop pole at {:.6g} {:+.6g}j rad/s ({:.4g} Hz) in the right half plane\n",
+               unstable->gain, unstable->pole.real(), unstable->pole.imag(), hz(unstable->pole));
+  } else {
+    fmt::print("stable at every gain computed (g = 0 to {:.6g})\n", largest);
   }
-  fmt::print("optimal gain {:.6g}: damping {:.4f} at {:.4g} Hz\n", r.optimum.gain, r.optimum.damping, hz(r.optimum.pole));
+  fmt::print("{} gains computed; the table of gains and closed-loop poles: --json or --out FILE.json\n", r.locus.gains.size());
   return 0;
 }
 
@@ -231,9 +263,9 @@ void add_iff_commands(CLI::App& app, Action& action) {
   auto o = std::make_shared<RlocusOptions>();
   CLI::App* rl = iff->add_subcommand("rlocus", "Closed-loop poles of the IFF loop u = u' + g K(s) Vs against the gain g");
   rl->add_option("--plant", o->plant_file, "TOML file with the plant u -> Vs (tf, zpk or ss); default: report eq. 2.3")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   rl->add_option("--controller", o->controller_file, "TOML file with K(s) at g = 1; default: report eq. 2.4")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   rl->add_option("--gains", o->gains, "comma-separated gains g (default: an automatic grid that follows every branch)");
   rl->add_option("--delay", o->delay, "pure delay added to the plant, s (the report's fit uses 200e-6)");
   rl->add_option("--pade-order", o->pade_order, "order of the Pade approximant of delays in the loop")
@@ -246,9 +278,10 @@ void add_iff_commands(CLI::App& app, Action& action) {
       ->capture_default_str();
   rl->add_option("--max-work", o->max_work,
                  "work budget of the automatic gain grid: eigenvalue problems x order^3 (exit 4 when exceeded)")
-      ->check(CLI::Range(1e3, 1e15))
+      ->check(number_in(1e3, 1e15))
       ->capture_default_str();
-  rl->add_flag("--json", o->json, "print one JSON document on stdout");
+  rl->add_flag("--json", o->json, "print one JSON document on stdout (with the full table of gains and poles)");
+  rl->add_option("--out", o->out, "write that JSON document to this file too")->check(output_extension({".json"}));
   rl->callback([o, &action] { action = [o] { return run_rlocus(*o); }; });
 
   auto so = std::make_shared<StudyOptions>();

@@ -385,7 +385,7 @@ void add_measure_commands(CLI::App& app, Action& action) {
       ->required();
   m->add_option("--bench", o->bench, "bench file (TOML): backend, channels, amplifier, limits (docs/hardware.md)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   o->unit_option = m->add_option("--unit", o->unit, "number of the unit under test (virtual bench: 1..7 of the batch)");
   m->add_option("--serial", o->serial, "the unit's serial number, recorded in the file (`run` checks it against the campaign's)");
   o->seed_option = m->add_option("--seed", o->seed, "virtual bench: seed of the batch and of the noise; excitation seed");
@@ -395,7 +395,7 @@ void add_measure_commands(CLI::App& app, Action& action) {
   o->gain_option = m->add_option("--gain", o->gain, "IFF gain g (280000)");
   m->add_option("--feedforward", o->feedforward,
                 "tracking: the hysteresis model (TOML, `hysteresis fit`) of the compensated run (default: identified from the open run)")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   m->add_flag("--open-circuit", o->open_circuit,
               "actuator stacks disconnected from the amplifier (stiffness k_oc; a real bench asks the operator first)");
   m->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (a real bench asks the operator first)");

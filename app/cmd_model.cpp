@@ -252,7 +252,7 @@ void add_model_commands(CLI::App& app, Action& action) {
   auto t = std::make_shared<TwoDofCommand>();
   CLI::App* two = model->add_subcommand("2dof", "Poles, zeros, static gains and FRFs u -> d_e, u -> Vs of the 2-DoF model");
   two->add_option("--params", t->params_file, "TOML file with m, k1, c1, ke, ce, ka, ca, ga, gs (SI); default Table 3.1")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   two->add_option("--fmin", t->fmin, "lowest frequency of the FRF, Hz")->capture_default_str();
   two->add_option("--fmax", t->fmax, "highest frequency of the FRF, Hz")->capture_default_str();
   two->add_option("--points", t->points, "number of log-spaced frequencies")->check(CLI::Range(2, 1000000))->capture_default_str();
@@ -266,7 +266,7 @@ void add_model_commands(CLI::App& app, Action& action) {
   CLI::App* tune = model->add_subcommand("tune", "Fit the 9 parameters of the 2-DoF model to measured FRFs u -> de, u -> Vs");
   tune->add_option("--frf", u->frf_file, "FRF file (.csv, .mat, .uff) with outputs de and Vs, input u")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   tune->add_option("--mass", u->options.mass, "known moving mass m, kg")->capture_default_str();
   add_bench_options(tune, u->options.bench);
   tune->add_option("--fmin", u->options.fmin_Hz, "lowest frequency used, Hz (default: 20 Hz as `run`, or where the coherence reaches 0.5)");

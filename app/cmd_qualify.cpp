@@ -223,11 +223,11 @@ int run_db_check(const DbCli& o) {
 void add_qualify_commands(CLI::App& app, Action& action) {
   auto o = std::make_shared<QualifyCli>();
   CLI::App* q = app.add_subcommand("qualify", "Run one unit through a station's phases on a bench and record it (docs/station.md)");
-  q->add_option("--bench", o->bench, "bench file (TOML, docs/hardware.md)")->required()->check(CLI::ExistingFile);
-  q->add_option("--station", o->station, "station file (TOML, docs/station.md)")->required()->check(CLI::ExistingFile);
+  q->add_option("--bench", o->bench, "bench file (TOML, docs/hardware.md)")->required()->check(input_file());
+  q->add_option("--station", o->station, "station file (TOML, docs/station.md)")->required()->check(input_file());
   q->add_option("--serial", o->serial, "serial number of the unit under test");
   q->add_option("--resume", o->resume, "serial number of an unfinished qualification to continue at its first incomplete phase");
-  q->add_option("--answers", o->answers, "the operator's answers (TOML) instead of prompts on the terminal")->check(CLI::ExistingFile);
+  q->add_option("--answers", o->answers, "the operator's answers (TOML) instead of prompts on the terminal")->check(input_file());
   q->add_option("--db", o->db, "station database (SQLite)")->capture_default_str();
   q->add_option("--data", o->data, "folder of the raw files (DATA/SERIAL/...)")->capture_default_str();
   q->add_option("--batch", o->batch, "batch of the unit (db export --batch)");

@@ -285,7 +285,7 @@ void add_rt_commands(CLI::App& app, Action& action) {
   rt->add_option("--controller", o->controller, "iff (eq. 2.4 discretized at the rate) or off (open loop)")->capture_default_str();
   rt->add_option("--gain", o->gain, "IFF gain g")->required();
   CLI::Option* rate = rt->add_option("--rate", o->rate, "loop rate, Hz (replay: the record's rate), at most 1e6")
-                          ->check(CLI::Range(0.0, rt::kMaxSampleRate))
+                          ->check(number_in(0.0, rt::kMaxSampleRate))
                           ->capture_default_str();
   rt->add_option("--duration", o->duration, "run length, s")->capture_default_str();
   rt->add_option("--log", o->log, "write the signals of every cycle to this .mat (or .csv) file");
@@ -298,7 +298,7 @@ void add_rt_commands(CLI::App& app, Action& action) {
   rt->add_option("--hysteresis-law", o->hysteresis_law, kHysteresisLawHelp)->capture_default_str();
   rt->add_option("--feedforward", o->feedforward,
                  "hysteresis model (TOML, `hysteresis fit`): u' passes through its inverse before the safety clamp")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   rt->add_option("--band", o->band, "noise band LO,HI, Hz")->capture_default_str();
   rt->add_option("--replay", o->replay, "replay: the recorded file (.mat or .csv with channels de and Vs)");
   rt->add_option("--realtime", *realtime, "true: paced by absolute deadlines; false: lockstep, as fast as possible")

@@ -27,6 +27,9 @@ namespace fs = std::filesystem;
 
 // Exit code of `run --strict` / `demo --strict` when a unit is rejected (docs/campaign.md).
 constexpr int kRejected = 5;
+// Exit code of `run`, `merge` and `demo` when a unit could not be analysed (a file missing or
+// unreadable, bad data): the other units were analysed and the outputs written (docs/cli.md).
+constexpr int kUnitNotAnalysed = 7;
 
 struct RunOptions {
   std::string campaign;
@@ -56,6 +59,20 @@ struct DemoCli {
   std::string units;  // "1,3,4"; empty = all seven
 };
 
+// The output folder's lock (io::OutputLock) whose file is removed when the run ends, while the lock
+// is still held: a finished run leaves only its outputs in --out.
+struct RunLock {
+  explicit RunLock(const fs::path& out) : lock(out), file(out / ".piezobench.lock") {}
+  ~RunLock() {
+    std::error_code ec;
+    fs::remove(file, ec);
+  }
+  RunLock(const RunLock&) = delete;
+  RunLock& operator=(const RunLock&) = delete;
+  io::OutputLock lock;  // released after the destructor's body: the file goes first
+  fs::path file;
+};
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -81,18 +98,29 @@ int write_and_print(const campaign::CampaignResult& r, const fs::path& out, bool
     for (const auto& [k, v] : extra.items()) doc[k] = v;
     print_json(doc);
   } else {
-    fmt::print("{} units: {} accepted, {} rejected ({:.1f} s)\n", r.accepted + r.rejected, r.accepted, r.rejected, elapsed);
+    fmt::print("{} units: {} accepted, {} rejected, {} not analysed ({:.1f} s)\n", r.units.size(), r.accepted, r.rejected, r.not_analysed,
+               elapsed);
     for (const auto& u : r.units) {
+      if (u.not_analysed) {
+        fmt::print("  {:<8} NOT ANALYSED ({})\n           - {}\n", u.name, u.not_analysed->file.empty() ? u.not_analysed->key : u.not_analysed->file,
+                   u.not_analysed->reason);
+        continue;
+      }
       fmt::print("  {:<8} {}\n", u.name, u.accepted ? "accepted" : "REJECTED");
       for (const auto& reason : u.reasons) fmt::print("           - {}\n", reason);
     }
     if (r.iff.optimal_gain && r.iff.unit) {
-      fmt::print("IFF: optimal gain {:.4g} (APA {}), maximum damping {:.3f}\n", *r.iff.optimal_gain, *r.iff.unit, r.iff.max_damping.value_or(0.0));
+      fmt::print("IFF: optimal controller gain g = {:.4g} (a factor on eq. 2.4's K0; unit {}), maximum damping ratio {:.3f}\n", *r.iff.optimal_gain, *r.iff.unit,
+                 r.iff.max_damping.value_or(0.0));
     }
     fmt::print("report: {}\n", fs::absolute(report).string());
     fmt::print("results: {}, {}\n", (out / "results.json").string(), (out / "results.mat").string());
   }
   log_line("report written to " + fs::absolute(report).string());
+  if (r.not_analysed > 0) {
+    log_line(fmt::format("{} of {} units could not be analysed (exit code {})", r.not_analysed, r.units.size(), kUnitNotAnalysed));
+    return kUnitNotAnalysed;
+  }
   return strict && r.rejected > 0 ? kRejected : 0;
 }
 
@@ -176,7 +204,7 @@ int run_part(const RunOptions& o) {
 
 // `merge PART... --out DIR`: the batch over the parts' units; the outputs of a single `run`.
 int run_merge(const MergeOptions& o) {
-  const io::OutputLock lock(o.out);
+  const RunLock lock(o.out);
   const auto t0 = std::chrono::steady_clock::now();
   campaign::remove_outputs(o.out);
   std::vector<campaign::CampaignPart> parts;
@@ -191,14 +219,14 @@ int run_merge(const MergeOptions& o) {
 int run_run(const RunOptions& o) {
   if (o.threads < 0) throw UsageError("--threads", "0 (all cores) or more", std::to_string(o.threads));
   if (o.list_units) return list_units(o);
-  const io::OutputLock lock(o.out);  // a second run on the same --out is refused (exit 3)
+  const RunLock lock(o.out);  // a second run on the same --out is refused (exit 3)
   if (!o.part.empty() || !o.units.empty()) return run_part(o);
   return run_pipeline(o.campaign, o.out, o.strict, o.json, o.threads);
 }
 
 int run_demo(const DemoCli& o) {
   if (o.threads < 0) throw UsageError("--threads", "0 (all cores) or more", std::to_string(o.threads));
-  const io::OutputLock lock(o.out);
+  const RunLock lock(o.out);
   const auto t0 = std::chrono::steady_clock::now();
   campaign::DemoOptions d;
   d.seed = o.seed;

@@ -74,13 +74,13 @@ void add_simulate_commands(CLI::App& app, Action& action) {
       ->capture_default_str();
   sim->add_option("--feedforward", o->feedforward,
                   "tracking: the hysteresis model (TOML, `hysteresis fit`) of the compensated run (default: identified from the open run)")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   sim->add_flag("--no-noise", o->no_noise, "no measurement noise (quantization stays)");
   sim->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (only the ADC's input resistance)");
   sim->add_flag("--open-circuit", o->open_circuit,
                 "actuator stacks disconnected from the amplifier (open circuit; for the stiffness test)");
   sim->add_option("--superelement", o->superelement, "TOML describing a super element to use instead of the 2-DoF model")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   sim->add_flag("--json", o->json, "print one JSON document (file, settings, the unit's truth) on stdout");
   sim->callback([o, &action] { action = [o] { return run_simulate(*o); }; });
 }

@@ -458,14 +458,14 @@ void add_superelement_commands(CLI::App& app, Action& action) {
       "superelement", "Import a super element (Ansys CMS text, CalculiX .sti/.mas/.dof, Matrix Market) and compute its "
                       "modes and frequency response; `superelement from-step` makes one from a STEP file");
   // The three files are required unless the from-step subcommand is used (checked in the callback).
-  se->add_option("K_FILE", o->k_file, "stiffness: Ansys K text, CalculiX .sti or Matrix Market (required)")->check(CLI::ExistingFile);
-  se->add_option("M_FILE", o->m_file, "mass: Ansys M text, CalculiX .mas or Matrix Market (required)")->check(CLI::ExistingFile);
+  se->add_option("K_FILE", o->k_file, "stiffness: Ansys K text, CalculiX .sti or Matrix Market (required)")->check(input_file());
+  se->add_option("M_FILE", o->m_file, "mass: Ansys M text, CalculiX .mas or Matrix Market (required)")->check(input_file());
   se->add_option("NODES_FILE", o->nodes_file,
                  "DOF list: Ansys master-DOF listing, CalculiX .dof or a piezobench DOF list (required)")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   se->add_option("--nlist", o->nlist_file,
                  "node coordinates: Ansys node list (default: out_NLIST.txt beside NODES_FILE) or a CalculiX deck with *NODE")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   se->add_option("--format", o->format, "auto, ansys, calculix or matrix-market")->capture_default_str();
   se->add_option("--fix", o->fix, "clamp every DOF of this node (repeatable)");
   se->add_option("--force", o->forces, "NODE_A:NODE_B:DIR: +1 N on B, -1 N on A along DIR (x|y|z|rx|ry|rz); repeatable");

@@ -235,6 +235,15 @@ entry of results.json (every analysis, in the units its keys name).)");
         .def_readonly("tracking", &UnitAnalysis::tracking, "campaign.TrackingAnalysis or None")
         .def_readonly("not_measured", &UnitAnalysis::not_measured, "experiments the campaign does not list")
         .def_readonly("failed", &UnitAnalysis::failed, "one line per analysis that failed")
+        .def_readonly("warnings", &UnitAnalysis::warnings, "cross-checks that disagree (high-pass corner, resonance, ...)")
+        .def_property_readonly(
+            "not_analysed",
+            [](const UnitAnalysis& u) -> py::object {
+              if (!u.not_analysed) return py::none();
+              return py::dict(py::arg("file") = u.not_analysed->file, py::arg("key") = u.not_analysed->key,
+                              py::arg("reason") = u.not_analysed->reason);
+            },
+            "None, or {file, key, reason} of a unit whose data could not be analysed (nothing else of it is filled in)")
         .def_readonly("accepted", &UnitAnalysis::accepted, "the acceptance")
         .def_readonly("reasons", &UnitAnalysis::reasons, "why it is rejected")
         .def("json", [](const UnitAnalysis& u) { return from_json(unit_json(u), "UnitResults", true); },
@@ -329,6 +338,8 @@ the report's units: _um, _uF, _Hz, ...); to_dict() is that document as plain dic
                                py::return_value_policy::reference_internal, "campaign.IffStudy")
         .def_property_readonly("accepted", [](const CampaignRun& r) { return r.result.accepted; }, "units accepted")
         .def_property_readonly("rejected", [](const CampaignRun& r) { return r.result.rejected; }, "units rejected")
+        .def_property_readonly("not_analysed", [](const CampaignRun& r) { return r.result.not_analysed; },
+                               "units whose data could not be analysed (neither accepted nor rejected)")
         .def_readonly("written", &CampaignRun::written, "files written (empty without out_dir)")
         .def_property_readonly("results", [](const CampaignRun& r) {
           return from_json(results_json(r.result), "CampaignResults", true);

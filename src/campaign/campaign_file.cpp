@@ -231,11 +231,13 @@ struct Context {
   std::map<std::string, std::string> channels;  // campaign-wide
 };
 
-fs::path resolve(const Context& ctx, const std::string& given, const std::string& key) {
+// `must_exist`: refused here when missing (the super element's files); a unit's measurement file is
+// not, so that a missing one leaves that unit out of the batch (not analysed), never the batch.
+fs::path resolve(const Context& ctx, const std::string& given, const std::string& key, bool must_exist = true) {
   if (given.empty()) throw InputError(ctx.source, key, "a file name", "an empty string");
   const fs::path p(given);
   const fs::path full = p.is_absolute() ? p : ctx.folder / p;
-  if (ctx.check_files) {
+  if (ctx.check_files && must_exist) {
     std::error_code ec;
     if (!fs::is_regular_file(full, ec)) {
       throw InputError(ctx.source, key, "an existing measurement file",
@@ -293,7 +295,7 @@ FileSpec read_file_spec(const Context& ctx, const Reader& unit, const std::strin
   } else {
     throw InputError(ctx.source, f.key, "a file name or a table {file = ..., channels = {...}}", describe_toml(node));
   }
-  f.path = resolve(ctx, f.given, f.key + (node.is_table() ? ".file" : ""));
+  f.path = resolve(ctx, f.given, f.key + (node.is_table() ? ".file" : ""), /*must_exist=*/false);
   return f;
 }
 
@@ -373,7 +375,9 @@ void read_bench(const Reader& r, BenchConstants& b) {
   r.positive("suspended_mass_kg", b.suspended_mass);
   r.positive("added_mass_kg", b.added_mass);
   r.positive("gravity_m_per_s2", b.gravity);
-  r.positive("hpf_resistance_ohm", b.hpf_resistance);
+  double resistance = 0.0;
+  r.positive("hpf_resistance_ohm", resistance, true);
+  if (resistance > 0.0) b.hpf_resistance = resistance;
   double probe_um = b.probe_accuracy * 1e6;
   r.positive("probe_accuracy_um", probe_um, true);
   b.probe_accuracy = probe_um * 1e-6;

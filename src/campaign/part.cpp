@@ -214,7 +214,7 @@ template <class V> void fields(V& v, FlatnessAnalysis::Interface& s) { v("id", s
 template <class V> void fields(V& v, FlatnessAnalysis& s) {
   v("method", s.method); v("flatness", s.flatness); v("least_squares", s.least_squares); v("minimum_zone", s.minimum_zone);
   v("points", s.points); v("per_interface", s.per_interface); v("probe_accuracy", s.probe_accuracy);
-  v("provenance", s.provenance); v("deviation", s.deviation);
+  v("provenance", s.provenance); v("deviation", s.deviation); v("probe_xy", s.probe_xy);
 }
 template <class V> void fields(V& v, CapacitanceAnalysis& s) {
   v("sensor", s.sensor); v("actuator", s.actuator); v("provenance", s.provenance); v("key", s.key);
@@ -284,7 +284,7 @@ template <class V> void fields(V& v, NmpEvidence::Zero& s) {
 template <class V> void fields(V& v, NmpEvidence& s) { v("zero", s.zero); v("iff_plant_fit_xz", s.iff_plant_fit_xz); v("verdict_from", s.verdict_from); v("verdict_reason", s.verdict_reason); }
 template <class V> void fields(V& v, HighPassCorner& s) {
   v("first_order_fit_Hz", s.first_order_fit_Hz); v("first_order_fit_points", s.first_order_fit_points); v("r_c_Hz", s.r_c_Hz);
-  v("iff_plant_fit_Hz", s.iff_plant_fit_Hz); v("iff_plant_fit_error", s.iff_plant_fit_error); v("method", s.method); v("corner_Hz", s.corner_Hz);
+  v("iff_plant_fit_Hz", s.iff_plant_fit_Hz); v("iff_plant_fit_error", s.iff_plant_fit_error); v("method", s.method); v("observable_above_Hz", s.observable_above_Hz); v("corner_Hz", s.corner_Hz);
 }
 template <class V> void fields(V& v, dsp::FrfProvenance& s) {
   v("source", s.source); v("estimator", s.estimator); v("window", s.window); v("nfft", s.nfft); v("overlap", s.overlap);
@@ -355,8 +355,9 @@ template <class V> void fields(V& v, FlexibleModes::Mode& s) { v("frequency_Hz",
 template <class V> void fields(V& v, FlexibleModes& s) {
   v("provenance", s.provenance); v("welch", s.welch); v("peak_picking", s.peak_picking); v("lscf", s.lscf); v("frf", s.frf);
 }
+template <class V> void fields(V& v, NotAnalysed& s) { v("file", s.file); v("key", s.key); v("reason", s.reason); }
 template <class V> void fields(V& v, UnitAnalysis& s) {
-  v("id", s.id); v("name", s.name); v("flatness_analysis", s.flatness_analysis); v("capacitance_analysis", s.capacitance_analysis);
+  v("id", s.id); v("name", s.name); v("not_analysed", s.not_analysed); v("flatness_analysis", s.flatness_analysis); v("capacitance_analysis", s.capacitance_analysis);
   v("stroke_analysis", s.stroke_analysis); v("hysteresis", s.hysteresis); v("hysteresis_model", s.hysteresis_model); v("tracking", s.tracking);
   v("stiffness_analysis", s.stiffness_analysis);
   v("stiffness_open_analysis", s.stiffness_open_analysis); v("frf_analysis", s.frf_analysis); v("resistor", s.resistor);
@@ -364,7 +365,7 @@ template <class V> void fields(V& v, UnitAnalysis& s) {
   v("capacitance_sensor", s.capacitance_sensor); v("capacitance_actuator", s.capacitance_actuator); v("stroke", s.stroke);
   v("k1", s.k1); v("k2", s.k2); v("k_resonance", s.k_resonance); v("k_oc", s.k_oc); v("resonance_Hz", s.resonance_Hz);
   v("antiresonance_Hz", s.antiresonance_Hz); v("static_gain", s.static_gain); v("frf", s.frf); v("iff_plant", s.iff_plant);
-  v("de_plant", s.de_plant); v("not_measured", s.not_measured); v("failed", s.failed); v("accepted", s.accepted); v("reasons", s.reasons);
+  v("de_plant", s.de_plant); v("not_measured", s.not_measured); v("failed", s.failed); v("warnings", s.warnings); v("accepted", s.accepted); v("reasons", s.reasons);
 }
 
 std::string generator() { return std::string("piezobench ") + kVersion; }

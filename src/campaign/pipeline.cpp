@@ -44,31 +44,27 @@ namespace {
 
 struct Quantity {
   std::string name;   // results key, e.g. "capacitance_sensor_uF"
+  std::string label;  // for people (the report, a rejection's reason)
+  std::string unit;   // of the reported values
   double scale;       // SI -> reported unit
   std::optional<double> UnitAnalysis::*member;
+  bool rejects = false;  // a batch outlier rejects the unit (with reject_outliers)
 };
 
+// In the order of the report: metrology, stiffness, dynamics.
 const std::vector<Quantity>& quantities() {
   static const std::vector<Quantity> q = {
-      {"flatness_um", 1e6, &UnitAnalysis::flatness},
-      {"capacitance_sensor_uF", 1e6, &UnitAnalysis::capacitance_sensor},
-      {"capacitance_actuator_uF", 1e6, &UnitAnalysis::capacitance_actuator},
-      {"stroke_um", 1e6, &UnitAnalysis::stroke},
-      {"k1_N_per_um", 1e-6, &UnitAnalysis::k1},
-      {"k2_N_per_um", 1e-6, &UnitAnalysis::k2},
-      {"k_resonance_N_per_um", 1e-6, &UnitAnalysis::k_resonance},
-      {"resonance_Hz", 1.0, &UnitAnalysis::resonance_Hz},
-      {"antiresonance_Hz", 1.0, &UnitAnalysis::antiresonance_Hz},
-      {"static_gain_um_per_V", 1e6, &UnitAnalysis::static_gain}};
+      {"flatness_um", "flatness", "um", 1e6, &UnitAnalysis::flatness},
+      {"capacitance_sensor_uF", "capacitance of the sensor stack", "uF", 1e6, &UnitAnalysis::capacitance_sensor, true},
+      {"capacitance_actuator_uF", "capacitance of the actuator stacks", "uF", 1e6, &UnitAnalysis::capacitance_actuator, true},
+      {"stroke_um", "stroke", "um", 1e6, &UnitAnalysis::stroke, true},
+      {"k1_N_per_um", "stiffness k1", "N/um", 1e-6, &UnitAnalysis::k1},
+      {"k2_N_per_um", "stiffness k2", "N/um", 1e-6, &UnitAnalysis::k2},
+      {"k_resonance_N_per_um", "stiffness from the resonance", "N/um", 1e-6, &UnitAnalysis::k_resonance},
+      {"resonance_Hz", "resonance", "Hz", 1.0, &UnitAnalysis::resonance_Hz},
+      {"antiresonance_Hz", "anti-resonance", "Hz", 1.0, &UnitAnalysis::antiresonance_Hz},
+      {"static_gain_um_per_V", "static gain u -> d_e", "um/V", 1e6, &UnitAnalysis::static_gain}};
   return q;
-}
-
-// Quantities whose batch outliers reject a unit (with reject_outliers), and how a reason names them.
-const std::map<std::string, std::string>& rejecting_outliers() {
-  static const std::map<std::string, std::string> m = {{"capacitance_sensor_uF", "capacitance of the sensor stack"},
-                                                       {"capacitance_actuator_uF", "capacitance of the actuator stacks"},
-                                                       {"stroke_um", "stroke"}};
-  return m;
 }
 
 using core::median;
@@ -110,16 +106,15 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
     const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
     const double med = median(values);
     const metrology::OutlierAnalysis a = metrology::robust_outliers(values, c.specs.outliers, c.file.string(), q.name);
-    out.batch.spread.push_back({q.name, static_cast<long>(values.size()), *lo, *hi, med,
+    out.batch.spread.push_back({q.name, q.label, q.unit, static_cast<long>(values.size()), *lo, *hi, med,
                                 med != 0.0 ? (*hi - *lo) / std::abs(med) : 0.0, a.mad});
     for (std::size_t i = 0; i < values.size(); ++i) {
       if (!a.outlier[i]) continue;
       out.batch.outliers.push_back({who[i]->id, q.name, values[i], a.median, a.robust_z[i]});
-      const auto it = rejecting_outliers().find(q.name);
-      if (c.specs.reject_outliers && it != rejecting_outliers().end()) {
+      if (c.specs.reject_outliers && q.rejects) {
         out.outlier_reasons[who[i]->id].push_back(
-            fmt::format("{} {:.4g} is a batch outlier (median of the batch {:.4g}, robust z-score {:.1f}, limit {:.1f})", it->second,
-                        values[i], a.median, a.robust_z[i], c.specs.outliers.threshold));
+            fmt::format("{} {:.4g} {} is a batch outlier (median of the batch {:.4g} {}, robust z-score {:.1f}, limit {:.1f})", q.label,
+                        values[i], q.unit, a.median, q.unit, a.robust_z[i], c.specs.outliers.threshold));
       }
     }
   }
@@ -465,8 +460,10 @@ std::vector<UnitAnalysis> analyze_units(const Campaign& c, const std::vector<std
   core::parallel_for(n, threads, [&](std::size_t i) {
     const UnitSpec& spec = c.units[indices[i]];
     units[i] = analyze_unit(c, spec, log);
-    log(fmt::format("{}: done ({} of the experiments not measured, {} analyses failed)", spec.name,
-                    units[i].not_measured.size(), units[i].failed.size()));
+    if (!units[i].not_analysed) {
+      log(fmt::format("{}: done ({} of the experiments not measured, {} analyses failed)", spec.name,
+                      units[i].not_measured.size(), units[i].failed.size()));
+    }
   });
   return units;
 }
@@ -478,6 +475,13 @@ CampaignResult finish_campaign(const Campaign& c, std::vector<UnitAnalysis> unit
   r.campaign = c;
   BatchOutput batch = batch_analysis(c, units);
   for (auto& u : units) {
+    if (u.not_analysed) {
+      // Neither accepted nor rejected: nothing of it was measured into the batch.
+      u.accepted = false;
+      u.reasons = {"not analysed: " + u.not_analysed->reason};
+      r.not_analysed += 1;
+      continue;
+    }
     const auto it = batch.outlier_reasons.find(u.id);
     u.reasons = acceptance(c, u, it == batch.outlier_reasons.end() ? std::vector<std::string>{} : it->second);
     u.accepted = u.reasons.empty();

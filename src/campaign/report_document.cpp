@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <numbers>
 #include <optional>
 #include <tuple>
@@ -254,30 +255,31 @@ json table(const std::string& title, const std::vector<std::string>& columns, js
   return t;
 }
 
-// A model's phase drawn on the measurement's branch: each model point is moved by the multiple of
-// 360 degrees that brings it nearest to the measured phase at the nearest frequency (phases are
-// defined modulo 360 degrees; unwrapped separately, a model and its measurement can sit one turn
-// apart). Where that multiple changes (a model zero on the other side of the axis than the
-// measured one), a gap is left rather than a vertical line.
+// A model's phase drawn on the measurement's branch: the model's unwrapped phase, continuous,
+// moved by the one multiple of 360 degrees that brings most of its points nearest to the measured
+// phase at the nearest frequency (phases are defined modulo 360 degrees; unwrapped separately, a
+// model and its measurement can sit one turn apart). Where the model's zero is on the other side
+// of the axis than the measured one, the curves part by 360 degrees past the anti-resonance
+// instead of the model jumping there.
 std::pair<json, json> on_branch(const json& f_model, const json& ph_model, const json& f_ref, const json& ph_ref) {
-  json x = json::array(), y = json::array();
+  std::map<long, int> votes;  // turns -> points
   std::size_t j = 0;
-  double last_shift = 0.0;
-  bool first = true;
   for (std::size_t i = 0; i < f_model.size(); ++i) {
     if (!f_model[i].is_number() || !ph_model[i].is_number()) continue;
     const double f = f_model[i].get<double>(), ph = ph_model[i].get<double>();
     while (j + 1 < f_ref.size() && f_ref[j + 1].is_number() && std::abs(f_ref[j + 1].get<double>() - f) <= std::abs(f_ref[j].get<double>() - f)) ++j;
-    double shift = last_shift;
-    if (j < ph_ref.size() && ph_ref[j].is_number()) shift = 360.0 * std::round((ph_ref[j].get<double>() - ph) / 360.0);
-    if (!first && shift != last_shift) {
-      x.push_back(f);
-      y.push_back(nullptr);
-    }
-    x.push_back(f);
-    y.push_back(ph + shift);
-    last_shift = shift;
-    first = false;
+    if (j < ph_ref.size() && ph_ref[j].is_number()) ++votes[std::lround((ph_ref[j].get<double>() - ph) / 360.0)];
+  }
+  long turns = 0;
+  int most = 0;
+  for (const auto& [t, n] : votes) {
+    if (n > most) std::tie(turns, most) = std::pair{t, n};
+  }
+  json x = json::array(), y = json::array();
+  for (std::size_t i = 0; i < f_model.size(); ++i) {
+    if (!f_model[i].is_number() || !ph_model[i].is_number()) continue;
+    x.push_back(f_model[i]);
+    y.push_back(ph_model[i].get<double>() + 360.0 * static_cast<double>(turns));
   }
   return {x, y};
 }
@@ -326,7 +328,7 @@ json frf_section(const std::vector<UnitCurves>& units) {
   json figs = json::array();
   figs.push_back(frf_figure(units, measured_de, model_de, "frf-de", "Fig. 2.5a: u -> d_e", "um/V", "2-DoF model", true,
                             "Solid: measured (Welch H1); dashed: the tuned 2-DoF model (section 3). The model's phase is drawn "
-                            "on the measurement's branch (modulo 360 deg)."));
+                            "continuous, shifted by the whole turn that puts it on the measurement's."));
   figs.push_back(frf_figure(units, measured_vs, iff_fit, "frf-vs", "Fig. 2.5b: u -> Vs", "V/V", "IFF plant fit", true,
                             "Solid: measured; dashed: the IFF plant fit (eq. 2.3 with delay). The phase falls by 180 deg at the "
                             "anti-resonance: a non-minimum-phase zero."));
@@ -342,9 +344,13 @@ json frf_section(const std::vector<UnitCurves>& units) {
   }
   json tables = json::array({table("FRF features per unit",
                                    {"unit", "static gain [um/V]", "resonance [Hz]", "damping", "anti-resonance [Hz]", "zero damping",
-                                    "zero", "phase change at the zero [deg]", "k_shell [N/um]", "HPF corner [Hz]"},
+                                    "zero pair", "phase change at the zero [deg]", "k_shell [N/um]", "HPF corner [Hz]"},
                                    rows, "Zero damping < 0: the zero is in the right half plane.")});
-  return {{"id", "frf"}, {"title", "Frequency responses (report 2.3)"},
+  json warnings = json::array();
+  for (const auto& u : units) {
+    for (const auto& w : u.result->warnings) warnings.push_back(u.name() + ": " + w);
+  }
+  return {{"id", "frf"}, {"title", "Frequency responses (report 2.3)"}, {"warnings", warnings},
           {"text", "FRFs from the DAC voltage u to the encoder d_e and to the force-sensor voltage Vs, all units "
                    "overlaid, with the coherence."},
           {"tables", tables}, {"figures", figs}};
@@ -406,8 +412,11 @@ std::optional<json> resistor_section(const Campaign& c, const std::vector<UnitCu
   }
   if (mag.empty()) return std::nullopt;
   return json{{"id", "resistor"}, {"title", "The resistor across the force sensor (report 2.5)"},
-              {"text", fmt::format("u -> Vs at low frequency with and without the {:.3g} kOhm resistor in parallel with the sensor "
-                                   "stack: with it, a high-pass at 1/(2 pi R C).", c.bench.hpf_resistance * 1e-3)},
+              {"text", c.bench.hpf_resistance ? fmt::format("u -> Vs at low frequency with and without the {:.3g} kOhm resistor in parallel "
+                                                                   "with the sensor stack: with it, a high-pass at 1/(2 pi R C).",
+                                                                   *c.bench.hpf_resistance * 1e-3)
+                                                     : std::string("u -> Vs at low frequency with and without a resistor in parallel with "
+                                                                   "the sensor stack (its value is not in [bench] hpf_resistance_ohm).")},
               {"tables", json::array({table("High-pass corner per unit",
                                             {"unit", "with R [Hz]", "without R [Hz]", "fitted without R [Hz]", "lowest line [Hz]",
                                              "1/(2 pi R C_sensor) [Hz]"},
@@ -530,7 +539,13 @@ std::optional<json> iff_section(const std::vector<UnitCurves>& units, const IffS
   }
   if (!s.failed && s.plant && !s.damped_poles.empty() && s.warning) warnings.push_back(*s.warning);
   if (figs.empty() && tables.empty()) return std::nullopt;
-  return json{{"id", "iff"}, {"title", "Integral Force Feedback (report 2.6)"}, {"warnings", warnings}, {"tables", tables},
+  std::string text;
+  if (mag.empty()) {
+    text = "No damped plant was measured (no unit lists the iff experiment): Figure 2.10a and the damped poles against the "
+           "root locus are not shown.";
+  }
+  if (s.failed) text += (text.empty() ? "" : " ") + std::string("The IFF study failed: ") + *s.failed;
+  return json{{"id", "iff"}, {"title", "Integral Force Feedback (report 2.6)"}, {"text", text}, {"warnings", warnings}, {"tables", tables},
               {"figures", figs}};
 }
 
@@ -541,7 +556,8 @@ json model_section(const std::vector<UnitCurves>& units) {
   figs.push_back(frf_figure(units, measured_vs, model_vs, "model-vs", "Fig. 3.4b: 2-DoF model against the measurement, u -> Vs", "V/V",
                             "2-DoF model", false,
                             "Solid: measured; dashed: the tuned 2-DoF model. Its zero is minimum phase: where the measured phase "
-                            "falls through the anti-resonance, the model's (drawn on the measurement's branch) jumps by one turn."));
+                            "falls by 180 deg through the anti-resonance, the model's rises by 180 deg, so on one side of it the "
+                            "two curves are one turn (360 deg) apart (the same phase modulo 360 deg)."));
   json rows = json::array();
   for (const auto& u : units) {
     if (!u.result->model_2dof) continue;
@@ -553,7 +569,10 @@ json model_section(const std::vector<UnitCurves>& units) {
           {"tables", json::array({table("2-DoF parameters per unit (Table 3.1)",
                                         {"unit", "m [kg]", "k1 [N/um]", "c1 [Ns/m]", "ke [N/um]", "ce [Ns/m]", "ka [N/um]",
                                          "ca [Ns/m]", "ga [N/V]", "gs [V/um]", "error d_e", "error Vs"},
-                                        rows, "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46.")})},
+                                        rows,
+                                        "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46. Signs (the report's "
+                                        "convention): ga < 0, so more voltage lowers the APA (a negative static gain u -> d_e), while "
+                                        "the sensor voltage Vs rises with it (gs > 0).")})},
           {"figures", figs}};
 }
 
@@ -648,8 +667,8 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
                                              json::array({trace("record", p.x, p.y, "record"),
                                                           trace(m.output.identity() ? "Prandtl-Ishlinskii model" : "modified Prandtl-Ishlinskii model",
                                                                 p.x, u.hysteresis_model_um, "model")}))}),
-                          "The model's inverse is the feedforward of `rt --feedforward` and `measure tracking` "
-                          "(docs/hysteresis.md)."));
+                          "The model's inverse is the feedforward of the real-time loop (piezobench rt --feedforward) and of the tracking "
+                          "experiment (docs/hysteresis.md)."));
   }
   if (!model_rows.empty()) {
     tables.push_back(table(fmt::format("Hysteresis model of the largest loop (Prandtl-Ishlinskii, thresholds (i - 1/2) R / n; Kuhnen's "
@@ -682,7 +701,7 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
     figs.push_back(figure(fmt::format("tracking-{}", u.result->id),
                           u.name() + ": d_e against the command, without and with the inverse hysteresis feedforward", "command [V]", false,
                           panels,
-                          "The 1 Hz sine and triangle of the tracking experiment (`measure tracking`), the last periods of each: "
+                          "The 1 Hz sine and triangle of the tracking experiment (piezobench measure tracking), the last periods of each: "
                           "with the model's inverse in front of the amplifier the loop closes onto a straight line "
                           "(docs/hysteresis.md)."));
   }
@@ -695,6 +714,36 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
   }
   if (figs.empty()) return std::nullopt;
   return json{{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}};
+}
+
+// Report 1.2 (Table 1.1): each unit's probe points against its fitted plane, by position.
+std::optional<json> flatness_section(const Campaign& c, const std::vector<UnitCurves>& units) {
+  json traces = json::array(), rows = json::array();
+  for (const auto& u : units) {
+    const auto& f = u.result->flatness_analysis;
+    if (!f) continue;
+    json x = json::array(), text = json::array();
+    for (std::size_t i = 0; i < f->probe_xy.x.size() && i < f->deviation.size(); ++i) {
+      x.push_back(static_cast<long>(i) + 1);
+      text.push_back(fmt::format("x {:.4g} mm, y {:.4g} mm: {:+.3g} um", f->probe_xy.x[i] * 1e3, f->probe_xy.y[i] * 1e3, f->deviation[i] * 1e6));
+    }
+    json dev = values(std::vector<double>(f->deviation.begin(), f->deviation.begin() + static_cast<std::ptrdiff_t>(x.size())), 1e6);
+    traces.push_back(with_text(trace(u.name(), x, dev, u.name(), false, "markers"), text));
+    rows.push_back({u.name(), f->points, f->flatness * 1e6, f->least_squares * 1e6, io::to_json(f->minimum_zone, 1e6), f->probe_accuracy * 1e6});
+  }
+  if (traces.empty()) return std::nullopt;
+  const std::string method = metrology::to_string(c.specs.flatness_method);
+  return json{{"id", "flatness"},
+              {"title", "Flatness (report 1.2)"},
+              {"text", fmt::format("Every probe point's distance from the unit's fitted plane ({} plane, the specification's method): the "
+                                   "plane is the 0 line, the flatness is the spread of the points above and below it.",
+                                   method)},
+              {"tables", json::array({table("Flatness per unit", {"unit", "probe points", "flatness [um] (" + method + ")",
+                                                                  "least squares [um]", "minimum zone [um]", "probe accuracy [um]"},
+                                            rows)})},
+              {"figures", json::array({figure("flatness", "Table 1.1: probe points against the fitted plane", "probe point (file order)", false,
+                                              json::array({panel("distance from the plane [um]", false, traces)}),
+                                              "Markers: probe points (hover: x, y and the distance); 0: the fitted plane.")})}};
 }
 
 // results.json writes stiffness_N_per_um only when one of these is known.
@@ -736,11 +785,11 @@ std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitC
   json tables = json::array({table("Stiffness per unit [N/um]",
                                    {"unit", "k1", "k2", "k_sc", "k_oc", "from the resonance", "creep under load [um/decade]"}, rows)});
   if (!creep_rows.empty()) {
-    tables.push_back(table("Creep, Prony series (ident::fit_creep: d_e = offset + gain (F + sum c_j F_j), F the weight, F_j its "
+    tables.push_back(table("Creep, Prony series (d_e = offset + gain (F + sum c_j F_j), F the weight, F_j its "
                            "first-order lags of time constant tau_j)",
                            {"record", "tau_j [s]", "c_j", "instantaneous stiffness [N/um]", "creep [% per decade]",
                             "rms residual [um] (of the range)", "fit"},
-                           creep_rows, "The model `hysteresis creep` fits (docs/hysteresis.md); a poor fit says the record's creep is not a "
+                           creep_rows, "The model piezobench hysteresis creep fits (docs/hysteresis.md); a poor fit says the record's creep is not a "
                                        "sum of these exponentials."));
   }
   return json{{"id", "stiffness"},
@@ -764,8 +813,54 @@ std::optional<json> modes_section(const std::vector<UnitCurves>& units) {
                                               json::array({panel("|H| [m/s/N]", true, traces)}))})}};
 }
 
+// The batch's numbers as tables: the spread per quantity (in the order of the report, with its
+// unit), the outliers and the FRF similarity, units by name.
+json batch_tables(const CampaignResult& r) {
+  const auto name_of = [&](int id) {
+    for (const auto& u : r.units) {
+      if (u.id == id) return u.name;
+    }
+    return std::to_string(id);
+  };
+  const BatchAnalysis& b = r.batch;
+  json spread = json::array();
+  for (const QuantitySpread& q : b.spread) {
+    spread.push_back({fmt::format("{} [{}]", q.label, q.unit), q.units, q.min, q.median, q.max, finite_scaled(q.relative_spread, 100.0), q.mad});
+  }
+  json tables = json::array({table("Spread over the batch",
+                                   {"quantity", "units measured", "minimum", "median", "maximum", "(max - min) / median [%]",
+                                    "median absolute deviation"},
+                                   spread, "Over the units analysed; a unit that could not be analysed is left out.")});
+  if (!b.outliers.empty()) {
+    json rows = json::array();
+    for (const BatchOutlier& o : b.outliers) {
+      std::string label = o.quantity;
+      for (const QuantitySpread& q : b.spread) {
+        if (q.quantity == o.quantity) label = fmt::format("{} [{}]", q.label, q.unit);
+      }
+      rows.push_back({name_of(o.unit), label, o.value, o.median, finite_scaled(o.robust_z, 1.0)});
+    }
+    tables.push_back(table("Batch outliers", {"unit", "quantity", "value", "batch median", "robust z-score"}, rows,
+                           fmt::format("Robust z-score: (value - median) / (1.4826 median absolute deviation); an outlier beyond {:.1f} "
+                                       "{} the unit when it is a capacitance or the stroke.",
+                                       b.rule.threshold, b.rejects ? "rejects" : "would reject (reject_outliers is off)")));
+  }
+  if (b.similarity) {
+    json rows = json::array();
+    for (const auto& u : b.similarity->units) rows.push_back({name_of(u.unit), finite_scaled(u.de_rms_dB, 1.0), finite_scaled(u.vs_rms_dB, 1.0)});
+    tables.push_back(table("Unit-to-unit similarity of the FRFs",
+                           {"unit", "u -> d_e: rms distance from the batch median [dB]", "u -> Vs: rms distance from the batch median [dB]"},
+                           rows,
+                           fmt::format("|H| on 120 log-spaced frequencies from {:g} to {:g} Hz against the median |H| of the batch.",
+                                       b.similarity->fmin_Hz, b.similarity->fmax_Hz)));
+  }
+  return tables;
+}
+
 // Bars with both limits of every spec.
-json batch_section(const Campaign& c, const std::vector<UnitAnalysis>& units) {
+json batch_section(const CampaignResult& result) {
+  const Campaign& c = result.campaign;
+  const std::vector<UnitAnalysis>& units = result.units;
   json names = json::array();
   for (const auto& u : units) names.push_back(u.name);
   const auto bars = [&](const std::string& name, const std::function<json(const UnitAnalysis&)>& value) {
@@ -790,25 +885,37 @@ json batch_section(const Campaign& c, const std::vector<UnitAnalysis>& units) {
     return [which](const UnitAnalysis& u) { return has_stiffness(u) ? io::to_json(u.*which, 1e-6) : json(nullptr); };
   };
   json figs = json::array();
+  std::vector<std::string> not_measured;
+  // A figure only when a unit has a bar in it (its first traces are the bars, the limits follow).
+  const auto add = [&](const json& traces, const std::string& what, json fig) {
+    const bool measured = std::any_of(traces.begin(), traces.end(), [](const json& tr) {
+      return tr["mode"] == "bars" && std::any_of(tr["y"].begin(), tr["y"].end(), [](const json& v) { return !v.is_null(); });
+    });
+    if (measured) {
+      figs.push_back(std::move(fig));
+    } else {
+      not_measured.push_back(what);
+    }
+  };
   {
     json t = json::array({bars("sensor stack", capacitance(&CapacitanceAnalysis::sensor)),
                           bars("actuator stacks", capacitance(&CapacitanceAnalysis::actuator))});
     range(t, "sensor", c.specs.capacitance_sensor, 1e6);
     range(t, "actuator", c.specs.capacitance_actuator, 1e6);
-    figs.push_back(figure("batch-capacitance", "Capacitance (Table 1.2)", "", false, json::array({panel("C [uF]", false, t)})));
+    add(t, "capacitance", figure("batch-capacitance", "Capacitance (Table 1.2)", "", false, json::array({panel("C [uF]", false, t)})));
   }
   {
     json t = json::array({bars("k1", stiffness(&UnitAnalysis::k1)), bars("k2", stiffness(&UnitAnalysis::k2)),
                           bars("k_oc", stiffness(&UnitAnalysis::k_oc)), bars("from the resonance", stiffness(&UnitAnalysis::k_resonance))});
     range(t, "stiffness", c.specs.stiffness, 1e-6);
-    figs.push_back(figure("batch-stiffness", "Stiffness (Table 2.1)", "", false, json::array({panel("k [N/um]", false, t)})));
+    add(t, "stiffness", figure("batch-stiffness", "Stiffness (Table 2.1)", "", false, json::array({panel("k [N/um]", false, t)})));
   }
   {
     json t = json::array({bars("flatness", [](const UnitAnalysis& u) {
       return u.flatness_analysis ? json(u.flatness_analysis->flatness * 1e6) : json(nullptr);
     })});
     if (c.specs.flatness_max) t.push_back(limit("flatness maximum", *c.specs.flatness_max * 1e6));
-    figs.push_back(figure("batch-flatness", "Flatness (Table 1.1, " + metrology::to_string(c.specs.flatness_method) + ")", "", false,
+    add(t, "flatness", figure("batch-flatness", "Flatness (Table 1.1, " + metrology::to_string(c.specs.flatness_method) + ")", "", false,
                           json::array({panel("flatness [um]", false, t)})));
   }
   {
@@ -816,11 +923,14 @@ json batch_section(const Campaign& c, const std::vector<UnitAnalysis>& units) {
       return u.stroke_analysis ? json(u.stroke_analysis->result.stroke * 1e6) : json(nullptr);
     })});
     if (c.specs.stroke_min) t.push_back(limit("stroke minimum", *c.specs.stroke_min * 1e6));
-    figs.push_back(figure("batch-stroke", "Stroke (Figure 1.4)", "", false, json::array({panel("stroke [um]", false, t)}),
+    add(t, "stroke", figure("batch-stroke", "Stroke (Figure 1.4)", "", false, json::array({panel("stroke [um]", false, t)}),
                           "The specification gives a minimum stroke only."));
   }
+  std::string text = "Dashed lines: the specification's limits (both where it has two).";
+  if (!not_measured.empty()) text += fmt::format(" Not measured on any analysed unit, so not drawn: {}.", fmt::join(not_measured, ", "));
   return {{"id", "batch"}, {"title", "Batch comparison"},
-          {"text", "Dashed lines: the specification's limits (both where it has two)."},
+          {"text", text},
+          {"tables", batch_tables(result)},
           {"figures", figs}};
 }
 
@@ -874,7 +984,12 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
                            {"unit", "ga [N/V]", "vs eq. 4.1 [%]", "gs [V/um]", "vs eq. 4.1 [%]", "resonance model [Hz]",
                             "resonance measured [Hz]", "anti-resonance model [Hz]", "anti-resonance measured [Hz]",
                             "u -> d_e error [dB]", "u -> V_s error [dB]"},
-                           rows, "Errors: median |model / measured| in dB from the tuning band's start to twice the resonance."));
+                           rows,
+                           "Errors: median |model / measured| in dB from the tuning band's start to twice the resonance. Signs: ga "
+                           "and gs carry the signs that make the model's phases agree with the measurement in the super "
+                           "element's own axes (ga > 0 with gs < 0, or the reverse); the 2-DoF model's convention is ga < 0, "
+                           "gs > 0. The data fix only the sign of the product ga gs (negative in both), so the comparison with eq. 4.1 "
+                           "is on |ga| and |gs|."));
     figs.push_back(figure("superelement", "Fig. 4.2: super element against the measurement of " + m.name + " (u -> d_e, u -> V_s)",
                           "Frequency [Hz]", true,
                           json::array({panel("|u -> d_e| [um/V]", true, de_mag), panel("d_e phase [deg]", false, de_ph),
@@ -892,27 +1007,48 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
 
 }  // namespace
 
+// A section of the report whose experiment no unit of the campaign lists (or none could be
+// analysed): its title, and why it has no figure, instead of empty plots.
+json not_run(const std::string& id, const std::string& title, const std::string& experiments) {
+  return {{"id", id},
+          {"title", title},
+          {"text", "Not measured in this campaign: no analysed unit has " + experiments + ", so this section has no figure or table."},
+          {"figures", json::array()}};
+}
+
 json report_document(const CampaignResult& result) {
   const Campaign& c = result.campaign;
   std::vector<UnitCurves> units;
   for (const auto& u : result.units) units.push_back(unit_curves(c, u));
   const auto any = [&](const std::function<bool(const UnitCurves&)>& has) { return std::any_of(units.begin(), units.end(), has); };
   json sections = json::array();
+  const bool has_frf = any([](const UnitCurves& u) { return u.de.has_value(); });
   // Section 2.3: frequency responses (Figure 2.5), 2.4: the NMP zero (Figure 2.6).
-  if (any([](const UnitCurves& u) { return u.de.has_value(); })) sections.push_back(frf_section(units));
-  if (any([](const UnitCurves& u) { return u.nmp.has_value(); })) sections.push_back(nmp_section(units));
-  // Section 2.5: the resistor (Figure 2.7); 2.6: IFF (Figures 2.8, 2.10).
-  for (const auto& section : {resistor_section(c, units), iff_section(units, result.iff)}) {
-    if (section) sections.push_back(*section);
+  sections.push_back(has_frf ? frf_section(units) : not_run("frf", "Frequency responses (report 2.3)", "an FRF record (frf)"));
+  if (any([](const UnitCurves& u) { return u.nmp.has_value(); })) {
+    sections.push_back(nmp_section(units));
+  } else {
+    sections.push_back(not_run("nmp", "The non-minimum-phase zero (report 2.4)", "an anti-resonance in u -> Vs (frf)"));
   }
+  // Section 2.5: the resistor (Figure 2.7); 2.6: IFF (Figures 2.8, 2.10).
+  const auto add = [&](const std::optional<json>& section, const char* id, const char* title, const char* experiments) {
+    sections.push_back(section ? *section : not_run(id, title, experiments));
+  };
+  add(resistor_section(c, units), "resistor", "The resistor across the force sensor (report 2.5)", "a record without the resistor (frf_without_resistor)");
+  add(iff_section(units, result.iff), "iff", "Integral Force Feedback (report 2.6)", "an FRF record (frf) or IFF records (iff)");
   // Section 3: the 2-DoF model (Figure 3.4).
-  if (any([](const UnitCurves& u) { return u.model_de.has_value(); })) sections.push_back(model_section(units));
+  if (any([](const UnitCurves& u) { return u.model_de.has_value(); })) {
+    sections.push_back(model_section(units));
+  } else {
+    sections.push_back(not_run("model", "Two degrees-of-freedom model (report 3)", has_frf ? "a tuned 2-DoF model (the tuning failed: see each unit's failed list in results.json)" : "an FRF record (frf)"));
+  }
   // Sections 2.1 and 1.3: hysteresis and stroke (Figures 2.3, 1.4b); 2.2: stiffness (Figure 2.4),
   // short and open circuit; 1.4: flexible modes (Figure 1.7).
-  for (const auto& section : {quasi_static_section(units), stiffness_section(c, units), modes_section(units)}) {
-    if (section) sections.push_back(*section);
-  }
-  sections.push_back(batch_section(c, result.units));
+  add(flatness_section(c, units), "flatness", "Flatness (report 1.2)", "a flatness record (flatness)");
+  add(quasi_static_section(units), "quasi-static", "Stroke and hysteresis (report 1.3, 2.1)", "a stroke, hysteresis or tracking record");
+  add(stiffness_section(c, units), "stiffness", "Static stiffness (report 2.2)", "a static stiffness record (stiffness, stiffness_open_circuit) or a resonance");
+  add(modes_section(units), "modes", "Flexible modes, hammer test (report 1.4)", "a hammer test record (hammer)");
+  sections.push_back(batch_section(result));
   sections.push_back(superelement_section(result, units));
   return {{"title", c.title},
           {"subtitle", fmt::format("{} — piezobench {}", c.file.filename().string(), kVersion)},

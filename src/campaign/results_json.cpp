@@ -169,6 +169,7 @@ json hpf(const HighPassCorner& h) {
     out["iff_plant_fit_error"] = *h.iff_plant_fit_error;
   }
   out["method"] = h.method;
+  if (!h.corner_Hz) out["observable_above_Hz"] = h.observable_above_Hz;
   return out;
 }
 
@@ -442,7 +443,11 @@ json unit_json(const UnitAnalysis& u) {
   if (!u.damped.empty()) r["iff_damped_plants"] = damped_plants(u.damped);
   if (u.flexible_modes) r["flexible_modes"] = flexible_modes(*u.flexible_modes);
   r["not_measured"] = u.not_measured;
+  if (u.not_analysed) {
+    r["not_analysed"] = {{"file", u.not_analysed->file}, {"key", u.not_analysed->key}, {"reason", u.not_analysed->reason}};
+  }
   r["failed"] = u.failed;
+  r["warnings"] = u.warnings;
   r["accepted"] = u.accepted;
   r["reasons"] = u.reasons;
   return r;
@@ -469,19 +474,19 @@ json results_json(const CampaignResult& r) {
           {"iff", iff(r.iff)},
           {"superelement", r.superelement ? superelement(*r.superelement) : json(nullptr)},
           {"specs", specs},
-          {"summary", {{"units", r.units.size()}, {"accepted", r.accepted}, {"rejected", r.rejected}}},
+          {"summary", {{"units", r.units.size()}, {"accepted", r.accepted}, {"rejected", r.rejected}, {"not_analysed", r.not_analysed}}},
           {"provenance",
            {{"campaign", c.file.string()},
             {"window", dsp::to_string(a.window)},
             {"nfft", a.nfft == 0 ? json("auto (4 s, at most a quarter of the record)") : json(a.nfft)},
             {"overlap", a.overlap},
-            {"detrend", "linear"},
+            {"detrend", "mean (per segment)"},
             {"estimator", "H1"},
             {"band_Hz", {a.fmin_Hz, a.fmax_Hz}},
             {"fit_order", a.fit_order},
             {"bench", {{"amplifier_gain", c.bench.amplifier_gain}, {"suspended_mass_kg", c.bench.suspended_mass},
                        {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},
-                       {"hpf_resistance_ohm", c.bench.hpf_resistance}, {"probe_accuracy_um", c.bench.probe_accuracy * 1e6}}},
+                       {"hpf_resistance_ohm", io::to_json(c.bench.hpf_resistance)}, {"probe_accuracy_um", c.bench.probe_accuracy * 1e6}}},
             {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
 }
 

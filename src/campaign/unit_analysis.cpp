@@ -295,6 +295,7 @@ FlatnessAnalysis flatness(const Campaign& c, const Record& r) {
   out.probe_accuracy = c.bench.probe_accuracy;
   out.provenance = provenance(r, {"x", "y", "z", "interface"});
   out.deviation = thin(chosen.deviations);
+  out.probe_xy = Curve{thin(x), thin(y)};
   if (r.has("interface")) {
     const VectorXd itf = r.channel("interface");
     std::vector<double> ids(itf.data(), itf.data() + itf.size());
@@ -466,6 +467,69 @@ const T* nearest(const std::vector<T>& features, double target) {
   return best;
 }
 
+// The unit's corner: 1/(2 pi R C_sensor) when the bench has a resistor and C_sensor is measured;
+// else the IFF plant fit's, else the first-order fit's, each only when observable in the record (at
+// least a third of its lowest line, as LowFrequencyVs): a bench without the resistor has no
+// high-pass the record can show, and a default resistance must not invent one.
+void choose_high_pass_corner(const Campaign& c, double lowest_line_Hz, double w_rc, HighPassCorner& hpf) {
+  hpf.observable_above_Hz = lowest_line_Hz / 3.0;
+  const std::string bench = c.bench.hpf_resistance ? fmt::format("R = {:g} Ohm from [bench]", *c.bench.hpf_resistance)
+                                                   : "no resistor in [bench] (hpf_resistance_ohm)";
+  if (w_rc > 0.0) {
+    hpf.corner_Hz = w_rc / kTwoPi;
+    hpf.method = "1/(2 pi R C_sensor), " + bench + ", C_sensor measured";
+    return;
+  }
+  for (const auto& [fit, name] : {std::pair{hpf.iff_plant_fit_Hz, "IFF plant fit (eq. 2.3) down to the lowest frequency"},
+                                  std::pair{hpf.first_order_fit_Hz, "first-order fit below hpf_fmax_Hz"}}) {
+    if (!fit) continue;
+    if (*fit >= hpf.observable_above_Hz) {
+      hpf.corner_Hz = fit;
+      hpf.method = std::string(name) + "; " + bench;
+    } else {
+      hpf.method = fmt::format("{}; the fitted corner {:.3g} Hz is below a third of the lowest line ({:.3g} Hz): not observable, "
+                               "no corner reported",
+                               bench, *fit, hpf.observable_above_Hz);
+    }
+    return;
+  }
+  hpf.method = bench + "; no fit of the corner";
+}
+
+// The cross-checks of the corner that disagree by more than kHighPassCrossCheckRatio: 1/(2 pi R C)
+// against each fit, and the two fits against each other when both are observable.
+std::vector<std::string> high_pass_warnings(const HighPassCorner& hpf) {
+  std::vector<std::string> out;
+  const auto apart = [](double a, double b) { return std::max(a, b) / std::min(a, b) > kHighPassCrossCheckRatio; };
+  const std::string limit = fmt::format("more than a factor {:g} apart", kHighPassCrossCheckRatio);
+  if (hpf.r_c_Hz) {
+    for (const auto& [fit, name] : {std::pair{hpf.iff_plant_fit_Hz, "the IFF plant fit"}, std::pair{hpf.first_order_fit_Hz, "the first-order fit"}}) {
+      if (fit && *fit > 0.0 && apart(*hpf.r_c_Hz, *fit)) {
+        out.push_back(fmt::format("high-pass corner: 1/(2 pi R C_sensor) = {:.3g} Hz but {} of u -> Vs gives {:.3g} Hz ({}): is the "
+                                  "resistor of [bench] hpf_resistance_ohm on the bench, and is C_sensor right? The report uses {:.3g} Hz",
+                                  *hpf.r_c_Hz, name, *fit, limit, *hpf.r_c_Hz));
+      }
+    }
+  } else if (hpf.iff_plant_fit_Hz && hpf.first_order_fit_Hz && *hpf.iff_plant_fit_Hz >= hpf.observable_above_Hz &&
+             *hpf.first_order_fit_Hz >= hpf.observable_above_Hz && apart(*hpf.iff_plant_fit_Hz, *hpf.first_order_fit_Hz)) {
+    out.push_back(fmt::format("high-pass corner: the IFF plant fit gives {:.3g} Hz, the first-order fit {:.3g} Hz ({}); the report uses "
+                              "the IFF plant fit's",
+                              *hpf.iff_plant_fit_Hz, *hpf.first_order_fit_Hz, limit));
+  }
+  return out;
+}
+
+// A feature read two ways (the reported value and its cross-check) that differ by more than
+// `tolerance` (relative): a warning naming both.
+void cross_check(UnitAnalysis& u, const std::string& what, const std::string& unit, const std::optional<double>& reported,
+                 const std::string& reported_from, const std::optional<double>& check, const std::string& check_from, double tolerance) {
+  if (!reported || !check || *reported == 0.0) return;
+  const double d = std::abs(*check / *reported - 1.0);
+  if (d <= tolerance) return;
+  u.warnings.push_back(fmt::format("{}: {} {:.4g} {} but {} {:.4g} {} ({:.0f} % apart, more than {:.0f} %); the report uses the {}", what,
+                                   reported_from, *reported, unit, check_from, *check, unit, 100.0 * d, 100.0 * tolerance, reported_from));
+}
+
 void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   const AnalysisSettings& a = c.analysis;
   const long nfft = frf_segment_length(a, static_cast<long>(r.ts.samples()), r.ts.sample_rate);
@@ -508,8 +572,8 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   // The resistor high-pass: its corner is 1 / (2 pi R C_sensor) (report section 2.5) when the
   // capacitance is measured; the FRF below a few Hz is dominated by the stacks' creep and
   // hysteresis, so the corner fitted to it is a cross-check only.
-  // rad/s; 0 when the capacitance is not measured.
-  const double w_rc = u.capacitance_sensor ? 1.0 / (c.bench.hpf_resistance * *u.capacitance_sensor) : 0.0;
+  // rad/s; 0 when the capacitance is not measured or the bench has no resistor.
+  const double w_rc = u.capacitance_sensor && c.bench.hpf_resistance ? 1.0 / (*c.bench.hpf_resistance * *u.capacitance_sensor) : 0.0;
   const std::string fit_source = c.file.string() + ": " + r.spec.key;
   ident::ActuatorPlantOptions po;
   po.fmin_Hz = a.fmin_Hz;
@@ -580,14 +644,8 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
       hpf.iff_plant_fit_error = e.what();
     }
   }
-  hpf.method = w_rc > 0.0 ? "1/(2 pi R C_sensor), R from [bench], C_sensor measured" : "IFF plant fit (eq. 2.3) down to the lowest frequency";
-  if (u.capacitance_sensor) {
-    hpf.corner_Hz = 1.0 / (kTwoPi * c.bench.hpf_resistance * *u.capacitance_sensor);
-  } else if (hpf.iff_plant_fit_Hz) {
-    hpf.corner_Hz = hpf.iff_plant_fit_Hz;
-  } else if (hpf.first_order_fit_Hz) {
-    hpf.corner_Hz = hpf.first_order_fit_Hz;
-  }
+  choose_high_pass_corner(c, frf.freq_Hz.size() > 1 ? frf.freq_Hz(1) : 0.0, w_rc, hpf);
+  for (auto& w : high_pass_warnings(hpf)) u.warnings.push_back(std::move(w));
 
   // The verdict: the phase of the data when it decides unambiguously, else the sign of xz in the
   // IFF plant fit, else the ambiguous phase, else the vector fit's zero (ident::zero_phase_verdict).
@@ -634,6 +692,13 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   if (anti_z) out.antiresonance_damping = (verdict.value_or(false) ? -1.0 : 1.0) * *anti_z;
   out.zero_is_nonminimum_phase = verdict;
   if (anti_w) out.shell_stiffness = c.bench.suspended_mass * *anti_w * *anti_w;
+  // The features read two ways (results.hpp: kFeatureCrossCheckTolerance).
+  cross_check(u, "resonance", "Hz", out.resonance_Hz, "second-order fit of u -> d_e", out.resonance_vector_fit_Hz, "the vector fit",
+              kFeatureCrossCheckTolerance);
+  cross_check(u, "anti-resonance", "Hz", out.antiresonance_Hz, "IFF plant fit", out.antiresonance_vector_fit_Hz, "the vector fit",
+              kFeatureCrossCheckTolerance);
+  cross_check(u, "static gain u -> d_e", "m/V", out.static_gain, out.static_gain_source, out.static_gain_vector_fit, "the vector fit",
+              kFeatureCrossCheckTolerance);
   u.frf_analysis = std::move(out);
 
   // The tuned 2-DoF model (report section 3) with the fitted measurement chain.
@@ -641,7 +706,7 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     apa::TuningOptions t;
     t.mass = c.bench.suspended_mass;
     t.bench.amplifier_gain = c.bench.amplifier_gain;
-    if (u.iff_plant) t.bench.hpf_resistance = c.bench.hpf_resistance;
+    if (u.iff_plant) t.bench.hpf_resistance = c.bench.hpf_resistance.value_or(0.0);
     t.fmin_Hz = a.fmin_Hz;
     t.fmax_Hz = a.fmax_Hz;
     t.min_coherence = 0.5;
@@ -760,22 +825,22 @@ FlexibleModes hammer(const Campaign& c, const Record& r, UnitAnalysis& u) {
 
 }  // namespace
 
-UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& log) {
-  UnitAnalysis u;
-  u.id = spec.id;
-  u.name = spec.name;
+namespace {
+
+// Every analysis of the unit; `current` is the file entry being read or analysed (for the report of
+// a unit that cannot be analysed). InputError as analyze_unit's contract used to be.
+void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& log, UnitAnalysis& u, const FileSpec*& current) {
   auto say = [&](const std::string& what, const FileSpec& f) {
+    current = &f;
     if (log) log(fmt::format("{}: {} ({})", spec.name, what, f.given));
   };
-  for (const Experiment e : all_experiments()) {
-    if (!spec.has(e)) u.not_measured.push_back(to_string(e));
-  }
   if (spec.flatness) {
     say("flatness", *spec.flatness);
     u.flatness_analysis = flatness(c, load_record(c, spec, *spec.flatness, Experiment::kFlatness));
     u.flatness = u.flatness_analysis->flatness;
   }
   if (spec.has(Experiment::kCapacitance)) {
+    current = spec.capacitance ? &*spec.capacitance : nullptr;
     u.capacitance_analysis = capacitance(c, spec);
     u.capacitance_sensor = u.capacitance_analysis->sensor;
     u.capacitance_actuator = u.capacitance_analysis->actuator;
@@ -860,6 +925,30 @@ UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& lo
   if (spec.hammer) {
     say("hammer test", *spec.hammer);
     u.flexible_modes = hammer(c, load_record(c, spec, *spec.hammer, Experiment::kHammer), u);
+  }
+}
+
+}  // namespace
+
+UnitAnalysis analyze_unit(const Campaign& c, const UnitSpec& spec, const Log& log) {
+  UnitAnalysis u;
+  u.id = spec.id;
+  u.name = spec.name;
+  for (const Experiment e : all_experiments()) {
+    if (!spec.has(e)) u.not_measured.push_back(to_string(e));
+  }
+  const FileSpec* current = nullptr;
+  try {
+    analyze_measurements(c, spec, log, u, current);
+  } catch (const InputError& e) {
+    // The unit is left out as a whole (its other results too): the batch is then the batch without it.
+    UnitAnalysis bad;
+    bad.id = spec.id;
+    bad.name = spec.name;
+    bad.not_measured = std::move(u.not_measured);
+    bad.not_analysed = NotAnalysed{current ? current->given : "", current ? current->key : e.field(), e.what()};
+    if (log) log(fmt::format("{}: NOT ANALYSED: {}", spec.name, e.what()));
+    return bad;
   }
   return u;
 }

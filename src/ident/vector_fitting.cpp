@@ -1049,11 +1049,14 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
   // Quality: every output's own relative error (a small output is not hidden by a large one), and
   // no pole far outside the band of the data (such a pole fits noise or an unexcited band).
   result.relative_rms_error_per_output.resize(data.cols());
+  bool misses = false;  // an output's error is too large: too few poles for its modes
   for (Index i = 0; i < data.cols(); ++i) {
     const double e = std::sqrt((fit.col(i) - data.col(i)).squaredNorm() / data.col(i).squaredNorm());
     result.relative_rms_error_per_output(i) = e;
     result.quality.check_error("output " + std::to_string(i + 1), e);
+    misses = misses || !(e <= core::kPoorRelativeError);
   }
+  bool spurious = false;  // poles that fit noise: outside the band, or unstable
   const double w_lo = omega.minCoeff() > 0.0 ? omega.minCoeff() : (omega.size() > 1 ? omega(1) : omega(0));
   const double w_hi = omega.maxCoeff();
   for (Index k = 0; k < result.poles.size(); ++k) {
@@ -1065,11 +1068,27 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
       text << "pole at " << w / kTwoPi << " Hz outside the fitted band " << w_lo / kTwoPi
            << " to " << w_hi / kTwoPi << " Hz";
       result.quality.add_problem(text.str());
+      spurious = true;
     }
-    if (p.real() > 0.0) result.quality.add_problem("unstable pole (Re > 0) at " + std::to_string(w / kTwoPi) + " Hz");
+    if (p.real() > 0.0) {
+      result.quality.add_problem("unstable pole (Re > 0) at " + std::to_string(w / kTwoPi) + " Hz");
+      spurious = true;
+    }
   }
   if (!result.converged) result.quality.add_problem("the poles did not settle (not converged)");
-  result.quality.advise("a lower order, a band where the coherence is high (--fmin/--fmax), or --weighting output-scale");
+  // The advice points the way the problems do: a large error with every pole in the band means
+  // modes the order cannot hold; poles outside the band or unstable fit noise.
+  const std::string order = std::to_string(n);
+  if (misses && !spurious) {
+    result.quality.advise("a higher order than " + order + " (--order " + std::to_string(n + 4) +
+                          ": the fit misses modes), or a band where the coherence is high (--fmin/--fmax)");
+  } else if (spurious && !misses) {
+    result.quality.advise("a lower order than " + order + " (the extra poles fit noise), a band where the coherence is high "
+                          "(--fmin/--fmax), or --weighting output-scale");
+  } else {
+    result.quality.advise("a band where the coherence is high (--fmin/--fmax), another order than " + order +
+                          ", or --weighting output-scale");
+  }
   return result;
 }
 

@@ -147,6 +147,8 @@ struct Cell {
 
 struct Unit {
   std::string id;
+  std::string name;  // the unit's name when results.json gives one, else its id
+  std::optional<std::string> not_analysed;  // "file: reason" of a unit that could not be analysed
   bool accepted = false;
   std::vector<std::string> reasons;
   std::vector<Cell> cells;  // one per kColumns entry
@@ -234,6 +236,16 @@ std::vector<Unit> read_units(const json& results) {
       fail(child(at, "accepted"), "true or false", accepted == u.end() ? "nothing" : describe(*accepted));
     }
     unit.accepted = accepted->get<bool>();
+    unit.name = optional_string(u, "name", at).value_or(unit.id);
+    if (const auto na = u.find("not_analysed"); na != u.end() && !na->is_null()) {
+      const std::string nat = child(at, "not_analysed");
+      require_object(*na, nat, {"file", "key", "reason"});
+      const std::string file = optional_string(*na, "file", nat).value_or("");
+      const std::string reason = required_string(*na, "reason", nat);
+      // The file first, unless the reason already names it.
+      unit.not_analysed = file.empty() || reason.find(file) != std::string::npos ? reason : file + ": " + reason;
+      if (unit.accepted) fail(child(at, "accepted"), "false for a unit that was not analysed", "true");
+    }
     if (const auto reasons = u.find("reasons"); reasons != u.end() && !reasons->is_null()) {
       if (!reasons->is_array()) fail(child(at, "reasons"), "a list of strings", describe(*reasons));
       for (std::size_t k = 0; k < reasons->size(); ++k) {
@@ -654,9 +666,11 @@ void acceptance_table(std::string& out, const Document& doc) {
   }
   out += "<th>Reasons</th></tr></thead>\n<tbody>\n";
   for (const Unit& u : doc.units) {
-    out += u.accepted ? "<tr class=\"accepted\">" : "<tr class=\"rejected\">";
-    out += "<th scope=\"row\">" + escape(u.id) + "</th>";
-    out += u.accepted ? "<td class=\"status\">accepted</td>" : "<td class=\"status\">rejected</td>";
+    out += u.accepted ? "<tr class=\"accepted\">" : u.not_analysed ? "<tr class=\"not-analysed\">" : "<tr class=\"rejected\">";
+    out += "<th scope=\"row\">" + escape(u.name) + "</th>";
+    out += u.accepted       ? "<td class=\"status\">accepted</td>"
+           : u.not_analysed ? "<td class=\"status\">not analysed</td>"
+                            : "<td class=\"status\">rejected</td>";
     for (const Cell& c : u.cells) out += cell_html(c);
     out += "<td class=\"reasons\">";
     if (!u.reasons.empty()) {
@@ -671,125 +685,40 @@ void acceptance_table(std::string& out, const Document& doc) {
       "results.json has them in full.</p>\n</section>\n";
 }
 
-// results.batch, compactly: scalars (and lists of scalars) as "key value" lines, an object whose
-// values are all flat objects (e.g. the spread per quantity) and a list of flat objects (e.g. the
-// outliers) as one table each with a row per entry, deeper objects as titled blocks. Numbers to 3
-// significant digits.
-bool is_scalar_list(const json& v) {
-  if (!v.is_array()) return false;
-  for (const json& x : v) {
-    if (x.is_structured()) return false;
-  }
-  return true;
-}
-bool is_flat_object(const json& v) {
-  if (!v.is_object() || v.empty()) return false;
-  for (const auto& item : v.items()) {
-    if (item.value().is_structured() && !is_scalar_list(item.value())) return false;
-  }
-  return true;
-}
-std::string scalar_text(const json& v) {
-  if (v.is_null()) return "&ndash;";
-  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
-  if (v.is_number_integer() || v.is_number_unsigned()) return v.dump();
-  if (v.is_number()) return readable(v.get<double>());
-  if (v.is_string()) return escape(v.get<std::string>());
-  if (v.is_array()) {
-    if (v.empty()) return "none";
-    std::string s;
-    for (const json& x : v) s += (s.empty() ? "" : ", ") + scalar_text(x);
-    return s;
-  }
-  return "&hellip;";
-}
-std::string pretty_key(const std::string& key) {
-  std::string s = key;
-  for (char& c : s) c = c == '_' ? ' ' : c;
-  return escape(s);
-}
-// Rows (name, flat object) as one table, columns the union of their keys in first-seen order.
-void rows_table(std::string& out, const std::vector<std::pair<std::string, const json*>>& rows, const std::string& first) {
-  std::vector<std::string> keys;
-  for (const auto& [name, obj] : rows) {
-    for (const auto& item : obj->items()) {
-      if (std::find(keys.begin(), keys.end(), item.key()) == keys.end()) keys.push_back(item.key());
-    }
-  }
-  out += "<div class=\"table-wrap\"><table class=\"params\"><thead><tr>";
-  if (!first.empty()) out += "<th>" + escape(first) + "</th>";
-  for (const auto& k : keys) out += "<th>" + pretty_key(k) + "</th>";
-  out += "</tr></thead><tbody>";
-  for (const auto& [name, obj] : rows) {
-    out += "<tr>";
-    if (!first.empty()) out += "<th scope=\"row\">" + pretty_key(name) + "</th>";
-    for (const auto& k : keys) {
-      const auto it = obj->find(k);
-      out += it == obj->end() ? "<td class=\"nm\">&ndash;</td>" : "<td class=\"num\">" + scalar_text(*it) + "</td>";
-    }
-    out += "</tr>";
-  }
-  out += "</tbody></table></div>";
-}
-void batch_value(std::string& out, const json& value, int depth) {
-  if (depth > 4 || !value.is_object()) {
-    out += "<p>" + scalar_text(value) + "</p>";
-    return;
-  }
-  std::string line;
-  for (const auto& item : value.items()) {
-    const json& v = item.value();
-    if (!v.is_structured() || is_scalar_list(v)) line += "<span class=\"kv\"><b>" + pretty_key(item.key()) + "</b> " + scalar_text(v) + "</span> ";
-  }
-  if (!line.empty()) out += "<p class=\"kvs\">" + line + "</p>";
-  for (const auto& item : value.items()) {
-    const json& v = item.value();
-    if (!v.is_structured() || is_scalar_list(v)) continue;
-    out += "<h4>" + pretty_key(item.key()) + "</h4>";
-    std::vector<std::pair<std::string, const json*>> rows;
-    bool tabular = !v.empty();
-    if (v.is_object()) {
-      for (const auto& e : v.items()) {
-        tabular = tabular && is_flat_object(e.value());
-        rows.emplace_back(e.key(), &e.value());
-      }
-    } else {
-      for (const json& e : v) {
-        tabular = tabular && is_flat_object(e);
-        rows.emplace_back("", &e);
-      }
-    }
-    if (tabular) {
-      rows_table(out, rows, v.is_object() ? "quantity" : "");
-    } else if (v.is_array()) {
-      out += v.empty() ? "<p>none</p>" : "<p>" + std::to_string(v.size()) + " entries (results.json)</p>";
-    } else {
-      batch_value(out, v, depth + 1);
-    }
-  }
-}
-
+// Counts, and the units rejected or not analysed by name (the batch's tables are in the report's
+// "Batch comparison" section).
 void batch_summary(std::string& out, const Document& doc) {
   std::size_t accepted = 0;
-  for (const Unit& u : doc.units) accepted += u.accepted ? 1 : 0;
+  std::vector<const Unit*> rejected, not_analysed;
+  for (const Unit& u : doc.units) {
+    if (u.accepted) {
+      ++accepted;
+    } else {
+      (u.not_analysed ? not_analysed : rejected).push_back(&u);
+    }
+  }
+  const auto names = [](const std::vector<const Unit*>& list) {
+    std::string text;
+    for (const Unit* u : list) text += (text.empty() ? ": " : ", ") + escape(u->name);
+    return text;
+  };
   out += "<section id=\"batch\"><h2>2. Batch summary</h2>\n<dl class=\"summary\">";
   out += "<dt>Units</dt><dd>" + std::to_string(doc.units.size()) + "</dd>";
   out += "<dt>Accepted</dt><dd>" + std::to_string(accepted) + "</dd>";
-  out += "<dt>Rejected</dt><dd>" + std::to_string(doc.units.size() - accepted);
-  bool first = true;
-  for (const Unit& u : doc.units) {
-    if (u.accepted) continue;
-    out += first ? ": " : ", ";
-    first = false;
-    out += escape(u.id);
+  out += "<dt>Rejected</dt><dd>" + std::to_string(rejected.size()) + names(rejected) + "</dd>";
+  if (!not_analysed.empty()) {
+    out += "<dt>Not analysed</dt><dd>" + std::to_string(not_analysed.size()) + names(not_analysed) + "<ul>";
+    for (const Unit* u : not_analysed) out += "<li>" + escape(u->name) + ": " + escape(*u->not_analysed) + "</li>";
+    out += "</ul></dd>";
   }
-  out += "</dd>";
-  if (doc.iff_optimal_gain != nullptr) out += "<dt>IFF optimal gain</dt><dd>" + scalar_text(*doc.iff_optimal_gain) + "</dd>";
+  if (doc.iff_optimal_gain != nullptr) {
+    out += "<dt>IFF optimal gain g</dt><dd>" + (doc.iff_optimal_gain->is_number() ? readable(doc.iff_optimal_gain->get<double>())
+                                                                                    : escape(doc.iff_optimal_gain->dump())) +
+           " (a factor on the controller of eq. 2.4)</dd>";
+  }
   out += "</dl>\n";
-  if (doc.batch != nullptr) {
-    out += "<div class=\"table-wrap\">";
-    batch_value(out, *doc.batch, 0);
-    out += "</div>\n";
+  if (!rejected.empty()) {
+    out += "<p>Why each rejected unit is rejected: the Reasons column of the acceptance table.</p>\n";
   }
   out += "</section>\n";
 }

@@ -128,7 +128,7 @@ TEST(RtCli, BadInputIsReported) {
     const test::CliRun r = run_cli(args);
     EXPECT_EQ(r.exit_code, code) << args << "\n" << r.err;
     EXPECT_TRUE(test::contains(r.err, needle)) << args << "\n" << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(test::no_result(r)) << r.out;
   };
   expect(2, "rt --bench hardware --gain 1 --json", "--bench");
   expect(2, "rt --bench replay --gain 1 --json", "--replay");

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "test_util.hpp"
@@ -29,6 +30,14 @@ inline CliRun run_cli(const std::string& args) {
   r.out = read_text(out);
   r.err = read_text(err);
   return r;
+}
+
+// True when a failed run printed no result: stdout empty, or (with --json) only the JSON error
+// document {"error": {...}} of docs/cli.md.
+inline bool no_result(const CliRun& r) {
+  if (r.out.empty()) return true;
+  const auto doc = nlohmann::json::parse(r.out, nullptr, false);
+  return doc.is_object() && doc.size() == 1 && doc.contains("error") && doc["error"]["exit_code"] == r.exit_code;
 }
 
 // Writes `text` to dir/name and returns the path.

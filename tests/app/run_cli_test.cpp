@@ -179,14 +179,57 @@ std::string fmt_name(int i) {
   return name;
 }
 
+// Issue 33: a unit whose file is missing or whose channel is not in its file is not analysed; the
+// other unit is, every output is written, and the exit code is 7 (docs/cli.md); --json prints the
+// results with the unit's not_analysed entry.
+TEST(RunCli, BadUnitIsNotAnalysedWithExit7) {
+  const fs::path& d = demo_dir();
+  TempDir dir;
+  const std::string stroke = (d / "data/unit1_stroke.mat").string();
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"frf = \"missing.mat\"\n", {"units[1].frf", "missing.mat"}},
+      {"stroke = { file = \"" + stroke + "\", channels = { de = \"laser\" } }\n", {"units[1].stroke", "laser"}},
+  };
+  int i = 0;
+  for (const auto& [bad, expected] : cases) {
+    const fs::path file = dir.path() / fmt_name(i++);
+    std::ofstream(file) << "[[units]]\nid = 1\nstroke = \"" + stroke + "\"\n[[units]]\nid = 2\n" + bad;
+    const fs::path out = dir.path() / ("out" + std::to_string(i));
+    const CliRun r = run_cli("run " + file.string() + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 7) << bad << r.err;
+    EXPECT_TRUE(contains(r.out, "1 accepted, 0 rejected, 1 not analysed")) << r.out;
+    EXPECT_TRUE(contains(r.out, "APA 2    NOT ANALYSED")) << r.out;
+    for (const auto& e : expected) EXPECT_TRUE(contains(r.out, e)) << e << " in " << r.out;
+    for (const char* f : {"results.json", "results.mat", "report.html"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+    EXPECT_FALSE(fs::exists(out / ".piezobench.lock"));
+    const json results = json::parse(read_text(out / "results.json"));
+    EXPECT_EQ(results["summary"]["not_analysed"], 1);
+    EXPECT_TRUE(results["units"][0]["accepted"].get<bool>());
+    EXPECT_EQ(results["units"][1]["not_analysed"]["key"], expected[0]);
+  }
+}
+
+// --json on a failure: one JSON error document on stdout, the same exit code.
+TEST(RunCli, JsonErrorDocument) {
+  TempDir dir;
+  const CliRun missing = run_cli("run " + (dir.path() / "none.toml").string() + " --json --out " + (dir.path() / "o").string());
+  EXPECT_EQ(missing.exit_code, 3) << missing.err;
+  const json e = json::parse(missing.out);
+  EXPECT_EQ(e["error"]["kind"], "input");
+  EXPECT_EQ(e["error"]["exit_code"], 3);
+  EXPECT_TRUE(contains(e["error"]["message"].get<std::string>(), "none.toml")) << missing.out;
+  const CliRun usage = run_cli("demo --seeed 2 --json");
+  EXPECT_EQ(usage.exit_code, 2);
+  EXPECT_EQ(json::parse(usage.out)["error"]["kind"], "usage");
+  EXPECT_TRUE(contains(usage.err, "did you mean --seed")) << usage.err;
+}
+
 // Bad campaigns: exit 3, the campaign file and the key named, no results left in --out.
 TEST(RunCli, BadInputNamesFileAndKeyAndWritesNothing) {
   const fs::path& d = demo_dir();
   TempDir dir;
   const std::string stroke = (d / "data/unit1_stroke.mat").string();
   const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
-      {"[[units]]\nid = 1\nfrf = \"missing.mat\"\n", {"units[0].frf", "missing.mat", "does not exist"}},
-      {"[[units]]\nid = 1\nstroke = { file = \"" + stroke + "\", channels = { de = \"laser\" } }\n", {"units[0].stroke", "laser"}},
       {"[[units]]\nid = 1\n[[units]]\nid = 1\n", {"units[1].id", "listed twice"}},
       {"[[units]]\nid = 1\nfrequency = 3\n", {"units[0].frequency", "unknown key"}},
   };

@@ -41,6 +41,8 @@ struct Batch {
     };
     const std::string text = R"(
 title = "pipeline test"
+[bench]
+hpf_resistance_ohm = 80.6e3
 [specs]
 flatness_um = 25.0
 capacitance_sensor_uF = [4.0, 6.0]
@@ -276,12 +278,62 @@ TEST(Pipeline, Apa300mlSuperElementTunedNearEq41) {
   EXPECT_TRUE(table);
 }
 
-// Bad data stops the run with the campaign key named, before anything is written.
-TEST(Pipeline, BadDataStopsTheRun) {
+// Issue 33: one bad unit never sinks the batch. A unit whose file is missing, or whose data cannot
+// be analysed, is reported as not analysed with the file and the reason, neither accepted nor
+// rejected; the other units' results and the batch are those of the campaign without it; the
+// report and results.json are written.
+TEST(Pipeline, BadUnitIsNotAnalysedAndTheOthersAreThoseOfTheBatchWithoutIt) {
   Batch b;
-  b.campaign.units[1].stroke->channels["de"] = "laser";
-  const std::string msg = test::input_error([&] { (void)run_campaign(b.campaign); }, "units[1].stroke");
-  EXPECT_TRUE(test::contains(msg, "laser")) << msg;
+  Campaign without = b.campaign;
+  without.units.erase(without.units.begin() + 1);
+  const json reference = results_json(run_campaign(without));
+  for (const bool missing : {true, false}) {
+    Campaign c = b.campaign;
+    if (missing) {
+      c.units[1].stroke->path = b.dir.path() / "no-such-file.csv";
+      c.units[1].stroke->given = "no-such-file.csv";
+    } else {
+      c.units[1].stroke->channels["de"] = "laser";  // not in the file
+    }
+    const CampaignResult r = run_campaign(c);
+    EXPECT_EQ(r.accepted, 1);
+    EXPECT_EQ(r.rejected, 1);
+    EXPECT_EQ(r.not_analysed, 1);
+    const json results = results_json(r);
+    const json& u2 = unit(results, 2);
+    EXPECT_FALSE(u2["accepted"].get<bool>());
+    EXPECT_EQ(u2["not_analysed"]["file"], missing ? "no-such-file.csv" : "stroke2.csv");
+    EXPECT_EQ(u2["not_analysed"]["key"], "units[1].stroke");
+    const std::string reason = u2["not_analysed"]["reason"].get<std::string>();
+    EXPECT_TRUE(test::contains(reason, missing ? "no-such-file.csv" : "laser")) << reason;
+    EXPECT_TRUE(u2["capacitance_uF"].is_null());  // measured, but the unit is left out as a whole
+    EXPECT_EQ(results["summary"]["not_analysed"], 1);
+    for (const int id : {1, 3}) EXPECT_EQ(unit(results, id), unit(reference, id)) << id;
+    EXPECT_EQ(results["batch"], reference["batch"]);
+    EXPECT_EQ(results["iff"], reference["iff"]);
+    const fs::path out = b.dir.path() / (missing ? "out-missing" : "out-channel");
+    ASSERT_EQ(write_outputs(r, out).size(), 3u);
+    const std::string html = test::read_text(out / "report.html");
+    EXPECT_TRUE(test::contains(html, "<td class=\"status\">not analysed</td>"));
+    EXPECT_TRUE(test::contains(html, "<dt>Not analysed</dt><dd>1: APA 2")) << html.substr(0, 200);
+    EXPECT_TRUE(test::contains(html, "<dt>Rejected</dt><dd>1: APA 3</dd>"));
+  }
+}
+
+// A dead force sensor (Vs a constant 0 V in the FRF record): the unit is not analysed, naming the
+// file; the batch goes on.
+TEST(Pipeline, DeadForceSensorLeavesTheUnitOut) {
+  Batch b;
+  io::TimeSeries dead = syn::frf_record(8.0);
+  dead.data.col(2).setZero();
+  io::write_timeseries(dead, b.dir.path() / "frf1.mat");
+  const CampaignResult r = run_campaign(b.campaign);
+  const json results = results_json(r);
+  const json& u1 = unit(results, 1);
+  ASSERT_TRUE(u1.contains("not_analysed")) << u1.dump().substr(0, 400);
+  EXPECT_EQ(u1["not_analysed"]["file"], "frf1.mat");
+  EXPECT_EQ(r.not_analysed, 1);
+  EXPECT_EQ(r.accepted + r.rejected, 2);
 }
 
 }  // namespace

@@ -59,9 +59,30 @@ stiffness = "s.mat"
   }
   for (const char* s : {"frf", "quasi-static", "stiffness", "iff", "batch"}) EXPECT_EQ(sections.count(s), 1u) << s;
   for (const char* f : {"frf-de", "frf-vs", "model-vs", "hysteresis-1", "stiffness", "root-locus", "damped-plants",
-                        "batch-capacitance", "batch-stiffness", "batch-flatness", "batch-stroke"}) {
+                        "batch-capacitance", "batch-stiffness"}) {
     EXPECT_EQ(figures.count(f), 1u) << f;
   }
+  // Experiments no unit has: a line saying so, never an empty plot (issue 33).
+  for (const char* f : {"batch-flatness", "batch-stroke", "hammer"}) EXPECT_EQ(figures.count(f), 0u) << f;
+  std::string texts;
+  for (const auto& s : doc["sections"]) {
+    if (s.contains("text")) texts += s["text"].get<std::string>() + "\n";
+    if (s["id"] == "modes") EXPECT_TRUE(s["figures"].empty());
+  }
+  EXPECT_TRUE(test::contains(texts, "Not measured on any analysed unit, so not drawn: flatness, stroke.")) << texts;
+  EXPECT_TRUE(test::contains(texts, "Not measured in this campaign: no analysed unit has a hammer test record (hammer)")) << texts;
+  // The batch's spread with display names and units, in the report's order (no results keys).
+  const json* spread = nullptr;
+  for (const auto& s : doc["sections"]) {
+    if (s["id"] != "batch") continue;
+    for (const auto& t : s["tables"]) {
+      if (t["title"] == "Spread over the batch") spread = &t;
+    }
+  }
+  ASSERT_NE(spread, nullptr);
+  EXPECT_EQ((*spread)["columns"][0], "quantity");
+  EXPECT_EQ((*spread)["rows"][0][0], "capacitance of the sensor stack [uF]");
+  EXPECT_FALSE(test::contains((*spread).dump(), "_uF")) << (*spread).dump();
   // The frequency responses overlay the measurement (solid) and the model (dashed) of unit 1.
   const json& frf_de = doc["sections"][0]["figures"][0];
   ASSERT_GE(frf_de["panels"][0]["traces"].size(), 2u);

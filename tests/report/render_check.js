@@ -54,7 +54,10 @@ function nearestIndex(xs, x) {
 
 // In every figure with a magnitude panel first and a "Phase" panel, each group's model (dashed)
 // and measurement (solid): wherever their magnitudes agree within 25 %, their phases must be within
-// 180 degrees (the same branch). Returns the failures.
+// 180 degrees (the same branch). Model phases are drawn continuous; in `model-vs` the 2-DoF model's
+// zero is minimum phase while the measured one is not, so past the anti-resonance the two are one
+// turn apart by design: there a difference within 180 degrees of 360 passes too. Returns the
+// failures.
 function phaseBranchFailures(data) {
   const failures = [];
   let compared = 0;
@@ -76,7 +79,8 @@ function phaseBranchFailures(data) {
         if (a < 0 || b < 0 || c < 0 || dMag.y[a] === null || mMag.y[b] === null || mPh.y[c] === null) continue;
         if (Math.abs(Math.log(dMag.y[a] / mMag.y[b])) > Math.log(1.25)) continue;
         ++compared;
-        const d = Math.abs(y - mPh.y[c]);
+        let d = Math.abs(y - mPh.y[c]);
+        if (fig.id === 'model-vs') d = Math.min(d, Math.abs(d - 360));
         if (d > worst) { worst = d; worstX = x; }
       }
       if (worst > 180) failures.push(`figure ${fig.id}: ${g}: model and measured phase ${worst.toFixed(0)} deg apart at ${worstX.toPrecision(4)} where their magnitudes agree`);

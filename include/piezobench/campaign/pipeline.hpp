@@ -10,12 +10,13 @@
 //   flatness (spec method) <= flatness_um; capacitance of the sensor and of the actuator stacks
 //   inside their ranges; stroke >= stroke_min_um; k1, k2 and the resonance stiffness inside
 //   stiffness_N_per_um; with reject_outliers, no batch outlier in capacitance or stroke (robust
-//   z-score, metrology/capacitance.hpp); every analysis that was run succeeded.
+//   z-score, metrology/capacitance.hpp); every analysis that was run succeeded. A unit that could
+//   not be analysed is neither accepted nor rejected (CampaignResult::not_analysed).
 //
 // Outputs (write_outputs): OUT/results.mat, OUT/report.html and OUT/results.json, staged in a hidden
 // folder inside OUT and renamed into place only when all three are written, results.json last, so
 // results.json exists only when the run completed and a failed write leaves OUT as it was. Only these
-// fixed names (and the staging folder and the .piezobench.lock of `run`) under OUT are written.
+// fixed names (and the staging folder and the .piezobench.lock of `run`, removed when the run ends) under OUT are written.
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -32,9 +33,11 @@ struct PipelineOptions {
   Log log;          // progress lines (called under a lock; may be empty)
 };
 
-// Analyses every unit and the batch: finish_campaign(analyze_units(every unit)). InputError for bad
-// data (the first in unit order, the other units stop early); a NumericalError inside an analysis
-// is recorded, not thrown.
+// Analyses every unit and the batch: finish_campaign(analyze_units(every unit)). A unit whose data
+// cannot be analysed (a file missing or unreadable, bad data: analyze_unit) is reported as not
+// analysed with its file and reason, neither accepted nor rejected, and left out of the batch: the
+// other units' results are those of the campaign without it. A NumericalError inside an analysis is
+// recorded in the unit's `failed` (the unit is then rejected), not thrown.
 CampaignResult run_campaign(const Campaign& campaign, const PipelineOptions& options = {});
 
 // The per-unit half: the units at `indices` into campaign.units, in that order, on a pool of

@@ -59,6 +59,7 @@ struct FlatnessAnalysis {
   double probe_accuracy = 0.0;               // m, [bench]
   RecordProvenance provenance;
   std::vector<double> deviation;             // m, of every point (thinned), for the report
+  Curve probe_xy;                            // x, y of the same points [m] (the report's figure)
 };
 
 struct CapacitanceAnalysis {
@@ -164,9 +165,22 @@ struct HighPassCorner {
   std::optional<double> r_c_Hz;              // 1 / (2 pi R C_sensor) when C_sensor is measured
   std::optional<double> iff_plant_fit_Hz;    // eq. 2.3 fitted down to the lowest frequency
   std::optional<std::string> iff_plant_fit_error;  // the cross-check's failure (with r_c_Hz)
-  std::string method;
-  std::optional<double> corner_Hz;           // the unit's corner: r_c, else the IFF fit's, else the first-order fit's
+  std::string method;                        // how corner_Hz was chosen, or why there is none
+  double observable_above_Hz = 0.0;          // a third of the FRF's lowest line: a fitted corner below is not observable
+  // The unit's corner: r_c (a resistor in [bench] and C_sensor measured), else the IFF fit's, else
+  // the first-order fit's when observable; nullopt otherwise (no resistor: no high-pass to report).
+  std::optional<double> corner_Hz;
 };
+
+// Cross-checks of a unit's FRF features (UnitAnalysis::warnings when they disagree): the high-pass
+// corner's (1/(2 pi R C), the IFF plant fit, the first-order fit) by more than this ratio (the
+// free IFF plant fit of an 8 s record lands up to a factor 1.6 below 1/(2 pi R C); a bench
+// without the resistor read with the default 80.6 kOhm is a factor 50 to 100 off) ...
+inline constexpr double kHighPassCrossCheckRatio = 2.0;
+// ... and the resonance, anti-resonance and static gain of the fits against the vector fit's by
+// more than this relative difference (the demo's anti-resonances differ by up to 7 %: the vector
+// fit spreads the narrow notch over its poles).
+inline constexpr double kFeatureCrossCheckTolerance = 0.10;
 
 // The FRFs u -> [d_e, Vs] and what is read from them.
 struct FrfAnalysis {
@@ -245,9 +259,19 @@ struct FlexibleModes {
   dsp::Frf frf;  // F -> v
 };
 
+// Why a unit could not be analysed: one of its files is missing, unreadable or holds data no
+// analysis can use (a channel missing, NaN, a dead sensor's constant signal, ...). The unit's other
+// results are then left out, so the batch is the batch without it (pipeline.hpp).
+struct NotAnalysed {
+  std::string file;    // as given in the campaign ("" when the failure is not a file's)
+  std::string key;     // campaign key of the file entry, e.g. "units[1].frf"
+  std::string reason;  // the InputError's message
+};
+
 struct UnitAnalysis {
   int id = 0;
   std::string name;
+  std::optional<NotAnalysed> not_analysed;  // set: nothing else of the unit is filled in
   std::optional<FlatnessAnalysis> flatness_analysis;
   std::optional<CapacitanceAnalysis> capacitance_analysis;
   std::optional<StrokeAnalysis> stroke_analysis;
@@ -274,6 +298,7 @@ struct UnitAnalysis {
   std::optional<ident::DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
   std::vector<std::string> not_measured;     // experiments the campaign does not list
   std::vector<std::string> failed;           // "frf: vector fitting failed: ..." (NumericalError)
+  std::vector<std::string> warnings;         // cross-checks that disagree (kHighPassCrossCheckRatio, ...)
   // The acceptance (pipeline.hpp).
   bool accepted = false;
   std::vector<std::string> reasons;
@@ -283,6 +308,8 @@ struct UnitAnalysis {
 
 struct QuantitySpread {
   std::string quantity;  // results key, e.g. "capacitance_sensor_uF" (values in that unit)
+  std::string label;     // for people, e.g. "capacitance of the sensor stack"
+  std::string unit;      // of the values, e.g. "uF"
   long units = 0;
   double min = 0.0, max = 0.0, median = 0.0, relative_spread = 0.0, mad = 0.0;
 };
@@ -387,7 +414,8 @@ struct CampaignResult {
   IffStudy iff;
   std::optional<SuperElementComparison> superelement;  // when the campaign gives one
   int accepted = 0;
-  int rejected = 0;
+  int rejected = 0;      // analysed and rejected
+  int not_analysed = 0;  // units with UnitAnalysis::not_analysed (neither accepted nor rejected)
 };
 
 }  // namespace piezobench::campaign

@@ -23,8 +23,10 @@
 //                 report's second-order fit for comparison
 //   hammer        F -> v (Welch), flexible modes by peak picking and by LSCF (ident/modal.hpp)
 //
-// Data problems (a channel that is not in a file, NaN, too short a record, ...) are InputErrors
-// naming the campaign file and the key of the file entry, and stop the campaign. A method that fails
+// Data problems (a file missing or unreadable, a channel that is not in a file, NaN, too short a
+// record, a dead sensor's constant signal, ...) are InputErrors naming the campaign file and the key
+// of the file entry; analyze_unit records the first in UnitAnalysis::not_analysed (file, key,
+// reason) and leaves every other result of the unit out, so one bad unit never stops a batch. A method that fails
 // on valid data (NumericalError) is recorded in `failed` and the analysis is left out; the unit is
 // then not accepted (pipeline.hpp). An experiment the campaign does not list is `not_measured`.
 #include <functional>
@@ -61,7 +63,9 @@ Record load_record(const Campaign& campaign, const UnitSpec& unit, const FileSpe
 
 using Log = std::function<void(const std::string&)>;
 
-// All analyses of one unit (results.hpp; the acceptance is left to the pipeline) (single-threaded; the pipeline runs units in parallel).
+// All analyses of one unit (results.hpp; the acceptance is left to the pipeline) (single-threaded; the
+// pipeline runs units in parallel). Never throws InputError: a unit whose data cannot be analysed
+// comes back with `not_analysed` set.
 UnitAnalysis analyze_unit(const Campaign& campaign, const UnitSpec& unit, const Log& log = {});
 
 // Welch segment length used for a record of `samples` at `fs`: the campaign's nfft, or

@@ -42,14 +42,16 @@
 //     (shown to 3 significant digits), a string, true/false or null ("–"); trace "text": one hover
 //     label per point (string or null), shown with the point's x and y.
 //   - A trace's colour is its group's (its name's when it has no group), the same in every figure.
-//   - results.units: a list of objects with "id" (string or number, unique), "accepted" (bool) and
-//     "reasons" (a list of strings, at least one for a rejected unit). The key figures of the table
-//     are read where CLI.md puts them (flatness_um, capacitance_uF.{sensor,actuator}, stroke_um,
-//     stiffness_N_per_um.{k1,k2,resonance}, frf.{resonance_Hz,antiresonance_Hz,
-//     static_gain_um_per_V}, hpf_corner_Hz); a missing or null one reads "not measured". Other
-//     keys of results are ignored, except results.batch (shown compactly in the batch summary:
-//     its scalars as "key value" lines, an object of flat objects or a list of flat objects as one
-//     table, numbers to 3 significant digits) and results.iff.optimal_gain.
+//   - results.units: a list of objects with "id" (string or number, unique), optional "name" (shown
+//     instead of the id), "accepted" (bool), "reasons" (a list of strings, at least one for a unit
+//     not accepted) and optional "not_analysed" {"file", "key", "reason"} (a unit whose data could
+//     not be analysed: neither accepted, which is then an error, nor rejected). The key figures
+//     of the table are read where CLI.md puts them (flatness_um, capacitance_uF.{sensor,actuator},
+//     stroke_um, stiffness_N_per_um.{k1,k2,resonance}, frf.{resonance_Hz,antiresonance_Hz,
+//     static_gain_um_per_V}, hpf_corner_Hz); a missing or null one reads "not measured". The
+//     batch summary counts the units and names the rejected and not analysed ones. Other keys of
+//     results are ignored (results.batch must be an object when present; its tables belong in a
+//     section), except results.iff.optimal_gain.
 //   Every string is escaped: a unit name or a reason cannot inject HTML or script.
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>
