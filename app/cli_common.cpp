@@ -15,6 +15,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/io/units.hpp"
 
 namespace piezobench::app {
 
@@ -85,6 +86,46 @@ CLI::Validator parsed_by(const std::function<void(const std::string&)>& parse, c
         return {};
       },
       description);
+}
+
+std::map<std::string, std::string> parse_units(const std::string& text) {
+  std::map<std::string, std::string> out;
+  if (text.empty()) return out;
+  for (const std::string& item : split_list(text, "--units")) {
+    const std::size_t eq = item.find('=');
+    const auto trim = [](std::string s) {
+      const auto first = s.find_first_not_of(" \t"), last = s.find_last_not_of(" \t");
+      return first == std::string::npos ? std::string() : s.substr(first, last - first + 1);
+    };
+    const std::string name = eq == std::string::npos ? std::string() : trim(item.substr(0, eq));
+    const std::string unit = eq == std::string::npos ? std::string() : trim(item.substr(eq + 1));
+    if (name.empty() || unit.empty()) throw UsageError("--units", "CHANNEL=UNIT items (de=um,Vs=mV)", "'" + item + "'");
+    if (!io::find_unit(unit)) {
+      throw UsageError("--units", "a unit of the table (" + io::known_units() + ", or products and quotients of them) for " + name,
+                       "'" + unit + "'");
+    }
+    if (!out.emplace(name, unit).second) throw UsageError("--units", "each channel once", "'" + name + "' twice");
+  }
+  return out;
+}
+
+void add_units_option(CLI::App* command, std::string& text) {
+  command->add_option("--units", text,
+                      "units of the input file's channels, replacing or completing the file's: CHANNEL=UNIT,... (de=um,Vs=mV; "
+                      "for an FRF file also H_NAME=um/V or the input's name); every name must be a channel of the file")
+      ->check(parsed_by([](const std::string& v) { (void)parse_units(v); }, "CHANNEL=UNIT,..."));
+}
+
+void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) log_line("warning: " + w);
+}
+
+io::FrfFile read_frf_with_units(const std::string& file, const std::string& units) {
+  io::FrfReadOptions options;
+  options.unit_overrides = parse_units(units);
+  io::FrfFile frf = io::read_frf_file(file, options);
+  print_warnings(frf.warnings);
+  return frf;
 }
 
 CLI::Validator output_extension(const std::vector<std::string>& extensions) {

@@ -2,11 +2,13 @@
 // What every piezobench command shares: how it is registered, how it prints, how lists are parsed.
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "piezobench/core/fit_quality.hpp"
+#include "piezobench/io/frf_file.hpp"
 
 namespace piezobench::app {
 
@@ -49,6 +51,18 @@ nlohmann::json quality_json(const core::FitQuality& quality);
 int exit_code_for(const core::FitQuality& quality);
 // Prints a poor fit's problems and what to try on stderr; returns exit_code_for(quality).
 int report_quality(const core::FitQuality& quality);
+
+// `--units de=um,Vs=mV` (units of the input file's channels, replacing what the file says or
+// giving what it does not), added the same way to every command that reads a measurement or an
+// FRF file (frf, fit, fit iff-plant, model tune).
+void add_units_option(CLI::App* command, std::string& text);
+// "de=um, Vs=mV" -> {de: um, Vs: mV}; UsageError (option --units, exit 2) for an item without
+// '=', a name twice or a unit the unit table cannot parse (io/units.hpp).
+std::map<std::string, std::string> parse_units(const std::string& text);
+// Each warning on stderr ("piezobench: warning: ...").
+void print_warnings(const std::vector<std::string>& warnings);
+// An FRF file read with the command's --units (io::read_frf_file); its warnings printed.
+io::FrfFile read_frf_with_units(const std::string& file, const std::string& units);
 
 // A check that an output file's extension is one of `extensions` (lower case, with the dot).
 CLI::Validator output_extension(const std::vector<std::string>& extensions);

@@ -22,6 +22,7 @@
 #include "piezobench/io/json.hpp"
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
+#include "piezobench/io/units.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/core/units.hpp"
 
@@ -43,7 +44,19 @@ struct FrfOptions {
   bool json = false;
   std::string delimiter = "auto";  // CSV input only
   std::string decimal = "auto";
+  std::string units;               // --units de=um,Vs=mV
 };
+
+// The unit of H = output / input from the SI symbols of the record ("m/V"; "" when neither is known).
+std::string h_unit(const std::string& output_unit, const std::string& input_unit) {
+  if (output_unit.empty() && input_unit.empty()) return "";
+  const io::Unit num = output_unit.empty() ? io::Unit{} : io::unit_from_string(output_unit, "", "unit");
+  const io::Unit den = input_unit.empty() ? io::Unit{} : io::unit_from_string(input_unit, "", "unit");
+  const std::string symbol = io::divide(num, den).si_symbol;
+  const auto wrap = [](const std::string& u) { return u.find('/') == std::string::npos ? u : "(" + u + ")"; };
+  if (symbol.empty() && !output_unit.empty() && !input_unit.empty()) return wrap(output_unit) + "/" + wrap(input_unit);  // V/V
+  return symbol.empty() ? "1" : symbol;
+}
 
 nlohmann::json frf_json(const dsp::Frf& frf) {
   nlohmann::json outputs = nlohmann::json::object();
@@ -69,28 +82,40 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
 int run_frf(const FrfOptions& o) {
   io::ReadOptions read;
   read.fs = o.fs;
-  read.channels = split_list(o.outputs, "--output");
-  read.channels.insert(read.channels.begin(), o.input);
+  const std::vector<std::string> output_names = split_list(o.outputs, "--output");
+  // The input may be an output too (H = 1: a single-channel file still gives its spectrum's FRF).
+  read.channels = {o.input};
+  for (const std::string& name : output_names) {
+    if (std::find(read.channels.begin(), read.channels.end(), name) == read.channels.end()) read.channels.push_back(name);
+  }
   read.delimiter = io::csv_delimiter_from_string(o.delimiter);
   read.decimal = io::csv_decimal_from_string(o.decimal);
+  read.unit_overrides = parse_units(o.units);
   if (!o.json) log_line("reading " + o.file);
   // One pass over the samples: a large v5 record is used in place from the file's mapping, its
   // channels checked for NaN/Inf by the estimate's own pass (dsp::estimate_frf).
   const io::TimeSeriesView ts = io::read_timeseries_view(o.file, read, io::FiniteCheck::kCaller);
+  print_warnings(ts.warnings);
   // The settings `run` uses for a record (dsp::welch_options_for_record), then the options given.
   dsp::WelchOptions welch = dsp::welch_options_for_record(ts.samples, ts.sample_rate, o.resolution, "--resolution");
   welch.window = dsp::window_type_from_string(o.window);
-  if (o.nfft > 0) welch.nfft = o.nfft;
+  if (o.nfft > 0) {
+    welch.nfft = o.nfft;
+  } else if (welch.nfft > ts.samples) {
+    // A record shorter than `run`'s 256-sample minimum (UFF examples hold 13 or 250 samples):
+    // four segments of a quarter of it, 8 samples at least.
+    welch.nfft = std::min<Eigen::Index>(ts.samples, std::max<Eigen::Index>(8, ts.samples / 4));
+    if (!o.json) log_line(fmt::format("a short record ({} samples): nfft {} (--nfft to choose)", ts.samples, welch.nfft));
+  }
   welch.overlap = o.overlap;
   welch.detrend = dsp::detrend_from_string(o.detrend);
   welch.estimator = dsp::frf_estimator_from_string(o.estimator);
   welch.validate("command line");
 
   std::vector<dsp::Channel> outputs;
-  for (std::size_t i = 1; i < read.channels.size(); ++i) {
-    outputs.push_back({read.channels[i], {ts.columns[i], static_cast<std::size_t>(ts.samples)}});
-  }
-  const dsp::Channel input{o.input, {ts.columns[0], static_cast<std::size_t>(ts.samples)}};
+  const auto column = [&](const std::string& name) { return ts.columns[static_cast<std::size_t>(ts.index(name))]; };
+  for (const std::string& name : output_names) outputs.push_back({name, {column(name), static_cast<std::size_t>(ts.samples)}});
+  const dsp::Channel input{o.input, {column(o.input), static_cast<std::size_t>(ts.samples)}};
   if (!o.json) {
     log_line(fmt::format("{} samples at {:g} Hz, nfft {} ({:.4g} Hz bins), {} outputs", ts.samples, ts.sample_rate, welch.nfft,
                          ts.sample_rate / static_cast<double>(welch.nfft), outputs.size()));
@@ -102,7 +127,12 @@ int run_frf(const FrfOptions& o) {
   const dsp::FrequencyBand band = dsp::excited_band(estimate.frf, 0.5);
 
   if (!o.out.empty()) {
-    io::write_frf(estimate.frf, o.out);
+    io::FrfWriteOptions wo;
+    if (!ts.units.empty()) {
+      for (const std::string& name : estimate.frf.outputs) wo.output_units.push_back(ts.unit(name));
+      wo.input_unit = ts.unit(o.input);
+    }
+    io::write_frf(estimate.frf, o.out, wo);
     if (!o.json) log_line("wrote " + o.out);
   }
   if (o.json) {
@@ -114,6 +144,7 @@ int run_frf(const FrfOptions& o) {
       units[name] = (num.empty() ? "1" : num) + "/" + (den.empty() ? "1" : den);
     }
     document["H_units"] = std::move(units);
+    document["warnings"] = ts.warnings;
     print_json(document);
     return 0;
   }
@@ -133,8 +164,9 @@ int run_frf(const FrfOptions& o) {
       coh_sum += frf.coherence[i](k);
       ++count;
     }
-    fmt::print("  {}: peak |H| {:.4g} at {:.4g} Hz, mean coherence {:.3f} in the band\n", frf.outputs[i], std::abs(frf.H[i](peak)),
-               frf.freq_Hz(peak), count > 0 ? coh_sum / count : 0.0);
+    const std::string unit = h_unit(ts.unit(frf.outputs[i]), ts.unit(o.input));
+    fmt::print("  {}: peak |H| {:.4g} {} at {:.4g} Hz, mean coherence {:.3f} in the band\n", frf.outputs[i], std::abs(frf.H[i](peak)),
+               unit.empty() ? "(no unit: SI assumed)" : unit, frf.freq_Hz(peak), count > 0 ? coh_sum / count : 0.0);
   }
   return 0;
 }
@@ -150,6 +182,7 @@ struct FitOptions {
   int max_iterations = 50;
   std::string out;
   bool json = false;
+  std::string units;  // --units
 };
 
 // The part of an FRF inside [fmin, fmax], for the named outputs (empty = all). Without --fmin and
@@ -287,12 +320,17 @@ int run_fit(const FitOptions& o) {
   vf.weighting = ident::weighting_from_string(o.weighting);
   vf.max_iterations = o.max_iterations;
   vf.validate();
-  const dsp::Frf band = select_band(io::read_frf(o.file), o);
+  const io::FrfFile file = read_frf_with_units(o.file, o.units);
+  const dsp::Frf band = select_band(file.frf, o);
   if (!o.json) log_line(fmt::format("fitting {} poles to {} points of {}", o.order, band.freq_Hz.size(), fmt::join(band.outputs, ", ")));
   const ident::VectorFittingResult r = ident::vector_fit(band, vf);
   std::vector<std::vector<ZeroReport>> zeros;
   for (std::size_t i = 0; i < band.outputs.size(); ++i) zeros.push_back(zero_reports(r, band, static_cast<Eigen::Index>(i), vf));
-  const nlohmann::json document = fit_json(r, band, zeros);
+  nlohmann::json document = fit_json(r, band, zeros);
+  document["warnings"] = file.warnings;
+  nlohmann::json units = nlohmann::json::object();
+  for (std::size_t i = 0; i < file.frf.outputs.size(); ++i) units[file.frf.outputs[i]] = file.units[i];
+  document["H_units"] = std::move(units);
   if (!o.out.empty()) io::write_text_atomically(o.out, document.dump(2) + "\n");
   if (o.json) {
     print_json(document);
@@ -334,13 +372,15 @@ struct IffPlantOptions {
   double min_coherence = 0.5;
   std::string out;
   bool json = false;
+  std::string units;  // --units
 };
 
 int run_fit_iff_plant(const IffPlantOptions& o) {
   if (o.fmin < 0.0 || (o.fmax > 0.0 && o.fmax <= o.fmin)) {
     throw UsageError("--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
   }
-  const dsp::Frf frf = io::read_frf(o.file);
+  const io::FrfFile file = read_frf_with_units(o.file, o.units);
+  const dsp::Frf& frf = file.frf;
   const auto i = static_cast<std::size_t>(frf.output_index(o.output));
   ident::IffPlantFitOptions fo;
   fo.fmin_Hz = o.fmin;
@@ -370,6 +410,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
                     {"delay_s", io::to_json(p.delay)}, {"zero_is_nonminimum_phase", p.zero_is_nonminimum_phase()}};
   }
   doc.update(quality_json(p.quality));
+  doc["warnings"] = file.warnings;
   if (!o.out.empty() && !p.quality.impossible) {
     io::write_lti_toml(p.transfer_function(), o.out,
                        fmt::format("IFF plant (eq. 2.3) fitted to u -> {} of {} by piezobench fit iff-plant, {:.4g} to {:.4g} Hz, "
@@ -399,7 +440,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
 void add_frf_commands(CLI::App& app, Action& action) {
   auto f = std::make_shared<FrfOptions>();
   CLI::App* frf = app.add_subcommand("frf", "FRFs (Welch H1 or H2) and coherence from one input to several outputs of a time-series file");
-  frf->add_option("file", f->file, "time series: .mat (v5 or v7.3) or .csv with a header row")->required()->check(input_file());
+  frf->add_option("file", f->file, "time series: .mat (v5 or v7.3), .csv with a header row or .uff (UFF58 time histories)")->required()->check(input_file());
   frf->add_option("--input", f->input, "input channel name (e.g. u)")->required();
   frf->add_option("--output", f->outputs, "output channel names, comma-separated (e.g. de,Vs)")->required();
   frf->add_option("--fs", f->fs, "sample rate, Hz (needed when the file has no time vector t)");
@@ -423,6 +464,7 @@ void add_frf_commands(CLI::App& app, Action& action) {
   frf->add_option("--out", f->out, "write the FRF: .csv, .mat or .uff (Universal File Format 58)")
       ->check(output_extension({".csv", ".mat", ".uff", ".unv", ".uf"}));
   frf->add_flag("--json", f->json, "print one JSON document on stdout");
+  add_units_option(frf, f->units);
   frf->add_option("--delimiter", f->delimiter, "CSV input: auto (detected), ',', ';', tab or space")
       ->check(CLI::IsMember({"auto", ",", ";", "tab", "space"}))
       ->capture_default_str();
@@ -451,6 +493,7 @@ void add_frf_commands(CLI::App& app, Action& action) {
   fit->add_option("--max-iterations", v->max_iterations, "pole relocations at most")->capture_default_str();
   fit->add_option("--out", v->out, "write the fitted model as JSON (same document as --json)")->check(output_extension({".json"}));
   fit->add_flag("--json", v->json, "print one JSON document on stdout");
+  add_units_option(fit, v->units);
 
   auto ip = std::make_shared<IffPlantOptions>();
   CLI::App* iff_plant = fit->add_subcommand("iff-plant", "Fit the IFF plant of the report (eq. 2.3 with delay) to u -> Vs; --out writes "
@@ -466,6 +509,7 @@ void add_frf_commands(CLI::App& app, Action& action) {
   iff_plant->add_option("--out", ip->out, "write the plant as an LTI TOML file (transfer function with delay)")
       ->check(output_extension({".toml"}));
   iff_plant->add_flag("--json", ip->json, "print one JSON document on stdout");
+  add_units_option(iff_plant, ip->units);
   iff_plant->callback([ip, &action] { action = [ip] { return run_fit_iff_plant(*ip); }; });
 
   fit->callback([v, fit, &action] {

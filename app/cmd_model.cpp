@@ -121,13 +121,15 @@ struct TuneCommand {
   bool min_coherence_given = false;
   bool delay_given = false;
   bool json = false;
+  std::string units;  // --units
 };
 
 int run_tune(const TuneCommand& c) {
   apa::TuningOptions o = c.options;
   o.refine = !c.no_refine;
   o.validate();
-  const dsp::Frf frf = io::read_frf(c.frf_file);
+  const io::FrfFile file = read_frf_with_units(c.frf_file, c.units);
+  const dsp::Frf& frf = file.frf;
   const Eigen::Index de = frf.output_index(o.de_output), vs = frf.output_index(o.vs_output);
   const auto ude = static_cast<std::size_t>(de), uvs = static_cast<std::size_t>(vs);
   // The campaign's procedure and defaults (as `run`): the campaign's band (20 to 500 Hz: eq. 2.3
@@ -184,6 +186,7 @@ int run_tune(const TuneCommand& c) {
                 {"status", apa::to_string(t.status)},
                 {"message", t.message}};
     doc.update(quality_json(t.quality));
+    doc["warnings"] = file.warnings;
     print_json(doc);
     return report_quality(t.quality);
   }
@@ -278,6 +281,7 @@ void add_model_commands(CLI::App& app, Action& action) {
   tune->add_option("--vs-output", u->options.vs_output, "name of the force-sensor output")->capture_default_str();
   tune->add_flag("--no-refine", u->no_refine, "stop after the report's procedure (no least-squares refinement)");
   tune->add_flag("--json", u->json, "print one JSON document on stdout");
+  add_units_option(tune, u->units);
   tune->callback([u, tune, &action] {
     u->min_coherence_given = tune->count("--min-coherence") > 0;
     u->delay_given = tune->count("--delay") > 0;

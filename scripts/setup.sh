@@ -47,7 +47,7 @@ packages=(
   libopenblas0-serial
   # External programs piezobench drives (`superelement from-step`) and the independent checks of
   # the test suite (scipy reads the virtual bench's files).
-  gmsh calculix-ccx python3-scipy
+  gmsh calculix-ccx python3-scipy python3-h5py
   # The Python module (python/, pybind11) and its pytest suite, for Debian's python3.
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest
   # The fuzz job (docs/fuzzing.md): clang with libFuzzer and the sanitizer runtimes, and the

@@ -15,6 +15,7 @@
 
 #include "io/csv_table.hpp"
 #include "io/mat_file.hpp"
+#include "io/uff58.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
@@ -62,24 +63,96 @@ void FrfWriteOptions::validate() const {
 
 void write_frf(const dsp::Frf& frf, const fs::path& file, const FrfWriteOptions& options) {
   switch (frf_format_from_path(file)) {
-    case FrfFormat::kCsv: return write_frf_csv(frf, file);
+    case FrfFormat::kCsv: return write_frf_csv(frf, file, options);
     case FrfFormat::kMat: return write_frf_mat(frf, file, options);
     case FrfFormat::kUff58: return write_frf_uff58(frf, file, options);
   }
 }
 
-dsp::Frf read_frf(const fs::path& file, const FrfReadOptions& options) {
+namespace {
+detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& options);
+detail::StatedFrf stated_frf_mat(const fs::path& file);
+
+// The unit of output i's H: the override (H_NAME, else NAME / input), else what the file states.
+std::string frf_unit(const detail::StatedFrf& stated, size_t i, const FrfReadOptions& options) {
+  const auto& o = options.unit_overrides;
+  const std::string& name = stated.frf.outputs[i];
+  if (const auto h = o.find("H_" + name); h != o.end()) return h->second;
+  auto in = o.find(stated.frf.input.empty() ? std::string("input") : stated.frf.input);
+  if (in == o.end()) in = o.find("input");
+  const auto out = o.find(name);
+  if (out == o.end() && in == o.end()) return stated.units[i];
+  return "(" + (out != o.end() ? out->second : std::string("1")) + ")" + (in != o.end() ? "/(" + in->second + ")" : std::string());
+}
+
+// H in SI: each output's unit (frf_unit) parsed by the unit table and applied; warnings for an
+// output without a unit and for a file unit an override replaces.
+FrfFile to_si(detail::StatedFrf stated, const FrfReadOptions& options, const std::string& source) {
+  const dsp::Frf& frf = stated.frf;
+  if (stated.units.size() != frf.outputs.size()) stated.units.resize(frf.outputs.size());
+  for (const auto& [key, unit] : options.unit_overrides) {
+    const bool output = std::find(frf.outputs.begin(), frf.outputs.end(), key) != frf.outputs.end() ||
+                        (key.rfind("H_", 0) == 0 && std::find(frf.outputs.begin(), frf.outputs.end(), key.substr(2)) != frf.outputs.end());
+    if (!output && key != "input" && key != frf.input) {
+      throw InputError(source, "--units " + key, "an output (" + text::join(frf.outputs) + "), H_OUTPUT or the input (" +
+                                                    (frf.input.empty() ? std::string("input") : frf.input + " or input") + ")",
+                       quote(key) + ", which names no channel of the FRF");
+    }
+  }
+  FrfFile out;
+  for (size_t i = 0; i < frf.outputs.size(); ++i) {
+    const std::string unit = frf_unit(stated, i, options);
+    const std::string& name = frf.outputs[i];
+    if (unit != stated.units[i] && !stated.units[i].empty()) {
+      out.warnings.push_back(source + ": output " + name + ": unit " + quote(unit) + " from --units replaces " + quote(stated.units[i]) +
+                             " in the file");
+    }
+    if (unit.empty()) {
+      out.warnings.push_back(source + ": output " + name + " has no unit: H taken as SI (give it with --units H_" + name + "=UNIT)");
+      out.units.emplace_back();
+      continue;
+    }
+    const Unit u = unit_from_string(unit, source, "unit of H_" + name);
+    if (u.to_si != 1.0) stated.frf.H[i] *= u.to_si;
+    out.units.push_back(u.si_symbol.empty() ? "1" : u.si_symbol);
+  }
+  out.frf = std::move(stated.frf);
+  out.frf.validate(source);  // every message names source
+  return out;
+}
+}  // namespace
+
+FrfFile read_frf_file(const fs::path& file, const FrfReadOptions& options) {
+  const std::string source = file.string();
   switch (frf_format_from_path(file)) {
-    case FrfFormat::kCsv: return read_frf_csv(file, options);
-    case FrfFormat::kMat: return read_frf_mat(file);
-    case FrfFormat::kUff58: return read_frf_uff58(file);
+    case FrfFormat::kCsv: return to_si(stated_frf_csv(file, options), options, source);
+    case FrfFormat::kMat: return to_si(stated_frf_mat(file), options, source);
+    case FrfFormat::kUff58: return to_si(detail::read_uff58_frf(file), options, source);
   }
   return {};
 }
 
+dsp::Frf read_frf(const fs::path& file, const FrfReadOptions& options) { return read_frf_file(file, options).frf; }
+dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) { return to_si(stated_frf_csv(file, options), options, file.string()).frf; }
+dsp::Frf read_frf_mat(const fs::path& file, const FrfReadOptions& options) { return to_si(stated_frf_mat(file), options, file.string()).frf; }
+dsp::Frf read_frf_uff58(const fs::path& file, const FrfReadOptions& options) {
+  return to_si(detail::read_uff58_frf(file), options, file.string()).frf;
+}
+
 // ---- CSV ------------------------------------------------------------------------------------
 
-void write_frf_csv(const dsp::Frf& frf, const fs::path& file) {
+namespace {
+// The unit of output i's H from the write options ("" when not known).
+std::string written_unit(const FrfWriteOptions& options, size_t i) {
+  if (i >= options.output_units.size() || (options.output_units[i].empty() && options.input_unit.empty())) return "";
+  const Unit out = options.output_units[i].empty() ? Unit{} : unit_from_string(options.output_units[i], "FrfWriteOptions", "output_units");
+  const Unit in = options.input_unit.empty() ? Unit{} : unit_from_string(options.input_unit, "FrfWriteOptions", "input_unit");
+  const std::string symbol = divide(out, in).symbol;
+  return symbol.empty() ? "1" : symbol;
+}
+}  // namespace
+
+void write_frf_csv(const dsp::Frf& frf, const fs::path& file, const FrfWriteOptions& options) {
   frf.validate(file.string());
   for (const std::string& name : frf.outputs) {
     if (name.find_first_of(",\"\r\n") != std::string::npos || name != text::trim(name)) {
@@ -89,8 +162,11 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file) {
   const bool coh = !frf.coherence.empty();
   write_atomically(file, [&](std::ostream& out) {
     std::string line = "freq_Hz";
-    for (const std::string& name : frf.outputs) {
-      line += ",re_" + name + ",im_" + name;
+    for (size_t i = 0; i < frf.outputs.size(); ++i) {
+      const std::string& name = frf.outputs[i];
+      const std::string unit = written_unit(options, i);
+      const std::string suffix = unit.empty() ? std::string() : " [" + unit + "]";
+      line += ",re_" + name + suffix + ",im_" + name + suffix;
       if (coh) line += ",coh_" + name;
     }
     out << line << '\n';
@@ -107,7 +183,8 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file) {
   });
 }
 
-dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) {
+namespace {
+detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& options) {
   const detail::CsvTable table(file, {options.delimiter, options.decimal});
   const std::string& source = table.source();
   const auto& columns = table.columns();
@@ -126,6 +203,7 @@ dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) {
   }
   enum class Part { kRe, kIm, kCoh };
   dsp::Frf frf;
+  std::vector<std::string> stated_units;  // per output, as written
   std::vector<int> target(columns.size(), -1);
   std::map<std::string, std::array<int, 3>> seen;  // output -> column index of re, im, coh
   target[0] = 0;
@@ -147,12 +225,21 @@ dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) {
       throw InputError(source, where, "re_NAME, im_NAME or coh_NAME", quote(cell));
     }
     if (name.empty()) throw InputError(source, where, "a channel name after the prefix", quote(cell));
-    if (!columns[c].unit.empty()) {
-      throw InputError(source, where, "no unit (an FRF file holds the response in the units of its measurement)",
-                       "unit " + quote(columns[c].unit));
-    }
     auto [it, inserted] = seen.try_emplace(name, std::array<int, 3>{-1, -1, -1});
-    if (inserted) frf.outputs.push_back(name);
+    if (inserted) {
+      frf.outputs.push_back(name);
+      stated_units.emplace_back();
+    }
+    // The unit of H on re_ and im_ (`re_de [um/V]`): the same on both; coherence has none.
+    const std::string& unit = columns[c].unit;
+    std::string& stated = stated_units[static_cast<size_t>(std::find(frf.outputs.begin(), frf.outputs.end(), name) - frf.outputs.begin())];
+    if (part == Part::kCoh) {
+      if (!unit.empty() && unit != "-" && unit != "1") throw InputError(source, where, "no unit for a coherence (or - or 1)", "unit " + quote(unit));
+    } else if (!unit.empty() || !stated.empty()) {
+      const bool first_part = seen[name][0] < 0 && seen[name][1] < 0;
+      if (first_part) stated = unit;
+      else if (stated != unit) throw InputError(source, where, "the unit of the other part of " + name + " (" + quote(stated) + ")", "unit " + quote(unit));
+    }
     int& slot = it->second[static_cast<size_t>(part)];
     if (slot >= 0) throw InputError(source, where, "each column once", quote(cell) + " twice");
     slot = static_cast<int>(c);
@@ -186,9 +273,9 @@ dsp::Frf read_frf_csv(const fs::path& file, const FrfReadOptions& options) {
     if (with_coh != 0) frf.coherence.emplace_back(data.col(base + 2));
   }
   frf.provenance.source = source;
-  frf.validate(source);
-  return frf;
+  return {std::move(frf), std::move(stated_units)};
 }
+}  // namespace
 
 // ---- MAT ------------------------------------------------------------------------------------
 
@@ -226,10 +313,17 @@ void write_frf_mat(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
       if (!frf.coherence.empty()) w.write(detail::make_real_column("coh_" + frf.outputs[i], frf.coherence[i]));
     }
     w.write(detail::make_struct("provenance", provenance_fields(frf.provenance)));
+    std::vector<std::pair<std::string, detail::MatValue>> units;
+    for (size_t i = 0; i < frf.outputs.size(); ++i) {
+      const std::string unit = written_unit(options, i);
+      if (!unit.empty()) units.emplace_back("H_" + frf.outputs[i], detail::make_text("H_" + frf.outputs[i], unit));
+    }
+    if (!units.empty()) w.write(detail::make_struct("units", std::move(units)));
   });
 }
 
-dsp::Frf read_frf_mat(const fs::path& file) {
+namespace {
+detail::StatedFrf stated_frf_mat(const fs::path& file) {
   const std::string source = file.string();
   detail::MatFilePtr mat = detail::open_mat_for_reading(file);
   const std::vector<detail::MatVarInfo> vars = detail::list_mat_variables(mat.get(), file);
@@ -296,8 +390,33 @@ dsp::Frf read_frf_mat(const fs::path& file) {
     }
   }
   if (frf.provenance.source.empty()) frf.provenance.source = source;
-  frf.validate(source);  // every message names source
-  return frf;
+  // Units of H: a `units` struct (field H_NAME or NAME, e.g. 'um/V'), else (v7.3) the `units`
+  // attribute of the H_NAME dataset. A field naming no output is an InputError.
+  std::vector<std::string> units(frf.outputs.size());
+  for (size_t i = 0; i < frf.outputs.size(); ++i) {
+    const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == "H_" + frf.outputs[i]; });
+    if (info != vars.end()) units[i] = info->unit;
+  }
+  const auto units_var = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return text::to_lower(v.name) == "units"; });
+  if (units_var != vars.end()) {
+    const detail::MatValue u = detail::read_mat_variable(mat.get(), file, units_var->name);
+    if (u.class_type != MAT_C_STRUCT || u.count() != 1) throw InputError(source, units_var->name, "a 1x1 struct of units (H_NAME = 'um/V')", detail::describe(u));
+    for (const std::string& f : u.field_names) {
+      const std::string where = units_var->name + "." + f;
+      const std::string name = f.rfind("H_", 0) == 0 ? f.substr(2) : f;
+      const auto it = std::find(frf.outputs.begin(), frf.outputs.end(), name);
+      if (it == frf.outputs.end()) {
+        if (f == kFreq || f == "freq" || f.rfind("coh_", 0) == 0) continue;
+        throw InputError(source, where, "the unit of an output (H_" + text::join(frf.outputs, ", H_") + ")", quote(f) + ", which names no output");
+      }
+      const std::string unit(text::trim(detail::to_text(*u.field(f), source, where)));
+      std::string& slot = units[static_cast<size_t>(it - frf.outputs.begin())];
+      if (!slot.empty() && slot != unit) throw InputError(source, where, "the unit the H_" + name + " attribute gives (" + slot + ")", quote(unit));
+      slot = unit;
+    }
+  }
+  return {std::move(frf), std::move(units)};
 }
+}  // namespace
 
 }  // namespace piezobench::io

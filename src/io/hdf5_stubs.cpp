@@ -26,6 +26,8 @@
   X(hid_t, H5Oopen, (hid_t loc_id, const char* name, hid_t lapl_id), (loc_id, name, lapl_id))                    \
   X(herr_t, H5Oclose, (hid_t object_id), (object_id))                                                            \
   X(htri_t, H5Aexists, (hid_t obj_id, const char* attr_name), (obj_id, attr_name))                               \
+  X(herr_t, H5Aiterate2, (hid_t loc_id, H5_index_t idx_type, H5_iter_order_t order, hsize_t* idx, H5A_operator2_t op, void* op_data), \
+    (loc_id, idx_type, order, idx, op, op_data))                                                                 \
   X(hid_t, H5Aopen, (hid_t obj_id, const char* attr_name, hid_t aapl_id), (obj_id, attr_name, aapl_id))          \
   X(hid_t, H5Aget_space, (hid_t attr_id), (attr_id))                                                             \
   X(hid_t, H5Aget_type, (hid_t attr_id), (attr_id))                                                              \

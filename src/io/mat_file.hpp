@@ -81,6 +81,11 @@ struct MatValue {
   // struct: element e's field f at items[e * field_names.size() + f]; cell: the cells
   std::vector<MatValue> items;
   bool has_data = true;  // false: the header only (sparse, object, function: never read)
+  // v7.3 (HDF5) only: a dataset's string attribute `units` (or `unit`, any case: h5py users write
+  // one), and a group's other string attributes (name, text), e.g. `units` = "u=V, de=um" or
+  // `de_units` = "um". Empty for v5.
+  std::string unit;
+  std::vector<std::pair<std::string, std::string>> attributes;
 
   [[nodiscard]] size_t count() const;  // product of dims
   [[nodiscard]] const double* real() const { return view != nullptr ? view : re.data(); }

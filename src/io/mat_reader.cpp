@@ -692,6 +692,38 @@ std::string read_string_attribute(hid_t obj, const char* name, const std::string
   return out;
 }
 
+// The `units` attribute of a dataset, spelled units, unit, Units, Unit or UNITS ("" when none).
+std::string read_unit_attribute(hid_t obj, const std::string& source, const std::string& field) {
+  for (const char* name : {"units", "unit", "Units", "Unit", "UNITS"}) {
+    if (H5Aexists(obj, name) > 0) return read_string_attribute(obj, name, source, field + " (attribute " + name + ")");
+  }
+  return "";
+}
+
+// The string attributes of a group other than MATLAB's own (MATLAB_class, ...), at most 4096.
+std::vector<std::pair<std::string, std::string>> read_group_attributes(hid_t obj, const std::string& source, const std::string& field) {
+  std::vector<std::string> names;
+  hsize_t idx = 0;
+  const auto collect = [](hid_t, const char* name, const H5A_info_t*, void* data) -> herr_t {
+    auto* out = static_cast<std::vector<std::string>*>(data);
+    if (out->size() > 4096) return 1;
+    out->emplace_back(name);
+    return 0;
+  };
+  if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, &idx, collect, &names) < 0) {
+    throw InputError(source, field, "readable attributes", "HDF5 cannot list them");
+  }
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const std::string& name : names) {
+    if (name.rfind("MATLAB_", 0) == 0) continue;
+    const H5Id attr(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose);
+    const H5Id type(attr.valid() ? H5Aget_type(attr.get()) : -1, H5Tclose);
+    if (!type.valid() || H5Tget_class(type.get()) != H5T_STRING) continue;  // numbers are no units
+    out.emplace_back(name, read_string_attribute(obj, name.c_str(), source, field + " (attribute " + name + ")"));
+  }
+  return out;
+}
+
 bool read_flag_attribute(hid_t obj, const char* name, const std::string& source, const std::string& field) {
   if (H5Aexists(obj, name) <= 0) return false;
   const H5Id attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
@@ -820,6 +852,7 @@ void check_h5_storage(const H5File& in, const H5Var& v, const std::string& field
 }
 
 MatValue read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth);
+MatValue read_h5_data(const H5File& in, const H5Var& v, const std::string& name, const std::string& field, size_t n);
 
 MatValue read_h5_struct(const H5File& in, const H5Var& v, const std::string& name, const std::string& field, int depth) {
   const std::string source = in.source();
@@ -838,6 +871,7 @@ MatValue read_h5_struct(const H5File& in, const H5Var& v, const std::string& nam
   if (names.size() > 4096) throw InputError(source, field, "a struct of at most 4096 fields", "more");
   MatValue out(name, MAT_C_STRUCT, {1, 1});
   out.field_names = names;
+  out.attributes = read_group_attributes(v.obj.get(), source, field);
   for (const auto& n : names) {
     out.items.push_back(read_h5_var(in, v.obj.get(), n, field + "." + n, depth + 1));
     out.items.back().name = n;
@@ -863,6 +897,17 @@ MatValue read_h5_var(const H5File& in, hid_t parent, const std::string& name, co
   }
   check_h5_storage(in, v, field);
   if (n == 0 || v.empty_flag) return MatValue(name, v.cls == MAT_C_CHAR ? MAT_C_CHAR : MAT_C_DOUBLE, v.dims);
+  if (v.cls != MAT_C_CHAR) {
+    MatValue out = read_h5_data(in, v, name, field, n);
+    out.unit = read_unit_attribute(v.obj.get(), source, field);
+    return out;
+  }
+  return read_h5_data(in, v, name, field, n);
+}
+
+// The data of a numeric or char dataset of n > 0 elements.
+MatValue read_h5_data(const H5File& in, const H5Var& v, const std::string& name, const std::string& field, size_t n) {
+  const std::string source = in.source();
   const auto fail_read = [&] { throw InputError(source, field, "data HDF5 can read", "the read failed (corrupt or truncated file)"); };
   if (v.cls == MAT_C_CHAR) {
     std::vector<std::uint16_t> units(n);
@@ -998,6 +1043,12 @@ void put_value(IsolatedOut& out, const MatValue& v) {
   for (const std::string& f : v.field_names) out.put_string(f);
   out.put_u64(v.items.size());
   for (const MatValue& item : v.items) put_value(out, item);
+  out.put_string(v.unit);
+  out.put_u64(v.attributes.size());
+  for (const auto& [key, text] : v.attributes) {
+    out.put_string(key);
+    out.put_string(text);
+  }
 }
 
 // The MatValue put_value sent. `budget`: the bytes of data and the items the answer may still
@@ -1032,6 +1083,13 @@ MatValue get_value(IsolatedIn& in, double& budget, int depth) {
   const std::uint64_t items = in.get_u64();
   spend(64.0 * static_cast<double>(items));
   for (std::uint64_t i = 0; i < items; ++i) v.items.push_back(get_value(in, budget, depth + 1));
+  v.unit = in.get_string(4096);
+  const std::uint64_t attributes = in.get_u64();
+  if (attributes > 4096) in.malformed(std::to_string(attributes) + " attributes");
+  for (std::uint64_t a = 0; a < attributes; ++a) {
+    std::string key = in.get_string(4096);
+    v.attributes.emplace_back(std::move(key), in.get_string(4096));
+  }
   return v;
 }
 
@@ -1053,7 +1111,7 @@ class Mat73Input final : public MatInput {
               const H5Var v = open_h5_var(h5, h5.root(), name, name);
               // Readers size their buffers from this list: the declared size is checked here, first.
               if (!v.group && (is_numeric_class(v.cls) || v.cls == MAT_C_CHAR)) check_h5_storage(h5, v, name);
-              list.push_back({name, v.cls, v.complex, v.dims, read_string_attribute(v.obj.get(), "units", h5.source(), name)});
+              list.push_back({name, v.cls, v.complex, v.dims, v.group ? std::string() : read_unit_attribute(v.obj.get(), h5.source(), name)});
             }
           } catch (const InputError& e) {
             // Reported by list_mat_variables, as when the file was read in this process.

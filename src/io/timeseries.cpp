@@ -12,6 +12,7 @@
 
 #include "io/csv_table.hpp"
 #include "io/mat_file.hpp"
+#include "io/uff58.hpp"
 #include "io/mapped_file.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
@@ -34,6 +35,9 @@ constexpr const char* kChannelOrder = "channels";  // comma-separated names, in 
 // Samples read from a .mat file at once (256 KiB): large enough for full-speed reads, small enough
 // for the checks that follow each piece to find it in the L2 cache.
 constexpr Eigen::Index kReadChunk = Eigen::Index{1} << 15;
+// Stamps within this many sample periods of the line through their end points are exact (the
+// reader's fast pass, time_samples_ok); others go through fit_time.
+constexpr double kExactTime = 1e-6;
 
 // True when every sample is finite: x * 0 is 0 for a finite x and NaN for NaN and +-Inf, and
 // Eigen's sum runs on vectors (the caller finds the bad sample with check_finite only when there
@@ -103,10 +107,61 @@ bool time_samples_ok(const double* t, Eigen::Index n, Eigen::Index first, Eigen:
   return nonfinite == 0.0 && step > 0.0 && worst / dt <= tol;
 }
 
-// Strictly increasing and uniform within tol sample periods; returns the sample rate in Hz.
-// `prechecked`: the reader has verified all of it in its own pass (time_samples_ok).
-double sample_rate_from_time(const std::string& source, const Eigen::Ref<const Eigen::VectorXd>& t, double tol, bool prechecked) {
-  if (prechecked) return 1.0 / ((t(t.size() - 1) - t(0)) / static_cast<double>(t.size() - 1));
+// What a time vector says about the sampling: the rate of a least-squares line through the
+// stamps (t[k] = a + k dt), the precision the stamps are stored with and how far the worst stamp
+// lies from the line beyond that precision.
+struct TimeFit {
+  double rate = 0.0;       // Hz, 1 / dt of the fitted line
+  double precision = 0.0;  // s: half the quantum the file stores the stamps with, plus double round-off
+  double deviation = 0.0;  // s: largest |t[k] - (a + k dt)|
+  double jitter = 0.0;     // that deviation beyond `precision`, in sample periods
+  Eigen::Index worst = 0;  // the stamp of that deviation
+};
+
+// Half the quantum of stored stamps (s): the largest of their printed decimals (10^-d, from the
+// smallest d that every stamp examined is a multiple of), float32 storage (half an ulp of the
+// largest stamp) and double round-off. `scale`: seconds per stored unit (ms files: 1e-3), so that
+// the decimals and float32 are judged on the numbers as the file holds them.
+double stored_precision(const Eigen::Ref<const Eigen::VectorXd>& t, double scale, double dt) {
+  const Eigen::Index n = t.size();
+  const Eigen::Index step = std::max<Eigen::Index>(1, n / 4096);  // a sample of the stamps suffices
+  double largest = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) largest = std::max(largest, std::abs(t(k)));
+  const double eps = std::numeric_limits<double>::epsilon();
+  double half_quantum = 0.0;
+  bool float32 = true;
+  for (Eigen::Index k = 0; k < n && float32; k += step) {
+    const double raw = t(k) / scale;
+    float32 = std::abs(raw - static_cast<double>(static_cast<float>(raw))) <= 4.0 * eps * std::abs(raw);
+  }
+  if (float32) {
+    int exponent = 0;
+    (void)std::frexp(largest / scale, &exponent);
+    half_quantum = 0.5 * std::ldexp(1.0, exponent - 24) * scale;
+  }
+  for (int d = 0; d <= 15; ++d) {
+    const double quantum = std::pow(10.0, -d);
+    bool multiple = true;
+    for (Eigen::Index k = 0; k < n && multiple; k += step) {
+      const double units = t(k) / scale / quantum;
+      multiple = std::abs(units - std::round(units)) <= 16.0 * eps * std::abs(units) + 1e-9;
+    }
+    if (multiple) {
+      // A grid whose step is a whole number of quanta (10 kHz stamps with 4 decimals) is stored
+      // exactly: no rounding to allow for.
+      const double steps = dt / (quantum * scale);
+      if (!(steps >= 0.5 && std::abs(steps - std::round(steps)) <= 1e-6 * steps)) half_quantum = std::max(half_quantum, 0.5 * quantum * scale);
+      break;
+    }
+  }
+  return half_quantum + 8.0 * eps * largest;
+}
+
+bool is_time_name(const std::string& name);
+bool is_rate_name(const std::string& name);
+
+// Strictly increasing stamps (InputError otherwise), fitted by a line (see TimeFit).
+TimeFit fit_time(const std::string& source, const Eigen::Ref<const Eigen::VectorXd>& t, double scale) {
   check_finite(source, kTime, t);
   const Eigen::Index n = t.size();
   for (Eigen::Index k = 1; k < n; ++k) {
@@ -116,44 +171,102 @@ double sample_rate_from_time(const std::string& source, const Eigen::Ref<const E
                            "] = " + format_number(t(k - 1), 10));
     }
   }
-  const double dt = (t(n - 1) - t(0)) / static_cast<double>(n - 1);
-  // The reference line t0 + k dt is exact at both ends; measuring deviations from it (instead of
-  // from consecutive differences) catches slow drifts and single jitters alike.
-  for (Eigen::Index k = 1; k + 1 < n; ++k) {
-    const double expected = t(0) + static_cast<double>(k) * dt;
-    const double deviation = std::abs(t(k) - expected) / dt;
-    if (deviation > tol) {
-      throw InputError(source, kTime, "uniform sampling (deviation <= " + format_number(tol, 10) + " sample periods)",
-                       "t[" + std::to_string(k) + "] = " + format_number(t(k), 10) + ", " + format_number(deviation, 10) +
-                           " periods away from uniform");
+  // Offsets from t[0] (exact for epoch stamps: t[0] <= t[k] <= 2 t[0]), against centred indices.
+  const double t0 = t(0), kbar = 0.5 * static_cast<double>(n - 1);
+  double xbar = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) xbar += t(k) - t0;
+  xbar /= static_cast<double>(n);
+  double sxy = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) sxy += (static_cast<double>(k) - kbar) * (t(k) - t0 - xbar);
+  const double nn = static_cast<double>(n);
+  const double dt = sxy / (nn * (nn * nn - 1.0) / 12.0);
+  TimeFit fit;
+  fit.rate = 1.0 / dt;
+  // Stamps coarser than a quarter period cannot show a dropped sample (a step of half a period
+  // from the line at least): their precision counts as a quarter period at most.
+  fit.precision = std::min(stored_precision(t, scale, dt), 0.25 * dt);
+  double worst = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double r = std::abs(t(k) - t0 - (xbar + (static_cast<double>(k) - kbar) * dt));
+    if (r > worst) {
+      worst = r;
+      fit.worst = k;
     }
   }
-  return 1.0 / dt;
+  fit.deviation = worst;
+  fit.jitter = std::max(0.0, worst - fit.precision) / dt;
+  return fit;
+}
+
+std::string percent(double fraction) { return format_number(100.0 * fraction, 3) + " %"; }
+
+// The sample rate of a time vector: exact stamps (prechecked by the reader's own pass, or within
+// kExactTime periods of the line through the end points) give the end-to-end rate; others the
+// fitted one, when their jitter beyond the stored precision is at most `tol` sample periods.
+// `forced`: an explicit --fs replaces the stamps' rate, so jitter beyond `tol` is a warning.
+struct TimeRate {
+  double rate = 0.0;  // Hz
+  double relative_uncertainty = 0.0;
+};
+TimeRate sample_rate_from_time(const std::string& source, const Eigen::Ref<const Eigen::VectorXd>& t, double tol, bool prechecked,
+                               double scale, bool forced, std::vector<std::string>& warnings) {
+  const Eigen::Index n = t.size();
+  const double end_to_end = 1.0 / ((t(n - 1) - t(0)) / static_cast<double>(n - 1));
+  if (prechecked) return {end_to_end, 0.0};
+  const TimeFit fit = fit_time(source, t, scale);
+  const double dt = 1.0 / fit.rate;
+  if (fit.jitter > tol) {
+    const std::string found = "t[" + std::to_string(fit.worst) + "] = " + format_number(t(fit.worst), 12) + " s is " +
+                              percent(fit.jitter) + " of a sample period off the stamps' fitted rate " +
+                              format_number(fit.rate, 10) + " Hz (beyond the stored precision " +
+                              format_number(fit.precision, 3) + " s)";
+    if (!forced) {
+      throw InputError(source, kTime,
+                       "uniform sampling: jitter at most " + percent(tol) + " of a sample period beyond the stored precision "
+                       "(docs/formats.md, \"Time stamps\"; --fs overrides the time vector)",
+                       found);
+    }
+    warnings.push_back(source + ": t: non-uniform time stamps (" + found + "), ignored for the sample rate given");
+  }
+  // Uniform to round-off: the end-to-end rate (what exact stamps give, as the reader's own pass).
+  if (fit.deviation <= kExactTime * dt) return {end_to_end, 0.0};
+  // The fitted rate is good to about the worst deviation over the record's length.
+  return {fit.rate, 2.0 * fit.deviation / (t(n - 1) - t(0))};
 }
 
 bool agree(double a, double b, double tol) { return std::abs(a - b) <= tol * std::abs(b); }
 
 // Sample rate from, in order of precedence for the value returned: an explicit fs, the file's own
-// `fs`, the time vector. Every pair that is present must agree.
+// `fs`, the time vector. The file's fs must agree with the time vector; an explicit fs that
+// disagrees with either is used, with a warning naming both. `t_scale`: seconds per unit of the
+// stamps as the file stores them (time_unit_factor).
 double resolve_sample_rate(const std::string& source, const Eigen::Ref<const Eigen::VectorXd>& t, double fs_option,
-                           std::optional<double> fs_file, double tol, bool t_prechecked = false) {
+                           std::optional<double> fs_file, double tol, std::vector<std::string>& warnings,
+                           bool t_prechecked = false, double t_scale = 1.0) {
   std::optional<double> fs_time;
-  if (t.size() >= 2) fs_time = sample_rate_from_time(source, t, tol, t_prechecked);
+  double time_uncertainty = 0.0;
+  if (t.size() >= 2) {
+    const TimeRate r = sample_rate_from_time(source, t, tol, t_prechecked, t_scale, fs_option > 0.0, warnings);
+    fs_time = r.rate;
+    time_uncertainty = r.relative_uncertainty;
+  }
   if (t.size() == 1) check_finite(source, kTime, t);
   if (fs_file && !(std::isfinite(*fs_file) && *fs_file > 0.0)) {
     throw InputError(source, kFs, "a positive finite sample rate in Hz", format_number(*fs_file, 10));
   }
-  if (fs_option > 0.0 && fs_time && !agree(fs_option, *fs_time, tol)) {
-    throw InputError(source, "fs", "a sample rate consistent with t (" + format_number(*fs_time, 10) + " Hz from t)",
-                     "fs = " + format_number(fs_option, 10) + " Hz given");
+  const double rate_tol = kExactTime + time_uncertainty;
+  const auto disagreement = [](double a, double b) { return format_number(100.0 * (a - b) / b, 3) + " %"; };
+  if (fs_option > 0.0 && fs_time && !agree(fs_option, *fs_time, rate_tol)) {
+    warnings.push_back(source + ": --fs " + format_number(fs_option, 10) + " Hz overrides the time vector's " +
+                       format_number(*fs_time, 10) + " Hz (" + disagreement(fs_option, *fs_time) + ")");
   }
-  if (fs_option > 0.0 && fs_file && !agree(fs_option, *fs_file, tol)) {
-    throw InputError(source, "fs", "a sample rate consistent with the file's fs = " + format_number(*fs_file, 10) + " Hz",
-                     "fs = " + format_number(fs_option, 10) + " Hz given");
+  if (fs_option > 0.0 && fs_file && !agree(fs_option, *fs_file, kExactTime)) {
+    warnings.push_back(source + ": --fs " + format_number(fs_option, 10) + " Hz overrides the file's fs = " +
+                       format_number(*fs_file, 10) + " Hz (" + disagreement(fs_option, *fs_file) + ")");
   }
-  if (fs_file && fs_time && !agree(*fs_file, *fs_time, tol)) {
+  if (fs_option <= 0.0 && fs_file && fs_time && !agree(*fs_file, *fs_time, rate_tol)) {
     throw InputError(source, kFs, "a sample rate consistent with t (" + format_number(*fs_time, 10) + " Hz from t)",
-                     "fs = " + format_number(*fs_file, 10) + " Hz in the file");
+                     "fs = " + format_number(*fs_file, 10) + " Hz in the file (give --fs to choose)");
   }
   if (fs_option > 0.0) return fs_option;
   if (fs_file) return *fs_file;
@@ -164,6 +277,12 @@ double resolve_sample_rate(const std::string& source, const Eigen::Ref<const Eig
 bool is_time_name(const std::string& name) {
   const std::string l = text::to_lower(name);
   return l == "t" || l == "time";
+}
+
+// Whether a variable or field is called `units` (or `unit`, any case).
+bool is_units_name(const std::string& name) {
+  const std::string l = text::to_lower(name);
+  return l == "units" || l == "unit";
 }
 
 bool is_rate_name(const std::string& name) {
@@ -218,12 +337,13 @@ double time_unit_factor(const std::string& unit, const std::string& source, cons
   return u.to_si;
 }
 
-// SI units: each channel's unit (from the file, else ReadOptions::units) is looked up in the unit
-// table and replaced by its SI symbol; a unit the table does not know is an InputError naming the
-// channel and the units known. Units stay "" where nothing says one (all "": `units` is cleared).
-// Returns the factor from each channel's unit to SI.
+// SI units: each channel's unit (ReadOptions::unit_overrides, else the file's, else
+// ReadOptions::units) is looked up in the unit table and replaced by its SI symbol; a unit the
+// table does not know is an InputError naming the channel and the units known. A channel no unit
+// is given for stays "" (SI assumed) with a warning; all "": `units` is cleared. Returns the
+// factor from each channel's unit to SI.
 std::vector<double> to_si_units(const std::string& source, const std::vector<std::string>& names,
-                                std::vector<std::string>& units, const ReadOptions& options) {
+                                std::vector<std::string>& units, const ReadOptions& options, std::vector<std::string>& warnings) {
   if (units.empty()) units.assign(names.size(), "");
   std::vector<double> factors(names.size(), 1.0);
   for (size_t j = 0; j < names.size(); ++j) {
@@ -236,7 +356,18 @@ std::vector<double> to_si_units(const std::string& source, const std::vector<std
       }
       unit = given->second;
     }
-    if (unit.empty()) continue;
+    const auto forced = options.unit_overrides.find(names[j]);
+    if (forced != options.unit_overrides.end()) {
+      if (!unit.empty() && unit != forced->second) {
+        warnings.push_back(source + ": channel " + names[j] + ": unit " + quote(forced->second) + " from --units replaces " +
+                           quote(unit) + " in the file");
+      }
+      unit = forced->second;
+    }
+    if (unit.empty()) {
+      warnings.push_back(source + ": channel " + names[j] + " has no unit: taken as SI (give it with --units " + names[j] + "=UNIT)");
+      continue;
+    }
     const Unit u = unit_from_string(unit, source, "channel " + names[j]);
     factors[j] = u.to_si;
     unit = u.si_symbol;
@@ -247,10 +378,32 @@ std::vector<double> to_si_units(const std::string& source, const std::vector<std
 
 // Samples in SI units (see to_si_units).
 void convert_to_si(TimeSeries& ts, const ReadOptions& options) {
-  const std::vector<double> factors = to_si_units(ts.source, ts.names, ts.units, options);
+  const std::vector<double> factors = to_si_units(ts.source, ts.names, ts.units, options, ts.warnings);
   for (size_t j = 0; j < factors.size(); ++j) {
     if (factors[j] != 1.0) ts.data.col(static_cast<Eigen::Index>(j)) *= factors[j];
   }
+}
+
+// A unit entry (ReadOptions::unit_overrides, or the file's own `units`) must name a channel of the
+// file (any of them, read or not), its time vector or another variable `known` lists: a typo is an
+// InputError, never dropped.
+void check_unit_names(const std::string& source, const std::string& field_prefix, const std::vector<std::string>& keys,
+                      const std::vector<std::string>& available, const std::vector<std::string>& known = {}) {
+  for (const std::string& key : keys) {
+    if (is_time_name(key) || is_rate_name(key)) continue;
+    if (std::find(available.begin(), available.end(), key) != available.end()) continue;
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::vector<std::string> sorted = available;
+    std::sort(sorted.begin(), sorted.end());
+    throw InputError(source, field_prefix + key, "the unit of a channel of the file (" + text::join(sorted) + ")",
+                     quote(key) + ", which names no channel");
+  }
+}
+
+std::vector<std::string> override_keys(const ReadOptions& options) {
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : options.unit_overrides) keys.push_back(k);
+  return keys;
 }
 
 std::vector<std::string> available_names(const std::vector<std::string>& names) {
@@ -379,6 +532,7 @@ void ReadOptions::validate() const {
   }
   detail::CsvDialect{delimiter, decimal}.validate();
   for (const auto& [channel, unit] : units) (void)unit_from_string(unit, "ReadOptions", "units." + channel);
+  for (const auto& [channel, unit] : unit_overrides) (void)unit_from_string(unit, "--units", channel);
 }
 
 std::string to_string(MatVersion v) {
@@ -402,7 +556,8 @@ TimeSeries read_timeseries(const fs::path& file, const ReadOptions& options) {
   const std::string ext = text::to_lower(file.extension().string());
   if (ext == ".mat") return read_timeseries_mat(file, options);
   if (ext == ".csv") return read_timeseries_csv(file, options);
-  throw InputError(file.string(), "file", "a .mat or .csv file", "extension " + quote(ext));
+  if (ext == ".uff" || ext == ".unv" || ext == ".uf") return read_timeseries_uff58(file, options);
+  throw InputError(file.string(), "file", "a .mat, .csv or .uff file", "extension " + quote(ext));
 }
 
 namespace {
@@ -464,7 +619,7 @@ MatLayout mat_layout(detail::MatInput* mat, const fs::path& file, const ReadOpti
   for (const auto& v : vars) {
     if (is_time_name(v.name) || is_rate_name(v.name)) continue;
     if (is_numeric_vector(v)) layout.channels.push_back(v.name);
-    if (v.class_type == MAT_C_STRUCT && v.name != kUnits && v.name != kSettings) structs.push_back(v.name);
+    if (v.class_type == MAT_C_STRUCT && !is_units_name(v.name) && v.name != kSettings) structs.push_back(v.name);
   }
   // Files written by piezobench list their channels in order (HDF5 lists variables by name).
   const auto order_var = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return v.name == kChannelOrder; });
@@ -519,6 +674,155 @@ std::map<std::string, Setting> read_struct_settings(const detail::MatValue& var,
     }
   }
   return out;
+}
+
+// The texts of a cell array's elements (char rows), column-major; InputError naming `field` for
+// any other element.
+std::vector<std::string> cell_texts(const detail::MatValue& cell, const std::string& source, const std::string& field) {
+  std::vector<std::string> out;
+  for (size_t i = 0; i < cell.items.size(); ++i) {
+    out.push_back(std::string(text::trim(detail::to_text(cell.items[i], source, field + "{" + std::to_string(i + 1) + "}"))));
+  }
+  return out;
+}
+
+// "u=V, de=um" or "u: V; de: um" as (name, unit) pairs; nullopt when the text is not such a list.
+std::optional<std::vector<std::pair<std::string, std::string>>> unit_pairs(const std::string& list) {
+  std::vector<std::pair<std::string, std::string>> out;
+  std::string normalized = list;
+  std::replace(normalized.begin(), normalized.end(), ';', ',');
+  for (std::string_view part : text::split(normalized, ',')) {
+    part = text::trim(part);
+    if (part.empty()) continue;
+    const size_t sep = part.find_first_of("=:");
+    if (sep == std::string_view::npos) return std::nullopt;
+    out.emplace_back(std::string(text::trim(part.substr(0, sep))), std::string(text::trim(part.substr(sep + 1))));
+  }
+  if (out.empty()) return std::nullopt;
+  return out;
+}
+
+// The units a MAT file gives its variables, from every place writers put them (docs/formats.md,
+// "Units in .mat files"): a `units` struct (top level or inside the record struct: one char field
+// per channel), a `units` cell array (name/unit pairs as an N x 2 or 2 x N cell, or one unit per
+// name of a `channels` / `names` / `labels` list of the same length), v7.3 `units` attributes of
+// datasets (top level or in a group) and a group's attributes (`units` = "u=V, de=um", `de_units`,
+// `units_de`, or an attribute named as the channel). Two places that disagree, a units cell that
+// cannot be matched to names, or an entry that names no variable of the file are InputErrors.
+std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::path& file, const std::vector<detail::MatVarInfo>& vars,
+                                             const MatLayout& layout) {
+  const std::string source = file.string();
+  std::map<std::string, std::string> units, place_of;
+  std::vector<std::string> known;  // every variable and field a unit may name
+  for (const auto& v : vars) known.push_back(v.name);
+  if (layout.group_var) known.insert(known.end(), layout.group_var->field_names.begin(), layout.group_var->field_names.end());
+  const auto add = [&](const std::string& name, const std::string& unit, const std::string& place, bool check_name) {
+    const std::string u(text::trim(unit));
+    if (u.empty()) return;
+    if (check_name) check_unit_names(source, place + ": ", {name}, known);
+    const auto [it, inserted] = units.emplace(name, u);
+    if (inserted) {
+      place_of[name] = place;
+    } else if (it->second != u) {
+      throw InputError(source, place, "the unit " + place_of[name] + " gives " + name + " (" + it->second + ")", "unit " + quote(u));
+    }
+  };
+  // Names a units cell of one row or column pairs with: `channels`, `names`, `labels` (a cell of
+  // char rows, or a char row of comma-separated names) beside it.
+  const auto names_beside = [&](const detail::MatValue* group) -> std::optional<std::vector<std::string>> {
+    for (const char* candidate : {"channels", "names", "channel_names", "labels"}) {
+      std::optional<detail::MatValue> value;
+      if (group != nullptr) {
+        if (const detail::MatValue* f = group->field(candidate)) value = *f;
+      } else if (std::any_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == candidate; })) {
+        value = detail::read_mat_variable(mat, file, candidate);
+      }
+      if (!value) continue;
+      if (value->class_type == MAT_C_CELL) return cell_texts(*value, source, candidate);
+      std::vector<std::string> out;
+      for (std::string_view part : text::split(detail::to_text(*value, source, candidate), ',')) out.emplace_back(text::trim(part));
+      return out;
+    }
+    return std::nullopt;
+  };
+  const auto from_value = [&](const detail::MatValue& uv, const std::string& place, const detail::MatValue* group) {
+    if (uv.class_type == MAT_C_STRUCT) {
+      for (const auto& [name, value] : read_struct_settings(uv, source, place)) {
+        if (std::holds_alternative<std::string>(value)) add(name, std::get<std::string>(value), place + "." + name, true);
+      }
+      return;
+    }
+    if (uv.class_type == MAT_C_CHAR) {
+      const std::string t = detail::to_text(uv, source, place);
+      const auto pairs = unit_pairs(t);
+      if (!pairs) throw InputError(source, place, "units as NAME=UNIT pairs (\"u=V, de=um\"), a struct or a cell", quote(t));
+      for (const auto& [name, unit] : *pairs) add(name, unit, place + " (" + name + ")", true);
+      return;
+    }
+    if (uv.class_type != MAT_C_CELL) throw InputError(source, place, "a struct, a cell or a char row of units", detail::describe(uv));
+    if (!uv.has_data) {
+      throw InputError(source, place, "units as a struct (a v7.3 file's cell arrays are not read)", detail::describe(uv));
+    }
+    const std::vector<std::string> texts = cell_texts(uv, source, place);
+    const size_t rows = uv.dims.empty() ? 0 : uv.dims[0], cols = texts.size() / std::max<size_t>(rows, 1);
+    const auto all_known = [&](size_t first, size_t stride, size_t count) {
+      for (size_t i = 0; i < count; ++i) {
+        const std::string& n = texts[first + i * stride];
+        if (std::find(known.begin(), known.end(), n) == known.end() && !is_time_name(n)) return false;
+      }
+      return true;
+    };
+    const bool vector = rows == 1 || cols == 1;
+    if (!vector && cols == 2 && all_known(0, 1, rows)) {  // N x 2: {'u', 'V'; 'de', 'um'}
+      for (size_t i = 0; i < rows; ++i) add(texts[i], texts[rows + i], place + "{" + std::to_string(i + 1) + ",2}", true);
+      return;
+    }
+    if (!vector && rows == 2 && all_known(0, 2, cols)) {  // 2 x N: {'u', 'de'; 'V', 'um'}
+      for (size_t i = 0; i < cols; ++i) add(texts[2 * i], texts[2 * i + 1], place + "{2," + std::to_string(i + 1) + "}", true);
+      return;
+    }
+    const std::optional<std::vector<std::string>> names = vector ? names_beside(group) : std::nullopt;
+    if (!names || names->size() != texts.size()) {
+      throw InputError(source, place,
+                       "units a channel can be matched to: NAME/UNIT pairs (an N x 2 cell) or one unit per name of a "
+                       "`channels`, `names` or `labels` list of the same length",
+                       detail::describe(uv) + (names ? " beside " + std::to_string(names->size()) + " names" : " without names"));
+    }
+    for (size_t i = 0; i < texts.size(); ++i) add((*names)[i], texts[i], place + "{" + std::to_string(i + 1) + "}", true);
+  };
+  // v7.3 attributes of the datasets themselves.
+  for (const auto& v : vars) add(v.name, v.unit, v.name + " (attribute units)", false);
+  if (layout.group_var) {
+    const detail::MatValue& g = *layout.group_var;
+    for (size_t f = 0; f < g.field_names.size(); ++f) {
+      const detail::MatValue* field = g.field(g.field_names[f]);
+      if (field != nullptr) add(g.field_names[f], field->unit, layout.group + "." + g.field_names[f] + " (attribute units)", false);
+    }
+    for (const auto& [key, value] : g.attributes) {
+      const std::string place = layout.group + " (attribute " + key + ")";
+      const std::string l = text::to_lower(key);
+      if (is_units_name(key)) {
+        const auto pairs = unit_pairs(value);
+        if (!pairs) throw InputError(source, place, "units as NAME=UNIT pairs (\"u=V, de=um\")", quote(value));
+        for (const auto& [name, unit] : *pairs) add(name, unit, place, true);
+      } else if (l.size() > 6 && l.compare(l.size() - 6, 6, "_units") == 0) {
+        add(key.substr(0, key.size() - 6), value, place, true);
+      } else if (l.size() > 5 && l.compare(l.size() - 5, 5, "_unit") == 0) {
+        add(key.substr(0, key.size() - 5), value, place, true);
+      } else if (l.rfind("units_", 0) == 0 && l.size() > 6) {
+        add(key.substr(6), value, place, true);
+      } else if (std::find(g.field_names.begin(), g.field_names.end(), key) != g.field_names.end()) {
+        add(key, value, place, false);
+      }
+    }
+    for (const std::string& f : g.field_names) {
+      if (is_units_name(f)) from_value(*g.field(f), layout.group + "." + f, &g);
+    }
+  }
+  for (const auto& v : vars) {
+    if (is_units_name(v.name)) from_value(detail::read_mat_variable(mat, file, v.name), v.name, nullptr);
+  }
+  return units;
 }
 
 // read_timeseries_mat, and read_timeseries_view's use of a MAT file: with `view`, a time vector and
@@ -613,7 +917,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
       const double dt = (t[n - 1] - t[0]) / static_cast<double>(n - 1);  // as sample_rate_from_time
       bool ok = true;
       for (Eigen::Index first = 0; first < n && ok; first += kReadChunk) {
-        ok = time_samples_ok(t, n, first, std::min(kReadChunk, n - first), dt, options.time_tolerance);
+        ok = time_samples_ok(t, n, first, std::min(kReadChunk, n - first), dt, kExactTime);
       }
       t_prechecked = ok;
       read = true;
@@ -624,7 +928,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
       double dt = 0.0;
       const auto check = [&](Eigen::Index first, Eigen::Index piece) {
         if (first == 0) dt = (*t_last - ts.t(0)) / static_cast<double>(n - 1);  // as sample_rate_from_time
-        ok = ok && time_samples_ok(ts.t.data(), n, first, piece, dt, options.time_tolerance);
+        ok = ok && time_samples_ok(ts.t.data(), n, first, piece, dt, kExactTime);
       };
       read = detail::read_double_vector_into(mat.get(), t_name, ts.t, kReadChunk, check);
       t_prechecked = read && ok && ts.t(n - 1) == *t_last;
@@ -646,21 +950,21 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
     fs_file = f(0);
   }
 
-  // Units: the `units` struct of the file (one char field per channel, and the time vector's).
-  std::map<std::string, Setting> file_units;
-  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kUnits; })) {
-    const detail::MatValue uv = detail::read_mat_variable(mat.get(), file, kUnits);
-    if (uv.class_type == MAT_C_STRUCT) file_units = read_struct_settings(uv, source, kUnits);
-  }
-  // A field of `units`, else (v7.3) the dataset's own `units` attribute.
+  // Units from every place a writer puts them (mat_units).
+  const std::map<std::string, std::string> file_units = mat_units(mat.get(), file, vars, layout);
   const auto unit_of = [&](const std::string& name) {
     const auto it = file_units.find(name);
-    if (it != file_units.end() && std::holds_alternative<std::string>(it->second)) return std::get<std::string>(it->second);
-    const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; });
-    return layout.group.empty() && info != vars.end() ? info->unit : std::string();
+    return it != file_units.end() ? it->second : std::string();
   };
+  {
+    std::vector<std::string> all = layout.channels;
+    if (!t_name.empty()) all.push_back(t_name);
+    check_unit_names(source, "--units ", override_keys(options), all);
+  }
+  double t_scale = 1.0;  // seconds per unit of the stored stamps
   if (ts.t.size() > 0 || t_mapped) {
     const double factor = time_unit_factor(unit_of(t_name), source, std::string(kUnits) + "." + t_name);
+    t_scale = factor;
     if (t_mapped && factor != 1.0) {
       ts.t = Eigen::Map<const Eigen::VectorXd>(t_mapped->data, t_length) * factor;
       t_mapped.reset();
@@ -675,7 +979,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
   if (view != nullptr && !layout.group_var) {
     std::vector<std::string> units;
     for (const std::string& name : names) units.push_back(unit_of(name));
-    const std::vector<double> factors = to_si_units(source, names, units, options);
+    const std::vector<double> factors = to_si_units(source, names, units, options, view->warnings);
     std::vector<detail::MappedDoubles> mapped;
     if (std::all_of(factors.begin(), factors.end(), [](double f) { return f == 1.0; })) {
       for (const std::string& name : names) {
@@ -694,7 +998,8 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
         if (!finite) check_finite(source, names[j], Eigen::Map<const Eigen::VectorXd>(mapped[j].data, n));
         view->columns.push_back(mapped[j].data);
       }
-      view->sample_rate = resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, t_prechecked);
+      view->sample_rate =
+          resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, view->warnings, t_prechecked, t_scale);
       view->names = names;
       view->units = std::move(units);
       view->samples = n;
@@ -726,7 +1031,7 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
     }
     if (!finite) check_finite(source, field, ts.data.col(col));
   }
-  ts.sample_rate = resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, t_prechecked);
+  ts.sample_rate = resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, ts.warnings, t_prechecked, t_scale);
   ts.units.assign(names.size(), "");
   for (size_t j = 0; j < names.size(); ++j) ts.units[j] = unit_of(names[j]);
   convert_to_si(ts, options);
@@ -755,6 +1060,7 @@ TimeSeriesView read_timeseries_view(const fs::path& file, const ReadOptions& opt
   view.sample_rate = owned->sample_rate;
   view.units = owned->units;
   view.source = owned->source;
+  view.warnings = owned->warnings;
   view.storage = std::move(owned);
   return view;
 }
@@ -796,6 +1102,7 @@ TimeSeries read_timeseries_csv(const fs::path& file, const ReadOptions& options)
       available.push_back(columns[c].name);
     }
   }
+  check_unit_names(source, "--units ", override_keys(options), available);
   const std::vector<std::string> names = select_channels(source, options, available);
   // For each CSV column, the column of the table it fills (-1: not read); the time vector last.
   std::vector<int> target(columns.size(), -1);
@@ -815,17 +1122,49 @@ TimeSeries read_timeseries_csv(const fs::path& file, const ReadOptions& options)
   TimeSeries ts;
   ts.source = source;
   ts.names = names;
+  double t_scale = 1.0;
   if (time_column >= 0) {
     const detail::CsvColumn& tc = columns[static_cast<size_t>(time_column)];
     ts.t = data.col(nread - 1);
-    ts.t *= time_unit_factor(tc.unit, source, "column " + tc.name);
+    t_scale = time_unit_factor(tc.unit, source, "column " + tc.name);
+    ts.t *= t_scale;
     ts.data = data.leftCols(nread - 1);
   } else {
     ts.data = std::move(data);
   }
   ts.units = std::move(units);
   convert_to_si(ts, options);
-  ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_comment, options.time_tolerance);
+  ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_comment, options.time_tolerance, ts.warnings, false, t_scale);
+  ts.validate();
+  return ts;
+}
+
+TimeSeries read_timeseries_uff58(const fs::path& file, const ReadOptions& options) {
+  options.validate();
+  const std::string source = file.string();
+  detail::UffTimeHistories uff = detail::read_uff58_time_histories(file);
+  check_unit_names(source, "--units ", override_keys(options), uff.names);
+  const std::vector<std::string> names = select_channels(source, options, uff.names);
+  TimeSeries ts;
+  ts.source = source;
+  ts.names = names;
+  ts.data.resize(uff.data.rows(), static_cast<Eigen::Index>(names.size()));
+  for (size_t j = 0; j < names.size(); ++j) {
+    const auto k = static_cast<size_t>(std::find(uff.names.begin(), uff.names.end(), names[j]) - uff.names.begin());
+    ts.data.col(static_cast<Eigen::Index>(j)) = uff.data.col(static_cast<Eigen::Index>(k));
+    ts.units.push_back(uff.units[k]);
+  }
+  convert_to_si(ts, options);
+  std::optional<double> fs_file;
+  if (uff.increment_s > 0.0) {
+    // Record 7 keeps the increment to 6 significant digits (E13.5): a whole rate in Hz that
+    // rounds to it is the rate (1.52588E-05 s is 65536 Hz, not 65535.95 Hz).
+    const double rate = 1.0 / uff.increment_s, whole = std::round(rate);
+    const double printed = std::stod(format_number(1.0 / whole, 6));
+    fs_file = whole > 0.0 && std::abs(printed - uff.increment_s) <= 1e-9 * uff.increment_s ? whole : rate;
+  }
+  ts.t = uff.t;
+  ts.sample_rate = resolve_sample_rate(source, ts.t, options.fs, fs_file, options.time_tolerance, ts.warnings, false, uff.time_scale);
   ts.validate();
   return ts;
 }

@@ -16,6 +16,7 @@
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
+#include "io/uff58.hpp"
 #include "piezobench/io/units.hpp"
 
 namespace piezobench::io {
@@ -40,6 +41,10 @@ constexpr int kFuncFrf = 4;
 constexpr int kFuncCoherence = 6;
 constexpr int kOrdRealSingle = 2, kOrdRealDouble = 4, kOrdComplexSingle = 5, kOrdComplexDouble = 6;
 constexpr int kSpecFrequency = 18;
+constexpr int kSpecTime = 17;
+constexpr int kSpecAcceleration = 12;
+constexpr int kFuncTime = 1;  // time response (what Testlab and Simcenter export as time histories)
+constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
 constexpr int kDirZ = 3;
 constexpr const char* kResponseTag = "piezobench response: ";
 constexpr const char* kReferenceTag = "piezobench reference: ";
@@ -96,7 +101,8 @@ std::string provenance_line(const dsp::FrfProvenance& p) {
 void write_dataset(std::ostream& out, int func_type, int func_id, const std::string& response, int response_node,
                    const std::string& reference, int reference_node, const Eigen::VectorXd& freq,
                    const Eigen::VectorXcd* complex_values, const Eigen::VectorXd* real_values,
-                   const FrfWriteOptions& options, const std::string& id5) {
+                   const FrfWriteOptions& options, const std::string& id5, const std::string& ord_unit = "",
+                   const std::string& denom_unit = "") {
   const Index n = freq.size();
   const bool even = is_uniform(freq);
   const bool is_complex = complex_values != nullptr;
@@ -118,8 +124,9 @@ void write_dataset(std::ostream& out, int func_type, int func_id, const std::str
       << '\n';
   // Records 8..11: Format(I10,3I5,2(1X,20A1)).
   out << fmt_line("%10d%5d%5d%5d %-20s %-20s", kSpecFrequency, 0, 0, 0, "Frequency", "Hz") << '\n';
-  out << fmt_line("%10d%5d%5d%5d %-20s %-20s", 0, 0, 0, 0, label20(response).c_str(), "NONE") << '\n';
-  out << fmt_line("%10d%5d%5d%5d %-20s %-20s", 0, 0, 0, 0, label20(func_type == kFuncFrf ? reference : response).c_str(), "NONE")
+  out << fmt_line("%10d%5d%5d%5d %-20s %-20s", 0, 0, 0, 0, label20(response).c_str(), label20(ord_unit).c_str()) << '\n';
+  out << fmt_line("%10d%5d%5d%5d %-20s %-20s", 0, 0, 0, 0, label20(func_type == kFuncFrf ? reference : response).c_str(),
+                  label20(denom_unit).c_str())
       << '\n';
   out << fmt_line("%10d%5d%5d%5d %-20s %-20s", 0, 0, 0, 0, "NONE", "NONE") << '\n';
   // Record 12: cases 5..8 of the format's addendum B.
@@ -176,8 +183,10 @@ void write_frf_uff58(const dsp::Frf& frf, const fs::path& file, const FrfWriteOp
   write_atomically(file, [&](std::ostream& out) {
     for (size_t i = 0; i < frf.outputs.size(); ++i) {
       const int node = static_cast<int>(i) + 1;
+      const std::string ord_unit = i < options.output_units.size() ? options.output_units[i] : std::string();
+      const std::string denom_unit = options.output_units.empty() ? std::string() : options.input_unit;
       write_dataset(out, kFuncFrf, node, frf.outputs[i], node, input, options.reference_node, frf.freq_Hz, &frf.H[i], nullptr,
-                    options, id5);
+                    options, id5, ord_unit.empty() && !denom_unit.empty() ? "1" : ord_unit, denom_unit);
       if (!frf.coherence.empty()) {
         write_dataset(out, kFuncCoherence, node, frf.outputs[i], node, input, options.reference_node, frf.freq_Hz, nullptr,
                       &frf.coherence[i], options, id5);
@@ -202,6 +211,10 @@ struct Dataset58 {
   int abscissa_spec = 0;
   std::string ord_label, denom_label;
   std::string abscissa_unit, ord_unit, denom_unit;  // records 8-10 units labels ("" = NONE)
+  int ord_spec = 0;                                  // record 9 specific data type (12 acceleration, ...)
+  double abscissa_scale = 1.0;                       // SI per abscissa unit (ms: 1e-3)
+  bool abscissa_time = false;                        // abscissa in s (else Hz), from its unit or type
+  std::string frf_unit;                              // an FRF's SI unit from records 9 and 10 ("" = none given)
   Eigen::VectorXd x;
   Eigen::VectorXcd y;
 };
@@ -358,6 +371,7 @@ class UffReader {
     d.abscissa_spec = static_cast<int>(int_field(d, r8, 0, 10, "record 8 (abscissa data type)"));
     d.abscissa_unit = units_label(r8);
     const std::string_view r9 = require_line(d, "record 9");
+    d.ord_spec = static_cast<int>(int_field(d, r9, 0, 10, "record 9 (ordinate data type)"));
     d.ord_label = std::string(text::trim(column(r9, 26, 20)));
     d.ord_unit = units_label(r9);
     const std::string_view r10 = require_line(d, "record 10");
@@ -378,23 +392,46 @@ class UffReader {
     return d;
   }
 
-  // Units labels of records 8-10, honoured or refused: the abscissa in Hz (kHz converted), an
-  // FRF's ordinate as numerator / denominator in SI (e.g. um / V scales by 1e-6). An unlabelled
-  // ("NONE") axis is taken as SI. Coherence (function type 6) is dimensionless.
+  // Units labels of records 8-10, honoured or refused: the abscissa in Hz (kHz converted) or, for
+  // a time history (function type 1, abscissa type 17), in s (ms converted); an FRF's ordinate as
+  // numerator / denominator in SI (e.g. um / V scales by 1e-6; a numerator that is a quotient
+  // holding the denominator already, such as `(1/N)*(m/s^2)` over `N`, is not divided twice). An
+  // unlabelled ("NONE") axis is taken as SI. Coherence (function type 6) is dimensionless; a time
+  // history's ordinate is converted by the time-series reader (its unit is kept in ord_unit).
   void to_si(Dataset58& d) const {
+    d.abscissa_time = is_time_history(d);
     if (!d.abscissa_unit.empty()) {
-      const Unit u = unit_from_string(d.abscissa_unit, source_, field(d, "record 8 (abscissa units)"));
-      if (u.quantity != Quantity::kFrequency) {
-        throw InputError(source_, field(d, "record 8 (abscissa units)"), "a frequency unit (Hz, kHz)", "unit " + quote(d.abscissa_unit));
+      const std::string where = field(d, "record 8 (abscissa units)");
+      const Unit u = unit_from_string(d.abscissa_unit, source_, where);
+      if (u.quantity != Quantity::kTime && u.quantity != Quantity::kFrequency) {
+        throw InputError(source_, where, "a frequency unit (Hz, kHz) or a time unit (s, ms)", "unit " + quote(d.abscissa_unit));
       }
+      d.abscissa_time = u.quantity == Quantity::kTime;
+      d.abscissa_scale = u.to_si;
       d.x *= u.to_si;
     }
+    if (d.func_type == kFuncTime && (d.ord_unit == "g" || d.ord_unit == "G") && d.ord_spec == kSpecAcceleration) {
+      d.y *= kStandardGravity;  // an accelerometer's g, not grams
+      d.ord_unit = "m/s^2";
+    }
     if (d.func_type != kFuncFrf) return;
-    double factor = 1.0;
-    if (!d.ord_unit.empty()) factor *= unit_from_string(d.ord_unit, source_, field(d, "record 9 (ordinate units)")).to_si;
-    if (!d.denom_unit.empty()) factor /= unit_from_string(d.denom_unit, source_, field(d, "record 10 (denominator units)")).to_si;
-    if (factor != 1.0) d.y *= factor;
+    // The FRF's unit as text the unit table parses ("(m/s^2)/(N)"); H stays as stored.
+    std::string numerator = d.ord_unit;
+    if (d.ord_unit == "g" && d.ord_spec == kSpecAcceleration) {
+      d.y *= kStandardGravity;
+      numerator = "m/s^2";
+    }
+    if (numerator.empty() && d.denom_unit.empty()) return;
+    d.frf_unit = numerator.empty() ? "1" : "(" + numerator + ")";
+    const Unit num = numerator.empty() ? Unit{} : unit_from_string(numerator, source_, field(d, "record 9 (ordinate units)"));
+    if (d.denom_unit.empty()) return;
+    const Unit den = unit_from_string(d.denom_unit, source_, field(d, "record 10 (denominator units)"));
+    const std::vector<std::string_view> parts = text::split(num.si_symbol, '/');
+    const bool divided = parts.size() > 1 && std::find(parts.begin() + 1, parts.end(), std::string_view(den.si_symbol)) != parts.end();
+    if (!divided) d.frf_unit += "/(" + d.denom_unit + ")";
   }
+
+  static bool is_time_history(const Dataset58& d) { return d.func_type == kFuncTime || d.abscissa_spec == kSpecTime; }
 
   bool is_complex(const Dataset58& d) const { return d.ord_type == kOrdComplexSingle || d.ord_type == kOrdComplexDouble; }
 
@@ -610,8 +647,10 @@ void parse_provenance(const std::string& id5, dsp::FrfProvenance& p) {
 
 }  // namespace
 
-dsp::Frf read_frf_uff58(const fs::path& file) {
+namespace detail {
+StatedFrf read_uff58_frf(const fs::path& file) {
   const std::string source = file.string();
+  StatedFrf stated;
   UffReader reader(read_file(file), source);
   const std::vector<Dataset58> datasets = reader.read_all();
   const Dataset58* first = nullptr;
@@ -628,6 +667,9 @@ dsp::Frf read_frf_uff58(const fs::path& file) {
       continue;
     }
     if (d.func_type != kFuncFrf) continue;
+    if (d.abscissa_time) {
+      throw InputError(source, where + " record 8 (abscissa units)", "a frequency unit (Hz, kHz) for an FRF", "unit " + quote(d.abscissa_unit));
+    }
     const std::string out = response_name(d), in = reference_name(d);
     if (first == nullptr) {
       first = &d;
@@ -649,6 +691,7 @@ dsp::Frf read_frf_uff58(const fs::path& file) {
     }
     frf.outputs.push_back(out);
     frf.H.push_back(d.y);
+    stated.units.push_back(d.frf_unit);
   }
   if (first == nullptr) {
     throw InputError(source, "datasets", "at least one dataset 58 of function type 4 (FRF)",
@@ -664,8 +707,95 @@ dsp::Frf read_frf_uff58(const fs::path& file) {
     for (const std::string& o : frf.outputs) frf.coherence.emplace_back(coherence[o]->y.real());
   }
   frf.provenance.source = source;
-  frf.validate(source);  // every message names source
-  return frf;
+  stated.frf = std::move(frf);
+  return stated;
 }
+}  // namespace detail
 
 }  // namespace piezobench::io
+
+namespace piezobench::io::detail {
+namespace {
+
+bool unique(const std::vector<std::string>& names) {
+  std::set<std::string> seen;
+  for (const std::string& n : names) {
+    if (!seen.insert(n).second) return false;
+  }
+  return true;
+}
+
+// A time history's channel name: the piezobench tag of ID line 2, else the response entity name
+// of record 6 ("Mic 01"), else its node and direction ("3+Z"), else ID line 1; names that repeat
+// across records get the node and direction ("Point:3+Z"), then ID line 1, then "#k" appended.
+std::vector<std::string> time_history_names(const std::vector<const Dataset58*>& records) {
+  std::vector<std::string> names;
+  for (const Dataset58* d : records) {
+    if (std::string s = tagged(d->id[1], kResponseTag); !s.empty()) names.push_back(s);
+    else if (usable_label(d->rsp_entity)) names.push_back(d->rsp_entity);
+    else if (d->rsp_node != 0) names.push_back(dof_name(d->rsp_node, d->rsp_dir));
+    else if (usable_label(d->id[0])) names.push_back(d->id[0]);
+    else names.push_back(dof_name(d->rsp_node, d->rsp_dir));
+  }
+  if (unique(names)) return names;
+  std::vector<std::string> with_dof = names;
+  for (size_t i = 0; i < records.size(); ++i) {
+    if (std::count(names.begin(), names.end(), names[i]) > 1) with_dof[i] = names[i] + ":" + dof_name(records[i]->rsp_node, records[i]->rsp_dir);
+  }
+  if (unique(with_dof)) return with_dof;
+  std::vector<std::string> by_id = with_dof;
+  for (size_t i = 0; i < records.size(); ++i) {
+    if (std::count(with_dof.begin(), with_dof.end(), with_dof[i]) > 1 && usable_label(records[i]->id[0])) by_id[i] = records[i]->id[0];
+  }
+  if (unique(by_id)) return by_id;
+  for (size_t i = 0; i < records.size(); ++i) by_id[i] += "#" + std::to_string(i + 1);
+  return by_id;
+}
+
+}  // namespace
+
+UffTimeHistories read_uff58_time_histories(const fs::path& file) {
+  const std::string source = file.string();
+  UffReader reader(read_file(file), source);
+  const std::vector<Dataset58> datasets = reader.read_all();
+  std::vector<const Dataset58*> records;
+  for (const Dataset58& d : datasets) {
+    if (d.func_type == kFuncTime || d.abscissa_spec == kSpecTime) records.push_back(&d);
+  }
+  if (records.empty()) {
+    throw InputError(source, "datasets", "at least one dataset 58 of function type 1 (time response)",
+                     std::to_string(datasets.size()) + " datasets 58, none a time history");
+  }
+  const Dataset58& first = *records.front();
+  UffTimeHistories out;
+  out.names = time_history_names(records);
+  out.data.resize(static_cast<Index>(first.n), static_cast<Index>(records.size()));
+  out.time_scale = first.abscissa_scale;
+  if (first.even) {
+    out.increment_s = first.abscissa_inc * first.abscissa_scale;
+  } else {
+    out.t = first.x;
+  }
+  for (size_t j = 0; j < records.size(); ++j) {
+    const Dataset58& d = *records[j];
+    const std::string where = "dataset 58 at line " + std::to_string(d.line);
+    if (!d.abscissa_time) {
+      throw InputError(source, where + " record 8 (abscissa units)", "a time unit (s, ms) for a time history", "unit " + quote(d.abscissa_unit));
+    }
+    if (d.ord_type == kOrdComplexSingle || d.ord_type == kOrdComplexDouble) {
+      throw InputError(source, where + " record 7 (ordinate data type)", "real values (2 or 4) for a time history", std::to_string(d.ord_type));
+    }
+    if (d.n != first.n || d.even != first.even ||
+        (d.even ? std::abs(d.abscissa_inc * d.abscissa_scale - out.increment_s) > 1e-9 * out.increment_s
+                : (d.x - first.x).cwiseAbs().maxCoeff() > 0.0)) {
+      throw InputError(source, where + " record 7", "the samples of the first time history (" + std::to_string(first.n) + " values, " +
+                           (first.even ? "increment " + format_number(out.increment_s, 6) + " s" : std::string("uneven")) + ")",
+                       std::to_string(d.n) + " values, " + (d.even ? "increment " + format_number(d.abscissa_inc * d.abscissa_scale, 6) + " s" : std::string("uneven")));
+    }
+    out.data.col(static_cast<Index>(j)) = d.y.real();
+    out.units.push_back(d.ord_unit);
+  }
+  return out;
+}
+
+}  // namespace piezobench::io::detail

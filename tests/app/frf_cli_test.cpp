@@ -96,6 +96,42 @@ TEST(FitCli, RecoversKnownPolesFromAnExactFrf) {
   }
 }
 
+// Issue 33: UFF58 time histories in, scipy's H1 out; every file of the record in other units and
+// time stamps gives the same FRF in SI (scripts/fixtures/make_io_units_fixtures.py).
+TEST(FrfCli, UffTimeHistoriesAndFilesInOtherUnitsGiveScipysH1) {
+  const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("io/units/expected.json")));
+  for (const char* name : {"th_multi_ascii.uff", "th_multi_58b.uff", "v5_units_cell_pairs.mat", "h5_group_attr_map.mat",
+                           "time_ms3.csv", "time_float32.csv"}) {
+    SCOPED_TRACE(name);
+    const std::string file = test::fixture_path(std::string("io/units/") + name).string();
+    const test::CliRun r = run_cli("frf " + file + " --input u --output d_e,Vs --nfft 512 --overlap 0.5 --detrend none --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto got = nlohmann::json::parse(r.out);
+    EXPECT_EQ(got["H_units"]["d_e"], "m/V");
+    EXPECT_TRUE(got["warnings"].empty()) << got["warnings"];
+    const bool csv = std::string(name).find(".csv") != std::string::npos;
+    const auto& want = ref[csv ? "H_d_e_csv" : "H_d_e"];
+    const double tol = std::string(name).find("ascii") != std::string::npos ? 1e-10 : 1e-12;  // 13 printed digits
+    for (std::size_t k = 1; k < ref["freq_Hz"].size(); ++k) {
+      const std::complex<double> h(want["re"][k].get<double>(), want["im"][k].get<double>());
+      ASSERT_TRUE(test::near(pair(got["outputs"]["d_e"]["H"][k]), h, {tol, 0.0})) << "bin " << k;
+    }
+  }
+  // --units overrides, --fs overrides the stamps: warnings on stderr and in --json.
+  const std::string f6 = test::fixture_path("io/units/time_f6.csv").string();
+  const test::CliRun r = run_cli("frf " + f6 + " --input u --output d_e --units d_e=mm --fs 2000 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto got = nlohmann::json::parse(r.out);
+  ASSERT_EQ(got["warnings"].size(), 2u);
+  EXPECT_NE(got["warnings"][0].get<std::string>().find("unit 'mm' from --units replaces 'um'"), std::string::npos);
+  EXPECT_NE(got["warnings"][1].get<std::string>().find("--fs 2000 Hz overrides the time vector's 2048 Hz"), std::string::npos);
+  EXPECT_NE(r.err.find("warning: " + f6 + ": --fs 2000 Hz"), std::string::npos) << r.err;
+  EXPECT_EQ(run_cli("frf " + f6 + " --input u --output d_e --units de=mm").exit_code, 3);
+  const test::CliRun jitter = run_cli("frf " + test::fixture_path("io/units/time_jitter_5.csv").string() + " --input u --output d_e");
+  EXPECT_EQ(jitter.exit_code, 3);
+  EXPECT_NE(jitter.err.find("time_jitter_5.csv: t: expected uniform sampling"), std::string::npos) << jitter.err;
+}
+
 TEST(FrfCli, BadInputNamesFileAndChannel) {
   test::TempDir dir;
   const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();

@@ -179,6 +179,41 @@ TEST(ModelCli, TuneRecoversTheParameters) {
   EXPECT_NE(text.out.find("converged"), std::string::npos) << text.out;
 }
 
+// Issue 33: an FRF in um/V (stated in the header, or given by --units) gives the same ga as in
+// SI; a file that says nothing is read as SI with a warning.
+TEST(ModelCli, TuneHonoursTheUnitsOfTheFrf) {
+  test::TempDir dir;
+  const double k1 = 0.42e6, ke = 5.6e6, ka = 2.8e6, ce = 90.0, ca = 55.0, ga = -2.9, gs = 0.5e6;
+  std::istringstream si(frf_csv(k1, ke, ka, ce, ca, ga, gs, 0.01));
+  std::ostringstream um;
+  um.precision(17);
+  std::string line;
+  std::getline(si, line);
+  um << "freq_Hz,re_de [um/V],im_de [um/V],re_Vs [V/V],im_Vs [V/V]\n";
+  std::ostringstream bare;
+  bare.precision(17);
+  bare << "freq_Hz,re_de,im_de,re_Vs,im_Vs\n";
+  while (std::getline(si, line)) {
+    std::vector<double> v;
+    std::istringstream cells(line);
+    for (std::string c; std::getline(cells, c, ',');) v.push_back(std::stod(c));
+    um << v[0] << ',' << v[1] * 1e6 << ',' << v[2] * 1e6 << ',' << v[3] << ',' << v[4] << '\n';
+    bare << v[0] << ',' << v[1] * 1e6 << ',' << v[2] * 1e6 << ',' << v[3] << ',' << v[4] << '\n';
+  }
+  const std::string stated = test::write_text_file(dir, "frf_um.csv", um.str());
+  const std::string unstated = test::write_text_file(dir, "frf_bare.csv", bare.str());
+  for (const std::string& args : {"--frf " + stated, "--frf " + unstated + " --units de=um"}) {
+    const Outcome r = run_cli("model tune " + args + " --mass 5.7 --json");
+    ASSERT_EQ(r.exit_code, 0) << args << r.err;
+    EXPECT_TRUE(near(nlohmann::json::parse(r.out)["model_2dof"]["ga"].get<double>(), ga, 0.02)) << args << r.out;
+  }
+  const Outcome warned = run_cli("model tune --frf " + unstated + " --mass 5.7 --json");
+  EXPECT_NE(warned.err.find("warning: " + unstated + ": output de has no unit: H taken as SI"), std::string::npos) << warned.err;
+  EXPECT_EQ(nlohmann::json::parse(warned.out)["warnings"].size(), 2u);  // de and Vs
+  EXPECT_EQ(run_cli("model tune --frf " + unstated + " --units d=um").exit_code, 3);   // names no channel
+  EXPECT_EQ(run_cli("model tune --frf " + unstated + " --units de=furlong").exit_code, 2);
+}
+
 TEST(ModelCli, TuneBadInputExitsWithThree) {
   test::TempDir dir;
   const std::string no_vs = test::write_text_file(dir, "novs.csv", "freq_Hz,re_de,im_de\n1,1,0\n2,1,0\n");

@@ -504,5 +504,73 @@ TEST(FrfFormat, NamesAndExtensions) {
   EXPECT_TRUE(contains(input_error([&] { o.validate(); }), "reference_node"));
 }
 
+// ---- units of FRF files (scripts/fixtures/make_io_units_fixtures.py) ---------------------------
+
+TEST(FrfUnits, FilesStateTheirUnitsAndAreReadInSi) {
+  const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("io/units/expected.json")));
+  for (const char* name : {"frf_um_per_V.csv", "frf_um_per_V.mat"}) {
+    SCOPED_TRACE(name);
+    const FrfFile f = read_frf_file(test::fixture_path(std::string("io/units/") + name));
+    ASSERT_EQ(f.frf.outputs, (std::vector<std::string>{"d_e", "Vs"}));
+    EXPECT_EQ(f.units, (std::vector<std::string>{"m/V", "1"}));
+    EXPECT_TRUE(f.warnings.empty()) << text::join(f.warnings, "; ");
+    for (size_t k = 0; k < ref["freq_Hz"].size(); k += 7) {
+      const std::complex<double> de(ref["H_d_e"]["re"][k].get<double>(), ref["H_d_e"]["im"][k].get<double>());
+      const std::complex<double> vs(ref["H_Vs"]["re"][k].get<double>(), ref["H_Vs"]["im"][k].get<double>());
+      EXPECT_LE(std::abs(f.frf.H[0](static_cast<Index>(k)) - de), 1e-14 * std::abs(de)) << k;
+      EXPECT_LE(std::abs(f.frf.H[1](static_cast<Index>(k)) - vs), 1e-14 * std::abs(vs)) << k;
+    }
+  }
+  // A compound UFF unit, (1/N)*(m/s^2) over N, is not divided twice: H = 2 x H_d_e in SI.
+  const FrfFile c = read_frf_file(test::fixture_path("io/units/frf_compound.uff"));
+  EXPECT_EQ(c.units, (std::vector<std::string>{"m/N/s^2"}));
+  for (size_t k = 1; k < ref["freq_Hz"].size(); k += 7) {
+    const std::complex<double> de(ref["H_d_e"]["re"][k].get<double>(), ref["H_d_e"]["im"][k].get<double>());
+    EXPECT_LE(std::abs(c.frf.H[0](static_cast<Index>(k)) - 2.0 * de), 1e-11 * std::abs(de)) << k;
+  }
+}
+
+TEST(FrfUnits, MissingUnitsWarnOverridesReplaceAndTyposAreRefused) {
+  const fs::path none = test::fixture_path("io/units/frf_no_units.csv");
+  const FrfFile plain = read_frf_file(none);
+  EXPECT_EQ(plain.units, (std::vector<std::string>{""}));
+  ASSERT_EQ(plain.warnings.size(), 1u);
+  EXPECT_TRUE(contains(plain.warnings[0], "frf_no_units.csv: output d_e has no unit: H taken as SI")) << plain.warnings[0];
+  FrfReadOptions o;
+  o.unit_overrides = {{"d_e", "um"}, {"input", "mV"}};
+  const FrfFile scaled = read_frf_file(none, o);
+  EXPECT_EQ(scaled.units, (std::vector<std::string>{"m/V"}));
+  EXPECT_EQ(scaled.frf.H[0](3), plain.frf.H[0](3) * 1e-3);
+  o.unit_overrides = {{"H_d_e", "nm/V"}};
+  EXPECT_EQ(read_frf_file(none, o).frf.H[0](3), plain.frf.H[0](3) * 1e-9);
+  o.unit_overrides = {{"H_d_e", "nm/V"}};
+  const FrfFile replaced = read_frf_file(test::fixture_path("io/units/frf_um_per_V.csv"), o);
+  EXPECT_TRUE(contains(replaced.warnings.at(0), "output d_e: unit 'nm/V' from --units replaces 'um/V' in the file")) << replaced.warnings[0];
+  o.unit_overrides = {{"de", "um"}};
+  test::expect_input_error([&] { (void)read_frf_file(none, o); }, {"frf_no_units.csv", "--units de", "'de', which names no channel"});
+  TempDir dir;
+  const fs::path file = dir.path() / "mixed.csv";
+  write_bytes(file, "freq_Hz,re_a [um/V],im_a [mm/V]\n1,2,3\n");
+  test::expect_input_error([&] { (void)read_frf(file); }, {"mixed.csv", "header column 3", "'um/V'"});
+  write_bytes(file, "freq_Hz,re_a [furlong],im_a [furlong]\n1,2,3\n");
+  test::expect_input_error([&] { (void)read_frf(file); }, {"mixed.csv", "unit of H_a", "'furlong'"});
+}
+
+TEST(FrfUnits, WrittenUnitsReadBack) {
+  TempDir dir;
+  const dsp::Frf frf = sample_frf(even_grid());
+  FrfWriteOptions w;
+  w.output_units.assign(frf.outputs.size(), "m");
+  w.input_unit = "V";
+  for (const char* name : {"u.csv", "u.mat", "u.uff"}) {
+    SCOPED_TRACE(name);
+    const fs::path file = dir.path() / name;
+    write_frf(frf, file, w);
+    const FrfFile back = read_frf_file(file);
+    EXPECT_EQ(back.units, std::vector<std::string>(frf.outputs.size(), "m/V"));
+    EXPECT_TRUE(back.warnings.empty()) << text::join(back.warnings, "; ");
+  }
+}
+
 }  // namespace
 }  // namespace piezobench::io

@@ -50,5 +50,31 @@ TEST(Units, UnknownUnitNamesSourceFieldAndTheKnownUnits) {
   EXPECT_EQ(known_units().find("\xC2\xB5"), std::string::npos);  // aliases are not listed
 }
 
+TEST(Units, CompoundUnitsParseIntoAnSiFactorAndADimension) {
+  const Unit a = find_unit("(1/N)*(m/s^2)").value();
+  EXPECT_EQ(a.to_si, 1.0);
+  EXPECT_EQ(a.si_symbol, "m/N/s^2");
+  EXPECT_EQ(a.dimension, (Dimension{0, -1, 0, 0}));  // m s^-2 / (kg m s^-2)
+  EXPECT_EQ(a.quantity, Quantity::kCompound);
+  const Unit umv = find_unit("um/V").value();
+  EXPECT_EQ(umv.to_si, 1e-6);
+  EXPECT_EQ(umv.si_symbol, "m/V");
+  EXPECT_EQ(umv.dimension, (Dimension{-1, -1, 3, 1}));
+  EXPECT_EQ(find_unit("mV/V")->to_si, 1e-3);
+  EXPECT_EQ(find_unit("mV/V")->quantity, Quantity::kDimensionless);
+  EXPECT_EQ(find_unit("N/mm^2")->to_si, 1e6);  // MPa
+  EXPECT_EQ(find_unit("N/mm^2")->si_symbol, "Pa");
+  EXPECT_EQ(find_unit("1/s")->quantity, Quantity::kFrequency);
+  EXPECT_EQ(find_unit("m/s/s")->si_symbol, "m/s^2");
+  EXPECT_EQ(find_unit("mm/s2")->to_si, 1e-3);
+  EXPECT_EQ(find_unit("m/s\xC2\xB2")->si_symbol, "m/s^2");
+  EXPECT_EQ(find_unit("N.m")->si_symbol, "N*m");
+  EXPECT_FALSE(find_unit("um/furlong").has_value());
+  EXPECT_FALSE(find_unit("(m/s").has_value());
+  EXPECT_FALSE(find_unit("m//s").has_value());
+  EXPECT_EQ(divide(find_unit("um").value(), find_unit("V").value()).to_si, 1e-6);
+  EXPECT_EQ(divide(find_unit("um").value(), find_unit("V").value()).si_symbol, "m/V");
+}
+
 }  // namespace
 }  // namespace piezobench::io

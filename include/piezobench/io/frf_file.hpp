@@ -33,7 +33,9 @@
 // (column, variable, dataset and record); writers write a temporary file and rename it, so a
 // failure never leaves a partial file.
 #include <filesystem>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/io/timeseries.hpp"
@@ -50,13 +52,18 @@ struct FrfWriteOptions {
   MatVersion mat_version = MatVersion::kV5;  // .mat only
   int reference_node = 1000;                 // UFF: node number of the input (reference) DOF
   std::string date;                          // UFF ID line 3 (e.g. "21-NOV-25 10:48:00"); "" = NONE
+  // Units of the measured channels H relates (unit table symbols, "" = not known): H of output i
+  // is in output_units[i] / input_unit. Written as the CSV header's `re_NAME [m/V]`, the .mat
+  // `units` struct (H_NAME = 'm/V') and UFF records 9 and 10. Empty vector: no units written.
+  std::vector<std::string> output_units;
+  std::string input_unit;
 
   void validate() const;  // InputError naming the field
 };
 
 // Writes `frf` (validated first) in the format of the file's extension.
 void write_frf(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
-void write_frf_csv(const dsp::Frf& frf, const std::filesystem::path& file);
+void write_frf_csv(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
 void write_frf_mat(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
 void write_frf_uff58(const dsp::Frf& frf, const std::filesystem::path& file, const FrfWriteOptions& options = {});
 
@@ -65,13 +72,29 @@ struct FrfReadOptions {
   // separator (0 = detect; '.' or ','), as for time series (timeseries.hpp).
   char delimiter = 0;
   char decimal = 0;
+  // Units replacing the file's (the command line's --units): an output's name -> that output's
+  // unit, the input's name (or "input") -> the input's unit (H = output / input; the one not
+  // given is taken as SI), or "H_NAME" -> the unit of that FRF itself ("um/V"). A file unit
+  // replaced is a warning; a key that names no output or input is an InputError (field --units).
+  std::map<std::string, std::string> unit_overrides;
 };
 
-// Reads an FRF in the format of the file's extension. provenance.source is the time-series file
-// recorded in a .mat FRF, else the FRF file itself.
+// An FRF as read: H in SI units, with the unit each output's H was converted to.
+struct FrfFile {
+  dsp::Frf frf;
+  std::vector<std::string> units;    // per output: the SI unit of H ("m/V"; "" = none stated: taken as SI)
+  std::vector<std::string> warnings; // an output without a unit, a unit replaced by --units (one line each)
+};
+
+// Reads an FRF in the format of the file's extension, converting H to SI with the units the file
+// states (Units in FRF files, docs/formats.md) or the overrides. provenance.source is the
+// time-series file recorded in a .mat FRF, else the FRF file itself.
+[[nodiscard]] FrfFile read_frf_file(const std::filesystem::path& file, const FrfReadOptions& options = {});
+// read_frf_file's FRF (its warnings dropped).
 [[nodiscard]] dsp::Frf read_frf(const std::filesystem::path& file, const FrfReadOptions& options = {});
+// One format each (read_frf_file's FRF).
 [[nodiscard]] dsp::Frf read_frf_csv(const std::filesystem::path& file, const FrfReadOptions& options = {});
-[[nodiscard]] dsp::Frf read_frf_mat(const std::filesystem::path& file);
-[[nodiscard]] dsp::Frf read_frf_uff58(const std::filesystem::path& file);
+[[nodiscard]] dsp::Frf read_frf_mat(const std::filesystem::path& file, const FrfReadOptions& options = {});
+[[nodiscard]] dsp::Frf read_frf_uff58(const std::filesystem::path& file, const FrfReadOptions& options = {});
 
 }  // namespace piezobench::io

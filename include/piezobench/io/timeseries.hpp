@@ -53,6 +53,10 @@ struct TimeSeries {
   std::vector<std::string> units;    // per channel, SI symbol ("" = unknown); empty or names.size() entries
   std::map<std::string, Setting> settings;  // how the record was made (experiment, seed, ...)
   std::string source;                // file it was read from ("" when built in memory)
+  // What the reader accepted but the user should know, one line each, naming the file: a channel
+  // without a unit (taken as SI), a unit replaced by ReadOptions::unit_overrides, an --fs that
+  // disagrees with the time vector. Commands print them on stderr and in --json ("warnings").
+  std::vector<std::string> warnings;
 
   [[nodiscard]] Eigen::Index samples() const { return data.rows(); }
   [[nodiscard]] Eigen::Index channels() const { return data.cols(); }
@@ -70,16 +74,21 @@ struct TimeSeries {
 
 struct ReadOptions {
   // Sample rate in Hz; 0 = take it from the time vector `t` (or, for files written by piezobench,
-  // the scalar `fs`). When both this and `t` are present they must agree within time_tolerance.
+  // the scalar `fs`). When given, it overrides the time vector and the file's fs; a disagreement
+  // is a warning that shows both rates.
   double fs = 0.0;
   // Channels to read, in this order; empty = every numeric vector in the file except `t`.
   std::vector<std::string> channels;
   // .mat only: name of a 1x1 struct variable whose fields are the channels ("" = top level; if
   // the top level holds no vector but exactly one struct does, that struct is used).
   std::string group;
-  // Largest accepted deviation of t[k] from t[0] + k / fs, as a fraction of the sample period.
-  // Also the largest accepted relative difference between an explicit fs and the one from `t`.
-  double time_tolerance = 1e-6;
+  // Jitter tolerance of a time vector: the largest accepted deviation of a stamp from the
+  // least-squares line through the stamps, beyond the precision the file stores them with (printed
+  // decimals, float32, double round-off; capped at a quarter period), as a fraction of the sample
+  // period. 1 % accepts random jitter of 0.1 % RMS (its largest deviation in 10^7 stamps is
+  // ~0.55 %) and refuses a dropped or doubled sample (half a period at least). Beyond it the reader
+  // refuses the file with the measured figure, unless `fs` is given (then a warning).
+  double time_tolerance = 0.01;
   // CSV only: the delimiter (0 = detect; ',', ';', '\t' or ' ' for runs of blanks) and the decimal
   // separator (0 = detect; '.' or ',').
   char delimiter = 0;
@@ -87,6 +96,10 @@ struct ReadOptions {
   // Units of channels whose file gives none (e.g. from a campaign file): channel -> unit symbol.
   // A file that gives another unit for such a channel is an InputError.
   std::map<std::string, std::string> units;
+  // Units that replace the file's (the command line's --units de=um,Vs=mV): channel -> unit
+  // symbol. A file that gives another unit is overridden with a warning; a channel the file does
+  // not have is an InputError (field "--units").
+  std::map<std::string, std::string> unit_overrides;
 
   // Throws InputError (source "ReadOptions") naming the bad field.
   void validate() const;
@@ -106,10 +119,14 @@ struct MatWriteOptions {
   bool compress = false;                 // zlib compression of v5 variables (ignored for v7.3)
 };
 
-// Reads a time series; the format comes from the extension (.mat or .csv, case-insensitive).
+// Reads a time series; the format comes from the extension (.mat, .csv, or .uff/.unv/.uf for UFF58
+// time histories; case-insensitive).
 [[nodiscard]] TimeSeries read_timeseries(const std::filesystem::path& file, const ReadOptions& options = {});
 [[nodiscard]] TimeSeries read_timeseries_mat(const std::filesystem::path& file, const ReadOptions& options = {});
 [[nodiscard]] TimeSeries read_timeseries_csv(const std::filesystem::path& file, const ReadOptions& options = {});
+// UFF dataset 58 time histories (function type 1, as Testlab and Simcenter export; ASCII or binary
+// 58b, one record per channel): docs/formats.md, "UFF58 time histories".
+[[nodiscard]] TimeSeries read_timeseries_uff58(const std::filesystem::path& file, const ReadOptions& options = {});
 
 // A record read for one pass over its samples (what `piezobench frf` needs): the same checks and
 // results as read_timeseries, but the channels of a v5 MAT file stored as uncompressed doubles in
@@ -127,6 +144,7 @@ struct TimeSeriesView {
   double sample_rate = 0.0;                      // Hz
   std::vector<std::string> units;                // as TimeSeries::units
   std::string source;
+  std::vector<std::string> warnings;             // as TimeSeries::warnings
   std::shared_ptr<const void> storage;           // owns what `columns` point to
   bool mapped = false;                           // true when the columns point into the file's mapping
 
