@@ -125,13 +125,21 @@ Quantity quantity_of(const Dimension& d) {
 struct Product {
   double factor = 1.0;
   std::vector<std::pair<std::string, int>> powers;  // SI symbol, exponent
+  bool valid = true;                                // false: a power beyond +-12 somewhere (no unit has one)
 
   void multiply(const Product& other, int exponent) {
+    valid = valid && other.valid;
     factor *= std::pow(other.factor, exponent);
     for (const auto& [symbol, e] : other.powers) {
+      const int add = std::clamp(e, -12, 12) * exponent;  // |e| <= 12 and |exponent| <= 9: no overflow
+      valid = valid && std::abs(e) <= 12 && std::abs(add) <= 12;
       const auto it = std::find_if(powers.begin(), powers.end(), [&](const auto& p) { return p.first == symbol; });
-      if (it == powers.end()) powers.emplace_back(symbol, e * exponent);
-      else it->second += e * exponent;
+      if (it == powers.end()) {
+        powers.emplace_back(symbol, add);
+      } else {
+        it->second = std::clamp(it->second, -12, 12) + add;
+        valid = valid && std::abs(it->second) <= 12;
+      }
     }
   }
 };
@@ -294,7 +302,9 @@ std::optional<Unit> find_unit(std::string_view symbol) {
   symbol = text::trim(symbol);
   if (std::optional<Unit> u = table_unit(symbol)) return u;
   if (symbol.empty() || symbol.size() > 80) return std::nullopt;
-  if (const std::optional<Product> p = CompoundParser(symbol).parse()) return unit_of_product(symbol, *p);
+  const std::optional<Product> p = CompoundParser(symbol).parse();
+  // A factor that over- or underflows would scale the samples by 0 or inf: no unit.
+  if (p && p->valid && std::isfinite(p->factor) && p->factor > 0.0) return unit_of_product(symbol, *p);
   return std::nullopt;
 }
 

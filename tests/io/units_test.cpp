@@ -72,6 +72,8 @@ TEST(Units, CompoundUnitsParseIntoAnSiFactorAndADimension) {
   EXPECT_FALSE(find_unit("um/furlong").has_value());
   EXPECT_FALSE(find_unit("(m/s").has_value());
   EXPECT_FALSE(find_unit("m//s").has_value());
+  EXPECT_FALSE(find_unit("((nm^9)^9)^9").has_value());  // a factor of 1e-6561 is no unit
+  EXPECT_FALSE(find_unit("(((((m^9)^9)^9)^9)^9)^9").has_value());
   EXPECT_EQ(divide(find_unit("um").value(), find_unit("V").value()).to_si, 1e-6);
   EXPECT_EQ(divide(find_unit("um").value(), find_unit("V").value()).si_symbol, "m/V");
 }
