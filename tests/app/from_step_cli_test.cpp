@@ -129,7 +129,7 @@ TEST(FromStepCli, BadInputExitsWithThreeAndSaysWhat) {
   for (const Case& c : cases) {
     const test::CliRun r = run_cli("superelement from-step " + c.args + " --json");
     EXPECT_EQ(r.exit_code, c.exit_code) << c.args << "\n" << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(test::no_result(r)) << r.out;
     for (const auto& needle : c.needles) EXPECT_TRUE(test::contains(r.err, needle)) << c.args << "\n" << r.err;
     EXPECT_FALSE(fs::exists(dir.path() / "out" / "from_step_work")) << c.args;
   }

@@ -139,8 +139,18 @@ capacitance_uF = { sensor = 5.10, actuator = 10.03 }
 }
 
 // A second run on a --out another run holds is refused with exit 3 and leaves the folder alone.
+// results.json of a one-unit run whose unit was refused: written, the unit not analysed and not accepted.
+void expect_not_analysed(const fs::path& results) {
+  ASSERT_TRUE(fs::exists(results));
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(results));
+  ASSERT_EQ(j["units"].size(), 1u);
+  EXPECT_FALSE(j["units"][0]["not_analysed"].is_null()) << j["units"][0].dump();
+  EXPECT_NE(j["units"][0]["accepted"], true);
+}
+
 // Issue 35's reproducers of item 2, through the command: unit 1's files given for unit 3, an FRF
-// record given as a stroke: exit 3 naming both, no results written.
+// record given as a stroke: the unit is not analysed (exit 7, issue 33's code for a unit that could
+// not be analysed), the reason names both, and the unit is never accepted with another's numbers.
 TEST(RunCli, RecordsOfAnotherUnitOrKindAreRefused) {
   test::TempDir dir;
   const auto file = [&dir](const std::string& name) { return (dir.path() / name).string(); };
@@ -149,16 +159,16 @@ TEST(RunCli, RecordsOfAnotherUnitOrKindAreRefused) {
   ASSERT_EQ(run_cli("simulate frf-noise --unit 3 --duration 1 --out " + file("f3.mat")).exit_code, 0);
   std::ofstream(dir.path() / "swapped.toml") << "[[units]]\nid = 3\ncapacitance = \"c1.mat\"\nstroke = \"s1.mat\"\n";
   CliRun r = run_cli("run " + file("swapped.toml") + " --out " + file("out1"));
-  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(r.exit_code, 7) << r.err;
   EXPECT_TRUE(test::contains(r.err, "expected a record of unit 3 (units[0].id)")) << r.err;
   EXPECT_TRUE(test::contains(r.err, "a record of unit 1 (its settings.unit)")) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out1" / "results.json"));
+  expect_not_analysed(dir.path() / "out1" / "results.json");
   std::ofstream(dir.path() / "kind.toml") << "[[units]]\nid = 3\nstroke = \"f3.mat\"\n";
   r = run_cli("run " + file("kind.toml") + " --out " + file("out2"));
-  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(r.exit_code, 7) << r.err;
   EXPECT_TRUE(test::contains(r.err, "expected a stroke record (stroke), found '" )) << r.err;
   EXPECT_TRUE(test::contains(r.err, "a frf-noise record (its settings.experiment)")) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out2" / "results.json"));
+  expect_not_analysed(dir.path() / "out2" / "results.json");
 }
 
 TEST(RunCli, BusyOutFolderIsRefused) {
