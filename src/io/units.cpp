@@ -130,7 +130,9 @@ struct Product {
   void multiply(const Product& other, int exponent) {
     valid = valid && other.valid;
     factor *= std::pow(other.factor, exponent);
-    for (const auto& [symbol, e] : other.powers) {
+    for (const auto& power : other.powers) {
+      const std::string& symbol = power.first;
+      const int e = power.second;
       const int add = std::clamp(e, -12, 12) * exponent;  // |e| <= 12 and |exponent| <= 9: no overflow
       valid = valid && std::abs(e) <= 12 && std::abs(add) <= 12;
       const auto it = std::find_if(powers.begin(), powers.end(), [&](const auto& p) { return p.first == symbol; });
