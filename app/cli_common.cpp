@@ -81,7 +81,12 @@ CLI::Validator parsed_by(const std::function<void(const std::string&)>& parse, c
         try {
           parse(value);
         } catch (const Error& e) {
-          return e.what();
+          // CLI11 puts the option's name before this message: a UsageError's own "--units: "
+          // prefix would repeat it.
+          const std::string message = e.what();
+          const std::size_t colon = message.find(": ");
+          if (message.rfind("--", 0) == 0 && colon != std::string::npos) return message.substr(colon + 2);
+          return message;
         }
         return {};
       },

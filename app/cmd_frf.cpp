@@ -396,6 +396,11 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
   const lti::Vector coh = i < frf.coherence.size() ? frf.coherence[i] : lti::Vector();
   const ident::IffPlantFit p = ident::fit_iff_plant(kTwoPi * frf.freq_Hz, frf.H[i], coh, fo, o.file);
   const double hz = 1.0 / kTwoPi;
+  // g0 has the unit of H (output / input) in SI, as the file states it; V/V only for u -> Vs in V.
+  const std::string g0_unit = i < file.units.size() ? file.units[i] : std::string();
+  const std::string g0_unit_text = g0_unit.empty() ? "(H's unit, not stated in the file: SI assumed)"
+                                   : g0_unit == "1"  ? "(dimensionless: output and input in one unit)"
+                                                     : g0_unit;
   nlohmann::json doc = {{"source", o.file},
                         {"output", o.output},
                         {"band_Hz", {fo.fmin_Hz, fo.fmax_Hz}},
@@ -405,7 +410,10 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
                         {"status", core::to_string(p.status)},
                         {"formula", "G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) s / (w_hpf + s) exp(-s delay)"}};
   if (!p.quality.impossible) {
-    doc["plant"] = {{"g0", io::to_json(p.g0)},          {"wz_Hz", io::to_json(p.wz * hz)},   {"xz", io::to_json(p.xz)},
+    doc["plant"] = {{"g0", io::to_json(p.g0)},
+                    {"g0_unit", g0_unit.empty() ? nlohmann::json() : nlohmann::json(g0_unit)},
+                    {"wz_Hz", io::to_json(p.wz * hz)},
+                    {"xz", io::to_json(p.xz)},
                     {"wp_Hz", io::to_json(p.wp * hz)},  {"xp", io::to_json(p.xp)},          {"w_hpf_Hz", io::to_json(p.w_hpf * hz)},
                     {"delay_s", io::to_json(p.delay)}, {"zero_is_nonminimum_phase", p.zero_is_nonminimum_phase()}};
   }
@@ -425,7 +433,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
   fmt::print("IFF plant (eq. 2.3 with delay) fitted to u -> {} of {}, {:.4g} to {:.4g} Hz ({} points)\n", o.output, o.file,
              fo.fmin_Hz, fo.fmax_Hz, p.points);
   if (!p.quality.impossible) {
-    fmt::print("  g0 = {:.5g} V/V, wz = {:.5g} Hz, xz = {:+.4g}, wp = {:.5g} Hz, xp = {:.4g}\n", p.g0, p.wz * hz, p.xz, p.wp * hz, p.xp);
+    fmt::print("  g0 = {:.5g} {}, wz = {:.5g} Hz, xz = {:+.4g}, wp = {:.5g} Hz, xp = {:.4g}\n", p.g0, g0_unit_text, p.wz * hz, p.xz, p.wp * hz, p.xp);
     fmt::print("  high-pass corner {:.4g} Hz, delay {:.4g} us\n", p.w_hpf * hz, p.delay * 1e6);
     fmt::print("  zero pair: {} phase (xz {} 0)\n", p.zero_is_nonminimum_phase() ? "NON-minimum" : "minimum",
                p.zero_is_nonminimum_phase() ? "<" : ">=");

@@ -40,6 +40,8 @@
   X(herr_t, H5Dread, (hid_t dset_id, hid_t mem_type_id, hid_t mem_space_id, hid_t file_space_id, hid_t dxpl_id, void* buf), \
     (dset_id, mem_type_id, mem_space_id, file_space_id, dxpl_id, buf))                                           \
   X(int, H5Pget_nfilters, (hid_t plist_id), (plist_id))                                                          \
+  X(hid_t, H5Rdereference2, (hid_t obj_id, hid_t oapl_id, H5R_type_t ref_type, const void* ref),                 \
+    (obj_id, oapl_id, ref_type, ref))                                                                            \
   X(herr_t, H5Pclose, (hid_t plist_id), (plist_id))                                                              \
   X(hid_t, H5Screate_simple, (int rank, const hsize_t dims[], const hsize_t maxdims[]), (rank, dims, maxdims))   \
   X(int, H5Sget_simple_extent_dims, (hid_t space_id, hsize_t dims[], hsize_t maxdims[]), (space_id, dims, maxdims)) \
@@ -70,7 +72,8 @@
   X(H5T_NATIVE_DOUBLE_g)             \
   X(H5T_NATIVE_LLONG_g)              \
   X(H5T_NATIVE_UINT16_g)             \
-  X(H5T_NATIVE_ULLONG_g)
+  X(H5T_NATIVE_ULLONG_g)             \
+  X(H5T_STD_REF_OBJ_g)
 
 #define PIEZOBENCH_HDF5_DEFINE_VARIABLE(name) \
   extern "C" {                                \

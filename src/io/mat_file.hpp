@@ -80,7 +80,8 @@ struct MatValue {
   std::vector<std::string> field_names;     // struct
   // struct: element e's field f at items[e * field_names.size() + f]; cell: the cells
   std::vector<MatValue> items;
-  bool has_data = true;  // false: the header only (sparse, object, function: never read)
+  bool has_data = true;  // false: the header only (sparse, object, function: never read; a v7.3 cell of
+                         // structs or cells, or of more than 2^20 values in all)
   // v7.3 (HDF5) only: a dataset's string attribute `units` (or `unit`, any case: h5py users write
   // one), and a group's other string attributes (name, text), e.g. `units` = "u=V, de=um" or
   // `de_units` = "um". Empty for v5.
@@ -142,6 +143,9 @@ struct MatVarInfo {
   std::string unit;  // v7.3: the dataset's string attribute `units` (h5py users write one), else ""
 };
 [[nodiscard]] std::vector<MatVarInfo> list_mat_variables(MatInput* mat, const std::filesystem::path& file);
+// v7.3: the file's own (root group's) string attributes other than MATLAB's, e.g. h5py's
+// f.attrs["units"] = "u=V, de=um" (at most 4096); empty for v5.
+[[nodiscard]] std::vector<std::pair<std::string, std::string>> mat_file_attributes(MatInput* mat);
 // Reads a variable with its data; InputError (field = name) when absent or unreadable. Classes
 // piezobench never reads the data of (sparse, object, function) come back as their header only.
 [[nodiscard]] MatValue read_mat_variable(MatInput* mat, const std::filesystem::path& file, const std::string& name);

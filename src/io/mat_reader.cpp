@@ -753,14 +753,21 @@ bool is_complex_type(hid_t type) {
   return H5Tget_member_index(type, "real") >= 0 && H5Tget_member_index(type, "imag") >= 0;
 }
 
+H5Var describe_h5_object(const H5File& in, H5Id obj, const std::string& field);
+
 H5Var open_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field) {
-  const std::string source = in.source();
-  H5Var v;
   if (H5Lexists(parent, name.c_str(), H5P_DEFAULT) <= 0) {
-    throw InputError(source, field, "a variable of the file", "none of that name");
+    throw InputError(in.source(), field, "a variable of the file", "none of that name");
   }
   H5Id obj(H5Oopen(parent, name.c_str(), H5P_DEFAULT), H5Oclose);
-  if (!obj.valid()) throw InputError(source, field, "a readable variable", "HDF5 cannot open it");
+  if (!obj.valid()) throw InputError(in.source(), field, "a readable variable", "HDF5 cannot open it");
+  return describe_h5_object(in, std::move(obj), field);
+}
+
+// What an open dataset or group holds (its class, shape, flags).
+H5Var describe_h5_object(const H5File& in, H5Id obj, const std::string& field) {
+  const std::string source = in.source();
+  H5Var v;
   const H5I_type_t kind = H5Iget_type(obj.get());
   v.class_name = read_string_attribute(obj.get(), "MATLAB_class", source, field);
   if (kind == H5I_GROUP) {
@@ -881,6 +888,44 @@ MatValue read_h5_struct(const H5File& in, const H5Var& v, const std::string& nam
 
 // A variable of the file as the reader returns it (numeric classes as doubles), straight from
 // HDF5 (no matio).
+MatValue read_h5_array(const H5File& in, const H5Var& v, const std::string& name, const std::string& field);
+
+// A cell's elements of at most this many values in all are read (units and channel-name cells);
+// a larger cell comes back as its header only.
+constexpr size_t kMaxCellValues = size_t{1} << 20;
+
+// A v7.3 cell: a dataset of object references (class cell) to the elements' datasets in #refs#
+// (MATLAB, hdf5storage). Read when every element is a numeric or char array and all hold at most
+// kMaxCellValues values; a cell of structs or cells, or a larger one, comes back as its header
+// only (has_data false), as before cells were read. A reference that leads nowhere is an InputError.
+MatValue read_h5_cell(const H5File& in, const H5Var& v, const std::string& name, const std::string& field) {
+  MatValue out(name, MAT_C_CELL, v.dims);
+  const size_t n = product(v.dims);
+  out.has_data = n == 0;  // an empty cell is complete
+  const H5Id type(H5Dget_type(v.obj.get()), H5Tclose);
+  if (n == 0 || n > kMaxCellValues || v.empty_flag || !type.valid() || H5Tget_class(type.get()) != H5T_REFERENCE) return out;
+  check_h5_storage(in, v, field);
+  std::vector<hobj_ref_t> refs(n);
+  if (H5Dread(v.obj.get(), H5T_STD_REF_OBJ, H5S_ALL, H5S_ALL, H5P_DEFAULT, refs.data()) < 0) {
+    throw InputError(in.source(), field, "a cell's references HDF5 can read", "the read failed (corrupt or truncated file)");
+  }
+  std::vector<H5Var> elements;
+  size_t values = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const std::string element_field = field + "{" + std::to_string(i + 1) + "}";
+    H5Id obj(H5Rdereference2(v.obj.get(), H5P_DEFAULT, H5R_OBJECT, &refs[i]), H5Oclose);
+    if (!obj.valid()) throw InputError(in.source(), element_field, "a reference to an object of the file", "a reference HDF5 cannot follow");
+    H5Var e = describe_h5_object(in, std::move(obj), element_field);
+    if (e.group || (!is_numeric_class(e.cls) && e.cls != MAT_C_CHAR)) return out;  // nested: not read
+    values += product(e.dims);
+    if (values > kMaxCellValues) return out;
+    elements.push_back(std::move(e));
+  }
+  for (size_t i = 0; i < n; ++i) out.items.push_back(read_h5_array(in, elements[i], "", field + "{" + std::to_string(i + 1) + "}"));
+  out.has_data = true;
+  return out;
+}
+
 MatValue read_h5_var(const H5File& in, hid_t parent, const std::string& name, const std::string& field, int depth) {
   const std::string source = in.source();
   const H5Var v = open_h5_var(in, parent, name, field);
@@ -888,13 +933,20 @@ MatValue read_h5_var(const H5File& in, hid_t parent, const std::string& name, co
     if (v.cls != MAT_C_STRUCT) throw InputError(source, field, "a struct group", "MATLAB class " + text::quote(v.class_name));
     return read_h5_struct(in, v, name, field, depth);
   }
-  const size_t n = product(v.dims);
+  if (v.cls == MAT_C_CELL) return read_h5_cell(in, v, name, field);
   if (!is_numeric_class(v.cls) && v.cls != MAT_C_CHAR) {
-    // Classes piezobench never reads (cell, object, function handle): the header only.
+    // Classes piezobench never reads (object, function handle): the header only.
     MatValue out(name, v.cls, v.dims);
-    out.has_data = v.cls == MAT_C_CELL && n == 0;  // an empty cell is complete
+    out.has_data = false;
     return out;
   }
+  return read_h5_array(in, v, name, field);
+}
+
+// A numeric or char dataset, with its unit attribute.
+MatValue read_h5_array(const H5File& in, const H5Var& v, const std::string& name, const std::string& field) {
+  const std::string source = in.source();
+  const size_t n = product(v.dims);
   check_h5_storage(in, v, field);
   if (n == 0 || v.empty_flag) return MatValue(name, v.cls == MAT_C_CHAR ? MAT_C_CHAR : MAT_C_DOUBLE, v.dims);
   if (v.cls != MAT_C_CHAR) {
@@ -1106,7 +1158,10 @@ class Mat73Input final : public MatInput {
         [&](IsolatedOut& out) {
           H5File h5(file());
           std::vector<MatVarInfo> list;
+          std::vector<std::pair<std::string, std::string>> attributes;
           try {
+            // h5py users put units on the file itself: f.attrs["units"] = "u=V, de=um".
+            attributes = read_group_attributes(h5.root(), h5.source(), "/");
             for (const std::string& name : h5_top_level_names(h5)) {
               const H5Var v = open_h5_var(h5, h5.root(), name, name);
               // Readers size their buffers from this list: the declared size is checked here, first.
@@ -1129,6 +1184,11 @@ class Mat73Input final : public MatInput {
             for (size_t d : v.dims) out.put_u64(d);
             out.put_string(v.unit);
           }
+          out.put_u64(attributes.size());
+          for (const auto& [key, text] : attributes) {
+            out.put_string(key);
+            out.put_string(text);
+          }
         },
         [&](IsolatedIn& in) {
           if (in.get_u64() != 0) {
@@ -1148,6 +1208,12 @@ class Mat73Input final : public MatInput {
             v.unit = in.get_string(4096);
             list_.push_back(std::move(v));
           }
+          const std::uint64_t attributes = in.get_u64();
+          if (attributes > 4097) in.malformed(std::to_string(attributes) + " attributes");
+          for (std::uint64_t a = 0; a < attributes; ++a) {
+            std::string key = in.get_string(4096);
+            attributes_.emplace_back(std::move(key), in.get_string(4096));
+          }
         });
   }
   [[nodiscard]] bool v73() const override { return true; }
@@ -1157,6 +1223,11 @@ class Mat73Input final : public MatInput {
     if (!list_error_.empty()) throw InputError(list_error_);
     return list_;
   }
+  // The root group's string attributes (read_group_attributes).
+  [[nodiscard]] const std::vector<std::pair<std::string, std::string>>& attributes() const {
+    if (!list_error_.empty()) throw InputError(list_error_);
+    return attributes_;
+  }
   // Runs `child` (given the file open in HDF5) isolated, `parent` on its answer.
   void run(const std::function<void(IsolatedOut&)>& child, const std::function<void(IsolatedIn&)>& parent) const {
     run_isolated(isolated_options(source()), child, parent);
@@ -1164,6 +1235,7 @@ class Mat73Input final : public MatInput {
 
  private:
   std::vector<MatVarInfo> list_;
+  std::vector<std::pair<std::string, std::string>> attributes_;
   std::string list_error_;
   double limit_ = 0.0;
 };
@@ -1308,6 +1380,11 @@ std::vector<MatVarInfo> list_mat_variables(MatInput* in, const fs::path& file) {
     throw InputError(file.string(), "file", "a well-formed MAT file", "matio: " + reason);
   }
   return out;
+}
+
+std::vector<std::pair<std::string, std::string>> mat_file_attributes(MatInput* in) {
+  if (const Mat73Input* h5 = as_v73(in)) return h5->attributes();
+  return {};
 }
 
 MatValue read_mat_variable(MatInput* in, const fs::path& file, const std::string& name) {

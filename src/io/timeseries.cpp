@@ -706,7 +706,7 @@ std::optional<std::vector<std::pair<std::string, std::string>>> unit_pairs(const
 // "Units in .mat files"): a `units` struct (top level or inside the record struct: one char field
 // per channel), a `units` cell array (name/unit pairs as an N x 2 or 2 x N cell, or one unit per
 // name of a `channels` / `names` / `labels` list of the same length), v7.3 `units` attributes of
-// datasets (top level or in a group) and a group's attributes (`units` = "u=V, de=um", `de_units`,
+// datasets (top level or in a group) and a group's or the file's (root group's) attributes (`units` = "u=V, de=um", `de_units`,
 // `units_de`, or an attribute named as the channel). Two places that disagree, a units cell that
 // cannot be matched to names, or an entry that names no variable of the file are InputErrors.
 std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::path& file, const std::vector<detail::MatVarInfo>& vars,
@@ -761,7 +761,7 @@ std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::pa
     }
     if (uv.class_type != MAT_C_CELL) throw InputError(source, place, "a struct, a cell or a char row of units", detail::describe(uv));
     if (!uv.has_data) {
-      throw InputError(source, place, "units as a struct (a v7.3 file's cell arrays are not read)", detail::describe(uv));
+      throw InputError(source, place, "units as a cell of texts (a cell of structs or cells is not read)", detail::describe(uv));
     }
     const std::vector<std::string> texts = cell_texts(uv, source, place);
     const size_t rows = uv.dims.empty() ? 0 : uv.dims[0], cols = texts.size() / std::max<size_t>(rows, 1);
@@ -790,16 +790,12 @@ std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::pa
     }
     for (size_t i = 0; i < texts.size(); ++i) add((*names)[i], texts[i], place + "{" + std::to_string(i + 1) + "}", true);
   };
-  // v7.3 attributes of the datasets themselves.
-  for (const auto& v : vars) add(v.name, v.unit, v.name + " (attribute units)", false);
-  if (layout.group_var) {
-    const detail::MatValue& g = *layout.group_var;
-    for (size_t f = 0; f < g.field_names.size(); ++f) {
-      const detail::MatValue* field = g.field(g.field_names[f]);
-      if (field != nullptr) add(g.field_names[f], field->unit, layout.group + "." + g.field_names[f] + " (attribute units)", false);
-    }
-    for (const auto& [key, value] : g.attributes) {
-      const std::string place = layout.group + " (attribute " + key + ")";
+  // A group's attributes (the record group's, or the file's own root group's): `units` =
+  // "u=V, de=um", `de_units`, `de_unit`, `units_de`, or an attribute named as a member.
+  const auto from_attributes = [&](const std::vector<std::pair<std::string, std::string>>& attributes, const std::string& group,
+                                   const std::vector<std::string>& members) {
+    for (const auto& [key, value] : attributes) {
+      const std::string place = group + " (attribute " + key + ")";
       const std::string l = text::to_lower(key);
       if (is_units_name(key)) {
         const auto pairs = unit_pairs(value);
@@ -811,10 +807,23 @@ std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::pa
         add(key.substr(0, key.size() - 5), value, place, true);
       } else if (l.rfind("units_", 0) == 0 && l.size() > 6) {
         add(key.substr(6), value, place, true);
-      } else if (std::find(g.field_names.begin(), g.field_names.end(), key) != g.field_names.end()) {
+      } else if (std::find(members.begin(), members.end(), key) != members.end()) {
         add(key, value, place, false);
       }
     }
+  };
+  // v7.3 attributes of the datasets themselves, and of the file.
+  for (const auto& v : vars) add(v.name, v.unit, v.name + " (attribute units)", false);
+  std::vector<std::string> top_level;
+  for (const auto& v : vars) top_level.push_back(v.name);
+  from_attributes(detail::mat_file_attributes(mat), "file", top_level);
+  if (layout.group_var) {
+    const detail::MatValue& g = *layout.group_var;
+    for (size_t f = 0; f < g.field_names.size(); ++f) {
+      const detail::MatValue* field = g.field(g.field_names[f]);
+      if (field != nullptr) add(g.field_names[f], field->unit, layout.group + "." + g.field_names[f] + " (attribute units)", false);
+    }
+    from_attributes(g.attributes, layout.group, g.field_names);
     for (const std::string& f : g.field_names) {
       if (is_units_name(f)) from_value(*g.field(f), layout.group + "." + f, &g);
     }

@@ -3,6 +3,7 @@
 
 #include <complex>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -101,7 +102,7 @@ TEST(FitCli, RecoversKnownPolesFromAnExactFrf) {
 TEST(FrfCli, UffTimeHistoriesAndFilesInOtherUnitsGiveScipysH1) {
   const auto ref = nlohmann::json::parse(test::read_text(test::fixture_path("io/units/expected.json")));
   for (const char* name : {"th_multi_ascii.uff", "th_multi_58b.uff", "v5_units_cell_pairs.mat", "h5_group_attr_map.mat",
-                           "time_ms3.csv", "time_float32.csv"}) {
+                           "h5_root_attr_map.mat", "v73_units_cell_pairs.mat", "time_ms3.csv", "time_float32.csv"}) {
     SCOPED_TRACE(name);
     const std::string file = test::fixture_path(std::string("io/units/") + name).string();
     const test::CliRun r = run_cli("frf " + file + " --input u --output d_e,Vs --nfft 512 --overlap 0.5 --detrend none --json");
@@ -218,6 +219,49 @@ TEST(FitCli, IffPlantTomlFeedsTheRootLocus) {
   const auto l = nlohmann::json::parse(rl.out);
   EXPECT_NEAR(std::abs(pair(l["resonance_pole"])) / (2 * std::numbers::pi) / truth["resonance_Hz"].get<double>(), 1.0, 0.01);
   EXPECT_GT(l["max_damping"].get<double>(), 0.05);
+}
+
+// Issue 33: g0 is in the unit of H the file states (converted to SI), never V/V whatever the file:
+// the same FRF with H_Vs in mV/V (values x 1000) gives the same g0, dimensionless; without units
+// the summary says that SI was assumed.
+TEST(FitCli, IffPlantG0InTheUnitTheFileStates) {
+  test::TempDir dir;
+  const std::string f = test::fixture_path("ident/two_dof_welch_frf.csv").string();
+  std::istringstream in(test::read_text(f));
+  std::ostringstream scaled;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (line.rfind("freq_Hz", 0) == 0) {
+      scaled << "freq_Hz,re_de [m/V],im_de [m/V],coh_de,re_Vs [mV/V],im_Vs [mV/V],coh_Vs\n";
+      continue;
+    }
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+    ASSERT_EQ(cells.size(), 7u) << line;
+    for (const std::size_t k : {std::size_t{4}, std::size_t{5}}) {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.17g", 1e3 * std::stod(cells[k]));
+      cells[k] = buf;
+    }
+    for (std::size_t k = 0; k < cells.size(); ++k) scaled << (k ? "," : "") << cells[k];
+    scaled << "\n";
+  }
+  const std::string mv = test::write_text_file(dir, "mV_per_V.csv", scaled.str());
+  const test::CliRun si = run_cli("fit iff-plant " + f + " --fmax 500 --json");
+  const test::CliRun milli = run_cli("fit iff-plant " + mv + " --fmax 500 --json");
+  ASSERT_EQ(si.exit_code, 0) << si.err;
+  ASSERT_EQ(milli.exit_code, 0) << milli.err;
+  const auto a = nlohmann::json::parse(si.out), b = nlohmann::json::parse(milli.out);
+  EXPECT_TRUE(a["plant"]["g0_unit"].is_null());
+  EXPECT_EQ(b["plant"]["g0_unit"], "1");
+  EXPECT_NEAR(b["plant"]["g0"].get<double>() / a["plant"]["g0"].get<double>(), 1.0, 1e-6);
+  const test::CliRun text = run_cli("fit iff-plant " + mv + " --fmax 500");
+  EXPECT_NE(text.out.find(" (dimensionless: output and input in one unit), wz"), std::string::npos) << text.out;
+  const test::CliRun bare = run_cli("fit iff-plant " + f + " --fmax 500");
+  EXPECT_NE(bare.out.find(" (H's unit, not stated in the file: SI assumed), wz"), std::string::npos) << bare.out;
+  EXPECT_EQ(bare.out.find("V/V"), std::string::npos) << bare.out;
 }
 
 // Other programs' window names are accepted; a bad option is exit 2 before any computation.

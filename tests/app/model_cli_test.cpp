@@ -211,7 +211,11 @@ TEST(ModelCli, TuneHonoursTheUnitsOfTheFrf) {
   EXPECT_NE(warned.err.find("warning: " + unstated + ": output de has no unit: H taken as SI"), std::string::npos) << warned.err;
   EXPECT_EQ(nlohmann::json::parse(warned.out)["warnings"].size(), 2u);  // de and Vs
   EXPECT_EQ(run_cli("model tune --frf " + unstated + " --units d=um").exit_code, 3);   // names no channel
-  EXPECT_EQ(run_cli("model tune --frf " + unstated + " --units de=furlong").exit_code, 2);
+  const test::CliRun furlong = run_cli("model tune --frf " + unstated + " --units de=furlong");
+  EXPECT_EQ(furlong.exit_code, 2);
+  // The option is named once ("--units: expected ..."), not twice.
+  EXPECT_NE(furlong.err.find("--units: expected a unit of the table"), std::string::npos) << furlong.err;
+  EXPECT_EQ(furlong.err.find("--units: --units"), std::string::npos) << furlong.err;
 }
 
 TEST(ModelCli, TuneBadInputExitsWithThree) {

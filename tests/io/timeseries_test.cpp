@@ -812,7 +812,9 @@ TimeSeries expect_units_record(const std::string& name, double rel_tol, const Re
 
 TEST(TimeSeriesUnits, EveryPlaceAWriterPutsUnits) {
   for (const char* name : {"h5_dataset_attrs_in_group.mat", "h5_group_attr_map.mat", "h5_group_attrs_per_channel.mat",
-                           "v5_units_struct_in_record.mat", "v5_units_cell_pairs.mat", "v5_units_cell_list.mat"}) {
+                           "h5_root_attr_map.mat", "h5_root_attrs_per_channel.mat", "v73_units_cell_pairs.mat",
+                           "v73_units_cell_list.mat", "v5_units_struct_in_record.mat", "v5_units_cell_pairs.mat",
+                           "v5_units_cell_list.mat"}) {
     const TimeSeries ts = expect_units_record(name, 1e-15);
     EXPECT_TRUE(ts.warnings.empty()) << name << ": " << text::join(ts.warnings, "; ");
   }
@@ -821,6 +823,8 @@ TEST(TimeSeriesUnits, EveryPlaceAWriterPutsUnits) {
 TEST(TimeSeriesUnits, AUnitNamingNoChannelOrAnUnmatchedCellIsRefused) {
   test::expect_input_error([] { (void)read_timeseries(test::fixture_path("io/units/v5_units_typo.mat")); },
                            {"v5_units_typo.mat", "units.d_ee", "'d_ee', which names no channel", "d_e"});
+  test::expect_input_error([] { (void)read_timeseries(test::fixture_path("io/units/h5_root_attr_typo.mat")); },
+                           {"h5_root_attr_typo.mat", "file (attribute units)", "'d_ee', which names no channel", "d_e"});
   test::expect_input_error([] { (void)read_timeseries(test::fixture_path("io/units/v5_units_cell_unmatched.mat")); },
                            {"v5_units_cell_unmatched.mat", "units", "`channels`", "without names"});
   ReadOptions o;
