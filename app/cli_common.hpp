@@ -27,6 +27,7 @@ void add_measure_commands(CLI::App& app, Action& action);  // measure, bench ser
 void add_run_commands(CLI::App& app, Action& action);  // run, merge, demo
 void add_hysteresis_commands(CLI::App& app, Action& action);  // hysteresis fit, hysteresis creep
 void add_qualify_commands(CLI::App& app, Action& action);  // qualify, db
+void add_twin_commands(CLI::App& app, Action& action);        // twin
 
 // Prints exactly one JSON document on stdout (round-trip precision for doubles; invalid UTF-8 in a
 // string replaced by U+FFFD).

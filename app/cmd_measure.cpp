@@ -96,6 +96,13 @@ std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& b, bool re
     return std::make_unique<rt::UdpBackend>(b.udp_address, b.sample_rate, b.udp_timeout, o);
   }
   if (b.backend == "comedi") return std::make_unique<rt::ComediBackend>(b);
+  if (!b.twin.empty()) {
+    const bench::Twin twin = bench::read_twin(b.twin);
+    bench::BenchOptions options = rt::bench_options(b);
+    bench::apply_chain(twin, options);
+    options.sample_rate = b.sample_rate;  // the loop's rate
+    return std::make_unique<rt::VirtualBenchBackend>(twin.unit, options, b.seed);
+  }
   return std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(b.unit, b.seed), rt::bench_options(b), b.seed);
 }
 
@@ -129,6 +136,8 @@ int run_measurement(const MeasureRequest& r) {
   if (hardware) {
     if (r.unit < 1) throw UsageError("--unit", "the number of the unit under test (>= 1)", std::to_string(r.unit));
     unit.id = r.unit;  // a real unit: only its number is known
+  } else if (r.twin) {
+    unit = r.twin->unit;
   } else {
     try {
       unit = bench::batch_unit(r.unit, r.seed);
@@ -297,7 +306,12 @@ int run_measure(const MeasureCli& o) {
                      "backend " + desc.backend);
   }
   set_feedforward(r.options, o.feedforward);
-  r.unit = o.unit_option->count() > 0 || desc.hardware() ? o.unit : desc.unit;
+  if (!desc.hardware() && !desc.twin.empty()) {
+    r.twin = bench::read_twin(desc.twin);
+    bench::apply_chain(*r.twin, r.options.bench);
+    r.options.bench.sample_rate = desc.sample_rate;
+  }
+  r.unit = o.unit_option->count() > 0 || desc.hardware() ? o.unit : r.twin ? r.twin->unit.id : desc.unit;
   r.seed = o.seed_option->count() > 0 || desc.hardware() ? o.seed : desc.seed;
   r.out = o.out;
   r.json = o.json;
@@ -324,6 +338,7 @@ struct ServeCli {
   std::uint64_t drop_every = 0;
   std::string key_file;
   std::string hysteresis_law = "prandtl-ishlinskii";
+  std::string twin;
   bool json = false;
 };
 
@@ -332,10 +347,17 @@ int run_serve(const ServeCli& o) {
   bo.sample_rate = o.rate;
   bo.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
   bench::UnitTruth unit;
-  try {
-    unit = bench::batch_unit(o.unit, o.seed);
-  } catch (const InputError& e) {
-    throw InputError("--" + std::string(e.what()));
+  if (!o.twin.empty()) {
+    const bench::Twin twin = bench::read_twin(o.twin);
+    bench::apply_chain(twin, bo);
+    bo.sample_rate = o.rate;  // the clients' rate
+    unit = twin.unit;
+  } else {
+    try {
+      unit = bench::batch_unit(o.unit, o.seed);
+    } catch (const InputError& e) {
+      throw InputError("--" + std::string(e.what()));
+    }
   }
   checked_duration_s(o.idle_timeout, 1e-3, 1e6, NumberOrigin::command_line("--idle-timeout"));
   checked_duration_s(o.session_timeout, 1e-3, 3600.0, NumberOrigin::command_line("--session-timeout"));
@@ -427,6 +449,8 @@ void add_measure_commands(CLI::App& app, Action& action) {
   serve->add_option("--key-file", s->key_file, "shared key (>= 16 bytes): every datagram carries its HMAC-SHA256 (docs/hardware.md)")
       ->check(CLI::ExistingFile);
   serve->add_option("--hysteresis-law", s->hysteresis_law, kHysteresisLawHelp)->capture_default_str();
+  serve->add_option("--twin", s->twin, "serve a unit's digital twin (TOML, `piezobench twin`) instead of the batch unit")
+      ->check(input_file());
   serve->add_flag("--json", s->json, "print the session counts as JSON at the end");
   serve->callback([s, &action] { action = [s] { return run_serve(*s); }; });
 }

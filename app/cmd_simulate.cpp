@@ -21,6 +21,7 @@ struct SimulateOptions {
   CLI::Option* gain_option = nullptr;
   bool no_delay = false, no_nmp_zero = false, no_resistor = false, open_circuit = false, no_hysteresis = false, no_creep = false, no_noise = false;
   std::string superelement;
+  std::string twin;
   std::string hysteresis_law = "prandtl-ishlinskii";
   std::string feedforward;
   bool json = false;
@@ -30,6 +31,10 @@ struct SimulateOptions {
 int run_simulate(const SimulateOptions& o) {
   MeasureRequest r;
   r.experiment = o.experiment;
+  if (!o.twin.empty()) {
+    r.twin = bench::read_twin(o.twin);
+    bench::apply_chain(*r.twin, r.options.bench);  // the switches below act on the twin's chain
+  }
   if (o.amplitude_option->count() > 0) r.options.amplitude = o.amplitude;
   if (o.duration_option->count() > 0) r.options.duration = o.duration;
   if (o.gain_option->count() > 0) r.options.gain = o.gain;
@@ -43,7 +48,7 @@ int run_simulate(const SimulateOptions& o) {
   if (!o.superelement.empty()) r.options.bench.superelement = o.superelement;
   r.options.bench.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
   set_feedforward(r.options, o.feedforward);
-  r.unit = o.unit;
+  r.unit = r.twin ? r.twin->unit.id : o.unit;
   r.seed = o.seed;
   r.out = o.out;
   r.json = o.json;
@@ -74,6 +79,8 @@ void add_simulate_commands(CLI::App& app, Action& action) {
       ->capture_default_str();
   sim->add_option("--feedforward", o->feedforward,
                   "tracking: the hysteresis model (TOML, `hysteresis fit`) of the compensated run (default: identified from the open run)")
+      ->check(input_file());
+  sim->add_option("--twin", o->twin, "a unit's digital twin (TOML, `piezobench twin`) instead of the batch unit --unit")
       ->check(input_file());
   sim->add_flag("--no-noise", o->no_noise, "no measurement noise (quantization stays)");
   sim->add_flag("--no-resistor", o->no_resistor, "no resistor across the sensor stack (only the ADC's input resistance)");

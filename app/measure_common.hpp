@@ -9,6 +9,7 @@
 #include <string>
 
 #include "piezobench/bench/experiments.hpp"
+#include "piezobench/bench/twin.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/rt/backend.hpp"
 #include "piezobench/rt/bench_file.hpp"
@@ -30,6 +31,9 @@ struct MeasureRequest {
   std::string log;                   // raw loop log
   bool reset_target = false;
   std::string serial;                // the unit's serial number when known: recorded (settings.serial)         // --reset-target: clear a UDP target's latched safe state after the operator's Enter
+  // The virtual bench of a digital twin (bench/twin.hpp) instead of the batch unit: its unit; its
+  // chain is already in options.bench (bench::apply_chain).
+  std::optional<bench::Twin> twin;
 };
 // --feedforward MODEL.toml of simulate and measure: the tracking experiment's model (InputError
 // naming the file; a model for another experiment is refused by ExperimentOptions::validate).
@@ -50,7 +54,7 @@ nlohmann::json loop_timing_json(const rt::LoopReport& report);
 // p50, p99, p999, max, mean and count of a timing summary.
 nlohmann::json timing_json(const rt::TimingSummary& summary);
 
-// The backend a bench file names (virtual: the batch unit of its [virtual] table). InputError when
+// The backend a bench file names (virtual: the batch unit of its [virtual] table, or its twin). InputError when
 // the device cannot be used. reset_target: a UDP target found in its latched safe state is reset
 // once the operator confirms on stdin (otherwise refused).
 std::unique_ptr<rt::Backend> make_backend(const rt::BenchDescription& bench, bool reset_target = false);

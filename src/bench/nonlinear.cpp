@@ -14,6 +14,19 @@ PlayHysteresis PlayHysteresis::bench_default(double scale) {
   return {r, w};
 }
 
+PlayHysteresis PlayHysteresis::from(const std::vector<double>& thresholds, const std::vector<double>& weights) {
+  std::array<double, kOperators> r{};
+  std::array<double, kOperators> w{};
+  double last = 1.0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    // Unused operators: weight 0 (their threshold, above the last one, never matters).
+    last = i < thresholds.size() ? thresholds[i] : 2.0 * last;
+    r[i] = last;
+    w[i] = i < weights.size() ? weights[i] : 0.0;
+  }
+  return {r, w};
+}
+
 PlayHysteresis::PlayHysteresis(const std::array<double, kOperators>& thresholds,
                                const std::array<double, kOperators>& weights)
     : thresholds_(Eigen::Map<const Array>(thresholds.data())), weights_(Eigen::Map<const Array>(weights.data())) {}

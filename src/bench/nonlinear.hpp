@@ -3,6 +3,7 @@
 // Fixed-size state, no allocation, no virtual call: they run inside VirtualBench::step().
 #include <Eigen/Core>
 #include <array>
+#include <vector>
 #include <cmath>
 
 namespace piezobench::bench::detail {
@@ -28,6 +29,8 @@ class PlayHysteresis {
   static PlayHysteresis bench_default(double scale);
 
   PlayHysteresis() = default;
+  // Up to kOperators operators (the rest: weight 0); the sizes are checked by UnitTruth::validate.
+  static PlayHysteresis from(const std::vector<double>& thresholds, const std::vector<double>& weights);
   PlayHysteresis(const std::array<double, kOperators>& thresholds, const std::array<double, kOperators>& weights);
 
   // Advances every operator to the voltage v and returns sum_i w_i P_{r_i}[v] (V), the amount to

@@ -84,6 +84,18 @@ void UnitTruth::validate() const {
           "creep_coefficient", "a creep per decade in [0, 1)", creep_coefficient);
   require(std::isfinite(load_creep_coefficient) && load_creep_coefficient >= 0.0 && load_creep_coefficient < 1.0, source,
           "load_creep_coefficient", "a creep per decade in [0, 1)", load_creep_coefficient);
+  if (hysteresis_thresholds.size() != hysteresis_weights.size() || hysteresis_thresholds.size() > kMaxPlayOperators) {
+    throw InputError(source, "hysteresis_weights", fmt::format("as many weights as thresholds, at most {}", kMaxPlayOperators),
+                     fmt::format("{} thresholds and {} weights", hysteresis_thresholds.size(), hysteresis_weights.size()));
+  }
+  for (std::size_t i = 0; i < hysteresis_thresholds.size(); ++i) {
+    const double r = hysteresis_thresholds[i];
+    const double previous = i == 0 ? 0.0 : hysteresis_thresholds[i - 1];
+    require(std::isfinite(r) && r > previous, source, fmt::format("hysteresis_thresholds[{}]", i),
+            "a threshold > 0 V and above the previous one", r);
+    require(std::isfinite(hysteresis_weights[i]) && hysteresis_weights[i] >= 0.0, source, fmt::format("hysteresis_weights[{}]", i),
+            "a weight >= 0", hysteresis_weights[i]);
+  }
   require(std::isfinite(mode_y_Hz) && mode_y_Hz > 0.0, source, "mode_y_Hz", "a frequency > 0 Hz", mode_y_Hz);
   require(std::isfinite(mode_x_Hz) && mode_x_Hz > 0.0, source, "mode_x_Hz", "a frequency > 0 Hz", mode_x_Hz);
   require(std::isfinite(mode_damping) && mode_damping >= 0.0 && mode_damping < 1.0, source, "mode_damping",
@@ -377,14 +389,18 @@ VirtualBench::VirtualBench(const UnitTruth& unit, const BenchOptions& options, s
   } else {
     s.ga = s.params.ga;
   }
-  s.use_hysteresis = options.hysteresis && unit.hysteresis_scale > 0.0;
+  const bool own_operators = !unit.hysteresis_thresholds.empty() && options.hysteresis_law == HysteresisLaw::kPrandtlIshlinskii;
+  s.use_hysteresis = options.hysteresis && (own_operators ? true : unit.hysteresis_scale > 0.0);
   s.use_creep = options.creep && (unit.creep_coefficient > 0.0 || unit.load_creep_coefficient > 0.0);
   switch (options.hysteresis_law) {
     case HysteresisLaw::kBoucWen: s.d.hysteresis = detail::BoucWenHysteresis::bench_default(unit.hysteresis_scale); break;
     case HysteresisLaw::kBoucWenAsymmetric:
       s.d.hysteresis = detail::Hysteresis(detail::BoucWenHysteresis::bench_default(unit.hysteresis_scale), kAsymmetricQuadratic * unit.hysteresis_scale);
       break;
-    case HysteresisLaw::kPrandtlIshlinskii: s.d.hysteresis = detail::PlayHysteresis::bench_default(unit.hysteresis_scale); break;
+    case HysteresisLaw::kPrandtlIshlinskii:
+      s.d.hysteresis = own_operators ? detail::PlayHysteresis::from(unit.hysteresis_thresholds, unit.hysteresis_weights)
+                                     : detail::PlayHysteresis::bench_default(unit.hysteresis_scale);
+      break;
   }
   // The super element has no stack extension to drive the load creep: voltage creep only there.
   s.d.creep = detail::Creep(unit.creep_coefficient, s.superelement() ? 0.0 : unit.load_creep_coefficient, s.ts);

@@ -252,6 +252,12 @@ void HysteresisFitOptions::validate() const {
     const double tau = creep_time_constants[j];
     if (!(std::isfinite(tau) && tau > 0.0)) throw InputError(s, fmt::format("creep_time_constants[{}]", j), "a time > 0 s", num(tau));
   }
+  if (thresholds.size() > 200) throw InputError(s, "thresholds", "at most 200 thresholds", std::to_string(thresholds.size()));
+  for (std::size_t i = 0; i < thresholds.size(); ++i) {
+    if (!(std::isfinite(thresholds[i]) && thresholds[i] > (i == 0 ? 0.0 : thresholds[i - 1]))) {
+      throw InputError(s, fmt::format("thresholds[{}]", i), "thresholds > 0, strictly increasing", num(thresholds[i]));
+    }
+  }
   if (dead_zones < 0 || dead_zones > 50) throw InputError(s, "dead_zones", "an integer in 0..50", std::to_string(dead_zones));
   if (!(std::isfinite(max_relative_residual) && max_relative_residual > 0.0)) {
     throw InputError(s, "max_relative_residual", "a fraction > 0", num(max_relative_residual));
@@ -382,8 +388,10 @@ HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double>
   if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) throw InputError(source, "sample_rate", "a rate > 0 Hz", num(sample_rate));
   const double va_range = range(va);
   if (!(va_range > 0.0)) throw InputError(source, "Va", "a voltage that moves", "a constant");
-  const int n = options.operators;
-  const std::vector<double> r = default_thresholds(n, options.threshold_range > 0.0 ? options.threshold_range : 0.5 * va_range);
+  const std::vector<double> r = !options.thresholds.empty()
+                                    ? options.thresholds
+                                    : default_thresholds(options.operators, options.threshold_range > 0.0 ? options.threshold_range : 0.5 * va_range);
+  const auto n = static_cast<Eigen::Index>(r.size());
   const auto m = static_cast<Eigen::Index>(options.creep_time_constants.size());
   const auto rows = static_cast<Eigen::Index>(va.size());
 

@@ -242,7 +242,11 @@ BenchDescription parse_bench_description(const std::string& text, const std::str
   d.encoder_resolution = enc.number("resolution_m").value_or(d.encoder_resolution);
 
   const Table virt = top.table("virtual");
-  virt.only({"unit", "seed"});
+  virt.only({"unit", "seed", "twin"});
+  if (const auto twin = virt.string("twin")) {
+    if (twin->empty()) throw InputError(source, "virtual.twin", "a twin file", "an empty path");
+    d.twin = (std::filesystem::path(source).parent_path() / *twin).string();
+  }
   d.unit = static_cast<int>(virt.integer("unit", 1, 7).value_or(1));
   if (const auto s = virt.integer("seed", 0, std::numeric_limits<std::int64_t>::max())) d.seed = static_cast<std::uint64_t>(*s);
   const Table udp = top.table("udp");

@@ -59,11 +59,15 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "piezobench/apa/two_dof.hpp"
 #include "piezobench/lti/state_space.hpp"
 
 namespace piezobench::bench {
+
+// Most play operators the bench's Prandtl-Ishlinskii law takes (UnitTruth::hysteresis_thresholds).
+inline constexpr std::size_t kMaxPlayOperators = 8;
 
 // The true properties of one virtual actuator: what a perfect characterization would find. The
 // campaign's tests compare their results with these (truth.hpp).
@@ -79,6 +83,12 @@ struct UnitTruth {
   double flatness_tilt_direction = 0.0;     // rad, direction of that tilt in the probe plane (x-y)
   double flatness_warp = 0.0;               // m, saddle-shaped warp amplitude of the interfaces
   double hysteresis_scale = 1.0;            // relative width (and large-signal gain) of the hysteresis
+  // The Prandtl-Ishlinskii law's play operators when given (a digital twin's identified hysteresis,
+  // bench/twin.hpp): thresholds (V, > 0, increasing) and weights (effective V per V, >= 0), at most
+  // kMaxPlayOperators of each; they replace the default operators (10, 20, ..., 80 V, each
+  // 0.163 x hysteresis_scale), and hysteresis_scale then only scales the Bouc-Wen laws. Empty: the
+  // default.
+  std::vector<double> hysteresis_thresholds, hysteresis_weights;
   double creep_coefficient = 0.0;           // voltage creep per decade of time, relative to the step
   double load_creep_coefficient = 0.0;      // creep of the stacks' elastic strain under a load,
                                             // per decade of time (relative)
@@ -90,7 +100,7 @@ struct UnitTruth {
 
   // InputError (source "unit N") naming the field: the model (TwoDofParams::validate), positive
   // capacitances and stroke factor, non-negative scales and coefficients, modes > 0 Hz, damping in
-  // [0, 1).
+  // [0, 1), play operators as said above.
   void validate() const;
 };
 

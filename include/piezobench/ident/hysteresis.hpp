@@ -141,6 +141,9 @@ struct HysteresisFitOptions {
   double threshold_range = 0.0;               // V, R: thresholds (i - 1/2) R / n, i = 1..n; 0 = half
                                               // the range of Va (a larger threshold never turns)
   std::vector<double> creep_time_constants;   // s, > 0; empty: no creep states
+  // V: the thresholds themselves (> 0, strictly increasing, at most 200); when given they replace
+  // `operators` and `threshold_range` (e.g. a twin's i A / 8 grid for the virtual bench's 8 operators).
+  std::vector<double> thresholds;
   // Kuhnen's modified PI (asymmetric loops): > 0 identifies S too, with this many dead zones on
   // each side of the displacement's centre (thresholds (j/(k+1)) of its half range, weights >= 0:
   // S saturates towards both ends). The fit is then Kuhnen's linear one in (H, S^-1): Va = S^-1[d]

@@ -9,7 +9,7 @@
 //   [limits]     actuator, va_min_V, va_max_V, slew_rate_V_per_s (required for udp and comedi),
 //                va_safe_V, ramp_s, stale_cycles, watchdog_s (optional)
 //   [encoder]    resolution_m
-//   [virtual]    unit, seed                       (backend "virtual")
+//   [virtual]    unit, seed, twin ("FILE": a unit's digital twin, bench/twin.hpp)   (backend "virtual")
 //   [udp]        address "HOST:PORT", timeout_s, key_file (the shared key; relative to the
 //                bench file's folder)   (backend "udp")
 //   [comedi]     device, calibration ("auto" | "soft" | "hard" | "none")   (backend "comedi")
@@ -51,6 +51,8 @@ struct BenchDescription {
   // virtual
   int unit = 1;
   std::uint64_t seed = 1;
+  std::string twin;                   // a digital twin file (bench/twin.hpp) instead of the batch
+                                      // unit, resolved against the bench file's folder; "" = none
   // udp
   std::string udp_address;            // "127.0.0.1:5600"
   double udp_timeout = 2e-3;          // s: a reply later than this is a stale input
