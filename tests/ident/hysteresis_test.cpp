@@ -328,3 +328,28 @@ TEST(LoopMetrics, AsymmetryIsTheBendOfTheLoop) {
 
 }  // namespace
 }  // namespace piezobench::ident
+
+namespace piezobench::ident {
+namespace {
+
+// Explicit thresholds (HysteresisFitOptions::thresholds): a record made by a PI operator with the
+// same thresholds gives its weights back exactly; bad thresholds are refused.
+TEST(FitHysteresis, ExplicitThresholdsGiveTheOperatorsWeightsBack) {
+  PrandtlIshlinskii h;
+  h.thresholds = {10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0};
+  h.weights = {0.22, 0.1, 0.3, 0.0, 0.15, 0.25, 0.05, 0.2};
+  const std::vector<double> v = sine(65.0, 80.0, 3, 2000);
+  std::vector<double> d = evaluate(h, v);
+  for (double& x : d) x *= -1.5e-6;  // m per effective volt, the APA shortens
+  HysteresisFitOptions o;
+  o.thresholds = h.thresholds;
+  const HysteresisFit f = fit_hysteresis(v, d, 1000.0, o);
+  ASSERT_EQ(f.model.hysteresis.weights.size(), 8u);
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_NEAR(f.model.hysteresis.weights[i], h.weights[i], 1e-9) << i;
+  EXPECT_NEAR(f.model.gain, -1.5e-6, 1e-15);
+  o.thresholds = {10.0, 10.0};
+  EXPECT_THROW(fit_hysteresis(v, d, 1000.0, o), InputError);
+}
+
+}  // namespace
+}  // namespace piezobench::ident
