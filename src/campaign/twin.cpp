@@ -297,9 +297,10 @@ Index quiet_length(const io::TimeSeries& ts, const std::map<std::string, std::st
   return end;
 }
 
+// `limit` (samples, 0 = none): where the record stops being quiet for a reason no channel shows.
 void collect_quiet(const io::TimeSeries& ts, const std::string& label, const std::map<std::string, std::string>& names, double min_s,
-                   std::map<std::string, QuietSegment>& best) {
-  const Index n = quiet_length(ts, names);
+                   std::map<std::string, QuietSegment>& best, Index limit = 0) {
+  const Index n = limit > 0 ? std::min(limit, quiet_length(ts, names)) : quiet_length(ts, names);
   if (static_cast<double>(n) / ts.sample_rate < min_s) return;
   for (const char* role : {"de", "Vs"}) {
     const std::string name = names.count(role) ? names.at(role) : std::string(role);
@@ -337,11 +338,16 @@ TwinNoise channel_noise(const std::string& role, const std::map<std::string, Qui
   return out;
 }
 
-void measure_noise(const Campaign& c, const UnitSpec& u, const TwinOptions& o, bench::Twin& twin, TwinBuild& out) {
+void measure_noise(const Campaign& c, const UnitSpec& u, const UnitAnalysis& a, const TwinOptions& o, bench::Twin& twin, TwinBuild& out) {
   std::map<std::string, QuietSegment> quiet;
   for (const auto& file : o.quiet) collect_quiet(io::read_timeseries(file), file.string(), c.channels, o.min_quiet_s, quiet);
-  if (u.stiffness) collect_quiet(load_record(c, *u.stiffness, Experiment::kStiffness).ts, u.stiffness->given, c.channels, o.min_quiet_s, quiet);
-  if (u.frf) collect_quiet(load_record(c, *u.frf, Experiment::kFrf).ts, u.frf->given, c.channels, o.min_quiet_s, quiet);
+  if (u.stiffness && a.stiffness_analysis) {
+    // Before the mass goes on (the analysis's t_on; 0.1 s earlier: the operator's ramp).
+    const Record r = load_record(c, *u.stiffness, Experiment::kStiffness);
+    const auto limit = static_cast<Index>(std::max(0.0, a.stiffness_analysis->result.t_on - 0.1) * r.ts.sample_rate);
+    if (limit > 0) collect_quiet(r.ts, u.stiffness->given, u.stiffness->channels, o.min_quiet_s, quiet, limit);
+  }
+  if (u.frf) collect_quiet(load_record(c, *u.frf, Experiment::kFrf).ts, u.frf->given, u.frf->channels, o.min_quiet_s, quiet);
   const bench::BenchOptions& b = twin.options;
   out.de_noise = channel_noise("de", quiet, b.encoder_resolution, b.encoder_noise);
   out.vs_noise = channel_noise("Vs", quiet, 2.0 * b.adc_range / std::ldexp(1.0, b.adc_bits), b.vs_noise);
@@ -502,7 +508,7 @@ TwinBuild build_twin(const Campaign& campaign, const UnitSpec& unit, const TwinO
   calibrate_load_creep(campaign, a, out.twin, out);
   identify_hysteresis(campaign, unit, a, out.twin, out);
   say("twin: noise of the quiet segments");
-  measure_noise(campaign, unit, options, out.twin, out);
+  measure_noise(campaign, unit, a, options, out.twin, out);
   const auto [gain, damping] = bench_iff_optimum(out.twin.unit, out.twin.options, campaign.analysis.controller);
   out.iff_optimal_gain = gain;
   out.iff_max_damping = damping;
