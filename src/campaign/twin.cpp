@@ -207,7 +207,7 @@ void identify_hysteresis(const Campaign& c, const UnitSpec& u, const UnitAnalysi
   const ident::HysteresisFitOptions o = twin_hysteresis_options(a.hysteresis_model->amplitude);
   std::vector<HysteresisTarget> targets;
   for (std::size_t j = 0; j < u.hysteresis.size() && j < a.hysteresis.size(); ++j) {
-    const Record r = load_record(c, u.hysteresis[j], Experiment::kHysteresis);
+    const Record r = load_record(c, u, u.hysteresis[j], Experiment::kHysteresis);
     targets.push_back({a.hysteresis[j].result.amplitude, fit_record(r.channel("Va"), r.channel("de"), r.ts.sample_rate, o)});
   }
   const auto fit_twin = [&](const bench::Twin& t, double amplitude) {
@@ -343,11 +343,11 @@ void measure_noise(const Campaign& c, const UnitSpec& u, const UnitAnalysis& a, 
   for (const auto& file : o.quiet) collect_quiet(io::read_timeseries(file), file.string(), c.channels, o.min_quiet_s, quiet);
   if (u.stiffness && a.stiffness_analysis) {
     // Before the mass goes on (the analysis's t_on; 0.1 s earlier: the operator's ramp).
-    const Record r = load_record(c, *u.stiffness, Experiment::kStiffness);
+    const Record r = load_record(c, u, *u.stiffness, Experiment::kStiffness);
     const auto limit = static_cast<Index>(std::max(0.0, a.stiffness_analysis->result.t_on - 0.1) * r.ts.sample_rate);
     if (limit > 0) collect_quiet(r.ts, u.stiffness->given, u.stiffness->channels, o.min_quiet_s, quiet, limit);
   }
-  if (u.frf) collect_quiet(load_record(c, *u.frf, Experiment::kFrf).ts, u.frf->given, u.frf->channels, o.min_quiet_s, quiet);
+  if (u.frf) collect_quiet(load_record(c, u, *u.frf, Experiment::kFrf).ts, u.frf->given, u.frf->channels, o.min_quiet_s, quiet);
   const bench::BenchOptions& b = twin.options;
   out.de_noise = channel_noise("de", quiet, b.encoder_resolution, b.encoder_noise);
   out.vs_noise = channel_noise("Vs", quiet, 2.0 * b.adc_range / std::ldexp(1.0, b.adc_bits), b.vs_noise);
