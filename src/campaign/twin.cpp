@@ -378,7 +378,10 @@ bench::Twin tuned_twin(const Campaign& c, const UnitAnalysis& a) {
   t.options.gravity = c.bench.gravity;
   t.options.delay = a.model_2dof->bench.delay;
   const std::optional<double> corner = a.frf_analysis ? a.frf_analysis->hpf.corner_Hz : std::nullopt;
-  t.options.hpf_resistance = corner ? 1.0 / (kTwoPi * *corner * t.unit.capacitance_sensor) : c.bench.hpf_resistance;
+  // Without a measured corner nor a resistor in [bench], the sensor stack's only shunt is the ADC's
+  // input resistance (the twin file's hpf_resistance_ohm is that shunt): no invented high-pass.
+  if (corner) t.options.hpf_resistance = 1.0 / (kTwoPi * *corner * t.unit.capacitance_sensor);
+  else t.options.hpf_resistance = c.bench.hpf_resistance.value_or(t.options.adc_input_resistance);
   // The zero's side: the ground return's resistance (refined below) starts at the bench's, or
   // small (not 0: the refinement takes its magnitude, whose derivative vanishes there).
   const bool nmp = a.frf_analysis && a.frf_analysis->zero_is_nonminimum_phase.value_or(false);
