@@ -1,8 +1,13 @@
 // `piezobench hysteresis fit` (a Prandtl-Ishlinskii model with creep from a Va -> d_e record, written
 // as TOML for `rt --feedforward`) and `piezobench hysteresis creep` (a Prony creep fit of a step record).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <memory>
+#include <utility>
+#include <variant>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
@@ -43,12 +48,46 @@ nlohmann::json model_json(const ident::HysteresisModel& m) {
           {"output_slopes", {m.output.slope_below, m.output.slope_above}}};
 }
 
-io::TimeSeries read_pair(const std::string& file, const std::string& input, const std::string& output, double fs, bool quiet) {
+// What a command reads a record for: the kinds of record it analyses (a record's own
+// settings.experiment, when it says, must be one: issue 35) and the SI unit each channel must
+// have ("" = any; a channel without a unit is taken as SI with a warning).
+struct RecordUse {
+  std::string command;
+  std::vector<std::string> kinds;
+  std::string input_unit, output_unit;
+};
+
+// The input and output channels of `file` in SI; exit 3 for a record of another kind or a channel
+// in a unit of another quantity. The reader's warnings (a channel without a unit) go to stderr.
+io::TimeSeries read_pair(const std::string& file, const std::string& input, const std::string& output, double fs, bool quiet,
+                         const RecordUse& use) {
   io::ReadOptions read;
   read.fs = fs;
   read.channels = {input, output};
   if (!quiet) log_line("reading " + file);
-  return io::read_timeseries(file, read);
+  io::TimeSeries ts = io::read_timeseries(file, read);
+  const auto kind = ts.settings.find("experiment");
+  if (kind != ts.settings.end() && std::holds_alternative<std::string>(kind->second)) {
+    const std::string& k = std::get<std::string>(kind->second);
+    if (std::find(use.kinds.begin(), use.kinds.end(), k) == use.kinds.end()) {
+      throw InputError(file, "settings.experiment", fmt::format("a {} record (what `{}` analyses)", fmt::join(use.kinds, ", "), use.command),
+                       "'" + k + "', a " + k + " record");
+    }
+  }
+  for (const auto& [name, si] : {std::pair{input, use.input_unit}, std::pair{output, use.output_unit}}) {
+    const std::string unit = ts.unit(name);
+    if (!si.empty() && !unit.empty() && unit != si) {
+      throw InputError(file, "channel " + name, fmt::format("a channel in {} (or a unit of that quantity)", si), "unit '" + unit + "'");
+    }
+  }
+  print_warnings(ts.warnings);
+  return ts;
+}
+
+// A channel's unit for the summary: its SI symbol, or `si` marked as assumed when the file gives none.
+std::string shown_unit(const io::TimeSeries& ts, const std::string& name, const std::string& si) {
+  const std::string unit = ts.unit(name);
+  return unit.empty() ? (si.empty() ? "(SI, no unit in the file)" : si + " (assumed: no unit in the file)") : unit;
 }
 
 int run_hysteresis_fit(const HysteresisFitArgs& o) {
@@ -59,7 +98,8 @@ int run_hysteresis_fit(const HysteresisFitArgs& o) {
   if (!o.creep_tau.empty()) fo.creep_time_constants = parse_number_list(o.creep_tau, "--creep-tau");
   fo.max_relative_residual = o.max_residual;
   fo.validate();
-  const io::TimeSeries ts = read_pair(o.file, o.input, o.output, o.fs, o.json);
+  const io::TimeSeries ts =
+      read_pair(o.file, o.input, o.output, o.fs, o.json, {"hysteresis fit", {"hysteresis", "stroke", "tracking"}, "V", "m"});
   const Eigen::VectorXd va = ts.channel(o.input), de = ts.channel(o.output);
   if (!o.json) log_line(fmt::format("{} samples at {:g} Hz, {} play operators", ts.samples(), ts.sample_rate, fo.operators));
   const ident::HysteresisFit fit = ident::fit_hysteresis({va.data(), static_cast<std::size_t>(va.size())},
@@ -78,7 +118,8 @@ int run_hysteresis_fit(const HysteresisFitArgs& o) {
                 {"rms_residual_m", fit.rms_residual},
                 {"relative_residual", fit.relative_residual},
                 {"stroke_m", fit.stroke},
-                {"hysteresis_width", loop.width}};
+                {"hysteresis_width", loop.width},
+                {"warnings", ts.warnings}};
     doc.update(quality_json(fit.quality));
     print_json(doc);
   } else {
@@ -86,13 +127,13 @@ int run_hysteresis_fit(const HysteresisFitArgs& o) {
     fmt::print("Prandtl-Ishlinskii model of {} -> {} ({} samples)\n", o.input, o.output, fit.samples);
     fmt::print("  d_e = {:.6g} m + {:.6g} m/V * {}(H[Va] + creep)\n", m.offset, m.gain, m.output.identity() ? "" : "S");
     fmt::print("  thresholds (V): {:.4g}\n", fmt::join(m.hysteresis.thresholds, ", "));
-    fmt::print("  weights:        {:.4g}\n", fmt::join(m.hysteresis.weights, ", "));
+    fmt::print("  weights (V/V):  {:.4g}\n", fmt::join(m.hysteresis.weights, ", "));
     if (!m.output.identity()) {
       fmt::print("  S (dead-zone superposition, knots V -> V): x {:.4g}; y {:.4g}; end slopes {:.4g}, {:.4g}\n", fmt::join(m.output.x, ", "),
                  fmt::join(m.output.y, ", "), m.output.slope_below, m.output.slope_above);
     }
     if (!m.creep_time_constants.empty()) {
-      fmt::print("  creep: time constants (s) {:.4g}; coefficients {:.4g}\n", fmt::join(m.creep_time_constants, ", "),
+      fmt::print("  creep: time constants (s) {:.4g}; coefficients (dimensionless) {:.4g}\n", fmt::join(m.creep_time_constants, ", "),
                  fmt::join(m.creep_coefficients, ", "));
     }
     fmt::print("  compensated line: {:.6g} V/V, {:.6g} V\n", m.reference_slope, m.reference_intercept);
@@ -115,7 +156,7 @@ struct CreepOptions {
 
 int run_creep(const CreepOptions& o) {
   const std::vector<double> tau = o.tau.empty() ? std::vector<double>{} : parse_number_list(o.tau, "--tau");
-  const io::TimeSeries ts = read_pair(o.file, o.input, o.output, o.fs, o.json);
+  const io::TimeSeries ts = read_pair(o.file, o.input, o.output, o.fs, o.json, {"hysteresis creep", {"stiffness"}, "", ""});
   const Eigen::VectorXd x = ts.channel(o.input), y = ts.channel(o.output);
   const ident::CreepFit c = ident::fit_creep({x.data(), static_cast<std::size_t>(x.size())}, {y.data(), static_cast<std::size_t>(y.size())},
                                              ts.sample_rate, tau, o.max_residual);
@@ -127,12 +168,18 @@ int run_creep(const CreepOptions& o) {
                 {"offset", c.offset},
                 {"creep_per_decade", c.creep_per_decade},
                 {"rms_residual", c.rms_residual},
-                {"relative_residual", c.relative_residual}};
+                {"relative_residual", c.relative_residual},
+                {"units", {{"input", ts.unit(o.input)}, {"output", ts.unit(o.output)}}},
+                {"warnings", ts.warnings}};
     doc.update(quality_json(c.quality));
     print_json(doc);
   } else {
-    fmt::print("Creep of {} -> {}: y = {:.6g} + {:.6g} (x + sum_j c_j F_j[x])\n", o.input, o.output, c.offset, c.gain);
-    fmt::print("  time constants (s): {:.4g}\n  coefficients:       {:.4g}\n", fmt::join(c.time_constants, ", "), fmt::join(c.coefficients, ", "));
+    const std::string in_unit = shown_unit(ts, o.input, ""), out_unit = shown_unit(ts, o.output, "");
+    fmt::print("Creep of {} [{}] -> {} [{}]: y = {:.6g} + {:.6g} (x + sum_j c_j F_j[x])\n", o.input, in_unit, o.output, out_unit, c.offset,
+               c.gain);
+    fmt::print("  offset in the unit of {}, gain in {} per {}\n", o.output, out_unit, in_unit);
+    fmt::print("  time constants (s): {:.4g}\n  coefficients (dimensionless): {:.4g}\n", fmt::join(c.time_constants, ", "),
+               fmt::join(c.coefficients, ", "));
     fmt::print("  creep per decade {:.4g} %; rms residual {:.3g} % of the range ({})\n", 100.0 * c.creep_per_decade,
                100.0 * c.relative_residual, c.quality.summary());
   }

@@ -193,9 +193,15 @@ int run_measurement(const MeasureRequest& r) {
   std::optional<bench::TrackingSummary> tracking;
   if (experiment == bench::Experiment::kTracking) tracking = bench::tracking_summary(ts);
   if (!r.json) {
+    // Every channel with its unit (issue 33: a summary prints the unit of every number).
+    std::vector<std::string> channels;
+    for (const std::string& name : ts.names) {
+      const std::string u = ts.unit(name);
+      channels.push_back(name + " [" + (u.empty() ? "no unit" : u) + "]");
+    }
     fmt::print("wrote {}: {} on unit {}{} ({} samples at {:g} Hz; channels {}{})\n", out, r.experiment, r.unit,
-               unit.defective ? " (defective)" : "", ts.samples(), ts.sample_rate, ts.t.size() > 0 ? "t, " : "",
-               fmt::join(ts.names, ", "));
+               unit.defective ? " (defective)" : "", ts.samples(), ts.sample_rate, ts.t.size() > 0 ? "t [s], " : "",
+               fmt::join(channels, ", "));
     if (tracking) {
       for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking->sine},
                                     {"triangle", tracking->triangle}}) {

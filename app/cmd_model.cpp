@@ -28,6 +28,14 @@ namespace {
 
 constexpr const char* kCommandLine = "command line";
 
+// The sign convention of ga and gs (docs/models.md), and whether `p` follows it.
+std::string sign_note(const apa::TwoDofParams& p) {
+  const bool follows = p.ga < 0.0 && p.gs > 0.0;
+  return fmt::format("  signs: the report's convention is ga < 0 (more voltage lowers the APA: a negative static gain u -> d_e) "
+                     "and gs > 0 (Vs rises with it){}",
+                     follows ? "" : fmt::format("; these parameters differ (ga {} 0, gs {} 0)", p.ga < 0.0 ? "<" : ">=", p.gs > 0.0 ? ">" : "<="));
+}
+
 nlohmann::json params_json(const apa::TwoDofParams& p) {
   nlohmann::json j = nlohmann::json::object();
   for (const auto& n : apa::TwoDofParams::names()) j[n] = io::to_json(p.get(n));
@@ -97,6 +105,7 @@ int run_two_dof(const TwoDofCommand& o) {
              p.ka * 1e-6, p.ca);
   fmt::print("  ga = {:.4g} N/V, gs = {:.4g} V/um, k_tot = {:.4g} N/um\n", p.ga, p.gs * 1e-6,
              p.total_stiffness() * 1e-6);
+  fmt::print("{}\n", sign_note(p));
   fmt::print("bench: amplifier {:.4g} V/V, moving mass {:.4g} kg", o.bench.amplifier_gain, o.bench.moving_mass(p));
   if (o.bench.has_hpf()) fmt::print(", high-pass on Vs at {:.4g} Hz", o.bench.hpf_corner() / kTwoPi);
   if (o.bench.delay > 0.0) fmt::print(", delay {:.4g} us", o.bench.delay * 1e6);
@@ -203,6 +212,7 @@ int run_tune(const TuneCommand& c) {
   fmt::print("  ke = {:.4g} N/um, ce = {:.4g} Ns/m, ka = {:.4g} N/um, ca = {:.4g} Ns/m\n", p.ke * 1e-6, p.ce,
              p.ka * 1e-6, p.ca);
   fmt::print("  ga = {:.4g} N/V, gs = {:.4g} V/um\n", p.ga, p.gs * 1e-6);
+  fmt::print("{}\n", sign_note(p));
   fmt::print("{}\n{}\nquality: {}\n", t.brief_report(), t.message, core::to_string(t.quality.verdict));
   return report_quality(t.quality);
 }
@@ -236,6 +246,7 @@ int run_piezo(const PiezoCommand& c) {
   fmt::print("  ka = cE A / L           = {:.6g} N/m ({:.4g} N/um)\n", s.ka, s.ka * 1e-6);
   fmt::print("  ga = d33 n ka           = {:.6g} N/V\n", s.ga);
   fmt::print("  gs = d33 / (eps_T sD n) = {:.6g} V/m ({:.4g} V/um)\n", s.gs, s.gs * 1e-6);
+  fmt::print("  signs: magnitudes; the 2-DoF model's convention gives ga the sign < 0 and gs > 0 (docs/models.md)\n");
   return 0;
 }
 

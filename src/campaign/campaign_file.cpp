@@ -14,6 +14,7 @@
 #include "piezobench/io/units.hpp"
 #include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/timestamp.hpp"
 #include "piezobench/core/units.hpp"
 
 namespace piezobench::campaign {
@@ -366,8 +367,43 @@ UnitSpec read_unit(const Context& ctx, const toml::table& t, std::size_t index) 
   return u;
 }
 
+// A TOML date or date-time as seconds since the epoch, UTC: a date's first second (`end`: its last),
+// a date-time with its offset applied, one without an offset taken as UTC.
+long long read_time(const Reader& r, const std::string& k, bool end) {
+  const toml::node* n = r.get(k);
+  const auto fail = [&](const std::string& found) -> long long {
+    throw InputError(r.source(), r.key(k), "a date (2026-11-27) or a date-time (2026-11-27T08:00:00Z)", found);
+  };
+  toml::date date;
+  toml::time time{end ? 23 : 0, end ? 59 : 0, end ? 59 : 0, 0};
+  long long offset_s = 0;
+  if (const auto* d = n->as_date()) {
+    date = d->get();
+  } else if (const auto* dt = n->as_date_time()) {
+    date = dt->get().date;
+    time = dt->get().time;
+    if (dt->get().offset) offset_s = 60LL * dt->get().offset->minutes;
+  } else {
+    return fail(describe_toml(*n));
+  }
+  const auto s = utc_seconds(date.year, date.month, date.day, time.hour, time.minute, time.second);
+  if (!s) return fail(fmt::format("{:04}-{:02}-{:02}", date.year, date.month, date.day));
+  return *s - offset_s;
+}
+
 void read_bench(const Reader& r, BenchConstants& b) {
-  r.only({"amplifier_gain", "suspended_mass_kg", "added_mass_kg", "gravity_m_per_s2", "hpf_resistance_ohm", "probe_accuracy_um"});
+  r.only({"amplifier_gain", "suspended_mass_kg", "added_mass_kg", "gravity_m_per_s2", "hpf_resistance_ohm", "probe_accuracy_um",
+          "name", "recorded_from", "recorded_until"});
+  if (const auto name = r.string("name")) {
+    if (name->empty()) throw InputError(r.source(), r.key("name"), "the name of the bench (what its records say in settings.bench)", "''");
+    b.name = *name;
+  }
+  if (r.get("recorded_from")) b.recorded_from_s = read_time(r, "recorded_from", false);
+  if (r.get("recorded_until")) b.recorded_until_s = read_time(r, "recorded_until", true);
+  if (b.recorded_from_s && b.recorded_until_s && *b.recorded_from_s > *b.recorded_until_s) {
+    throw InputError(r.source(), r.key("recorded_until"), "a time not before recorded_from (" + utc_timestamp(*b.recorded_from_s) + ")",
+                     utc_timestamp(*b.recorded_until_s));
+  }
   if (const auto g = r.number("amplifier_gain")) {
     if (*g == 0.0) throw InputError(r.source(), r.key("amplifier_gain"), "a non-zero gain (V/V)", "0");
     b.amplifier_gain = *g;

@@ -15,6 +15,7 @@
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/timestamp.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/ident/dominant_pole.hpp"
@@ -150,9 +151,10 @@ std::vector<std::string> recorded_kinds(Experiment e) {
 }
 
 // What a record says about itself (the settings piezobench's writers record: unit, serial,
-// experiment) against the campaign entry that names it: a record of another unit or another kind
-// is refused, naming both (issue 35: unit 1's files given for unit 3 made the defective unit pass
-// with unit 1's numbers). A record without these settings (another tool's) is taken as given.
+// experiment, bench, recorded_at) against the campaign entry that names it: a record of another
+// unit, serial, kind or bench, or taken outside the campaign's time window, is refused, naming
+// both (issue 35: unit 1's files given for unit 3 made the defective unit pass with unit 1's
+// numbers). A record without these settings (another tool's) is taken as given.
 void check_provenance(const Campaign& campaign, const UnitSpec& unit, const FileSpec& spec, Experiment experiment,
                       const io::TimeSeries& ts) {
   const std::string source = campaign.file.string();
@@ -177,6 +179,22 @@ void check_provenance(const Campaign& campaign, const UnitSpec& unit, const File
     if (std::find(kinds.begin(), kinds.end(), *kind) == kinds.end()) {
       throw InputError(source, spec.key, fmt::format("a {} record ({})", to_string(experiment), fmt::join(kinds, " or ")),
                        fmt::format("'{}', a {} record (its settings.experiment)", spec.given, *kind));
+    }
+  }
+  const BenchConstants& bench = campaign.bench;
+  if (const auto name = text("bench"); name && !bench.name.empty() && *name != bench.name) {
+    throw InputError(source, spec.key, fmt::format("a record of bench '{}' (bench.name)", bench.name),
+                     fmt::format("'{}', a record of bench '{}' (its settings.bench)", spec.given, *name));
+  }
+  if (bench.recorded_from_s || bench.recorded_until_s) {
+    const std::string window = fmt::format("from {} until {}", bench.recorded_from_s ? utc_timestamp(*bench.recorded_from_s) : "any time",
+                                           bench.recorded_until_s ? utc_timestamp(*bench.recorded_until_s) : "any time");
+    if (const auto at = text("recorded_at")) {
+      const std::optional<long long> t = parse_utc_timestamp(*at);
+      if (!t || (bench.recorded_from_s && *t < *bench.recorded_from_s) || (bench.recorded_until_s && *t > *bench.recorded_until_s)) {
+        throw InputError(source, spec.key, fmt::format("a record taken {} (bench.recorded_from/recorded_until)", window),
+                         fmt::format("'{}', recorded at '{}' (its settings.recorded_at)", spec.given, *at));
+      }
     }
   }
 }

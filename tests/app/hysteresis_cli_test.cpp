@@ -57,6 +57,36 @@ TEST(HysteresisCli, CreepOfTheStiffnessRecord) {
   EXPECT_EQ(j["time_constants_s"].size(), 2u);           // 1 and 10 s: up to half of the 20 s record
 }
 
+// Issue 35 (a record of another kind), under the exit-code policy of docs/cli.md: a command that
+// analyses one record refuses a record whose own settings say it is of a kind the command does not
+// analyse with exit 3, naming both (a batch leaves such a unit not analysed, exit 7). Issue 33: the
+// creep summary prints the unit of every number; a channel in a unit of another quantity is exit 3.
+TEST(HysteresisCli, ARecordOfAnotherKindIsExit3AndTheSummaryHasUnits) {
+  test::TempDir dir;
+  const auto file = [&](const std::string& name) { return (dir.path() / name).string(); };
+  ASSERT_EQ(run_cli("simulate stiffness --unit 2 --out " + file("stiff.mat")).exit_code, 0);
+  ASSERT_EQ(run_cli("simulate hysteresis --amplitude 20 --out " + file("h.mat")).exit_code, 0);
+  const test::CliRun fit = run_cli("hysteresis fit " + file("stiff.mat") + " --input added_mass");
+  EXPECT_EQ(fit.exit_code, 3) << fit.err;
+  EXPECT_NE(fit.err.find("settings.experiment: expected a hysteresis, stroke, tracking record (what `hysteresis fit` analyses), "
+                         "found 'stiffness', a stiffness record"),
+            std::string::npos)
+      << fit.err;
+  const test::CliRun creep = run_cli("hysteresis creep " + file("h.mat") + " --input Va");
+  EXPECT_EQ(creep.exit_code, 3) << creep.err;
+  EXPECT_NE(creep.err.find("found 'hysteresis', a hysteresis record"), std::string::npos) << creep.err;
+  const test::CliRun text = run_cli("hysteresis creep " + file("stiff.mat"));
+  ASSERT_TRUE(text.exit_code == 0 || text.exit_code == 6) << text.err;
+  EXPECT_NE(text.out.find("Creep of added_mass [kg] -> de [m]"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("gain in m per kg"), std::string::npos) << text.out;
+  // Va in m: a unit of another quantity than the voltage the model needs.
+  test::write_text(dir.path() / "swapped.csv", "t [s],Va [m],de [m]\n0,0,0\n0.001,1,2\n0.002,2,1\n0.003,1,0\n");
+  const test::CliRun swapped = run_cli("hysteresis fit " + file("swapped.csv"));
+  EXPECT_EQ(swapped.exit_code, 3) << swapped.err;
+  EXPECT_NE(swapped.err.find("channel Va: expected a channel in V (or a unit of that quantity), found unit 'm'"), std::string::npos)
+      << swapped.err;
+}
+
 TEST(HysteresisCli, BadInputIsRefused) {
   test::TempDir dir;
   const std::string bad = (dir.path() / "bad.toml").string();

@@ -334,6 +334,13 @@ TEST(Pipeline, DeadForceSensorLeavesTheUnitOut) {
   EXPECT_EQ(u1["not_analysed"]["file"], "frf1.mat");
   EXPECT_EQ(r.not_analysed, 1);
   EXPECT_EQ(r.accepted + r.rejected, 2);
+  // Issue 33's check: the other units' results equal those of the campaign without the dead unit
+  // (their analyses, acceptance, reasons and the batch's outlier statistics over them).
+  Campaign without = b.campaign;
+  without.units.erase(without.units.begin());
+  const json other = results_json(run_campaign(without));
+  for (const int id : {2, 3}) EXPECT_EQ(unit(results, id), unit(other, id)) << "unit " << id;
+  EXPECT_EQ(results["batch"]["outliers"], other["batch"]["outliers"]);
 }
 
 }  // namespace

@@ -362,6 +362,46 @@ TEST(UnitAnalysis, ARecordOfAnotherUnitSerialOrKindIsRefused) {
   EXPECT_TRUE(test::contains(msg, "expected a stroke record (stroke), found 'frf_as_stroke.mat', a frf-noise record")) << msg;
 }
 
+// Issue 35: the bench and the time a record says it was taken are compared with the campaign's
+// [bench] name and recorded_from / recorded_until (a date counts whole; an offset applies).
+TEST(UnitAnalysis, ARecordOfAnotherBenchOrTakenOutsideTheCampaignsTimeIsRefused) {
+  const Files f;
+  io::TimeSeries stroke = syn::stroke_record(-1.5e-6);
+  stroke.settings["experiment"] = std::string("stroke");
+  stroke.settings["unit"] = 5.0;
+  stroke.settings["bench"] = std::string("bench-2");
+  stroke.settings["recorded_at"] = std::string("2026-11-20T23:30:00Z");
+  io::write_timeseries(stroke, f.dir.path() / "s.mat");
+  const std::string unit = "stroke = { file = \"s.mat\", channels = { Va = \"V_stack\", de = \"probe\" } }\n";
+  const auto reason = [&](const std::string& bench) {
+    const Campaign c = f.campaign(unit, bench);
+    const UnitAnalysis u = analyze_unit(c, c.units[0]);
+    return u.not_analysed ? u.not_analysed->reason : std::string();
+  };
+  EXPECT_EQ(reason("name = \"bench-2\"\nrecorded_from = 2026-11-20\nrecorded_until = 2026-11-20\n"), "");
+  EXPECT_EQ(reason("recorded_from = 2026-11-21T00:00:00+01:00\n"), "");  // 23:00 UTC on the 20th
+  std::string msg = reason("name = \"bench-1\"\n");
+  EXPECT_TRUE(test::contains(msg, "expected a record of bench 'bench-1' (bench.name), found 's.mat', a record of bench 'bench-2' "
+                                  "(its settings.bench)")) << msg;
+  msg = reason("recorded_from = 2026-11-21\n");
+  EXPECT_TRUE(test::contains(msg, "expected a record taken from 2026-11-21T00:00:00Z until any time (bench.recorded_from/recorded_until), "
+                                  "found 's.mat', recorded at '2026-11-20T23:30:00Z' (its settings.recorded_at)")) << msg;
+  msg = reason("recorded_until = 2026-11-20T23:00:00Z\n");
+  EXPECT_TRUE(test::contains(msg, "until 2026-11-20T23:00:00Z")) << msg;
+  stroke.settings["recorded_at"] = std::string("yesterday");
+  io::write_timeseries(stroke, f.dir.path() / "s.mat");
+  msg = reason("recorded_from = 2026-11-01\n");
+  EXPECT_TRUE(test::contains(msg, "recorded at 'yesterday'")) << msg;
+  EXPECT_EQ(reason("name = \"bench-2\"\n"), "");  // no time window: the time is not read
+  // The campaign's own values are checked when it is read.
+  test::expect_input_error([&] { (void)f.campaign(unit, "recorded_from = 2026-11-21\nrecorded_until = 2026-11-20\n"); },
+                           {"campaign.toml", "bench.recorded_until", "a time not before recorded_from (2026-11-21T00:00:00Z)",
+                            "2026-11-20T23:59:59Z"});
+  test::expect_input_error([&] { (void)f.campaign(unit, "recorded_from = \"last week\"\n"); },
+                           {"bench.recorded_from", "a date (2026-11-27) or a date-time"});
+  test::expect_input_error([&] { (void)f.campaign(unit, "name = \"\"\n"); }, {"bench.name"});
+}
+
 // LCR readings of one sample in a .mat file (what the bench writes) and in a CSV file.
 TEST(UnitAnalysis, CapacitanceReadingsOfOneSample) {
   const Files f;

@@ -96,6 +96,13 @@ struct BenchConstants {
   // high-pass is computed from R C_sensor (the report's bench has 80.6 kOhm).
   std::optional<double> hpf_resistance;
   double probe_accuracy = 0.5e-6;   // m (probe_accuracy_um), flatness probe
+  // Provenance (docs/campaign.md): the bench the records come from (`name`: a record whose
+  // settings.bench names another is refused; "" = not checked) and when they were taken
+  // (`recorded_from`, `recorded_until`: TOML dates or date-times; a record whose recorded_at is
+  // outside, or unreadable, is refused). Seconds since the epoch, UTC; a date counts whole, an
+  // offset-less date-time as UTC; nullopt = open.
+  std::string name;
+  std::optional<long long> recorded_from_s, recorded_until_s;
 };
 
 // [analysis]: how the data are processed.
