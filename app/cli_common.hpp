@@ -28,6 +28,7 @@ void add_run_commands(CLI::App& app, Action& action);  // run, merge, demo
 void add_hysteresis_commands(CLI::App& app, Action& action);  // hysteresis fit, hysteresis creep
 void add_qualify_commands(CLI::App& app, Action& action);  // qualify, db
 void add_twin_commands(CLI::App& app, Action& action);        // twin
+void add_station_commands(CLI::App& app, Action& action);  // station serve
 
 // Prints exactly one JSON document on stdout (round-trip precision for doubles; invalid UTF-8 in a
 // string replaced by U+FFFD).

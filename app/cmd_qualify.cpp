@@ -13,7 +13,10 @@
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/station/certificate.hpp"
 #include "piezobench/station/phase_runner.hpp"
+#include "piezobench/station/record_json.hpp"
 #include "piezobench/version.hpp"
+#include "piezobench/web/web_operator.hpp"
+#include "station_ui.hpp"
 
 namespace piezobench::app {
 
@@ -21,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using station::Verdict;
+using station::qualification_json;
 
 struct QualifyCli {
   std::string bench, station, serial, resume, answers, db = "station.db", data = "station-data", batch, operator_name;
@@ -28,6 +32,7 @@ struct QualifyCli {
   std::uint64_t seed = 0;
   CLI::Option *unit_option = nullptr, *seed_option = nullptr;
   bool paced = false, strict = false, json = false;
+  UiCli ui;
 };
 
 void check_serial(const std::string& option, const std::string& serial) {
@@ -36,33 +41,6 @@ void check_serial(const std::string& option, const std::string& serial) {
                     return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
                   });
   if (!ok) throw UsageError(option, "a serial number of letters, digits, '-', '_' and '.' (at most 64)", "'" + serial + "'");
-}
-
-nlohmann::json measurements_json(const std::vector<station::MeasurementRow>& rows) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& m : rows) {
-    out.push_back({{"name", m.name}, {"unit", m.unit}, {"value", m.value ? nlohmann::json(*m.value) : nlohmann::json(nullptr)},
-                   {"min", m.min ? nlohmann::json(*m.min) : nlohmann::json(nullptr)},
-                   {"max", m.max ? nlohmann::json(*m.max) : nlohmann::json(nullptr)}, {"verdict", m.verdict}, {"reason", m.reason},
-                   {"stop_on_fail", m.stop_on_fail}});
-  }
-  return out;
-}
-
-nlohmann::json qualification_json(const station::QualificationRow& q, const std::vector<station::PhaseTryRow>& tries) {
-  nlohmann::json t = nlohmann::json::array();
-  for (const auto& r : tries) {
-    nlohmann::json files = nlohmann::json::array();
-    for (const auto& f : r.raw_files) files.push_back({{"path", f.path}, {"campaign_key", f.campaign_key}, {"sha256", f.sha256}, {"bytes", f.bytes}});
-    t.push_back({{"phase", r.phase_name}, {"index", r.phase_index}, {"try", r.try_number}, {"status", r.status}, {"verdict", r.verdict},
-                 {"reason", r.reason}, {"started", r.started}, {"finished", r.finished}, {"measurements", measurements_json(r.measurements)},
-                 {"raw_files", files}});
-  }
-  return {{"id", q.id}, {"serial", q.serial}, {"batch", q.batch}, {"station", q.station}, {"station_sha256", q.station_sha256},
-          {"operator", q.operator_name}, {"bench_file", q.bench_file}, {"bench_sha256", q.bench_sha256},
-          {"software_version", q.software_version}, {"started", q.started}, {"finished", q.finished}, {"status", q.status},
-          {"verdict", q.verdict}, {"deciding_phase", q.deciding_phase}, {"deciding_measurement", q.deciding_measurement},
-          {"certificate_sha256", q.certificate_sha256}, {"phase_tries", t}};
 }
 
 void print_qualification(const station::QualificationRow& q, const std::vector<station::PhaseTryRow>& tries) {
@@ -88,8 +66,19 @@ int run_qualify(const QualifyCli& o) {
   std::unique_ptr<station::Operator> op;
   if (!o.answers.empty()) {
     op = std::make_unique<station::AnswersOperator>(station::read_answers(o.answers, st));
-  } else {
+  } else if (o.ui.listen.empty()) {
     op = std::make_unique<station::TerminalOperator>(std::cin, std::cerr, o.operator_name);
+  }
+  // The live page (--ui): the hub follows the runner and the records; the page's operator answers
+  // the prompts with the terminal (an answers file still answers alone).
+  std::unique_ptr<web::LiveHub> hub;
+  if (!o.ui.listen.empty()) {
+    hub = std::make_unique<web::LiveHub>();
+    web::WebOperatorOptions wo;
+    wo.inner = std::move(op);
+    wo.name = o.operator_name;
+    wo.stop = stop_on_sigint();
+    op = std::make_unique<web::WebOperator>(*hub, std::move(wo));
   }
   station::BenchInstrumentOptions bo;
   bo.bench = bench;
@@ -102,8 +91,23 @@ int run_qualify(const QualifyCli& o) {
   bo.log = log_line;
   if (!bench.hardware() && (bo.unit < 1 || bo.unit > 7)) throw UsageError("--unit", "a unit of the virtual batch, 1 to 7", std::to_string(bo.unit));
   if (o.paced && bench.hardware()) throw UsageError("--paced", "the virtual bench (hardware is paced by its clock)", "backend " + bench.backend);
+  if (hub) bo.on_record = [&hub](const io::TimeSeries& ts, std::chrono::steady_clock::time_point start) { hub->record(ts, start); };
   station::BenchInstrument instrument(bo);
   station::RecordStore store(o.db);
+  std::optional<StationUi> ui;
+  if (hub) {
+    hub->plan(st, serial, o.batch, expected_phase_durations(store, st.name));
+    if (!o.resume.empty()) {
+      // The phases kept by the run being resumed: shown finished, as they will not run again.
+      const auto q = store.latest_qualification(serial);
+      if (q && q->status != "complete") {
+        for (const auto& t : store.phase_tries(q->id)) {
+          if (t.status == "complete") hub->phase_finished(serial, t);
+        }
+      }
+    }
+    ui.emplace(o.ui, o.db, hub.get());
+  }
   station::QualifyOptions qo;
   qo.serial = serial;
   qo.batch = o.batch;
@@ -116,7 +120,9 @@ int run_qualify(const QualifyCli& o) {
   qo.resume = !o.resume.empty();
   qo.stop = bo.stop;
   qo.log = log_line;
+  qo.observer = hub.get();
   const station::QualifyResult r = station::qualify(st, instrument, *op, store, qo);
+  if (hub) hub->finished(r.status, !r.certificate.empty());
   const auto q = store.qualification(r.qualification_id);
   if (o.json) {
     nlohmann::json doc = qualification_json(*q, store.phase_tries(r.qualification_id));
@@ -131,6 +137,8 @@ int run_qualify(const QualifyCli& o) {
     print_qualification(*q, store.phase_tries(r.qualification_id));
     for (const auto& reason : r.reasons) fmt::print("  - {}\n", reason);
   }
+  std::fflush(stdout);
+  if (ui) ui->linger(qo.stop);
   if (r.status != "complete") {
     throw InputError(o.db, "qualification " + serial,
                      "a completed qualification",
@@ -237,6 +245,7 @@ void add_qualify_commands(CLI::App& app, Action& action) {
   q->add_flag("--paced", o->paced, "virtual bench: each record takes its real duration");
   q->add_flag("--strict", o->strict, "exit 5 when the unit's verdict is fail");
   q->add_flag("--json", o->json, "print the qualification as one JSON document");
+  add_ui_options(q, o->ui, "");
   q->callback([o, &action] { action = [o] { return run_qualify(*o); }; });
 
   auto d = std::make_shared<DbCli>();

@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   piezobench::app::add_hysteresis_commands(app, action);
   piezobench::app::add_qualify_commands(app, action);
   piezobench::app::add_twin_commands(app, action);
+  piezobench::app::add_station_commands(app, action);
 
   const bool json = wants_json(argc, argv);
   try {

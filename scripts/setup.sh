@@ -42,6 +42,8 @@ packages=(
   # The station's record store (`qualify`, `db`: SQLite) and the raw files' SHA-256 (nettle; also the
   # UDP protocol's HMAC-SHA256).
   libsqlite3-dev nettle-dev
+  # The station's live web page (src/web): Boost.Beast, header-only.
+  libboost-dev
   # An optimized BLAS under CHOLMOD (Debian's alternatives select it): the Craig-Bampton reduction
   # of a 150,000-DOF model takes 31 s of CPU with it and 83 s with the reference BLAS.
   libopenblas0-serial

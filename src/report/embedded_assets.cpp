@@ -3,23 +3,14 @@
 // definitions set by src/report/CMakeLists.txt; the hash is part of the preprocessed text, so
 // ccache rebuilds this file whenever an asset changes.
 #include "report/embedded_assets.hpp"
+#include "report/incbin.hpp"
 
 #ifndef PIEZOBENCH_REPORT_PLOTLY_JS
 #error "PIEZOBENCH_REPORT_PLOTLY_JS is set by src/report/CMakeLists.txt"
 #endif
 
-// begin/end symbol pairs in .rodata; each blob is followed by a NUL that is not part of it.
-// clang-format off
-#define PIEZOBENCH_REPORT_BLOB(name, file)              \
-  ".balign 16\n"                                        \
-  ".globl piezobench_report_" name "_begin\n"           \
-  ".hidden piezobench_report_" name "_begin\n"          \
-  "piezobench_report_" name "_begin:\n"                 \
-  ".incbin \"" file "\"\n"                              \
-  ".globl piezobench_report_" name "_end\n"             \
-  ".hidden piezobench_report_" name "_end\n"            \
-  "piezobench_report_" name "_end:\n"                   \
-  ".byte 0\n"
+// begin/end symbol pairs in .rodata (incbin.hpp).
+#define PIEZOBENCH_REPORT_BLOB(name, file) PIEZOBENCH_INCBIN("piezobench_report_" name, file)
 
 asm(".pushsection .rodata.piezobench_report,\"a\",@progbits\n"
     "# assets sha256 " PIEZOBENCH_REPORT_ASSETS_SHA256 "\n"
@@ -27,11 +18,8 @@ asm(".pushsection .rodata.piezobench_report,\"a\",@progbits\n"
     PIEZOBENCH_REPORT_BLOB("script", PIEZOBENCH_REPORT_SCRIPT_JS)
     PIEZOBENCH_REPORT_BLOB("style", PIEZOBENCH_REPORT_STYLE_CSS)
     ".popsection\n");
-// clang-format on
 
-#define PIEZOBENCH_REPORT_DECLARE(name)                                                           \
-  extern "C" __attribute__((visibility("hidden"))) const char piezobench_report_##name##_begin[]; \
-  extern "C" __attribute__((visibility("hidden"))) const char piezobench_report_##name##_end[];
+#define PIEZOBENCH_REPORT_DECLARE(name) PIEZOBENCH_INCBIN_DECLARE(piezobench_report_##name)
 
 PIEZOBENCH_REPORT_DECLARE(plotly)
 PIEZOBENCH_REPORT_DECLARE(script)

@@ -95,9 +95,13 @@ Acquired BenchInstrument::acquire(const PhaseSpec& p, const PhaseValues& values,
   io::TimeSeries ts;
   if (!options_.bench.hardware()) {
     ts = bench::simulate(e, bench::batch_unit(options_.unit, options_.seed), eo, options_.seed);
+    const double duration = static_cast<double>(ts.samples()) / ts.sample_rate;
+    if (options_.on_record && bench::runs_on_bench(e)) {
+      options_.on_record(ts, options_.paced ? start : std::chrono::steady_clock::now() - std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                                       std::chrono::duration<double>(duration)));
+    }
     if (options_.paced && bench::runs_on_bench(e)) {
       // The virtual bench computes faster than real time: the phase takes the record's duration.
-      const double duration = static_cast<double>(ts.samples()) / ts.sample_rate;
       const auto end = start + std::chrono::duration<double>(duration);
       while (std::chrono::steady_clock::now() < end && !(options_.stop && options_.stop->load())) {
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -119,6 +123,11 @@ Acquired BenchInstrument::acquire(const PhaseSpec& p, const PhaseValues& values,
     bench::UnitTruth unit;
     unit.id = options_.unit;  // a real unit: only its number is known
     ts = bench::run_experiment(e, runner, unit, eo, options_.seed);
+    if (options_.on_record && ts.sample_rate > 0.0) {
+      const double duration = static_cast<double>(ts.samples()) / ts.sample_rate;
+      options_.on_record(ts, std::chrono::steady_clock::now() -
+                                 std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(duration)));
+    }
   }
   const fs::path target = fs::path(stem.string() + ".mat");
   io::write_timeseries(ts, target);

@@ -158,42 +158,7 @@ function inkStatistics(png) {
   return { inkFraction: ink / n, colours: colours.size };
 }
 
-// ---- DevTools protocol over a pipe -------------------------------------------------------------
-class Cdp {
-  constructor(writable, readable) {
-    this.writable = writable;
-    this.nextId = 1;
-    this.pending = new Map();
-    this.listeners = [];
-    let buffered = '';
-    readable.on('data', (chunk) => {
-      buffered += chunk.toString('utf8');
-      let end;
-      while ((end = buffered.indexOf('\0')) >= 0) {
-        const message = JSON.parse(buffered.slice(0, end));
-        buffered = buffered.slice(end + 1);
-        if (message.id !== undefined && this.pending.has(message.id)) {
-          const { resolve, reject, method } = this.pending.get(message.id);
-          this.pending.delete(message.id);
-          if (message.error) reject(new Error(`${method}: ${message.error.message}`));
-          else resolve(message.result);
-        } else if (message.method) {
-          for (const listener of this.listeners) listener(message);
-        }
-      }
-    });
-  }
-  send(method, params = {}, sessionId = undefined) {
-    const id = this.nextId++;
-    const message = { id, method, params };
-    if (sessionId) message.sessionId = sessionId;
-    return new Promise((resolve, reject) => {
-      this.pending.set(id, { resolve, reject, method });
-      this.writable.write(JSON.stringify(message) + '\0');
-    });
-  }
-  on(listener) { this.listeners.push(listener); }
-}
+const { Cdp, chromiumArgs, watchConsole } = require('./chromium.js');
 
 const t0 = Date.now();
 function trace(what) { if (process.env.PIEZOBENCH_RENDER_CHECK_VERBOSE) console.error(`${Date.now() - t0} ms: ${what}`); }
@@ -228,13 +193,7 @@ async function main() {
   }
 
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'piezobench-chromium-'));
-  const args = [
-    '--headless', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--disable-quic',
-    '--no-first-run', '--no-default-browser-check', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync', '--disable-extensions', '--mute-audio',
-    '--hide-scrollbars', '--remote-debugging-pipe', `--user-data-dir=${profile}`,
-    `--window-size=${WIDTH},${HEIGHT}`, 'about:blank',
-  ];
+  const args = chromiumArgs(profile, WIDTH, HEIGHT);
   const browser = spawn(chromium, args, { stdio: ['ignore', 'ignore', 'pipe', 'pipe', 'pipe'] });
   let browserLog = '';
   browser.stderr.on('data', (d) => { browserLog = (browserLog + d.toString()).slice(-4000); });
@@ -254,24 +213,7 @@ async function main() {
     const page = (method, params) => cdp.send(method, params, sessionId);
 
     const consoleErrors = [];
-    cdp.on((m) => {
-      if (m.sessionId !== sessionId) return;
-      const p = m.params;
-      if (m.method === 'Runtime.consoleAPICalled' && (p.type === 'error' || p.type === 'assert')) {
-        consoleErrors.push('console.' + p.type + ': ' + p.args.map((a) => a.value ?? a.description ?? '').join(' '));
-      } else if (m.method === 'Runtime.exceptionThrown') {
-        const d = p.exceptionDetails;
-        consoleErrors.push('uncaught exception: ' + ((d.exception && d.exception.description) || d.text));
-      } else if (m.method === 'Log.entryAdded' && p.entry.level === 'error') {
-        consoleErrors.push('log error: ' + p.entry.text + (p.entry.url ? ' (' + p.entry.url + ')' : ''));
-      } else if (m.method === 'Page.javascriptDialogOpening') {
-        consoleErrors.push(`a ${p.type} dialog opened ("${p.message}"): injected script ran`);
-        page('Page.handleJavaScriptDialog', { accept: false }).catch(() => {});
-      } else if (m.method === 'Network.requestWillBeSent') {
-        const url = p.request.url;
-        if (!/^(file|data|blob|about):/.test(url)) consoleErrors.push('network request (not offline): ' + url);
-      }
-    });
+    watchConsole(cdp, sessionId, page, consoleErrors, (url) => /^(file|data|blob|about):/.test(url), 'network request (not offline): ');
     await page('Runtime.enable');
     await page('Log.enable');
     await page('Page.enable');

@@ -25,6 +25,7 @@
 // marks the try failed with the reason and the qualification failed, and qualify returns: the
 // qualification can be resumed.
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -79,6 +80,11 @@ struct BenchInstrumentOptions {
   int operator_fd = 0;          // in-record confirmations (stiffness mass on/off); -1: answered at once
   const std::atomic<bool>* stop = nullptr;
   std::function<void(const std::string&)> log;
+  // A live view of the signals (web::LiveHub::record): each bench record as soon as it exists, with
+  // the moment its first sample was measured (paced virtual bench: when the phase started, the
+  // samples then come due at their times; otherwise the record is complete and all of it is past).
+  // Called on the runner's thread; must not block.
+  std::function<void(const io::TimeSeries&, std::chrono::steady_clock::time_point)> on_record;
 };
 
 // The bench as `measure` drives it: the virtual bench through bench::simulate, hardware through

@@ -1,0 +1,306 @@
+#!/usr/bin/env node
+// The station's live page in a real browser (issue 29): runs `piezobench qualify --ui 127.0.0.1:0
+// --paced` on the virtual bench with no answers file and no terminal (its operator steps must be
+// answered in the page), opens the page in headless Chromium (Debian's, over the DevTools protocol:
+// tests/report/chromium.js) and checks, as an operator would see it:
+//   - the page loads with no console error, no uncaught exception, no request leaving the station;
+//   - every phase is seen running and then finished, in order;
+//   - the live signals and the FRF update while the phases run (screen samples arrive at 10-20 Hz,
+//     the FRF's average count grows);
+//   - each operator prompt appears as buttons; clicking "confirm" with the mouse resumes the run;
+//   - a sample reaches the page less than 200 ms after it was measured (the sample's measurement
+//     time, server clock, against its arrival, both on the server's clock);
+//   - the final verdict table equals the terminal's (qualify's stdout) and the database's (db show
+//     --json), measurement by measurement;
+//   - the database tab lists the unit and its certificate link answers;
+//   - hostile requests while the phases run (oversized, unknown and escaping paths, foreign Host and
+//     Origin, an answer without the operator token, 1,000 concurrent connections) are refused
+//     cleanly and the qualification goes on;
+//   - Ctrl-C with the page's stream open ends qualify within 1 s.
+// Screenshots: OUT/live.png (during the FRF phase), OUT/final.png, OUT/database.png.
+//
+//   node station_page_check.js PIEZOBENCH BENCH.toml STATION.toml OUT_DIR
+'use strict';
+const { spawn, execFileSync } = require('node:child_process');
+const fs = require('node:fs');
+const os = require('node:os');
+const path = require('node:path');
+const { Cdp, chromiumArgs, watchConsole } = require('../report/chromium.js');
+
+const WIDTH = 1280, HEIGHT = 1100;
+const TIMEOUT_MS = Number(process.env.PIEZOBENCH_PAGE_TIMEOUT_MS || 100000);
+const LATENCY_LIMIT_MS = 200;
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+const t0 = Date.now();
+const trace = (what) => { if (process.env.PIEZOBENCH_PAGE_CHECK_VERBOSE) console.error(`${Date.now() - t0} ms: ${what}`); };
+
+// qualify's table on stdout: "      NAME   VALUE UNIT [MIN, MAX] VERDICT" under "  PHASE  try N ...".
+function terminalTable(text) {
+  const rows = [];
+  let phase = null;
+  for (const line of text.split('\n')) {
+    let m = line.match(/^  (\S+)\s+try \d+ (\S+)/);
+    if (m) { phase = m[1]; continue; }
+    m = line.match(/^      (\S+)\s+(\S+) (\S*)\s+\[([^\]]*)\] (pass|marginal|fail)$/);
+    if (m && phase) rows.push({ phase, name: m[1], value: m[2] === 'none' ? null : Number(m[2]), verdict: m[5] });
+  }
+  return rows;
+}
+
+function compareTables(what, expected, found, relative, failures) {
+  if (expected.length !== found.length) {
+    failures.push(`${what}: ${expected.length} measurements, the page shows ${found.length}`);
+    return;
+  }
+  for (let i = 0; i < expected.length; ++i) {
+    const e = expected[i], f = found[i];
+    const same = e.phase === f.phase && e.name === f.name && e.verdict === f.verdict &&
+      ((e.value === null && f.value === null) || Math.abs(e.value - f.value) <= relative * Math.abs(e.value));
+    if (!same) failures.push(`${what}: row ${i} is ${JSON.stringify(e)}, the page shows ${JSON.stringify(f)}`);
+  }
+}
+
+// Hostile requests while the station runs, over raw sockets: each must get a clean refusal (the
+// status given) and the station must go on. Returns the failures.
+function rawRequest(port, text, timeoutMs = 5000) {
+  const net = require('node:net');
+  return new Promise((resolve) => {
+    let data = '';
+    const socket = net.connect(port, '127.0.0.1', () => socket.write(text));
+    socket.setTimeout(timeoutMs, () => socket.destroy());
+    socket.on('data', (d) => { data += d.toString('latin1'); });
+    socket.on('error', () => {});
+    socket.on('close', () => resolve(Number((data.match(/^HTTP\/1\.1 (\d{3})/) || [])[1] || 0)));
+  });
+}
+
+async function hostileBurst(port) {
+  const get = (target, extra = '') => `GET ${target} HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\nConnection: close\r\n${extra}\r\n`;
+  const cases = [
+    ['oversized headers', get('/', 'X-Pad: ' + 'a'.repeat(20000) + '\r\n'), 431],
+    ['oversized body', `POST /api/answer HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\nContent-Length: 99999999\r\n\r\n`, 413],
+    ['unknown path', get('/etc/passwd'), 404],
+    ['dot-dot', get('/../../etc/passwd'), 400],
+    ['encoded dot-dot', get('/%2e%2e/%2e%2e/etc/passwd'), 400],
+    ['foreign Host', `GET / HTTP/1.1\r\nHost: evil.example\r\nConnection: close\r\n\r\n`, 421],
+    ['foreign Origin', get('/api/state', 'Origin: http://evil.example\r\n'), 403],
+    ['answer without the operator token', `POST /api/answer HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\nContent-Length: 25\r\nConnection: close\r\n\r\n{"id":1,"answer":"abort"}`, 403],
+  ];
+  const failures = [];
+  for (const [what, text, expected] of cases) {
+    const status = await rawRequest(port, text);
+    if (status !== expected) failures.push(`hostile request (${what}): HTTP ${status}, expected ${expected}`);
+  }
+  // 1,000 concurrent connections: each one served (200) or refused (503), none left hanging.
+  const statuses = await Promise.all(Array.from({ length: 1000 }, () => rawRequest(port, get('/api/state'), 10000)));
+  const served = statuses.filter((x) => x === 200).length, busy = statuses.filter((x) => x === 503).length;
+  if (served + busy !== 1000 || served < 1) failures.push(`1,000 concurrent connections: ${served} served, ${busy} refused 503, ${1000 - served - busy} other`);
+  return { failures, served, busy };
+}
+
+async function main() {
+  const [binary, bench, station, outArg] = process.argv.slice(2);
+  if (!outArg) { console.error('usage: node station_page_check.js PIEZOBENCH BENCH.toml STATION.toml OUT_DIR'); process.exit(2); }
+  const out = path.resolve(outArg);
+  fs.rmSync(out, { recursive: true, force: true });
+  fs.mkdirSync(out, { recursive: true });
+  const chromium = process.env.PIEZOBENCH_CHROMIUM || '/usr/bin/chromium';
+  if (!fs.existsSync(chromium)) throw new Error(`${chromium} not found: install Debian's chromium package (scripts/setup.sh does)`);
+  const failures = [];
+  const db = path.join(out, 'station.db');
+  const serial = 'WEB-0001';
+
+  // The station, its stdin closed: only the page can answer.
+  const qualify = spawn(binary, ['qualify', '--bench', bench, '--station', station, '--serial', serial, '--batch', 'W1', '--db', db,
+    '--data', path.join(out, 'data'), '--paced', '--ui', '127.0.0.1:0', '--ui-linger', '60'], { stdio: ['ignore', 'pipe', 'pipe'] });
+  let stdout = '', stderr = '';
+  qualify.stdout.on('data', (d) => { stdout += d; });
+  qualify.stderr.on('data', (d) => { stderr += d; });
+  const qualifyExit = new Promise((resolve) => qualify.on('exit', (code, signal) => resolve({ code, signal, at: Date.now() })));
+  let url = null;
+  for (let i = 0; i < 100 && !url; ++i) {
+    const m = stderr.match(/station page: (http:\/\/127\.0\.0\.1:\d+\/)#token=([0-9a-f]+)/);
+    if (m) url = { base: m[1], token: m[2] };
+    else await sleep(50);
+  }
+  if (!url) throw new Error('qualify printed no page address:\n' + stderr);
+  trace('qualify serving ' + url.base);
+
+  const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'piezobench-chromium-'));
+  const browser = spawn(chromium, chromiumArgs(profile, WIDTH, HEIGHT), { stdio: ['ignore', 'ignore', 'pipe', 'pipe', 'pipe'] });
+  let browserLog = '';
+  browser.stderr.on('data', (d) => { browserLog = (browserLog + d.toString()).slice(-4000); });
+  const exited = new Promise((resolve) => browser.on('exit', resolve));
+  const timer = setTimeout(() => {
+    console.error(`station_page_check: timed out after ${TIMEOUT_MS / 1000} s\n${browserLog}\n${stderr.slice(-3000)}`);
+    browser.kill('SIGKILL');
+    qualify.kill('SIGKILL');
+    process.exit(1);
+  }, TIMEOUT_MS);
+
+  let summary = '';
+  try {
+    const cdp = new Cdp(browser.stdio[3], browser.stdio[4]);
+    const { targetId } = await cdp.send('Target.createTarget', { url: 'about:blank' });
+    const { sessionId } = await cdp.send('Target.attachToTarget', { targetId, flatten: true });
+    const page = (method, params) => cdp.send(method, params, sessionId);
+    const consoleErrors = [];
+    watchConsole(cdp, sessionId, page, consoleErrors, (u) => u.startsWith(url.base) || /^(data|blob|about):/.test(u), 'request outside the station: ');
+    for (const domain of ['Runtime', 'Log', 'Page', 'Network']) await page(domain + '.enable');
+    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: HEIGHT, deviceScaleFactor: 1, mobile: false });
+    const evaluate = async (expression) => {
+      const r = await page('Runtime.evaluate', { expression, returnByValue: true, awaitPromise: true });
+      if (r.exceptionDetails) throw new Error('evaluate: ' + ((r.exceptionDetails.exception || {}).description || r.exceptionDetails.text));
+      return r.result.value;
+    };
+    const screenshot = async (file) => {
+      const shot = await page('Page.captureScreenshot', { format: 'png' });
+      fs.writeFileSync(path.join(out, file), Buffer.from(shot.data, 'base64'));
+    };
+    const mouseClick = async (selector) => {
+      const box = await evaluate(`(() => { const b = document.querySelector(${JSON.stringify(selector)});
+        if (!b) return null; b.scrollIntoView({block: 'center'}); const r = b.getBoundingClientRect(); return {x: r.left + r.width / 2, y: r.top + r.height / 2}; })()`);
+      if (!box) return false;
+      for (const type of ['mouseMoved', 'mousePressed', 'mouseReleased']) {
+        await page('Input.dispatchMouseEvent', { type, x: box.x, y: box.y, button: 'left', clickCount: 1 });
+      }
+      return true;
+    };
+
+    await page('Page.navigate', { url: url.base + '#token=' + url.token });
+    let loaded = false;
+    for (let i = 0; i < 100 && !loaded; ++i) {
+      loaded = await evaluate("document.readyState === 'complete' && !!window.pbLive");
+      if (!loaded) await sleep(50);
+    }
+    if (!loaded) throw new Error('the page did not load within 5 s');
+    trace('loaded');
+    // Follow the qualification: answer each prompt with the mouse, watch the live data.
+    const port = Number(url.base.match(/:(\d+)\//)[1]);
+    let hostile = null;
+    const answered = [];
+    const samplesAt = [];
+    const frfAverages = new Set();
+    let liveShot = false, complete = false;
+    const deadline = Date.now() + 60000;
+    while (Date.now() < deadline) {
+      const s = await evaluate(`(() => { const l = window.pbLive || {}; const st = l.state || {};
+        const box = document.getElementById('prompt');
+        return { state: document.getElementById('pb-status').dataset.state, status: st.status, prompt: st.prompt ? st.prompt.id : null,
+          shown: box && !box.hidden ? box.dataset.id : null, samples: l.samplesReceived || 0, frf: l.frf ? l.frf.averages : null,
+          frfPhase: l.frf ? l.frf.phase : null, drawn: document.querySelectorAll('#plot-signals .scatterlayer .trace').length }; })()`);
+      samplesAt.push({ t: Date.now(), n: s.samples });
+      if (s.frf !== null) frfAverages.add(s.frf);
+      if (s.shown && s.prompt !== null && String(s.prompt) === s.shown && !answered.includes(s.prompt)) {
+        if (hostile) await hostile;  // the page's own requests must not meet the burst's 503s
+        await sleep(300);  // an operator reads it
+        if (await mouseClick('#prompt-buttons button[data-answer="confirm"]')) answered.push(s.prompt);
+        trace('answered prompt ' + s.prompt);
+        if (answered.length === 1) hostile = hostileBurst(port);  // while the phases run
+      }
+      if (!liveShot && s.frf !== null && s.frf >= 3 && s.drawn > 0) {
+        await screenshot('live.png');
+        liveShot = true;
+      }
+      if (s.status === 'complete' || s.status === 'aborted' || s.status === 'failed') { complete = s.status === 'complete'; break; }
+      await sleep(100);
+    }
+    trace('qualification over');
+    if (!complete) failures.push('the qualification did not complete within 60 s: ' + stderr.slice(-1500));
+    if (answered.length !== 2) failures.push(`${answered.length} prompts answered in the page, the station asks 2`);
+    const hostileResult = hostile ? await hostile : { failures: ['the hostile requests did not run'], served: 0, busy: 0 };
+    failures.push(...hostileResult.failures);
+    await sleep(400);  // the last state and samples
+
+    const live = await evaluate(`(() => { const l = window.pbLive; const lat = l.latencies.slice().sort((a, b) => a - b);
+      const q = (p) => lat.length ? lat[Math.min(lat.length - 1, Math.floor(p * lat.length))] : null;
+      const seen = {}; for (const [k, v] of Object.entries(l.phasesSeen)) seen[k] = Array.from(v);
+      return { latencies: lat.length, p50: q(0.5), p99: q(0.99), max: lat.length ? lat[lat.length - 1] : null, seen, samples: l.samplesReceived,
+        messages: l.messages, phases: l.state.phases.map((p) => ({ name: p.name, state: p.state, record_s: p.record_s, started_ms: p.started_ms, finished_ms: p.finished_ms })),
+        table: Array.from(document.querySelectorAll('#verdicts tbody tr[data-name]')).map((r) => ({ phase: r.dataset.phase, name: r.dataset.name,
+          value: r.dataset.value === '' ? null : Number(r.dataset.value), verdict: r.dataset.verdict })),
+        certificate: !!document.getElementById('certificate-link'), verdict: (document.getElementById('unit-verdict') || {}).textContent }; })()`);
+    // Phases advance: each one started after the one before it and finished; those that take time
+    // (a record on the paced bench) were seen running. An instrument phase (flatness, capacitance)
+    // lasts milliseconds: the page's mailbox may skip its running state, by design.
+    let previousStart = 0;
+    for (const p of live.phases) {
+      const seen = live.seen[p.name] || [];
+      if (p.record_s > 1 && !seen.includes('running') && !seen.includes('retried')) failures.push(`phase ${p.name} was never seen running (${seen.join(', ')})`);
+      if (!['passed', 'marginal', 'failed'].includes(p.state)) failures.push(`phase ${p.name} ends ${p.state}`);
+      if (!(p.started_ms >= previousStart && p.finished_ms >= p.started_ms)) failures.push(`phase ${p.name} did not start after the one before it`);
+      previousStart = p.started_ms;
+    }
+    const seenRunning = live.phases.filter((p) => (live.seen[p.name] || []).includes('running')).length;
+    // The signals: screen samples arrived during the paced phases, at a screen rate (10-20 per second of signal).
+    const growth = samplesAt.filter((x, i) => i > 0 && x.n > samplesAt[i - 1].n).length;
+    if (live.samples < 50 || growth < 10) failures.push(`live signals: ${live.samples} screen samples in ${growth} updates`);
+    if (frfAverages.size < 3) failures.push(`FRF built up over ${frfAverages.size} average counts (${Array.from(frfAverages).join(', ')})`);
+    if (live.latencies < 50 || !(live.max < LATENCY_LIMIT_MS)) {
+      failures.push(`latency: ${live.latencies} samples, p50 ${live.p50} ms, p99 ${live.p99} ms, max ${live.max} ms (limit ${LATENCY_LIMIT_MS} ms)`);
+    }
+    if (!live.certificate) failures.push('no certificate link after the qualification');
+    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: 1700, deviceScaleFactor: 1, mobile: false });
+    await sleep(300);
+    await screenshot('final.png');
+
+    // The verdict table: the terminal's and the database's.
+    const terminal = terminalTable(stdout);
+    compareTables('terminal', terminal, live.table, 1e-4, failures);
+    const shown = JSON.parse(execFileSync(binary, ['db', 'show', serial, '--json', '--db', db], { encoding: 'utf8' }));
+    const database = [];
+    for (const t of shown.phase_tries) for (const m of t.measurements) database.push({ phase: t.phase, name: m.name, value: m.value, verdict: m.verdict });
+    compareTables('database', database, live.table, 0, failures);
+
+    // The database tab.
+    await mouseClick('#tab-db');
+    let dbState = null;
+    for (let i = 0; i < 50 && dbState !== 'loaded'; ++i) { await sleep(100); dbState = await evaluate("document.getElementById('pb-status').dataset.database || ''"); }
+    const dbView = await evaluate(`({ rows: Array.from(document.querySelectorAll('#quals tbody tr')).map((r) => r.dataset.serial),
+      charts: document.querySelectorAll('#charts .plot .main-svg').length })`);
+    if (!dbView.rows.includes(serial)) failures.push(`the database tab lists ${JSON.stringify(dbView.rows)}, not ${serial}`);
+    if (dbView.charts < 1) failures.push('the database tab draws no control chart');
+    await mouseClick(`#quals tbody tr[data-serial="${serial}"] button`);
+    await sleep(400);
+    await screenshot('database.png');
+    const cert = await evaluate(`fetch('/api/certificate/${serial}', {headers: {Authorization: 'Bearer ${url.token}'}}).then(async (r) => [r.status, (await r.text()).length])`);
+    if (cert[0] !== 200 || cert[1] < 1000) failures.push(`certificate: HTTP ${cert[0]}, ${cert[1]} bytes`);
+    failures.push(...consoleErrors);
+
+    // Ctrl-C with the page's event stream open: qualify ends within 1 s.
+    await mouseClick('#tab-live');
+    const streams = await evaluate('window.pbLive.source.readyState');
+    const before = Date.now();
+    qualify.kill('SIGINT');
+    const end = await Promise.race([qualifyExit, sleep(5000).then(() => null)]);
+    const shutdownMs = end ? end.at - before : null;
+    if (streams !== 1) failures.push(`the page's event stream is not open before Ctrl-C (readyState ${streams})`);
+    if (!end) failures.push('qualify did not end within 5 s of Ctrl-C');
+    else if (shutdownMs >= 1000) failures.push(`qualify ended ${shutdownMs} ms after Ctrl-C (limit 1000 ms)`);
+    else if (end.code !== 0) failures.push(`qualify exited with ${end.code} (${end.signal})`);
+    summary = `station_page_check: ${live.phases.length} phases finished in order (${seenRunning} seen running), ${answered.length} prompts answered in the page, ` +
+      `${live.samples} screen samples in ${live.messages} messages, FRF averages ${Array.from(frfAverages).sort((a, b) => a - b).join(',')}; ` +
+      `latency sample -> page p50 ${live.p50.toFixed(0)} ms, p99 ${live.p99.toFixed(0)} ms, max ${live.max.toFixed(0)} ms over ${live.latencies} samples; ` +
+      `verdict table (${live.table.length} measurements, unit ${live.verdict}) equal to the terminal's and the database's; ` +
+      `hostile requests refused cleanly while it ran (1,000 concurrent: ${hostileResult.served} served, ${hostileResult.busy} refused 503); ` +
+      `no console error; Ctrl-C with a stream open: exit in ${shutdownMs} ms; screenshots in ${out}`;
+    await cdp.send('Browser.close').catch(() => {});
+  } finally {
+    clearTimeout(timer);
+    const closed = await Promise.race([exited.then(() => true), sleep(3000).then(() => false)]);
+    if (!closed) browser.kill('SIGKILL');
+    qualify.kill('SIGKILL');
+    fs.rmSync(profile, { recursive: true, force: true });
+    for (const stream of browser.stdio) if (stream) stream.destroy();
+  }
+  if (failures.length > 0) {
+    console.error('station_page_check: FAILED\n  ' + failures.join('\n  ') + '\n--- qualify stderr (end):\n' + stderr.slice(-2000));
+    process.exit(1);
+  }
+  console.log(summary);
+}
+
+main().then(() => process.exit(0)).catch((e) => {
+  console.error('station_page_check: ' + e.stack);
+  process.exit(1);
+});
