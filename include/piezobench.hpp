@@ -15,3 +15,4 @@
 #include "piezobench/rt.hpp"
 #include "piezobench/station.hpp"
 #include "piezobench/version.hpp"
+#include "piezobench/web.hpp"

@@ -6,5 +6,6 @@
 #include "piezobench/station/certificate.hpp"
 #include "piezobench/station/measurements.hpp"
 #include "piezobench/station/phase_runner.hpp"
+#include "piezobench/station/record_json.hpp"
 #include "piezobench/station/record_store.hpp"
 #include "piezobench/station/station_file.hpp"

@@ -124,6 +124,7 @@ void LiveHub::phase_started(const std::string&, const station::PhaseSpec& phase,
     s.started_ms = now_unix_ms(), s.finished_ms = 0.0, s.record_s = 0.0;
     s.reason.clear();
   }
+  last_message_.clear();  // the operator's step was answered
   bump();
 }
 
