@@ -54,6 +54,13 @@ def command(reader, path, workdir):
         return ["model", "2dof", "--params", path, "--json"]
     if reader == "campaign_toml":
         return ["run", path, "--out", os.path.join(workdir, "out")]
+    if reader in ("station_toml", "answers_toml"):
+        # Refused before anything moves: the station file, then the answers against it.
+        examples = os.path.join(ROOT, "docs", "examples")
+        station = path if reader == "station_toml" else os.path.join(examples, "station.toml")
+        answers = path if reader == "answers_toml" else os.path.join(examples, "station-answers.toml")
+        return ["qualify", "--bench", os.path.join(examples, "bench-virtual.toml"), "--station", station, "--answers", answers,
+                "--serial", "H1", "--db", os.path.join(workdir, "station.db"), "--data", os.path.join(workdir, "data"), "--json"]
     if reader == "ansys_text":
         return ["superelement"] + split(path, 3, ["k.txt", "m.txt", "master.txt"], workdir) + ["--json"]
     if reader == "matrix_market":

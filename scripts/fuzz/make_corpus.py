@@ -27,7 +27,11 @@ def write(kind, reader, name, text):
 
 
 def clean(kind):
-    shutil.rmtree(os.path.join(ROOT, "fuzz", kind), ignore_errors=True)
+    """Removes this script's folders of fuzz/KIND (udp_target's are make_udp_seeds.py's)."""
+    top = os.path.join(ROOT, "fuzz", kind)
+    for reader in os.listdir(top) if os.path.isdir(top) else []:
+        if reader != "udp_target":
+            shutil.rmtree(os.path.join(top, reader))
 
 
 def seeds():
@@ -122,6 +126,68 @@ ga_N_per_V = 23.2
     write("seeds", "calculix", "bar.txt", sti + SEP[1:] + mas + SEP[1:] + dof + SEP[1:] + inp)
 
 
+# A station whose phases need values in the answers (fuzz/station_fuzz.cpp reads it as its second station).
+VALUES_STATION = """name = "values"
+[[phases]]
+name = "flatness"
+experiment = "flatness"
+source = "file"
+steps = ["put the actuator on the probe's table"]
+[[phases.measurements]]
+name = "flatness_um"
+max = 25.0
+[[phases]]
+name = "capacitance"
+experiment = "capacitance"
+source = "typed"
+[[phases.measurements]]
+name = "capacitance_sensor_uF"
+min = 4.0
+max = 6.0
+"""
+
+
+def station_seeds():
+    """The station file and the answers file (docs/station.md): the docs' examples and a station of values."""
+    for name, reader in (("station.toml", "station_toml"), ("station-answers.toml", "answers_toml")):
+        with open(os.path.join(ROOT, "docs", "examples", name)) as f:
+            write("seeds", reader, name, f.read())
+    write("seeds", "station_toml", "values.toml", VALUES_STATION)
+    write("seeds", "answers_toml", "values_answers.toml", 'operator = "B"\n[phases.flatness]\nsteps = ["confirm"]\n'
+          'file = "probe.csv"\n[phases.capacitance]\nsensor_uF = 4.95\nactuator_uF = 9.9\non_check_fail = ["retry", "abort"]\n')
+
+
+def station_regression():
+    """Hostile station and answers files (issue 35: a parser for every new file the station reads)."""
+    deep = ".a" * 20000
+    for reader in ("station_toml", "answers_toml"):
+        write("regression", reader, "deep_header.toml", "[a" + deep + "]\nx = 1\n")
+        write("regression", reader, "deep_arrays.toml", "v = " + "[" * 5000 + "]" * 5000 + "\n")
+        write("regression", reader, "not_toml.toml", "\x00\xff[[[\n= = =\n")
+    top = 'name = "hostile"\n'  # the station's name, so that the reader gets to the phases
+    phase = '[[phases]]\nname = "stroke"\nexperiment = "stroke"\n'
+    write("regression", "station_toml", "retries_int64.toml", top + phase + "retries = 9223372036854775807\n")
+    write("regression", "station_toml", "retries_float.toml", top + phase + "retries = 1e300\n")
+    write("regression", "station_toml", "clamped_negative.toml", top + phase + "max_clamped_samples = -9223372036854775808\n")
+    write("regression", "station_toml", "duration_1e300.toml",
+          top + '[[phases]]\nname = "frf"\nexperiment = "frf-noise"\nduration_s = 1e300\namplitude_V = nan\n')
+    write("regression", "station_toml", "limit_min_above_max.toml",
+          top + phase + '[[phases.measurements]]\nname = "stroke_um"\nmin = 300.0\nmax = 200.0\n')
+    write("regression", "station_toml", "measurement_of_another_experiment.toml",
+          top + phase + '[[phases.measurements]]\nname = "k1_N_per_um"\n')
+    write("regression", "station_toml", "phase_twice.toml", top + phase + phase)
+    write("regression", "station_toml", "campaign_gain_zero.toml", top + "[campaign.bench]\namplifier_gain = 0\n" + phase)
+    write("regression", "station_toml", "campaign_unknown_table.toml", top + "[campaign.units]\nid = 1\n" + phase)
+    write("regression", "station_toml", "steps_not_text.toml", top + phase + "steps = [1, [2], {a = 3}]\n")
+    write("regression", "answers_toml", "phase_typo.toml", '[phases.stroek]\nsteps = ["confirm"]\n')
+    write("regression", "answers_toml", "steps_too_many.toml", '[phases.stroke]\nsteps = ["confirm", "confirm", "confirm"]\n')
+    write("regression", "answers_toml", "step_word.toml", '[phases.stroke]\nsteps = ["yes"]\n')
+    write("regression", "answers_toml", "phases_not_table.toml", 'phases = 3\n')
+    write("regression", "answers_toml", "typed_1e308.toml",
+          '[phases.capacitance]\nsensor_uF = 1e308\nactuator_uF = -inf\n')
+    write("regression", "answers_toml", "file_outside.toml", '[phases.flatness]\nsteps = ["confirm"]\nfile = "/dev/zero"\n')
+
+
 def regression():
     # Not cleaned: files the fuzzer found are added to fuzz/regression/READER/ by hand (docs/fuzzing.md).
     # 21.2: a table header / dotted key of 100,000 parts recursed 30,000 frames deep in toml++;
@@ -172,4 +238,6 @@ def regression():
 
 if __name__ == "__main__":
     seeds()
+    station_seeds()
     regression()
+    station_regression()
