@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Clean after a crash (issue 35): kill -9 `demo` and `run` at random moments, then run them again to
-# the end; nothing of the killed runs may be left (no `.staging-*` folder, no `.*.tmp-*` file, no
-# `.piezobench.lock`), and the results of the rerun are complete.
+# Clean after a crash (issue 35): kill -9 (odd rounds) or SIGTERM (even rounds) `demo` and `run` at
+# random moments, then run them again to the end; nothing of the killed runs may be left (no
+# `.staging-*` folder, no `.*.tmp-*` file, no `.piezobench.lock`), and the results of the rerun are
+# complete. It prints how many runs were killed mid-run and how many leftovers the reruns removed.
 #
 #   scripts/test_crash_leftovers.sh [BINARY] [ROUNDS]     (defaults: build/app/piezobench, 6)
 #
@@ -17,13 +18,15 @@ work="$(mktemp -d "${TMPDIR:-/tmp}/piezobench-crash.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 RANDOM=$$
 
-# Runs "$@" in the background, kills it with SIGKILL after a random 0.05 .. 2.5 s (or lets it end).
+# Runs "$@" in the background and sends it $signal after a random 0.05 .. 2.5 s (or lets it end);
+# counts a kill that found the process still running.
+killed=0
 kill_at_random() {
   "$@" >/dev/null 2>&1 &
   local pid=$!
   sleep "$(printf '0.%02d' $((RANDOM % 100)))"
   sleep $((RANDOM % 3))
-  kill -9 "$pid" 2>/dev/null || true
+  if kill "-$signal" "$pid" 2>/dev/null; then killed=$((killed + 1)); fi
   wait "$pid" 2>/dev/null || true
 }
 
@@ -34,9 +37,15 @@ leftovers() {
 fail=0
 # A complete demo first: the campaign `run` analyses.
 "$bin" demo --seed 1 --threads 2 --out "$work/demo" >/dev/null 2>&1
+found=0
 for round in $(seq 1 "$rounds"); do
+  # SIGKILL in odd rounds, SIGTERM in even ones (issue 35: both left staging folders).
+  signal=KILL
+  [ $((round % 2)) -eq 0 ] && signal=TERM
   kill_at_random "$bin" demo --seed 1 --threads 2 --out "$work/demo"
   kill_at_random "$bin" run "$work/demo/campaign.toml" --threads 2 --out "$work/run"
+  # What the killed runs left (the lock of a killed run included), before the reruns remove it.
+  found=$((found + $(leftovers "$work" | wc -l)))
   # The next runs remove what the killed ones left, and finish.
   "$bin" demo --seed 1 --threads 2 --out "$work/demo" >/dev/null 2>&1 || { echo "round $round: demo rerun failed" >&2; fail=1; }
   "$bin" run "$work/demo/campaign.toml" --threads 2 --out "$work/run" >/dev/null 2>&1 || { echo "round $round: run rerun failed" >&2; fail=1; }
@@ -50,5 +59,7 @@ for round in $(seq 1 "$rounds"); do
     [ -s "$work/run/$f" ] || { echo "round $round: run/$f missing after the rerun" >&2; fail=1; }
   done
 done
-if [ "$fail" -eq 0 ]; then echo "test_crash_leftovers: $rounds rounds, nothing left behind"; fi
+echo "test_crash_leftovers: $rounds rounds (SIGKILL and SIGTERM in turn), $killed of $((2 * rounds)) runs killed mid-run," \
+     "$found leftovers found after the kills"
+if [ "$fail" -eq 0 ]; then echo "test_crash_leftovers: every rerun completed and removed them: nothing left behind"; fi
 exit "$fail"
