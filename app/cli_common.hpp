@@ -22,6 +22,7 @@ void add_iff_commands(CLI::App& app, Action& action);  // iff rlocus, iff study
 void add_rt_commands(CLI::App& app, Action& action);  // rt
 void add_model_commands(CLI::App& app, Action& action);  // model 2dof, model tune, piezo
 void add_superelement_commands(CLI::App& app, Action& action);  // superelement
+CLI::App* add_superelement_update_command(CLI::App& superelement, Action& action);  // superelement update
 void add_simulate_commands(CLI::App& app, Action& action);  // simulate
 void add_measure_commands(CLI::App& app, Action& action);  // measure, bench serve
 void add_run_commands(CLI::App& app, Action& action);  // run, merge, demo

@@ -477,8 +477,9 @@ void add_superelement_commands(CLI::App& app, Action& action) {
   se->add_option("--points", o->points, "number of log-spaced frequencies")->check(CLI::Range(1, 100000))->capture_default_str();
   se->add_flag("--json", o->json, "print one JSON document on stdout");
   CLI::App* from_step = add_from_step_command(*se, action);
-  se->callback([o, from_step, &action] {
-    if (from_step->parsed()) return;  // its own callback has set the action
+  CLI::App* update = add_superelement_update_command(*se, action);
+  se->callback([o, from_step, update, &action] {
+    if (from_step->parsed() || update->parsed()) return;  // their own callbacks have set the action
     if (o->k_file.empty()) throw CLI::RequiredError("K_FILE");
     if (o->m_file.empty()) throw CLI::RequiredError("M_FILE");
     if (o->nodes_file.empty()) throw CLI::RequiredError("NODES_FILE");

@@ -9,5 +9,6 @@
 #include "piezobench/campaign/part.hpp"
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/campaign/superelement_fit.hpp"
+#include "piezobench/campaign/superelement_update.hpp"
 #include "piezobench/campaign/twin.hpp"
 #include "piezobench/campaign/unit_analysis.hpp"

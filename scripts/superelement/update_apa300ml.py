@@ -5,10 +5,10 @@ measures, what the data determine (sensitivity matrix, its rank and condition), 
 to the static sensitivities. numpy/scipy only, on the shipped matrices: no gmsh, no ccx.
 
 Why no re-meshing is needed for these two parameters: the shell is one material, so its stiffness
-matrix scales with its Young's modulus (alpha = E_shell / 200 GPa) and a Craig-Bampton reduction of
+matrix scales with its Young's modulus (alpha = E_shell / E_built) and a Craig-Bampton reduction of
 alpha K is alpha times the reduction of K (the constraint modes and the fixed-interface mode shapes
 do not change, their eigenvalues scale); the stacks are beams between interface nodes, added to the
-reduced model (fem/beam.hpp), whose matrices scale with the stack modulus (beta = E_stack / 48 GPa).
+reduced model (fem/beam.hpp), whose matrices scale with the stack modulus (beta = E_stack / E_built).
 So K(alpha, beta) = alpha (K_shipped - K_beams) + beta K_beams, M unchanged.
 
 The bench is campaign/superelement_fit.hpp's: bottom clamped, 5.7 kg on the top interface guided
@@ -17,7 +17,11 @@ stack_mid -> stack_b along x. Resonance: the first eigenfrequency; anti-resonanc
 force -> sensor extension below it (undamped, by bisection of the sign change).
 
 Usage: /usr/bin/python3 scripts/superelement/update_apa300ml.py [--resonance HZ] [--antiresonance HZ]
-(defaults: the mean of the accepted units of `demo --seed 1`, docs/apa300ml.md).
+  [--shell-modulus PA] [--stack-modulus PA]   (the moduli the shipped element was built with)
+(defaults: the mean of the accepted units of `demo --seed 1`, docs/apa300ml.md; the shipped
+element's moduli since issue 31, 210.8 and 29.4 GPa: pass 200e9 and 48e9 for the one before).
+It is the scipy reference of tests/campaign/superelement_update_test.cpp (`piezobench superelement
+update` is the command).
 """
 import argparse
 import json
@@ -79,6 +83,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--resonance", type=float, default=95.4)
     ap.add_argument("--antiresonance", type=float, default=41.1)
+    ap.add_argument("--shell-modulus", type=float, default=210.8e9, help="the shell's modulus the shipped element was built with, Pa")
+    ap.add_argument("--stack-modulus", type=float, default=29.4e9, help="the stacks' modulus the shipped element was built with, Pa")
     args = ap.parse_args()
     K = scipy.io.mmread(os.path.join(SE, "apa300ml_K.mtx")).toarray()
     M = scipy.io.mmread(os.path.join(SE, "apa300ml_M.mtx")).toarray()
@@ -93,12 +99,12 @@ def main():
         a, b = s["node_a"], s["node_b"]
         L = float(np.linalg.norm(coords[b] - coords[a]))
         assert abs(coords[b][1] - coords[a][1]) < 1e-9 and abs(coords[b][2] - coords[a][2]) < 1e-9
-        kbeam = beam_along_x(L, 48e9)
+        kbeam = beam_along_x(L, args.stack_modulus)
         if coords[b][0] < coords[a][0]:
             a, b = b, a
         idx = [index[(a, d)] for d in dof_names] + [index[(b, d)] for d in dof_names]
         kb[np.ix_(idx, idx)] += kbeam
-        assert abs(s["axial_stiffness_N_per_m"] - 48e9 * 1e-4 / L) < 1e-3 * s["axial_stiffness_N_per_m"]
+        assert abs(s["axial_stiffness_N_per_m"] - args.stack_modulus * 1e-4 / L) < 1e-3 * s["axial_stiffness_N_per_m"]
     kshell = K - kb
 
     fixed = {node["bottom"]}
@@ -159,8 +165,8 @@ def main():
         "shipped": {"resonance_Hz": resonance(1, 1), "antiresonance_Hz": antiresonance(1, 1),
                     "static_top_per_N": static(1, 1)[0], "static_sensor_per_N": static(1, 1)[1]},
         "target": {"resonance_Hz": args.resonance, "antiresonance_Hz": args.antiresonance},
-        "updated": {"shell_modulus_scale": alpha, "shell_E_Pa": alpha * 200e9, "stack_modulus_scale": beta,
-                    "stack_E_Pa": beta * 48e9, "resonance_Hz": resonance(alpha, beta),
+        "updated": {"shell_modulus_scale": alpha, "shell_E_Pa": alpha * args.shell_modulus, "stack_modulus_scale": beta,
+                    "stack_E_Pa": beta * args.stack_modulus, "resonance_Hz": resonance(alpha, beta),
                     "antiresonance_Hz": antiresonance(alpha, beta),
                     "static_top_per_N": static(alpha, beta)[0], "static_sensor_per_N": static(alpha, beta)[1]},
         "sensitivity_log_log": J.tolist(),

@@ -75,7 +75,7 @@ class Keys {
       if (used_.count(std::string(k.str())) == 0) {
         throw InputError(source_, std::string(k.str()),
                          "one of k_file, m_file, nodes_file, coordinates_file, format, fix, actuator, sensor, output, ga, gs, "
-                         "modal_damping, max_mode_Hz, guided",
+                         "modal_damping, max_mode_Hz, guided, stack_modulus_Pa",
                          "an unknown key");
       }
     }
@@ -148,6 +148,11 @@ SuperElementBench read_superelement_spec(const std::filesystem::path& file) {
   s.max_mode_Hz = keys.number("max_mode_Hz", s.max_mode_Hz);
   if (!(s.max_mode_Hz > 0.0)) throw InputError(source, "max_mode_Hz", "a frequency > 0 Hz", fmt::format("{:g}", s.max_mode_Hz));
   s.guided = keys.boolean("guided", s.guided);
+  // The stacks' effective modulus the element was built with: information for the campaign's eq. 4.1
+  // (campaign_file.hpp's stack_modulus_Pa), ga and gs above already include it.
+  if (const double e = keys.number("stack_modulus_Pa", 48e9); !(e > 0.0 && e < 1e13)) {
+    throw InputError(source, "stack_modulus_Pa", "a modulus in (0, 1e13) Pa", fmt::format("{:g}", e));
+  }
   keys.check_unknown();
   for (long n : setup.model.fixed_nodes) {
     if (n == out.node_b) throw InputError(source, "fix", "nodes other than the output node", std::to_string(n));

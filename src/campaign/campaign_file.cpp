@@ -497,7 +497,7 @@ void read_analysis(const Reader& r, AnalysisSettings& a) {
 }
 
 CampaignSuperElement read_superelement(const Context& ctx, const Reader& r) {
-  r.only({"format", "k_file", "m_file", "nodes_file", "coordinates_file", "fix", "actuator", "output", "sensor", "masses", "damping"});
+  r.only({"format", "k_file", "m_file", "nodes_file", "coordinates_file", "fix", "actuator", "output", "sensor", "masses", "damping", "stack_modulus_Pa"});
   CampaignSuperElement c;
   fem::SuperElementSetup& s = c.setup;
   s.source = ctx.source;
@@ -556,6 +556,10 @@ CampaignSuperElement read_superelement(const Context& ctx, const Reader& r) {
   if (s.model.forces[0].node_a < 0) throw InputError(ctx.source, r.key("actuator"), "a force pair A:B:DIR", "one node");
   s.force_fields = {r.key("actuator")};
   s.output_fields = {r.key("output"), r.key("sensor")};
+  if (const auto e = r.number("stack_modulus_Pa")) {
+    if (!(*e > 0.0 && *e < 1e13)) throw InputError(ctx.source, r.key("stack_modulus_Pa"), "a modulus in (0, 1e13) Pa", fmt::format("{}", *e));
+    c.stack_modulus = *e;
+  }
   return c;
 }
 

@@ -215,9 +215,10 @@ DemoFiles write_demo_campaign(const fs::path& dir, const DemoOptions& options) {
         "actuator = \"{}\"     # remote points 3 -> 4: the two actuator stacks\n"
         "sensor = \"{}\"       # remote points 4 -> 5: the sensor stack\n"
         "output = \"{}\"             # top interface (remote point 1): d_e\n"
-        "damping = \"modal:0.02\"\n\n",
+        "damping = \"modal:0.02\"\n"
+        "stack_modulus_Pa = {:g}      # the stacks' effective modulus the element was built with (eq. 4.1)\n\n",
         text("k_file"), text("m_file"), text("nodes_file"), se["fix"][0].value<int64_t>().value_or(0), text("actuator"), text("sensor"),
-        text("output"));
+        text("output"), se["stack_modulus_Pa"].value<double>().value_or(48e9));
   }
   for (const int id : options.units) {
     const std::string u = fmt::format("data/unit{}", id);

@@ -383,7 +383,12 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
   fo.modal_damping = s.modal_damping;
   fo.band_min_Hz = std::max(fo.band_min_Hz, c.analysis.fmin_Hz);
   const fem::Modes modes = fem::modes(superelement_bench_model(se, s.setup, fo));
-  const apa::PiezoSensitivities eq41 = apa::piezo_sensitivities(apa::PiezoConstants{});
+  // Eq. 4.1 with the stacks' effective modulus (campaign_file.hpp's stack_modulus_Pa): c^E replaced,
+  // s^D scaled so that gs scales with the modulus as ga does.
+  apa::PiezoConstants pc;
+  pc.s_d *= pc.c_e / s.stack_modulus;
+  pc.c_e = s.stack_modulus;
+  const apa::PiezoSensitivities eq41 = apa::piezo_sensitivities(pc);
   SuperElementComparison out;
   out.source = s.given;
   out.dofs = static_cast<long>(se.size());
@@ -391,6 +396,7 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
   out.moving_mass = fo.moving_mass;
   out.eq41_ga = eq41.ga;
   out.eq41_gs = eq41.gs;
+  out.stack_modulus = s.stack_modulus;
   out.warnings = se.warnings;
   std::vector<double> ga, gs, measured_res;
   for (const auto& u : units) {

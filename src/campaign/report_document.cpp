@@ -971,8 +971,8 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
     vs_mag.push_back(trace("super element", se_vs.f, se_vs.abs, "model", true));
     text = fmt::format("The super element ({}, {} DOF) on the bench ({:.3g} kg on the moving interface), its sensitivities tuned "
                        "against each unit's measured FRFs (docs/apa300ml.md) and compared with eq. 4.1 for Table 4.1's "
-                       "constants: ga {:.3g} N/V, gs {:.3g} V/um.",
-                       s->source, s->dofs, s->moving_mass, s->eq41_ga, s->eq41_gs * 1e-6);
+                       "constants and the stacks' effective modulus {:.3g} GPa (Table 4.1: 48 GPa): ga {:.3g} N/V, gs {:.3g} V/um.",
+                       s->source, s->dofs, s->moving_mass, s->stack_modulus * 1e-9, s->eq41_ga, s->eq41_gs * 1e-6);
     json rows = json::array();
     for (const SuperElementUnitFit& row : s->units) {
       rows.push_back({row.name, io::to_json(row.ga), finite_scaled(row.ga_relative_to_eq41, 100.0), io::to_json(row.gs * 1e-6),
@@ -985,7 +985,7 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
                             "resonance measured [Hz]", "anti-resonance model [Hz]", "anti-resonance measured [Hz]",
                             "u -> d_e error [dB]", "u -> V_s error [dB]"},
                            rows,
-                           "Errors: median |model / measured| in dB from the tuning band's start to twice the resonance. Signs: ga "
+                           "Errors: median |model / measured| in dB from the tuning band's start to 300 Hz. Signs: ga "
                            "and gs carry the signs that make the model's phases agree with the measurement in the super "
                            "element's own axes (ga > 0 with gs < 0, or the reverse); the 2-DoF model's convention is ga < 0, "
                            "gs > 0. The data fix only the sign of the product ga gs (negative in both), so the comparison with eq. 4.1 "

@@ -382,7 +382,7 @@ json superelement(const SuperElementComparison& s) {
               {"dofs", s.dofs},
               {"modes_Hz", s.modes_Hz},
               {"moving_mass_kg", num(s.moving_mass)},
-              {"eq41", {{"ga_N_per_V", num(s.eq41_ga)}, {"gs_V_per_um", num(s.eq41_gs * 1e-6)}}},
+              {"eq41", {{"ga_N_per_V", num(s.eq41_ga)}, {"gs_V_per_um", num(s.eq41_gs * 1e-6)}, {"stack_modulus_Pa", num(s.stack_modulus)}}},
               {"units", units},
               {"ga_N_per_V", io::to_json(s.ga)},
               {"gs_V_per_um", io::to_json(s.gs, 1e-6)},

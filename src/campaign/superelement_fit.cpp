@@ -16,6 +16,8 @@ namespace piezobench::campaign {
 namespace {
 
 const char* const kSource = "superelement fit";
+// gs is tuned on the band's frequencies farther than this from the model's anti-resonance.
+constexpr double kZeroExclusion = 0.15;
 
 using core::median;
 
@@ -34,6 +36,7 @@ void SuperElementFitOptions::validate() const {
   if (!(modal_damping > 0.0 && modal_damping < 1.0)) throw InputError(kSource, "modal_damping", "a damping ratio in (0, 1)", fmt::format("{}", modal_damping));
   if (!(band_min_Hz > 0.0 && std::isfinite(band_min_Hz))) throw InputError(kSource, "band_min_Hz", "a frequency > 0 Hz", fmt::format("{}", band_min_Hz));
   if (!(band_fraction > 0.0 && band_fraction < 1.0)) throw InputError(kSource, "band_fraction", "a fraction in (0, 1)", fmt::format("{}", band_fraction));
+  if (!(error_max_Hz > band_min_Hz && std::isfinite(error_max_Hz))) throw InputError(kSource, "error_max_Hz", "a frequency above band_min_Hz", fmt::format("{}", error_max_Hz));
 }
 
 fem::StructuralModel superelement_bench_model(const fem::SuperElement& se, const fem::SuperElementSetup& setup,
@@ -105,13 +108,23 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
   std::vector<double> ga_ratio, gs_ratio, de_phase, vs_phase;
   for (std::size_t i = 0; i < band.size(); ++i) {
     const std::complex<double> m_de = measured.H[static_cast<std::size_t>(ide)](band[i]);
-    const std::complex<double> m_vs = measured.H[static_cast<std::size_t>(ivs)](band[i]);
     const std::complex<double> h_de = options.amplifier_gain * hb.H[i](0, 0);
-    const std::complex<double> h_s = options.amplifier_gain * hb.H[i](1, 0);
     ga_ratio.push_back(std::abs(m_de) / std::abs(h_de));
     de_phase.push_back(std::cos(std::arg(m_de / h_de)));
-    gs_ratio.push_back(std::abs(m_vs) / std::abs(h_s));  // divided by |ga| below
-    vs_phase.push_back(std::cos(std::arg(m_vs / h_s)));
+  }
+  // gs away from the anti-resonance, where the ratio measures where the two zeros sit rather than
+  // gs; every point of the band when fewer than 3 are left.
+  for (const bool exclude : {true, false}) {
+    for (std::size_t i = 0; i < band.size(); ++i) {
+      if (exclude && r.antiresonance_Hz > 0.0 && std::abs(fb(static_cast<Eigen::Index>(i)) / r.antiresonance_Hz - 1.0) < kZeroExclusion) continue;
+      const std::complex<double> m_vs = measured.H[static_cast<std::size_t>(ivs)](band[i]);
+      const std::complex<double> h_s = options.amplifier_gain * hb.H[i](1, 0);
+      gs_ratio.push_back(std::abs(m_vs) / std::abs(h_s));  // divided by |ga| below
+      vs_phase.push_back(std::cos(std::arg(m_vs / h_s)));
+    }
+    if (gs_ratio.size() >= 3) break;
+    gs_ratio.clear();
+    vs_phase.clear();
   }
   r.ga = median(ga_ratio) * (median(de_phase) < 0.0 ? -1.0 : 1.0);
   const double ga_sign = r.ga < 0.0 ? -1.0 : 1.0;
@@ -120,7 +133,7 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
     throw NumericalError("super element sensitivities", "the model has no response to the actuator in the band", false);
   }
 
-  // The tuned model at the measured frequencies, and its error up to twice the resonance.
+  // The tuned model at the measured frequencies, and its error up to error_max_Hz.
   // (On the measured grid itself: freq_Hz is f, not f converted to rad/s and back.)
   const lti::FrequencyResponse h = response(model, modes, f);
   r.model.freq_Hz = f;
@@ -131,7 +144,7 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
   const Eigen::VectorXcd &de = r.model.H[0], &vs = r.model.H[1];
   std::vector<double> e_de, e_vs;
   for (Eigen::Index k = 0; k < f.size(); ++k) {
-    if (f(k) >= r.band_lo_Hz && f(k) <= 2.0 * r.resonance_Hz) {
+    if (f(k) >= r.band_lo_Hz && f(k) <= options.error_max_Hz) {
       e_de.push_back(std::abs(20.0 * std::log10(std::abs(de(k)) / std::abs(measured.H[static_cast<std::size_t>(ide)](k)))));
       e_vs.push_back(std::abs(20.0 * std::log10(std::abs(vs(k)) / std::abs(measured.H[static_cast<std::size_t>(ivs)](k)))));
     }

@@ -181,6 +181,7 @@ struct BenchOptions {
   //   modal_damping                damping ratio of every mode (default 0.01)
   //   max_mode_Hz                  modes kept (above: static correction), default 20000
   //   guided                       true (default): the mass node moves along DIR only (air bearing)
+  //   stack_modulus_Pa             information: the stacks' modulus the element was built with (> 0)
   // Example for the APA95ML of /work/shared/data/apa95ml-ansys: docs/virtual-bench.md.
   std::optional<std::filesystem::path> superelement;
 

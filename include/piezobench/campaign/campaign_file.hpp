@@ -135,6 +135,10 @@ struct CampaignSuperElement {
   fem::SuperElementSetup setup;  // forces [actuator], outputs [output, sensor]; source = the campaign
   std::string given;             // the K file as written in the campaign
   double modal_damping = 0.02;
+  // Pa (stack_modulus_Pa): the stacks' effective modulus the element was built with (default: Table
+  // 4.1's c^E). Eq. 4.1 is evaluated with it: ga = d33 n E A / L, and gs times E / c^E (the ceramic's
+  // share of the stack's strain when glue and electrodes soften it; docs/apa300ml.md).
+  double stack_modulus = 48e9;
 };
 
 struct Campaign {

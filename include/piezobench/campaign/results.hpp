@@ -389,8 +389,9 @@ struct SuperElementComparison {
   long dofs = 0;
   std::vector<double> modes_Hz;  // the first ten of the bench model
   double moving_mass = 0.0;      // kg, on the moving interface
-  double eq41_ga = 0.0;          // N/V, eq. 4.1 with Table 4.1's constants
+  double eq41_ga = 0.0;          // N/V, eq. 4.1 with Table 4.1's constants and the stacks' modulus
   double eq41_gs = 0.0;          // V/m
+  double stack_modulus = 48e9;   // Pa, the stacks' effective modulus eq. 4.1 is evaluated with
   std::vector<SuperElementUnitFit> units;
   std::optional<double> ga, gs;  // N/V, V/m: medians of |ga|, |gs| over the units
   std::optional<double> resonance_Hz;           // the first unit's tuned model

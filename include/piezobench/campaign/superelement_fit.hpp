@@ -10,7 +10,8 @@
 //   u -> d_e = amplifier_gain ga H_de(f),   u -> V_s = amplifier_gain ga gs H_s(f).
 // ga is the median of |measured u -> d_e| / |amplifier_gain H_de| over the tuning band (below the
 // resonances, where neither the damping nor the moving mass's dynamics matter much), gs the
-// median of |measured u -> V_s| / |amplifier_gain ga H_s| there; each takes the sign that makes
+// median of |measured u -> V_s| / |amplifier_gain ga H_s| there, away (15 %) from the model's
+// anti-resonance, where the ratio measures the zeros' positions, not gs; each takes the sign that makes
 // the phases agree in the band. The measurement chain (the sensor's high-pass, the ADC's
 // low-pass, the delays) is not in the model: the band stays well above the high-pass corner.
 #include <Eigen/Dense>
@@ -28,6 +29,7 @@ struct SuperElementFitOptions {
   double modal_damping = 0.02;   // every mode of the bench model
   double band_min_Hz = 5.0;      // tuning band: from here ...
   double band_fraction = 0.5;    // ... to this fraction of the lower of the two resonances
+  double error_max_Hz = 300.0;   // the errors are judged from band_min_Hz to here (issue 31: 20-300 Hz)
   // InputError (source "superelement fit") for values out of range.
   void validate() const;
 };
@@ -38,7 +40,7 @@ struct SuperElementFit {
   double band_lo_Hz = 0.0, band_hi_Hz = 0.0;
   double resonance_Hz = 0.0;       // first peak of the model's u -> d_e
   double antiresonance_Hz = 0.0;   // dip of the model's u -> V_s below the resonance (0: none)
-  double de_error_dB = 0.0;        // median |20 log10 model/measured| of u -> d_e, band_lo .. 2 x resonance
+  double de_error_dB = 0.0;        // median |20 log10 model/measured| of u -> d_e, band_lo .. error_max_Hz
   double vs_error_dB = 0.0;        // same for u -> V_s
   // The tuned model at the measured frequencies: input "u", outputs "de" (u -> d_e, m/V) and "Vs"
   // (u -> V_s, V/V), no coherence.
