@@ -63,6 +63,7 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
   for (std::size_t i = 0; i < frf.outputs.size(); ++i) {
     nlohmann::json o = {{"H", io::to_json(frf.H[i])}};
     if (i < frf.coherence.size() && frf.coherence[i].size() > 0) o["coherence"] = io::to_json(frf.coherence[i]);
+    if (i < frf.std_H.size() && frf.std_H[i].size() > 0) o["std"] = io::to_json(frf.std_H[i]);
     outputs[frf.outputs[i]] = std::move(o);
   }
   const auto& p = frf.provenance;
@@ -75,6 +76,7 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
           {"detrend", p.detrend},
           {"estimator", p.estimator},
           {"averages", p.averages},
+          {"effective_averages", io::to_json(p.effective_averages)},
           {"sample_rate_Hz", p.sample_rate},
           {"outputs", std::move(outputs)}};
 }
@@ -392,6 +394,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
   }
   fo.hpf_fmax_Hz = o.hpf_fmax;
   fo.min_coherence = o.min_coherence;
+  fo.effective_averages = frf.provenance.effective_averages;
   if (!o.json) log_line(fmt::format("fitting the IFF plant (eq. 2.3 with delay) to u -> {} of {}, {:.4g} to {:.4g} Hz", o.output, o.file, fo.fmin_Hz, fo.fmax_Hz));
   const lti::Vector coh = i < frf.coherence.size() ? frf.coherence[i] : lti::Vector();
   const ident::IffPlantFit p = ident::fit_iff_plant(kTwoPi * frf.freq_Hz, frf.H[i], coh, fo, o.file);
@@ -416,6 +419,10 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
                     {"xz", io::to_json(p.xz)},
                     {"wp_Hz", io::to_json(p.wp * hz)},  {"xp", io::to_json(p.xp)},          {"w_hpf_Hz", io::to_json(p.w_hpf * hz)},
                     {"delay_s", io::to_json(p.delay)}, {"zero_is_nonminimum_phase", p.zero_is_nonminimum_phase()}};
+    doc["uncertainty"] = io::to_json(p.uncertainty);
+    const ident::ZeroPhaseVerdict v = ident::zero_phase_verdict(nullptr, &p);
+    doc["zero_verdict"] = {{"nonminimum_phase", v.nonminimum_phase ? nlohmann::json(*v.nonminimum_phase) : nlohmann::json(nullptr)},
+                           {"reason", v.reason}};
   }
   doc.update(quality_json(p.quality));
   doc["warnings"] = file.warnings;
@@ -435,8 +442,15 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
   if (!p.quality.impossible) {
     fmt::print("  g0 = {:.5g} {}, wz = {:.5g} Hz, xz = {:+.4g}, wp = {:.5g} Hz, xp = {:.4g}\n", p.g0, g0_unit_text, p.wz * hz, p.xz, p.wp * hz, p.xp);
     fmt::print("  high-pass corner {:.4g} Hz, delay {:.4g} us\n", p.w_hpf * hz, p.delay * 1e6);
-    fmt::print("  zero pair: {} phase (xz {} 0)\n", p.zero_is_nonminimum_phase() ? "NON-minimum" : "minimum",
-               p.zero_is_nonminimum_phase() ? "<" : ">=");
+    const ident::ZeroPhaseVerdict v = ident::zero_phase_verdict(nullptr, &p);
+    fmt::print("  zero pair: {} ({})\n", v.nonminimum_phase ? (*v.nonminimum_phase ? "NON-minimum phase" : "minimum phase") : "undetermined",
+               v.reason);
+    const auto& u = p.uncertainty;
+    fmt::print("  standard errors ({}): g0 {:.2g}, wz {:.2g} Hz, xz {:.2g}, wp {:.2g} Hz, xp {:.2g}, delay {:.2g} us; condition number {:.3g}\n",
+               u.from_data_variance ? "from the FRF's variance" : "from the residuals' scatter", u.standard_error_of("g0"),
+               u.standard_error_of("wz") * hz, u.standard_error_of("xz"), u.standard_error_of("wp") * hz, u.standard_error_of("xp"),
+               u.standard_error_of("delay") * 1e6, u.condition_number);
+    for (const auto& c : u.high_correlations) fmt::print("  correlated (> 0.95): {}\n", c);
   }
   fmt::print("  relative rms error {:.3g}, Levenberg-Marquardt {} after {} steps\n", p.relative_rms_error, core::to_string(p.status),
              p.iterations);

@@ -1,6 +1,7 @@
 // `piezobench model 2dof`, `piezobench model tune` and `piezobench piezo`: the 2-DoF actuator
 // model of report section 3, its tuning to measured FRFs, and the stack sensitivities of eq. 4.1.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <fstream>
@@ -129,6 +130,7 @@ struct TuneCommand {
   bool no_refine = false;
   bool min_coherence_given = false;
   bool delay_given = false;
+  bool free_ratios = false;
   bool json = false;
   std::string units;  // --units
 };
@@ -163,6 +165,8 @@ int run_tune(const TuneCommand& c) {
   po.fmin_Hz = o.fmin_Hz;
   po.fmax_Hz = o.fmax_Hz;
   po.min_coherence = o.min_coherence;
+  po.effective_averages = frf.provenance.effective_averages;
+  if (c.free_ratios) o.stack_stiffness_ratio = o.stack_damping_ratio = 0.0;
   if (o.bench.hpf_resistance > 0.0 && o.bench.hpf_capacitance > 0.0) po.fixed_w_hpf = o.bench.hpf_corner();
   const lti::Vector omega = kTwoPi * frf.freq_Hz;
   const auto coh = [&](std::size_t i) { return i < frf.coherence.size() ? frf.coherence[i] : lti::Vector(); };
@@ -190,6 +194,9 @@ int run_tune(const TuneCommand& c) {
                 {"min_coherence", o.min_coherence},
                 {"chain", {{"delay_s", t.bench.delay}, {"hpf_corner_Hz", t.bench.hpf_corner() / kTwoPi}}},
                 {"stack_stiffness_ratio", o.stack_stiffness_ratio},
+                {"stack_damping_ratio", o.stack_damping_ratio},
+                {"uncertainty", io::to_json(t.uncertainty)},
+                {"undetermined", t.undetermined},
                 {"points", t.points},
                 {"iterations", t.iterations},
                 {"status", apa::to_string(t.status)},
@@ -213,6 +220,16 @@ int run_tune(const TuneCommand& c) {
              p.ka * 1e-6, p.ca);
   fmt::print("  ga = {:.4g} N/V, gs = {:.4g} V/um\n", p.ga, p.gs * 1e-6);
   fmt::print("{}\n", sign_note(p));
+  if (!t.uncertainty.empty()) {
+    std::string se;
+    for (const auto& name : apa::TwoDofParams::names()) {
+      if (name != "m") se += fmt::format("{}{} {:.2g} %", se.empty() ? "" : ", ", name, 100.0 * t.uncertainty.relative_standard_error_of(name));
+    }
+    fmt::print("  relative standard errors ({}): {}; condition number {:.3g}\n",
+               t.uncertainty.from_data_variance ? "from the FRF's variance" : "from the residuals' scatter", se, t.uncertainty.condition_number);
+    for (const auto& h : t.uncertainty.high_correlations) fmt::print("  correlated (> 0.95): {}\n", h);
+  }
+  if (!t.undetermined.empty()) fmt::print("  undetermined: {}\n", fmt::join(t.undetermined, ", "));
   fmt::print("{}\n{}\nquality: {}\n", t.brief_report(), t.message, core::to_string(t.quality.verdict));
   return report_quality(t.quality);
 }
@@ -288,6 +305,9 @@ void add_model_commands(CLI::App& app, Action& action) {
   tune->add_option("--min-coherence", u->options.min_coherence, "leave out frequencies with a lower coherence (default 0.5 when the file has coherence)");
   tune->add_option("--stack-ratio", u->options.stack_stiffness_ratio, "ke/ka kept during the refinement (0 = free)")
       ->capture_default_str();
+  tune->add_option("--damping-ratio", u->options.stack_damping_ratio, "ce/ca kept during the refinement (0 = free)")
+      ->capture_default_str();
+  tune->add_flag("--free-ratios", u->free_ratios, "free ke and ce (both ratios 0): parameters the data do not determine are reported undetermined");
   tune->add_option("--de-output", u->options.de_output, "name of the displacement output")->capture_default_str();
   tune->add_option("--vs-output", u->options.vs_output, "name of the force-sensor output")->capture_default_str();
   tune->add_flag("--no-refine", u->no_refine, "stop after the report's procedure (no least-squares refinement)");

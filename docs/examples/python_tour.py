@@ -72,7 +72,10 @@ checks = [
     ("fitted plant: zero pair as the truth", plant_fit.zero_is_nonminimum_phase == bool(truth.zero_is_nonminimum_phase)),
     ("fitted plant: good", plant_fit.quality.verdict == "good"),
     ("IFF damps the resonance above 10 %", locus.optimum.damping > 0.10),
-    ("tuning: good", tuning.quality.verdict == "good"),
+    # Issue 30: the dampings' standard errors exceed 5 % on this record, so they are reported
+    # undetermined and the verdict is poor; the stiffnesses and gains are determined.
+    ("tuning: stiffnesses and gains determined",
+     not set(tuning.undetermined) & {"k1", "ke", "ka", "ga", "gs"} and not tuning.quality.impossible),
     ("tuned k1 within 5 %", abs(tuning.params["k1"] / truth.model_2dof["k1"] - 1) < 0.05),
 ]
 failed = [name for name, ok in checks if not ok]

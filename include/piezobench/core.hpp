@@ -6,6 +6,7 @@
 #include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
+#include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/least_squares.hpp"

@@ -3,6 +3,7 @@
 #include "piezobench/dsp/detrend.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/dsp/window.hpp"

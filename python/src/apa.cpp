@@ -117,6 +117,8 @@ py::object tuning_result(const TwoDofTuning& r) {
   d["message"] = r.message;
   d["bench"] = two_dof_bench_dict(r.bench);
   d["quality"] = py::cast(r.quality);
+  d["uncertainty"] = r.uncertainty.empty() ? py::none() : py::cast(r.uncertainty);  // ident.ParameterUncertainty
+  d["undetermined"] = py::cast(r.undetermined);
   d["brief_report"] = r.brief_report();
   return result("TwoDofTuning", d);
 }

@@ -103,6 +103,8 @@ void bind_result_classes(py::module_& m) {
     py::class_<NmpEvidence> c(m, "NmpEvidence", "Evidence of a non-minimum-phase zero pair in u -> Vs (report section 2.3).");
     c.def_readonly("zero", &NmpEvidence::zero, "campaign.NmpZero or None")
         .def_readonly("iff_plant_fit_xz", &NmpEvidence::iff_plant_fit_xz, "xz of the IFF plant fit (< 0: non-minimum phase)")
+        .def_readonly("iff_plant_fit_xz_standard_error", &NmpEvidence::iff_plant_fit_xz_standard_error,
+                      "standard error of xz; the verdict's 95 % interval is xz +- 1.96 of it")
         .def_readonly("verdict_from", &NmpEvidence::verdict_from, "\"phase\", \"iff-plant-fit\", \"fitted-zero\" or \"none\"")
         .def_readonly("verdict_reason", &NmpEvidence::verdict_reason, "why: which evidence decided and what it said, e.g. an ambiguous phase change and the plant fit's xz");
     typed(c);

@@ -233,6 +233,7 @@ py::dict provenance_dict(const dsp::FrfProvenance& p) {
   d["detrend"] = p.detrend;
   d["averages"] = p.averages;
   d["sample_rate"] = p.sample_rate;
+  d["effective_averages"] = p.effective_averages;
   return d;
 }
 
@@ -246,9 +247,11 @@ void bind_dsp(py::module_& m) {
 
   py::class_<Frf>(m, "Frf", R"(A frequency response: one input, named outputs, a common grid (dsp/frf.hpp).
 
-H[i][k] = output i / input at freq_Hz[k]; coherence where known; provenance says how it was estimated.)")
+H[i][k] = output i / input at freq_Hz[k]; coherence where known; std_H the standard deviation of the
+random error of H's real and imaginary parts (std |H|, and std phase = std_H / |H| rad; Bendat & Piersol,
+dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
       .def(py::init([](py::object freq_Hz, py::object H, py::object outputs, const std::string& input,
-                       py::object coherence) {
+                       py::object coherence, py::object std_H) {
              const std::string src = "dsp.Frf";
              Frf f;
              f.freq_Hz = to_vector(freq_Hz, src, "freq_Hz");
@@ -267,12 +270,18 @@ H[i][k] = output i / input at freq_Hz[k]; coherence where known; provenance says
                if (c.cols() == 1 && c.rows() == f.freq_Hz.size()) c.transposeInPlace();
                for (Index i = 0; i < c.rows(); ++i) f.coherence.push_back(c.row(i).transpose());
              }
+             if (!std_H.is_none()) {
+               auto c = to_matrix(std_H, src, "std_H", true);
+               if (c.cols() == 1 && c.rows() == f.freq_Hz.size()) c.transposeInPlace();
+               for (Index i = 0; i < c.rows(); ++i) f.std_H.push_back(c.row(i).transpose());
+             }
              f.validate(src);
              return f;
            }),
            arg("freq_Hz"), arg("H"), arg("outputs") = py::none(), arg("input") = "u", arg("coherence") = py::none(),
+           arg("std_H") = py::none(),
            "freq_Hz (Hz, increasing); H: 1-D for one output or (outputs, points); outputs: names; coherence "
-           "like H (None = unknown).")
+           "and std_H like H (None = unknown).")
       .def_property_readonly("freq_Hz", [](py::object self) { return view(self.cast<const Frf&>().freq_Hz, self); }, "Hz")
       .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_Hz)); }, "rad/s")
       .def_readonly("input", &Frf::input)
@@ -283,6 +292,10 @@ H[i][k] = output i / input at freq_Hz[k]; coherence where known; provenance says
         if (f.coherence.empty()) return py::none();
         return stack(f.coherence, f.coherence.size() == 1);
       }, "like H (None when unknown)")
+      .def_property_readonly("std_H", [](const Frf& f) -> py::object {
+        if (f.std_H.empty()) return py::none();
+        return stack(f.std_H, f.std_H.size() == 1);
+      }, "standard deviation of Re H and of Im H, H's units, like H (None when unknown); 95 % band |H| +- 1.96 std_H")
       .def_property_readonly("provenance", [](const Frf& f) { return provenance_dict(f.provenance); })
       .def("response", [](const Frf& f, const std::string& name) { return to_numpy(f.H[static_cast<std::size_t>(f.output_index(name))]); },
            arg("output"), "H of the named output (InputError listing the names when unknown).")
@@ -335,6 +348,7 @@ H[i][k] = output i / input at freq_Hz[k]; coherence where known; provenance says
         d["freq_Hz"] = to_numpy(e.spectra.freq_Hz);
         d["H"] = stack(e.frf.H, single);
         d["coherence"] = stack(e.frf.coherence, single);
+        d["std_H"] = stack(e.frf.std_H, single);
         d["Suu"] = to_numpy(std::move(e.spectra.Suu));
         d["Syy"] = stack(e.spectra.Syy, single);
         d["Suy"] = stack(e.spectra.Suy, single);

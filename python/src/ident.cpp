@@ -108,7 +108,10 @@ const Options<IffPlantFitOptions>& plant_fit_options() {
         .add("min_coherence", &IffPlantFitOptions::min_coherence, "points with a known coherence below this are left out")
         .add("fit_delay", &IffPlantFitOptions::fit_delay, "False: delay fixed at 0")
         .add("fixed_w_hpf", &IffPlantFitOptions::fixed_w_hpf, "rad/s; > 0: the high-pass corner is known (1 / (R C)), not fitted")
-        .add("max_iterations", &IffPlantFitOptions::max_iterations, "Levenberg-Marquardt steps");
+        .add("max_iterations", &IffPlantFitOptions::max_iterations, "Levenberg-Marquardt steps")
+        .add("effective_averages", &IffPlantFitOptions::effective_averages,
+             "Welch's n_d of the FRF (> 0 with a coherence: points weighted by their variance, standard errors from it); "
+             "taken from an Frf's provenance when 0");
     return o;
   }();
   return t;
@@ -122,7 +125,9 @@ const Options<ActuatorPlantOptions>& actuator_plant_options() {
         .add("iff_fmin_Hz", &ActuatorPlantOptions::iff_fmin_Hz, "Hz, lowest frequency of the Vs fit")
         .add("hpf_fmax_Hz", &ActuatorPlantOptions::hpf_fmax_Hz, "Hz, points below this start the high-pass corner")
         .add("fixed_w_hpf", &ActuatorPlantOptions::fixed_w_hpf, "rad/s; > 0: the high-pass corner is known (1 / (R C_sensor))")
-        .add("min_coherence", &ActuatorPlantOptions::min_coherence, "points with a known coherence below this are left out");
+        .add("min_coherence", &ActuatorPlantOptions::min_coherence, "points with a known coherence below this are left out")
+        .add("effective_averages", &ActuatorPlantOptions::effective_averages,
+             "Welch's n_d of the FRF (weights and standard errors); taken from the Frf's provenance when 0");
     return o;
   }();
   return t;
@@ -134,6 +139,7 @@ struct PlantData {
   Vector omega;
   CVector h;
   Vector coherence;
+  double effective_averages = 0.0;  // of an Frf's provenance
 };
 PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle coherence, const std::string& source) {
   PlantData d;
@@ -143,6 +149,7 @@ PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle
     d.omega = kTwoPi * f.freq_Hz;
     d.h = f.H[i];
     if (i < f.coherence.size()) d.coherence = f.coherence[i];
+    d.effective_averages = f.provenance.effective_averages;
     return d;
   }
   d.omega = to_vector(omega_or_frf, source, "omega");
@@ -240,6 +247,20 @@ parameter and its number; advice says what to try.)");
     typed(c);
   }
   {
+    py::class_<core::ParameterUncertainty> c(m, "ParameterUncertainty", R"(A fit's parameters with their standard errors
+(core/fit_covariance.hpp): linearized at the solution, from the FRF's variance when known, else from the
+residuals' scatter. A 95 % interval is value +- 1.96 standard_error.)");
+    c.def_readonly("names", &core::ParameterUncertainty::names)
+        .def_property_readonly("value", [](const core::ParameterUncertainty& u) { return to_numpy(u.value); }, "natural units")
+        .def_property_readonly("standard_error", [](const core::ParameterUncertainty& u) { return to_numpy(u.standard_error); }, "same units")
+        .def_property_readonly("correlation", [](const core::ParameterUncertainty& u) { return to_numpy(u.correlation); })
+        .def_readonly("condition_number", &core::ParameterUncertainty::condition_number)
+        .def_readonly("chi2_per_dof", &core::ParameterUncertainty::chi2_per_dof)
+        .def_readonly("from_data_variance", &core::ParameterUncertainty::from_data_variance)
+        .def_readonly("high_correlations", &core::ParameterUncertainty::high_correlations, "\"a/b 0.97\" for |correlation| > 0.95")
+        .def("standard_error_of", &core::ParameterUncertainty::standard_error_of, arg("name"), "NaN when unknown");
+  }
+  {
     py::class_<IffPlantFit> c(m, "IffPlantFit", R"(The IFF plant of eq. 2.3 fitted to a u -> Vs FRF (ident/plant_fit.hpp):
 
   G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
@@ -264,6 +285,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         .def_property_readonly("status", [](const IffPlantFit& f) { return core::to_string(f.status); }, "Levenberg-Marquardt's stop")
         .def_readonly("quality", &IffPlantFit::quality, "ident.FitQuality")
         .def_property_readonly("zero_is_nonminimum_phase", &IffPlantFit::zero_is_nonminimum_phase, "xz < 0")
+        .def_readonly("uncertainty", &IffPlantFit::uncertainty, "ident.ParameterUncertainty of g0, wz, xz, wp, xp, w_hpf, delay")
         .def("params", [](const IffPlantFit& f) {
           py::dict d;
           d["g0"] = f.g0; d["wz"] = f.wz; d["xz"] = f.xz; d["wp"] = f.wp; d["xp"] = f.xp; d["w_hpf"] = f.w_hpf; d["delay"] = f.delay;
@@ -289,6 +311,8 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         .def_property_readonly("status", [](const DelayedSecondOrderFit& f) { return core::to_string(f.status); }, "Levenberg-Marquardt's stop")
         .def_readonly("quality", &DelayedSecondOrderFit::quality, "ident.FitQuality")
         .def_property_readonly("pole", &DelayedSecondOrderFit::pole, "rad/s, -zeta wn + j wn sqrt(1 - zeta^2)")
+        .def_readonly("uncertainty", &DelayedSecondOrderFit::uncertainty,
+                      "ident.ParameterUncertainty of static_gain, natural_frequency, damping, delay")
         .def("response", [](const DelayedSecondOrderFit& f, py::object omega) {
           return to_numpy(f.response(to_vector(omega, "DelayedSecondOrderFit.response", "omega")));
         }, arg("omega"), "H(j omega) at omega (rad/s), complex.");
@@ -301,6 +325,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         const std::string src = "ident.fit_iff_plant";
         auto o = plant_fit_options().from_kwargs(kwargs_dict(kw), src);
         auto d = plant_data(omega_or_frf, h_or_output, coherence, src);
+        if (o.effective_averages == 0.0) o.effective_averages = d.effective_averages;
         return without_gil([&] { return fit_iff_plant(d.omega, d.h, d.coherence, o, src); });
       },
       arg("omega"), arg("h"), arg("coherence") = py::none(),
@@ -315,6 +340,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         const std::string src = "ident.fit_delayed_second_order";
         auto o = plant_fit_options().from_kwargs(kwargs_dict(kw), src);
         auto d = plant_data(omega_or_frf, h_or_output, coherence, src);
+        if (o.effective_averages == 0.0) o.effective_averages = d.effective_averages;
         return without_gil([&] { return fit_delayed_second_order(d.omega, d.h, d.coherence, o, src); });
       },
       arg("omega"), arg("h"), arg("coherence") = py::none(),
@@ -333,6 +359,7 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         const auto ivs = static_cast<std::size_t>(f.output_index(vs_output));
         const auto coh = [&](std::size_t i) { return i < f.coherence.size() ? f.coherence[i] : Vector(); };
         const std::string source = f.provenance.source.empty() ? src : f.provenance.source;
+        if (o.effective_averages == 0.0) o.effective_averages = f.provenance.effective_averages;
         auto p = without_gil([&] {
           return fit_actuator_plants(kTwoPi * f.freq_Hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
         });

@@ -57,6 +57,25 @@ def test_h1_h2_coherence_equal_scipy_to_1e12():
     assert est.averages == (len(u) - nfft) // (nfft // 2) + 1
 
 
+def test_frf_std_is_bendat_piersol_with_welchs_effective_averages():
+    # Computed here from scipy's window and coherence: n_d (Welch 1967) and
+    # std_H = |H| sqrt((1 - coh) / (2 n_d coh)).
+    u, y, _, fs = _record()
+    nfft, step = 4096, 2048
+    est = dsp.frf(u, y, fs, nfft=nfft, overlap=0.5, window="hann-periodic", detrend="none")
+    w = ss.get_window("hann", nfft)
+    k = est.averages
+    rho = [np.dot(w[: nfft - j * step], w[j * step:]) / np.dot(w, w) for j in range(1, k) if j * step < nfft]
+    n_d = k / (1 + 2 * sum((1 - (j + 1) / k) * r**2 for j, r in enumerate(rho)))
+    assert est.frf.provenance["effective_averages"] == pytest.approx(n_d, rel=1e-12)
+    _, coh = ss.coherence(u, y, fs=fs, window="hann", nperseg=nfft, noverlap=step, detrend=False)
+    want = np.abs(est.H) * np.sqrt((1 - coh) / (2 * n_d * coh))
+    np.testing.assert_allclose(est.std_H, want, rtol=1e-9)
+    np.testing.assert_array_equal(est.frf.std_H, est.std_H)
+    f = dsp.Frf(est.freq_Hz, est.H, coherence=est.coherence, std_H=est.std_H)
+    np.testing.assert_array_equal(f.std_H, est.std_H)
+
+
 def test_arrays_are_read_in_place_and_results_are_numpy():
     u, y, _, fs = _record(n=8192)
     f, h = dsp.h1(u, y, fs, nfft=1024)

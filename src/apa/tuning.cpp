@@ -5,13 +5,16 @@
 #include <complex>
 #include <fmt/format.h>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/least_squares.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 
@@ -81,6 +84,9 @@ struct FitData {
   Vector omega;  // rad/s
   CVector de;    // m/V
   CVector vs;    // V/V
+  // Relative standard deviation of each point (dsp/frf_variance.hpp, floored at 1e-4) when the FRF's
+  // variance is known (coherence of both outputs and n_d); empty otherwise.
+  Vector eps_de, eps_vs;
 };
 
 // The quality verdict of a tuning (tuning.hpp).
@@ -148,8 +154,18 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
   d.de.resize(n);
   d.vs.resize(n);
   const double wc = o.bench.hpf_corner();
+  const bool variance = has_coh(ide) && has_coh(ivs) && frf.provenance.effective_averages > 0.0;
+  if (variance) {
+    d.eps_de.resize(n);
+    d.eps_vs.resize(n);
+  }
   for (Index i = 0; i < n; ++i) {
     const Index k = used[static_cast<std::size_t>(i)];
+    if (variance) {
+      const double nd = frf.provenance.effective_averages;
+      d.eps_de(i) = std::max(dsp::frf_relative_std(frf.coherence[static_cast<std::size_t>(ide)](k), nd), dsp::kMinFitRelativeStd);
+      d.eps_vs(i) = std::max(dsp::frf_relative_std(frf.coherence[static_cast<std::size_t>(ivs)](k), nd), dsp::kMinFitRelativeStd);
+    }
     const double w = kTwoPi * frf.freq_Hz(k);
     const Complex s(0.0, w);
     Complex chain = o.bench.amplifier_gain * std::exp(-s * o.bench.delay);
@@ -227,6 +243,23 @@ struct Layout {
   }
 };
 
+// The parameters' standard errors from the covariance of the log-parameters (d value / d log value
+// = value); ke and ce tied to ka and ca move with them (the same solver index, correlation 1).
+core::ParameterUncertainty tuning_uncertainty(const TwoDofParams& p, const Layout& l, const core::FitCovariance& cov, bool from_variance) {
+  const std::vector<std::string> names = TwoDofParams::names();
+  Eigen::VectorXd value(static_cast<Index>(names.size())), deriv(static_cast<Index>(names.size()));
+  std::vector<int> fitted;
+  const int ke = l.ke_ratio == 0.0 ? 6 : 2;
+  const int ce = l.ce_ratio == 0.0 ? (l.ke_ratio == 0.0 ? 7 : 6) : 3;
+  const std::map<std::string, int> index = {{"m", -1}, {"k1", 0}, {"c1", 1}, {"ka", 2}, {"ca", 3}, {"ga", 4}, {"gs", 5}, {"ke", ke}, {"ce", ce}};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    value(static_cast<Index>(i)) = p.get(names[i]);
+    deriv(static_cast<Index>(i)) = p.get(names[i]);
+    fitted.push_back(index.at(names[i]));
+  }
+  return core::parameter_uncertainty(names, value, deriv, fitted, cov, from_variance);
+}
+
 bool usable(const TwoDofParams& p) {
   for (const auto& n : TwoDofParams::names()) {
     if (!std::isfinite(p.get(n))) return false;
@@ -234,19 +267,53 @@ bool usable(const TwoDofParams& p) {
   return p.k1 > 0.0 && p.ke > 0.0 && p.ka > 0.0 && p.ca + p.ce > 0.0 && p.ga != 0.0 && p.gs != 0.0;
 }
 
-// Relative complex errors H_model / H_data - 1, [Re, Im] of d_e then of Vs, each output divided by
-// sqrt(points); NaN when the parameters are out of range.
-Vector residuals(const TwoDofParams& p, const FitData& d) {
+// Per-point weights of the relative errors of each output: 1/sqrt(points) (each output's mean), and
+// with the FRF's variance known, 1/sqrt(eps_k^2 + kFitModelRelativeError^2) normalized to the same
+// mean square (the lines of low coherence count less, the two outputs still alike).
+struct Weights {
+  Vector de, vs;
+};
+Weights weights(const FitData& d) {
+  const Index n = d.omega.size();
+  const double w = 1.0 / std::sqrt(static_cast<double>(n));
+  Weights out{Vector::Constant(n, w), Vector::Constant(n, w)};
+  if (d.eps_de.size() == n) {
+    const auto inverse = [](const Vector& eps) {
+      return eps.unaryExpr([](double e) { return 1.0 / std::hypot(e, dsp::kFitModelRelativeError); }).eval();
+    };
+    out.de = inverse(d.eps_de);
+    out.vs = inverse(d.eps_vs);
+    out.de *= w / std::sqrt(out.de.squaredNorm() / static_cast<double>(n));
+    out.vs *= w / std::sqrt(out.vs.squaredNorm() / static_cast<double>(n));
+  }
+  return out;
+}
+
+// The standard deviation of each weighted residual part (weight eps), for the covariance; empty
+// without the FRF's variance.
+Vector residual_std(const FitData& d, const Weights& w) {
+  const Index n = d.omega.size();
+  if (d.eps_de.size() != n) return {};
+  Vector s(4 * n);
+  for (Index k = 0; k < n; ++k) {
+    s(2 * k) = s(2 * k + 1) = w.de(k) * d.eps_de(k);
+    s(2 * n + 2 * k) = s(2 * n + 2 * k + 1) = w.vs(k) * d.eps_vs(k);
+  }
+  return s;
+}
+
+// Weighted relative complex errors H_model / H_data - 1, [Re, Im] of d_e then of Vs (weights());
+// NaN when the parameters are out of range.
+Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
   const Index n = d.omega.size();
   Vector r(4 * n);
   if (!usable(p)) return Vector::Constant(4 * n, std::numeric_limits<double>::quiet_NaN());
   TwoDofBench bare;
   bare.amplifier_gain = 1.0;
   const lti::CMatrix h = two_dof_response(p, bare, d.omega);
-  const double w = 1.0 / std::sqrt(static_cast<double>(n));
   for (Index k = 0; k < n; ++k) {
-    const Complex ede = (h(k, kOutputDe) / d.de(k) - 1.0) * w;
-    const Complex evs = (h(k, kOutputVs) / d.vs(k) - 1.0) * w;
+    const Complex ede = (h(k, kOutputDe) / d.de(k) - 1.0) * wt.de(k);
+    const Complex evs = (h(k, kOutputVs) / d.vs(k) - 1.0) * wt.vs(k);
     r(2 * k) = ede.real();
     r(2 * k + 1) = ede.imag();
     r(2 * n + 2 * k) = evs.real();
@@ -256,10 +323,39 @@ Vector residuals(const TwoDofParams& p, const FitData& d) {
 }
 
 std::pair<double, double> fit_errors(const TwoDofParams& p, const FitData& d) {
-  const Vector r = residuals(p, d);
   const Index n = d.omega.size();
+  const double w = 1.0 / std::sqrt(static_cast<double>(n));
+  const Vector r = residuals(p, d, Weights{Vector::Constant(n, w), Vector::Constant(n, w)});
   // The residuals carry 1/sqrt(n): their squared norm per output is already the mean.
   return {std::sqrt(r.head(2 * n).squaredNorm()), std::sqrt(r.tail(2 * n).squaredNorm())};
+}
+
+// Parameters the data do not determine (tuning.hpp): relative standard error above
+// kUndeterminedRelativeError, no standard error at all, or driven 1000 times away from the report's
+// procedure (towards 0 or infinity, i.e. to the edge of what the log-parameters can reach). The
+// verdict cannot then be good.
+void mark_undetermined(TwoDofTuning& t, const TuningOptions& o) {
+  if (t.status == TuningStatus::kNotRefined) return;
+  for (const auto& name : TwoDofParams::names()) {
+    if (name == "m") continue;
+    const double v = t.params.get(name), v0 = t.initial.get(name);
+    const double ratio = v0 != 0.0 ? std::abs(v / v0) : 1.0;
+    const double rel = t.uncertainty.empty() ? std::numeric_limits<double>::infinity() : t.uncertainty.relative_standard_error_of(name);
+    std::string why;
+    if (!(ratio > 1e-3 && ratio < 1e3)) {
+      why = fmt::format("{} = {:.3g} driven to a bound ({:.2g} times the report's procedure's {:.3g})", name, v, ratio, v0);
+    } else if (!(rel <= kUndeterminedRelativeError)) {
+      why = fmt::format("{} = {:.3g} undetermined (relative standard error {:.2g} > {:g})", name, v, rel, kUndeterminedRelativeError);
+    }
+    if (why.empty()) continue;
+    t.undetermined.push_back(name);
+    t.quality.add_problem(why);
+  }
+  if (!t.undetermined.empty()) {
+    t.quality.advise(o.stack_damping_ratio == 0.0 || o.stack_stiffness_ratio == 0.0
+                         ? "impose the stack ratios (ke/ka = ce/ca = 2, the report's) or use a band reaching the node relaxation"
+                         : "a band with more points of high coherence around the resonance and the anti-resonance");
+  }
 }
 
 }  // namespace
@@ -360,9 +456,15 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
   layout.ce_ratio = o.stack_damping_ratio;
   core::LmOptions lm;
   lm.max_iterations = o.max_iterations;
-  const core::LmResult r = core::levenberg_marquardt(
-      [&](const Vector& x) { return residuals(layout.unpack(x), d); }, layout.pack(p), lm);
+  const Weights wt = weights(d);
+  const core::ResidualFunction residual = [&](const Vector& x) { return residuals(layout.unpack(x), d, wt); };
+  const core::LmResult r = core::levenberg_marquardt(residual, layout.pack(p), lm);
   out.params = layout.unpack(r.x);
+  if (r.x.allFinite() && usable(out.params)) {
+    out.uncertainty = tuning_uncertainty(out.params, layout, core::fit_covariance(core::central_difference_jacobian(residual, r.x),
+                                                                                   residual(r.x), residual_std(d, wt)),
+                                         d.eps_de.size() > 0);
+  }
   out.iterations = r.iterations;
   std::tie(out.fit_error_de, out.fit_error_vs) = fit_errors(out.params, d);
   out.status = r.converged() ? TuningStatus::kConverged
@@ -371,6 +473,7 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
   out.message = fmt::format("Levenberg-Marquardt: {} after {} steps ({} evaluations), cost {:.4g} -> {:.4g}",
                             core::to_string(r.status), r.iterations, r.evaluations, r.initial_cost, r.cost);
   out.quality = assess(out, d);
+  mark_undetermined(out, o);
   return out;
 }
 

@@ -281,27 +281,35 @@ template <class V> void fields(V& v, NmpEvidence::Zero& s) {
   v("phase_verdict", s.phase_verdict); v("phase_change_deg", s.phase_change_deg); v("fitted_zero", s.fitted_zero);
   v("fitted_zero_nonminimum_phase", s.fitted_zero_nonminimum_phase);
 }
-template <class V> void fields(V& v, NmpEvidence& s) { v("zero", s.zero); v("iff_plant_fit_xz", s.iff_plant_fit_xz); v("verdict_from", s.verdict_from); v("verdict_reason", s.verdict_reason); }
+template <class V> void fields(V& v, NmpEvidence& s) { v("zero", s.zero); v("iff_plant_fit_xz", s.iff_plant_fit_xz);
+  v("iff_plant_fit_xz_standard_error", s.iff_plant_fit_xz_standard_error); v("verdict_from", s.verdict_from); v("verdict_reason", s.verdict_reason); }
 template <class V> void fields(V& v, HighPassCorner& s) {
   v("first_order_fit_Hz", s.first_order_fit_Hz); v("first_order_fit_points", s.first_order_fit_points); v("r_c_Hz", s.r_c_Hz);
   v("iff_plant_fit_Hz", s.iff_plant_fit_Hz); v("iff_plant_fit_error", s.iff_plant_fit_error); v("method", s.method); v("observable_above_Hz", s.observable_above_Hz); v("corner_Hz", s.corner_Hz);
 }
 template <class V> void fields(V& v, dsp::FrfProvenance& s) {
   v("source", s.source); v("estimator", s.estimator); v("window", s.window); v("nfft", s.nfft); v("overlap", s.overlap);
-  v("detrend", s.detrend); v("averages", s.averages); v("sample_rate", s.sample_rate);
+  v("detrend", s.detrend); v("averages", s.averages); v("sample_rate", s.sample_rate); v("effective_averages", s.effective_averages);
 }
 template <class V> void fields(V& v, dsp::Frf& s) {
-  v("freq_Hz", s.freq_Hz); v("input", s.input); v("outputs", s.outputs); v("H", s.H); v("coherence", s.coherence); v("provenance", s.provenance);
+  v("freq_Hz", s.freq_Hz); v("input", s.input); v("outputs", s.outputs); v("H", s.H); v("coherence", s.coherence); v("std_H", s.std_H);
+  v("provenance", s.provenance);
+}
+template <class V> void fields(V& v, core::ParameterUncertainty& s) {
+  v("names", s.names); v("value", s.value); v("standard_error", s.standard_error); v("correlation", s.correlation);
+  v("condition_number", s.condition_number); v("chi2_per_dof", s.chi2_per_dof); v("from_data_variance", s.from_data_variance);
+  v("high_correlations", s.high_correlations);
 }
 template <class V> void fields(V& v, ident::DelayedSecondOrderFit& s) {
   v("static_gain", s.static_gain); v("natural_frequency", s.natural_frequency); v("damping", s.damping); v("delay", s.delay);
   v("relative_rms_error", s.relative_rms_error); v("points", s.points); v("iterations", s.iterations); v("status", s.status); v("quality", s.quality);
+  v("uncertainty", s.uncertainty);
 }
 template <class V> void fields(V& v, ident::IffPlantFit& s) {
   v("g0", s.g0); v("wz", s.wz); v("xz", s.xz); v("wp", s.wp); v("xp", s.xp); v("w_hpf", s.w_hpf); v("delay", s.delay);
   v("relative_rms_error", s.relative_rms_error); v("weighted_relative_rms_error", s.weighted_relative_rms_error);
   v("initial_relative_rms_error", s.initial_relative_rms_error); v("points", s.points); v("iterations", s.iterations);
-  v("converged", s.converged); v("status", s.status); v("quality", s.quality);
+  v("converged", s.converged); v("status", s.status); v("quality", s.quality); v("uncertainty", s.uncertainty);
 }
 template <class V> void fields(V& v, FrfAnalysis& s) {
   v("provenance", s.provenance); v("welch", s.welch); v("fit_de", s.fit_de); v("fit_vs", s.fit_vs);
@@ -329,6 +337,7 @@ template <class V> void fields(V& v, apa::TwoDofTuning& s) {
   v("params", s.params); v("initial", s.initial); v("features", s.features); v("bench", s.bench); v("fit_error_de", s.fit_error_de);
   v("fit_error_vs", s.fit_error_vs); v("initial_fit_error_de", s.initial_fit_error_de); v("initial_fit_error_vs", s.initial_fit_error_vs);
   v("points", s.points); v("iterations", s.iterations); v("status", s.status); v("message", s.message); v("quality", s.quality);
+  v("uncertainty", s.uncertainty); v("undetermined", s.undetermined);
 }
 template <class V> void fields(V& v, Model2DofFit& s) { v("tuning", s.tuning); v("bench", s.bench); v("fmin_Hz", s.fmin_Hz); v("fmax_Hz", s.fmax_Hz); }
 template <class V> void fields(V& v, LowFrequencyVs& s) {

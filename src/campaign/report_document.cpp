@@ -1,6 +1,7 @@
 #include "piezobench/campaign/report_document.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "piezobench/apa/two_dof.hpp"
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
@@ -61,6 +63,10 @@ std::vector<Index> log_indices(const VectorXd& f, double fmin, double fmax, int 
 // degrees and, for measurements, the coherence (null where there is none).
 struct Bode {
   json f = json::array(), abs = json::array(), phase = json::array(), coh = json::array();
+  // The 95 % band of a measurement (dsp/frf_variance.hpp): |H| +- 1.96 std_H (scaled; the lower edge
+  // kept above |H| / 1000 for the log axis) and phase +- 1.96 std_H / |H| (deg, at most 180); empty
+  // when the FRF has no std_H.
+  json abs_lo = json::array(), abs_hi = json::array(), phase_lo = json::array(), phase_hi = json::array();
 };
 
 // |H|, coherence and unwrapped phase of one output at the indices `idx` (|H| times `scale`).
@@ -75,6 +81,16 @@ Bode frf_lines(const dsp::Frf& frf, Index output, const std::vector<Index>& idx,
     h.push_back(frf.H[o](k));
   }
   p.phase = unwrapped_degrees(h);
+  if (frf.std_H.size() > o) {
+    for (std::size_t i = 0; i < idx.size(); ++i) {
+      const double mag = std::abs(h[i]), s = core::kCoverage95 * frf.std_H[o](idx[i]);
+      const double dphi = mag > 0.0 ? std::min(180.0, s / mag * 180.0 / std::numbers::pi) : 180.0;
+      p.abs_lo.push_back(std::max(mag - s, 1e-3 * mag) * scale);
+      p.abs_hi.push_back((mag + s) * scale);
+      p.phase_lo.push_back(p.phase[i].get<double>() - dphi);
+      p.phase_hi.push_back(p.phase[i].get<double>() + dphi);
+    }
+  }
   return p;
 }
 
@@ -233,6 +249,13 @@ json trace(const std::string& name, const json& x, const json& y, const std::str
   return t;
 }
 
+// The shaded band between lo and hi, drawn under the unit's curve (report.js mode "band").
+json band_trace(const std::string& name, const json& f, const json& lo, const json& hi, const std::string& group) {
+  json t = trace(name + " 95 % band", f, lo, group, false, "band");
+  t["y_upper"] = hi;
+  return t;
+}
+
 json with_text(json t, json text) {
   t["text"] = std::move(text);
   return t;
@@ -294,6 +317,10 @@ json frf_figure(const std::vector<UnitCurves>& units, const std::function<const 
   for (const auto& u : units) {
     const Bode* p = measured(u);
     if (!p) continue;
+    if (!p->abs_lo.empty()) {
+      mag.push_back(band_trace(u.name(), p->f, p->abs_lo, p->abs_hi, u.name()));
+      phase.push_back(band_trace(u.name(), p->f, p->phase_lo, p->phase_hi, u.name()));
+    }
     mag.push_back(trace(u.name(), p->f, p->abs, u.name()));
     phase.push_back(trace(u.name(), p->f, p->phase, u.name()));
     if (coherence) coh.push_back(trace(u.name(), p->f, p->coh, u.name()));
@@ -352,7 +379,8 @@ json frf_section(const std::vector<UnitCurves>& units) {
   }
   return {{"id", "frf"}, {"title", "Frequency responses (report 2.3)"}, {"warnings", warnings},
           {"text", "FRFs from the DAC voltage u to the encoder d_e and to the force-sensor voltage Vs, all units "
-                   "overlaid, with the coherence."},
+                   "overlaid, with the coherence. The shaded bands are 95 % intervals of each measurement's random "
+                   "error (|H| +- 1.96 std, phase +- 1.96 std / |H|; Bendat & Piersol, docs/uncertainty.md)."},
           {"tables", tables}, {"figures", figs}};
 }
 
@@ -362,6 +390,10 @@ json nmp_section(const std::vector<UnitCurves>& units) {
   for (const auto& u : units) {
     if (!u.nmp) continue;
     const Bode& z = *u.nmp;
+    if (!z.abs_lo.empty()) {
+      mag.push_back(band_trace(u.name(), z.f, z.abs_lo, z.abs_hi, u.name()));
+      phase.push_back(band_trace(u.name(), z.f, z.phase_lo, z.phase_hi, u.name()));
+    }
     mag.push_back(trace(u.name(), z.f, z.abs, u.name(), false, "lines+markers"));
     coh.push_back(trace(u.name(), z.f, z.coh, u.name(), false, "lines+markers"));
     phase.push_back(trace(u.name(), z.f, z.phase, u.name(), false, "lines+markers"));
@@ -498,13 +530,18 @@ std::optional<json> iff_section(const std::vector<UnitCurves>& units, const IffS
   for (const auto& u : units) {
     if (!u.result->frf_analysis || !u.result->frf_analysis->iff_plant) continue;
     const ident::IffPlantFit& f = *u.result->frf_analysis->iff_plant;
-    prow.push_back({u.name(), f.g0, f.wz / kTwoPi, f.xz, f.wp / kTwoPi, f.xp, f.w_hpf / kTwoPi, f.delay * 1e6, f.relative_rms_error});
+    const double se_xz = f.uncertainty.standard_error_of("xz");
+    prow.push_back({u.name(), f.g0, f.wz / kTwoPi, f.xz, std::isfinite(se_xz) ? json(core::kCoverage95 * se_xz) : json(nullptr),
+                    f.wp / kTwoPi, f.xp, f.w_hpf / kTwoPi, f.delay * 1e6, f.relative_rms_error});
   }
   if (!prow.empty()) {
     tables.push_back(table("IFF plant (eq. 2.3) per unit",
-                           {"unit", "g0", "w_z [Hz]", "xi_z", "w_p [Hz]", "xi_p", "w_HPF [Hz]", "delay [us]", "relative rms error"}, prow,
+                           {"unit", "g0", "w_z [Hz]", "xi_z", "xi_z +- (95 %)", "w_p [Hz]", "xi_p", "w_HPF [Hz]", "delay [us]",
+                            "relative rms error"},
+                           prow,
                            "The report's hand-tuned values: g0 0.64, w_z 42.7 Hz, xi_z 0.4 %, w_p 95.2 Hz, xi_p 2 %, "
-                           "w_HPF 0.4 Hz, 200 us."));
+                           "w_HPF 0.4 Hz, 200 us. xi_z +-: half the 95 % interval; the zero is called non-minimum phase "
+                           "only when the whole interval is below 0 (docs/uncertainty.md)."));
   }
   if (s.plant && !s.failed) figs.push_back(root_locus_figure(s));
   json mag = json::array(), phase = json::array();
@@ -558,21 +595,38 @@ json model_section(const std::vector<UnitCurves>& units) {
                             "Solid: measured; dashed: the tuned 2-DoF model. Its zero is minimum phase: where the measured phase "
                             "falls by 180 deg through the anti-resonance, the model's rises by 180 deg, so on one side of it the "
                             "two curves are one turn (360 deg) apart (the same phase modulo 360 deg)."));
-  json rows = json::array();
+  json rows = json::array(), se_rows = json::array();
+  const std::vector<std::string> fitted = {"k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs"};
   for (const auto& u : units) {
     if (!u.result->model_2dof) continue;
     const apa::TwoDofTuning& t = u.result->model_2dof->tuning;
     const apa::TwoDofParams& m = t.params;
     rows.push_back({u.name(), m.m, m.k1 * 1e-6, m.c1, m.ke * 1e-6, m.ce, m.ka * 1e-6, m.ca, m.ga, m.gs * 1e-6, t.fit_error_de, t.fit_error_vs});
+    if (t.uncertainty.empty()) continue;
+    json row = json::array({u.name()});
+    for (const auto& n : fitted) row.push_back(io::to_json(100.0 * t.uncertainty.relative_standard_error_of(n)));
+    row.push_back(t.undetermined.empty() ? std::string("-") : fmt::format("{}", fmt::join(t.undetermined, ", ")));
+    row.push_back(t.uncertainty.condition_number);
+    row.push_back(t.uncertainty.high_correlations.empty() ? std::string("-") : fmt::format("{}", fmt::join(t.uncertainty.high_correlations, "; ")));
+    se_rows.push_back(row);
+  }
+  json tables = json::array({table("2-DoF parameters per unit (Table 3.1)",
+                                   {"unit", "m [kg]", "k1 [N/um]", "c1 [Ns/m]", "ke [N/um]", "ce [Ns/m]", "ka [N/um]", "ca [Ns/m]",
+                                    "ga [N/V]", "gs [V/um]", "error d_e", "error Vs"},
+                                   rows,
+                                    "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46. Signs (the report's "
+                                    "convention): ga < 0, so more voltage lowers the APA (a negative static gain u -> d_e), while "
+                                    "the sensor voltage Vs rises with it (gs > 0).")});
+  if (!se_rows.empty()) {
+    tables.push_back(table("2-DoF parameters: relative standard errors [%]",
+                           {"unit", "k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs", "undetermined", "condition number",
+                            "correlations > 0.95"},
+                           se_rows,
+                           "Linearized at the solution, from the FRF's variance (docs/uncertainty.md); ke, ce follow ka, ca "
+                           "(ratios 2 imposed). A parameter above 5 % (a 95 % interval wider than +-10 %) is undetermined."));
   }
   return {{"id", "model"}, {"title", "Two degrees-of-freedom model (report 3)"},
-          {"tables", json::array({table("2-DoF parameters per unit (Table 3.1)",
-                                        {"unit", "m [kg]", "k1 [N/um]", "c1 [Ns/m]", "ke [N/um]", "ce [Ns/m]", "ka [N/um]",
-                                         "ca [Ns/m]", "ga [N/V]", "gs [V/um]", "error d_e", "error Vs"},
-                                        rows,
-                                        "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46. Signs (the report's "
-                                        "convention): ga < 0, so more voltage lowers the APA (a negative static gain u -> d_e), while "
-                                        "the sensor voltage Vs rises with it (gs > 0).")})},
+          {"tables", tables},
           {"figures", figs}};
 }
 

@@ -188,7 +188,8 @@ json frf(const FrfAnalysis& f) {
                            {"damping", p.damping},
                            {"delay_s", p.delay},
                            {"relative_rms_error", p.relative_rms_error},
-                           {"points", p.points}};
+                           {"points", p.points},
+                           {"uncertainty", io::to_json(p.uncertainty)}};
   }
   if (f.iff_plant) {
     const auto& p = *f.iff_plant;
@@ -203,7 +204,8 @@ json frf(const FrfAnalysis& f) {
                             {"band_Hz", {f.iff_plant_fmin_Hz, f.iff_plant_fmax_Hz}},
                             {"relative_rms_error", p.relative_rms_error},
                             {"points", p.points},
-                            {"iterations", p.iterations}};
+                            {"iterations", p.iterations},
+                            {"uncertainty", io::to_json(p.uncertainty)}};
   }
   json nmp = json::object();
   if (f.nmp.zero) {
@@ -214,6 +216,7 @@ json frf(const FrfAnalysis& f) {
            {"fitted_zero_nonminimum_phase", z.fitted_zero_nonminimum_phase}};
   }
   if (f.nmp.iff_plant_fit_xz) nmp["iff_plant_fit_xz"] = *f.nmp.iff_plant_fit_xz;
+  if (f.nmp.iff_plant_fit_xz_standard_error) nmp["iff_plant_fit_xz_standard_error"] = io::to_json(*f.nmp.iff_plant_fit_xz_standard_error);
   nmp["verdict_from"] = f.nmp.verdict_from;
   nmp["verdict_reason"] = f.nmp.verdict_reason;
   out["nmp_evidence"] = nmp;
@@ -246,7 +249,10 @@ void model_2dof(const Model2DofFit& m, json& unit) {
                             {"points", t.points},
                             {"delay_s", m.bench.delay},
                             {"band_Hz", {m.fmin_Hz, m.fmax_Hz}},
-                            {"units", "SI: kg, N/m, N s/m, N/V, V/m"}};
+                            {"units", "SI: kg, N/m, N s/m, N/V, V/m"},
+                            {"quality", core::to_string(t.quality.verdict)},
+                            {"undetermined", t.undetermined},
+                            {"uncertainty", io::to_json(t.uncertainty)}};
 }
 
 json damped_plants(const std::vector<DampedPlant>& plants) {

@@ -600,6 +600,7 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   po.hpf_fmax_Hz = a.hpf_fmax_Hz;
   po.fixed_w_hpf = w_rc;
   po.min_coherence = 0.5;
+  po.effective_averages = frf.provenance.effective_averages;
   const ident::ActuatorPlants plants =
       ident::fit_actuator_plants(kTwoPi * frf.freq_Hz, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1], po, fit_source);
   for (const auto& f : plants.failures) u.failed.push_back(f);
@@ -647,6 +648,7 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
     out.iff_plant_fmax_Hz = plants.vs_options.fmax_Hz;
     out.iff_plant_w_hpf_measured = w_rc > 0.0;
     out.nmp.iff_plant_fit_xz = u.iff_plant->xz;
+    if (const double se = u.iff_plant->uncertainty.standard_error_of("xz"); std::isfinite(se)) out.nmp.iff_plant_fit_xz_standard_error = se;
     if (w_rc <= 0.0) hpf.iff_plant_fit_Hz = u.iff_plant->w_hpf / kTwoPi;
   }
   if (w_rc > 0.0) {
@@ -665,8 +667,9 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   choose_high_pass_corner(c, frf.freq_Hz.size() > 1 ? frf.freq_Hz(1) : 0.0, w_rc, hpf);
   for (auto& w : high_pass_warnings(hpf)) u.warnings.push_back(std::move(w));
 
-  // The verdict: the phase of the data when it decides unambiguously, else the sign of xz in the
-  // IFF plant fit, else the ambiguous phase, else the vector fit's zero (ident::zero_phase_verdict).
+  // The verdict: the 95 % interval of xz in the IFF plant fit (weighted by the FRF's variance):
+  // non-minimum-phase, minimum-phase or undetermined; without a plant fit, the phase of the data,
+  // else the vector fit's zero (ident::zero_phase_verdict).
   const ident::ZeroPhaseVerdict zv = ident::zero_phase_verdict(zero ? &*zero : nullptr, u.iff_plant ? &*u.iff_plant : nullptr);
   const std::optional<bool> verdict = zv.nonminimum_phase;
   out.nmp.verdict_from = zv.from;
@@ -706,8 +709,12 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   out.resonance_Hz = u.resonance_Hz;
   out.resonance_damping = res_z;
   out.antiresonance_Hz = u.antiresonance_Hz;
-  // Signed as in the truth: negative for a non-minimum-phase zero pair.
-  if (anti_z) out.antiresonance_damping = (verdict.value_or(false) ? -1.0 : 1.0) * *anti_z;
+  // Signed as in the truth: negative for a non-minimum-phase zero pair; the plant fit's own sign when
+  // the verdict is undetermined (its best estimate, whose interval contains 0).
+  if (anti_z) {
+    const double sign = verdict ? (*verdict ? -1.0 : 1.0) : (u.iff_plant && u.iff_plant->xz < 0.0 ? -1.0 : 1.0);
+    out.antiresonance_damping = sign * *anti_z;
+  }
   out.zero_is_nonminimum_phase = verdict;
   if (anti_w) out.shell_stiffness = c.bench.suspended_mass * *anti_w * *anti_w;
   // The features read two ways (results.hpp: kFeatureCrossCheckTolerance).

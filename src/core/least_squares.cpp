@@ -52,6 +52,19 @@ void LmOptions::validate() const {
   }
 }
 
+MatrixXd central_difference_jacobian(const ResidualFunction& fun, const VectorXd& x, double step) {
+  MatrixXd J;
+  for (Eigen::Index j = 0; j < x.size(); ++j) {
+    VectorXd xp = x, xm = x;
+    xp(j) += step;
+    xm(j) -= step;
+    const VectorXd d = (fun(xp) - fun(xm)) / (2.0 * step);
+    if (j == 0) J.resize(d.size(), x.size());
+    J.col(j) = d;
+  }
+  return J;
+}
+
 LmResult levenberg_marquardt(const ResidualFunction& fun, const VectorXd& x0, const LmOptions& options) {
   return levenberg_marquardt(fun, JacobianFunction(), x0, options);
 }
@@ -74,13 +87,8 @@ LmResult levenberg_marquardt(const ResidualFunction& fun, const JacobianFunction
       J = analytic(x);
       return;
     }
-    for (Eigen::Index j = 0; j < n; ++j) {
-      VectorXd xp = x, xm = x;
-      xp(j) += options.jacobian_step;
-      xm(j) -= options.jacobian_step;
-      J.col(j) = (fun(xp) - fun(xm)) / (2.0 * options.jacobian_step);
-      out.evaluations += 2;
-    }
+    J = central_difference_jacobian(fun, x, options.jacobian_step);
+    out.evaluations += 2 * static_cast<int>(n);
   };
 
   jacobian(out.x);

@@ -62,6 +62,9 @@ void Frf::validate(const std::string& source) const {
     throw InputError(src, "coherence", "none or " + std::to_string(outputs.size()) + " (one per output)",
                      std::to_string(coherence.size()));
   }
+  if (!std_H.empty() && std_H.size() != outputs.size()) {
+    throw InputError(src, "std_H", "none or " + std::to_string(outputs.size()) + " (one per output)", std::to_string(std_H.size()));
+  }
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (H[i].size() != n) {
       throw InputError(src, outputs[i], std::to_string(n) + " values (one per frequency)", std::to_string(H[i].size()));
@@ -86,6 +89,17 @@ void Frf::validate(const std::string& source) const {
         if (coherence[i](k) < 0.0 || coherence[i](k) > 1.0 + 1e-9) {
           throw InputError(src, outputs[i] + " coherence", "values in [0, 1]",
                            format_value(coherence[i](k)) + " at " + format_value(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
+        }
+      }
+    }
+    if (!std_H.empty()) {
+      if (std_H[i].size() != n) {
+        throw InputError(src, outputs[i] + " std", std::to_string(n) + " values (one per frequency)", std::to_string(std_H[i].size()));
+      }
+      for (Index k = 0; k < n; ++k) {
+        if (!std::isfinite(std_H[i](k)) || std_H[i](k) < 0.0) {
+          throw InputError(src, outputs[i] + " std", "finite values >= 0",
+                           format_value(std_H[i](k)) + " at " + format_value(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
         }
       }
     }
@@ -170,6 +184,7 @@ Frf select_band(const Frf& frf, const BandSelection& selection) {
     band.outputs.push_back(frf.outputs[ui]);
     band.H.emplace_back(frf.H[ui](keep));
     if (const Eigen::VectorXd* c = known_coherence(i)) band.coherence.emplace_back((*c)(keep));
+    if (!frf.std_H.empty()) band.std_H.emplace_back(frf.std_H[ui](keep));
   }
   return band;
 }

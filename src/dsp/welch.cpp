@@ -1,5 +1,7 @@
 #include "piezobench/dsp/welch.hpp"
 
+#include "piezobench/dsp/frf_variance.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cassert>
@@ -352,8 +354,14 @@ Frf frf_from_spectra(const CrossSpectra& spectra, FrfEstimator estimator, const 
       // H2 = Syy / Syu, Syu = conj(Suy): for y = H u both equal H.
       for (Index k = 0; k < h.size(); ++k) h(k) = suy(k) != 0.0 ? syy(k) / std::conj(suy(k)) : Complex(nan, nan);
     }
-    frf.H.push_back(std::move(h));
     frf.coherence.push_back(coherence(spectra, static_cast<Index>(o)));
+    frf.H.push_back(std::move(h));
+  }
+  frf.provenance.effective_averages = effective_averages(spectra.window, spectra.nfft, spectra.noverlap, spectra.averages);
+  // A NaN line (zero denominator) keeps a NaN std: validate() rejects the FRF there as for H.
+  for (std::size_t o = 0; o < frf.H.size(); ++o) {
+    frf.std_H.push_back(frf_standard_deviation(frf.H[o], frf.coherence[o].unaryExpr([](double c) { return std::isfinite(c) ? c : 0.0; }),
+                                               frf.provenance.effective_averages));
   }
   frf.provenance.source = source;
   frf.provenance.estimator = to_string(estimator);

@@ -14,6 +14,8 @@
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/core/fit_covariance.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
 
 namespace piezobench::ident {
@@ -35,6 +37,9 @@ void IffPlantFitOptions::validate() const {
   }
   if (!(min_coherence >= 0.0 && min_coherence < 1.0)) throw InputError(src, "min_coherence", "a value in [0, 1)", fmt::format("{}", min_coherence));
   if (max_iterations < 1) throw InputError(src, "max_iterations", "at least 1", std::to_string(max_iterations));
+  if (!(std::isfinite(effective_averages) && effective_averages >= 0.0)) {
+    throw InputError(src, "effective_averages", "0 (unknown) or Welch's n_d > 0", fmt::format("{}", effective_averages));
+  }
 }
 
 namespace {
@@ -59,9 +64,9 @@ std::optional<double> delay_from_phase(const std::vector<double>& omega, const s
   return std::clamp(-sxy / sxx, 0.0, 0.1);
 }
 
-// Points of the band with finite data and enough coherence.
+// Points of the band with finite data and enough coherence (c: their coherence, empty when unknown).
 void select_band(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
-                 const std::string& source, Vector& w, CVector& d) {
+                 const std::string& source, Vector& w, CVector& d, Vector& c) {
   if (omega.size() != h.size()) {
     throw InputError(source, "H", fmt::format("{} values (one per frequency)", omega.size()), std::to_string(h.size()));
   }
@@ -81,10 +86,46 @@ void select_band(const Vector& omega, const CVector& h, const Vector& coherence,
   }
   w.resize(static_cast<Index>(use.size()));
   d.resize(static_cast<Index>(use.size()));
+  c.resize(coherence.size() > 0 ? static_cast<Index>(use.size()) : 0);
   for (std::size_t i = 0; i < use.size(); ++i) {
     w(static_cast<Index>(i)) = omega(use[i]);
     d(static_cast<Index>(i)) = h(use[i]);
+    if (c.size() > 0) c(static_cast<Index>(i)) = coherence(use[i]);
   }
+}
+
+// Weights of the relative residual G/H_k - 1 of both fits. Every decade counts alike: on a uniform
+// grid the weight is 1/sqrt(omega), otherwise the mass line above the resonance, which holds most
+// of the points, would decide the fit. With the FRF's variance known (coherence and n_d), each point
+// is further divided by sqrt(eps_k^2 + kFitModelRelativeError^2), eps_k its relative standard
+// deviation (dsp/frf_variance.hpp): a line where the coherence drops (the anti-resonance) counts
+// little. residual_std is then the standard deviation of each weighted residual part's random error
+// (weight_k eps_k), for the sandwich covariance; else empty.
+struct PointWeights {
+  Vector weight, residual_std;
+};
+PointWeights point_weights(const Vector& w, const Vector& c, double effective_averages) {
+  PointWeights p;
+  p.weight.resize(w.size());
+  for (Index k = 0; k < w.size(); ++k) p.weight(k) = 1.0 / std::sqrt(w(k));
+  const bool known = c.size() == w.size() && effective_averages > 0.0;
+  if (known) {
+    p.residual_std.resize(2 * w.size());
+    for (Index k = 0; k < w.size(); ++k) {
+      const double eps = std::max(dsp::frf_relative_std(c(k), effective_averages), dsp::kMinFitRelativeStd);
+      p.weight(k) /= std::hypot(eps, dsp::kFitModelRelativeError);
+      p.residual_std(2 * k) = p.residual_std(2 * k + 1) = p.weight(k) * eps;
+    }
+  }
+  const double norm = std::sqrt(p.weight.squaredNorm() / static_cast<double>(w.size()));
+  p.weight /= norm;
+  if (known) p.residual_std /= norm;
+  return p;
+}
+
+// The covariance of the solver's parameters at its solution x (core/fit_covariance.hpp).
+core::FitCovariance covariance_at(const core::ResidualFunction& residual, const Eigen::VectorXd& x, const Vector& residual_std) {
+  return core::fit_covariance(core::central_difference_jacobian(residual, x), residual(x), residual_std);
 }
 
 Complex model(const IffPlantFit& p, double w) { return control::iff_plant_response(p, w); }
@@ -153,6 +194,29 @@ CVector IffPlantFit::response(const Vector& omega) const { return control::iff_p
 ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit* plant, double ambiguity_deg) {
   ZeroPhaseVerdict v;
   const auto kind = [](bool nmp) { return std::string(nmp ? "non-minimum-phase" : "minimum-phase"); };
+  if (plant) {
+    v.xz = plant->xz;
+    v.xz_standard_error = plant->uncertainty.standard_error_of("xz");
+  }
+  // The plant fit's interval xz +- kVerdictCoverage se decides when it has one: the sign only when
+  // the whole interval has it, else undetermined (the noise at the dip hides the sign).
+  if (plant && std::isfinite(v.xz_standard_error)) {
+    const double half = kVerdictCoverage * v.xz_standard_error;
+    const double lo = v.xz - half, hi = v.xz + half;
+    v.from = "iff-plant-fit";
+    const std::string interval = fmt::format("plant fit zero xz = {:.3g}, standard error {:.2g} (99.7 %: [{:.3g}, {:.3g}])", v.xz,
+                                             v.xz_standard_error, lo, hi);
+    if (hi < 0.0 || lo > 0.0) {
+      v.nonminimum_phase = hi < 0.0;
+      v.reason = interval + ": " + kind(*v.nonminimum_phase);
+    } else {
+      v.reason = interval + " contains 0: undetermined";
+    }
+    if (zero && zero->phase_verdict != PhaseVerdict::kUndetermined) {
+      v.reason += fmt::format("; phase change {:.1f} deg", zero->phase_change_deg);
+    }
+    return v;
+  }
   std::string phase;  // what the phase says, for the reason
   bool ambiguous = false;
   if (zero) {
@@ -193,9 +257,9 @@ ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit
 IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
                           const std::string& source) {
   options.validate();
-  Vector w;
+  Vector w, c;
   CVector d;
-  select_band(omega, h, coherence, options, source, w, d);
+  select_band(omega, h, coherence, options, source, w, d, c);
   if (w.size() < 12) throw InputError(source, "H", "at least 12 usable points in the band", std::to_string(w.size()));
   // Starting values.
   const double w_hpf_band = kTwoPi * options.hpf_fmax_Hz;
@@ -292,12 +356,8 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   if (start.g0 == 0.0) start.g0 = 1.0;
   const double sign = start.g0 > 0.0 ? 1.0 : -1.0;
 
-  // Every decade counts alike: on a uniform frequency grid the weight of a point is 1/sqrt(omega)
-  // (normalized to a mean square of 1), otherwise the mass line above the resonance, which holds
-  // most of the points, would decide the fit.
-  Vector weight(w.size());
-  for (Index k = 0; k < w.size(); ++k) weight(k) = 1.0 / std::sqrt(w(k));
-  weight /= std::sqrt(weight.squaredNorm() / static_cast<double>(w.size()));
+  const PointWeights pw = point_weights(w, c, options.effective_averages);
+  const Vector& weight = pw.weight;
   const auto residual = [&](const Eigen::VectorXd& x) {
     const IffPlantFit p = from_x(x, sign, layout, options.fixed_w_hpf);
     Eigen::VectorXd r(2 * w.size());
@@ -335,6 +395,16 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   fit.iterations = best.iterations;
   fit.converged = best.converged();
   fit.status = best.status;
+  {
+    const core::FitCovariance cov = covariance_at(residual, best.x, pw.residual_std);
+    // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
+    const int hpf = layout.hpf ? 5 : -1, delay = layout.delay ? (layout.hpf ? 6 : 5) : -1;
+    Eigen::VectorXd value(7), deriv(7);
+    value << fit.g0, fit.wz, fit.xz, fit.wp, fit.xp, fit.w_hpf, fit.delay;
+    deriv << fit.g0, fit.wz, kXzScale, fit.wp, fit.xp, layout.hpf ? fit.w_hpf : 0.0, layout.delay ? kDelayScale : 0.0;
+    fit.uncertainty = core::parameter_uncertainty({"g0", "wz", "xz", "wp", "xp", "w_hpf", "delay"}, value, deriv,
+                                                  {0, 1, 2, 3, 4, hpf, delay}, cov, pw.residual_std.size() > 0);
+  }
   fit.quality.check_error("u -> Vs (IFF plant, eq. 2.3)", fit.relative_rms_error);
   check_in_band(fit.quality, "anti-resonance wz", fit.wz, w);
   check_in_band(fit.quality, "resonance wp", fit.wp, w);
@@ -369,9 +439,9 @@ CVector DelayedSecondOrderFit::response(const Vector& omega) const {
 DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVector& h, const Vector& coherence,
                                                const IffPlantFitOptions& options, const std::string& source) {
   options.validate();
-  Vector w;
+  Vector w, c;
   CVector d;
-  select_band(omega, h, coherence, options, source, w, d);
+  select_band(omega, h, coherence, options, source, w, d, c);
   if (w.size() < 8) throw InputError(source, "H", "at least 8 usable points in the band", std::to_string(w.size()));
   Index peak = 0;
   for (Index k = 1; k < w.size(); ++k) {
@@ -414,9 +484,8 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
     }
   }
   const double sign = start.static_gain >= 0.0 ? 1.0 : -1.0;
-  Vector weight(w.size());
-  for (Index k = 0; k < w.size(); ++k) weight(k) = 1.0 / std::sqrt(w(k));
-  weight /= std::sqrt(weight.squaredNorm() / static_cast<double>(w.size()));
+  const PointWeights pw = point_weights(w, c, options.effective_averages);
+  const Vector& weight = pw.weight;
   const auto unpack = [&](const Eigen::VectorXd& x) {
     DelayedSecondOrderFit p;
     p.static_gain = sign * std::exp(x(0));
@@ -454,6 +523,14 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   fit.points = w.size();
   fit.iterations = o.iterations;
   fit.status = o.status;
+  {
+    const core::FitCovariance cov = covariance_at(residual, o.x, pw.residual_std);
+    Eigen::VectorXd value(4), deriv(4);
+    value << fit.static_gain, fit.natural_frequency, fit.damping, fit.delay;
+    deriv << fit.static_gain, fit.natural_frequency, fit.damping, options.fit_delay ? kDelayScale : 0.0;
+    fit.uncertainty = core::parameter_uncertainty({"static_gain", "natural_frequency", "damping", "delay"}, value, deriv,
+                                                  {0, 1, 2, options.fit_delay ? 3 : -1}, cov, pw.residual_std.size() > 0);
+  }
   fit.quality.check_error("second-order fit", fit.relative_rms_error);
   check_in_band(fit.quality, "natural frequency", fit.natural_frequency, w);
   check_lm(fit.quality, o.status);
@@ -472,6 +549,9 @@ void ActuatorPlantOptions::validate() const {
   }
   if (!(std::isfinite(hpf_fmax_Hz) && hpf_fmax_Hz > 0.0)) throw InputError(src, "hpf_fmax_Hz", "a frequency > 0 Hz", fmt::format("{}", hpf_fmax_Hz));
   if (!(min_coherence >= 0.0 && min_coherence < 1.0)) throw InputError(src, "min_coherence", "a value in [0, 1)", fmt::format("{}", min_coherence));
+  if (!(std::isfinite(effective_averages) && effective_averages >= 0.0)) {
+    throw InputError(src, "effective_averages", "0 (unknown) or Welch's n_d > 0", fmt::format("{}", effective_averages));
+  }
 }
 
 ActuatorPlants fit_actuator_plants(const Vector& omega, const CVector& h_de, const Vector& coh_de, const CVector& h_vs,
@@ -481,6 +561,8 @@ ActuatorPlants fit_actuator_plants(const Vector& omega, const CVector& h_de, con
   out.de_options.fmin_Hz = options.fmin_Hz;
   out.de_options.fmax_Hz = options.fmax_Hz;
   out.de_options.min_coherence = options.min_coherence;
+  out.de_options.effective_averages = options.effective_averages;
+  out.vs_options.effective_averages = options.effective_averages;
   out.vs_options.fmin_Hz = options.iff_fmin_Hz;
   out.vs_options.fmax_Hz = options.fmax_Hz;
   out.vs_options.hpf_fmax_Hz = options.hpf_fmax_Hz;

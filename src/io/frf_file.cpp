@@ -114,6 +114,7 @@ FrfFile to_si(detail::StatedFrf stated, const FrfReadOptions& options, const std
     }
     const Unit u = unit_from_string(unit, source, "unit of H_" + name);
     if (u.to_si != 1.0) stated.frf.H[i] *= u.to_si;
+    if (u.to_si != 1.0 && i < stated.frf.std_H.size()) stated.frf.std_H[i] *= u.to_si;  // std in H's unit
     out.units.push_back(u.si_symbol.empty() ? "1" : u.si_symbol);
   }
   out.frf = std::move(stated.frf);
@@ -160,6 +161,7 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
     }
   }
   const bool coh = !frf.coherence.empty();
+  const bool sd = !frf.std_H.empty();
   write_atomically(file, [&](std::ostream& out) {
     std::string line = "freq_Hz";
     for (size_t i = 0; i < frf.outputs.size(); ++i) {
@@ -168,6 +170,7 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
       const std::string suffix = unit.empty() ? std::string() : " [" + unit + "]";
       line += ",re_" + name + suffix + ",im_" + name + suffix;
       if (coh) line += ",coh_" + name;
+      if (sd) line += ",std_" + name + suffix;
     }
     out << line << '\n';
     for (Index k = 0; k < frf.freq_Hz.size(); ++k) {
@@ -176,6 +179,7 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
         line += ',' + format_number(frf.H[i](k).real(), 17);
         line += ',' + format_number(frf.H[i](k).imag(), 17);
         if (coh) line += ',' + format_number(frf.coherence[i](k), 17);
+        if (sd) line += ',' + format_number(frf.std_H[i](k), 17);
       }
       out << line << '\n';
       if (!out) return;
@@ -201,11 +205,11 @@ detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& opt
   } else {
     throw InputError(source, "header column 1", "freq_Hz (or freq [Hz], freq [kHz])", quote(columns[0].name));
   }
-  enum class Part { kRe, kIm, kCoh };
+  enum class Part { kRe, kIm, kCoh, kStd };
   dsp::Frf frf;
   std::vector<std::string> stated_units;  // per output, as written
   std::vector<int> target(columns.size(), -1);
-  std::map<std::string, std::array<int, 3>> seen;  // output -> column index of re, im, coh
+  std::map<std::string, std::array<int, 4>> seen;  // output -> column index of re, im, coh, std
   target[0] = 0;
   for (size_t c = 1; c < columns.size(); ++c) {
     const std::string& cell = columns[c].name;
@@ -221,16 +225,19 @@ detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& opt
     } else if (cell.rfind("coh_", 0) == 0) {
       part = Part::kCoh;
       name = cell.substr(4);
+    } else if (cell.rfind("std_", 0) == 0) {
+      part = Part::kStd;
+      name = cell.substr(4);
     } else {
-      throw InputError(source, where, "re_NAME, im_NAME or coh_NAME", quote(cell));
+      throw InputError(source, where, "re_NAME, im_NAME, coh_NAME or std_NAME", quote(cell));
     }
     if (name.empty()) throw InputError(source, where, "a channel name after the prefix", quote(cell));
-    auto [it, inserted] = seen.try_emplace(name, std::array<int, 3>{-1, -1, -1});
+    auto [it, inserted] = seen.try_emplace(name, std::array<int, 4>{-1, -1, -1, -1});
     if (inserted) {
       frf.outputs.push_back(name);
       stated_units.emplace_back();
     }
-    // The unit of H on re_ and im_ (`re_de [um/V]`): the same on both; coherence has none.
+    // The unit of H on re_, im_ and std_ (`re_de [um/V]`): the same on all; coherence has none.
     const std::string& unit = columns[c].unit;
     std::string& stated = stated_units[static_cast<size_t>(std::find(frf.outputs.begin(), frf.outputs.end(), name) - frf.outputs.begin())];
     if (part == Part::kCoh) {
@@ -245,9 +252,10 @@ detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& opt
     slot = static_cast<int>(c);
   }
   if (frf.outputs.empty()) throw InputError(source, "header", "at least one output (re_NAME,im_NAME)", "only freq_Hz");
-  size_t with_coh = 0;
+  size_t with_coh = 0, with_std = 0;
   for (const std::string& name : frf.outputs) {
     const auto& slots = seen[name];
+    if (slots[3] >= 0) ++with_std;
     if (slots[0] < 0) throw InputError(source, "header", "a column re_" + name, "im_" + name + " or coh_" + name + " without it");
     if (slots[1] < 0) throw InputError(source, "header", "a column im_" + name, "re_" + name + " without it");
     if (slots[2] >= 0) ++with_coh;
@@ -256,11 +264,17 @@ detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& opt
     throw InputError(source, "header", "coh_NAME columns for every output or for none",
                      std::to_string(with_coh) + " of " + std::to_string(frf.outputs.size()));
   }
-  // Table columns: freq, then re, im (and coh) per output in output order.
-  const int per_output = with_coh != 0 ? 3 : 2;
+  if (with_std != 0 && with_std != frf.outputs.size()) {
+    throw InputError(source, "header", "std_NAME columns for every output or for none",
+                     std::to_string(with_std) + " of " + std::to_string(frf.outputs.size()));
+  }
+  // Table columns: freq, then re, im, coh, std per output in output order (the absent ones unread).
+  const int per_output = 4;
   for (size_t i = 0; i < frf.outputs.size(); ++i) {
     const auto& slots = seen[frf.outputs[i]];
-    for (int p = 0; p < per_output; ++p) target[static_cast<size_t>(slots[static_cast<size_t>(p)])] = 1 + static_cast<int>(i) * per_output + p;
+    for (int p = 0; p < per_output; ++p) {
+      if (slots[static_cast<size_t>(p)] >= 0) target[static_cast<size_t>(slots[static_cast<size_t>(p)])] = 1 + static_cast<int>(i) * per_output + p;
+    }
   }
   const Eigen::MatrixXd data = table.read(target, 1 + static_cast<Index>(frf.outputs.size()) * per_output);
   frf.freq_Hz = data.col(0) * freq_factor;
@@ -271,6 +285,7 @@ detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& opt
     h.imag() = data.col(base + 1);
     frf.H.push_back(std::move(h));
     if (with_coh != 0) frf.coherence.emplace_back(data.col(base + 2));
+    if (with_std != 0) frf.std_H.emplace_back(data.col(base + 3));
   }
   frf.provenance.source = source;
   return {std::move(frf), std::move(stated_units)};
@@ -292,6 +307,7 @@ std::vector<std::pair<std::string, detail::MatValue>> provenance_fields(const ds
   f.emplace_back("detrend", detail::make_text("detrend", p.detrend));
   f.emplace_back("averages", detail::make_scalar("averages", static_cast<double>(p.averages)));
   f.emplace_back("sample_rate_Hz", detail::make_scalar("sample_rate_Hz", p.sample_rate));
+  f.emplace_back("effective_averages", detail::make_scalar("effective_averages", p.effective_averages));
   return f;
 }
 }  // namespace
@@ -311,6 +327,7 @@ void write_frf_mat(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
     for (size_t i = 0; i < frf.outputs.size(); ++i) {
       w.write(detail::make_complex_column("H_" + frf.outputs[i], frf.H[i]));
       if (!frf.coherence.empty()) w.write(detail::make_real_column("coh_" + frf.outputs[i], frf.coherence[i]));
+      if (!frf.std_H.empty()) w.write(detail::make_real_column("std_" + frf.outputs[i], frf.std_H[i]));
     }
     w.write(detail::make_struct("provenance", provenance_fields(frf.provenance)));
     std::vector<std::pair<std::string, detail::MatValue>> units;
@@ -347,8 +364,9 @@ detail::StatedFrf stated_frf_mat(const fs::path& file) {
     }
   }
   if (frf.outputs.empty()) throw InputError(source, "H_<name>", "at least one FRF variable", "none (variables: " + text::join(names) + ")");
-  size_t with_coh = 0;
+  size_t with_coh = 0, with_std = 0;
   for (const std::string& o : frf.outputs) {
+    if (has("std_" + o)) ++with_std;
     const std::string hname = "H_" + o;
     if (!has(hname)) throw InputError(source, hname, "the FRF of output " + o + " (listed in outputs)", "no such variable");
     frf.H.push_back(detail::to_complex_vector(detail::read_mat_variable(mat.get(), file, hname), source, hname));
@@ -362,6 +380,13 @@ detail::StatedFrf stated_frf_mat(const fs::path& file) {
     for (const std::string& o : frf.outputs) {
       frf.coherence.push_back(detail::to_real_vector(detail::read_mat_variable(mat.get(), file, "coh_" + o), source, "coh_" + o));
     }
+  }
+  if (with_std != 0 && with_std != frf.outputs.size()) {
+    throw InputError(source, "std_<name>", "a standard deviation for every output or for none",
+                     std::to_string(with_std) + " of " + std::to_string(frf.outputs.size()));
+  }
+  for (size_t i = 0; i < frf.outputs.size() && with_std != 0; ++i) {
+    frf.std_H.push_back(detail::to_real_vector(detail::read_mat_variable(mat.get(), file, "std_" + frf.outputs[i]), source, "std_" + frf.outputs[i]));
   }
   if (has("provenance")) {
     const detail::MatValue p = detail::read_mat_variable(mat.get(), file, "provenance");
@@ -387,6 +412,7 @@ detail::StatedFrf stated_frf_mat(const fs::path& file) {
       frf.provenance.overlap = number("overlap");
       frf.provenance.averages = static_cast<Index>(number("averages"));
       frf.provenance.sample_rate = number("sample_rate_Hz");
+      frf.provenance.effective_averages = number("effective_averages");
     }
   }
   if (frf.provenance.source.empty()) frf.provenance.source = source;

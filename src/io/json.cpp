@@ -42,4 +42,17 @@ nlohmann::json to_json(const Eigen::MatrixXd& values) {
   return out;
 }
 
+nlohmann::json to_json(const core::ParameterUncertainty& u) {
+  if (u.empty()) return nullptr;
+  nlohmann::json se = nlohmann::json::object();
+  for (std::size_t i = 0; i < u.names.size(); ++i) se[u.names[i]] = to_json(u.standard_error(static_cast<Eigen::Index>(i)));
+  return {{"names", u.names},
+          {"standard_errors", se},
+          {"correlation", to_json(u.correlation)},
+          {"high_correlations", u.high_correlations},
+          {"condition_number", to_json(u.condition_number)},
+          {"chi2_per_dof", to_json(u.chi2_per_dof)},
+          {"from", u.from_data_variance ? "frf variance" : "residual scatter"}};
+}
+
 }  // namespace piezobench::io

@@ -17,6 +17,7 @@
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
 #include "io/uff58.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/io/units.hpp"
 
 namespace piezobench::io {
@@ -706,6 +707,9 @@ StatedFrf read_uff58_frf(const fs::path& file) {
   if (all) {
     for (const std::string& o : frf.outputs) frf.coherence.emplace_back(coherence[o]->y.real());
   }
+  // UFF 58 has no function type for a standard deviation: it follows from the coherence and the
+  // Welch settings of ID line 5 (dsp/frf_variance.hpp), when both are there.
+  frf.std_H = dsp::std_from_coherence(frf);
   frf.provenance.source = source;
   stated.frf = std::move(frf);
   return stated;

@@ -288,7 +288,7 @@ bool all_strings(const json& values) {
 }
 
 json read_trace(const json& t, const std::string& at, std::optional<bool>& category_x) {
-  require_object(t, at, {"name", "x", "y", "mode", "dash", "group", "text"});
+  require_object(t, at, {"name", "x", "y", "y_upper", "mode", "dash", "group", "text"});
   json out = json::object();
   out["name"] = required_string(t, "name", at);
   const json& x = required_array(t, "x", at);
@@ -311,10 +311,18 @@ json read_trace(const json& t, const std::string& at, std::optional<bool>& categ
   }
   out["y"] = numeric_series(y, child(at, "y"));
   const std::string mode = optional_string(t, "mode", at).value_or("lines");
-  if (mode != "lines" && mode != "markers" && mode != "lines+markers" && mode != "bars") {
-    fail(child(at, "mode"), "\"lines\", \"markers\", \"lines+markers\" or \"bars\"", describe(t.at("mode")));
+  if (mode != "lines" && mode != "markers" && mode != "lines+markers" && mode != "bars" && mode != "band") {
+    fail(child(at, "mode"), "\"lines\", \"markers\", \"lines+markers\", \"bars\" or \"band\"", describe(t.at("mode")));
   }
   out["mode"] = mode;
+  // A band is drawn between y (lower edge) and y_upper, which only a band has.
+  if (mode == "band") {
+    const json& upper = required_array(t, "y_upper", at);
+    if (upper.size() != x.size()) fail(child(at, "y_upper"), std::to_string(x.size()) + " values (as many as x)", std::to_string(upper.size()) + " values");
+    out["y_upper"] = numeric_series(upper, child(at, "y_upper"));
+  } else if (t.contains("y_upper")) {
+    fail(child(at, "y_upper"), "no y_upper (only a trace of mode \"band\" has one)", describe(t.at("y_upper")));
+  }
   out["dash"] = optional_bool(t, "dash", at);
   if (auto group = optional_string(t, "group", at)) out["group"] = *group;
   if (const auto text = t.find("text"); text != t.end() && !text->is_null()) {

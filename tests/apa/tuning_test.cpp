@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -82,6 +84,7 @@ TEST(Tuning, NoiseFreeDataComeBackExactly) {
   const TwoDofParams p = truth();
   const dsp::Frf frf = make_frf(p, TwoDofBench{}, lti::logspace(0.0, std::log10(2000.0), 600), 0.0, 1);
   TuningOptions o;
+  o.stack_damping_ratio = 0.0;  // the truth's ce / ca is 3
   const TwoDofTuning t = tune_two_dof(frf, o);
   EXPECT_EQ(t.status, TuningStatus::kConverged) << t.message;
   expect_params(t.params, p, 1e-6, 1e-5);
@@ -102,7 +105,9 @@ TEST(Tuning, OnePercentNoiseMeetsTheAcceptance) {
   for (unsigned seed : {11U, 12U, 13U}) {
     SCOPED_TRACE(seed);
     const dsp::Frf frf = make_frf(p, TwoDofBench{}, lti::logspace(0.0, std::log10(2000.0), 600), 0.01, seed);
-    const TwoDofTuning t = tune_two_dof(frf);
+    TuningOptions o;
+    o.stack_damping_ratio = 0.0;  // the truth's ce / ca is 3
+    const TwoDofTuning t = tune_two_dof(frf, o);
     EXPECT_EQ(t.status, TuningStatus::kConverged) << t.message;
     expect_params(t.params, p, kStiffnessAndGain, kStackDamping);
     // The fit error is the noise: E|n| = 1 % rms.
@@ -124,6 +129,7 @@ TEST(Tuning, WelchLikeLinearGridWithTheBenchAroundIt) {
   const dsp::Frf frf = make_frf(p, b, f, 0.01, 7);
   TuningOptions o;
   o.bench = b;
+  o.stack_damping_ratio = 0.0;  // the truth's ce / ca is 3
   const TwoDofTuning t = tune_two_dof(frf, o);
   EXPECT_EQ(t.status, TuningStatus::kConverged) << t.message;
   EXPECT_EQ(t.points, 2000);
@@ -159,9 +165,52 @@ TEST(Tuning, FreeStiffnessRatio) {
   const dsp::Frf frf = make_frf(p, TwoDofBench{}, lti::logspace(0.0, std::log10(5000.0), 800), 0.0, 1);
   TuningOptions o;
   o.stack_stiffness_ratio = 0.0;
+  o.stack_damping_ratio = 0.0;
   const TwoDofTuning t = tune_two_dof(frf, o);
   EXPECT_EQ(t.status, TuningStatus::kConverged) << t.message;
   expect_params(t.params, p, 1e-4, 1e-3);
+}
+
+// Issue 30's held-out check: an actuator with other mass, stiffnesses and dampings than the report's
+// (and than truth()), ke / ka = ce / ca = 2, 1 % complex noise whose variance the FRF carries
+// (coherence 1 / (1 + 2 n_d eps^2) with n_d = 40). Every tuned parameter is within 10 % of the truth
+// or reported undetermined, by default and with the ratios freed; a parameter outside its 95 %
+// interval by more than a factor 3 is never called good; the standard errors are there.
+TEST(Tuning, HeldOutActuatorWithinTenPercentOrUndetermined) {
+  TwoDofParams p;
+  p.m = 3.2;
+  p.k1 = 0.9e6;
+  p.c1 = 25.0;
+  p.ka = 6.0e6;
+  p.ke = 12.0e6;
+  p.ca = 65.0;
+  p.ce = 130.0;
+  p.ga = -4.2;
+  p.gs = 0.3e6;
+  const double noise = 0.01, n_d = 40.0;
+  for (const bool free : {false, true}) {
+    for (unsigned seed : {21U, 22U, 23U}) {
+      SCOPED_TRACE(::testing::Message() << (free ? "ratios free" : "ratios 2") << ", seed " << seed);
+      dsp::Frf frf = make_frf(p, TwoDofBench{}, lti::Vector::LinSpaced(2000, 1.0, 2000.0), noise, seed);
+      const double eps = noise / std::sqrt(2.0);
+      frf.coherence.assign(2, Eigen::VectorXd::Constant(frf.freq_Hz.size(), 1.0 / (1.0 + 2.0 * n_d * eps * eps)));
+      frf.provenance.effective_averages = n_d;
+      TuningOptions o;
+      o.mass = p.m;  // known, as on the bench (the suspended mass)
+      if (free) o.stack_stiffness_ratio = o.stack_damping_ratio = 0.0;
+      const TwoDofTuning t = tune_two_dof(frf, o);
+      ASSERT_FALSE(t.uncertainty.empty());
+      EXPECT_TRUE(t.uncertainty.from_data_variance);
+      for (const auto& name : TwoDofParams::names()) {
+        if (name == "m") continue;
+        const bool undetermined = std::find(t.undetermined.begin(), t.undetermined.end(), name) != t.undetermined.end();
+        const double got = t.params.get(name), want = p.get(name), se = t.uncertainty.standard_error_of(name);
+        if (!undetermined) EXPECT_TRUE(near(got, want, 0.10)) << name << " = " << got << " +- " << se << ", truth " << want;
+        if (!t.quality.poor()) EXPECT_LE(std::abs(got - want), 3.0 * 1.96 * se) << name;
+      }
+      if (!t.undetermined.empty()) EXPECT_TRUE(t.quality.poor()) << t.quality.summary();
+    }
+  }
 }
 
 TEST(Tuning, BadInput) {
@@ -233,7 +282,15 @@ TEST(Tuning, MeasuredProcedureOnAScipyWelchFrf) {
   for (const char* key : {"k1", "ke", "ka", "ga", "gs"}) {
     EXPECT_TRUE(test::near(t.params.get(key), truth[key].get<double>(), 0.03)) << key;
   }
-  EXPECT_FALSE(t.quality.poor()) << t.quality.summary();
+  // The shell's damping c1 (5 N s/m against the stacks' 150) does not show in this FRF: the refinement
+  // drives it towards 0, and it is reported undetermined (so the verdict is poor) rather than printed
+  // as a value; every other parameter is within 10 % or undetermined too.
+  for (const auto& key : TwoDofParams::names()) {
+    const bool undetermined = std::find(t.undetermined.begin(), t.undetermined.end(), key) != t.undetermined.end();
+    if (!undetermined) EXPECT_TRUE(test::near(t.params.get(key), truth[key].get<double>(), 0.10)) << key;
+  }
+  EXPECT_EQ(t.undetermined, std::vector<std::string>{"c1"});
+  EXPECT_TRUE(t.quality.poor()) << t.quality.summary();
   EXPECT_NEAR(t.bench.delay, truth["effective_delay_s"].get<double>(), 0.05 * truth["effective_delay_s"].get<double>());
   EXPECT_NEAR(t.bench.hpf_corner() / (2.0 * std::numbers::pi), 0.39, 0.04);
 }

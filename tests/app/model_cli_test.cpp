@@ -148,16 +148,21 @@ TEST(ModelCli, TuneRecoversTheParameters) {
   const double k1 = 0.42e6, ke = 5.6e6, ka = 2.8e6, ce = 90.0, ca = 55.0, ga = -2.9, gs = 0.5e6;
   const std::string f = test::write_text_file(dir, "frf.csv", frf_csv(k1, ke, ka, ce, ca, ga, gs, 0.01));
   const Outcome r = run_cli("model tune --frf " + f + " --mass 5.7 --json");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const auto& p = j["model_2dof"];
   for (const char* key : {"m", "k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs"}) ASSERT_TRUE(p.contains(key)) << key;
   // Issue 4: stiffnesses and gains within 2 %. With `run`'s procedure (issue 12: the delays from
   // the plant fits, the IFF plant's delay also absorbing the node relaxation that eq. 2.3 lacks)
-  // the stack dampings ce, ca are not recovered on these chain-free data (ce goes to ~0, ca ~75);
-  // the fit stays within the noise's reach.
+  // the dampings are not recovered on these chain-free data (ce / ca = 1.6, not the imposed 2):
+  // issue 30 reports them undetermined, and the verdict is then poor (exit 6), never a confident
+  // wrong value.
   (void)ce;
   (void)ca;
+  for (const auto& name : j["undetermined"]) {
+    EXPECT_TRUE(name == "c1" || name == "ce" || name == "ca") << name;
+  }
+  EXPECT_EQ(r.exit_code, j["undetermined"].empty() ? 0 : 6) << r.err;
+  EXPECT_TRUE(j["uncertainty"].contains("standard_errors"));
   EXPECT_TRUE(near(p["k1"].get<double>(), k1, 0.02));
   EXPECT_TRUE(near(p["ke"].get<double>(), ke, 0.02));
   EXPECT_TRUE(near(p["ka"].get<double>(), ka, 0.02));
@@ -167,16 +172,17 @@ TEST(ModelCli, TuneRecoversTheParameters) {
   EXPECT_LT(j["fit_error"]["de"].get<double>(), 0.03);
   EXPECT_LT(j["fit_error"]["Vs"].get<double>(), 0.03);
   EXPECT_EQ(j["status"].get<std::string>(), "converged");
-  EXPECT_EQ(j["quality"], "good");
+  EXPECT_EQ(j["quality"], j["undetermined"].empty() ? "good" : "poor");
 
   // The amplifier gain scales ga: data through 20 V/V read as 10 V/V give twice the force per volt.
   const Outcome half = run_cli("model tune --frf " + f + " --amplifier-gain 10 --json");
-  ASSERT_EQ(half.exit_code, 0) << half.err;
+  ASSERT_NE(half.exit_code, 3) << half.err;
   EXPECT_TRUE(near(nlohmann::json::parse(half.out)["model_2dof"]["ga"].get<double>(), 2.0 * ga, 0.02));
 
   const Outcome text = run_cli("model tune --frf " + f);
-  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_EQ(text.exit_code, r.exit_code) << text.err;
   EXPECT_NE(text.out.find("converged"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("relative standard errors"), std::string::npos) << text.out;
 }
 
 // Issue 33: an FRF in um/V (stated in the header, or given by --units) gives the same ga as in
@@ -237,13 +243,16 @@ TEST(ModelCli, TuneOnAScipyWelchFrfWithOnlyTheMass) {
   const std::string f = test::fixture_path("ident/two_dof_welch_frf.csv").string();
   const auto truth = nlohmann::json::parse(test::read_text(test::fixture_path("ident/two_dof_welch_truth.json")));
   const Outcome r = run_cli("model tune --frf " + f + " --mass 5.7 --json");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const auto& p = j["model_2dof"];
   for (const char* key : {"k1", "ke", "ka", "ga", "gs"}) {
     EXPECT_TRUE(near(p[key].get<double>(), truth[key].get<double>(), 0.03)) << key << " " << p[key] << " vs " << truth[key];
   }
-  EXPECT_EQ(j["quality"], "good");
+  // The shell's damping c1 does not show in this FRF: the refinement drives it towards 0, and it is
+  // reported undetermined (issue 30), so the verdict is poor and the exit code 6.
+  EXPECT_EQ(j["undetermined"], nlohmann::json::array({"c1"}));
+  EXPECT_EQ(j["quality"], "poor");
+  EXPECT_EQ(r.exit_code, 6) << r.err;
   EXPECT_TRUE(near(j["chain"]["delay_s"].get<double>(), truth["effective_delay_s"].get<double>(), 0.05));
   EXPECT_TRUE(near(j["chain"]["hpf_corner_Hz"].get<double>(), 0.39, 0.1));
 }

@@ -83,11 +83,16 @@ stiffness = "s.mat"
   EXPECT_EQ((*spread)["columns"][0], "quantity");
   EXPECT_EQ((*spread)["rows"][0][0], "capacitance of the sensor stack [uF]");
   EXPECT_FALSE(test::contains((*spread).dump(), "_uF")) << (*spread).dump();
-  // The frequency responses overlay the measurement (solid) and the model (dashed) of unit 1.
+  // The frequency responses overlay the measurement's 95 % band (issue 30), the measurement (solid)
+  // and the model (dashed) of unit 1.
   const json& frf_de = doc["sections"][0]["figures"][0];
-  ASSERT_GE(frf_de["panels"][0]["traces"].size(), 2u);
-  EXPECT_FALSE(frf_de["panels"][0]["traces"][0]["dash"].get<bool>());
-  EXPECT_TRUE(frf_de["panels"][0]["traces"][1]["dash"].get<bool>());
+  ASSERT_GE(frf_de["panels"][0]["traces"].size(), 3u);
+  const json& band = frf_de["panels"][0]["traces"][0];
+  EXPECT_EQ(band["mode"], "band");
+  ASSERT_EQ(band["y_upper"].size(), band["y"].size());
+  for (std::size_t k = 0; k < band["y"].size(); ++k) EXPECT_LE(band["y"][k].get<double>(), band["y_upper"][k].get<double>());
+  EXPECT_FALSE(frf_de["panels"][0]["traces"][1]["dash"].get<bool>());
+  EXPECT_TRUE(frf_de["panels"][0]["traces"][2]["dash"].get<bool>());
   EXPECT_EQ(frf_de["panels"].size(), 3u);  // magnitude, phase, coherence
   // The report module accepts the document, and names are escaped.
   const std::string html = report::render_html(doc);

@@ -134,7 +134,9 @@ TEST(UnitAnalysis, EveryAnalysisOnKnownRecords) {
   EXPECT_TRUE(near(*u.static_gain, truth.static_gain_de, 1e-2));
   ASSERT_TRUE(u.frf_analysis);
   const FrfAnalysis& frf = *u.frf_analysis;
-  EXPECT_EQ(frf.zero_is_nonminimum_phase, true);
+  // Issue 30: non-minimum phase, or undetermined when the plant fit's 95 % interval of xz contains 0
+  // (eq. 2.3's misfit widens it); never minimum phase.
+  EXPECT_NE(frf.zero_is_nonminimum_phase, std::optional<bool>(false));
   ASSERT_TRUE(frf.nmp.zero);
   EXPECT_EQ(frf.nmp.zero->phase_verdict, ident::PhaseVerdict::kNonMinimumPhase);
   EXPECT_TRUE(near(*frf.antiresonance_damping, -zero.real() / std::abs(zero), 0.2));

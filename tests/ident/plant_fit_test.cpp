@@ -5,9 +5,13 @@
 #include <cmath>
 #include <random>
 
+#include <unsupported/Eigen/FFT>
+
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/welch.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "test_util.hpp"
@@ -103,12 +107,88 @@ TEST(ZeroPhaseVerdict, AmbiguousPhaseChangeIsDecidedByThePlantFit) {
       o.fixed_w_hpf = p.w_hpf;
       const IffPlantFit fit = fit_iff_plant(w_all, h, Vector(), o);
       const ZeroPhaseVerdict v = zero_phase_verdict(zero, &fit);
-      ASSERT_TRUE(v.nonminimum_phase.has_value());
+      ASSERT_TRUE(v.nonminimum_phase.has_value()) << "xz " << xz << " seed " << seed << ": " << v.reason;
       EXPECT_EQ(*v.nonminimum_phase, xz < 0.0) << "xz " << xz << " seed " << seed << ": " << v.reason;
       EXPECT_EQ(v.from, "iff-plant-fit") << v.reason;
-      EXPECT_NE(v.reason.find("ambiguous (within 20 deg of +-180 deg); plant fit zero xz = "), std::string::npos) << v.reason;
+      EXPECT_NE(v.reason.find("plant fit zero xz = "), std::string::npos) << v.reason;
+      EXPECT_NE(v.reason.find("; phase change "), std::string::npos) << v.reason;
     }
   }
+}
+
+// u filtered by the continuous response G(j omega) exactly, as a circular convolution over the
+// record (the FFT of u times G at each bin, conjugate for the negative frequencies): a stationary
+// record whose FRF is G itself (a zero-order-hold simulation would not do: the feedthrough of a
+// proper plant skips the half-sample lag of the rest and fills a lightly damped dip).
+Eigen::VectorXd filtered(const Eigen::VectorXd& u, double fs, const IffPlantFit& g) {
+  const auto n = static_cast<Eigen::Index>(u.size());
+  Eigen::FFT<double> fft;
+  std::vector<double> in(u.data(), u.data() + n), out;
+  std::vector<std::complex<double>> spectrum;
+  fft.fwd(spectrum, in);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Eigen::Index m = k <= n / 2 ? k : n - k;
+    const std::complex<double> h = m == 0 ? std::complex<double>(0.0) : g.response(Vector::Constant(1, kTwoPi * fs * static_cast<double>(m) / static_cast<double>(n)))(0);
+    spectrum[static_cast<std::size_t>(k)] *= k <= n / 2 ? h : std::conj(h);
+  }
+  fft.inv(out, spectrum);
+  return Eigen::Map<const Eigen::VectorXd>(out.data(), n);
+}
+
+// A held-out plant (not the report's: anti-resonance 61 Hz, resonance 133 Hz, xp 0.03, corner 0.8 Hz,
+// delay 200 us) with a truly mirrored (xz = -0.006) or truly minimum-phase (+0.006) zero pair, its
+// dip (0.7 Hz wide) narrower than a line: white noise u through the plant (60 s at 2 kHz), Gaussian
+// noise on the output of 0.1 % to 2 % of its rms, H1 by Welch with 1 Hz lines, and the plant fit
+// weighted by the FRF's variance. The verdict from the 95 % interval of xz is never the wrong one;
+// at 0.1 % it is always given; a zero 12 times lighter
+// (xz = -+0.0005) is hidden by 2 % noise: undetermined.
+TEST(ZeroPhaseVerdict, HeldOutPlantsNeverTheWrongVerdictAtAnyNoise) {
+  const double fs = 2e3;
+  int decided_low = 0, cases_low = 0, undetermined_high = 0;
+  for (const double xz : {-0.006, 0.006, -0.0005, 0.0005}) {
+    IffPlantFit p;
+    p.g0 = 0.4;
+    p.wz = kTwoPi * 61.0;
+    p.xz = xz;
+    p.wp = kTwoPi * 133.0;
+    p.xp = 0.03;
+    p.w_hpf = kTwoPi * 0.8;
+    p.delay = 200e-6;
+    for (const double noise : {0.001, 0.003, 0.01, 0.02}) {
+      for (const unsigned seed : {1u, 2u, 3u}) {
+        std::mt19937_64 rng(seed);
+        std::normal_distribution<double> n01;
+        const Eigen::Index n = static_cast<Eigen::Index>(60.0 * fs);
+        Eigen::VectorXd u(n);
+        for (Eigen::Index i = 0; i < n; ++i) u(i) = n01(rng);
+        Eigen::VectorXd y = filtered(u, fs, p);
+        const double rms = std::sqrt(y.squaredNorm() / static_cast<double>(n));
+        for (Eigen::Index i = 0; i < n; ++i) y(i) += noise * rms * n01(rng);
+        dsp::WelchOptions wo;
+        wo.nfft = 2000;
+        wo.threads = 1;
+        const dsp::Frf frf = dsp::estimate_frf(dsp::channel("u", u), {dsp::channel("Vs", y)}, fs, wo).frf;
+        IffPlantFitOptions o;
+        o.fmin_Hz = 20.0;
+        o.fmax_Hz = 300.0;
+        o.fixed_w_hpf = p.w_hpf;
+        o.effective_averages = frf.provenance.effective_averages;
+        const IffPlantFit fit = fit_iff_plant(kTwoPi * frf.freq_Hz, frf.H[0], frf.coherence[0], o);
+        EXPECT_TRUE(fit.uncertainty.from_data_variance);
+        const ZeroPhaseVerdict v = zero_phase_verdict(nullptr, &fit);
+        const std::string what = fmt::format("xz {} noise {} seed {}: {}", xz, noise, seed, v.reason);
+        EXPECT_EQ(v.from, "iff-plant-fit") << what;
+        if (v.nonminimum_phase) EXPECT_EQ(*v.nonminimum_phase, xz < 0.0) << what;
+        if (noise == 0.001 && std::abs(xz) > 0.001) {
+          ++cases_low;
+          decided_low += v.nonminimum_phase ? 1 : 0;
+        }
+        if (noise == 0.02 && std::abs(xz) < 0.001 && !v.nonminimum_phase) ++undetermined_high;
+      }
+    }
+  }
+  EXPECT_EQ(decided_low, cases_low);
+  EXPECT_GT(undetermined_high, 0);
 }
 
 TEST(ZeroPhaseVerdict, ClearPhaseDecidesAndMissingEvidenceFallsBack) {

@@ -15,6 +15,7 @@
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::io {
@@ -170,6 +171,35 @@ TEST(FrfMat, V5AndV73RoundTripsAreExactWithProvenance) {
     EXPECT_EQ(back.provenance.averages, 119);
     EXPECT_EQ(back.provenance.sample_rate, 10000.0);
   }
+}
+
+// std_H (dsp/frf_variance.hpp) goes through CSV and .mat exactly and is recomputed from the
+// coherence and ID line 5 for UFF 58, which has no function type for it.
+TEST(FrfFiles, StandardDeviationRoundTrips) {
+  TempDir dir;
+  dsp::Frf frf = sample_frf(even_grid());
+  frf.provenance.effective_averages = dsp::effective_averages(dsp::WindowType::kHannPeriodic, 10000, 5000, 119);
+  for (size_t i = 0; i < frf.H.size(); ++i) {
+    frf.std_H.push_back(dsp::frf_standard_deviation(frf.H[i], frf.coherence[i], frf.provenance.effective_averages));
+  }
+  write_frf(frf, dir.path() / "frf.csv");
+  const std::string text = test::read_text(dir.path() / "frf.csv");
+  EXPECT_EQ(text.substr(0, text.find('\n')), "freq_Hz,re_de,im_de,coh_de,std_de,re_Vs,im_Vs,coh_Vs,std_Vs");
+  write_frf(frf, dir.path() / "frf.mat");
+  write_frf(frf, dir.path() / "frf.uff");
+  for (const char* name : {"frf.csv", "frf.mat", "frf.uff"}) {
+    SCOPED_TRACE(name);
+    const dsp::Frf back = read_frf(dir.path() / name);
+    ASSERT_EQ(back.std_H.size(), 2u);
+    // UFF: H to 13 digits and the coherence to 13 digits, so std_H to ~1e-11 relative.
+    const Tolerance tol = std::string(name) == "frf.uff" ? Tolerance{1e-10, 0.0} : kExact;
+    for (size_t i = 0; i < 2; ++i) EXPECT_TRUE(all_near(back.std_H[i], frf.std_H[i], tol)) << frf.outputs[i];
+    // CSV keeps no provenance; .mat stores n_d, UFF recomputes it from ID line 5.
+    if (std::string(name) != "frf.csv") EXPECT_NEAR(back.provenance.effective_averages, frf.provenance.effective_averages, 1e-9);
+  }
+  // A CSV with std_ for one output of two is refused.
+  write_bytes(dir.path() / "half.csv", "freq_Hz,re_a,im_a,std_a,re_b,im_b\n1,1,0,0.1,2,0\n");
+  (void)input_error([&] { (void)read_frf(dir.path() / "half.csv"); }, "header");
 }
 
 TEST(FrfMat, MissingAndWrongVariablesAreNamed) {

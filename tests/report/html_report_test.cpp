@@ -308,6 +308,17 @@ TEST(HtmlReport, BadDocumentsAreInputErrorsNamingTheField) {
        fig0 + ".panels[1].traces[0].color"},
       {"trace without name", [&](json& d) { d["sections"][0]["figures"][0]["panels"][1]["traces"][6].erase("name"); },
        fig0 + ".panels[1].traces[6].name"},
+      {"y_upper on a line", [&](json& d) { d["sections"][0]["figures"][0]["panels"][1]["traces"][2]["y_upper"] = json::array(); },
+       fig0 + ".panels[1].traces[2].y_upper"},
+      {"band without y_upper", [&](json& d) { d["sections"][0]["figures"][0]["panels"][1]["traces"][2]["mode"] = "band"; },
+       fig0 + ".panels[1].traces[2].y_upper"},
+      {"band y_upper short", [&](json& d) {
+         json& t = d["sections"][0]["figures"][0]["panels"][1]["traces"][2];
+         t["mode"] = "band";
+         t["y_upper"] = t["y"];
+         t["y_upper"].erase(0);
+       },
+       fig0 + ".panels[1].traces[2].y_upper"},
       {"y shorter than x", [&](json& d) { d["sections"][0]["figures"][0]["panels"][1]["traces"][2]["y"].erase(0); },
        fig0 + ".panels[1].traces[2].y"},
       {"y an object", [&](json& d) { d["sections"][0]["figures"][0]["panels"][1]["traces"][2]["y"] = json::object(); },

@@ -154,6 +154,7 @@ struct NmpEvidence {
   };
   std::optional<Zero> zero;              // the vector fit's zero nearest the dip
   std::optional<double> iff_plant_fit_xz;
+  std::optional<double> iff_plant_fit_xz_standard_error;  // the verdict's 95 % interval is xz +- 1.96 of it
   std::string verdict_from;              // "phase", "iff-plant-fit", "fitted-zero" or "none"
   std::string verdict_reason;            // why (ident::ZeroPhaseVerdict::reason)
 };

@@ -53,6 +53,9 @@ using ResidualFunction = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
 // J(x), rows as r(x), one column per parameter.
 using JacobianFunction = std::function<Eigen::MatrixXd(const Eigen::VectorXd&)>;
 LmResult levenberg_marquardt(const ResidualFunction& r, const Eigen::VectorXd& x0, const LmOptions& options = {});
+// J(x) by central differences with the absolute step `step` in every x (what the solver uses
+// without an analytic Jacobian; 2 size(x) evaluations of r).
+Eigen::MatrixXd central_difference_jacobian(const ResidualFunction& r, const Eigen::VectorXd& x, double step = 1e-6);
 // The same with an analytic Jacobian.
 LmResult levenberg_marquardt(const ResidualFunction& r, const JacobianFunction& jacobian, const Eigen::VectorXd& x0,
                              const LmOptions& options = {});

@@ -20,6 +20,7 @@ struct FrfProvenance {
   std::string detrend;       // "none", "mean", "linear"
   Eigen::Index averages = 0; // number of segments averaged
   double sample_rate = 0.0;  // Hz
+  double effective_averages = 0.0;  // Welch's independent averages n_d (dsp/frf_variance.hpp); 0 = unknown
 };
 
 struct Frf {
@@ -28,12 +29,17 @@ struct Frf {
   std::vector<std::string> outputs;        // output channel names
   std::vector<Eigen::VectorXcd> H;         // H[i](k): output i / input at freq_Hz(k)
   std::vector<Eigen::VectorXd> coherence;  // same layout as H, in [0, 1]; empty (no vector at all) = unknown
+  // Standard deviation of the random error of H, same layout, in H's units: each of the error's real
+  // and imaginary parts (a circular complex Gaussian, dsp/frf_variance.hpp), i.e. std |H| and, divided
+  // by |H|, std of the phase in rad. Empty (no vector at all) = unknown; 0 for a computed response.
+  std::vector<Eigen::VectorXd> std_H;
   FrfProvenance provenance;
 
   // Index of the named output; throws InputError (field "output", expected one of the names).
   [[nodiscard]] Eigen::Index output_index(const std::string& name) const;
   // Throws InputError for inconsistent sizes, non-finite values, a non-increasing grid, a negative
-  // frequency or a coherence outside [0, 1] (1e-9 of round-off admitted).
+  // frequency, a coherence outside [0, 1] (1e-9 of round-off admitted) or a std_H that is negative or
+  // not finite.
   void validate(const std::string& source = "") const;
 };
 
@@ -53,7 +59,7 @@ struct Frf {
                          const std::vector<std::string>& output_names, Eigen::Index input = 0);
 
 // The part of an FRF a fit or a summary uses: the lines with fmin_Hz <= f <= fmax_Hz, of the
-// outputs listed, with their coherence (if known). A line is dropped where the coherence of a kept
+// outputs listed, with their coherence and std_H (if known). A line is dropped where the coherence of a kept
 // output is below min_coherence. The result has no line when none qualifies (the caller decides whether
 // that is an error); InputError for an output index out of range.
 struct BandSelection {

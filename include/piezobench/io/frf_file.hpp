@@ -4,20 +4,23 @@
 // exchange FRFs with piezobench.
 //
 // Layouts
-//  CSV   header `freq_Hz,re_NAME,im_NAME,coh_NAME` repeated per output (CLI.md), values %.17g, so
-//        a round trip is exact. On read, coh_ columns are optional, lines starting with '#' and
+//  CSV   header `freq_Hz,re_NAME,im_NAME,coh_NAME,std_NAME` repeated per output (CLI.md; std_ is
+//        dsp::Frf::std_H, in the units of H), values %.17g, so a round trip is exact. On read, coh_
+//        and std_ columns are optional (each for every output or none), lines starting with '#' and
 //        blank lines are ignored, the first column may also be `freq [Hz]` or `freq [kHz]`, and
 //        the dialect (delimiter, decimal comma) is detected as for time series; the input name is
 //        not stored (read back as "").
-//  .mat  `freq_Hz` (column, Hz), per output `H_<name>` (complex column) and `coh_<name>` (when the
-//        coherence is known), `input` and `outputs` (char rows; outputs comma-separated, keeps the
+//  .mat  `freq_Hz` (column, Hz), per output `H_<name>` (complex column), `coh_<name>` (when the
+//        coherence is known) and `std_<name>` (std_H, when known), `input` and `outputs` (char rows; outputs comma-separated, keeps the
 //        order) and `provenance` (struct). Exact round trip. Names must be MATLAB identifiers.
 //  .uff  (also .unv, .uf) one dataset 58 per output: function type 4 (FRF), ordinate type 6
 //        (complex double, 4E20.12 i.e. 13 significant digits), abscissa in Hz (specific data
 //        type 18), evenly spaced (record 7 holds min and increment, E13.5) when the grid is
 //        uniform to 1e-9 relative, else unevenly spaced (E13.5 abscissa per point). So a round trip
 //        keeps H to ~5e-13 relative and the frequencies to 6 significant digits (the format's).
-//        Coherence, when known, follows as a dataset 58 of function type 6 (real double). Node and
+//        Coherence, when known, follows as a dataset 58 of function type 6 (real double). The format
+//        has no function type for a standard deviation: on read, std_H is recomputed from the
+//        coherence and the Welch settings of ID line 5 (dsp::std_from_coherence), else unknown. Node and
 //        direction: response node k+1 for output k, reference node `reference_node`, direction +Z
 //        (3) for both. Channel names go in ID line 2 ("piezobench response: NAME"), ID line 4
 //        ("piezobench reference: NAME") and the ordinate / denominator axis labels; ID line 5

@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "piezobench/core/fit_covariance.hpp"
+
 namespace piezobench::io {
 
 nlohmann::json to_json(double value);
@@ -18,5 +20,9 @@ nlohmann::json to_json(const Eigen::VectorXcd& values);
 nlohmann::json to_json(const std::vector<double>& values);
 // A matrix as a list of rows.
 nlohmann::json to_json(const Eigen::MatrixXd& values);
+// A fit's standard errors as results.json and --json print them: {"standard_errors": {name: se},
+// "correlation": rows in the order of "names", "high_correlations": ["a/b 0.97"], "condition_number",
+// "chi2_per_dof", "from": "frf variance" | "residual scatter"}; null when empty.
+nlohmann::json to_json(const core::ParameterUncertainty& u);
 
 }  // namespace piezobench::io

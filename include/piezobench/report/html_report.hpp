@@ -34,7 +34,9 @@
 //     "-inf" that io::to_json writes (all three are drawn as gaps). An x made only of strings is a
 //     category axis (unit names for batch comparisons); every trace of that figure then has one
 //     and "x_log" must be false.
-//   - "mode" may also be "bars" (a bar per x, bars of one x side by side).
+//   - "mode" may also be "bars" (a bar per x, bars of one x side by side), or "band": a shaded area
+//     between y (lower edge) and "y_upper" (upper edge, as many values; only a band has it), drawn
+//     under the group's curves without a legend entry of its own (the 95 % bands of the FRFs).
 //   - Additions: section "id" ([a-z0-9-], unique, default "section-N"), figure "text" (a caption),
 //     section "warnings" (a list of strings, shown highlighted above everything else of the
 //     section), section "tables" (before the figures): [{ "title", "text" (optional caption),

@@ -76,17 +76,29 @@
       panel.traces.forEach(function (t, j) {
         const key = t.group !== undefined ? 'group:' + t.group : 'trace:' + fig.id + ':' + i + ':' + j;
         const c = colour(t.group !== undefined ? t.group : t.name);
+        const band = t.mode === 'band';
         const trace = {
           name: text(t.group !== undefined ? t.group : t.name),
           legendgroup: key,
-          showlegend: !shown.has(key),
+          showlegend: !band && !shown.has(key),
           x: t.x, y: t.y,
           xaxis: 'x', yaxis: axisName('y', i),
           hovertemplate: text(t.name) + '<br>' + (t.text ? '%{text}<br>' : '') + '%{x}, %{y}<extra></extra>',
         };
         if (t.text) trace.text = t.text.map(function (s) { return s === null ? '' : text(s); });
-        shown.add(key);
-        if (t.mode === 'bars') {
+        if (!band) shown.add(key);
+        if (band) {
+          // A 95 % band: the polygon lower edge then upper edge reversed, filled, under the curve.
+          trace.type = 'scatter';
+          trace.mode = 'lines';
+          trace.x = t.x.concat(t.x.slice().reverse());
+          trace.y = t.y.concat(t.y_upper.slice().reverse());
+          trace.fill = 'toself';
+          trace.fillcolor = c;
+          trace.opacity = 0.18;
+          trace.line = { color: c, width: 0 };
+          trace.hoverinfo = 'skip';
+        } else if (t.mode === 'bars') {
           trace.type = 'bar';
           trace.marker = { color: c };
           trace.opacity = t.dash ? 0.55 : 1;

@@ -1,0 +1,62 @@
+#pragma once
+// The random error of a Welch FRF estimate (J. S. Bendat, A. G. Piersol, "Random data: analysis and
+// measurement procedures", 4th ed., 2010, ch. 9, random errors of gain and phase factor estimates;
+// "Engineering applications of correlation and spectral analysis", 2nd ed., 1993, ch. 9): with gamma^2
+// the coherence and n_d the number of independent averages,
+//
+//   normalized random error of |H|:   eps = std(|H_est|) / |H| = sqrt((1 - gamma^2) / (2 n_d gamma^2))
+//   standard deviation of the phase:  std(phase) = eps  (radians)
+//
+// i.e. the error H_est - H is a circular complex Gaussian whose real and imaginary parts each have
+// the standard deviation |H| eps (along H it moves the magnitude, across H the phase). That per-part
+// standard deviation, in H's units, is what dsp::Frf::std_H holds. The first-order formulas hold for
+// eps below ~0.2 (B&P); the estimated coherence is used for gamma^2 (biased up for n_d < ~10).
+//
+// Overlapping windowed segments are not independent: n_d is the effective number of averages of
+// Welch's method (P. D. Welch, IEEE Trans. Audio Electroacoust. 15(2), 1967, eq. 13-14):
+//
+//   n_d = K / (1 + 2 sum_{j=1}^{K-1} (1 - j/K) rho(j)^2),  rho(j) = sum_n w(n) w(n + j D) / sum_n w(n)^2
+//
+// for K segments of the window w shifted by D = nfft - noverlap samples (hann at 50 %: rho(1) = 1/6,
+// n_d = K / 1.056 for large K; rectangular without overlap: n_d = K).
+#include <Eigen/Dense>
+
+#include <vector>
+
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/window.hpp"
+
+namespace piezobench::dsp {
+
+// Welch's effective number of independent averages (above). InputError (source "welch") for
+// nfft < 2, noverlap outside [0, nfft) or segments < 1.
+[[nodiscard]] double effective_averages(WindowType window, Eigen::Index nfft, Eigen::Index noverlap, Eigen::Index segments);
+
+// eps(gamma^2, n_d) above. The coherence is clamped to [1e-12, 1] (a zero coherence gives a large
+// but finite error); n_d must be > 0 (else InputError).
+[[nodiscard]] double frf_relative_std(double coherence, double effective_averages);
+
+// The smallest relative standard deviation a fit assumes for a line: below it (a coherence of
+// nearly 1) the spectra's round-off and quantization, not the random error, limit the estimate, and
+// a coherence of exactly 1 would give an infinite chi^2.
+inline constexpr double kMinFitRelativeStd = 1e-4;
+// The relative error of the models the fits use (eq. 2.3, the 2-DoF model) against a real bench:
+// the IFF plant fit's rms misfit on the virtual bench is ~5 %. The fits weight a line by
+// 1 / sqrt(eps^2 + kFitModelRelativeError^2): a line whose random error exceeds the model's (the
+// anti-resonance, low coherence) counts less, while the well-measured lines keep equal weights (a
+// pure 1/eps weighting lets the model's misfit where eps is smallest decide the fit).
+inline constexpr double kFitModelRelativeError = 0.05;
+
+// std_H (per part, H's units) at each line: |H(k)| frf_relative_std(coherence(k), n_d). Sizes must
+// agree (InputError).
+[[nodiscard]] Eigen::VectorXd frf_standard_deviation(const Eigen::VectorXcd& H, const Eigen::VectorXd& coherence,
+                                                     double effective_averages);
+
+// std_H of an FRF read from a file that keeps the coherence and the Welch provenance (window, nfft,
+// overlap, averages) but not the standard deviation (UFF 58 has no function type for it): n_d from
+// the provenance (stored in provenance.effective_averages when it was 0), then frf_standard_deviation
+// per output. Empty (and the FRF unchanged) when the coherence or a provenance field is missing or
+// unknown.
+[[nodiscard]] std::vector<Eigen::VectorXd> std_from_coherence(Frf& frf);
+
+}  // namespace piezobench::dsp

@@ -1,0 +1,142 @@
+#include "piezobench/core/fit_covariance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "piezobench/core/error.hpp"
+
+namespace piezobench::core {
+
+using Eigen::Index;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+FitCovariance fit_covariance(const MatrixXd& J, const VectorXd& r, const VectorXd& residual_std) {
+  const Index m = J.rows(), p = J.cols();
+  if (m <= p || p < 1) throw InputError("fit covariance", "Jacobian", "more residuals than parameters (>= 1)", std::to_string(m) + " x " + std::to_string(p));
+  if (r.size() != m) throw InputError("fit covariance", "residuals", std::to_string(m) + " values", std::to_string(r.size()));
+  if (residual_std.size() != 0 && residual_std.size() != m) {
+    throw InputError("fit covariance", "residual_std", std::to_string(m) + " values or none", std::to_string(residual_std.size()));
+  }
+  FitCovariance out;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double dof = static_cast<double>(m - p);
+  // Column scaling makes the conditioning (and the inverse) independent of the parameters' units.
+  const VectorXd norms = J.colwise().norm().transpose();
+  out.singular = (norms.array() == 0.0).any() || !J.allFinite();
+  const MatrixXd Js = J * norms.cwiseMax(1e-300).cwiseInverse().asDiagonal();
+  const Eigen::JacobiSVD<MatrixXd> svd(Js, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const VectorXd sv = svd.singularValues();
+  out.condition_number = sv(p - 1) > 0.0 ? sv(0) / sv(p - 1) : inf;
+  out.singular = out.singular || !(out.condition_number < 1e14);
+  if (residual_std.size() == m) {
+    out.chi2_per_dof = r.cwiseQuotient(residual_std).squaredNorm() / dof;
+  } else {
+    out.chi2_per_dof = r.squaredNorm() / dof;
+  }
+  if (out.singular) {
+    out.covariance = MatrixXd::Constant(p, p, inf);
+    out.standard_error = VectorXd::Constant(p, inf);
+    out.correlation = MatrixXd::Identity(p, p);
+    return out;
+  }
+  // (Js^T Js)^-1 = V S^-2 V^T; in the parameters' units divide by the column norms on both sides.
+  const MatrixXd V = svd.matrixV();
+  const MatrixXd A = V * sv.array().square().inverse().matrix().asDiagonal() * V.transpose();  // scaled (J^T J)^-1
+  MatrixXd Cs;
+  if (residual_std.size() == m) {
+    // L = (J^T J)^-1 J^T: row j is parameter j's influence of each residual; the local chi2 f_j.
+    const MatrixXd L = A * Js.transpose();
+    const Eigen::ArrayXXd L2 = L.array().square();
+    const VectorXd noise = (L2.matrix() * residual_std.array().square().matrix());
+    const VectorXd misfit = (L2.matrix() * r.array().square().matrix());
+    VectorXd widen(p);
+    const double hc1 = static_cast<double>(m) / dof;  // the residuals' lost degrees of freedom
+    for (Index j = 0; j < p; ++j) widen(j) = noise(j) > 0.0 ? std::sqrt(std::max(1.0, hc1 * misfit(j) / noise(j))) : 1.0;
+    const MatrixXd B = Js.transpose() * residual_std.array().square().matrix().asDiagonal() * Js;
+    Cs = widen.asDiagonal() * (A * B * A) * widen.asDiagonal();
+  } else {
+    Cs = A * out.chi2_per_dof;
+  }
+  const VectorXd inv = norms.cwiseInverse();
+  out.covariance = inv.asDiagonal() * Cs * inv.asDiagonal();
+  out.standard_error = out.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  out.correlation = MatrixXd::Identity(p, p);
+  for (Index i = 0; i < p; ++i) {
+    for (Index j = i + 1; j < p; ++j) {
+      const double d = out.standard_error(i) * out.standard_error(j);
+      const double c = d > 0.0 ? out.covariance(i, j) / d : 0.0;
+      out.correlation(i, j) = out.correlation(j, i) = c;
+      if (std::abs(c) > kHighCorrelation) out.high_correlations.emplace_back(static_cast<int>(i), static_cast<int>(j));
+    }
+  }
+  return out;
+}
+
+double ParameterUncertainty::standard_error_of(const std::string& name) const {
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) return standard_error(static_cast<Index>(i));
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+double ParameterUncertainty::relative_standard_error_of(const std::string& name) const {
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) {
+      const double v = std::abs(value(static_cast<Index>(i)));
+      return v > 0.0 ? standard_error(static_cast<Index>(i)) / v : std::numeric_limits<double>::infinity();
+    }
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+ParameterUncertainty parameter_uncertainty(const std::vector<std::string>& names, const VectorXd& value, const VectorXd& dvalue_dx,
+                                           const std::vector<int>& fitted, const FitCovariance& covariance, bool from_data_variance) {
+  const auto n = static_cast<Index>(names.size());
+  if (value.size() != n || dvalue_dx.size() != n || static_cast<Index>(fitted.size()) != n) {
+    throw InputError("parameter uncertainty", "sizes", std::to_string(n) + " values, derivatives and indices", "other counts");
+  }
+  ParameterUncertainty u;
+  u.names = names;
+  u.value = value;
+  u.standard_error = VectorXd::Zero(n);
+  u.correlation = MatrixXd::Identity(n, n);
+  u.condition_number = covariance.condition_number;
+  u.chi2_per_dof = covariance.chi2_per_dof;
+  u.from_data_variance = from_data_variance;
+  for (Index i = 0; i < n; ++i) {
+    const int a = fitted[static_cast<std::size_t>(i)];
+    if (a < 0) continue;
+    u.standard_error(i) = std::abs(dvalue_dx(i)) * covariance.standard_error(a);
+    for (Index j = 0; j < n; ++j) {
+      const int b = fitted[static_cast<std::size_t>(j)];
+      if (b < 0 || j == i) continue;
+      if (a == b) {  // tied to one solver parameter (e.g. ke = 2 ka): moves with it by construction
+        u.correlation(i, j) = 1.0;
+        continue;
+      }
+      // A monotone map per parameter keeps the correlation up to the sign of the derivatives.
+      const double sign = (dvalue_dx(i) < 0.0) != (dvalue_dx(j) < 0.0) ? -1.0 : 1.0;
+      u.correlation(i, j) = sign * covariance.correlation(a, b);
+      if (j > i && std::abs(u.correlation(i, j)) > kHighCorrelation) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "%s/%s %.3f", names[static_cast<std::size_t>(i)].c_str(), names[static_cast<std::size_t>(j)].c_str(),
+                      u.correlation(i, j));
+        u.high_correlations.emplace_back(buf);
+      }
+    }
+  }
+  return u;
+}
+
+MatrixXd propagate_covariance(const MatrixXd& G, const MatrixXd& covariance) {
+  if (G.cols() != covariance.rows() || covariance.rows() != covariance.cols()) {
+    throw InputError("covariance propagation", "sizes", std::to_string(covariance.rows()) + " columns in the Jacobian",
+                     std::to_string(G.cols()));
+  }
+  return G * covariance * G.transpose();
+}
+
+}  // namespace piezobench::core
