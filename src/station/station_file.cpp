@@ -102,6 +102,10 @@ void read_settings(const TableReader& r, PhaseSpec& p) {
     }
   }
   p.retries = r.integer("retries", 0).value_or(2);
+  // Each try is a whole experiment the operator sits through, kept in the record: a bound an
+  // operator could reach, not a counter that never ends.
+  constexpr long kMaxRetries = 20;
+  if (p.retries > kMaxRetries) r.fail("retries", fmt::format("at most {} tries after the first", kMaxRetries), fmt::format("{}", p.retries));
   p.min_coherence = r.number("min_coherence").value_or(0.0);
   if (p.min_coherence < 0.0 || p.min_coherence > 1.0) r.fail("min_coherence", "a coherence in [0, 1]", fmt::format("{:g}", p.min_coherence));
   if (p.min_coherence > 0.0 && p.record != campaign::Experiment::kFrf) r.fail("min_coherence", "only in a frf-noise phase with the resistor", p.experiment);
