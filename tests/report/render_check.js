@@ -8,12 +8,10 @@
 //   node render_check.js REPORT.html SCREENSHOT.png
 //
 // Environment: PIEZOBENCH_CHROMIUM overrides /usr/bin/chromium. Exit code 0 when every check
-// passes, 1 otherwise (each failure printed). No npm package: it speaks the DevTools protocol to
-// Chromium over --remote-debugging-pipe (file descriptors 3 and 4).
+// passes, 1 otherwise (each failure printed). Chromium is driven by npm's puppeteer-core
+// (tests/js/browser.js).
 'use strict';
-const { spawn } = require('node:child_process');
 const fs = require('node:fs');
-const os = require('node:os');
 const path = require('node:path');
 const zlib = require('node:zlib');
 
@@ -158,7 +156,7 @@ function inkStatistics(png) {
   return { inkFraction: ink / n, colours: colours.size };
 }
 
-const { Cdp, chromiumArgs, watchConsole } = require('./chromium.js');
+const { launchChromium, watchPage } = require('../js/browser.js');
 
 const t0 = Date.now();
 function trace(what) { if (process.env.PIEZOBENCH_RENDER_CHECK_VERBOSE) console.error(`${Date.now() - t0} ms: ${what}`); }
@@ -174,12 +172,8 @@ async function main() {
   }
   const report = path.resolve(reportArg);
   const screenshot = path.resolve(screenshotArg);
-  const chromium = process.env.PIEZOBENCH_CHROMIUM || '/usr/bin/chromium';
   const failures = [];
   if (!fs.existsSync(report)) throw new Error(`no report at ${report}`);
-  if (!fs.existsSync(chromium)) {
-    throw new Error(`${chromium} not found: install Debian's chromium package (scripts/setup.sh does)`);
-  }
   fs.rmSync(screenshot, { force: true });
   const embedded = embeddedDocument(fs.readFileSync(report, 'utf8'));
   const phase = phaseBranchFailures(embedded);
@@ -192,45 +186,26 @@ async function main() {
     for (const id of promised) if (!ids.has(id)) failures.push(`figure ${id}, listed in ${figuresList}, is not in the report`);
   }
 
-  const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'piezobench-chromium-'));
-  const args = chromiumArgs(profile, WIDTH, HEIGHT);
-  const browser = spawn(chromium, args, { stdio: ['ignore', 'ignore', 'pipe', 'pipe', 'pipe'] });
-  let browserLog = '';
-  browser.stderr.on('data', (d) => { browserLog = (browserLog + d.toString()).slice(-4000); });
-  const exited = new Promise((resolve) => browser.on('exit', resolve));
+  let chromium = null;
   const timer = setTimeout(() => {
-    console.error(`render_check: timed out after ${TIMEOUT_MS / 1000} s\n${browserLog}`);
-    browser.kill('SIGKILL');
-    fs.rmSync(profile, { recursive: true, force: true });
+    console.error(`render_check: timed out after ${TIMEOUT_MS / 1000} s`);
+    const proc = chromium && chromium.browser.process();
+    if (proc) proc.kill('SIGKILL');
     process.exit(1);
   }, TIMEOUT_MS);
 
   try {
-    const cdp = new Cdp(browser.stdio[3], browser.stdio[4]);
+    chromium = await launchChromium(WIDTH, HEIGHT);
     trace('chromium started');
-    const { targetId } = await cdp.send('Target.createTarget', { url: 'about:blank' });
-    const { sessionId } = await cdp.send('Target.attachToTarget', { targetId, flatten: true });
-    const page = (method, params) => cdp.send(method, params, sessionId);
-
+    const page = await chromium.browser.newPage();
     const consoleErrors = [];
-    watchConsole(cdp, sessionId, page, consoleErrors, (url) => /^(file|data|blob|about):/.test(url), 'network request (not offline): ');
-    await page('Runtime.enable');
-    await page('Log.enable');
-    await page('Page.enable');
-    await page('Network.enable');
-    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: HEIGHT, deviceScaleFactor: 1, mobile: false });
+    watchPage(page, consoleErrors, (url) => /^(file|data|blob|about):/.test(url), 'network request (not offline): ');
+    const viewport = (height) => page.setViewport({ width: WIDTH, height, deviceScaleFactor: 1 });
 
     trace('page ready');
     const started = Date.now();
-    await page('Page.navigate', { url: 'file://' + report });
-    const evaluate = async (expression) => {
-      const r = await page('Runtime.evaluate', { expression, returnByValue: true, awaitPromise: true });
-      if (r.exceptionDetails) {
-        const d = r.exceptionDetails;
-        throw new Error('evaluate failed: ' + ((d.exception && d.exception.description) || d.text));
-      }
-      return r.result.value;
-    };
+    await page.goto('file://' + report, { waitUntil: 'domcontentloaded', timeout: TIMEOUT_MS - 5000 });
+    const evaluate = (expression) => page.evaluate(expression);
     let state = 'pending';
     while (Date.now() - started < TIMEOUT_MS - 5000) {
       state = await evaluate("(document.getElementById('pb-status') || {dataset: {}}).dataset.state || 'loading'");
@@ -290,12 +265,9 @@ async function main() {
     trace('checked');
     // Full-page screenshot at the page's size.
     const height = Math.min(check.pageHeight, 16000);
-    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height, deviceScaleFactor: 1, mobile: false });
+    await viewport(height);
     await sleep(200);
-    const shot = await page('Page.captureScreenshot', {
-      format: 'png', captureBeyondViewport: true, clip: { x: 0, y: 0, width: WIDTH, height, scale: 1 },
-    });
-    fs.writeFileSync(screenshot, Buffer.from(shot.data, 'base64'));
+    await page.screenshot({ path: screenshot, captureBeyondViewport: true, clip: { x: 0, y: 0, width: WIDTH, height, scale: 1 } });
     trace('screenshot');
     // One screenshot per section too (SCREENSHOT-<id>.png), to look at each part at full size.
     const sections = await evaluate(`Array.from(document.querySelectorAll('main > section')).map((s) => {
@@ -304,13 +276,12 @@ async function main() {
     })`);
     const stem = screenshot.replace(/\.png$/, '');
     for (const sec of sections) {
-      await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: Math.ceil(Math.min(sec.height, 8000)), deviceScaleFactor: 1, mobile: false });
+      await viewport(Math.ceil(Math.min(sec.height, 8000)));
       await evaluate(`window.scrollTo(0, ${Math.floor(sec.top)})`);
       await sleep(150);
-      const part = await page('Page.captureScreenshot', { format: 'png' });
-      fs.writeFileSync(`${stem}-${sec.id}.png`, Buffer.from(part.data, 'base64'));
+      await page.screenshot({ path: `${stem}-${sec.id}.png` });
     }
-    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height, deviceScaleFactor: 1, mobile: false });
+    await viewport(height);
     await evaluate('window.scrollTo(0, 0)');
     await sleep(150);
     trace('section screenshots');
@@ -352,20 +323,17 @@ async function main() {
     } else if (target === null) {
       failures.push('no figure with several panels and grouped traces to check the interaction on');
     } else {
-      const mouse = (type, p, extra = {}) => page('Input.dispatchMouseEvent', { type, x: p.x, y: p.y, ...extra });
-      await mouse('mouseMoved', target.point);
+      await page.mouse.move(target.point.x, target.point.y);
       await sleep(300);
       const hover = await evaluate(`Array.from(document.querySelectorAll('#fig-${target.id} .hoverlayer .hovertext')).map((h) => h.textContent).join(' | ')`);
       if (!hover.includes(target.name) && !target.near.some((n) => n && hover.includes(n))) {
         failures.push(`hover on ${target.id}: label "${hover}" names neither "${target.name}" nor a trace drawn at that point`);
       }
-      await mouse('mouseMoved', { x: 2, y: 2 });
+      await page.mouse.move(2, 2);
       const hidden = (state) => `document.getElementById('fig-${target.id}')._fullData
         .filter((tr) => tr.legendgroup === ${JSON.stringify(target.group)}).map((tr) => tr.visible === ${state})`;
       for (const [round, state] of [[1, "'legendonly'"], [2, 'true']]) {
-        await mouse('mouseMoved', target.legend);
-        await mouse('mousePressed', target.legend, { button: 'left', clickCount: 1 });
-        await mouse('mouseReleased', target.legend, { button: 'left', clickCount: 1 });
+        await page.mouse.click(target.legend.x, target.legend.y);
         let flags = [];
         for (let i = 0; i < 30; ++i) {  // Plotly waits for a possible double click first
           await sleep(100);
@@ -393,8 +361,6 @@ async function main() {
     }
 
     trace('png');
-    await cdp.send('Browser.close').catch(() => {});
-    trace('close sent');
     if (failures.length === 0) {
       const traces = check.figures.reduce((n, f) => n + f.drawnTraces, 0);
       console.log(`render_check: ${check.figures.length} of ${check.figures.length} figures drawn (${traces} traces) ` +
@@ -406,13 +372,8 @@ async function main() {
     }
   } finally {
     clearTimeout(timer);
-    const closed = await Promise.race([exited.then(() => true), sleep(3000).then(() => false)]);
-    trace(closed ? 'chromium exited' : 'chromium killed');
-    if (!closed) browser.kill('SIGKILL');
-    fs.rmSync(profile, { recursive: true, force: true });
-    trace('profile removed');
-    // Chromium's helpers (crashpad) may hold the pipes a little longer: do not wait for them.
-    for (const stream of browser.stdio) if (stream) stream.destroy();
+    if (chromium) await chromium.close();
+    trace('chromium closed');
   }
   if (failures.length > 0) {
     console.error('render_check: FAILED\n  ' + failures.join('\n  '));

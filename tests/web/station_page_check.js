@@ -1,8 +1,8 @@
 #!/usr/bin/env node
 // The station's live page in a real browser (issue 29): runs `piezobench qualify --ui 127.0.0.1:0
 // --paced` on the virtual bench with no answers file and no terminal (its operator steps must be
-// answered in the page), opens the page in headless Chromium (Debian's, over the DevTools protocol:
-// tests/report/chromium.js) and checks, as an operator would see it:
+// answered in the page), opens the page in headless Chromium (Debian's, driven by npm's
+// puppeteer-core: tests/js/browser.js) and checks, as an operator would see it:
 //   - the page loads with no console error, no uncaught exception, no request leaving the station;
 //   - every phase is seen running and then finished, in order;
 //   - the live signals and the FRF update while the phases run (screen samples arrive at 10-20 Hz,
@@ -23,9 +23,8 @@
 'use strict';
 const { spawn, execFileSync } = require('node:child_process');
 const fs = require('node:fs');
-const os = require('node:os');
 const path = require('node:path');
-const { Cdp, chromiumArgs, watchConsole } = require('../report/chromium.js');
+const { launchChromium, watchPage } = require('../js/browser.js');
 
 const WIDTH = 1280, HEIGHT = 1100;
 const TIMEOUT_MS = Number(process.env.PIEZOBENCH_PAGE_TIMEOUT_MS || 100000);
@@ -104,8 +103,6 @@ async function main() {
   const out = path.resolve(outArg);
   fs.rmSync(out, { recursive: true, force: true });
   fs.mkdirSync(out, { recursive: true });
-  const chromium = process.env.PIEZOBENCH_CHROMIUM || '/usr/bin/chromium';
-  if (!fs.existsSync(chromium)) throw new Error(`${chromium} not found: install Debian's chromium package (scripts/setup.sh does)`);
   const failures = [];
   const db = path.join(out, 'station.db');
   const serial = 'WEB-0001';
@@ -126,48 +123,32 @@ async function main() {
   if (!url) throw new Error('qualify printed no page address:\n' + stderr);
   trace('qualify serving ' + url.base);
 
-  const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'piezobench-chromium-'));
-  const browser = spawn(chromium, chromiumArgs(profile, WIDTH, HEIGHT), { stdio: ['ignore', 'ignore', 'pipe', 'pipe', 'pipe'] });
-  let browserLog = '';
-  browser.stderr.on('data', (d) => { browserLog = (browserLog + d.toString()).slice(-4000); });
-  const exited = new Promise((resolve) => browser.on('exit', resolve));
+  let chromium = null;
   const timer = setTimeout(() => {
-    console.error(`station_page_check: timed out after ${TIMEOUT_MS / 1000} s\n${browserLog}\n${stderr.slice(-3000)}`);
-    browser.kill('SIGKILL');
+    console.error(`station_page_check: timed out after ${TIMEOUT_MS / 1000} s\n${stderr.slice(-3000)}`);
+    const proc = chromium && chromium.browser.process();
+    if (proc) proc.kill('SIGKILL');
     qualify.kill('SIGKILL');
     process.exit(1);
   }, TIMEOUT_MS);
 
   let summary = '';
   try {
-    const cdp = new Cdp(browser.stdio[3], browser.stdio[4]);
-    const { targetId } = await cdp.send('Target.createTarget', { url: 'about:blank' });
-    const { sessionId } = await cdp.send('Target.attachToTarget', { targetId, flatten: true });
-    const page = (method, params) => cdp.send(method, params, sessionId);
+    chromium = await launchChromium(WIDTH, HEIGHT);
+    const page = await chromium.browser.newPage();
     const consoleErrors = [];
-    watchConsole(cdp, sessionId, page, consoleErrors, (u) => u.startsWith(url.base) || /^(data|blob|about):/.test(u), 'request outside the station: ');
-    for (const domain of ['Runtime', 'Log', 'Page', 'Network']) await page(domain + '.enable');
-    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: HEIGHT, deviceScaleFactor: 1, mobile: false });
-    const evaluate = async (expression) => {
-      const r = await page('Runtime.evaluate', { expression, returnByValue: true, awaitPromise: true });
-      if (r.exceptionDetails) throw new Error('evaluate: ' + ((r.exceptionDetails.exception || {}).description || r.exceptionDetails.text));
-      return r.result.value;
-    };
-    const screenshot = async (file) => {
-      const shot = await page('Page.captureScreenshot', { format: 'png' });
-      fs.writeFileSync(path.join(out, file), Buffer.from(shot.data, 'base64'));
-    };
+    watchPage(page, consoleErrors, (u) => u.startsWith(url.base) || /^(data|blob|about):/.test(u), 'request outside the station: ');
+    const evaluate = (expression) => page.evaluate(expression);
+    const screenshot = (file) => page.screenshot({ path: path.join(out, file) });
+    // A click with the mouse at the element's centre (scrolled into view); false when it is absent.
     const mouseClick = async (selector) => {
-      const box = await evaluate(`(() => { const b = document.querySelector(${JSON.stringify(selector)});
-        if (!b) return null; b.scrollIntoView({block: 'center'}); const r = b.getBoundingClientRect(); return {x: r.left + r.width / 2, y: r.top + r.height / 2}; })()`);
-      if (!box) return false;
-      for (const type of ['mouseMoved', 'mousePressed', 'mouseReleased']) {
-        await page('Input.dispatchMouseEvent', { type, x: box.x, y: box.y, button: 'left', clickCount: 1 });
-      }
+      const element = await page.$(selector);
+      if (!element) return false;
+      await element.click();
       return true;
     };
 
-    await page('Page.navigate', { url: url.base + '#token=' + url.token });
+    await page.goto(url.base + '#token=' + url.token, { waitUntil: 'load' });
     let loaded = false;
     for (let i = 0; i < 100 && !loaded; ++i) {
       loaded = await evaluate("document.readyState === 'complete' && !!window.pbLive");
@@ -241,7 +222,7 @@ async function main() {
       failures.push(`latency: ${live.latencies} samples, p50 ${live.p50} ms, p99 ${live.p99} ms, max ${live.max} ms (limit ${LATENCY_LIMIT_MS} ms)`);
     }
     if (!live.certificate) failures.push('no certificate link after the qualification');
-    await page('Emulation.setDeviceMetricsOverride', { width: WIDTH, height: 1700, deviceScaleFactor: 1, mobile: false });
+    await page.setViewport({ width: WIDTH, height: 1700, deviceScaleFactor: 1 });
     await sleep(300);
     await screenshot('final.png');
 
@@ -285,14 +266,10 @@ async function main() {
       `verdict table (${live.table.length} measurements, unit ${live.verdict}) equal to the terminal's and the database's; ` +
       `hostile requests refused cleanly while it ran (1,000 concurrent: ${hostileResult.served} served, ${hostileResult.busy} refused 503); ` +
       `no console error; Ctrl-C with a stream open: exit in ${shutdownMs} ms; screenshots in ${out}`;
-    await cdp.send('Browser.close').catch(() => {});
   } finally {
     clearTimeout(timer);
-    const closed = await Promise.race([exited.then(() => true), sleep(3000).then(() => false)]);
-    if (!closed) browser.kill('SIGKILL');
+    if (chromium) await chromium.close();
     qualify.kill('SIGKILL');
-    fs.rmSync(profile, { recursive: true, force: true });
-    for (const stream of browser.stdio) if (stream) stream.destroy();
   }
   if (failures.length > 0) {
     console.error('station_page_check: FAILED\n  ' + failures.join('\n  ') + '\n--- qualify stderr (end):\n' + stderr.slice(-2000));
