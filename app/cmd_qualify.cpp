@@ -92,6 +92,8 @@ int run_qualify(const QualifyCli& o) {
   if (!bench.hardware() && (bo.unit < 1 || bo.unit > 7)) throw UsageError("--unit", "a unit of the virtual batch, 1 to 7", std::to_string(bo.unit));
   if (o.paced && bench.hardware()) throw UsageError("--paced", "the virtual bench (hardware is paced by its clock)", "backend " + bench.backend);
   if (hub) bo.on_record = [&hub](const io::TimeSeries& ts, std::chrono::steady_clock::time_point start) { hub->record(ts, start); };
+  // Hardware: the signals while each record runs, from the loop's log (its logger thread).
+  if (hub && bench.hardware()) bo.live_tap = hub->loop_tap(bench.sample_rate);
   station::BenchInstrument instrument(bo);
   station::RecordStore store(o.db);
   std::optional<StationUi> ui;

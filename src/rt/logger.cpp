@@ -22,7 +22,12 @@ void LoggerOptions::validate() const {
     throw InputError(source, "ring_capacity", "at most 2^26 records", std::to_string(ring_capacity));
   }
   detail::require_positive(sample_rate, "sample_rate", source);
+  if (tap.deliver && tap.every < 1) throw InputError(source, "tap.every", "at least 1", std::to_string(tap.every));
 }
+
+namespace {
+constexpr std::size_t kTapBatch = 256;  // records per delivery at most
+}  // namespace
 
 SignalLogger::SignalLogger(const LoggerOptions& options) : options_(options), ring_((options.validate(), options.ring_capacity)) {
   log_.names = kNames;
@@ -31,6 +36,7 @@ SignalLogger::SignalLogger(const LoggerOptions& options) : options_(options), ri
   log_.settings = options.settings;
   log_.data.resize(static_cast<Eigen::Index>(options.max_samples), static_cast<Eigen::Index>(kNames.size()));
   log_.t.resize(static_cast<Eigen::Index>(options.max_samples));
+  if (options_.tap.deliver) tap_batch_.reserve(kTapBatch);
 }
 
 SignalLogger::~SignalLogger() {
@@ -58,7 +64,27 @@ std::uint64_t SignalLogger::dropped() const noexcept {
   return dropped_ring_.load(std::memory_order_relaxed) + dropped_storage_.load(std::memory_order_relaxed);
 }
 
+void SignalLogger::tap(const LogRecord& r) noexcept {
+  if (tap_count_++ % options_.tap.every != 0) return;
+  tap_batch_.push_back(r);  // within the reserved capacity: flushed when full
+  if (tap_batch_.size() == kTapBatch) flush_tap(false);
+}
+
+void SignalLogger::flush_tap(bool run_over) noexcept {
+  const auto deliver = [this](std::span<const LogRecord> batch) noexcept {
+    try {
+      options_.tap.deliver(batch);
+    } catch (...) {
+      // A live view that fails must not end the record: its samples are lost, the log is not.
+    }
+  };
+  if (!tap_batch_.empty()) deliver(std::span<const LogRecord>(tap_batch_.data(), tap_batch_.size()));
+  tap_batch_.clear();
+  if (run_over) deliver({});  // an empty batch: the run is over
+}
+
 void SignalLogger::store(const LogRecord& r) noexcept {
+  if (!options_.keep) return;
   const std::uint64_t i = stored_.load(std::memory_order_relaxed);
   if (i >= options_.max_samples) {
     dropped_storage_.fetch_add(1, std::memory_order_relaxed);
@@ -77,11 +103,16 @@ void SignalLogger::run() noexcept {
   for (;;) {
     // Read the flag before draining: every record pushed before stop was requested is then seen.
     const bool stopping = stop_.load(std::memory_order_acquire);
-    while (ring_.pop(r)) store(r);
+    while (ring_.pop(r)) {
+      store(r);
+      if (options_.tap.deliver) tap(r);
+    }
     if (stopping) break;
+    if (options_.tap.deliver) flush_tap(false);  // what the ring held: delivered within a millisecond
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   if (abandon_.load(std::memory_order_acquire)) return;
+  if (options_.tap.deliver) flush_tap(true);
   // The run is over: shrink to what was stored and write the file (allocation and I/O are fine
   // here, the real-time thread has stopped).
   try {

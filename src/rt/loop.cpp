@@ -83,11 +83,13 @@ Loop::Loop(Backend& backend, const LoopOptions& options)
   ramp_out_cycles_ = static_cast<std::uint64_t>(std::llround(options.limits.ramp_out * rate_));
   period_ns_ = static_cast<std::int64_t>(std::llround(1e9 / rate_));
   watchdog_ns_ = static_cast<std::int64_t>(std::llround(options.limits.watchdog_timeout * 1e9));
-  if (options.keep_log || options.log_file) {
+  if (options.keep_log || options.log_file || options.log_tap.deliver) {
     LoggerOptions lo;
+    lo.keep = options.keep_log || options.log_file;
+    lo.tap = options.log_tap;
     lo.file = options.log_file;
     lo.ring_capacity = options.log_ring_capacity;
-    lo.max_samples = static_cast<std::size_t>(std::min<std::uint64_t>(total_cycles_, options.max_log_samples));
+    lo.max_samples = lo.keep ? static_cast<std::size_t>(std::min<std::uint64_t>(total_cycles_, options.max_log_samples)) : 0;
     lo.sample_rate = rate_;
     lo.settings = options.log_settings;
     lo.settings["backend"] = backend.name();
@@ -249,6 +251,7 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
     rec.y = y;
     rec.latency_us = latency_us;
     rec.step_us = static_cast<double>(end_ns - start_ns) * 1e-3;
+    rec.measured_ns = start_ns;
     rec.flags = (out.clamped ? kFlagClamped : 0u) | (out.slew_limited ? kFlagSlewLimited : 0u) |
                 (guard_.safe_state() ? kFlagSafeState : 0u) | (r < 1.0 ? kFlagRamping : 0u) |
                 (sensor_ok ? 0u : kFlagSensorFault);

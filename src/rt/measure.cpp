@@ -123,6 +123,7 @@ io::TimeSeries BackendRunner::run(LoopOptions lo, const std::vector<bench::Opera
   lo.keep_log = true;
   lo.max_log_samples = static_cast<std::size_t>(std::llround(lo.duration * rate)) + 16;
   lo.on_warning = options_.on_warning;
+  lo.log_tap = options_.log_tap;
   if (options_.raw_log) lo.log_file = numbered(*options_.raw_log, report_.runs.size() + 1);
   lo.log_settings["command"] = std::string("measure");
   lo.log_settings["bench_file"] = options_.bench.source;

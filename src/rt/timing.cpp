@@ -44,6 +44,7 @@ TimingSummary TimingHistogram::summary_us() const noexcept {
   s.p50 = percentile(0.5) * 1e-3;
   s.p99 = percentile(0.99) * 1e-3;
   s.p999 = percentile(0.999) * 1e-3;
+  s.p9999 = percentile(0.9999) * 1e-3;
   s.max = max_ * 1e-3;
   s.mean = count_ > 0 ? sum_ / static_cast<double>(count_) * 1e-3 : 0.0;
   return s;

@@ -119,6 +119,7 @@ Acquired BenchInstrument::acquire(const PhaseSpec& p, const PhaseValues& values,
     mo.stop = options_.stop;
     mo.operator_fd = pipe ? pipe->read_fd() : options_.operator_fd;
     if (options_.log) mo.on_warning = [this](const std::string& w) { options_.log("warning: " + w); };
+    mo.log_tap = options_.live_tap;
     rt::BackendRunner runner(*backend, mo);
     bench::UnitTruth unit;
     unit.id = options_.unit;  // a real unit: only its number is known

@@ -1,6 +1,7 @@
 // The operators of the phase runner: answers from a file, or prompts on the terminal.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <istream>
 #include <ostream>
 
@@ -58,26 +59,61 @@ CheckAnswer TerminalOperator::check_failed(const PhaseSpec& phase, int try_numbe
   }
 }
 
-PhaseValues TerminalOperator::values(const PhaseSpec& phase) {
+std::vector<TypedValueField> typed_value_fields(const PhaseSpec& phase) {
+  if (phase.source == ValueSource::kFile) return {{"file", "the " + phase.experiment + " file"}};
+  if (phase.source == ValueSource::kTyped) {
+    return {{"sensor_uF", "capacitance of the sensor stack(s), uF"}, {"actuator_uF", "capacitance of the actuator stack(s), uF"}};
+  }
+  return {};
+}
+
+namespace {
+
+// The number a capacitance field holds (uF), or InputError.
+double capacitance_uF(const PhaseSpec& phase, const std::string& field, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double x = std::stod(text, &used);
+    if (used == text.size() && x > 0.0 && std::isfinite(x)) return x;
+  } catch (const std::exception&) {
+    // refused below
+  }
+  throw InputError("operator", phase.name + "." + field, "a capacitance > 0 in uF", "'" + text + "'");
+}
+
+}  // namespace
+
+void check_typed_value(const PhaseSpec& phase, const std::string& field, const std::string& text) {
+  if (field == "file") {
+    if (text.empty()) throw InputError("operator", phase.name, "the file of the phase", "nothing");
+  } else {
+    (void)capacitance_uF(phase, field, text);
+  }
+}
+
+PhaseValues typed_values(const PhaseSpec& phase, const std::map<std::string, std::string>& typed) {
+  const auto text = [&](const std::string& field) {
+    const auto it = typed.find(field);
+    return it == typed.end() ? std::string() : it->second;
+  };
   PhaseValues v;
   if (phase.source == ValueSource::kFile) {
-    const std::string f = ask(fmt::format("operator, phase {}: the {} file: ", phase.name, phase.experiment));
-    if (f.empty()) throw InputError("operator", phase.name, "the file of the phase", "nothing");
-    v.file = f;
+    check_typed_value(phase, "file", text("file"));
+    v.file = text("file");
   } else if (phase.source == ValueSource::kTyped) {
-    for (auto [what, out] : {std::pair{"sensor", &v.sensor_uF}, std::pair{"actuator", &v.actuator_uF}}) {
-      const std::string s = ask(fmt::format("operator, phase {}: capacitance of the {} stack(s), uF: ", phase.name, what));
-      try {
-        std::size_t used = 0;
-        const double x = std::stod(s, &used);
-        if (used != s.size() || !(x > 0.0)) throw std::invalid_argument(s);
-        *out = x;
-      } catch (const std::exception&) {
-        throw InputError("operator", phase.name + "." + what + "_uF", "a capacitance > 0 in uF", "'" + s + "'");
-      }
-    }
+    v.sensor_uF = capacitance_uF(phase, "sensor_uF", text("sensor_uF"));
+    v.actuator_uF = capacitance_uF(phase, "actuator_uF", text("actuator_uF"));
   }
   return v;
+}
+
+PhaseValues TerminalOperator::values(const PhaseSpec& phase) {
+  std::map<std::string, std::string> typed;
+  for (const TypedValueField& f : typed_value_fields(phase)) {
+    typed[f.name] = ask(fmt::format("operator, phase {}: {}: ", phase.name, f.question));
+    check_typed_value(phase, f.name, typed[f.name]);  // refused at once, before the next question
+  }
+  return typed_values(phase, typed);
 }
 
 }  // namespace piezobench::station

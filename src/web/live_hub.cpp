@@ -65,7 +65,40 @@ struct LiveHub::Pending {
   std::vector<Clock::time_point> due;
   std::size_t next = 0;
   Eigen::Index block_samples = 1;
+  bool shown = false;  // its signals came from a loop tap while it ran
   std::shared_ptr<Frf> frf;
+};
+
+// A loop tap's screen samples in the making (the loop's logger thread alone touches it; the runs
+// of a record follow each other, each logger thread joined before the next starts).
+struct LiveHub::Tap {
+  std::size_t block_records = 1;  // tapped records per screen sample
+  double last_t = -1.0;           // the newest record's time in its run, s
+  ScreenSample block;             // the screen sample being formed
+  std::int64_t block_ns = 0;      // when its first record was measured
+  std::size_t in_block = 0;
+  std::vector<std::pair<ScreenSample, std::int64_t>> ready;  // complete, to append
+  std::pair<std::string, int> shown{"", -1};                 // the phase try being shown
+  std::int64_t record_ns = 0;                                // and its first sample's time
+
+  void add(const rt::LogRecord& r, std::int64_t ns) {
+    const double v[3] = {r.va, 1e6 * r.de, r.vs};
+    double* out[3] = {block.va, block.de_um, block.vs};
+    if (in_block == 0) {
+      block_ns = ns;
+      for (int c = 0; c < 3; ++c) out[c][0] = out[c][1] = v[c];
+    }
+    for (int c = 0; c < 3; ++c) {
+      out[c][0] = std::min(out[c][0], v[c]), out[c][1] = std::max(out[c][1], v[c]), out[c][2] = v[c];
+    }
+    if (++in_block == block_records) close();
+  }
+  void close() {
+    if (in_block == 0) return;
+    block.measured_unix_ms = unix_ms_of(Clock::time_point(std::chrono::nanoseconds(block_ns)));
+    ready.emplace_back(block, block_ns);
+    in_block = 0;
+  }
 };
 
 class LiveHub::Client final : public EventStream {
@@ -177,6 +210,7 @@ void LiveHub::record(const io::TimeSeries& ts, Clock::time_point start) {
         s.record_s = static_cast<double>(n) / fs;
       }
     }
+    p->shown = live_shown_ == std::pair<std::string, int>{phase, try_number};
     bump();
   }
   for (Eigen::Index k0 = 0; k0 < n; k0 += p->block_samples) {
@@ -217,11 +251,56 @@ void LiveHub::record(const io::TimeSeries& ts, Clock::time_point start) {
   wake_.notify_all();
 }
 
+rt::LogTap LiveHub::loop_tap(double loop_rate_Hz) {
+  rt::LogTap tap;
+  tap.every = static_cast<std::size_t>(std::max<long long>(1, std::llround(loop_rate_Hz / 1000.0)));
+  auto state = std::make_shared<Tap>();
+  const double tapped_Hz = loop_rate_Hz / static_cast<double>(tap.every);
+  state->block_records = static_cast<std::size_t>(std::max<long long>(1, std::llround(tapped_Hz / options_.screen_rate_Hz)));
+  tap.deliver = [this, state](std::span<const rt::LogRecord> records) {
+    Tap& t = *state;
+    for (const rt::LogRecord& r : records) {
+      if (r.t < t.last_t) t.close();  // a new loop run: its blocks start afresh
+      t.last_t = r.t;
+      t.add(r, r.measured_ns);
+    }
+    if (records.empty()) {  // the run is over: its last, shorter block
+      t.close();
+      t.last_t = -1.0;
+    }
+    if (!t.ready.empty()) append_live(t);
+  };
+  return tap;
+}
+
+void LiveHub::append_live(Tap& tap) {
+  const std::size_t keep = static_cast<std::size_t>(std::ceil(options_.window_s * options_.screen_rate_Hz));
+  std::lock_guard lock(mutex_);
+  std::pair<std::string, int> running{"", 0};
+  for (const PhaseState& p : phases_) {
+    if (p.state == "running" || p.state == "retried") running = {p.name, p.tries};
+  }
+  if (running != tap.shown) {
+    tap.shown = running;
+    tap.record_ns = tap.ready.front().second;
+  }
+  live_shown_ = running;
+  for (auto& [block, ns] : tap.ready) {
+    block.phase = running.first, block.try_number = running.second;
+    block.t_s = static_cast<double>(ns - tap.record_ns) * 1e-9;
+    block.seq = next_seq_++;
+    samples_.push_back(std::move(block));
+    if (samples_.size() > keep) samples_.pop_front();
+  }
+  tap.ready.clear();
+}
+
 void LiveHub::release_due(Clock::time_point now) {
   if (!pending_) return;
   const std::size_t keep = static_cast<std::size_t>(std::ceil(options_.window_s * options_.screen_rate_Hz));
   while (pending_->next < pending_->blocks.size() && pending_->due[pending_->next] <= now) {
     ScreenSample s = std::move(pending_->blocks[pending_->next++]);
+    if (pending_->shown) continue;  // the loop's tap has shown these signals already
     s.seq = next_seq_++;
     samples_.push_back(std::move(s));
     if (samples_.size() > keep) samples_.pop_front();
@@ -270,35 +349,54 @@ void LiveHub::feed() {
   }
 }
 
-std::uint64_t LiveHub::open_prompt(const std::string& phase, const std::string& text, std::vector<std::string> choices) {
+std::uint64_t LiveHub::open_prompt(const std::string& phase, const std::string& text, std::vector<std::string> choices,
+                                   std::vector<station::TypedValueField> fields, ValuesCheck check) {
   std::lock_guard lock(mutex_);
-  prompt_ = LivePrompt{next_prompt_id_++, phase, text, std::move(choices)};
+  prompt_ = LivePrompt{next_prompt_id_++, phase, text, std::move(choices), std::move(fields)};
+  prompt_check_ = std::move(check);
   answer_.reset();
   bump();
   return prompt_->id;
 }
 
-bool LiveHub::answer(std::uint64_t id, const std::string& choice) {
+AnswerResult LiveHub::answer(std::uint64_t id, const std::string& choice, const std::map<std::string, std::string>& typed) {
+  const auto open = [&] {
+    return prompt_ && prompt_->id == id && !answer_ &&
+           std::find(prompt_->choices.begin(), prompt_->choices.end(), choice) != prompt_->choices.end();
+  };
+  ValuesCheck check;
   {
     std::lock_guard lock(mutex_);
-    if (!prompt_ || prompt_->id != id || answer_) return false;
-    if (std::find(prompt_->choices.begin(), prompt_->choices.end(), choice) == prompt_->choices.end()) return false;
-    answer_.emplace(id, choice);
+    if (!open()) return {AnswerResult::Status::kNotOpen, "not the open prompt, or not one of its answers"};
+    if (!prompt_->fields.empty() && choice != "abort") check = prompt_check_;
+  }
+  if (check) {
+    try {
+      check(typed);
+    } catch (const std::exception& e) {
+      return {AnswerResult::Status::kRefused, e.what()};
+    }
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (!open()) return {AnswerResult::Status::kNotOpen, "not the open prompt, or not one of its answers"};
+    answer_ = Answer{id, choice, typed};
   }
   answered_.notify_all();
-  return true;
+  return {};
 }
 
-std::optional<std::string> LiveHub::wait_answer(std::uint64_t id, std::chrono::milliseconds timeout) {
+std::optional<std::string> LiveHub::wait_answer(std::uint64_t id, std::chrono::milliseconds timeout, std::map<std::string, std::string>* typed) {
   std::unique_lock lock(mutex_);
-  answered_.wait_for(lock, timeout, [&] { return stop_ || (answer_ && answer_->first == id); });
-  if (answer_ && answer_->first == id) return answer_->second;
-  return std::nullopt;
+  answered_.wait_for(lock, timeout, [&] { return stop_ || (answer_ && answer_->id == id); });
+  if (!answer_ || answer_->id != id) return std::nullopt;
+  if (typed != nullptr) *typed = answer_->typed;
+  return answer_->choice;
 }
 
 void LiveHub::close_prompt(std::uint64_t id) {
   std::lock_guard lock(mutex_);
-  if (prompt_ && prompt_->id == id) prompt_.reset();
+  if (prompt_ && prompt_->id == id) prompt_.reset(), prompt_check_ = nullptr;
   answer_.reset();
   bump();
 }
@@ -321,7 +419,11 @@ std::string LiveHub::state_json_locked() const {
                       {"verdict", s.verdict}, {"reason", s.reason}, {"measurements", ms}});
   }
   nlohmann::json prompt = nullptr;
-  if (prompt_) prompt = {{"id", prompt_->id}, {"phase", prompt_->phase}, {"text", prompt_->text}, {"choices", prompt_->choices}};
+  if (prompt_) {
+    nlohmann::json fields = nlohmann::json::array();
+    for (const auto& f : prompt_->fields) fields.push_back({{"name", f.name}, {"question", f.question}});
+    prompt = {{"id", prompt_->id}, {"phase", prompt_->phase}, {"text", prompt_->text}, {"choices", prompt_->choices}, {"fields", fields}};
+  }
   return nlohmann::json{{"live", !phases_.empty()}, {"serial", serial_}, {"batch", batch_}, {"station", station_}, {"status", status_},
                         {"verdict", verdict_}, {"deciding_phase", deciding_phase_}, {"deciding_measurement", deciding_measurement_},
                         {"certificate", certificate_}, {"started_ms", started_unix_ms_}, {"finished_ms", finished_unix_ms_},

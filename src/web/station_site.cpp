@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "piezobench/core/error.hpp"
@@ -53,13 +54,20 @@ HttpResponse StationSite::answer(const HttpRequest& r) {
   if (r.method != "POST") return error_response(405, "POST {\"id\": N, \"answer\": WORD}");
   if (!hub_) return error_response(409, "no qualification is running here");
   const nlohmann::json body = nlohmann::json::parse(r.body, nullptr, false);
+  const bool values_ok = !body.is_object() || !body.contains("values") ||
+                         (body["values"].is_object() && std::all_of(body["values"].begin(), body["values"].end(),
+                                                                    [](const nlohmann::json& v) { return v.is_string(); }));
   if (body.is_discarded() || !body.is_object() || !body.contains("id") || !body["id"].is_number_unsigned() || !body.contains("answer") ||
-      !body["answer"].is_string()) {
-    return error_response(400, "expected {\"id\": N, \"answer\": \"confirm\"|\"abort\"|\"retry\"|\"continue\"}");
+      !body["answer"].is_string() || !values_ok) {
+    return error_response(400, "expected {\"id\": N, \"answer\": \"confirm\"|\"abort\"|\"retry\"|\"continue\"[, \"values\": {FIELD: TEXT}]}");
   }
-  if (!hub_->answer(body["id"].get<std::uint64_t>(), body["answer"].get<std::string>())) {
-    return error_response(409, "not the open prompt, or not one of its answers");
+  std::map<std::string, std::string> typed;
+  if (body.contains("values")) {
+    for (const auto& [k, v] : body["values"].items()) typed[k] = v.get<std::string>();
   }
+  const AnswerResult a = hub_->answer(body["id"].get<std::uint64_t>(), body["answer"].get<std::string>(), typed);
+  if (a.status == AnswerResult::Status::kNotOpen) return error_response(409, a.message);
+  if (a.status == AnswerResult::Status::kRefused) return error_response(422, a.message);
   return json_response(200, R"({"ok":true})");
 }
 

@@ -7,6 +7,9 @@
 #include <unistd.h>
 
 #include <iostream>
+#include <map>
+
+#include "piezobench/core/error.hpp"
 
 namespace piezobench::web {
 
@@ -87,9 +90,44 @@ station::CheckAnswer WebOperator::check_failed(const station::PhaseSpec& phase, 
 
 station::PhaseValues WebOperator::values(const station::PhaseSpec& phase) {
   if (options_.inner) return options_.inner->values(phase);
-  if (phase.source == station::ValueSource::kBench) return {};
-  station::TerminalOperator terminal(std::cin, *options_.terminal_out, options_.name);
-  return terminal.values(phase);
+  const std::vector<station::TypedValueField> fields = station::typed_value_fields(phase);
+  if (fields.empty()) return {};
+  // The page: one prompt with every field, refused there as the terminal refuses; the terminal:
+  // the fields one by one, as TerminalOperator asks them. The first complete answer is taken.
+  const std::uint64_t id = hub_.open_prompt(phase.name, fmt::format("phase {}: type the values", phase.name), {"confirm"}, fields,
+                                            [phase](const std::map<std::string, std::string>& typed) { station::typed_values(phase, typed); });
+  std::map<std::string, std::string> typed;
+  std::size_t next = 0;
+  const auto question = [&] {
+    *options_.terminal_out << fmt::format("operator, phase {}: {} (or type it in the page): ", phase.name, fields[next].question) << std::flush;
+  };
+  question();
+  for (;;) {
+    if (options_.stop && options_.stop->load()) {
+      hub_.close_prompt(id);
+      throw InputError("operator", phase.name, "the typed values", "Ctrl-C");
+    }
+    std::map<std::string, std::string> from_page;
+    if (hub_.wait_answer(id, std::chrono::milliseconds(50), &from_page)) {
+      hub_.close_prompt(id);
+      *options_.terminal_out << "(typed in the page)\n" << std::flush;
+      return station::typed_values(phase, from_page);
+    }
+    if (const auto line = terminal_line()) {
+      typed[fields[next].name] = *line;
+      try {
+        station::check_typed_value(phase, fields[next].name, *line);  // refused at once, as on the terminal
+      } catch (...) {
+        hub_.close_prompt(id);
+        throw;
+      }
+      if (++next == fields.size()) {
+        hub_.close_prompt(id);
+        return station::typed_values(phase, typed);
+      }
+      question();
+    }
+  }
 }
 
 }  // namespace piezobench::web

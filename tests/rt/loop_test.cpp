@@ -5,6 +5,8 @@
 #include <atomic>
 #include <cmath>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "alloc_counter.hpp"
 #include "fake_backend.hpp"
@@ -125,6 +127,58 @@ TEST(Loop, CycleAllocatesNothing) {
   EXPECT_GT(rep.slew_limited_samples, 0u);
   EXPECT_EQ(rep.safe_state_reason, "non-finite sensor");
   EXPECT_EQ(rep.step_time_us.count, 3500u);
+}
+
+// The log tap (the station's live page) gets every N-th record on the logger's thread, in order,
+// then an empty batch at the run's end; a tap that does not return (a page that stops reading)
+// holds neither the cycles nor makes them allocate, and nothing is dropped from the log.
+TEST(Loop, TheLogTapGetsEveryNthRecordOffTheLoopAndNeverHoldsIt) {
+  FakeBackend backend(discrete_plant(), kFs);
+  LoopOptions o = lockstep_options(0.2);  // 2000 cycles
+  o.realtime = true;                      // push, never wait: paced by the test
+  o.controller = false;
+  o.excitation = test::gaussian_noise(500, 0.5, 3);
+  std::atomic<bool> open{false};
+  std::atomic<int> calls_while_closed{0};
+  std::vector<LogRecord> tapped;
+  std::vector<std::size_t> batch_sizes;
+  std::thread::id tap_thread;
+  o.log_tap.every = 10;
+  o.log_tap.deliver = [&](std::span<const LogRecord> records) {
+    if (!open.load()) calls_while_closed.fetch_add(1);
+    while (!open.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    tap_thread = std::this_thread::get_id();
+    tapped.insert(tapped.end(), records.begin(), records.end());
+    batch_sizes.push_back(records.size());
+  };
+  Loop loop(backend, o);
+  loop.start();
+  std::uint64_t n = 0;
+  const std::int64_t t0 = monotonic_ns();
+  {
+    test::AllocationCounter count;
+    while (loop.cycle(t0 + static_cast<std::int64_t>(n) * 100'000, monotonic_ns())) ++n;
+    EXPECT_EQ(count.allocations(), 0u);
+  }
+  EXPECT_EQ(n, 2000u);
+  EXPECT_LE(calls_while_closed.load(), 1);  // the logger waits in the first delivery
+  open.store(true);
+  const LoopReport rep = loop.finish();
+  EXPECT_EQ(rep.dropped_log_samples, 0u);
+  const io::TimeSeries& log = loop.log();
+  ASSERT_EQ(tapped.size(), 200u);
+  for (std::size_t k = 0; k < tapped.size(); ++k) {
+    const auto row = static_cast<Eigen::Index>(10 * k);
+    EXPECT_DOUBLE_EQ(tapped[k].t, log.t(row));
+    EXPECT_DOUBLE_EQ(tapped[k].u, log.channel("u")(row));
+    EXPECT_DOUBLE_EQ(tapped[k].vs, log.channel("Vs")(row));
+  }
+  EXPECT_NE(tap_thread, std::this_thread::get_id());
+  ASSERT_FALSE(batch_sizes.empty());
+  EXPECT_EQ(batch_sizes.back(), 0u);  // the run's end
+  // Each record's measurement time: its cycle's wake-up, as the test paced it.
+  EXPECT_GE(tapped.front().measured_ns, t0);
+  for (std::size_t k = 1; k < tapped.size(); ++k) EXPECT_GT(tapped[k].measured_ns, tapped[k - 1].measured_ns);
 }
 
 // Ramps: the command starts and ends at the safe output, linearly in between (open loop, u' = 1 V).

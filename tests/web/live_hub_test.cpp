@@ -119,6 +119,59 @@ TEST(LiveHub, ASlowClientGetsTheNewestWindowNotABacklog) {
   EXPECT_EQ(c["samples"].front()["seq"], 61);
 }
 
+TEST(LiveHub, ALoopTapShowsTheSignalsWhileTheRecordRunsAndOnlyOnce) {
+  LiveHub hub;
+  hub.plan(two_phases(), "SN1", "B1");
+  hub.phase_started("SN1", two_phases().phases[0], 1);
+  const rt::LogTap tap = hub.loop_tap(10000.0);
+  ASSERT_EQ(tap.every, 10u);  // 1,000 tapped records per second: 50 per screen sample
+  // The loop's logger delivers what the ring held, every millisecond: 1 s of a 10 kHz run
+  // (Va = 10 t V, de = 1e-6 sin(2 pi t) m, Vs = 2 V) whose cycle 0 was measured 2 s ago, every
+  // record with its measurement time.
+  const std::int64_t first_ns = std::chrono::duration_cast<std::chrono::nanoseconds>((Clock::now() - 2s).time_since_epoch()).count();
+  std::vector<rt::LogRecord> batch;
+  for (int k = 0; k < 10000; k += 10) {
+    rt::LogRecord r;
+    r.t = k / 10000.0;
+    r.measured_ns = first_ns + k * 100'000;
+    r.va = 10.0 * r.t, r.de = 1e-6 * std::sin(2 * M_PI * r.t), r.vs = 2.0;
+    batch.push_back(r);
+    if (batch.size() == 3) {
+      tap.deliver(batch);
+      batch.clear();
+    }
+  }
+  // Before the run's end: the complete blocks only (the last one, 49 records, waits for its 50th).
+  EXPECT_EQ(hub.samples_released(), 19u);
+  tap.deliver(batch);
+  tap.deliver({});  // the run is over
+  EXPECT_EQ(hub.samples_released(), 20u);
+  auto client = hub.mailbox();
+  const nlohmann::json got = drain(*client);
+  ASSERT_EQ(got["samples"].size(), 20u);
+  const double first_ms = std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count() - 2000.0;
+  for (int b = 0; b < 20; ++b) {
+    const auto& s = got["samples"][b];
+    const double t0 = 0.05 * b, t1 = 0.05 * b + 0.049;  // the block's first and last tapped record
+    EXPECT_NEAR(s["t"].get<double>(), t0, 1e-9);
+    EXPECT_NEAR(s["va"][0].get<double>(), 10 * t0, 1e-9);
+    EXPECT_NEAR(s["va"][1].get<double>(), 10 * t1, 1e-9);
+    EXPECT_NEAR(s["de"][2].get<double>(), std::sin(2 * M_PI * t1), 1e-9);
+    EXPECT_NEAR(s["at"].get<double>(), first_ms + 1e3 * t0, 50.0);  // the two clocks read apart
+    EXPECT_EQ(s["phase"], "hysteresis-20V");
+  }
+  // The whole record afterwards (as the instrument hands it): no second copy of the signals.
+  hub.record(ramp_record(10000.0, 1.0), Clock::now() - 1s);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(hub.samples_released(), 20u);
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(hub.state_json())["phases"][0]["record_s"].get<double>(), 1.0);
+  // The next phase's record, with no tap, shows its signals from the record.
+  hub.phase_started("SN1", two_phases().phases[1], 1);
+  hub.record(ramp_record(1000.0, 1.0), Clock::now() - 10s);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(hub.samples_released(), 40u);
+}
+
 TEST(LiveHub, BuildsTheFrfAverageByAverage) {
   // d_e = 2 um/V times u: |H| = 2 um/V and coherence 1 at every frequency.
   io::TimeSeries ts = ramp_record(10000.0, 4.0);
@@ -185,18 +238,18 @@ TEST(LiveHub, PhaseStatesFollowTheRunner) {
 TEST(LiveHub, OnlyTheOpenPromptTakesOneOfItsAnswers) {
   LiveHub hub;
   const std::uint64_t id = hub.open_prompt("frf", "connect the resistor", {"confirm", "abort"});
-  EXPECT_FALSE(hub.answer(id + 1, "confirm"));
-  EXPECT_FALSE(hub.answer(id, "retry"));
+  EXPECT_EQ(hub.answer(id + 1, "confirm").status, AnswerResult::Status::kNotOpen);
+  EXPECT_EQ(hub.answer(id, "retry").status, AnswerResult::Status::kNotOpen);
   EXPECT_FALSE(hub.wait_answer(id, 10ms).has_value());
   std::thread page([&] {
     std::this_thread::sleep_for(20ms);
-    EXPECT_TRUE(hub.answer(id, "confirm"));
+    EXPECT_EQ(hub.answer(id, "confirm").status, AnswerResult::Status::kTaken);
   });
   const auto a = hub.wait_answer(id, 2000ms);
   page.join();
   ASSERT_TRUE(a.has_value());
   EXPECT_EQ(*a, "confirm");
-  EXPECT_FALSE(hub.answer(id, "abort"));  // answered once
+  EXPECT_EQ(hub.answer(id, "abort").status, AnswerResult::Status::kNotOpen);  // answered once
   hub.close_prompt(id);
   EXPECT_TRUE(nlohmann::json::parse(hub.state_json())["prompt"].is_null());
 }

@@ -8,6 +8,9 @@
 //   - the live signals and the FRF update while the phases run (screen samples arrive at 10-20 Hz,
 //     the FRF's average count grows);
 //   - each operator prompt appears as buttons; clicking "confirm" with the mouse resumes the run;
+//   - the typed capacitances are asked in the page: a bad value (-1 uF) is refused with the
+//     terminal's words (qualify's own refusal on stdin, run alongside) and good ones are taken
+//     and end up in the verdict table;
 //   - a sample reaches the page less than 200 ms after it was measured (the sample's measurement
 //     time, server clock, against its arrival, both on the server's clock);
 //   - the final verdict table equals the terminal's (qualify's stdout) and the database's (db show
@@ -97,6 +100,43 @@ async function hostileBurst(port) {
   return { failures, served, busy };
 }
 
+// Types the capacitances in the page's fields as an operator would: first a bad sensor value
+// (-1 uF), which the station must refuse with the terminal's words (the prompt staying open), then
+// 5.2 and 10.1 uF. Returns { refusal, accepted }.
+async function typeValues(page, mouseClick) {
+  const fill = async (name, text) => {
+    await page.click(`#prompt-fields input[name="${name}"]`, { clickCount: 3 });
+    await page.keyboard.press('Backspace');
+    await page.type(`#prompt-fields input[name="${name}"]`, text);
+  };
+  await fill('sensor_uF', '-1');
+  await fill('actuator_uF', '10.1');
+  await mouseClick('#prompt-buttons button[data-answer="confirm"]');
+  let refusal = '';
+  for (let i = 0; i < 50 && !refusal; ++i) {
+    await sleep(100);
+    refusal = await page.evaluate("document.getElementById('prompt').hidden ? 'closed' : document.getElementById('prompt-error').textContent");
+  }
+  refusal = refusal.replace(/^Not answered: /, '');
+  await fill('sensor_uF', '5.2');
+  await mouseClick('#prompt-buttons button[data-answer="confirm"]');
+  let accepted = false;
+  for (let i = 0; i < 50 && !accepted; ++i) {
+    await sleep(100);
+    accepted = await page.evaluate("document.getElementById('prompt').hidden || document.getElementById('prompt').dataset.id !== String((window.pbLive.state.prompt || {}).id)");
+  }
+  return { refusal, accepted };
+}
+
+// The terminal's refusal of the same bad value: qualify with the same station, its prompts
+// answered on stdin (y to the first step, -1 for the sensor's capacitance); the message it exits with.
+function terminalRefusal(binary, bench, station, out) {
+  const { spawnSync } = require('node:child_process');
+  const r = spawnSync(binary, ['qualify', '--bench', bench, '--station', station, '--serial', 'TERM-0001', '--db', path.join(out, 'terminal.db'),
+    '--data', path.join(out, 'terminal-data')], { input: 'y\n-1\n', encoding: 'utf8', timeout: 60000 });
+  return ((r.stderr || '').match(/error: (operator: [^\n]*sensor_uF[^\n]*)/) || ['', `no refusal (exit ${r.status}): ${(r.stderr || '').slice(-300)}`])[1];
+}
+
 async function main() {
   const [binary, bench, station, outArg] = process.argv.slice(2);
   if (!outArg) { console.error('usage: node station_page_check.js PIEZOBENCH BENCH.toml STATION.toml OUT_DIR'); process.exit(2); }
@@ -158,7 +198,7 @@ async function main() {
     trace('loaded');
     // Follow the qualification: answer each prompt with the mouse, watch the live data.
     const port = Number(url.base.match(/:(\d+)\//)[1]);
-    let hostile = null;
+    let hostile = null, typed = null;
     const answered = [];
     const samplesAt = [];
     const frfAverages = new Set();
@@ -168,6 +208,7 @@ async function main() {
       const s = await evaluate(`(() => { const l = window.pbLive || {}; const st = l.state || {};
         const box = document.getElementById('prompt');
         return { state: document.getElementById('pb-status').dataset.state, status: st.status, prompt: st.prompt ? st.prompt.id : null,
+          fields: st.prompt && st.prompt.fields ? st.prompt.fields.length : 0,
           shown: box && !box.hidden ? box.dataset.id : null, samples: l.samplesReceived || 0, frf: l.frf ? l.frf.averages : null,
           frfPhase: l.frf ? l.frf.phase : null, drawn: document.querySelectorAll('#plot-signals .scatterlayer .trace').length }; })()`);
       samplesAt.push({ t: Date.now(), n: s.samples });
@@ -175,7 +216,10 @@ async function main() {
       if (s.shown && s.prompt !== null && String(s.prompt) === s.shown && !answered.includes(s.prompt)) {
         if (hostile) await hostile;  // the page's own requests must not meet the burst's 503s
         await sleep(300);  // an operator reads it
-        if (await mouseClick('#prompt-buttons button[data-answer="confirm"]')) answered.push(s.prompt);
+        if (s.fields > 0) {
+          typed = await typeValues(page, mouseClick);
+          if (typed.accepted) answered.push(s.prompt);
+        } else if (await mouseClick('#prompt-buttons button[data-answer="confirm"]')) answered.push(s.prompt);
         trace('answered prompt ' + s.prompt);
         if (answered.length === 1) hostile = hostileBurst(port);  // while the phases run
       }
@@ -188,7 +232,14 @@ async function main() {
     }
     trace('qualification over');
     if (!complete) failures.push('the qualification did not complete within 60 s: ' + stderr.slice(-1500));
-    if (answered.length !== 2) failures.push(`${answered.length} prompts answered in the page, the station asks 2`);
+    if (answered.length !== 3) failures.push(`${answered.length} prompts answered in the page, the station asks 3`);
+    // The typed capacitances: a bad value refused with the terminal's words, then taken.
+    const refusal = terminalRefusal(binary, bench, station, out);
+    if (!typed) failures.push('no prompt asked for typed values');
+    else {
+      if (!typed.refusal || refusal !== typed.refusal) failures.push(`typed -1 uF: the page says "${typed.refusal}", the terminal "${refusal}"`);
+      if (!typed.accepted) failures.push('the typed values 5.2 and 10.1 uF were not taken');
+    }
     const hostileResult = hostile ? await hostile : { failures: ['the hostile requests did not run'], served: 0, busy: 0 };
     failures.push(...hostileResult.failures);
     await sleep(400);  // the last state and samples
@@ -247,6 +298,9 @@ async function main() {
     await screenshot('database.png');
     const cert = await evaluate(`fetch('/api/certificate/${serial}', {headers: {Authorization: 'Bearer ${url.token}'}}).then(async (r) => [r.status, (await r.text()).length])`);
     if (cert[0] !== 200 || cert[1] < 1000) failures.push(`certificate: HTTP ${cert[0]}, ${cert[1]} bytes`);
+    // The refused value's answer is a 422 by design: Chromium logs it as a failed load, once.
+    const refused = consoleErrors.findIndex((e) => /status of 422/.test(e) && /\/api\/answer/.test(e));
+    if (refused >= 0) consoleErrors.splice(refused, 1);
     failures.push(...consoleErrors);
 
     // Ctrl-C with the page's event stream open: qualify ends within 1 s.

@@ -94,6 +94,23 @@ TEST(StationSite, AnswersTheOpenPromptOnly) {
   EXPECT_EQ(hub.wait_answer(id, std::chrono::milliseconds(0)).value_or(""), "confirm");
   EXPECT_NE(site.open_stream(site_get("/api/events")), nullptr);
   EXPECT_EQ(nlohmann::json::parse(site.handle(site_get("/api/state")).body)["prompt"]["id"], id);
+  hub.close_prompt(id);
+  // Typed values: 422 with the check's refusal (the prompt stays open), 400 for values not text.
+  const std::uint64_t typed = hub.open_prompt("capacitance", "type the values", {"confirm"}, {{"sensor_uF", "capacitance"}},
+                                              [](const std::map<std::string, std::string>& v) {
+                                                if (v.count("sensor_uF") == 0 || v.at("sensor_uF") != "5") throw std::runtime_error("refused: not 5");
+                                              });
+  post.body = nlohmann::json{{"id", typed}, {"answer", "confirm"}, {"values", {{"sensor_uF", 5}}}}.dump();
+  EXPECT_EQ(site.handle(post).status, 400);
+  post.body = nlohmann::json{{"id", typed}, {"answer", "confirm"}, {"values", {{"sensor_uF", "4"}}}}.dump();
+  const HttpResponse refused = site.handle(post);
+  EXPECT_EQ(refused.status, 422);
+  EXPECT_EQ(nlohmann::json::parse(refused.body)["error"], "refused: not 5");
+  post.body = nlohmann::json{{"id", typed}, {"answer", "confirm"}, {"values", {{"sensor_uF", "5"}}}}.dump();
+  EXPECT_EQ(site.handle(post).status, 200);
+  std::map<std::string, std::string> got;
+  EXPECT_EQ(hub.wait_answer(typed, std::chrono::milliseconds(0), &got).value_or(""), "confirm");
+  EXPECT_EQ(got.at("sensor_uF"), "5");
 }
 
 }  // namespace

@@ -16,10 +16,13 @@
 #include <cstdint>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/rt/spsc_ring.hpp"
@@ -38,6 +41,7 @@ struct LogRecord {
   double latency_us = 0.0;
   double step_us = 0.0;
   std::uint32_t flags = 0;
+  std::int64_t measured_ns = 0;  // CLOCK_MONOTONIC (steady_clock) at the cycle's start (not logged)
 };
 inline constexpr std::uint32_t kFlagClamped = 1u << 0;
 inline constexpr std::uint32_t kFlagSlewLimited = 1u << 1;
@@ -45,12 +49,25 @@ inline constexpr std::uint32_t kFlagSafeState = 1u << 2;
 inline constexpr std::uint32_t kFlagRamping = 1u << 3;
 inline constexpr std::uint32_t kFlagSensorFault = 1u << 4;
 
+// A live copy of the log while the run goes (the station's web page, web/live_hub.hpp): every
+// `every`-th record, handed to `deliver` in order, in batches, on the logger thread, never on the
+// loop's (the loop only pushes into the ring, as for the log); each record says when it was
+// measured (measured_ns). An empty batch says the run is over. `deliver` should return within
+// milliseconds: while it runs the ring fills, and the loop drops log records (counted) only when
+// the ring is full (ring_capacity records). An exception from it is swallowed (the log goes on).
+struct LogTap {
+  std::size_t every = 1;
+  std::function<void(std::span<const LogRecord> records)> deliver;  // empty: no tap
+};
+
 struct LoggerOptions {
   std::optional<std::filesystem::path> file;  // written at the end (.mat or .csv); none = memory only
   std::size_t ring_capacity = 1u << 16;       // records (6.5 s at 10 kHz)
   std::size_t max_samples = 0;                // storage; records beyond it are dropped and counted
   double sample_rate = 10e3;                  // Hz, of the log (the loop's rate)
   std::map<std::string, io::Setting> settings;  // written into the file's `settings`
+  bool keep = true;                           // false: records only go to the tap (no storage)
+  LogTap tap;
   void validate() const;                      // InputError naming the field
 };
 
@@ -79,6 +96,8 @@ class SignalLogger {
  private:
   void run() noexcept;
   void store(const LogRecord& r) noexcept;
+  void tap(const LogRecord& r) noexcept;
+  void flush_tap(bool run_over) noexcept;
 
   LoggerOptions options_;
   SpscRing<LogRecord> ring_;
@@ -89,6 +108,8 @@ class SignalLogger {
   std::atomic<std::uint64_t> dropped_ring_{0};
   std::atomic<std::uint64_t> dropped_storage_{0};
   std::atomic<std::uint64_t> stored_{0};
+  std::vector<LogRecord> tap_batch_;  // allocated once; the tap's records not yet delivered
+  std::size_t tap_count_ = 0;
   std::exception_ptr error_;
   bool finished_ = false;
 };

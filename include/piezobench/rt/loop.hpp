@@ -84,6 +84,10 @@ struct LoopOptions {
   // 10 kHz); records beyond are dropped and counted in dropped_log_samples.
   std::size_t max_log_samples = 3'000'000;
   std::map<std::string, io::Setting> log_settings;  // added to the log file's settings
+  // A live copy of the log while the run goes (logger.hpp, LogTap): on the logger thread, so the
+  // cycles never wait on it, lock or allocate for it. With neither keep_log nor log_file, a logger
+  // runs for the tap alone.
+  LogTap log_tap;
   // Stop request (Ctrl-C; set from a signal handler): the loop enters its safe state (reason
   // "interrupted"), brings the output to the safe value at the slew limit (at most
   // max(|va_max|, |va_min|) / slew_rate + one period: 1.5 ms for the APA300ML) and ends the run

@@ -36,6 +36,8 @@ struct MeasureOptions {
   // FILE for one run, FILE with "-2", "-3" before the extension for the next ones.
   std::optional<std::filesystem::path> raw_log;
   std::function<void(const std::string&)> on_warning;
+  // A live copy of each loop run's log while it runs (LoopOptions::log_tap; the station's page).
+  LogTap log_tap;
 };
 
 struct OperatorConfirmation {

@@ -13,7 +13,7 @@ namespace piezobench::rt {
 
 struct TimingSummary {
   std::uint64_t count = 0;
-  double p50 = 0.0, p99 = 0.0, p999 = 0.0, max = 0.0;  // same unit as the samples
+  double p50 = 0.0, p99 = 0.0, p999 = 0.0, p9999 = 0.0, max = 0.0;  // same unit as the samples
   double mean = 0.0;
 };
 
@@ -26,7 +26,7 @@ class TimingHistogram {
   [[nodiscard]] double percentile(double q) const noexcept;
   [[nodiscard]] std::uint64_t count() const noexcept { return count_; }
   [[nodiscard]] double max() const noexcept { return max_; }
-  // p50, p99, p999, max and mean converted to microseconds.
+  // p50, p99, p999, p9999, max and mean converted to microseconds.
   [[nodiscard]] TimingSummary summary_us() const noexcept;
 
  private:

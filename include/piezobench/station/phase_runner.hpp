@@ -39,6 +39,7 @@
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/rt/backend.hpp"
 #include "piezobench/rt/bench_file.hpp"
+#include "piezobench/rt/logger.hpp"
 #include "piezobench/station/answers.hpp"
 #include "piezobench/station/record_store.hpp"
 #include "piezobench/station/station_file.hpp"
@@ -85,6 +86,9 @@ struct BenchInstrumentOptions {
   // samples then come due at their times; otherwise the record is complete and all of it is past).
   // Called on the runner's thread; must not block.
   std::function<void(const io::TimeSeries&, std::chrono::steady_clock::time_point)> on_record;
+  // Hardware: a live copy of the loop's log while each record runs (rt::LogTap, on the loop's
+  // logger thread; web::LiveHub::loop_tap), before on_record hands the whole record.
+  rt::LogTap live_tap;
 };
 
 // The bench as `measure` drives it: the virtual bench through bench::simulate, hardware through
@@ -123,6 +127,19 @@ class AnswersOperator final : public Operator {
   Answers answers_;
   std::map<std::string, std::size_t> check_answers_used_;
 };
+
+// The values an operator types for a phase (source "typed" or "file"), as every operator (the
+// terminal, the page) asks and checks them. `typed_value_fields` lists them in the order asked
+// ("sensor_uF", "actuator_uF"; or "file"; none for a bench phase), with the question of each;
+// `typed_values` checks the typed texts, `check_typed_value` one of them (InputError naming
+// "PHASE.FIELD_uF": a capacitance > 0 in uF; naming the phase: a file name that is not empty).
+struct TypedValueField {
+  std::string name;      // "sensor_uF", "actuator_uF", "file"
+  std::string question;  // "capacitance of the sensor stack(s), uF"
+};
+std::vector<TypedValueField> typed_value_fields(const PhaseSpec& phase);
+void check_typed_value(const PhaseSpec& phase, const std::string& field, const std::string& text);
+PhaseValues typed_values(const PhaseSpec& phase, const std::map<std::string, std::string>& typed);
 
 // Prompts on `out` (stderr), answers typed on `in` (stdin): "y" confirms, "a" aborts; after a
 // failed check "r" retries, "c" continues, "a" aborts. The end of the input aborts.

@@ -8,7 +8,9 @@
 // lock only to append (no I/O, no serialisation); a feeder thread of the hub releases each
 // record's screen samples when their measurement time has come (a paced virtual bench: sample k
 // of a record that started at T0 is measured at T0 + k / rate; hardware and unpaced records are
-// past when they arrive) and builds the FRF's averages. Clients read through a Mailbox: each call
+// past when they arrive) and builds the FRF's averages. On hardware the signals come sooner, while
+// each record runs, from the loop's log tap (loop_tap(): the loop's logger thread forms the screen
+// samples and appends each one as soon as its block has been measured). Clients read through a Mailbox: each call
 // of next() gives what changed since that client's previous call (the newest state, the screen
 // samples it has not had, bounded to the last window_s seconds, the newest FRF), so a slow client
 // skips states and never makes anything queue.
@@ -16,6 +18,8 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -24,6 +28,7 @@
 #include <vector>
 
 #include "piezobench/io/timeseries.hpp"
+#include "piezobench/rt/logger.hpp"
 #include "piezobench/station/phase_runner.hpp"
 #include "piezobench/web/http_server.hpp"
 
@@ -52,7 +57,16 @@ struct LivePrompt {
   std::uint64_t id = 0;
   std::string phase, text;
   std::vector<std::string> choices;  // "confirm", "abort", "retry", "continue"
+  std::vector<station::TypedValueField> fields;  // values to type with the answer (capacitance, a file)
 };
+
+// The page's answer to a prompt: taken, or why not.
+struct AnswerResult {
+  enum class Status { kTaken, kNotOpen, kRefused } status = Status::kTaken;
+  std::string message;  // kRefused: the refusal, as the terminal words it (the InputError's text)
+};
+// Checks a prompt's typed values (throws InputError to refuse them).
+using ValuesCheck = std::function<void(const std::map<std::string, std::string>& typed)>;
 
 class LiveHub final : public station::Observer {
  public:
@@ -78,12 +92,23 @@ class LiveHub final : public station::Observer {
   // sample was measured at `start`; decimated here, released by the feeder as its time comes.
   void record(const io::TimeSeries& record, std::chrono::steady_clock::time_point start);
 
+  // The live signals of a hardware bench (station::BenchInstrumentOptions::live_tap, rt::LogTap):
+  // about 1,000 of the loop's records per second of its `loop_rate_Hz` (every N-th), formed into
+  // screen samples on the loop's logger thread and appended as each block ends; the record
+  // given to record() afterwards then only feeds the FRF and the phase's length.
+  [[nodiscard]] rt::LogTap loop_tap(double loop_rate_Hz);
+
   // Prompts (web_operator.hpp): open one, wait for the page's answer, close it.
-  std::uint64_t open_prompt(const std::string& phase, const std::string& text, std::vector<std::string> choices);
-  // The page's answer to prompt `id`: false when it is not the open prompt or not one of its choices.
-  bool answer(std::uint64_t id, const std::string& choice);
-  // The answer to `id` when one came within `timeout`.
-  std::optional<std::string> wait_answer(std::uint64_t id, std::chrono::milliseconds timeout);
+  // A prompt with `fields` takes their typed texts with its answer, checked by `check` on the
+  // answering (server's) thread, outside the hub's lock.
+  std::uint64_t open_prompt(const std::string& phase, const std::string& text, std::vector<std::string> choices,
+                            std::vector<station::TypedValueField> fields = {}, ValuesCheck check = {});
+  // The page's answer to prompt `id`: kNotOpen when it is not the open prompt or not one of its
+  // choices; kRefused (the prompt stays open) when `check` refuses the typed values.
+  AnswerResult answer(std::uint64_t id, const std::string& choice, const std::map<std::string, std::string>& typed = {});
+  // The answer to `id` when one came within `timeout`; with its typed values in `typed`.
+  std::optional<std::string> wait_answer(std::uint64_t id, std::chrono::milliseconds timeout,
+                                         std::map<std::string, std::string>* typed = nullptr);
   void close_prompt(std::uint64_t id);
 
   // The whole state (phases, prompt, verdicts) as JSON text.
@@ -96,11 +121,13 @@ class LiveHub final : public station::Observer {
 
   struct Pending;
   struct Frf;
+  struct Tap;
 
  private:
   class Client;
   void feed();
   void release_due(std::chrono::steady_clock::time_point now);
+  void append_live(Tap& tap);
   void bump() { ++state_version_; }
   [[nodiscard]] std::string state_json_locked() const;
 
@@ -115,12 +142,19 @@ class LiveHub final : public station::Observer {
   std::vector<PhaseState> phases_;
   std::optional<LivePrompt> prompt_;
   std::uint64_t next_prompt_id_ = 1;
-  std::optional<std::pair<std::uint64_t, std::string>> answer_;
+  ValuesCheck prompt_check_;
+  struct Answer {
+    std::uint64_t id = 0;
+    std::string choice;
+    std::map<std::string, std::string> typed;
+  };
+  std::optional<Answer> answer_;
   std::string last_message_;
   std::uint64_t state_version_ = 1;
   std::deque<ScreenSample> samples_;
   std::uint64_t next_seq_ = 1;
   std::unique_ptr<Pending> pending_;  // the record being released
+  std::pair<std::string, int> live_shown_{"", -1};  // the phase try whose signals came from a loop tap
   std::unique_ptr<Frf> frf_;
   std::string frf_json_;
   std::uint64_t frf_version_ = 0;

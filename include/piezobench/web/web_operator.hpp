@@ -4,7 +4,9 @@
 // on the terminal as TerminalOperator shows it; the first answer from either side is taken, with
 // the same effect. The end of the terminal's input leaves the page alone to answer (a station run
 // in the background). With an answers file (`inner`), the file answers and the page only shows.
-// Typed values and files (capacitance, flatness) are asked on the terminal (or the file gives them).
+// Typed values and files (capacitance, flatness) are asked in the page (a field each, checked and
+// refused as the terminal refuses them, the prompt staying open) and on the terminal (one line
+// each; a bad line refused as TerminalOperator refuses it), or the answers file gives them.
 #include <atomic>
 #include <iosfwd>
 #include <memory>

@@ -141,16 +141,29 @@
     box.dataset.id = String(s.prompt.id);
     $('prompt-text').textContent = 'Operator: ' + s.prompt.text;
     $('prompt-error').textContent = '';
+    // Values to type (capacitance, a file name): a field each, checked here for its form and by the
+    // station as the terminal checks it (its refusal shown below, the prompt staying open).
+    const fields = (s.prompt.fields || []).map((f) => el('label', { class: 'field' }, f.question + ' ',
+      el('input', Object.assign({ type: 'text', name: f.name, 'data-field': f.name, required: true, autocomplete: 'off' },
+        f.name.endsWith('_uF') ? { inputMode: 'decimal', pattern: '[+\\-]?[0-9]*\\.?[0-9]+([eE][+\\-]?[0-9]+)?', title: 'a number, uF' } : {}))));
     const buttons = s.prompt.choices.map((c) => el('button', {
-      type: 'button', 'data-answer': c, onclick: () => answer(s.prompt.id, c),
+      type: 'button', 'data-answer': c, onclick: () => answer(s.prompt.id, c, fields.length > 0),
     }, c));
+    $('prompt-fields').replaceChildren(...fields);
     $('prompt-buttons').replaceChildren(...buttons);
     box.hidden = false;
   }
 
-  async function answer(id, choice) {
+  async function answer(id, choice, withValues) {
+    const body = { id, answer: choice };
+    if (withValues) {
+      const inputs = Array.from(document.querySelectorAll('#prompt-fields input'));
+      const bad = inputs.find((i) => !i.checkValidity());
+      if (bad) { $('prompt-error').textContent = `Not answered: ${bad.title || 'required'} (${bad.name})`; return; }
+      body.values = Object.fromEntries(inputs.map((i) => [i.name, i.value.trim()]));
+    }
     try {
-      await api('/api/answer', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ id, answer: choice }) });
+      await api('/api/answer', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
       live.answered.push({ id, choice });
       $('prompt').hidden = true;
     } catch (e) {
