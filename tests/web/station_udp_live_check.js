@@ -105,7 +105,7 @@ async function main() {
     const latencies = record.map((s) => s.arrived - s.at).sort((a, b) => a - b);
     const q = (p) => latencies[Math.min(latencies.length - 1, Math.floor(p * latencies.length))];
     if (early < 0.5 * record.length) failures.push(`only ${early} of ${record.length} screen samples arrived before the record's last sample was measured`);
-    if (!(q(0.99) < LATENCY_LIMIT_MS)) failures.push(`latency p99 ${q(0.99)} ms (limit ${LATENCY_LIMIT_MS} ms)`);
+    if (!(q(0.99) < LATENCY_LIMIT_MS)) failures.push(`latency p99 ${q(0.99).toFixed(0)} ms (limit ${LATENCY_LIMIT_MS} ms)`);
     // 20 screen samples per second of record, shown once (the record is ~RECORD_S long plus ramps).
     const expected = 20 * span;
     if (record.length > expected + 25 || record.length < 20 * RECORD_S - 5) failures.push(`${record.length} screen samples for ${span.toFixed(2)} s of record`);
@@ -116,7 +116,7 @@ async function main() {
     }
     console.log(`station_udp_live_check: qualify over UDP (bench serve on ${address}, 5 kHz): ${record.length} screen samples over ` +
       `${span.toFixed(2)} s of record, ${early} of them on the stream before the record's last sample was measured; ` +
-      `latency sample -> stream p50 ${q(0.5)} ms, p99 ${q(0.99)} ms, max ${latencies[latencies.length - 1]} ms`);
+      `latency sample -> stream p50 ${q(0.5).toFixed(0)} ms, p99 ${q(0.99).toFixed(0)} ms, max ${latencies[latencies.length - 1].toFixed(0)} ms`);
   } finally {
     clearTimeout(timer);
     for (const c of children) c.kill('SIGKILL');
