@@ -57,8 +57,7 @@ packages=(
   clang-14 libclang-rt-14-dev llvm-14
   # A one-node Slurm for the test of a campaign split over a cluster (tests/slurm, docs/cluster.md).
   slurm-wlm munge
-  # The report's plotting library comes from npm (src/report/js); the browser tests run headless
-  # Chromium, driven by npm's puppeteer-core (tests/js).
+  # The report's plotting library comes from npm (src/report/js); its test runs headless Chromium.
   nodejs chromium
 )
 # npm: Debian's package, unless the installed Node.js brings its own (NodeSource's conflicts with it).
@@ -78,17 +77,14 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-# npm trees, at the versions their package-lock.json pins; again whenever the lock file is newer
-# than the installed tree: the plotting library inlined into report.html (src/report/js), and
-# puppeteer-core, which drives Debian's chromium in the browser tests (tests/js).
-for npm_tree in src/report/js tests/js; do
-  npm_dir="$root/$npm_tree"
-  if [ ! -f "$npm_dir/node_modules/.package-lock.json" ] || \
-     [ "$npm_dir/package-lock.json" -nt "$npm_dir/node_modules/.package-lock.json" ]; then
-    echo "setup.sh: installing $npm_tree's npm packages with npm ci" >&2
-    npm ci --prefix "$npm_dir" --no-audit --no-fund --loglevel=error >/dev/null
-  fi
-done
+# The plotting library inlined into report.html, at the versions package-lock.json pins; again
+# whenever the lock file is newer than the installed tree.
+report_js="$root/src/report/js"
+if [ ! -f "$report_js/node_modules/.package-lock.json" ] || \
+   [ "$report_js/package-lock.json" -nt "$report_js/node_modules/.package-lock.json" ]; then
+  echo "setup.sh: installing the report's plotting library with npm ci" >&2
+  npm ci --prefix "$report_js" --no-audit --no-fund --loglevel=error >/dev/null
+fi
 
 if [ "$job" = fuzz ]; then
   # Only the reader libraries and the fuzz targets, with clang; Debian's matio, HDF5, ... linked.

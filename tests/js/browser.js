@@ -1,7 +1,8 @@
 // Headless Chromium for the browser checks (tests/report/render_check.js,
 // tests/web/station_page_check.js): Debian's /usr/bin/chromium (or $PIEZOBENCH_CHROMIUM) driven by
-// npm's puppeteer-core, pinned in tests/js/package-lock.json (`npm ci --prefix tests/js`, which
-// scripts/setup.sh runs). puppeteer-core never downloads a browser.
+// npm's puppeteer-core, pinned in tests/js/package-lock.json (tests/js/install.sh: `npm ci` when
+// missing or stale; the ctest fixture browser.npm_ci runs it). puppeteer-core never downloads a
+// browser.
 'use strict';
 const fs = require('node:fs');
 const os = require('node:os');
@@ -9,7 +10,7 @@ const path = require('node:path');
 
 // puppeteer-core at the version package-lock.json pins (a stale node_modules after a bump fails).
 function loadPuppeteer() {
-  const install = `run\n    npm ci --prefix ${__dirname} --no-audit --no-fund\n(scripts/setup.sh does)`;
+  const install = `run\n    bash ${path.join(__dirname, 'install.sh')}\n(the ctest fixture browser.npm_ci does)`;
   const lock = JSON.parse(fs.readFileSync(path.join(__dirname, 'package-lock.json'), 'utf8'));
   const pinned = lock.packages['node_modules/puppeteer-core'].version;
   let installed = null;
