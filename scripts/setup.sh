@@ -4,14 +4,16 @@
 #   scripts/setup.sh demo [--sanitize]   install what is missing, build, run the main job
 #   scripts/setup.sh test [--sanitize]   install what is missing, build, run the whole test suite
 #   scripts/setup.sh build [--sanitize]  install what is missing and build
-#   scripts/setup.sh fuzz                install what is missing, build the readers' libFuzzer
-#                                        targets with clang in build-fuzz/, replay the regression
+#   scripts/setup.sh fuzz                install what is missing, build the sanitizer tree (with
+#                                        the readers' libFuzzer targets), replay the regression
 #                                        corpus (fatal) and fuzz for PIEZOBENCH_FUZZ_SECONDS
 #                                        (default 88) in all, findings reported (docs/fuzzing.md)
 #
 # Installing is idempotent: packages already present are left alone, and nothing is installed
-# (not even an `apt-get update`) when everything is there. --sanitize builds in build-sanitize/
-# with AddressSanitizer and UndefinedBehaviorSanitizer; the normal build lives in build/.
+# (not even an `apt-get update`) when everything is there. The normal build lives in build/ (g++,
+# Release). --sanitize and fuzz share build-sanitize/: clang++-14 with AddressSanitizer,
+# UndefinedBehaviorSanitizer and libFuzzer's coverage instrumentation, the fuzz targets included,
+# so the two compilers both build the project and CI compiles the sanitized code once.
 set -euo pipefail
 
 job="${1:-}"
@@ -85,33 +87,22 @@ if [ ! -f "$report_js/node_modules/.package-lock.json" ] || \
   echo "setup.sh: installing the report's plotting library with npm ci" >&2
   npm ci --prefix "$report_js" --no-audit --no-fund --loglevel=error >/dev/null
 fi
+# The browser tests' puppeteer-core (tests/js), the same way (the ctest fixture browser.npm_ci runs
+# the same script, a no-op once installed).
+bash "$root/tests/js/install.sh" >/dev/null
 
-if [ "$job" = fuzz ]; then
-  # Only the reader libraries and the fuzz targets, with clang; Debian's matio, HDF5, ... linked.
+if [ "$job" = fuzz ]; then sanitize=1; fi
+if [ "$sanitize" -eq 1 ]; then
   # clang-14 is in the packages list above, so a missing compiler is an error, never a skip.
   command -v clang++-14 >/dev/null || { echo "setup.sh: clang++-14 not found (package clang-14)" >&2; exit 1; }
-  build_dir="$root/build-fuzz"
-  # -O1 -g1 (line tables for the stack traces; -g0 saves only 5 % of the build's CPU time). The
-  # build takes about 235 s of CPU (2 min on 2 cores), the regression replay seconds, the fuzzing
-  # PIEZOBENCH_FUZZ_SECONDS (88: 6 s per target of 14): about 4 minutes in all.
-  cmake -S "$root" -B "$build_dir" -G Ninja -DPIEZOBENCH_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 \
-    -DPIEZOBENCH_BUILD_PYTHON=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${PIEZOBENCH_FUZZ_CXXFLAGS:--O1 -g1 -DNDEBUG}" >/dev/null
-  cmake --build "$build_dir" -j "$(nproc 2>/dev/null || echo 2)" --target fuzzers
-  # The regression corpus: known inputs, any failure fails the job.
-  bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" regression
-  # Fresh mutations: a finding is reported and kept in build-fuzz/fuzz-artifacts/, not fatal (a new
-  # mutation must not fail CI for an unrelated change); PIEZOBENCH_FUZZ_FINDINGS=fail makes it fatal.
-  PIEZOBENCH_FUZZ_FINDINGS="${PIEZOBENCH_FUZZ_FINDINGS:-report}" \
-    bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" fuzz "${PIEZOBENCH_FUZZ_SECONDS:-88}"
-  exit 0
-fi
-
-if [ "$sanitize" -eq 1 ]; then
   build_dir="$root/build-sanitize"
-  # No Python module there: python3 would need the sanitizer runtime preloaded to load it.
-  # -O1 -g1: line tables for the sanitizers' stack traces at about half the compile time of -O2 -g.
-  config=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
-          -DPIEZOBENCH_SANITIZE=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
+  # clang compiles this Eigen-heavy code in about half g++'s time (src/lti/spectral.cpp with the
+  # sanitizers at -O1: 35 s against 62 s of CPU), and libFuzzer needs it. No Python module there:
+  # python3 would need the sanitizer runtime preloaded to load it. -O1 -g1: line tables for the
+  # stack traces at about half the compile time of -O2 -g.
+  config=(-DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
+          "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${PIEZOBENCH_SANITIZE_CXXFLAGS:--O1 -g1 -DNDEBUG}"
+          -DPIEZOBENCH_FUZZ=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
 else
   build_dir="$root/build"
   # The Python module is built for Debian's interpreter (where apt puts numpy, scipy and pytest),
@@ -125,6 +116,14 @@ cmake -S "$root" -B "$build_dir" -G Ninja "${config[@]}" >/dev/null
 cmake --build "$build_dir" -j "$jobs"
 
 case "$job" in
+  fuzz)
+    # The regression corpus: known inputs, any failure fails the job.
+    bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" regression
+    # Fresh mutations: a finding is reported and kept in build-sanitize/fuzz-artifacts/, not fatal (a
+    # new mutation must not fail CI for an unrelated change); PIEZOBENCH_FUZZ_FINDINGS=fail makes it fatal.
+    PIEZOBENCH_FUZZ_FINDINGS="${PIEZOBENCH_FUZZ_FINDINGS:-report}" \
+      bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" fuzz "${PIEZOBENCH_FUZZ_SECONDS:-88}"
+    ;;
   demo)
     # The main job: the report's 7-unit campaign simulated on the virtual bench, then analysed;
     # prints where report.html is.
@@ -133,6 +132,11 @@ case "$job" in
   test)
     export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
     export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+    # The longest tests start first (their costs measured in a sanitizer run: tests/ctest_costs.txt),
+    # so that no long test runs alone at the end of a fresh build's suite; ctest keeps the file
+    # up to date from then on.
+    costs="$build_dir/Testing/Temporary/CTestCostData.txt"
+    if [ ! -f "$costs" ]; then mkdir -p "$(dirname "$costs")" && cp "$root/tests/ctest_costs.txt" "$costs"; fi
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
   build) ;;

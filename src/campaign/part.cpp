@@ -162,7 +162,7 @@ template <class T> void decode(const json& j, T& v, const Where& w) {
     if (j.is_null()) {
       v.reset();
     } else {
-      v.emplace();
+      v = typename T::value_type{};  // not emplace(): clang 14 takes NmpEvidence::Zero for not default-constructible
       decode(j, *v, w);
     }
   } else if constexpr (IsVector<T>::value) {
