@@ -20,7 +20,8 @@
 //     Origin, an answer without the operator token, 1,000 concurrent connections) are refused
 //     cleanly and the qualification goes on;
 //   - Ctrl-C with the page's stream open ends qualify within 1 s.
-// Screenshots: OUT/live.png (during the FRF phase), OUT/final.png, OUT/database.png.
+// Screenshots: OUT/typed.png (a typed value refused), OUT/live.png (during the FRF phase),
+// OUT/final.png, OUT/database.png.
 //
 //   node station_page_check.js PIEZOBENCH BENCH.toml STATION.toml OUT_DIR
 'use strict';
@@ -103,7 +104,7 @@ async function hostileBurst(port) {
 // Types the capacitances in the page's fields as an operator would: first a bad sensor value
 // (-1 uF), which the station must refuse with the terminal's words (the prompt staying open), then
 // 5.2 and 10.1 uF. Returns { refusal, accepted }.
-async function typeValues(page, mouseClick) {
+async function typeValues(page, mouseClick, shotPath) {
   const fill = async (name, text) => {
     await page.click(`#prompt-fields input[name="${name}"]`, { clickCount: 3 });
     await page.keyboard.press('Backspace');
@@ -118,6 +119,9 @@ async function typeValues(page, mouseClick) {
     refusal = await page.evaluate("document.getElementById('prompt').hidden ? 'closed' : document.getElementById('prompt-error').textContent");
   }
   refusal = refusal.replace(/^Not answered: /, '');
+  // The refusal in the page: the top of the page down to the prompt's box.
+  const bottom = await page.evaluate("Math.ceil(document.getElementById('prompt').getBoundingClientRect().bottom) + 12");
+  await page.screenshot({ path: shotPath, clip: { x: 0, y: 0, width: WIDTH, height: Math.min(bottom, HEIGHT) } });
   await fill('sensor_uF', '5.2');
   await mouseClick('#prompt-buttons button[data-answer="confirm"]');
   let accepted = false;
@@ -217,7 +221,7 @@ async function main() {
         if (hostile) await hostile;  // the page's own requests must not meet the burst's 503s
         await sleep(300);  // an operator reads it
         if (s.fields > 0) {
-          typed = await typeValues(page, mouseClick);
+          typed = await typeValues(page, mouseClick, path.join(out, 'typed.png'));
           if (typed.accepted) answered.push(s.prompt);
         } else if (await mouseClick('#prompt-buttons button[data-answer="confirm"]')) answered.push(s.prompt);
         trace('answered prompt ' + s.prompt);
