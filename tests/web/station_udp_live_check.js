@@ -40,8 +40,9 @@ async function main() {
   fs.rmSync(out, { recursive: true, force: true });
   fs.mkdirSync(out, { recursive: true });
   const children = [];
+  const logs = { target: '', qualify: '' };
   const timer = setTimeout(() => {
-    console.error('station_udp_live_check: timed out after 90 s');
+    console.error(`station_udp_live_check: timed out after 90 s\n--- bench serve:\n${logs.target.slice(-1500)}\n--- qualify:\n${logs.qualify.slice(-3000)}`);
     for (const c of children) c.kill('SIGKILL');
     process.exit(1);
   }, 90000);
@@ -50,20 +51,25 @@ async function main() {
     const target = spawn(binary, ['bench', 'serve', '--udp', '127.0.0.1:0', '--rate', String(RATE_HZ), '--idle-timeout', '60'], { stdio: ['ignore', 'pipe', 'pipe'] });
     children.push(target);
     let targetOut = '';
-    target.stdout.on('data', (d) => { targetOut += d; });
+    target.stdout.on('data', (d) => { targetOut += d; logs.target += d; });
+    target.stderr.on('data', (d) => { logs.target += d; });
     const address = await waitFor(() => (targetOut.match(/127\.0\.0\.1:\d+/) || [])[0], 'address from bench serve', 10000);
     const bench = path.join(out, 'bench-udp.toml'), station = path.join(out, 'station.toml');
     fs.writeFileSync(bench, `[bench]\nname = "udp loopback"\nbackend = "udp"\nsample_rate_Hz = ${RATE_HZ}\n[udp]\naddress = "${address}"\ntimeout_s = 0.2\n` +
       '[amplifier]\ngain_V_per_V = 20\n[limits]\nva_min_V = -20\nva_max_V = 150\nslew_rate_V_per_s = 1e5\nwatchdog_s = 5.0\n');
     fs.writeFileSync(station, `name = "udp live"\n[[phases]]\nname = "frf"\nexperiment = "frf-noise"\nduration_s = ${RECORD_S}\n` +
       '[[phases.measurements]]\nname = "resonance_Hz"\n');
+    // The operator's answers: a try that fails its checks (a loaded host can make the loop miss
+    // replies: stale inputs) continues, instead of waiting for an answer nobody gives.
+    const answers = path.join(out, 'answers.toml');
+    fs.writeFileSync(answers, 'operator = "test"\n[phases.frf]\non_check_fail = ["continue"]\n');
 
     // The station, its page on a free port.
     const qualify = spawn(binary, ['qualify', '--bench', bench, '--station', station, '--serial', 'UDP-1', '--db', path.join(out, 'st.db'),
-      '--data', path.join(out, 'data'), '--ui', '127.0.0.1:0', '--ui-linger', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+      '--data', path.join(out, 'data'), '--answers', answers, '--ui', '127.0.0.1:0', '--ui-linger', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
     children.push(qualify);
     let stderr = '';
-    qualify.stderr.on('data', (d) => { stderr += d; });
+    qualify.stderr.on('data', (d) => { stderr += d; logs.qualify += d; });
     qualify.stdout.on('data', () => {});
     const exited = new Promise((resolve) => qualify.on('exit', (code) => resolve(code)));
     const base = await waitFor(() => (stderr.match(/station page: (http:\/\/127\.0\.0\.1:\d+\/)/) || [])[1], 'page address from qualify', 20000);
