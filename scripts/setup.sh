@@ -59,7 +59,8 @@ packages=(
   clang-14 libclang-rt-14-dev llvm-14
   # A one-node Slurm for the test of a campaign split over a cluster (tests/slurm, docs/cluster.md).
   slurm-wlm munge
-  # The report's plotting library comes from npm (src/report/js); its test runs headless Chromium.
+  # The report's plotting library comes from npm (src/report/js); the browser tests run headless
+  # Chromium, driven by npm's puppeteer-core (tests/js).
   nodejs chromium
 )
 # npm: Debian's package, unless the installed Node.js brings its own (NodeSource's conflicts with it).
