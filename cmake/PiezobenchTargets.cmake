@@ -59,20 +59,55 @@ function(piezobench_unity_build target)
   endif()
 endfunction()
 
-# piezobench_add_module(NAME <name> SOURCES <files...> [DEPS <targets...>])
+# piezobench_module(<name> LAYER <n> [DEPS <modules...>] [DIR <folder>] [WRAPS <headers...>])
+# One row of the module map (cmake/PiezobenchModules.cmake, which says what each argument means;
+# DIR and WRAPS are for scripts/check_module_deps.py).
+function(piezobench_module name)
+  cmake_parse_arguments(ARG "" "LAYER;DIR" "DEPS;WRAPS" ${ARGN})
+  if(ARG_UNPARSED_ARGUMENTS OR NOT DEFINED ARG_LAYER)
+    message(FATAL_ERROR "piezobench_module(${name}): expected LAYER <n> [DEPS <modules...>] [DIR <folder>] [WRAPS <headers...>]")
+  endif()
+  foreach(dep IN LISTS ARG_DEPS)
+    get_property(dep_layer GLOBAL PROPERTY PIEZOBENCH_LAYER_${dep})
+    if(dep_layer STREQUAL "")
+      message(FATAL_ERROR "piezobench_module(${name}): ${dep} is not declared above it")
+    endif()
+    if(NOT dep_layer LESS ARG_LAYER)
+      message(FATAL_ERROR "piezobench_module(${name}) at layer ${ARG_LAYER} uses ${dep} at layer ${dep_layer}: a module uses lower layers only")
+    endif()
+  endforeach()
+  set_property(GLOBAL PROPERTY PIEZOBENCH_LAYER_${name} ${ARG_LAYER})
+  set_property(GLOBAL PROPERTY PIEZOBENCH_DEPS_${name} ${ARG_DEPS})
+  set_property(GLOBAL PROPERTY PIEZOBENCH_DECLARED_${name} TRUE)
+endfunction()
+
+# piezobench_add_module(NAME <name> SOURCES <files...> [DEPS <third-party targets...>])
 # Declares the library piezobench_<name> with the alias piezobench::<name>. Its public headers live
-# in include/piezobench/<name>/; its sources and private headers in src/<name>/.
+# in include/piezobench/<name>/; its sources and private headers in src/<name>/ (its folder in the
+# module map), which only this module sees. It links the piezobench modules the map
+# (cmake/PiezobenchModules.cmake) lists for it; DEPS names third-party libraries only.
 function(piezobench_add_module)
   cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS" ${ARGN})
+  get_property(declared GLOBAL PROPERTY PIEZOBENCH_DECLARED_${ARG_NAME})
+  if(NOT declared)
+    message(FATAL_ERROR "module ${ARG_NAME} is not in the module map (cmake/PiezobenchModules.cmake)")
+  endif()
+  foreach(dep IN LISTS ARG_DEPS)
+    if(dep MATCHES "^piezobench::")
+      message(FATAL_ERROR "module ${ARG_NAME}: ${dep} in DEPS; the module map (cmake/PiezobenchModules.cmake) lists the modules it uses")
+    endif()
+  endforeach()
+  get_property(module_deps GLOBAL PROPERTY PIEZOBENCH_DEPS_${ARG_NAME})
+  list(TRANSFORM module_deps PREPEND "piezobench::")
   set(target piezobench_${ARG_NAME})
   add_library(${target} STATIC ${ARG_SOURCES})
   add_library(piezobench::${ARG_NAME} ALIAS ${target})
   target_include_directories(${target}
     PUBLIC "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>" "$<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>"
            "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>"
-    PRIVATE "${PROJECT_SOURCE_DIR}/src")
+    PRIVATE "${CMAKE_CURRENT_SOURCE_DIR}")
   # The warnings and sanitizer flags are for this build only; an installed module asks for C++20.
-  target_link_libraries(${target} PUBLIC "$<BUILD_INTERFACE:piezobench::options>" ${ARG_DEPS})
+  target_link_libraries(${target} PUBLIC "$<BUILD_INTERFACE:piezobench::options>" ${module_deps} ${ARG_DEPS})
   target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON EXPORT_NAME ${ARG_NAME})
   piezobench_unity_build(${target})
@@ -104,11 +139,16 @@ function(piezobench_install_package)
 endfunction()
 
 # piezobench_add_test(NAME <name> SOURCES <files...> DEPS <targets...>)
-# One GoogleTest executable per module; each TEST becomes a CTest test.
+# One GoogleTest executable per module; each TEST becomes a CTest test. The tests of tests/<module>/
+# see that module's private headers (src/<module>/) and no other module's.
 function(piezobench_add_test)
   cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SOURCES})
-  target_include_directories(${ARG_NAME} PRIVATE "${PROJECT_SOURCE_DIR}/tests" "${PROJECT_SOURCE_DIR}/src")
+  get_filename_component(tested_module "${CMAKE_CURRENT_SOURCE_DIR}" NAME)
+  target_include_directories(${ARG_NAME} PRIVATE "${PROJECT_SOURCE_DIR}/tests")
+  if(IS_DIRECTORY "${PROJECT_SOURCE_DIR}/src/${tested_module}")
+    target_include_directories(${ARG_NAME} PRIVATE "${PROJECT_SOURCE_DIR}/src/${tested_module}")
+  endif()
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} piezobench::testutil GTest::gtest GTest::gmock GTest::gtest_main)
   target_compile_definitions(${ARG_NAME} PRIVATE
     PIEZOBENCH_SOURCE_DIR="${PROJECT_SOURCE_DIR}"

@@ -11,6 +11,7 @@
 #include "piezobench/io.hpp"
 #include "piezobench/lti.hpp"
 #include "piezobench/metrology.hpp"
+#include "piezobench/plant.hpp"
 #include "piezobench/report.hpp"
 #include "piezobench/rt.hpp"
 #include "piezobench/station.hpp"

@@ -2,13 +2,15 @@
 // The core module: errors (InputError, NumericalError, UsageError), shared constants, the one
 // Levenberg-Marquardt, the one golden-section search, fit-quality verdicts and sign-constrained
 // linear least squares, the median, a runner of independent jobs on a few threads, text helpers
-// whole-file input/output shared by the readers, and shared libraries loaded on first use.
+// whole-file input/output shared by the readers, shared libraries loaded on first use, and files
+// linked into the binary (incbin.hpp).
 #include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/format.hpp"
+#include "piezobench/core/incbin.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/core/memory.hpp"
 #include "piezobench/core/minimize.hpp"

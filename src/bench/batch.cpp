@@ -6,8 +6,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "bench/flatness.hpp"
-#include "bench/random.hpp"
+#include "flatness.hpp"
+#include "random.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"

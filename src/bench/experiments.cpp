@@ -9,8 +9,8 @@
 #include <span>
 #include <utility>
 
-#include "bench/flatness.hpp"
-#include "bench/random.hpp"
+#include "flatness.hpp"
+#include "random.hpp"
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/control/discrete_iff.hpp"
 #include "piezobench/control/hysteresis_feedforward.hpp"
@@ -153,7 +153,7 @@ io::TimeSeries stroke(BenchRunner& runner, const UnitTruth& unit, const Experime
     u(k) = va / b.amplifier_gain;
   }
   Eigen::MatrixXd y;  // u, Va, de, Vs at the bench's rate
-  runner.open_loop(u, detail::derive_seed(seed, stream(Experiment::kStroke, 0)), y, progress);
+  runner.open_loop(u, experiment_bench_seed(Experiment::kStroke, seed), y, progress);
   // The displacement probe (Millimar 1318): first-order bandwidth, noise; recorded at 1 kHz.
   const double probe_bw = 2.0;      // Hz
   const double probe_noise = 10e-9;  // m rms
@@ -216,7 +216,7 @@ io::TimeSeries hysteresis(BenchRunner& runner, const UnitTruth& unit, const Expe
   dsp::VoltageBounds bounds{b.va_min / b.amplifier_gain - 1e-9, b.va_max / b.amplifier_gain + 1e-9, dsp::BoundsPolicy::kReject};
   const dsp::Excitation ex = dsp::offset_sine(s, bounds);
   Eigen::MatrixXd y;
-  runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kHysteresis, 0)), y, progress);
+  runner.open_loop(ex.u, experiment_bench_seed(Experiment::kHysteresis, seed), y, progress);
   io::TimeSeries ts = open_loop_record(std::move(y), b.sample_rate, false);
   common_settings(ts, Experiment::kHysteresis, unit, b, seed, &runner);
   ts.settings["amplitude_V"] = amplitude;
@@ -239,7 +239,7 @@ io::TimeSeries stiffness(BenchRunner& runner, const UnitTruth& unit, const Exper
       {t_off, fmt::format("take the {:g} kg mass off", b.added_mass), 0.0, ramp}};
   Eigen::MatrixXd y;
   const std::vector<double> done =
-      runner.hold(n, steps, detail::derive_seed(seed, stream(Experiment::kStiffness, 0)), y, progress);
+      runner.hold(n, steps, experiment_bench_seed(Experiment::kStiffness, seed), y, progress);
   io::TimeSeries ts = make_record({"de", "added_mass"}, {"m", "kg"}, n, fs, true);
   ts.data = y;
   common_settings(ts, Experiment::kStiffness, unit, b, seed, &runner);
@@ -284,7 +284,7 @@ io::TimeSeries frf_noise(BenchRunner& runner, const UnitTruth& unit, const Exper
   const dsp::NoiseOptions& no = noise.options;
   const dsp::Excitation& ex = noise.excitation;
   Eigen::MatrixXd y;
-  runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kFrfNoise, 0)), y, progress);
+  runner.open_loop(ex.u, experiment_bench_seed(Experiment::kFrfNoise, seed), y, progress);
   io::TimeSeries ts = open_loop_record(std::move(y), b.sample_rate, true);
   common_settings(ts, Experiment::kFrfNoise, unit, b, seed, &runner);
   ts.settings["duration_s"] = duration;
@@ -317,7 +317,7 @@ io::TimeSeries frf_sweep(BenchRunner& runner, const UnitTruth& unit, const Exper
   const dsp::Excitation ex = dsp::sine_sweep(so, {-1e300, 1e300, dsp::BoundsPolicy::kReject});
   check_range(ex.u, b, fmt::format("a sweep of {:g} V amplitude at the stacks", va_amplitude));
   Eigen::MatrixXd y;
-  runner.open_loop(ex.u, detail::derive_seed(seed, stream(Experiment::kFrfSweep, 0)), y, progress);
+  runner.open_loop(ex.u, experiment_bench_seed(Experiment::kFrfSweep, seed), y, progress);
   io::TimeSeries ts = open_loop_record(std::move(y), b.sample_rate, true);
   common_settings(ts, Experiment::kFrfSweep, unit, b, seed, &runner);
   ts.settings["duration_s"] = duration;
@@ -340,7 +340,7 @@ io::TimeSeries iff(BenchRunner& runner, const UnitTruth& unit, const ExperimentO
   const dsp::Excitation& ex = noise.excitation;
   const Eigen::Index n = ex.u.size();
   Eigen::MatrixXd y;
-  const std::uint64_t clamped = runner.iff(ex.u, gain, detail::derive_seed(seed, stream(Experiment::kIff, 0)), y, progress);
+  const std::uint64_t clamped = runner.iff(ex.u, gain, experiment_bench_seed(Experiment::kIff, seed), y, progress);
   io::TimeSeries ts = make_record({"u_prime", "u", "Va", "de", "Vs"}, {"V", "V", "V", "m", "V"}, n, b.sample_rate, true);
   ts.data.col(0) = ex.u;
   ts.data.rightCols(4) = y;
@@ -405,7 +405,7 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
   Eigen::VectorXd u(n);
   for (Eigen::Index k = 0; k < n; ++k) u(k) = c[static_cast<std::size_t>(k)] / b.amplifier_gain;
   Eigen::MatrixXd open, comp;  // u, Va, de, Vs
-  runner.open_loop(u, detail::derive_seed(seed, stream(Experiment::kTracking, 0)), open, progress_part(0.0, 0.5));
+  runner.open_loop(u, experiment_bench_seed(Experiment::kTracking, seed), open, progress_part(0.0, 0.5));
 
   ident::HysteresisModel model;
   double fit_residual = 0.0;
@@ -470,7 +470,7 @@ io::TimeSeries hammer(const UnitTruth& unit, const ExperimentOptions& o, std::ui
   const int impacts = 5;
   const double spacing = 2.0, first = 0.5, width = 1e-3;
   const auto n = static_cast<Eigen::Index>(std::llround((first + spacing * impacts) * fs));
-  detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kHammer, 0)));
+  detail::Xoshiro256 rng(experiment_bench_seed(Experiment::kHammer, seed));
   // Impact force: half-sine pulses of 1 ms, 50..150 N.
   Eigen::VectorXd force = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < impacts; ++i) {
@@ -520,7 +520,7 @@ io::TimeSeries hammer(const UnitTruth& unit, const ExperimentOptions& o, std::ui
 
 io::TimeSeries flatness(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed) {
   const double probe_noise = 0.5e-6;  // m: the probe's specified accuracy, a uniform error within +-
-  detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kFlatness, 0)));
+  detail::Xoshiro256 rng(experiment_bench_seed(Experiment::kFlatness, seed));
   const Eigen::Matrix<double, 8, 3> layout = detail::probe_layout();
   const Eigen::Matrix<double, 8, 1> z = detail::probe_heights(unit);
   // The part sits in its clamp with some tilt and height of its own (removed by the plane fit).
@@ -539,7 +539,7 @@ io::TimeSeries flatness(const UnitTruth& unit, const ExperimentOptions& o, std::
 
 io::TimeSeries capacitance(const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed) {
   const double accuracy = 5e-4;  // LCR-819: 0.05 %, a uniform error within +-
-  detail::Xoshiro256 rng(detail::derive_seed(seed, stream(Experiment::kCapacitance, 0)));
+  detail::Xoshiro256 rng(experiment_bench_seed(Experiment::kCapacitance, seed));
   io::TimeSeries ts = make_record({"C_sensor", "C_actuator"}, {"F", "F"}, 1, 1.0, false);
   const double e1 = o.bench.noise ? accuracy * rng.symmetric() : 0.0;
   const double e2 = o.bench.noise ? accuracy * rng.symmetric() : 0.0;
@@ -552,6 +552,10 @@ io::TimeSeries capacitance(const UnitTruth& unit, const ExperimentOptions& o, st
 }
 
 }  // namespace
+
+std::uint64_t experiment_bench_seed(Experiment experiment, std::uint64_t seed) noexcept {
+  return detail::derive_seed(seed, stream(experiment, 0));
+}
 
 VirtualRunner::VirtualRunner(const UnitTruth& unit, const BenchOptions& options) : unit_(unit), options_(options) {}
 VirtualRunner::~VirtualRunner() = default;

@@ -1,4 +1,4 @@
-#include "bench/flatness.hpp"
+#include "flatness.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "bench/nonlinear.hpp"
+#include "nonlinear.hpp"
 
 #include <cmath>
 

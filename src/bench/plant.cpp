@@ -1,4 +1,4 @@
-#include "bench/plant.hpp"
+#include "plant.hpp"
 
 #include <fmt/format.h>
 

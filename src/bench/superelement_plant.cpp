@@ -1,4 +1,4 @@
-#include "bench/superelement_plant.hpp"
+#include "superelement_plant.hpp"
 
 #include <fmt/format.h>
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/plant.hpp"
+#include "plant.hpp"
 #include "piezobench/fem/structural_model.hpp"
 #include "piezobench/fem/superelement.hpp"
 #include "piezobench/fem/superelement_setup.hpp"

@@ -7,8 +7,8 @@
 #include <optional>
 #include <utility>
 
-#include "bench/flatness.hpp"
-#include "bench/plant.hpp"
+#include "flatness.hpp"
+#include "plant.hpp"
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/core/units.hpp"

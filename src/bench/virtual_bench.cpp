@@ -9,10 +9,10 @@
 #include <numbers>
 #include <vector>
 
-#include "bench/nonlinear.hpp"
-#include "bench/plant.hpp"
-#include "bench/random.hpp"
-#include "bench/superelement_plant.hpp"
+#include "nonlinear.hpp"
+#include "plant.hpp"
+#include "random.hpp"
+#include "superelement_plant.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
 

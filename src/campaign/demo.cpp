@@ -12,7 +12,7 @@
 
 #include <toml++/toml.h>
 
-#include "campaign/embedded_superelement.hpp"
+#include "embedded_superelement.hpp"
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/bench/truth.hpp"
 #include "piezobench/bench/virtual_bench.hpp"

@@ -1,7 +1,7 @@
 // The shipped APA300ML super element, pulled into the object file by the assembler (.incbin). The
 // folder and a SHA-256 of the files are compile definitions set by src/campaign/CMakeLists.txt; the
 // hash is part of the preprocessed text, so ccache rebuilds this file whenever a file changes.
-#include "campaign/embedded_superelement.hpp"
+#include "embedded_superelement.hpp"
 
 #include "piezobench/io/atomic_file.hpp"
 

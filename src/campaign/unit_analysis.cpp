@@ -1,7 +1,6 @@
 #include "piezobench/campaign/unit_analysis.hpp"
 
 #include <fmt/format.h>
-#include <matio.h>
 
 #include <algorithm>
 #include <cctype>
@@ -26,8 +25,6 @@
 #include "piezobench/metrology/stiffness.hpp"
 #include "piezobench/metrology/stroke.hpp"
 
-#include "io/mat_file.hpp"
-
 namespace piezobench::campaign {
 
 namespace fs = std::filesystem;
@@ -47,41 +44,6 @@ VectorXd Record::time() const {
   if (ts.t.size() == ts.samples()) return ts.t;
   return VectorXd::LinSpaced(ts.samples(), 0.0, static_cast<double>(ts.samples() - 1) / ts.sample_rate);
 }
-
-namespace {
-
-// LCR readings are one sample per channel, which the time-series readers refuse in a .mat file
-// (a record has 2 samples or more): read them as real numeric scalars or vectors.
-// Returns false when the file is not a .mat file or lacks a channel (the reader's message is then
-// the one to show).
-bool read_readings_mat(const fs::path& file, const std::vector<std::string>& channels, io::TimeSeries& out) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  if (ext != ".mat") return false;
-  // io's bounded MAT reader (a v7.3 file is read by an isolated child, never by HDF5 here).
-  const io::detail::MatFilePtr mat = io::detail::open_mat_for_reading(file);
-  const std::vector<io::detail::MatVarInfo> vars = io::detail::list_mat_variables(mat.get(), file);
-  std::vector<VectorXd> values;
-  for (const auto& name : channels) {
-    if (std::none_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; })) return false;
-    const io::detail::MatValue v = io::detail::read_mat_variable(mat.get(), file, name);
-    const bool ok = v.class_type == MAT_C_DOUBLE && !v.is_complex && v.has_data && v.dims.size() == 2 &&
-                    (v.dims[0] == 1 || v.dims[1] == 1) && v.count() >= 1;
-    if (!ok) return false;
-    values.push_back(io::detail::to_real_vector(v, file.string(), name));
-  }
-  const Index n = values.front().size();
-  if (std::any_of(values.begin(), values.end(), [&](const VectorXd& v) { return v.size() != n; })) return false;
-  out.names = channels;
-  out.data.resize(n, static_cast<Index>(channels.size()));
-  for (std::size_t j = 0; j < values.size(); ++j) out.data.col(static_cast<Index>(j)) = values[j];
-  out.sample_rate = 1.0;
-  out.source = file.string();
-  out.validate();
-  return true;
-}
-
-}  // namespace
 
 namespace {
 
@@ -123,7 +85,13 @@ Record read_record(const Campaign& campaign, const FileSpec& spec, Experiment ex
     r.ts = io::read_timeseries(spec.path, read);
   } catch (const InputError& e) {
     try {
-      if (experiment == Experiment::kCapacitance && read_readings_mat(spec.path, read.channels, r.ts)) return r;
+      // LCR readings are one sample per channel, which read_timeseries refuses in a .mat file.
+      if (experiment == Experiment::kCapacitance) {
+        if (std::optional<io::TimeSeries> readings = io::read_mat_readings(spec.path, read.channels)) {
+          r.ts = std::move(*readings);
+          return r;
+        }
+      }
     } catch (const InputError&) {
       // NaN readings and the like: the reader's message below
     }

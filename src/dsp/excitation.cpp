@@ -10,7 +10,7 @@
 #include <sstream>
 #include <utility>
 
-#include "dsp/fft.hpp"
+#include "fft.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/memory.hpp"

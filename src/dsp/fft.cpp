@@ -1,4 +1,4 @@
-#include "dsp/fft.hpp"
+#include "fft.hpp"
 
 #include <fftw3.h>
 

@@ -10,7 +10,7 @@
 #include <limits>
 #include <thread>
 
-#include "dsp/fft.hpp"
+#include "fft.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::dsp {

@@ -10,8 +10,8 @@
 #include <system_error>
 #include <unistd.h>
 
-#include "fem/from_step_files.hpp"
-#include "fem/from_step_process.hpp"
+#include "from_step_files.hpp"
+#include "from_step_process.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"

@@ -1,4 +1,4 @@
-#include "fem/from_step_files.hpp"
+#include "from_step_files.hpp"
 
 #include <algorithm>
 #include <cctype>

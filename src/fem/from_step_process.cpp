@@ -1,4 +1,4 @@
-#include "fem/from_step_process.hpp"
+#include "from_step_process.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>

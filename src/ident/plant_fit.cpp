@@ -128,7 +128,7 @@ core::FitCovariance covariance_at(const core::ResidualFunction& residual, const 
   return core::fit_covariance(core::central_difference_jacobian(residual, x), residual(x), residual_std);
 }
 
-Complex model(const IffPlantFit& p, double w) { return control::iff_plant_response(p, w); }
+Complex model(const IffPlantFit& p, double w) { return plant::iff_plant_response(p, w); }
 
 // Scaled parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, log w_hpf, delay / 100 us.
 constexpr double kXzScale = 0.01;
@@ -187,9 +187,9 @@ core::LmResult least_squares(const core::ResidualFunction& residual, const Eigen
 
 }  // namespace
 
-lti::TransferFunction IffPlantFit::transfer_function() const { return control::iff_plant(*this); }
+lti::TransferFunction IffPlantFit::transfer_function() const { return plant::iff_plant(*this); }
 
-CVector IffPlantFit::response(const Vector& omega) const { return control::iff_plant_response(*this, omega); }
+CVector IffPlantFit::response(const Vector& omega) const { return plant::iff_plant_response(*this, omega); }
 
 ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit* plant, double ambiguity_deg) {
   ZeroPhaseVerdict v;

@@ -1,4 +1,4 @@
-#include "io/csv_table.hpp"
+#include "csv_table.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -13,9 +13,9 @@
 #include <set>
 #include <sstream>
 
-#include "io/csv_table.hpp"
-#include "io/mat_file.hpp"
-#include "io/uff58.hpp"
+#include "csv_table.hpp"
+#include "mat_file.hpp"
+#include "uff58.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"

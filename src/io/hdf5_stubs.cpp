@@ -9,7 +9,7 @@
 // The soname is the one the build found (PIEZOBENCH_HDF5_SONAME, src/io/CMakeLists.txt).
 #include <hdf5.h>
 
-#include "io/isolated.hpp"
+#include "isolated.hpp"
 #include "piezobench/core/shared_library.hpp"
 
 #define PIEZOBENCH_HDF5_FUNCTIONS(X)                                                                             \

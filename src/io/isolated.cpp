@@ -1,4 +1,4 @@
-#include "io/isolated.hpp"
+#include "isolated.hpp"
 
 #include <fcntl.h>
 #include <sys/wait.h>

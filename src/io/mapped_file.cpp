@@ -1,4 +1,4 @@
-#include "io/mapped_file.hpp"
+#include "mapped_file.hpp"
 
 #if defined(__unix__)
 #include <fcntl.h>

@@ -1,9 +1,9 @@
-#include "io/mat_file.hpp"
+#include "mat_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
 
-#include "io/isolated.hpp"
+#include "isolated.hpp"
 
 #include <algorithm>
 #include <array>

@@ -12,9 +12,9 @@
 #include <fstream>
 #include <limits>
 
-#include "io/isolated.hpp"
-#include "io/mat_file.hpp"
-#include "io/mapped_file.hpp"
+#include "isolated.hpp"
+#include "mat_file.hpp"
+#include "mapped_file.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/text.hpp"
 

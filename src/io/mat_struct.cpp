@@ -9,7 +9,7 @@
 #include <set>
 #include <vector>
 
-#include "io/mat_file.hpp"
+#include "mat_file.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::io {

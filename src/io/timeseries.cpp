@@ -10,10 +10,10 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "io/csv_table.hpp"
-#include "io/mat_file.hpp"
-#include "io/uff58.hpp"
-#include "io/mapped_file.hpp"
+#include "csv_table.hpp"
+#include "mat_file.hpp"
+#include "uff58.hpp"
+#include "mapped_file.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
@@ -1056,6 +1056,31 @@ TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeries
 }  // namespace
 
 TimeSeries read_timeseries_mat(const fs::path& file, const ReadOptions& options) { return read_mat(file, options, nullptr); }
+
+std::optional<TimeSeries> read_mat_readings(const fs::path& file, const std::vector<std::string>& channels) {
+  if (channels.empty() || text::to_lower(file.extension().string()) != ".mat") return std::nullopt;
+  const detail::MatFilePtr mat = detail::open_mat_for_reading(file);
+  const std::vector<detail::MatVarInfo> vars = detail::list_mat_variables(mat.get(), file);
+  std::vector<Eigen::VectorXd> values;
+  for (const auto& name : channels) {
+    if (std::none_of(vars.begin(), vars.end(), [&](const detail::MatVarInfo& v) { return v.name == name; })) return std::nullopt;
+    const detail::MatValue v = detail::read_mat_variable(mat.get(), file, name);
+    const bool vector = v.class_type == MAT_C_DOUBLE && !v.is_complex && v.has_data && v.dims.size() == 2 &&
+                        (v.dims[0] == 1 || v.dims[1] == 1) && v.count() >= 1;
+    if (!vector) return std::nullopt;
+    values.push_back(detail::to_real_vector(v, file.string(), name));
+  }
+  const Eigen::Index n = values.front().size();
+  if (std::any_of(values.begin(), values.end(), [&](const Eigen::VectorXd& v) { return v.size() != n; })) return std::nullopt;
+  TimeSeries ts;
+  ts.names = channels;
+  ts.data.resize(n, static_cast<Eigen::Index>(channels.size()));
+  for (std::size_t j = 0; j < values.size(); ++j) ts.data.col(static_cast<Eigen::Index>(j)) = values[j];
+  ts.sample_rate = 1.0;
+  ts.source = file.string();
+  ts.validate();
+  return ts;
+}
 
 TimeSeriesView read_timeseries_view(const fs::path& file, const ReadOptions& options, FiniteCheck finite) {
   TimeSeriesView view;

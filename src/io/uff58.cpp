@@ -16,7 +16,7 @@
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
-#include "io/uff58.hpp"
+#include "uff58.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/io/units.hpp"
 

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <limits>
 
-#include "lti/balance.hpp"
-#include "lti/check.hpp"
-#include "lti/spectral.hpp"
+#include "balance.hpp"
+#include "check.hpp"
+#include "spectral.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
 

@@ -1,4 +1,4 @@
-#include "lti/balance.hpp"
+#include "balance.hpp"
 
 #include <algorithm>
 #include <cmath>

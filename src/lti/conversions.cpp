@@ -7,9 +7,9 @@
 #include <limits>
 #include <vector>
 
-#include "lti/balance.hpp"
-#include "lti/check.hpp"
-#include "lti/spectral.hpp"
+#include "balance.hpp"
+#include "check.hpp"
+#include "spectral.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/lti/interconnect.hpp"

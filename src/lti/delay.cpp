@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "lti/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "lti/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/lti/conversions.hpp"

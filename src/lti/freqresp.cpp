@@ -8,7 +8,7 @@
 #include <string>
 #include <thread>
 
-#include "lti/balance.hpp"
+#include "balance.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
 

@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "lti/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 

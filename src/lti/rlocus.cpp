@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "lti/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/minimize.hpp"
 #include "piezobench/core/format.hpp"

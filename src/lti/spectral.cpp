@@ -1,12 +1,12 @@
-#include "lti/spectral.hpp"
+#include "spectral.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
 
-#include "lti/balance.hpp"
-#include "lti/check.hpp"
+#include "balance.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::lti::detail {

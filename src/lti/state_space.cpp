@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "lti/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::lti {

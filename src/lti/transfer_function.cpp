@@ -2,8 +2,8 @@
 
 #include <utility>
 
-#include "lti/check.hpp"
-#include "lti/spectral.hpp"
+#include "check.hpp"
+#include "spectral.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 

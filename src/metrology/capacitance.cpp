@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "metrology/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/statistics.hpp"

@@ -7,7 +7,7 @@
 #include <limits>
 #include <numeric>
 
-#include "metrology/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::metrology {

@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "metrology/check.hpp"
+#include "check.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 

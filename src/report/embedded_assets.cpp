@@ -2,8 +2,8 @@
 // as a multi-megabyte C++ string literal. The paths and a SHA-256 of the files are compile
 // definitions set by src/report/CMakeLists.txt; the hash is part of the preprocessed text, so
 // ccache rebuilds this file whenever an asset changes.
-#include "report/embedded_assets.hpp"
-#include "report/incbin.hpp"
+#include "piezobench/report/embedded_assets.hpp"
+#include "piezobench/core/incbin.hpp"
 
 #ifndef PIEZOBENCH_REPORT_PLOTLY_JS
 #error "PIEZOBENCH_REPORT_PLOTLY_JS is set by src/report/CMakeLists.txt"
@@ -25,7 +25,7 @@ PIEZOBENCH_REPORT_DECLARE(plotly)
 PIEZOBENCH_REPORT_DECLARE(script)
 PIEZOBENCH_REPORT_DECLARE(style)
 
-namespace piezobench::report::detail {
+namespace piezobench::report {
 
 namespace {
 std::string_view blob(const char* begin, const char* end) {
@@ -46,4 +46,4 @@ std::string_view report_style() {
   return blob(piezobench_report_style_begin, piezobench_report_style_end);
 }
 
-}  // namespace piezobench::report::detail
+}  // namespace piezobench::report

@@ -14,7 +14,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/version.hpp"
-#include "report/embedded_assets.hpp"
+#include "piezobench/report/embedded_assets.hpp"
 
 namespace piezobench::report {
 namespace {
@@ -753,7 +753,7 @@ void contents(std::string& out, const Document& doc) {
 
 std::string render_html(const nlohmann::json& document) {
   const Document doc = read_document(document);
-  const std::string_view library = detail::plotting_library();
+  const std::string_view library = plotting_library();
   // Inlined verbatim: the library must not end its own <script> element (checked by the tests).
   std::string out;
   out.reserve(library.size() + 64 * 1024);
@@ -763,9 +763,9 @@ std::string render_html(const nlohmann::json& document) {
       "<meta name=\"generator\" content=\"piezobench ";
   out += kVersion;
   out += ", plotly.js ";
-  out += detail::plotting_library_version();
+  out += plotting_library_version();
   out += "\">\n<title>" + escape(doc.title) + "</title>\n<style>\n";
-  out += detail::report_style();
+  out += report_style();
   out += "</style>\n</head>\n<body>\n<header>\n<h1>" + escape(doc.title) + "</h1>\n";
   if (!doc.subtitle.empty()) out += "<p class=\"subtitle\">" + escape(doc.subtitle) + "</p>\n";
   out += "<p id=\"pb-status\" data-state=\"pending\" data-figures=\"" + std::to_string(doc.figure_count) +
@@ -804,7 +804,7 @@ std::string render_html(const nlohmann::json& document) {
   out += "</script>\n<script>\n";
   out += library;
   out += "\n</script>\n<script>\n";
-  out += detail::report_script();
+  out += report_script();
   out += "</script>\n</body>\n</html>\n";
   return out;
 }

@@ -17,7 +17,7 @@
 #include "piezobench/lti/interconnect.hpp"
 #include "piezobench/rt/loop.hpp"
 #include "piezobench/rt/virtual_backend.hpp"
-#include "rt/util.hpp"
+#include "util.hpp"
 #include "piezobench/core/units.hpp"
 
 namespace piezobench::rt {

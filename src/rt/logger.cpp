@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "piezobench/core/error.hpp"
-#include "rt/util.hpp"
+#include "util.hpp"
 
 namespace piezobench::rt {
 namespace {

@@ -18,7 +18,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
-#include "rt/util.hpp"
+#include "util.hpp"
 
 namespace piezobench::rt {
 

@@ -6,7 +6,7 @@
 #include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
-#include "rt/util.hpp"
+#include "util.hpp"
 
 namespace piezobench::rt {
 

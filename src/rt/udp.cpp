@@ -23,8 +23,8 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
-#include "rt/udp_socket.hpp"
-#include "rt/util.hpp"
+#include "udp_socket.hpp"
+#include "util.hpp"
 
 namespace piezobench::rt {
 

@@ -10,7 +10,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/rt/timing.hpp"
 #include "piezobench/rt/udp_target.hpp"
-#include "rt/udp_socket.hpp"
+#include "udp_socket.hpp"
 
 // `piezobench bench serve`: rt::UdpTarget on a socket, driving the virtual bench.
 namespace piezobench::rt {

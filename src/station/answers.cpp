@@ -4,7 +4,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/toml_table.hpp"
-#include "station/toml_reader.hpp"
+#include "toml_reader.hpp"
 
 namespace piezobench::station {
 

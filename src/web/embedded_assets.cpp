@@ -1,9 +1,9 @@
 // The station page's files, pulled into the object file by the assembler (incbin.hpp). The paths
 // and a SHA-256 of the files are compile definitions (src/web/CMakeLists.txt), so ccache rebuilds
 // this file when one changes.
-#include "web/embedded_assets.hpp"
+#include "embedded_assets.hpp"
 
-#include "report/incbin.hpp"
+#include "piezobench/core/incbin.hpp"
 
 #ifndef PIEZOBENCH_WEB_HTML
 #error "PIEZOBENCH_WEB_HTML is set by src/web/CMakeLists.txt"

@@ -9,8 +9,8 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/station/certificate.hpp"
 #include "piezobench/station/record_json.hpp"
-#include "report/embedded_assets.hpp"
-#include "web/embedded_assets.hpp"
+#include "piezobench/report/embedded_assets.hpp"
+#include "embedded_assets.hpp"
 
 namespace piezobench::web {
 
@@ -38,7 +38,7 @@ HttpResponse StationSite::handle(const HttpRequest& r) {
   if (p == "/" || p == "/index.html") return asset(detail::page_html(), "text/html; charset=utf-8");
   if (p == "/station.js") return asset(detail::page_script(), "text/javascript; charset=utf-8");
   if (p == "/station.css") return asset(detail::page_style(), "text/css; charset=utf-8");
-  if (p == "/plotly.min.js") return asset(report::detail::plotting_library(), "text/javascript; charset=utf-8");
+  if (p == "/plotly.min.js") return asset(report::plotting_library(), "text/javascript; charset=utf-8");
   if (p == "/api/state") return json_response(200, hub_ ? hub_->state_json() : R"({"live":false})");
   if (p == "/api/answer") return answer(r);
   if (p.rfind("/api/", 0) == 0) return database(r);

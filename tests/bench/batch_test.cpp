@@ -4,7 +4,7 @@
 
 #include <array>
 
-#include "bench/flatness.hpp"
+#include "flatness.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "test_util.hpp"
 

@@ -10,7 +10,7 @@
 #include <complex>
 #include <numbers>
 
-#include "bench/flatness.hpp"
+#include "flatness.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::bench {
@@ -115,6 +115,49 @@ TEST(Experiments, SameSeedSameRecord) {
   EXPECT_EQ(a.data, b.data);
   EXPECT_NE(a.data, c.data);
   EXPECT_EQ(run(Experiment::kFlatness, 4, {}, 21).data, run(Experiment::kFlatness, 4, {}, 21).data);
+}
+
+// The virtual runner, noting the seed of each open-loop run it is given.
+class SeedRecordingRunner final : public BenchRunner {
+ public:
+  SeedRecordingRunner(const UnitTruth& unit, const BenchOptions& options) : inner_(unit, options) {}
+  void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) override {
+    seeds.push_back(seed);
+    inner_.open_loop(u, seed, out, progress);
+  }
+  std::uint64_t open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
+                                      std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) override {
+    return inner_.open_loop_feedforward(u_prime, w, model, seed, out, progress);
+  }
+  std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
+                    const Progress& progress) override {
+    return inner_.iff(u_prime, gain, seed, out, progress);
+  }
+  std::vector<double> hold(Eigen::Index n, const std::vector<OperatorStep>& steps, std::uint64_t seed, Eigen::MatrixXd& out,
+                           const Progress& progress) override {
+    return inner_.hold(n, steps, seed, out, progress);
+  }
+  void describe(io::TimeSeries& record) const override { inner_.describe(record); }
+  std::vector<std::uint64_t> seeds;
+
+ private:
+  VirtualRunner inner_;
+};
+
+TEST(Experiments, TheMainRunGetsTheExperimentsBenchSeed) {
+  const UnitTruth unit = batch_unit(4, 21);
+  for (const Experiment e : {Experiment::kFrfNoise, Experiment::kHysteresis}) {
+    ExperimentOptions o;
+    if (e == Experiment::kFrfNoise) o.duration = 0.2;
+    SeedRecordingRunner runner(unit, o.bench);
+    const io::TimeSeries ts = run_experiment(e, runner, unit, o, 21);
+    ASSERT_EQ(runner.seeds.size(), 1u) << to_string(e);
+    EXPECT_EQ(runner.seeds.front(), experiment_bench_seed(e, 21)) << to_string(e);
+    EXPECT_EQ(ts.data, simulate(e, unit, o, 21).data) << to_string(e);
+  }
+  // One stream per experiment and per seed.
+  EXPECT_NE(experiment_bench_seed(Experiment::kFrfNoise, 21), experiment_bench_seed(Experiment::kHysteresis, 21));
+  EXPECT_NE(experiment_bench_seed(Experiment::kFrfNoise, 21), experiment_bench_seed(Experiment::kFrfNoise, 22));
 }
 
 TEST(Experiments, StrokeOfAGoodUnitAndOfTheDefectiveOne) {

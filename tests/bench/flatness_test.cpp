@@ -1,6 +1,6 @@
 // Flatness geometry of the virtual units (src/bench/flatness.hpp): the least-squares plane and
 // the heights made by a tilt and a warp, against closed forms.
-#include "bench/flatness.hpp"
+#include "flatness.hpp"
 
 #include <gtest/gtest.h>
 

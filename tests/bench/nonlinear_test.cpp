@@ -1,6 +1,6 @@
 // Hysteresis and creep of the virtual bench's stacks (src/bench/nonlinear.hpp), against their
 // closed forms.
-#include "bench/nonlinear.hpp"
+#include "nonlinear.hpp"
 
 #include <gtest/gtest.h>
 

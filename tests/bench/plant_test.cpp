@@ -1,6 +1,6 @@
 // The linear part of the virtual bench (src/bench/plant.hpp): the coupled 2-DoF model against its
 // closed form, the high-pass corner, the non-minimum-phase zero, and the exact discretizations.
-#include "bench/plant.hpp"
+#include "plant.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The bench's random numbers (src/bench/random.hpp): the published reference outputs of
 // xoshiro256** and splitmix64, reproducibility, and the moments of the normal approximation.
-#include "bench/random.hpp"
+#include "random.hpp"
 
 #include <gtest/gtest.h>
 

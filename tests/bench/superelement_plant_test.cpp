@@ -1,6 +1,6 @@
 // A super element as the bench's actuator (src/bench/superelement_plant.hpp): the TOML checks, and
 // the reduced plant of the APA95ML (shared data) against the full constrained structural model.
-#include "bench/superelement_plant.hpp"
+#include "superelement_plant.hpp"
 
 #include <gtest/gtest.h>
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
-#include "bench/plant.hpp"
+#include "plant.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/discretize.hpp"
 #include "test_util.hpp"

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "dsp/fft.hpp"
+#include "fft.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
 #include "test_util.hpp"

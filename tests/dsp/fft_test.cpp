@@ -1,5 +1,5 @@
 // The private FFTW wrapper against a naive DFT (the same test over both "backends").
-#include "dsp/fft.hpp"
+#include "fft.hpp"
 
 #include <gtest/gtest.h>
 

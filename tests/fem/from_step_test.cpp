@@ -14,8 +14,8 @@
 #include <cstdlib>
 #include <fstream>
 
-#include "fem/from_step_files.hpp"
-#include "fem/from_step_process.hpp"
+#include "from_step_files.hpp"
+#include "from_step_process.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/fem/superelement.hpp"

@@ -1,6 +1,6 @@
 // The CSV table reader: dialects detected and forced, units in headers, messages that say which
 // dialect was used.
-#include "io/csv_table.hpp"
+#include "csv_table.hpp"
 
 #include "piezobench/io/timeseries.hpp"
 

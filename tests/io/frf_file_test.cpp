@@ -11,7 +11,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "io/mat_file.hpp"
+#include "mat_file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"

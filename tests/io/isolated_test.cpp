@@ -1,6 +1,6 @@
 // Tests of the isolated child (isolated.cpp): answers of any size arrive intact, and a child that
 // crashes, exits or answers badly becomes an InputError naming the file; the parent never hangs.
-#include "io/isolated.hpp"
+#include "isolated.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

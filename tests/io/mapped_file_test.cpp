@@ -1,6 +1,6 @@
 // Read-only file mappings (io/mapped_file.cpp): contents, bounds and alignment of doubles(), and
 // the files that cannot be mapped (the caller then reads them).
-#include "io/mapped_file.hpp"
+#include "mapped_file.hpp"
 
 #include <gtest/gtest.h>
 

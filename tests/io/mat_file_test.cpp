@@ -1,7 +1,7 @@
 // Tests of the private MAT-file layer: the own v5 encoder and reader (mat_file.cpp, the v5 parts of
 // mat_reader.cpp) against scipy.io.loadmat and matio, and its helpers (reading is tested further
 // through mat_reader_test, timeseries_test and frf_file_test).
-#include "io/mat_file.hpp"
+#include "mat_file.hpp"
 
 #include <gtest/gtest.h>
 #include <matio.h>

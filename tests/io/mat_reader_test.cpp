@@ -1,7 +1,7 @@
 // Tests of the MAT readers' defences (mat_reader.cpp): hostile files made by
 // scripts/fixtures/make_io_hostile_fixtures.py from scipy and h5py output, each refused with an
 // InputError naming the variable before anything is allocated for what it declares.
-#include "io/mat_file.hpp"
+#include "mat_file.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>

@@ -11,7 +11,7 @@
 #include <tuple>
 #include <nlohmann/json.hpp>
 
-#include "io/mat_file.hpp"
+#include "mat_file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"
 #include "piezobench/core/error.hpp"
@@ -210,6 +210,34 @@ TEST(TimeSeriesScipy, TwoOutputsFileReadsExactly) {
     }
     EXPECT_EQ(ts.t(4), expected["first"]["t"][4].get<double>());
   }
+}
+
+// read_mat_readings on scipy's files: double vectors as stored, at 1 Hz without a time vector;
+// anything else (single, a matrix, a missing variable, a CSV file) is not readings.
+TEST(TimeSeriesScipy, ReadingsAreTheDoubleVectorsAsStored) {
+  const nlohmann::json expected = expected_json()["two_outputs"];
+  const fs::path file = test::fixture_path("io/scipy_two_outputs.mat");
+  const std::optional<TimeSeries> ts = read_mat_readings(file, {"d_enc", "u_dac"});
+  ASSERT_TRUE(ts.has_value());
+  EXPECT_EQ(ts->names, (std::vector<std::string>{"d_enc", "u_dac"}));
+  ASSERT_EQ(ts->samples(), expected["samples"].get<Eigen::Index>());
+  EXPECT_EQ(ts->sample_rate, 1.0);
+  EXPECT_EQ(ts->t.size(), 0);
+  EXPECT_EQ(ts->source, file.string());
+  for (const std::string channel : {"u_dac", "d_enc"}) {
+    const auto first = expected["first"][channel].get<std::vector<double>>();
+    for (size_t k = 0; k < first.size(); ++k) EXPECT_EQ(ts->channel(channel)(static_cast<Eigen::Index>(k)), first[k]) << channel;
+    EXPECT_EQ(ts->channel(channel)(ts->samples() - 1), expected["last"][channel].get<double>()) << channel;
+  }
+  const fs::path types = test::fixture_path("io/scipy_types.mat");
+  EXPECT_FALSE(read_mat_readings(types, {"a"}).has_value());        // single
+  EXPECT_FALSE(read_mat_readings(types, {"M"}).has_value());        // 3x2 matrix
+  EXPECT_FALSE(read_mat_readings(types, {"t", "nope"}).has_value());  // a missing variable
+  EXPECT_FALSE(read_mat_readings(types, {"t", "b"}).has_value());   // int16
+  const test::TempDir dir;
+  const fs::path csv = dir.path() / "readings.csv";
+  { std::ofstream(csv) << "C_sensor\n5.1e-6\n"; }
+  EXPECT_FALSE(read_mat_readings(csv, {"C_sensor"}).has_value());   // not a .mat file
 }
 
 TEST(TimeSeriesScipy, ChannelsInAStruct) {

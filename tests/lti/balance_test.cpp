@@ -1,5 +1,5 @@
 // Tests of the private Parlett-Reinsch balancing: powers of two, and bounded on overflowed input.
-#include "lti/balance.hpp"
+#include "balance.hpp"
 
 #include <gtest/gtest.h>
 

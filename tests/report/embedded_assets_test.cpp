@@ -1,4 +1,4 @@
-#include "report/embedded_assets.hpp"
+#include "piezobench/report/embedded_assets.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 
 #include "test_util.hpp"
 
-namespace piezobench::report::detail {
+namespace piezobench::report {
 namespace {
 
 std::string lower(std::string_view text) {
@@ -58,4 +58,4 @@ TEST(EmbeddedAssets, AssetsCanBeInlinedVerbatim) {
 }
 
 }  // namespace
-}  // namespace piezobench::report::detail
+}  // namespace piezobench::report

@@ -9,7 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "report/embedded_assets.hpp"
+#include "piezobench/report/embedded_assets.hpp"
 #include "report/sample_document.hpp"
 #include "test_util.hpp"
 
@@ -82,8 +82,8 @@ TEST(HtmlReport, RendersEveryFigureTheTableAndTheContents) {
   EXPECT_FALSE(contains(html, "resonance Hz"));
   EXPECT_FALSE(contains(html, "<dt>Not analysed</dt>"));
   // The library is inlined verbatim, once, and nothing is loaded from elsewhere.
-  EXPECT_EQ(count(html, std::string(detail::plotting_library().substr(0, 4096))), 1u);
-  EXPECT_TRUE(contains(html, std::string(detail::plotting_library().substr(detail::plotting_library().size() - 4096))));
+  EXPECT_EQ(count(html, std::string(plotting_library().substr(0, 4096))), 1u);
+  EXPECT_TRUE(contains(html, std::string(plotting_library().substr(plotting_library().size() - 4096))));
   EXPECT_FALSE(contains(lower(html), "<script src"));
   EXPECT_FALSE(contains(lower(html), "<link"));
 }

@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <sstream>
 
-#include "bench/random.hpp"
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
@@ -28,18 +27,13 @@ BenchDescription virtual_bench(double ramp) {
                                  "virtual.toml");
 }
 
-// The noise seed experiments.cpp gives the bench of experiment e (its `stream`).
-std::uint64_t bench_seed(bench::Experiment e, std::uint64_t seed) {
-  return bench::detail::derive_seed(seed, 1000 * (static_cast<std::uint64_t>(e) + 1));
-}
-
 TEST(BackendRunner, OnTheVirtualBenchItWritesTheSimulatedRecord) {
   const bench::UnitTruth unit = bench::batch_unit(2, 5);
   for (const bench::Experiment e : {bench::Experiment::kFrfNoise, bench::Experiment::kIff, bench::Experiment::kHysteresis}) {
     bench::ExperimentOptions eo;
     if (e != bench::Experiment::kHysteresis) eo.duration = 0.5;
     const io::TimeSeries simulated = bench::simulate(e, unit, eo, 5);
-    VirtualBenchBackend backend(unit, eo.bench, bench_seed(e, 5));
+    VirtualBenchBackend backend(unit, eo.bench, bench::experiment_bench_seed(e, 5));
     MeasureOptions mo;
     mo.bench = virtual_bench(0.0);  // the experiments' commands as they are: no ramps
     mo.lockstep = true;
@@ -73,7 +67,7 @@ TEST(BackendRunner, TrackingCompensatesTheHysteresisLiveInTheLoop) {
   const bench::UnitTruth unit = bench::batch_unit(2, 1);
   bench::ExperimentOptions eo;
   eo.bench.hysteresis_law = bench::HysteresisLaw::kBoucWen;
-  VirtualBenchBackend backend(unit, eo.bench, bench_seed(bench::Experiment::kTracking, 1));
+  VirtualBenchBackend backend(unit, eo.bench, bench::experiment_bench_seed(bench::Experiment::kTracking, 1));
   MeasureOptions mo;
   mo.bench = virtual_bench(0.0);
   mo.lockstep = true;

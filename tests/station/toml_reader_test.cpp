@@ -1,4 +1,4 @@
-#include "station/toml_reader.hpp"
+#include "toml_reader.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 
 #include "piezobench/station/certificate.hpp"
 #include "test_util.hpp"
-#include "web/embedded_assets.hpp"
+#include "embedded_assets.hpp"
 
 namespace piezobench::web {
 namespace {

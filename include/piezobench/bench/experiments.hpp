@@ -170,4 +170,8 @@ io::TimeSeries run_experiment(Experiment experiment, BenchRunner& runner, const 
 io::TimeSeries simulate(Experiment experiment, const UnitTruth& unit, const ExperimentOptions& options,
                         std::uint64_t seed, const Progress& progress = {});
 
+// The noise seed of the virtual bench in the main run of `experiment` recorded with `seed`: a
+// rt::VirtualBenchBackend seeded with it and driven by run_experiment gives simulate()'s record.
+std::uint64_t experiment_bench_seed(Experiment experiment, std::uint64_t seed) noexcept;
+
 }  // namespace piezobench::bench

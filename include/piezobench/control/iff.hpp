@@ -14,26 +14,15 @@
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/plant/iff_plant.hpp"
 
 namespace piezobench::control {
 
-// G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
-// from u (V) to Vs (V). Defaults: the report's manual fit (section 2.6). xz < 0 is a
-// non-minimum-phase zero pair (mirrored into the right half plane), which the report's data show.
-struct IffPlantParams {
-  double g0 = 0.64;                    // V/V
-  double wz = kTwoPi * 42.7;           // rad/s, anti-resonance
-  double xz = 0.004;                   // damping ratio of the zero (< 0: non-minimum phase)
-  double wp = kTwoPi * 95.2;           // rad/s, resonance
-  double xp = 0.02;                    // damping ratio of the pole
-  double w_hpf = kTwoPi * 0.4;         // rad/s, high-pass corner of the resistor across the sensor stack
-  double delay = 0.0;                  // s (the report adds 200 us to match the phase)
-  void validate() const;               // InputError naming the field
-};
-lti::TransferFunction iff_plant(const IffPlantParams& params = {});
-// G(j omega) of the same formula (omega in rad/s), without validation (for fits' inner loops).
-lti::Complex iff_plant_response(const IffPlantParams& params, double omega);
-lti::CVector iff_plant_response(const IffPlantParams& params, const lti::Vector& omega);
+// The plant of eq. 2.3 lives below control and ident (plant/iff_plant.hpp); the loop's functions
+// take it under these names.
+using plant::IffPlantParams;
+using plant::iff_plant;
+using plant::iff_plant_response;
 
 // K0(s) = gain * s/(s + w_hpf) * 1/(s + w_lpf) * 1/(s + w_robust): eq. 2.4 at g = 1 (gain = -10).
 struct IffControllerParams {

@@ -18,6 +18,7 @@
 //
 // and, when s is unknown, C = (J^T J)^-1 2 cost / (m - p) (every residual with the same variance).
 // A 95 % interval is x +- kCoverage95 sqrt(C_jj).
+// Units: the caller's (the parameters, residuals and tolerances are in the units of the caller's problem).
 #include <Eigen/Dense>
 #include <string>
 #include <utility>

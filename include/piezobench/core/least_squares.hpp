@@ -11,6 +11,7 @@
 // nu *= 2. References: K. Madsen, H. B. Nielsen, O. Tingleff, "Methods for non-linear least
 // squares problems", IMM 2004, section 3.2; J. J. More, "The Levenberg-Marquardt algorithm:
 // implementation and theory", 1978.
+// Units: the caller's (the parameters, residuals and tolerances are in the units of the caller's problem).
 #include <Eigen/Dense>
 #include <functional>
 #include <string>

@@ -3,6 +3,7 @@
 // search for a maximum", Proc. AMS 4, 1953) on a bracket, used by the high-pass corner fit
 // (ident/features.hpp) and the gain of maximum damping on a root-locus branch (lti/rlocus.hpp, and
 // through it control::iff_root_locus and the campaign's IFF optimum).
+// Units: the caller's (the parameters, residuals and tolerances are in the units of the caller's problem).
 #include <functional>
 
 namespace piezobench::core {

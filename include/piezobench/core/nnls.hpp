@@ -5,6 +5,7 @@
 // in the passive set from the start (so the free ones never leave it); each subproblem is solved by
 // a column-pivoting Householder QR of the passive columns. The one place for constrained linear
 // least squares in piezobench (the hysteresis identification, ident/hysteresis.hpp, uses it).
+// Units: the caller's (the parameters, residuals and tolerances are in the units of the caller's problem).
 #include <Eigen/Core>
 #include <vector>
 

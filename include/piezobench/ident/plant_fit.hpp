@@ -1,5 +1,5 @@
 #pragma once
-// Fit of the IFF plant model of the report (eq. 2.3, section 2.6; control::iff_plant) to a measured
+// Fit of the IFF plant model of the report (eq. 2.3, section 2.6; plant::iff_plant) to a measured
 // u -> Vs FRF:
 //
 //   G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "piezobench/control/iff.hpp"
+#include "piezobench/plant/iff_plant.hpp"
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/least_squares.hpp"
@@ -55,9 +55,9 @@ struct IffPlantFitOptions {
   void validate() const;      // InputError (source "iff plant fit options")
 };
 
-// The fitted plant is a control::IffPlantParams (g0 V/V signed, wz, wp, w_hpf rad/s, xz < 0 for a
+// The fitted plant is a plant::IffPlantParams (g0 V/V signed, wz, wp, w_hpf rad/s, xz < 0 for a
 // non-minimum-phase zero pair, xp, delay s) with how well it fits.
-struct IffPlantFit : control::IffPlantParams {
+struct IffPlantFit : plant::IffPlantParams {
   double relative_rms_error = 0.0;           // rms |G/H - 1| over the points used
   double weighted_relative_rms_error = 0.0;  // the same with the fit's per-decade weights
   double initial_relative_rms_error = 0.0;   // weighted, at the better of the two starts
@@ -73,9 +73,9 @@ struct IffPlantFit : control::IffPlantParams {
   core::ParameterUncertainty uncertainty;
 
   [[nodiscard]] bool zero_is_nonminimum_phase() const { return xz < 0.0; }
-  // G(s) as a transfer function (with the delay): control::iff_plant(*this).
+  // G(s) as a transfer function (with the delay): plant::iff_plant(*this).
   [[nodiscard]] lti::TransferFunction transfer_function() const;
-  // G(j omega) at every omega (rad/s): control::iff_plant_response(*this, omega).
+  // G(j omega) at every omega (rad/s): plant::iff_plant_response(*this, omega).
   [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
 };
 

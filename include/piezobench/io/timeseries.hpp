@@ -35,6 +35,7 @@
 //        rate of a file without a time column (the writer adds the first form then).
 #include <Eigen/Dense>
 #include <filesystem>
+#include <optional>
 #include <map>
 #include <memory>
 #include <string>
@@ -127,6 +128,16 @@ struct MatWriteOptions {
 // UFF dataset 58 time histories (function type 1, as Testlab and Simcenter export; ASCII or binary
 // 58b, one record per channel): docs/formats.md, "UFF58 time histories".
 [[nodiscard]] TimeSeries read_timeseries_uff58(const std::filesystem::path& file, const ReadOptions& options = {});
+
+// Readings of one value per element (an LCR meter's capacitances), which read_timeseries refuses in
+// a .mat file (a record has 2 samples or more): the variables `channels` of a .mat file, each a
+// real double scalar or vector, all of one length n, as a TimeSeries of n samples at 1 Hz without
+// a time vector (no unit conversion: the values as stored). std::nullopt when the file is not a
+// .mat file (by its extension), lacks one of the channels or one is not such a vector (the
+// caller's own reader then has the message to show); InputError when the file cannot be read or
+// a value is NaN/Inf. MAT v7.3 files are read by an isolated child, as read_timeseries does.
+[[nodiscard]] std::optional<TimeSeries> read_mat_readings(const std::filesystem::path& file,
+                                                          const std::vector<std::string>& channels);
 
 // A record read for one pass over its samples (what `piezobench frf` needs): the same checks and
 // results as read_timeseries, but the channels of a v5 MAT file stored as uncompressed doubles in

@@ -1,6 +1,6 @@
 #pragma once
-// Files linked into the binary by the assembler's .incbin (report/embedded_assets.cpp,
-// web/embedded_assets.cpp): PIEZOBENCH_INCBIN(symbol, "path") is assembler text for an asm()
+// Files linked into the binary by the assembler's .incbin (src/report/embedded_assets.cpp,
+// src/web/embedded_assets.cpp): PIEZOBENCH_INCBIN(symbol, "path") is assembler text for an asm()
 // statement in a .rodata section; it defines symbol_begin and symbol_end around the file's bytes,
 // followed by a NUL that is not part of them. PIEZOBENCH_INCBIN_DECLARE(symbol) declares them.
 // clang-format off
