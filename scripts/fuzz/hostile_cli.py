@@ -11,6 +11,7 @@ address-space limit is left out (ASan reserves terabytes of it), the timeout is 
 sanitizer reports count.
 """
 import argparse
+import mmap
 import os
 import re
 import resource
@@ -72,11 +73,16 @@ def command(reader, path, workdir):
 
 
 def sanitized(binary):
+    """Whether the binary carries a sanitizer runtime: g++ links libasan/libubsan as shared
+    libraries, clang links its runtime statically (its symbols are then in the binary itself)."""
     try:
         out = subprocess.run(["ldd", binary], capture_output=True, text=True).stdout
-    except OSError:
+        if "libasan" in out or "libubsan" in out:
+            return True
+        with open(binary, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as m:
+            return m.find(b"__asan_init") >= 0 or m.find(b"__ubsan_handle_") >= 0
+    except (OSError, ValueError):
         return False
-    return "libasan" in out or "libubsan" in out
 
 
 def run(binary, args, timeout, memory_mb, perturb, cwd):
