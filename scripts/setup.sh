@@ -4,16 +4,14 @@
 #   scripts/setup.sh demo [--sanitize]   install what is missing, build, run the main job
 #   scripts/setup.sh test [--sanitize]   install what is missing, build, run the whole test suite
 #   scripts/setup.sh build [--sanitize]  install what is missing and build
-#   scripts/setup.sh fuzz                install what is missing, build the sanitizer tree (with
-#                                        the readers' libFuzzer targets), replay the regression
+#   scripts/setup.sh fuzz                install what is missing, build the readers' libFuzzer
+#                                        targets with clang in build-fuzz/, replay the regression
 #                                        corpus (fatal) and fuzz for PIEZOBENCH_FUZZ_SECONDS
 #                                        (default 88) in all, findings reported (docs/fuzzing.md)
 #
 # Installing is idempotent: packages already present are left alone, and nothing is installed
-# (not even an `apt-get update`) when everything is there. The normal build lives in build/ (g++,
-# Release). --sanitize and fuzz share build-sanitize/: clang++-14 with AddressSanitizer,
-# UndefinedBehaviorSanitizer and libFuzzer's coverage instrumentation, the fuzz targets included,
-# so the two compilers both build the project and CI compiles the sanitized code once.
+# (not even an `apt-get update`) when everything is there. --sanitize builds in build-sanitize/
+# with AddressSanitizer and UndefinedBehaviorSanitizer; the normal build lives in build/.
 set -euo pipefail
 
 job="${1:-}"
@@ -92,35 +90,41 @@ fi
 # the same script, a no-op once installed).
 bash "$root/tests/js/install.sh" >/dev/null
 
-if [ "$job" = fuzz ]; then sanitize=1; fi
-if [ "$sanitize" -eq 1 ]; then
+if [ "$job" = fuzz ]; then
   # clang-14 is in the packages list above, so a missing compiler is an error, never a skip.
   command -v clang++-14 >/dev/null || { echo "setup.sh: clang++-14 not found (package clang-14)" >&2; exit 1; }
-  build_dir="$root/build-sanitize"
-  # clang compiles this Eigen-heavy code in about half g++'s time (src/lti/spectral.cpp with the
-  # sanitizers at -O1: 35 s against 62 s of CPU), and libFuzzer needs it. No Python module there:
-  # python3 would need the sanitizer runtime preloaded to load it. -O1 -g1: line tables for the
-  # stack traces at about half the compile time of -O2 -g.
+  build_dir="$root/build-fuzz"
+  # clang with ASan, UBSan and libFuzzer's coverage instrumentation; only the targets `fuzzers` needs
+  # are built (the reader modules and their dependencies). -O1 -g1: line tables for the stack traces.
   config=(-DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
-          "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${PIEZOBENCH_SANITIZE_CXXFLAGS:--O1 -g1 -DNDEBUG}"
-          -DPIEZOBENCH_FUZZ=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
+          "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${PIEZOBENCH_FUZZ_CXXFLAGS:--O1 -g1 -DNDEBUG}"
+          -DPIEZOBENCH_FUZZ=ON -DPIEZOBENCH_BUILD_TESTS=OFF -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
+  targets=(--target fuzzers)
+elif [ "$sanitize" -eq 1 ]; then
+  build_dir="$root/build-sanitize"
+  # No Python module there: python3 would need the sanitizer runtime preloaded to load it.
+  # -O1 -g1: line tables for the sanitizers' stack traces at about half the compile time of -O2 -g.
+  config=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
+          -DPIEZOBENCH_SANITIZE=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
+  targets=()
 else
   build_dir="$root/build"
   # The Python module is built for Debian's interpreter (where apt puts numpy, scipy and pytest),
   # not for another python3 that may come first on PATH.
   config=(-DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3)
+  targets=()
 fi
 jobs="$(nproc 2>/dev/null || echo 2)"
 
 echo "setup.sh: configuring and building in $build_dir" >&2
 cmake -S "$root" -B "$build_dir" -G Ninja "${config[@]}" >/dev/null
-cmake --build "$build_dir" -j "$jobs"
+cmake --build "$build_dir" -j "$jobs" "${targets[@]}"
 
 case "$job" in
   fuzz)
     # The regression corpus: known inputs, any failure fails the job.
     bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" regression
-    # Fresh mutations: a finding is reported and kept in build-sanitize/fuzz-artifacts/, not fatal (a
+    # Fresh mutations: a finding is reported and kept in build-fuzz/fuzz-artifacts/, not fatal (a
     # new mutation must not fail CI for an unrelated change); PIEZOBENCH_FUZZ_FINDINGS=fail makes it fatal.
     PIEZOBENCH_FUZZ_FINDINGS="${PIEZOBENCH_FUZZ_FINDINGS:-report}" \
       bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" fuzz "${PIEZOBENCH_FUZZ_SECONDS:-88}"
