@@ -137,7 +137,7 @@ case "$job" in
   test)
     export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
     export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-    # The longest tests start first (their costs measured in a sanitizer run: tests/ctest_costs.txt),
+    # The longest tests start first (tests/ctest_costs.txt: each test's larger cost of a Release and a sanitizer run),
     # so that no long test runs alone at the end of a fresh build's suite; ctest keeps the file
     # up to date from then on.
     costs="$build_dir/Testing/Temporary/CTestCostData.txt"
