@@ -13,11 +13,13 @@
 #include "cli_common.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/demo.hpp"
+#include "piezobench/campaign/field_reference.hpp"
 #include "piezobench/campaign/part.hpp"
 #include "piezobench/campaign/pipeline.hpp"
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/output_dir.hpp"
 
 namespace piezobench::app {
@@ -298,6 +300,21 @@ void add_run_commands(CLI::App& app, Action& action) {
   demo->add_option("--units", d->units, "Units of the batch to simulate, e.g. 1,3,4 (default all seven)");
   demo->add_option("--threads", d->threads, "Worker threads (0 = all cores)")->capture_default_str();
   demo->callback([d, &action] { action = [d] { return run_demo(*d); }; });
+
+  auto fields_out = std::make_shared<std::string>();
+  CLI::App* fields = app.add_subcommand("fields", "Print the reference of every result field (docs/fields.md) from their declarations");
+  fields->add_option("--out", *fields_out, "Write it to this file instead of stdout");
+  fields->callback([fields_out, &action] {
+    action = [fields_out] {
+      const std::string doc = campaign::field_reference_markdown();
+      if (fields_out->empty()) {
+        fmt::print("{}", doc);
+      } else {
+        io::write_text_atomically(*fields_out, doc);
+      }
+      return 0;
+    };
+  });
 }
 
 }  // namespace piezobench::app

@@ -4,6 +4,7 @@
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/io/lti_toml.hpp"
 #include "piezobench/io/mat_struct.hpp"

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/demo.hpp"
 #include "piezobench/campaign/pipeline.hpp"
@@ -68,190 +69,22 @@ py::array real_array(const std::vector<double>& v) {
 // The typed results of campaign/results.hpp as read-only classes (SI unless the name ends in a
 // unit). Nested results are views that keep the run alive.
 void bind_result_classes(py::module_& m) {
-  {
-    py::class_<RecordProvenance> c(m, "RecordProvenance", "Where an analysis' data came from.");
-    c.def_readonly("file", &RecordProvenance::file, "as given in the campaign")
-        .def_readonly("key", &RecordProvenance::key, "campaign key, e.g. \"units[0].frf\"")
-        .def_readonly("channels", &RecordProvenance::channels, "(role, channel name in the file) pairs")
-        .def_readonly("samples", &RecordProvenance::samples)
-        .def_readonly("sample_rate_Hz", &RecordProvenance::sample_rate_Hz, "Hz")
-        .def_readonly("input", &RecordProvenance::input, "FRF: the input role")
-        .def_readonly("outputs", &RecordProvenance::outputs, "FRF: the output roles");
-    typed(c);
-  }
-  {
-    py::class_<Curve> c(m, "Curve", "A curve of the report (thinned or log-spaced samples): x, y as arrays.");
-    c.def_property_readonly("x", [](const Curve& k) { return real_array(k.x); })
-        .def_property_readonly("y", [](const Curve& k) { return real_array(k.y); });
-    typed(c);
-  }
-  {
-    py::class_<VectorFitSummary> c(m, "VectorFitSummary", "A vector fit's summary.");
-    c.def_readonly("order", &VectorFitSummary::order)
-        .def_readonly("relative_rms_error", &VectorFitSummary::relative_rms_error)
-        .def_readonly("converged", &VectorFitSummary::converged);
-    typed(c);
-  }
-  {
-    py::class_<NmpEvidence::Zero> z(m, "NmpZero", "The vector fit's zero of u -> Vs nearest the dip, with the phase verdict.");
-    z.def_property_readonly("phase_verdict", [](const NmpEvidence::Zero& x) { return ident::to_string(x.phase_verdict); },
-                            "\"minimum-phase\", \"non-minimum-phase\" or \"undetermined\" (measured phase)")
-        .def_readonly("phase_change_deg", &NmpEvidence::Zero::phase_change_deg, "deg, across the dip")
-        .def_readonly("fitted_zero", &NmpEvidence::Zero::fitted_zero, "rad/s")
-        .def_readonly("fitted_zero_nonminimum_phase", &NmpEvidence::Zero::fitted_zero_nonminimum_phase);
-    typed(z);
-    py::class_<NmpEvidence> c(m, "NmpEvidence", "Evidence of a non-minimum-phase zero pair in u -> Vs (report section 2.3).");
-    c.def_readonly("zero", &NmpEvidence::zero, "campaign.NmpZero or None")
-        .def_readonly("iff_plant_fit_xz", &NmpEvidence::iff_plant_fit_xz, "xz of the IFF plant fit (< 0: non-minimum phase)")
-        .def_readonly("iff_plant_fit_xz_standard_error", &NmpEvidence::iff_plant_fit_xz_standard_error,
-                      "standard error of xz; the verdict's 95 % interval is xz +- 1.96 of it")
-        .def_readonly("verdict_from", &NmpEvidence::verdict_from, "\"phase\", \"iff-plant-fit\", \"fitted-zero\" or \"none\"")
-        .def_readonly("verdict_reason", &NmpEvidence::verdict_reason, "why: which evidence decided and what it said, e.g. an ambiguous phase change and the plant fit's xz");
-    typed(c);
-  }
-  {
-    py::class_<HighPassCorner> c(m, "HighPassCorner", "The resistor high-pass of the force sensor's read-out (Hz).");
-    c.def_readonly("first_order_fit_Hz", &HighPassCorner::first_order_fit_Hz, "Hz, first-order fit below hpf_fmax_Hz")
-        .def_readonly("first_order_fit_points", &HighPassCorner::first_order_fit_points)
-        .def_readonly("r_c_Hz", &HighPassCorner::r_c_Hz, "Hz, 1 / (2 pi R C_sensor) when C_sensor is measured")
-        .def_readonly("iff_plant_fit_Hz", &HighPassCorner::iff_plant_fit_Hz, "Hz, eq. 2.3 fitted down to the lowest frequency")
-        .def_readonly("iff_plant_fit_error", &HighPassCorner::iff_plant_fit_error, "the cross-check's failure")
-        .def_readonly("method", &HighPassCorner::method)
-        .def_readonly("corner_Hz", &HighPassCorner::corner_Hz, "Hz, the unit's corner");
-    typed(c);
-  }
-  {
-    py::class_<FrfAnalysis> c(m, "FrfAnalysis", "The FRFs u -> [d_e, Vs] of a unit and what is read from them (SI, frequencies in Hz).");
-    c.def_readonly("provenance", &FrfAnalysis::provenance)
-        .def_property_readonly("welch", [](const FrfAnalysis& a) { return provenance_dict(a.welch); }, "the Welch estimate's settings")
-        .def_readonly("fit_de", &FrfAnalysis::fit_de, "campaign.VectorFitSummary of u -> d_e or None")
-        .def_readonly("fit_vs", &FrfAnalysis::fit_vs, "campaign.VectorFitSummary of u -> Vs or None")
-        .def_readonly("static_gain_vector_fit", &FrfAnalysis::static_gain_vector_fit, "m/V, vector fit of u -> d_e")
-        .def_readonly("static_gain", &FrfAnalysis::static_gain, "m/V, the unit's")
-        .def_readonly("static_gain_source", &FrfAnalysis::static_gain_source)
-        .def_readonly("static_gain_vs", &FrfAnalysis::static_gain_vs, "V/V, vector fit of u -> Vs")
-        .def_readonly("de_plant", &FrfAnalysis::de_plant, "ident.DelayedSecondOrderFit of u -> d_e or None")
-        .def_readonly("iff_plant", &FrfAnalysis::iff_plant, "ident.IffPlantFit of u -> Vs (eq. 2.3) or None")
-        .def_readonly("iff_plant_fmin_Hz", &FrfAnalysis::iff_plant_fmin_Hz, "Hz, band of the IFF plant fit")
-        .def_readonly("iff_plant_fmax_Hz", &FrfAnalysis::iff_plant_fmax_Hz, "Hz")
-        .def_readonly("iff_plant_w_hpf_measured", &FrfAnalysis::iff_plant_w_hpf_measured, "w_hpf from R C_sensor (else fitted)")
-        .def_readonly("nmp", &FrfAnalysis::nmp, "campaign.NmpEvidence")
-        .def_readonly("hpf", &FrfAnalysis::hpf, "campaign.HighPassCorner")
-        .def_readonly("resonance_vector_fit_Hz", &FrfAnalysis::resonance_vector_fit_Hz, "Hz")
-        .def_readonly("resonance_vector_fit_damping", &FrfAnalysis::resonance_vector_fit_damping)
-        .def_readonly("antiresonance_vector_fit_Hz", &FrfAnalysis::antiresonance_vector_fit_Hz, "Hz")
-        .def_readonly("antiresonance_vector_fit_damping", &FrfAnalysis::antiresonance_vector_fit_damping)
-        .def_readonly("resonance_Hz", &FrfAnalysis::resonance_Hz, "Hz")
-        .def_readonly("resonance_damping", &FrfAnalysis::resonance_damping)
-        .def_readonly("antiresonance_Hz", &FrfAnalysis::antiresonance_Hz, "Hz")
-        .def_readonly("antiresonance_damping", &FrfAnalysis::antiresonance_damping, "< 0: non-minimum phase")
-        .def_readonly("zero_is_nonminimum_phase", &FrfAnalysis::zero_is_nonminimum_phase)
-        .def_readonly("shell_stiffness", &FrfAnalysis::shell_stiffness, "N/m, m_sus w_z^2");
-    typed(c);
-  }
-  {
-    py::class_<Model2DofFit> c(m, "Model2DofFit", "The tuned 2-DoF model (report section 3) with the fitted measurement chain.");
-    c.def_property_readonly("tuning", [](const Model2DofFit& f) { return tuning_result(f.tuning); },
-                            "as apa.tune_two_dof_measured returns it (params SI, quality)")
-        .def_property_readonly("bench", [](const Model2DofFit& f) { return two_dof_bench_dict(f.bench); },
-                               "the chain the model was tuned with (apa.two_dof_bench keywords)")
-        .def_readonly("fmin_Hz", &Model2DofFit::fmin_Hz, "Hz, band of the tuning")
-        .def_readonly("fmax_Hz", &Model2DofFit::fmax_Hz, "Hz");
-    typed(c);
-  }
-  {
-    py::class_<ident::DominantPole> c(m, "DominantPole", "The dominant pole pair of a vector fit (ident/dominant_pole.hpp).");
-    c.def_readonly("pole", &ident::DominantPole::pole, "rad/s, Im > 0")
-        .def_readonly("natural_frequency", &ident::DominantPole::natural_frequency, "rad/s")
-        .def_property_readonly("frequency_Hz", &ident::DominantPole::frequency_Hz, "Hz")
-        .def_readonly("damping", &ident::DominantPole::damping)
-        .def_readonly("peak", &ident::DominantPole::peak, "its peak contribution, data units")
-        .def_property_readonly("relative_rms_error", [](const ident::DominantPole& p) { return p.fit.relative_rms_error; },
-                               "of the vector fit it comes from")
-        .def_property_readonly("quality", [](const ident::DominantPole& p) { return p.fit.quality; }, "the vector fit's ident.FitQuality");
-    typed(c);
-  }
-  {
-    py::class_<DampedPlant> c(m, "DampedPlant", "One damped plant u' -> d_e of the IFF experiment (report section 2.6).");
-    c.def_readonly("gain", &DampedPlant::gain, "controller gain g")
-        .def_readonly("file", &DampedPlant::file)
-        .def_readonly("provenance", &DampedPlant::provenance)
-        .def_readonly("frf", &DampedPlant::frf, "dsp.Frf u' -> d_e")
-        .def_readonly("identified", &DampedPlant::identified, "campaign.DominantPole (d_e's delay removed) or None")
-        .def_readonly("identified_order", &DampedPlant::identified_order)
-        .def_readonly("fmin_Hz", &DampedPlant::fmin_Hz, "Hz, the damped-plant band")
-        .def_readonly("fmax_Hz", &DampedPlant::fmax_Hz, "Hz")
-        .def_readonly("second_order", &DampedPlant::second_order, "ident.DelayedSecondOrderFit or None")
-        .def_readonly("delay_removed", &DampedPlant::delay_removed, "s");
-    typed(c);
-  }
-  {
-    py::class_<bench::TrackingFigures> c(m, "TrackingFigures", "One waveform of the tracking experiment (bench/tracking.hpp).");
-    c.def_readonly("width_open", &bench::TrackingFigures::width_open, "hysteresis width / stroke, without the feedforward")
-        .def_readonly("width_ff", &bench::TrackingFigures::width_ff, "the same with it")
-        .def_readonly("rms_open", &bench::TrackingFigures::rms_open, "m, rms tracking error without")
-        .def_readonly("rms_ff", &bench::TrackingFigures::rms_ff, "m, with")
-        .def_readonly("stroke_open", &bench::TrackingFigures::stroke_open, "m")
-        .def_property_readonly("rms_reduction", &bench::TrackingFigures::rms_reduction, "rms_open / rms_ff");
-    typed(c);
-  }
-  {
-    py::class_<TrackingAnalysis> c(m, "TrackingAnalysis", "The tracking record: d_e against the command without and with the inverse "
-                                                          "hysteresis feedforward (docs/hysteresis.md).");
-    c.def_readonly("sine", &TrackingAnalysis::sine, "campaign.TrackingFigures of the 1 Hz sine")
-        .def_readonly("triangle", &TrackingAnalysis::triangle, "campaign.TrackingFigures of the triangle")
-        .def_readonly("amplitude", &TrackingAnalysis::amplitude, "V")
-        .def_readonly("feedforward", &TrackingAnalysis::feedforward, "\"identified\" (from the open run) or \"given\"")
-        .def_readonly("clamped_samples", &TrackingAnalysis::clamped_samples)
-        .def_readonly("provenance", &TrackingAnalysis::provenance)
-        .def_readonly("sine_open", &TrackingAnalysis::sine_open, "campaign.Curve: x command [V], y d_e [m]")
-        .def_readonly("sine_ff", &TrackingAnalysis::sine_ff)
-        .def_readonly("triangle_open", &TrackingAnalysis::triangle_open)
-        .def_readonly("triangle_ff", &TrackingAnalysis::triangle_ff);
-    typed(c);
-  }
-  {
-    py::class_<UnitAnalysis> c(m, "UnitAnalysis", R"(One unit's results (campaign/results.hpp): the numbers the batch and the
-acceptance use (SI: m, F, N/m, m/V; frequencies in Hz; None = not available), the FRF analysis, the
-tuned 2-DoF model, the damped plants, and the acceptance (accepted, reasons). json() is the unit's
-entry of results.json (every analysis, in the units its keys name).)");
-    c.def_readonly("id", &UnitAnalysis::id)
-        .def_readonly("name", &UnitAnalysis::name)
-        .def_readonly("flatness", &UnitAnalysis::flatness, "m, by the spec's method")
-        .def_readonly("capacitance_sensor", &UnitAnalysis::capacitance_sensor, "F")
-        .def_readonly("capacitance_actuator", &UnitAnalysis::capacitance_actuator, "F")
-        .def_readonly("stroke", &UnitAnalysis::stroke, "m")
-        .def_readonly("k1", &UnitAnalysis::k1, "N/m, static stiffness k1 (= k_sc)")
-        .def_readonly("k2", &UnitAnalysis::k2, "N/m")
-        .def_readonly("k_resonance", &UnitAnalysis::k_resonance, "N/m, from the resonance")
-        .def_readonly("k_oc", &UnitAnalysis::k_oc, "N/m, every stack open")
-        .def_readonly("resonance_Hz", &UnitAnalysis::resonance_Hz, "Hz")
-        .def_readonly("antiresonance_Hz", &UnitAnalysis::antiresonance_Hz, "Hz")
-        .def_readonly("static_gain", &UnitAnalysis::static_gain, "m/V")
-        .def_readonly("frf", &UnitAnalysis::frf, "dsp.Frf u -> [de, Vs] or None")
-        .def_readonly("iff_plant", &UnitAnalysis::iff_plant, "ident.IffPlantFit of u -> Vs or None")
-        .def_readonly("de_plant", &UnitAnalysis::de_plant, "ident.DelayedSecondOrderFit of u -> d_e or None")
-        .def_readonly("frf_analysis", &UnitAnalysis::frf_analysis, "campaign.FrfAnalysis or None")
-        .def_readonly("model_2dof", &UnitAnalysis::model_2dof, "campaign.Model2DofFit or None")
-        .def_readonly("damped", &UnitAnalysis::damped, "list of campaign.DampedPlant, by gain")
-        .def_readonly("tracking", &UnitAnalysis::tracking, "campaign.TrackingAnalysis or None")
-        .def_readonly("not_measured", &UnitAnalysis::not_measured, "experiments the campaign does not list")
-        .def_readonly("failed", &UnitAnalysis::failed, "one line per analysis that failed")
-        .def_readonly("warnings", &UnitAnalysis::warnings, "cross-checks that disagree (high-pass corner, resonance, ...)")
-        .def_property_readonly(
-            "not_analysed",
-            [](const UnitAnalysis& u) -> py::object {
-              if (!u.not_analysed) return py::none();
-              return py::dict(py::arg("file") = u.not_analysed->file, py::arg("key") = u.not_analysed->key,
-                              py::arg("reason") = u.not_analysed->reason);
-            },
-            "None, or {file, key, reason} of a unit whose data could not be analysed (nothing else of it is filled in)")
-        .def_readonly("accepted", &UnitAnalysis::accepted, "the acceptance")
-        .def_readonly("reasons", &UnitAnalysis::reasons, "why it is rejected")
-        .def("json", [](const UnitAnalysis& u) { return from_json(unit_json(u), "UnitResults", true); },
-             "The unit's entry of results.json as Results (values in the units their keys name).");
-    typed(c);
-  }
+  // Every struct a UnitAnalysis holds, from the field declarations beside them (results.hpp and the
+  // modules' headers), then the derived figures that are not fields.
+  bind_described<UnitAnalysis>(m);
+  bound_class<bench::TrackingFigures>().def_property_readonly("rms_reduction", &bench::TrackingFigures::rms_reduction, "rms_open / rms_ff");
+  bound_class<ident::DominantPole>()
+      .def_property_readonly("frequency_Hz", &ident::DominantPole::frequency_Hz, "Hz")
+      .def_property_readonly("relative_rms_error", [](const ident::DominantPole& p) { return p.fit.relative_rms_error; },
+                             "of the vector fit it comes from")
+      .def_property_readonly("quality", [](const ident::DominantPole& p) { return p.fit.quality; }, "the vector fit's ident.FitQuality");
+  bound_class<UnitAnalysis>().def("json", [](const UnitAnalysis& u) { return from_json(unit_json(u), "UnitResults", true); },
+                                  "The unit's entry of results.json as Results (values in the units their keys name).");
+  m.def("declarations", [] {
+    py::dict out;
+    collect_declarations<UnitAnalysis>(out);
+    return out;
+  }, "{declared struct: (its Python class, [field names])} for every struct a UnitAnalysis holds (docs/fields.md).");
   {
     py::class_<QuantitySpread> c(m, "QuantitySpread", "Spread of one quantity over the batch (values in the unit its name says).");
     c.def_readonly("quantity", &QuantitySpread::quantity, "results key, e.g. \"capacitance_sensor_uF\"")

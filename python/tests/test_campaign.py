@@ -124,3 +124,33 @@ def test_typed_results_equal_the_results_json_of_the_command_line(demo):
 def test_missing_campaign_file():
     with pytest.raises(pb.InputError):
         campaign.run("/nonexistent/campaign.toml")
+
+
+def test_every_declared_result_member_is_reachable_from_python(demo):
+    """Each result struct declares its fields once (core/fields.hpp); Python binds them all from the
+    declaration: every declared field is an attribute of the struct's class, and walking a unit's
+    results reaches a value for every field of every struct the demo fills."""
+    _, _, r = demo
+    decl = campaign.declarations()
+    assert "UnitAnalysis" in decl and "FrfAnalysis" in decl and "StrokeResult" in decl
+    for name, (cls, fields) in decl.items():
+        missing = [f for f in fields if not hasattr(cls, f)]
+        assert not missing, (name, missing)
+    by_class = {cls: fields for cls, fields in decl.values()}
+    reached = set()
+
+    def walk(obj):
+        fields = by_class.get(type(obj))
+        if fields is None:
+            if isinstance(obj, list):
+                for x in obj:
+                    walk(x)
+            return
+        reached.add(type(obj).__name__)
+        for f in fields:
+            walk(getattr(obj, f))  # every declared member is readable
+
+    walk(r.units[0])
+    assert {"UnitAnalysis", "FrfAnalysis", "StrokeAnalysis", "StaticStiffnessResult", "HysteresisLoop", "DampedPlant"} <= reached
+    assert r.units[0].stroke_analysis.result.sensitivity == pytest.approx(
+        r.units[0].json()["stroke"]["sensitivity_um_per_V"] * 1e-6, rel=1e-12)

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
@@ -29,8 +30,8 @@ namespace {
 constexpr const char* kFormat = "piezobench campaign part";
 
 // ------------------------------------------------------------------------------------ encoding
-// One list of fields per struct (`fields` below) serves both directions, so the reader is the
-// writer's inverse by construction.
+// Every struct is written and read through its field declaration (core/fields.hpp, beside the
+// struct): one list serves both directions, so the reader is the writer's inverse by construction.
 
 // Where a value is read: the file and the dotted path of the field.
 struct Where {
@@ -73,11 +74,6 @@ PIEZOBENCH_PART_ENUM(apa::TuningStatus, "tuning status", apa::tuning_status_from
 template <class T> json encode(const T& v);
 template <class T> void decode(const json& j, T& v, const Where& w);
 
-struct Writer {
-  json& out;
-  template <class T> void operator()(const char* key, const T& v) { out[key] = encode(v); }
-};
-
 struct PartReader {
   const json& in;
   Where where;
@@ -118,9 +114,9 @@ template <class T> json encode(const T& v) {
     }
     return a;
   } else {
+    static_assert(core::Described<T>, "part.json writes the structs with a field declaration (core/fields.hpp)");
     json o = json::object();
-    Writer w{o};
-    fields(w, const_cast<T&>(v));
+    core::for_each_field<T>([&](const auto& f) { o[std::string(f.name)] = encode(f.of(v)); });
     return o;
   }
 }
@@ -193,188 +189,11 @@ template <class T> void decode(const json& j, T& v, const Where& w) {
       }
     }
   } else {
+    static_assert(core::Described<T>, "part.json reads the structs with a field declaration (core/fields.hpp)");
     if (!j.is_object()) bad(w, "an object", j);
     PartReader r{j, w};
-    fields(r, v);
+    core::for_each_field<T>([&](const auto& f) { r(std::string(f.name).c_str(), f.of(v)); });
   }
-}
-
-// ------------------------------------------------------------------------------------ fields
-// Every field of every struct a UnitAnalysis holds (results.hpp and the modules' result types).
-
-template <class V> void fields(V& v, core::FitQuality& s) {
-  v("verdict", s.verdict); v("impossible", s.impossible); v("problems", s.problems); v("advice", s.advice);
-}
-template <class V> void fields(V& v, RecordProvenance& s) {
-  v("file", s.file); v("key", s.key); v("channels", s.channels); v("samples", s.samples);
-  v("sample_rate_Hz", s.sample_rate_Hz); v("input", s.input); v("outputs", s.outputs);
-}
-template <class V> void fields(V& v, Curve& s) { v("x", s.x); v("y", s.y); }
-template <class V> void fields(V& v, FlatnessAnalysis::Interface& s) { v("id", s.id); v("least_squares", s.least_squares); }
-template <class V> void fields(V& v, FlatnessAnalysis& s) {
-  v("method", s.method); v("flatness", s.flatness); v("least_squares", s.least_squares); v("minimum_zone", s.minimum_zone);
-  v("points", s.points); v("per_interface", s.per_interface); v("probe_accuracy", s.probe_accuracy);
-  v("provenance", s.provenance); v("deviation", s.deviation); v("probe_xy", s.probe_xy);
-}
-template <class V> void fields(V& v, CapacitanceAnalysis& s) {
-  v("sensor", s.sensor); v("actuator", s.actuator); v("provenance", s.provenance); v("key", s.key);
-}
-template <class V> void fields(V& v, metrology::StrokeResult& s) {
-  v("stroke", s.stroke); v("va_min", s.va_min); v("va_max", s.va_max); v("sensitivity", s.sensitivity); v("loop_width", s.loop_width);
-}
-template <class V> void fields(V& v, StrokeAnalysis& s) { v("result", s.result); v("provenance", s.provenance); v("de_vs_va", s.de_vs_va); }
-template <class V> void fields(V& v, metrology::HysteresisResult& s) {
-  v("offset", s.offset); v("amplitude", s.amplitude); v("width", s.width); v("loop_stroke", s.loop_stroke);
-  v("relative_width", s.relative_width); v("periods", s.periods); v("first_sample", s.first_sample); v("samples", s.samples);
-}
-template <class V> void fields(V& v, HysteresisLoop& s) { v("result", s.result); v("provenance", s.provenance); v("loop", s.loop); }
-template <class V> void fields(V& v, ident::PrandtlIshlinskii& s) {
-  v("linear_weight", s.linear_weight); v("thresholds", s.thresholds); v("weights", s.weights);
-}
-template <class V> void fields(V& v, ident::DeadZoneSuperposition& s) {
-  v("x", s.x); v("y", s.y); v("slope_below", s.slope_below); v("slope_above", s.slope_above);
-}
-template <class V> void fields(V& v, ident::HysteresisModel& s) {
-  v("hysteresis", s.hysteresis); v("output", s.output); v("creep_time_constants", s.creep_time_constants); v("creep_coefficients", s.creep_coefficients);
-  v("gain", s.gain); v("offset", s.offset); v("reference_slope", s.reference_slope); v("reference_intercept", s.reference_intercept);
-  v("input_min", s.input_min); v("input_max", s.input_max);
-}
-template <class V> void fields(V& v, ident::HysteresisFit& s) {
-  v("model", s.model); v("rms_residual", s.rms_residual); v("relative_residual", s.relative_residual); v("stroke", s.stroke);
-  v("samples", s.samples); v("quality", s.quality);
-}
-template <class V> void fields(V& v, HysteresisModelFit& s) {
-  v("fit", s.fit); v("alternative", s.alternative); v("alternative_error", s.alternative_error); v("asymmetry", s.asymmetry);
-  v("amplitude", s.amplitude); v("width", s.width); v("model_width", s.model_width); v("provenance", s.provenance);
-  v("loop", s.loop); v("model_loop", s.model_loop);
-}
-template <class V> void fields(V& v, bench::TrackingFigures& s) {
-  v("width_open", s.width_open); v("width_ff", s.width_ff); v("rms_open", s.rms_open); v("rms_ff", s.rms_ff); v("stroke_open", s.stroke_open);
-}
-template <class V> void fields(V& v, TrackingAnalysis& s) {
-  v("sine", s.sine); v("triangle", s.triangle); v("amplitude", s.amplitude); v("feedforward", s.feedforward);
-  v("clamped_samples", s.clamped_samples); v("provenance", s.provenance); v("sine_open", s.sine_open); v("sine_ff", s.sine_ff);
-  v("triangle_open", s.triangle_open); v("triangle_ff", s.triangle_ff);
-}
-template <class V> void fields(V& v, metrology::StaticStiffnessResult& s) {
-  v("t_on", s.t_on); v("t_off", s.t_off); v("d_before", s.d_before); v("d_loaded", s.d_loaded); v("d_after", s.d_after);
-  v("k1", s.k1); v("k2", s.k2); v("deflection_on", s.deflection_on); v("deflection_off", s.deflection_off);
-  v("k_elastic_on", s.k_elastic_on); v("k_elastic_off", s.k_elastic_off); v("creep_on", s.creep_on); v("creep_off", s.creep_off);
-  v("creep_time_constant", s.creep_time_constant); v("rms_residual", s.rms_residual); v("fit", s.fit);
-}
-template <class V> void fields(V& v, metrology::StaticStiffnessOptions& s) {
-  v("added_mass", s.added_mass); v("gravity", s.gravity); v("settle_s", s.settle_s); v("before_s", s.before_s);
-  v("loaded_s", s.loaded_s); v("after_s", s.after_s); v("t_on", s.t_on); v("t_off", s.t_off);
-  v("min_time_constant", s.min_time_constant); v("max_time_constant", s.max_time_constant);
-}
-template <class V> void fields(V& v, ident::CreepFit& s) {
-  v("time_constants", s.time_constants); v("coefficients", s.coefficients); v("gain", s.gain); v("offset", s.offset);
-  v("creep_per_decade", s.creep_per_decade); v("rms_residual", s.rms_residual); v("relative_residual", s.relative_residual);
-  v("quality", s.quality);
-}
-template <class V> void fields(V& v, StiffnessAnalysis& s) {
-  v("result", s.result); v("options", s.options); v("mass_log", s.mass_log); v("provenance", s.provenance); v("de", s.de); v("fit", s.fit);
-  v("creep", s.creep);
-}
-template <class V> void fields(V& v, VectorFitSummary& s) { v("order", s.order); v("relative_rms_error", s.relative_rms_error); v("converged", s.converged); }
-template <class V> void fields(V& v, NmpEvidence::Zero& s) {
-  v("phase_verdict", s.phase_verdict); v("phase_change_deg", s.phase_change_deg); v("fitted_zero", s.fitted_zero);
-  v("fitted_zero_nonminimum_phase", s.fitted_zero_nonminimum_phase);
-}
-template <class V> void fields(V& v, NmpEvidence& s) { v("zero", s.zero); v("iff_plant_fit_xz", s.iff_plant_fit_xz);
-  v("iff_plant_fit_xz_standard_error", s.iff_plant_fit_xz_standard_error); v("verdict_from", s.verdict_from); v("verdict_reason", s.verdict_reason); }
-template <class V> void fields(V& v, HighPassCorner& s) {
-  v("first_order_fit_Hz", s.first_order_fit_Hz); v("first_order_fit_points", s.first_order_fit_points); v("r_c_Hz", s.r_c_Hz);
-  v("iff_plant_fit_Hz", s.iff_plant_fit_Hz); v("iff_plant_fit_error", s.iff_plant_fit_error); v("method", s.method); v("observable_above_Hz", s.observable_above_Hz); v("corner_Hz", s.corner_Hz);
-}
-template <class V> void fields(V& v, dsp::FrfProvenance& s) {
-  v("source", s.source); v("estimator", s.estimator); v("window", s.window); v("nfft", s.nfft); v("overlap", s.overlap);
-  v("detrend", s.detrend); v("averages", s.averages); v("sample_rate", s.sample_rate); v("effective_averages", s.effective_averages);
-}
-template <class V> void fields(V& v, dsp::Frf& s) {
-  v("freq_Hz", s.freq_Hz); v("input", s.input); v("outputs", s.outputs); v("H", s.H); v("coherence", s.coherence); v("std_H", s.std_H);
-  v("provenance", s.provenance);
-}
-template <class V> void fields(V& v, core::ParameterUncertainty& s) {
-  v("names", s.names); v("value", s.value); v("standard_error", s.standard_error); v("correlation", s.correlation);
-  v("condition_number", s.condition_number); v("chi2_per_dof", s.chi2_per_dof); v("from_data_variance", s.from_data_variance);
-  v("high_correlations", s.high_correlations);
-}
-template <class V> void fields(V& v, ident::DelayedSecondOrderFit& s) {
-  v("static_gain", s.static_gain); v("natural_frequency", s.natural_frequency); v("damping", s.damping); v("delay", s.delay);
-  v("relative_rms_error", s.relative_rms_error); v("points", s.points); v("iterations", s.iterations); v("status", s.status); v("quality", s.quality);
-  v("uncertainty", s.uncertainty);
-}
-template <class V> void fields(V& v, ident::IffPlantFit& s) {
-  v("g0", s.g0); v("wz", s.wz); v("xz", s.xz); v("wp", s.wp); v("xp", s.xp); v("w_hpf", s.w_hpf); v("delay", s.delay);
-  v("relative_rms_error", s.relative_rms_error); v("weighted_relative_rms_error", s.weighted_relative_rms_error);
-  v("initial_relative_rms_error", s.initial_relative_rms_error); v("points", s.points); v("iterations", s.iterations);
-  v("converged", s.converged); v("status", s.status); v("quality", s.quality); v("uncertainty", s.uncertainty);
-}
-template <class V> void fields(V& v, FrfAnalysis& s) {
-  v("provenance", s.provenance); v("welch", s.welch); v("fit_de", s.fit_de); v("fit_vs", s.fit_vs);
-  v("static_gain_vector_fit", s.static_gain_vector_fit); v("static_gain", s.static_gain); v("static_gain_source", s.static_gain_source);
-  v("static_gain_vs", s.static_gain_vs); v("de_plant", s.de_plant); v("iff_plant", s.iff_plant); v("iff_plant_fmin_Hz", s.iff_plant_fmin_Hz);
-  v("iff_plant_fmax_Hz", s.iff_plant_fmax_Hz); v("iff_plant_w_hpf_measured", s.iff_plant_w_hpf_measured); v("nmp", s.nmp); v("hpf", s.hpf);
-  v("resonance_vector_fit_Hz", s.resonance_vector_fit_Hz); v("resonance_vector_fit_damping", s.resonance_vector_fit_damping);
-  v("antiresonance_vector_fit_Hz", s.antiresonance_vector_fit_Hz); v("antiresonance_vector_fit_damping", s.antiresonance_vector_fit_damping);
-  v("resonance_Hz", s.resonance_Hz); v("resonance_damping", s.resonance_damping); v("antiresonance_Hz", s.antiresonance_Hz);
-  v("antiresonance_damping", s.antiresonance_damping); v("zero_is_nonminimum_phase", s.zero_is_nonminimum_phase);
-  v("shell_stiffness", s.shell_stiffness);
-}
-template <class V> void fields(V& v, apa::TwoDofParams& s) {
-  v("m", s.m); v("k1", s.k1); v("c1", s.c1); v("ke", s.ke); v("ce", s.ce); v("ka", s.ka); v("ca", s.ca); v("ga", s.ga); v("gs", s.gs);
-}
-template <class V> void fields(V& v, apa::TuningFeatures& s) {
-  v("resonance", s.resonance); v("resonance_damping", s.resonance_damping); v("antiresonance", s.antiresonance);
-  v("antiresonance_damping", s.antiresonance_damping); v("static_gain_de", s.static_gain_de); v("static_gain_vs", s.static_gain_vs);
-}
-template <class V> void fields(V& v, apa::TwoDofBench& s) {
-  v("amplifier_gain", s.amplifier_gain); v("suspended_mass", s.suspended_mass); v("added_mass", s.added_mass);
-  v("hpf_resistance", s.hpf_resistance); v("hpf_capacitance", s.hpf_capacitance); v("delay", s.delay);
-}
-template <class V> void fields(V& v, apa::TwoDofTuning& s) {
-  v("params", s.params); v("initial", s.initial); v("features", s.features); v("bench", s.bench); v("fit_error_de", s.fit_error_de);
-  v("fit_error_vs", s.fit_error_vs); v("initial_fit_error_de", s.initial_fit_error_de); v("initial_fit_error_vs", s.initial_fit_error_vs);
-  v("points", s.points); v("iterations", s.iterations); v("status", s.status); v("message", s.message); v("quality", s.quality);
-  v("uncertainty", s.uncertainty); v("undetermined", s.undetermined);
-}
-template <class V> void fields(V& v, Model2DofFit& s) { v("tuning", s.tuning); v("bench", s.bench); v("fmin_Hz", s.fmin_Hz); v("fmax_Hz", s.fmax_Hz); }
-template <class V> void fields(V& v, LowFrequencyVs& s) {
-  v("provenance", s.provenance); v("frf", s.frf); v("lowest_line_Hz", s.lowest_line_Hz); v("fmax_Hz", s.fmax_Hz);
-  v("fitted_corner_Hz", s.fitted_corner_Hz); v("relative_rms_error", s.relative_rms_error); v("points", s.points); v("observable", s.observable);
-}
-template <class V> void fields(V& v, ResistorComparison& s) { v("with_resistor", s.with_resistor); v("without_resistor", s.without_resistor); }
-// The state space `model` is left out (see part.hpp): evaluate() uses the poles and residues.
-template <class V> void fields(V& v, ident::VectorFittingResult& s) {
-  v("poles", s.poles); v("residues", s.residues); v("d", s.d); v("e", s.e); v("rms_error", s.rms_error);
-  v("relative_rms_error", s.relative_rms_error); v("relative_rms_error_per_output", s.relative_rms_error_per_output);
-  v("quality", s.quality); v("iterations", s.iterations); v("converged", s.converged); v("convergence", s.convergence);
-  v("last_pole_change", s.last_pole_change); v("frequency_scale", s.frequency_scale);
-}
-template <class V> void fields(V& v, ident::DominantPole& s) {
-  v("pole", s.pole); v("natural_frequency", s.natural_frequency); v("damping", s.damping); v("peak", s.peak); v("fit", s.fit);
-}
-template <class V> void fields(V& v, DampedPlant& s) {
-  v("gain", s.gain); v("file", s.file); v("provenance", s.provenance); v("frf", s.frf); v("identified", s.identified);
-  v("identified_order", s.identified_order); v("fmin_Hz", s.fmin_Hz); v("fmax_Hz", s.fmax_Hz); v("second_order", s.second_order);
-  v("delay_removed", s.delay_removed);
-}
-template <class V> void fields(V& v, FlexibleModes::Mode& s) { v("frequency_Hz", s.frequency_Hz); v("damping", s.damping); v("stable_orders", s.stable_orders); }
-template <class V> void fields(V& v, FlexibleModes& s) {
-  v("provenance", s.provenance); v("welch", s.welch); v("peak_picking", s.peak_picking); v("lscf", s.lscf); v("frf", s.frf);
-}
-template <class V> void fields(V& v, NotAnalysed& s) { v("file", s.file); v("key", s.key); v("reason", s.reason); }
-template <class V> void fields(V& v, UnitAnalysis& s) {
-  v("id", s.id); v("name", s.name); v("not_analysed", s.not_analysed); v("flatness_analysis", s.flatness_analysis); v("capacitance_analysis", s.capacitance_analysis);
-  v("stroke_analysis", s.stroke_analysis); v("hysteresis", s.hysteresis); v("hysteresis_model", s.hysteresis_model); v("tracking", s.tracking);
-  v("stiffness_analysis", s.stiffness_analysis);
-  v("stiffness_open_analysis", s.stiffness_open_analysis); v("frf_analysis", s.frf_analysis); v("resistor", s.resistor);
-  v("model_2dof", s.model_2dof); v("damped", s.damped); v("flexible_modes", s.flexible_modes); v("flatness", s.flatness);
-  v("capacitance_sensor", s.capacitance_sensor); v("capacitance_actuator", s.capacitance_actuator); v("stroke", s.stroke);
-  v("k1", s.k1); v("k2", s.k2); v("k_resonance", s.k_resonance); v("k_oc", s.k_oc); v("resonance_Hz", s.resonance_Hz);
-  v("antiresonance_Hz", s.antiresonance_Hz); v("static_gain", s.static_gain); v("frf", s.frf); v("iff_plant", s.iff_plant);
-  v("de_plant", s.de_plant); v("not_measured", s.not_measured); v("failed", s.failed); v("warnings", s.warnings); v("accepted", s.accepted); v("reasons", s.reasons);
 }
 
 std::string generator() { return std::string("piezobench ") + kVersion; }

@@ -16,6 +16,8 @@
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
+#include "piezobench/core/fields.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
 
@@ -349,6 +351,19 @@ json plain(const std::optional<double>& v, double scale = 1.0) { return v ? json
 // A finite number times `scale`, else null (percentages of numbers written through io::to_json).
 json finite_scaled(double v, double scale) { return std::isfinite(v) ? json(v * scale) : json(nullptr); }
 
+// A report table's columns and cells for a result struct: the fields its declaration puts in the
+// report (core/fields.hpp), headed by name and shown unit, in that unit.
+template <class S> void report_columns(std::vector<std::string>& columns) {
+  core::for_each_field<S>([&](const auto& f) {
+    if (f.in(core::kReport)) columns.push_back(core::report_heading(f));
+  });
+}
+template <class S> void report_cells(json& row, const S& s) {
+  core::for_each_field<S>([&](const auto& f) {
+    if (f.in(core::kReport)) row.push_back(io::shown_json(f.of(s), f.shown.per_si));
+  });
+}
+
 // ---- the sections
 
 json frf_section(const std::vector<UnitCurves>& units) {
@@ -364,15 +379,18 @@ json frf_section(const std::vector<UnitCurves>& units) {
     if (!u.result->frf_analysis) continue;
     const FrfAnalysis& f = *u.result->frf_analysis;
     const json verdict = f.zero_is_nonminimum_phase ? json(*f.zero_is_nonminimum_phase ? "non-minimum phase" : "minimum phase") : json(nullptr);
-    rows.push_back({u.name(), io::to_json(f.static_gain, 1e6), io::to_json(f.resonance_Hz), io::to_json(f.resonance_damping),
-                    io::to_json(f.antiresonance_Hz), io::to_json(f.antiresonance_damping), verdict,
-                    f.nmp.zero ? json(f.nmp.zero->phase_change_deg) : json(nullptr), io::to_json(f.shell_stiffness, 1e-6),
-                    plain(f.hpf.corner_Hz)});
+    json row = json::array({u.name()});
+    report_cells(row, f);
+    row.push_back(verdict);
+    row.push_back(f.nmp.zero ? io::to_json(f.nmp.zero->phase_change_deg) : json(nullptr));
+    row.push_back(io::shown_json(f.hpf.corner_Hz));
+    rows.push_back(row);
   }
-  json tables = json::array({table("FRF features per unit",
-                                   {"unit", "static gain [um/V]", "resonance [Hz]", "damping", "anti-resonance [Hz]", "zero damping",
-                                    "zero pair", "phase change at the zero [deg]", "k_shell [N/um]", "HPF corner [Hz]"},
-                                   rows, "Zero damping < 0: the zero is in the right half plane.")});
+  std::vector<std::string> columns = {"unit"};
+  report_columns<FrfAnalysis>(columns);
+  columns.insert(columns.end(), {"zero pair", "phase change at the zero [deg]", "HPF corner [Hz]"});
+  json tables = json::array({table("FRF features per unit", columns, rows,
+                                   "Anti-resonance damping < 0: the zero is in the right half plane.")});
   json warnings = json::array();
   for (const auto& u : units) {
     for (const auto& w : u.result->warnings) warnings.push_back(u.name() + ": " + w);
@@ -601,7 +619,10 @@ json model_section(const std::vector<UnitCurves>& units) {
     if (!u.result->model_2dof) continue;
     const apa::TwoDofTuning& t = u.result->model_2dof->tuning;
     const apa::TwoDofParams& m = t.params;
-    rows.push_back({u.name(), m.m, m.k1 * 1e-6, m.c1, m.ke * 1e-6, m.ce, m.ka * 1e-6, m.ca, m.ga, m.gs * 1e-6, t.fit_error_de, t.fit_error_vs});
+    json values = json::array({u.name()});
+    report_cells(values, m);
+    report_cells(values, t);
+    rows.push_back(values);
     if (t.uncertainty.empty()) continue;
     json row = json::array({u.name()});
     for (const auto& n : fitted) row.push_back(io::to_json(100.0 * t.uncertainty.relative_standard_error_of(n)));
@@ -610,10 +631,10 @@ json model_section(const std::vector<UnitCurves>& units) {
     row.push_back(t.uncertainty.high_correlations.empty() ? std::string("-") : fmt::format("{}", fmt::join(t.uncertainty.high_correlations, "; ")));
     se_rows.push_back(row);
   }
-  json tables = json::array({table("2-DoF parameters per unit (Table 3.1)",
-                                   {"unit", "m [kg]", "k1 [N/um]", "c1 [Ns/m]", "ke [N/um]", "ce [Ns/m]", "ka [N/um]", "ca [Ns/m]",
-                                    "ga [N/V]", "gs [V/um]", "error d_e", "error Vs"},
-                                   rows,
+  std::vector<std::string> columns = {"unit"};
+  report_columns<apa::TwoDofParams>(columns);
+  report_columns<apa::TwoDofTuning>(columns);
+  json tables = json::array({table("2-DoF parameters per unit (Table 3.1)", columns, rows,
                                     "Report: k1 0.38, c1 5, ke 5.0, ce 100, ka 2.5, ca 50, ga -2.58, gs 0.46. Signs (the report's "
                                     "convention): ga < 0, so more voltage lowers the APA (a negative static gain u -> d_e), while "
                                     "the sensor voltage Vs rises with it (gs > 0).")});
@@ -770,6 +791,12 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
   return json{{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}};
 }
 
+std::vector<std::string> flatness_columns() {
+  std::vector<std::string> columns = {"unit"};
+  report_columns<FlatnessAnalysis>(columns);
+  return columns;
+}
+
 // Report 1.2 (Table 1.1): each unit's probe points against its fitted plane, by position.
 std::optional<json> flatness_section(const Campaign& c, const std::vector<UnitCurves>& units) {
   json traces = json::array(), rows = json::array();
@@ -783,7 +810,9 @@ std::optional<json> flatness_section(const Campaign& c, const std::vector<UnitCu
     }
     json dev = values(std::vector<double>(f->deviation.begin(), f->deviation.begin() + static_cast<std::ptrdiff_t>(x.size())), 1e6);
     traces.push_back(with_text(trace(u.name(), x, dev, u.name(), false, "markers"), text));
-    rows.push_back({u.name(), f->points, f->flatness * 1e6, f->least_squares * 1e6, io::to_json(f->minimum_zone, 1e6), f->probe_accuracy * 1e6});
+    json row = json::array({u.name()});
+    report_cells(row, *f);
+    rows.push_back(row);
   }
   if (traces.empty()) return std::nullopt;
   const std::string method = metrology::to_string(c.specs.flatness_method);
@@ -792,9 +821,7 @@ std::optional<json> flatness_section(const Campaign& c, const std::vector<UnitCu
               {"text", fmt::format("Every probe point's distance from the unit's fitted plane ({} plane, the specification's method): the "
                                    "plane is the 0 line, the flatness is the spread of the points above and below it.",
                                    method)},
-              {"tables", json::array({table("Flatness per unit", {"unit", "probe points", "flatness [um] (" + method + ")",
-                                                                  "least squares [um]", "minimum zone [um]", "probe accuracy [um]"},
-                                            rows)})},
+              {"tables", json::array({table("Flatness per unit (flatness: " + method + ")", flatness_columns(), rows)})},
               {"figures", json::array({figure("flatness", "Table 1.1: probe points against the fitted plane", "probe point (file order)", false,
                                               json::array({panel("distance from the plane [um]", false, traces)}),
                                               "Markers: probe points (hover: x, y and the distance); 0: the fitted plane.")})}};

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "piezobench/core/units.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
 
@@ -14,55 +15,13 @@ namespace {
 
 json num(double v) { return io::to_json(v); }
 
-json provenance(const RecordProvenance& p) {
-  json ch = json::object();
-  for (const auto& [role, name] : p.channels) ch[role] = name;
-  json out = {{"file", p.file}, {"key", p.key}, {"channels", ch}, {"samples", p.samples}, {"sample_rate_Hz", p.sample_rate_Hz}};
-  if (!p.input.empty()) {
-    out["input"] = p.input;
-    out["outputs"] = p.outputs;
-  }
-  return out;
-}
+json provenance(const RecordProvenance& p) { return io::results_object(p); }
 
+// The Welch settings with the line spacing they give.
 json welch(const dsp::FrfProvenance& p) {
-  return {{"estimator", p.estimator}, {"window", p.window}, {"nfft", p.nfft}, {"overlap", p.overlap},
-          {"detrend", p.detrend},     {"averages", p.averages}, {"resolution_Hz", p.sample_rate / static_cast<double>(p.nfft)}};
-}
-
-json flatness(const FlatnessAnalysis& f) {
-  json per_interface = json::array();
-  for (const auto& i : f.per_interface) per_interface.push_back({{"interface", i.id}, {"least_squares_um", i.least_squares * 1e6}});
-  return {{"method", metrology::to_string(f.method)},
-          {"least_squares_um", f.least_squares * 1e6},
-          {"minimum_zone_um", io::to_json(f.minimum_zone, 1e6)},
-          {"points", f.points},
-          {"per_interface", per_interface},
-          {"probe_accuracy_um", f.probe_accuracy * 1e6},
-          {"provenance", provenance(f.provenance)}};
-}
-
-json stroke(const StrokeAnalysis& s) {
-  return {{"va_min_V", s.result.va_min},
-          {"va_max_V", s.result.va_max},
-          {"sensitivity_um_per_V", s.result.sensitivity * 1e6},
-          {"loop_width_um", s.result.loop_width * 1e6},
-          {"provenance", provenance(s.provenance)}};
-}
-
-json hysteresis(const std::vector<HysteresisLoop>& loops) {
-  json list = json::array();
-  for (const auto& l : loops) {
-    const auto& h = l.result;
-    list.push_back({{"amplitude_V", h.amplitude},
-                    {"offset_V", h.offset},
-                    {"width_um", h.width * 1e6},
-                    {"loop_stroke_um", h.loop_stroke * 1e6},
-                    {"relative_width", h.relative_width},
-                    {"periods", h.periods},
-                    {"provenance", provenance(l.provenance)}});
-  }
-  return list;
+  json out = io::results_object(p);
+  out["resolution_Hz"] = p.sample_rate / static_cast<double>(p.nfft);
+  return out;
 }
 
 std::string hysteresis_model_name(const ident::HysteresisModel& m) {
@@ -107,13 +66,10 @@ json hysteresis_model(const HysteresisModelFit& h) {
 }
 
 json tracking(const TrackingAnalysis& t) {
-  const auto figures = [](const bench::TrackingFigures& f) {
-    return json{{"width_open", num(f.width_open)},         {"width_ff", num(f.width_ff)},
-                {"rms_open_um", num(f.rms_open * 1e6)},    {"rms_ff_um", num(f.rms_ff * 1e6)},
-                {"rms_reduction", num(f.rms_reduction())}, {"stroke_open_um", num(f.stroke_open * 1e6)}};
-  };
-  return {{"amplitude_V", num(t.amplitude)}, {"feedforward", t.feedforward},         {"clamped_samples", num(t.clamped_samples)},
-          {"sine", figures(t.sine)},         {"triangle", figures(t.triangle)},     {"provenance", provenance(t.provenance)}};
+  json out = io::results_object(t);
+  out["sine"]["rms_reduction"] = num(t.sine.rms_reduction());
+  out["triangle"]["rms_reduction"] = num(t.triangle.rms_reduction());
+  return out;
 }
 
 // The Prony creep of a stiffness record (input N, output m).
@@ -129,58 +85,9 @@ json creep(const ident::CreepFit& c) {
           {"quality_problems", c.quality.problems}};
 }
 
-json stiffness(const StiffnessAnalysis& a) {
-  const auto& s = a.result;
-  const auto& o = a.options;
-  json j = {{"k1_N_per_um", s.k1 * 1e-6},
-          {"k2_N_per_um", s.k2 * 1e-6},
-          {"t_on_s", s.t_on},
-          {"t_off_s", s.t_off},
-          {"readings_um", {{"before", s.d_before * 1e6}, {"loaded", s.d_loaded * 1e6}, {"after", s.d_after * 1e6}}},
-          {"reading_windows_s",
-           {{"before", {o.before_s[0], o.before_s[1]}}, {"loaded", {o.loaded_s[0], o.loaded_s[1]}}, {"after", {o.after_s[0], o.after_s[1]}}}},
-          {"elastic_N_per_um", {{"on", s.k_elastic_on * 1e-6}, {"off", s.k_elastic_off * 1e-6}}},
-          {"creep_um_per_decade", {{"on", s.creep_on * 1e6}, {"off", s.creep_off * 1e6}}},
-          {"creep_time_constant_s", s.creep_time_constant},
-          {"fit_rms_um", s.rms_residual * 1e6},
-          {"added_mass_kg", o.added_mass},
-          {"gravity_m_per_s2", o.gravity},
-          {"mass_log", a.mass_log},
-          {"provenance", provenance(a.provenance)}};
-  if (a.creep) j["creep_prony"] = creep(*a.creep);
-  return j;
-}
-
-json vector_fit(const VectorFitSummary& v) {
-  return {{"order", v.order}, {"relative_rms_error", v.relative_rms_error}, {"converged", v.converged}};
-}
-
-json hpf(const HighPassCorner& h) {
-  json out = json::object();
-  if (h.first_order_fit_Hz) {
-    out["first_order_fit_Hz"] = *h.first_order_fit_Hz;
-    out["first_order_fit_points"] = h.first_order_fit_points;
-  }
-  if (h.r_c_Hz) out["R_C_Hz"] = *h.r_c_Hz;
-  if (h.iff_plant_fit_Hz) {
-    out["iff_plant_fit_Hz"] = *h.iff_plant_fit_Hz;
-  } else if (h.iff_plant_fit_error) {
-    out["iff_plant_fit_Hz"] = nullptr;
-    out["iff_plant_fit_error"] = *h.iff_plant_fit_error;
-  }
-  out["method"] = h.method;
-  if (!h.corner_Hz) out["observable_above_Hz"] = h.observable_above_Hz;
-  return out;
-}
-
 json frf(const FrfAnalysis& f) {
-  json out = {{"provenance", provenance(f.provenance)}, {"welch", welch(f.welch)}};
-  if (f.fit_de) out["fit_de"] = vector_fit(*f.fit_de);
-  if (f.fit_vs) out["fit_Vs"] = vector_fit(*f.fit_vs);
-  if (f.static_gain_vs) out["static_gain_Vs_V_per_V"] = *f.static_gain_vs;
-  if (f.static_gain_vector_fit) out["static_gain_vector_fit_um_per_V"] = *f.static_gain_vector_fit * 1e6;
-  out["static_gain_um_per_V"] = io::to_json(f.static_gain, 1e6);
-  if (!f.static_gain_source.empty()) out["static_gain_source"] = f.static_gain_source;
+  json out = io::results_object(f);
+  out["welch"] = welch(f.welch);
   if (f.de_plant) {
     const auto& p = *f.de_plant;
     out["de_plant_fit"] = {{"static_gain_um_per_V", p.static_gain * 1e6},
@@ -207,33 +114,6 @@ json frf(const FrfAnalysis& f) {
                             {"iterations", p.iterations},
                             {"uncertainty", io::to_json(p.uncertainty)}};
   }
-  json nmp = json::object();
-  if (f.nmp.zero) {
-    const auto& z = *f.nmp.zero;
-    nmp = {{"phase_verdict", ident::to_string(z.phase_verdict)},
-           {"phase_change_deg", z.phase_change_deg},
-           {"fitted_zero", io::to_json(z.fitted_zero)},
-           {"fitted_zero_nonminimum_phase", z.fitted_zero_nonminimum_phase}};
-  }
-  if (f.nmp.iff_plant_fit_xz) nmp["iff_plant_fit_xz"] = *f.nmp.iff_plant_fit_xz;
-  if (f.nmp.iff_plant_fit_xz_standard_error) nmp["iff_plant_fit_xz_standard_error"] = io::to_json(*f.nmp.iff_plant_fit_xz_standard_error);
-  nmp["verdict_from"] = f.nmp.verdict_from;
-  nmp["verdict_reason"] = f.nmp.verdict_reason;
-  out["nmp_evidence"] = nmp;
-  if (f.antiresonance_vector_fit_Hz) {
-    out["antiresonance_vector_fit_Hz"] = *f.antiresonance_vector_fit_Hz;
-    out["antiresonance_vector_fit_damping"] = *f.antiresonance_vector_fit_damping;
-  }
-  if (f.resonance_vector_fit_Hz) {
-    out["resonance_vector_fit_Hz"] = *f.resonance_vector_fit_Hz;
-    out["resonance_vector_fit_damping"] = *f.resonance_vector_fit_damping;
-  }
-  out["resonance_Hz"] = io::to_json(f.resonance_Hz);
-  out["resonance_damping"] = io::to_json(f.resonance_damping);
-  out["antiresonance_Hz"] = io::to_json(f.antiresonance_Hz);
-  out["antiresonance_damping"] = io::to_json(f.antiresonance_damping);
-  out["zero_is_nonminimum_phase"] = f.zero_is_nonminimum_phase ? json(*f.zero_is_nonminimum_phase) : json(nullptr);
-  out["shell_stiffness_N_per_um"] = io::to_json(f.shell_stiffness, 1e-6);
   return out;
 }
 
@@ -304,13 +184,6 @@ json resistor(const ResistorComparison& r) {
   return {{"with_resistor", r.with_resistor ? low_frequency_vs(*r.with_resistor) : json(nullptr)},
           {"without_resistor", low_frequency_vs(r.without_resistor)},
           {"method", "first-order high-pass g s/(s + wc) fitted to u -> Vs below hpf_fmax_Hz (Welch, segments of half the record)"}};
-}
-
-json flexible_modes(const FlexibleModes& m) {
-  json peaks = json::array(), modes = json::array();
-  for (const auto& p : m.peak_picking) peaks.push_back({{"frequency_Hz", p.frequency_Hz}, {"damping", p.damping}});
-  for (const auto& p : m.lscf) modes.push_back({{"frequency_Hz", p.frequency_Hz}, {"damping", p.damping}, {"stable_orders", p.stable_orders}});
-  return {{"provenance", provenance(m.provenance)}, {"welch", welch(m.welch)}, {"peak_picking", peaks}, {"lscf", modes}};
 }
 
 json batch(const BatchAnalysis& b) {
@@ -406,56 +279,36 @@ json range(const std::optional<metrology::Range>& r, double scale) {
 }  // namespace
 
 json unit_json(const UnitAnalysis& u) {
-  json r = {{"id", u.id},
-            {"name", u.name},
-            {"flatness_um", nullptr},
-            {"capacitance_uF", nullptr},
-            {"stroke_um", nullptr},
-            {"stiffness_N_per_um", nullptr},
-            {"frf", nullptr},
-            {"hpf_corner_Hz", nullptr},
-            {"model_2dof", nullptr}};
-  if (u.flatness_analysis) {
-    r["flatness_um"] = u.flatness_analysis->flatness * 1e6;
-    r["flatness"] = flatness(*u.flatness_analysis);
-  }
+  json r = io::results_object(u);
+  r["capacitance_provenance"] = nullptr;
+  r["hpf"] = nullptr;
+  r["hpf_corner_Hz"] = nullptr;
+  r["model_2dof"] = nullptr;
   if (u.capacitance_analysis) {
     const auto& c = *u.capacitance_analysis;
-    r["capacitance_uF"] = {{"sensor", c.sensor * 1e6}, {"actuator", c.actuator * 1e6}};
     r["capacitance_provenance"] = c.provenance ? provenance(*c.provenance) : json({{"key", c.key}});
   }
-  if (u.stroke_analysis) {
-    r["stroke_um"] = u.stroke_analysis->result.stroke * 1e6;
-    r["stroke"] = stroke(*u.stroke_analysis);
-  }
-  if (!u.hysteresis.empty()) r["hysteresis"] = hysteresis(u.hysteresis);
   if (u.hysteresis_model) r["hysteresis_model"] = hysteresis_model(*u.hysteresis_model);
   if (u.tracking) r["tracking"] = tracking(*u.tracking);
-  if (u.stiffness_analysis) r["stiffness_static"] = stiffness(*u.stiffness_analysis);
-  if (u.stiffness_open_analysis) r["stiffness_open_circuit"] = stiffness(*u.stiffness_open_analysis);
+  if (u.stiffness_analysis && u.stiffness_analysis->creep) r["stiffness_static"]["creep_prony"] = creep(*u.stiffness_analysis->creep);
+  if (u.stiffness_open_analysis && u.stiffness_open_analysis->creep) {
+    r["stiffness_open_circuit"]["creep_prony"] = creep(*u.stiffness_open_analysis->creep);
+  }
   if (u.frf_analysis) {
     r["frf"] = frf(*u.frf_analysis);
-    r["hpf"] = hpf(u.frf_analysis->hpf);
-    if (u.frf_analysis->hpf.corner_Hz) r["hpf_corner_Hz"] = *u.frf_analysis->hpf.corner_Hz;
+    r["hpf"] = io::results_object(u.frf_analysis->hpf);
+    r["hpf_corner_Hz"] = io::shown_json(u.frf_analysis->hpf.corner_Hz);
   }
   if (u.model_2dof) model_2dof(*u.model_2dof, r);
   if (u.resistor) r["hpf_resistor"] = resistor(*u.resistor);
-  if (u.k1 || u.k_resonance || u.k_oc) {
-    // k_sc: the stacks short-circuited (on the amplifier, the sensor on R) = k1; k_oc: every stack
-    // open, read the same way (report section 2.2).
-    r["stiffness_N_per_um"] = {{"k1", io::to_json(u.k1, 1e-6)}, {"k2", io::to_json(u.k2, 1e-6)}, {"resonance", io::to_json(u.k_resonance, 1e-6)},
-                               {"k_sc", io::to_json(u.k1, 1e-6)}, {"k_oc", io::to_json(u.k_oc, 1e-6)}};
-  }
+  // k_sc: the stacks short-circuited (on the amplifier, the sensor on R) = k1 (report section 2.2).
+  r["stiffness_N_per_um"]["k_sc"] = r["stiffness_N_per_um"]["k1"];
+  // A group of numbers none of which was measured is null as a whole (as an analysis not run).
+  if (!u.capacitance_analysis) r["capacitance_uF"] = nullptr;
+  if (!u.k1 && !u.k_resonance && !u.k_oc) r["stiffness_N_per_um"] = nullptr;
   if (!u.damped.empty()) r["iff_damped_plants"] = damped_plants(u.damped);
-  if (u.flexible_modes) r["flexible_modes"] = flexible_modes(*u.flexible_modes);
-  r["not_measured"] = u.not_measured;
-  if (u.not_analysed) {
-    r["not_analysed"] = {{"file", u.not_analysed->file}, {"key", u.not_analysed->key}, {"reason", u.not_analysed->reason}};
-  }
-  r["failed"] = u.failed;
-  r["warnings"] = u.warnings;
-  r["accepted"] = u.accepted;
-  r["reasons"] = u.reasons;
+  if (u.flexible_modes) r["flexible_modes"]["welch"] = welch(u.flexible_modes->welch);
+  io::name_non_finite(r);
   return r;
 }
 
@@ -472,7 +325,7 @@ json results_json(const CampaignResult& r) {
                 {"stroke_min_um", sp.stroke_min ? json(*sp.stroke_min * 1e6) : json(nullptr)},
                 {"stiffness_N_per_um", range(sp.stiffness, 1e-6)},
                 {"reject_outliers", sp.reject_outliers}};
-  return {{"title", c.title},
+  json doc = {{"title", c.title},
           {"campaign", c.file.string()},
           {"generator", std::string("piezobench ") + kVersion},
           {"units", units},
@@ -494,6 +347,8 @@ json results_json(const CampaignResult& r) {
                        {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},
                        {"hpf_resistance_ohm", io::to_json(c.bench.hpf_resistance)}, {"probe_accuracy_um", c.bench.probe_accuracy * 1e6}}},
             {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
+  io::name_non_finite(doc);  // the one encoding of non-finite numbers (docs/formats.md)
+  return doc;
 }
 
 }  // namespace piezobench::campaign

@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <type_traits>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/fields.hpp"
 
 namespace piezobench::station {
 
@@ -29,32 +32,128 @@ Verdict verdict_from_string(const std::string& s) {
 
 Verdict worst(Verdict a, Verdict b) { return static_cast<int>(a) >= static_cast<int>(b) ? a : b; }
 
-const std::vector<MeasurementKind>& measurement_catalog() {
-  static const std::vector<MeasurementKind> catalog = {
-      {"flatness_um", "um", Experiment::kFlatness, "flatness of the interfaces by the campaign's method"},
-      {"capacitance_sensor_uF", "uF", Experiment::kCapacitance, "capacitance of the sensor stack"},
-      {"capacitance_actuator_uF", "uF", Experiment::kCapacitance, "capacitance of the actuator stacks"},
-      {"stroke_um", "um", Experiment::kStroke, "stroke, max - min of d_e over the stack range"},
-      {"sensitivity_um_per_V", "um/V", Experiment::kStroke, "slope of d_e against Va"},
-      {"hysteresis_relative_width", "1", Experiment::kHysteresis, "loop width at the offset / loop stroke"},
-      {"hysteresis_width_um", "um", Experiment::kHysteresis, "loop width at the offset"},
-      {"k1_N_per_um", "N/um", Experiment::kStiffness, "static stiffness, mass put on"},
-      {"k2_N_per_um", "N/um", Experiment::kStiffness, "static stiffness, mass taken off"},
-      {"k_oc_N_per_um", "N/um", Experiment::kStiffnessOpen, "static stiffness with every stack open"},
-      {"resonance_Hz", "Hz", Experiment::kFrf, "resonance of u -> d_e"},
-      {"antiresonance_Hz", "Hz", Experiment::kFrf, "anti-resonance of u -> Vs"},
-      {"resonance_damping", "1", Experiment::kFrf, "damping ratio of the resonance"},
-      {"k_resonance_N_per_um", "N/um", Experiment::kFrf, "stiffness from the resonance, m_sus w^2"},
-      {"static_gain_um_per_V", "um/V", Experiment::kFrf, "static gain u -> d_e"},
-      {"hpf_corner_Hz", "Hz", Experiment::kFrf, "high-pass corner of the force sensor"},
-      {"hpf_corner_without_resistor_Hz", "Hz", Experiment::kFrfNoResistor, "fitted corner without the resistor"},
-      {"damped_damping", "1", Experiment::kIff, "damping ratio of the identified damped pole"},
-      {"damped_frequency_Hz", "Hz", Experiment::kIff, "frequency of the identified damped pole"},
-      {"first_mode_Hz", "Hz", Experiment::kHammer, "first flexible mode (LSCF, else peak picking)"},
-      {"tracking_width_ff", "1", Experiment::kTracking, "hysteresis width of the 1 Hz sine with the feedforward"},
-      {"tracking_rms_reduction", "1", Experiment::kTracking, "rms tracking error without / with the feedforward (sine)"},
+namespace {
+
+using campaign::UnitAnalysis;
+using Si = std::optional<double>;
+// A measurement's value in SI from a unit's analysis; `file` picks the record of a multi-file experiment.
+using Reader = std::function<Si(const UnitAnalysis&, const std::string& file)>;
+
+// The shown unit of a declared member (core/fields.hpp): the catalog's units and factors are the
+// declaration's, not written again here.
+template <class S, class M> core::Shown shown_of(M S::*member) {
+  core::Shown out;
+  core::for_each_field<S>([&](const auto& f) {
+    if constexpr (std::is_same_v<decltype(f.member), M S::*>) {
+      if (f.member == member) out = f.shown;
+    }
+  });
+  return out;
+}
+
+struct Entry {
+  MeasurementKind kind;
+  double per_si = 1.0;
+  Reader read;
+};
+
+Entry entry(std::string name, Experiment experiment, std::string description, const core::Shown& shown, Reader read) {
+  return {{std::move(name), shown.unit.empty() ? "1" : std::string(shown.unit), experiment, std::move(description)}, shown.per_si,
+          std::move(read)};
+}
+
+// A number of UnitAnalysis itself.
+Entry unit_entry(std::string name, Experiment e, std::string description, Si UnitAnalysis::*member) {
+  return entry(std::move(name), e, std::move(description), shown_of(member),
+               [member](const UnitAnalysis& u, const std::string&) { return u.*member; });
+}
+
+template <class Item, class Pick>
+Si first_of(const std::vector<Item>& items, const std::string& file, const std::string Item::*file_of, Pick pick) {
+  for (const Item& x : items) {
+    if (!file.empty() && x.*file_of != file) continue;
+    return pick(x);
+  }
+  return std::nullopt;
+}
+
+Si hysteresis_pick(const UnitAnalysis& u, const std::string& file, double metrology::HysteresisResult::*member) {
+  for (const campaign::HysteresisLoop& h : u.hysteresis) {
+    if (!file.empty() && h.provenance.file != file) continue;
+    return h.result.*member;
+  }
+  return std::nullopt;
+}
+
+Si damped_pick(const UnitAnalysis& u, const std::string& file, double ident::DominantPole::*member) {
+  return first_of(u.damped, file, &campaign::DampedPlant::file,
+                  [&](const campaign::DampedPlant& d) { return d.identified ? Si((*d.identified).*member) : std::nullopt; });
+}
+
+const std::vector<Entry>& catalog() {
+  using campaign::FrfAnalysis;
+  static const std::vector<Entry> entries = {
+      unit_entry("flatness_um", Experiment::kFlatness, "flatness of the interfaces by the campaign's method", &UnitAnalysis::flatness),
+      unit_entry("capacitance_sensor_uF", Experiment::kCapacitance, "capacitance of the sensor stack", &UnitAnalysis::capacitance_sensor),
+      unit_entry("capacitance_actuator_uF", Experiment::kCapacitance, "capacitance of the actuator stacks", &UnitAnalysis::capacitance_actuator),
+      unit_entry("stroke_um", Experiment::kStroke, "stroke, max - min of d_e over the stack range", &UnitAnalysis::stroke),
+      entry("sensitivity_um_per_V", Experiment::kStroke, "slope of d_e against Va", shown_of(&metrology::StrokeResult::sensitivity),
+            [](const UnitAnalysis& u, const std::string&) { return u.stroke_analysis ? Si(u.stroke_analysis->result.sensitivity) : std::nullopt; }),
+      entry("hysteresis_relative_width", Experiment::kHysteresis, "loop width at the offset / loop stroke",
+            shown_of(&metrology::HysteresisResult::relative_width),
+            [](const UnitAnalysis& u, const std::string& f) { return hysteresis_pick(u, f, &metrology::HysteresisResult::relative_width); }),
+      entry("hysteresis_width_um", Experiment::kHysteresis, "loop width at the offset", shown_of(&metrology::HysteresisResult::width),
+            [](const UnitAnalysis& u, const std::string& f) { return hysteresis_pick(u, f, &metrology::HysteresisResult::width); }),
+      unit_entry("k1_N_per_um", Experiment::kStiffness, "static stiffness, mass put on", &UnitAnalysis::k1),
+      unit_entry("k2_N_per_um", Experiment::kStiffness, "static stiffness, mass taken off", &UnitAnalysis::k2),
+      unit_entry("k_oc_N_per_um", Experiment::kStiffnessOpen, "static stiffness with every stack open", &UnitAnalysis::k_oc),
+      unit_entry("resonance_Hz", Experiment::kFrf, "resonance of u -> d_e", &UnitAnalysis::resonance_Hz),
+      unit_entry("antiresonance_Hz", Experiment::kFrf, "anti-resonance of u -> Vs", &UnitAnalysis::antiresonance_Hz),
+      entry("resonance_damping", Experiment::kFrf, "damping ratio of the resonance", shown_of(&FrfAnalysis::resonance_damping),
+            [](const UnitAnalysis& u, const std::string&) { return u.frf_analysis ? u.frf_analysis->resonance_damping : std::nullopt; }),
+      unit_entry("k_resonance_N_per_um", Experiment::kFrf, "stiffness from the resonance, m_sus w^2", &UnitAnalysis::k_resonance),
+      unit_entry("static_gain_um_per_V", Experiment::kFrf, "static gain u -> d_e", &UnitAnalysis::static_gain),
+      entry("hpf_corner_Hz", Experiment::kFrf, "high-pass corner of the force sensor", shown_of(&campaign::HighPassCorner::corner_Hz),
+            [](const UnitAnalysis& u, const std::string&) { return u.frf_analysis ? u.frf_analysis->hpf.corner_Hz : std::nullopt; }),
+      entry("hpf_corner_without_resistor_Hz", Experiment::kFrfNoResistor, "fitted corner without the resistor",
+            shown_of(&campaign::LowFrequencyVs::fitted_corner_Hz),
+            [](const UnitAnalysis& u, const std::string&) { return u.resistor ? u.resistor->without_resistor.fitted_corner_Hz : std::nullopt; }),
+      entry("damped_damping", Experiment::kIff, "damping ratio of the identified damped pole", shown_of(&ident::DominantPole::damping),
+            [](const UnitAnalysis& u, const std::string& f) { return damped_pick(u, f, &ident::DominantPole::damping); }),
+      entry("damped_frequency_Hz", Experiment::kIff, "frequency of the identified damped pole", shown_of(&ident::DominantPole::natural_frequency),
+            [](const UnitAnalysis& u, const std::string& f) { return damped_pick(u, f, &ident::DominantPole::natural_frequency); }),
+      entry("first_mode_Hz", Experiment::kHammer, "first flexible mode (LSCF, else peak picking)",
+            shown_of(&campaign::FlexibleModes::Mode::frequency_Hz),
+            [](const UnitAnalysis& u, const std::string&) -> Si {
+              if (!u.flexible_modes) return std::nullopt;
+              const auto& m = u.flexible_modes->lscf.empty() ? u.flexible_modes->peak_picking : u.flexible_modes->lscf;
+              return m.empty() ? std::nullopt : Si(m.front().frequency_Hz);
+            }),
+      entry("tracking_width_ff", Experiment::kTracking, "hysteresis width of the 1 Hz sine with the feedforward",
+            shown_of(&bench::TrackingFigures::width_ff),
+            [](const UnitAnalysis& u, const std::string&) { return u.tracking ? Si(u.tracking->sine.width_ff) : std::nullopt; }),
+      // A ratio of two declared figures (bench::TrackingFigures::rms_reduction), not a field.
+      entry("tracking_rms_reduction", Experiment::kTracking, "rms tracking error without / with the feedforward (sine)", core::shown::kRatio,
+            [](const UnitAnalysis& u, const std::string&) { return u.tracking ? Si(u.tracking->sine.rms_reduction()) : std::nullopt; }),
   };
-  return catalog;
+  return entries;
+}
+
+const Entry* find_entry(const std::string& name) {
+  const auto& c = catalog();
+  const auto it = std::find_if(c.begin(), c.end(), [&](const Entry& e) { return e.kind.name == name; });
+  return it == c.end() ? nullptr : &*it;
+}
+
+}  // namespace
+
+const std::vector<MeasurementKind>& measurement_catalog() {
+  static const std::vector<MeasurementKind> kinds = [] {
+    std::vector<MeasurementKind> out;
+    for (const Entry& e : catalog()) out.push_back(e.kind);
+    return out;
+  }();
+  return kinds;
 }
 
 const MeasurementKind* find_measurement(const std::string& name) {
@@ -63,71 +162,11 @@ const MeasurementKind* find_measurement(const std::string& name) {
   return it == c.end() ? nullptr : &*it;
 }
 
-namespace {
-
-constexpr double kMicro = 1e6;
-
-std::optional<double> scaled(const std::optional<double>& v, double scale) {
-  return v ? std::optional<double>(*v * scale) : std::nullopt;
-}
-
-std::optional<double> hysteresis_value(const campaign::UnitAnalysis& u, const std::string& name, const std::string& file) {
-  for (const campaign::HysteresisLoop& h : u.hysteresis) {
-    if (!file.empty() && h.provenance.file != file) continue;
-    if (name == "hysteresis_relative_width") return h.result.relative_width;
-    return h.result.width * kMicro;
-  }
-  return std::nullopt;
-}
-
-std::optional<double> damped_value(const campaign::UnitAnalysis& u, const std::string& name, const std::string& file) {
-  for (const campaign::DampedPlant& d : u.damped) {
-    if (!file.empty() && d.file != file) continue;
-    if (!d.identified) return std::nullopt;
-    return name == "damped_damping" ? d.identified->damping : d.identified->frequency_Hz();
-  }
-  return std::nullopt;
-}
-
-std::optional<double> frf_value(const campaign::UnitAnalysis& u, const std::string& name) {
-  if (name == "resonance_Hz") return u.resonance_Hz;
-  if (name == "antiresonance_Hz") return u.antiresonance_Hz;
-  if (name == "k_resonance_N_per_um") return scaled(u.k_resonance, 1e-6);
-  if (name == "static_gain_um_per_V") return scaled(u.static_gain, kMicro);
-  if (!u.frf_analysis) return std::nullopt;
-  if (name == "resonance_damping") return u.frf_analysis->resonance_damping;
-  if (name == "hpf_corner_Hz") return u.frf_analysis->hpf.corner_Hz;
-  return std::nullopt;
-}
-
-}  // namespace
-
 std::optional<double> measured_value(const campaign::UnitAnalysis& u, const std::string& name, const std::string& file) {
-  if (name == "flatness_um") return scaled(u.flatness, kMicro);
-  if (name == "capacitance_sensor_uF") return scaled(u.capacitance_sensor, kMicro);
-  if (name == "capacitance_actuator_uF") return scaled(u.capacitance_actuator, kMicro);
-  if (name == "stroke_um") return scaled(u.stroke, kMicro);
-  if (name == "sensitivity_um_per_V") {
-    return u.stroke_analysis ? std::optional<double>(u.stroke_analysis->result.sensitivity * kMicro) : std::nullopt;
-  }
-  if (name.rfind("hysteresis_", 0) == 0) return hysteresis_value(u, name, file);
-  if (name == "k1_N_per_um") return scaled(u.k1, 1e-6);
-  if (name == "k2_N_per_um") return scaled(u.k2, 1e-6);
-  if (name == "k_oc_N_per_um") return scaled(u.k_oc, 1e-6);
-  if (name == "hpf_corner_without_resistor_Hz") {
-    return u.resistor ? u.resistor->without_resistor.fitted_corner_Hz : std::nullopt;
-  }
-  if (name.rfind("damped_", 0) == 0) return damped_value(u, name, file);
-  if (name == "first_mode_Hz") {
-    if (!u.flexible_modes) return std::nullopt;
-    const auto& m = u.flexible_modes->lscf.empty() ? u.flexible_modes->peak_picking : u.flexible_modes->lscf;
-    return m.empty() ? std::nullopt : std::optional<double>(m.front().frequency_Hz);
-  }
-  if (name == "tracking_width_ff") return u.tracking ? std::optional<double>(u.tracking->sine.width_ff) : std::nullopt;
-  if (name == "tracking_rms_reduction") {
-    return u.tracking ? std::optional<double>(u.tracking->sine.rms_reduction()) : std::nullopt;
-  }
-  return frf_value(u, name);
+  const Entry* e = find_entry(name);
+  if (e == nullptr) return std::nullopt;
+  const Si v = e->read(u, file);
+  return v ? Si(*v * e->per_si) : std::nullopt;
 }
 
 MeasuredValue judge(const MeasurementKind& kind, std::optional<double> value, const Limit& limit, double margin_relative) {

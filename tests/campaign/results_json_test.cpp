@@ -20,8 +20,10 @@ TEST(ResultsJson, UnitsOfTheKeysAndNullsForAbsentAnalyses) {
   u.stroke_analysis->result.stroke = 250e-6;
   u.stroke_analysis->result.sensitivity = -1.5e-6;
   u.stroke_analysis->provenance = {"stroke.mat", "units[0].stroke", {{"Va", "V_stack"}, {"de", "d_enc"}}, 100, 1e3, "", {}};
+  u.stroke = 250e-6;  // the unit's summary numbers (unit_analysis.cpp copies them from the analyses)
   u.k1 = 1.7e6;
   u.capacitance_analysis = CapacitanceAnalysis{5.1e-6, 10e-6, std::nullopt, "units[0].capacitance_uF"};
+  u.capacitance_sensor = 5.1e-6;
   u.accepted = false;
   u.reasons = {"stroke too small"};
   const json j = unit_json(u);
@@ -29,7 +31,7 @@ TEST(ResultsJson, UnitsOfTheKeysAndNullsForAbsentAnalyses) {
   EXPECT_DOUBLE_EQ(j["stroke_um"].get<double>(), 250.0);
   EXPECT_DOUBLE_EQ(j["stroke"]["sensitivity_um_per_V"].get<double>(), -1.5);
   EXPECT_EQ(j["stroke"]["provenance"]["channels"]["de"], "d_enc");
-  EXPECT_FALSE(j["stroke"]["provenance"].contains("input"));  // only FRF records have one
+  EXPECT_EQ(j["stroke"]["provenance"]["input"], "");  // every declared field is written; only FRF records have an input
   EXPECT_DOUBLE_EQ(j["stiffness_N_per_um"]["k1"].get<double>(), 1.7);
   EXPECT_TRUE(j["stiffness_N_per_um"]["k2"].is_null());
   EXPECT_DOUBLE_EQ(j["capacitance_uF"]["sensor"].get<double>(), 5.1);

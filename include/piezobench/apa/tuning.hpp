@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/apa/two_dof.hpp"
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/fit_quality.hpp"
@@ -137,5 +138,38 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& options = {}
 // chain removed.
 TwoDofTuning tune_two_dof_measured(const dsp::Frf& frf, TuningOptions options, const ident::DelayedSecondOrderFit* de_plant,
                                    const ident::IffPlantFit* vs_plant);
+
+constexpr auto describe(core::Type<TuningFeatures>) {
+  using S = TuningFeatures;
+  using namespace core::shown;
+  return core::fields<S>("TuningFeatures", "features read from the FRFs by the tuning's first step",
+      core::field("resonance", &S::resonance, kRadPerSecondAsHz, "resonance of u -> d_e"),
+      core::field("resonance_damping", &S::resonance_damping, kRatio, "its damping"),
+      core::field("antiresonance", &S::antiresonance, kRadPerSecondAsHz, "anti-resonance of u -> Vs"),
+      core::field("antiresonance_damping", &S::antiresonance_damping, kRatio, "from the depth of the dip (>= 0)"),
+      core::field("static_gain_de", &S::static_gain_de, kMetrePerVoltAsUmPerV, "|H_de| at the lowest frequency, signed"),
+      core::field("static_gain_vs", &S::static_gain_vs, kVoltPerVolt, "the same for Vs (high-pass removed)"));
+}
+
+constexpr auto describe(core::Type<TwoDofTuning>) {
+  using S = TwoDofTuning;
+  using namespace core::shown;
+  return core::fields<S>("TwoDofTuning", "the 2-DoF model tuned to a unit's FRFs",
+      core::field("params", &S::params, kNone, "the result"),
+      core::field("initial", &S::initial, kNone, "after step 1"),
+      core::field("features", &S::features, kNone, "read from the data by step 1"),
+      core::field("bench", &S::bench, kNone, "the measurement chain removed from the data"),
+      core::field("fit_error_de", &S::fit_error_de, kRatio, "rms |H_model / H_data - 1| of d_e").in_report(),
+      core::field("fit_error_vs", &S::fit_error_vs, kRatio, "the same of Vs").in_report(),
+      core::field("initial_fit_error_de", &S::initial_fit_error_de, kRatio, "d_e's error after step 1"),
+      core::field("initial_fit_error_vs", &S::initial_fit_error_vs, kRatio, "Vs's error after step 1"),
+      core::field("points", &S::points, kNone, "frequencies used"),
+      core::field("iterations", &S::iterations, kNone, "Levenberg-Marquardt steps"),
+      core::field("status", &S::status, kNone, "how the refinement ended"),
+      core::field("message", &S::message, kNone, "what stopped the refinement"),
+      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("uncertainty", &S::uncertainty, kNone, "standard errors of the 9 parameters"),
+      core::field("undetermined", &S::undetermined, kNone, "parameters the data do not determine"));
+}
 
 }  // namespace piezobench::apa

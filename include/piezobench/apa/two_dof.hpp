@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/lti/state_space.hpp"
 
 namespace piezobench::apa {
@@ -126,5 +127,32 @@ struct TwoDofCharacteristics {
   double antiresonance_damping = 0.0;
 };
 TwoDofCharacteristics characterize(const TwoDofParams& p, const TwoDofBench& bench);
+
+constexpr auto describe(core::Type<TwoDofParams>) {
+  using S = TwoDofParams;
+  using namespace core::shown;
+  return core::fields<S>("TwoDofParams", "the 9 parameters of the 2-DoF model (Table 3.1)",
+      core::field("m", &S::m, kKilogram, "mass carried by the APA").in_report(),
+      core::field("k1", &S::k1, kNewtonPerMetreAsNPerUm, "shell stiffness").in_report(),
+      core::field("c1", &S::c1, kNewtonSecondPerMetre, "shell damping").in_report(),
+      core::field("ke", &S::ke, kNewtonPerMetreAsNPerUm, "sensor stack stiffness").in_report(),
+      core::field("ce", &S::ce, kNewtonSecondPerMetre, "sensor stack damping").in_report(),
+      core::field("ka", &S::ka, kNewtonPerMetreAsNPerUm, "actuator stacks stiffness (the two in series)").in_report(),
+      core::field("ca", &S::ca, kNewtonSecondPerMetre, "actuator stacks damping").in_report(),
+      core::field("ga", &S::ga, kNewtonPerVolt, "actuator sensitivity f = ga Va").in_report(),
+      core::field("gs", &S::gs, kVoltPerMetreAsVPerUm, "sensor sensitivity Vs = gs e").in_report());
+}
+
+constexpr auto describe(core::Type<TwoDofBench>) {
+  using S = TwoDofBench;
+  using namespace core::shown;
+  return core::fields<S>("TwoDofBench", "the bench around the actuator: amplifier, masses, resistor, delay",
+      core::field("amplifier_gain", &S::amplifier_gain, kVoltPerVolt, "Va = G u"),
+      core::field("suspended_mass", &S::suspended_mass, kKilogram, "> 0 replaces the model's m"),
+      core::field("added_mass", &S::added_mass, kKilogram, "added on top"),
+      core::field("hpf_resistance", &S::hpf_resistance, kOhm, "resistor across the sensor stack (0: none)"),
+      core::field("hpf_capacitance", &S::hpf_capacitance, kFaradAsUf, "capacitance of the sensor stack"),
+      core::field("delay", &S::delay, kSecond, "pure delay on the input u"));
+}
 
 }  // namespace piezobench::apa

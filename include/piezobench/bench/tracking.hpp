@@ -29,6 +29,7 @@
 #include <span>
 #include <string>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/io/timeseries.hpp"
 
@@ -72,5 +73,16 @@ TrackingLayout tracking_layout(const io::TimeSeries& record);
 // fewer than 2 samples.
 TrackingFigures tracking_figures(std::span<const double> c, std::span<const double> de_open, std::span<const double> de_ff,
                                  double target_slope, double target_intercept);
+
+constexpr auto describe(core::Type<TrackingFigures>) {
+  using S = TrackingFigures;
+  using namespace core::shown;
+  return core::fields<S>("TrackingFigures", "one waveform tracked without and with the inverse hysteresis feedforward",
+      core::field("width_open", &S::width_open, kRatio, "hysteresis width / stroke without the feedforward"),
+      core::field("width_ff", &S::width_ff, kRatio, "the same with it"),
+      core::field("rms_open", &S::rms_open, kMetreAsUm, "rms tracking error without"),
+      core::field("rms_ff", &S::rms_ff, kMetreAsUm, "rms tracking error with"),
+      core::field("stroke_open", &S::stroke_open, kMetreAsUm, "stroke without"));
+}
 
 }  // namespace piezobench::bench

@@ -9,8 +9,8 @@
 // decimal; non-finite as "nan", "inf", "-inf"), so that the batch analyses, results.json,
 // results.mat and report.html of `merge` are those of a single `run`. One exception: the state
 // space `model` of a damped plant's vector fit is not carried (poles and residues are, which is
-// what evaluate() uses). A field added to results.hpp's structs goes into part.cpp's field lists
-// too: Part.* and RunCli.PartsMerged* fail when merge no longer reproduces run.
+// what evaluate() uses). The fields are those of each struct's declaration (core/fields.hpp,
+// beside the struct): a field declared there is written and read back with no change here.
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>

@@ -16,6 +16,7 @@
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/apa/two_dof.hpp"
 #include "piezobench/bench/tracking.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/dsp/frf.hpp"
@@ -40,10 +41,31 @@ struct RecordProvenance {
   std::vector<std::string> outputs;  // FRF: the output roles
 };
 
+constexpr auto describe(core::Type<RecordProvenance>) {
+  using S = RecordProvenance;
+  using namespace core::shown;
+  return core::fields<S>("RecordProvenance", "where an analysis' data came from",
+      core::field("file", &S::file, kNone, "as given in the campaign"),
+      core::field("key", &S::key, kNone, "campaign key, e.g. \"units[0].frf\""),
+      core::field("channels", &S::channels, kNone, "(role, channel name in the file) of the roles present"),
+      core::field("samples", &S::samples, kNone, "samples in the record"),
+      core::field("sample_rate_Hz", &S::sample_rate_Hz, kHertz, "of the record"),
+      core::field("input", &S::input, kNone, "FRF: the input role (\"\" for other records)"),
+      core::field("outputs", &S::outputs, kNone, "FRF: the output roles"));
+}
+
 // A curve of the report (thinned or log-spaced samples).
 struct Curve {
   std::vector<double> x, y;
 };
+
+constexpr auto describe(core::Type<Curve>) {
+  using S = Curve;
+  using namespace core::shown;
+  return core::fields<S>("Curve", "a curve of the report (thinned or log-spaced samples)",
+      core::field("x", &S::x, kNone, "abscissae, in the unit the curve's field names"),
+      core::field("y", &S::y, kNone, "ordinates, in the unit the curve's field names"));
+}
 
 struct FlatnessAnalysis {
   metrology::FlatnessMethod method = metrology::FlatnessMethod::kLeastSquares;  // the spec's
@@ -62,6 +84,30 @@ struct FlatnessAnalysis {
   Curve probe_xy;                            // x, y of the same points [m] (the report's figure)
 };
 
+constexpr auto describe(core::Type<FlatnessAnalysis::Interface>) {
+  using S = FlatnessAnalysis::Interface;
+  using namespace core::shown;
+  return core::fields<S>("FlatnessInterface", "the flatness of one interface",
+      core::field("id", &S::id, kNone, "value of the interface channel").key("interface"),
+      core::field("least_squares", &S::least_squares, kMetreAsUm, "least-squares flatness of its points"));
+}
+
+constexpr auto describe(core::Type<FlatnessAnalysis>) {
+  using S = FlatnessAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("FlatnessAnalysis", "flatness of the interfaces from the probe points (report 1.2)",
+      core::field("method", &S::method, kNone, "the spec's method"),
+      core::field("points", &S::points, kNone, "probe points").in_report(),
+      core::field("flatness", &S::flatness, kMetreAsUm, "by `method` (results.json: the unit's flatness_um)").part_only().in_report(),
+      core::field("least_squares", &S::least_squares, kMetreAsUm, "peak-to-valley distance from the least-squares plane").in_report(),
+      core::field("minimum_zone", &S::minimum_zone, kMetreAsUm, "minimum-zone flatness (at most 100 points)").in_report(),
+      core::field("per_interface", &S::per_interface, kNone, "interfaces with 3 non-collinear points or more"),
+      core::field("probe_accuracy", &S::probe_accuracy, kMetreAsUm, "[bench] probe accuracy").in_report(),
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("deviation", &S::deviation, kMetre, "of every point from the plane (thinned)").part_only(),
+      core::field("probe_xy", &S::probe_xy, kNone, "x, y of the same points [m]").part_only());
+}
+
 struct CapacitanceAnalysis {
   double sensor = 0.0;    // F, mean of the readings
   double actuator = 0.0;  // F
@@ -69,17 +115,45 @@ struct CapacitanceAnalysis {
   std::string key;                             // "units[i].capacitance_uF" when typed
 };
 
+constexpr auto describe(core::Type<CapacitanceAnalysis>) {
+  using S = CapacitanceAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("CapacitanceAnalysis", "capacitances of the stacks",
+      core::field("sensor", &S::sensor, kFaradAsUf, "sensor stack, mean of the readings"),
+      core::field("actuator", &S::actuator, kFaradAsUf, "actuator stacks"),
+      core::field("provenance", &S::provenance, kNone, "the record (None: typed into the campaign under `key`)"),
+      core::field("key", &S::key, kNone, "\"units[i].capacitance_uF\" when typed"));
+}
+
 struct StrokeAnalysis {
   metrology::StrokeResult result;
   RecordProvenance provenance;
   Curve de_vs_va;  // x Va [V], y d_e [m] (thinned)
 };
 
+constexpr auto describe(core::Type<StrokeAnalysis>) {
+  using S = StrokeAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("StrokeAnalysis", "the stroke record (report 1.3)",
+      core::field("result", &S::result, kNone, "stroke, voltage range, sensitivity, loop width").key("."),
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("de_vs_va", &S::de_vs_va, kNone, "x Va [V], y d_e [m] (thinned)").part_only());
+}
+
 struct HysteresisLoop {
   metrology::HysteresisResult result;
   RecordProvenance provenance;
   Curve loop;  // x Va [V], y d_e [m], the part of the record analysed (thinned)
 };
+
+constexpr auto describe(core::Type<HysteresisLoop>) {
+  using S = HysteresisLoop;
+  using namespace core::shown;
+  return core::fields<S>("HysteresisLoop", "one hysteresis record at an amplitude (report 2.1)",
+      core::field("result", &S::result, kNone, "the loop's figures").key("."),
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("loop", &S::loop, kNone, "x Va [V], y d_e [m] (thinned)").part_only());
+}
 
 // The asymmetry of the steady loop (ident::LoopMetrics::asymmetry) above which the campaign fits
 // Kuhnen's modified PI besides the plain one: 1 % of the stroke (at 80 V the bench's symmetric laws
@@ -109,6 +183,22 @@ struct HysteresisModelFit {
   Curve model_loop;            // x Va [V], y d_e [m]: the model's prediction of it (thinned)
 };
 
+constexpr auto describe(core::Type<HysteresisModelFit>) {
+  using S = HysteresisModelFit;
+  using namespace core::shown;
+  return core::fields<S>("HysteresisModelFit", "the hysteresis model identified from the largest loop",
+      core::field("fit", &S::fit, kNone, "the chosen model's fit (plain or modified PI)"),
+      core::field("alternative", &S::alternative, kNone, "the candidate not chosen (when both were fitted)"),
+      core::field("alternative_error", &S::alternative_error, kNone, "why the modified PI could not be fitted"),
+      core::field("asymmetry", &S::asymmetry, kRatio, "of the record's steady loop").key("loop_asymmetry"),
+      core::field("amplitude", &S::amplitude, kVolt, "of the record it comes from"),
+      core::field("width", &S::width, kRatio, "hysteresis width of the record's steady loop / stroke").key("hysteresis_width"),
+      core::field("model_width", &S::model_width, kRatio, "the same for the model's prediction").key("model_hysteresis_width"),
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("loop", &S::loop, kNone, "x Va [V], y d_e [m]: the record's loop (thinned)").part_only(),
+      core::field("model_loop", &S::model_loop, kNone, "x Va [V], y d_e [m]: the model's prediction (thinned)").part_only());
+}
+
 // The tracking experiment's record (`measure tracking`; the demo runs it on one unit with that
 // unit's hysteresis_model as the feedforward): d_e against the command without and with the
 // inverse hysteresis feedforward, the figures recomputed from the record's samples
@@ -124,6 +214,22 @@ struct TrackingAnalysis {
   Curve sine_open, sine_ff, triangle_open, triangle_ff;
 };
 
+constexpr auto describe(core::Type<TrackingAnalysis>) {
+  using S = TrackingAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("TrackingAnalysis", "the tracking record without and with the inverse hysteresis feedforward",
+      core::field("sine", &S::sine, kNone, "the 1 Hz sine"),
+      core::field("triangle", &S::triangle, kNone, "the triangle"),
+      core::field("amplitude", &S::amplitude, kVolt, "of the command"),
+      core::field("feedforward", &S::feedforward, kNone, "\"identified\" (from its open run) or \"given\""),
+      core::field("clamped_samples", &S::clamped_samples, kNone, "of the compensated command, at the stack range"),
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("sine_open", &S::sine_open, kNone, "x c [V], y d_e [m] without the feedforward").part_only(),
+      core::field("sine_ff", &S::sine_ff, kNone, "x c [V], y d_e [m] with it").part_only(),
+      core::field("triangle_open", &S::triangle_open, kNone, "x c [V], y d_e [m] without").part_only(),
+      core::field("triangle_ff", &S::triangle_ff, kNone, "x c [V], y d_e [m] with").part_only());
+}
+
 struct StiffnessAnalysis {
   metrology::StaticStiffnessResult result;  // its `fit` is emptied: see `de` and `fit`
   metrology::StaticStiffnessOptions options;
@@ -137,12 +243,34 @@ struct StiffnessAnalysis {
   std::optional<ident::CreepFit> creep;
 };
 
+constexpr auto describe(core::Type<StiffnessAnalysis>) {
+  using S = StiffnessAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("StiffnessAnalysis", "a static stiffness record (report 2.2)",
+      core::field("result", &S::result, kNone, "the readings, k1, k2, creep").key("."),
+      core::field("options", &S::options, kNone, "how it was read").key("."),
+      core::field("mass_log", &S::mass_log, kNone, "the record had an added_mass channel"),
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("de", &S::de, kNone, "x t [s], y d_e [m] (thinned)").part_only(),
+      core::field("fit", &S::fit, kNone, "x t [s], y creep model [m] (thinned)").part_only(),
+      core::field("creep", &S::creep, kNone, "Prony-series creep, weight (N) in, d_e (m) out (results.json: creep_prony)").part_only());
+}
+
 // A vector fit's summary (ident/vector_fitting.hpp).
 struct VectorFitSummary {
   long order = 0;
   double relative_rms_error = 0.0;
   bool converged = false;
 };
+
+constexpr auto describe(core::Type<VectorFitSummary>) {
+  using S = VectorFitSummary;
+  using namespace core::shown;
+  return core::fields<S>("VectorFitSummary", "a vector fit's summary",
+      core::field("order", &S::order, kNone, "poles"),
+      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms |fit - data| / rms |data|"),
+      core::field("converged", &S::converged, kNone, "the poles settled"));
+}
 
 // Evidence of a non-minimum-phase zero pair in u -> Vs.
 struct NmpEvidence {
@@ -159,6 +287,27 @@ struct NmpEvidence {
   std::string verdict_reason;            // why (ident::ZeroPhaseVerdict::reason)
 };
 
+constexpr auto describe(core::Type<NmpEvidence::Zero>) {
+  using S = NmpEvidence::Zero;
+  using namespace core::shown;
+  return core::fields<S>("NmpZero", "the vector fit's zero of u -> Vs nearest the dip, with the phase verdict",
+      core::field("phase_verdict", &S::phase_verdict, kNone, "from the measured phase change"),
+      core::field("phase_change_deg", &S::phase_change_deg, kDegree, "across the dip"),
+      core::field("fitted_zero", &S::fitted_zero, kRadPerSecond, "the vector fit's zero").key("fitted_zero"),
+      core::field("fitted_zero_nonminimum_phase", &S::fitted_zero_nonminimum_phase, kNone, "Re > 0"));
+}
+
+constexpr auto describe(core::Type<NmpEvidence>) {
+  using S = NmpEvidence;
+  using namespace core::shown;
+  return core::fields<S>("NmpEvidence", "evidence of a non-minimum-phase zero pair in u -> Vs (report 2.3)",
+      core::field("zero", &S::zero, kNone, "the vector fit's zero nearest the dip").key("."),
+      core::field("iff_plant_fit_xz", &S::iff_plant_fit_xz, kRatio, "xz of the IFF plant fit (< 0: non-minimum phase)"),
+      core::field("iff_plant_fit_xz_standard_error", &S::iff_plant_fit_xz_standard_error, kRatio, "its standard error"),
+      core::field("verdict_from", &S::verdict_from, kNone, "\"phase\", \"iff-plant-fit\", \"fitted-zero\" or \"none\""),
+      core::field("verdict_reason", &S::verdict_reason, kNone, "why"));
+}
+
 // The resistor high-pass of the force sensor's read-out.
 struct HighPassCorner {
   std::optional<double> first_order_fit_Hz;  // first-order fit below hpf_fmax_Hz
@@ -172,6 +321,20 @@ struct HighPassCorner {
   // the first-order fit's when observable; nullopt otherwise (no resistor: no high-pass to report).
   std::optional<double> corner_Hz;
 };
+
+constexpr auto describe(core::Type<HighPassCorner>) {
+  using S = HighPassCorner;
+  using namespace core::shown;
+  return core::fields<S>("HighPassCorner", "the resistor high-pass of the force sensor's read-out",
+      core::field("first_order_fit_Hz", &S::first_order_fit_Hz, kHertz, "first-order fit below hpf_fmax_Hz"),
+      core::field("first_order_fit_points", &S::first_order_fit_points, kNone, "its points"),
+      core::field("r_c_Hz", &S::r_c_Hz, kHertz, "1 / (2 pi R C_sensor) when C_sensor is measured").key("R_C_Hz"),
+      core::field("iff_plant_fit_Hz", &S::iff_plant_fit_Hz, kHertz, "eq. 2.3 fitted down to the lowest frequency"),
+      core::field("iff_plant_fit_error", &S::iff_plant_fit_error, kNone, "the cross-check's failure"),
+      core::field("method", &S::method, kNone, "how corner_Hz was chosen, or why there is none"),
+      core::field("observable_above_Hz", &S::observable_above_Hz, kHertz, "a third of the FRF's lowest line"),
+      core::field("corner_Hz", &S::corner_Hz, kHertz, "the unit's corner (results.json: the unit's hpf_corner_Hz)").part_only());
+}
 
 // Cross-checks of a unit's FRF features (UnitAnalysis::warnings when they disagree): the high-pass
 // corner's (1/(2 pi R C), the IFF plant fit, the first-order fit) by more than this ratio (the
@@ -206,12 +369,53 @@ struct FrfAnalysis {
   std::optional<double> shell_stiffness;         // N/m, m_sus w_z^2
 };
 
+constexpr auto describe(core::Type<FrfAnalysis>) {
+  using S = FrfAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("FrfAnalysis", "the FRFs u -> [d_e, Vs] and what is read from them (report 2.3-2.5)",
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("welch", &S::welch, kNone, "the Welch estimate's settings"),
+      core::field("fit_de", &S::fit_de, kNone, "vector fit of u -> d_e"),
+      core::field("fit_vs", &S::fit_vs, kNone, "vector fit of u -> Vs").key("fit_Vs"),
+      core::field("static_gain_vector_fit", &S::static_gain_vector_fit, kMetrePerVoltAsUmPerV, "vector fit of u -> d_e"),
+      core::field("static_gain", &S::static_gain, kMetrePerVoltAsUmPerV, "the unit's (second-order fit, else vector fit)").in_report(),
+      core::field("static_gain_source", &S::static_gain_source, kNone, "which fit gave static_gain"),
+      core::field("static_gain_vs", &S::static_gain_vs, kVoltPerVolt, "vector fit of u -> Vs").key("static_gain_Vs_V_per_V"),
+      core::field("de_plant", &S::de_plant, kNone, "u -> d_e, mass-spring-damper with delay (results.json: de_plant_fit)").part_only(),
+      core::field("iff_plant", &S::iff_plant, kNone, "u -> Vs, eq. 2.3 with delay (results.json: iff_plant_fit)").part_only(),
+      core::field("iff_plant_fmin_Hz", &S::iff_plant_fmin_Hz, kHertz, "band of the IFF plant fit, low end").part_only(),
+      core::field("iff_plant_fmax_Hz", &S::iff_plant_fmax_Hz, kHertz, "band of the IFF plant fit, high end").part_only(),
+      core::field("iff_plant_w_hpf_measured", &S::iff_plant_w_hpf_measured, kNone, "w_hpf from R C_sensor (else fitted)").part_only(),
+      core::field("nmp", &S::nmp, kNone, "evidence of a non-minimum-phase zero pair").key("nmp_evidence"),
+      core::field("hpf", &S::hpf, kNone, "the high-pass corner (results.json: the unit's hpf)").part_only(),
+      core::field("resonance_vector_fit_Hz", &S::resonance_vector_fit_Hz, kHertz, "resonance of the vector fit"),
+      core::field("resonance_vector_fit_damping", &S::resonance_vector_fit_damping, kRatio, "its damping"),
+      core::field("antiresonance_vector_fit_Hz", &S::antiresonance_vector_fit_Hz, kHertz, "anti-resonance of the vector fit"),
+      core::field("antiresonance_vector_fit_damping", &S::antiresonance_vector_fit_damping, kRatio, "its damping"),
+      core::field("resonance_Hz", &S::resonance_Hz, kHertz, "resonance of u -> d_e").in_report(),
+      core::field("resonance_damping", &S::resonance_damping, kRatio, "its damping ratio").in_report(),
+      core::field("antiresonance_Hz", &S::antiresonance_Hz, kHertz, "anti-resonance of u -> Vs").in_report(),
+      core::field("antiresonance_damping", &S::antiresonance_damping, kRatio, "its damping (< 0: non-minimum phase)").in_report(),
+      core::field("zero_is_nonminimum_phase", &S::zero_is_nonminimum_phase, kNone, "the verdict on the zero pair"),
+      core::field("shell_stiffness", &S::shell_stiffness, kNewtonPerMetreAsNPerUm, "m_sus w_z^2").in_report());
+}
+
 // The tuned 2-DoF model (report section 3) with the fitted measurement chain.
 struct Model2DofFit {
   apa::TwoDofTuning tuning;
   apa::TwoDofBench bench;  // the chain the model was tuned with (delay, high-pass)
   double fmin_Hz = 0.0, fmax_Hz = 0.0;
 };
+
+constexpr auto describe(core::Type<Model2DofFit>) {
+  using S = Model2DofFit;
+  using namespace core::shown;
+  return core::fields<S>("Model2DofFit", "the tuned 2-DoF model (report 3) with the fitted measurement chain",
+      core::field("tuning", &S::tuning, kNone, "the tuning"),
+      core::field("bench", &S::bench, kNone, "the chain the model was tuned with (delay, high-pass)"),
+      core::field("fmin_Hz", &S::fmin_Hz, kHertz, "band of the tuning, low end"),
+      core::field("fmax_Hz", &S::fmax_Hz, kHertz, "band of the tuning, high end"));
+}
 
 // u -> Vs at low frequency with or without the resistor across the sensor stack (report section
 // 2.5, Figure 2.7): Welch with segments of half the record, a first-order high-pass fitted below
@@ -227,10 +431,32 @@ struct LowFrequencyVs {
   bool observable = false;              // fitted corner >= lowest line / 3
 };
 
+constexpr auto describe(core::Type<LowFrequencyVs>) {
+  using S = LowFrequencyVs;
+  using namespace core::shown;
+  return core::fields<S>("LowFrequencyVs", "u -> Vs at low frequency, a first-order high-pass fitted (report 2.5)",
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("frf", &S::frf, kNone, "u -> Vs").part_only(),
+      core::field("lowest_line_Hz", &S::lowest_line_Hz, kHertz, "the FRF's lowest line"),
+      core::field("fmax_Hz", &S::fmax_Hz, kHertz, "band [lowest_line_Hz, fmax_Hz]").part_only(),
+      core::field("fitted_corner_Hz", &S::fitted_corner_Hz, kHertz, "the fitted corner"),
+      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "of the first-order fit"),
+      core::field("points", &S::points, kNone, "lines fitted"),
+      core::field("observable", &S::observable, kNone, "fitted corner >= lowest line / 3"));
+}
+
 struct ResistorComparison {
   std::optional<LowFrequencyVs> with_resistor;  // from the FRF record (when measured)
   LowFrequencyVs without_resistor;
 };
+
+constexpr auto describe(core::Type<ResistorComparison>) {
+  using S = ResistorComparison;
+  using namespace core::shown;
+  return core::fields<S>("ResistorComparison", "u -> Vs at low frequency with and without the resistor",
+      core::field("with_resistor", &S::with_resistor, kNone, "from the FRF record (when measured)"),
+      core::field("without_resistor", &S::without_resistor, kNone, "from the record without the resistor"));
+}
 
 // One damped plant u' -> d_e of the IFF experiment.
 struct DampedPlant {
@@ -248,6 +474,22 @@ struct DampedPlant {
   double delay_removed = 0.0;    // s
 };
 
+constexpr auto describe(core::Type<DampedPlant>) {
+  using S = DampedPlant;
+  using namespace core::shown;
+  return core::fields<S>("DampedPlant", "one damped plant u' -> d_e of the IFF experiment (report 2.6)",
+      core::field("gain", &S::gain, kNone, "controller gain g"),
+      core::field("file", &S::file, kNone, "as given in the campaign").part_only(),
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("frf", &S::frf, kNone, "u' -> d_e").part_only(),
+      core::field("identified", &S::identified, kNone, "the damped pole (vector fit, d_e's delay removed)").key("fit"),
+      core::field("identified_order", &S::identified_order, kNone, "order of that vector fit").part_only(),
+      core::field("fmin_Hz", &S::fmin_Hz, kHertz, "the damped-plant band, low end").part_only(),
+      core::field("fmax_Hz", &S::fmax_Hz, kHertz, "the damped-plant band, high end").part_only(),
+      core::field("second_order", &S::second_order, kNone, "the report's second-order fit of the same data").key("second_order_fit"),
+      core::field("delay_removed", &S::delay_removed, kSecond, "d_e's delay removed before the fit"));
+}
+
 struct FlexibleModes {
   RecordProvenance provenance;
   dsp::FrfProvenance welch;
@@ -260,6 +502,26 @@ struct FlexibleModes {
   dsp::Frf frf;  // F -> v
 };
 
+constexpr auto describe(core::Type<FlexibleModes::Mode>) {
+  using S = FlexibleModes::Mode;
+  using namespace core::shown;
+  return core::fields<S>("FlexibleMode", "one flexible mode",
+      core::field("frequency_Hz", &S::frequency_Hz, kHertz, "natural frequency"),
+      core::field("damping", &S::damping, kRatio, "damping ratio"),
+      core::field("stable_orders", &S::stable_orders, kNone, "LSCF: orders it is stable over"));
+}
+
+constexpr auto describe(core::Type<FlexibleModes>) {
+  using S = FlexibleModes;
+  using namespace core::shown;
+  return core::fields<S>("FlexibleModes", "flexible modes from the hammer test (report 2.7)",
+      core::field("provenance", &S::provenance, kNone, "the record"),
+      core::field("welch", &S::welch, kNone, "the Welch estimate's settings"),
+      core::field("peak_picking", &S::peak_picking, kNone, "modes by peak picking"),
+      core::field("lscf", &S::lscf, kNone, "modes by LSCF"),
+      core::field("frf", &S::frf, kNone, "F -> v").part_only());
+}
+
 // Why a unit could not be analysed: one of its files is missing, unreadable or holds data no
 // analysis can use (a channel missing, NaN, a dead sensor's constant signal, ...). The unit's other
 // results are then left out, so the batch is the batch without it (pipeline.hpp).
@@ -268,6 +530,15 @@ struct NotAnalysed {
   std::string key;     // campaign key of the file entry, e.g. "units[1].frf"
   std::string reason;  // the InputError's message
 };
+
+constexpr auto describe(core::Type<NotAnalysed>) {
+  using S = NotAnalysed;
+  using namespace core::shown;
+  return core::fields<S>("NotAnalysed", "why a unit could not be analysed",
+      core::field("file", &S::file, kNone, "as given in the campaign (\"\" when not a file's)"),
+      core::field("key", &S::key, kNone, "campaign key of the file entry"),
+      core::field("reason", &S::reason, kNone, "the InputError's message"));
+}
 
 struct UnitAnalysis {
   int id = 0;
@@ -304,6 +575,47 @@ struct UnitAnalysis {
   bool accepted = false;
   std::vector<std::string> reasons;
 };
+
+constexpr auto describe(core::Type<UnitAnalysis>) {
+  using S = UnitAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("UnitAnalysis", "one unit's analyses and acceptance",
+      core::field("id", &S::id, kNone, "unit id"),
+      core::field("name", &S::name, kNone, "unit name"),
+      core::field("not_analysed", &S::not_analysed, kNone, "set: nothing else of the unit is filled in"),
+      core::field("flatness_analysis", &S::flatness_analysis, kNone, "flatness of the interfaces").key("flatness"),
+      core::field("capacitance_analysis", &S::capacitance_analysis, kNone, "capacitances of the stacks (results.json: capacitance_provenance)").part_only(),
+      core::field("stroke_analysis", &S::stroke_analysis, kNone, "the stroke record").key("stroke"),
+      core::field("hysteresis", &S::hysteresis, kNone, "hysteresis loops, by amplitude"),
+      core::field("hysteresis_model", &S::hysteresis_model, kNone, "the model of the largest loop").part_only(),
+      core::field("tracking", &S::tracking, kNone, "the tracking record"),
+      core::field("stiffness_analysis", &S::stiffness_analysis, kNone, "stacks on the amplifier and the resistor").key("stiffness_static"),
+      core::field("stiffness_open_analysis", &S::stiffness_open_analysis, kNone, "every stack open (k_oc)").key("stiffness_open_circuit"),
+      core::field("frf_analysis", &S::frf_analysis, kNone, "the FRFs and their features").key("frf"),
+      core::field("resistor", &S::resistor, kNone, "u -> Vs with and without the resistor (results.json: hpf_resistor)").part_only(),
+      core::field("model_2dof", &S::model_2dof, kNone, "the tuned 2-DoF model (results.json: model_2dof, model_2dof_fit)").part_only(),
+      core::field("damped", &S::damped, kNone, "damped plants, by gain (results.json: iff_damped_plants)").part_only(),
+      core::field("flexible_modes", &S::flexible_modes, kNone, "flexible modes"),
+      core::field("flatness", &S::flatness, kMetreAsUm, "by the spec's method"),
+      core::field("capacitance_sensor", &S::capacitance_sensor, kFaradAsUf, "sensor stack").key("capacitance_uF.sensor"),
+      core::field("capacitance_actuator", &S::capacitance_actuator, kFaradAsUf, "actuator stacks").key("capacitance_uF.actuator"),
+      core::field("stroke", &S::stroke, kMetreAsUm, "max - min of d_e over the stack range"),
+      core::field("k1", &S::k1, kNewtonPerMetreAsNPerUm, "static stiffness, mass put on (= k_sc)").key("stiffness_N_per_um.k1"),
+      core::field("k2", &S::k2, kNewtonPerMetreAsNPerUm, "static stiffness, mass taken off").key("stiffness_N_per_um.k2"),
+      core::field("k_resonance", &S::k_resonance, kNewtonPerMetreAsNPerUm, "from the resonance, m_sus w^2").key("stiffness_N_per_um.resonance"),
+      core::field("k_oc", &S::k_oc, kNewtonPerMetreAsNPerUm, "static stiffness with every stack open").key("stiffness_N_per_um.k_oc"),
+      core::field("resonance_Hz", &S::resonance_Hz, kHertz, "resonance of u -> d_e").part_only(),
+      core::field("antiresonance_Hz", &S::antiresonance_Hz, kHertz, "anti-resonance of u -> Vs").part_only(),
+      core::field("static_gain", &S::static_gain, kMetrePerVoltAsUmPerV, "static gain u -> d_e").part_only(),
+      core::field("frf", &S::frf, kNone, "u -> [de, Vs]").part_only(),
+      core::field("iff_plant", &S::iff_plant, kNone, "u -> Vs, eq. 2.3 with delay").part_only(),
+      core::field("de_plant", &S::de_plant, kNone, "u -> d_e, mass-spring-damper with delay").part_only(),
+      core::field("not_measured", &S::not_measured, kNone, "experiments the campaign does not list"),
+      core::field("failed", &S::failed, kNone, "one line per analysis that failed"),
+      core::field("warnings", &S::warnings, kNone, "cross-checks that disagree"),
+      core::field("accepted", &S::accepted, kNone, "the acceptance"),
+      core::field("reasons", &S::reasons, kNone, "why it is rejected"));
+}
 
 // ------------------------------------------------------------------------------------ batch
 

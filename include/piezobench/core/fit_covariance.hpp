@@ -19,6 +19,7 @@
 // and, when s is unknown, C = (J^T J)^-1 2 cost / (m - p) (every residual with the same variance).
 // A 95 % interval is x +- kCoverage95 sqrt(C_jj).
 // Units: the caller's (the parameters, residuals and tolerances are in the units of the caller's problem).
+#include "piezobench/core/fields.hpp"
 #include <Eigen/Dense>
 #include <string>
 #include <utility>
@@ -78,5 +79,18 @@ struct ParameterUncertainty {
 
 // The covariance of y = f(x) from that of x, to first order: G C G^T with G = dy/dx (q x p).
 [[nodiscard]] Eigen::MatrixXd propagate_covariance(const Eigen::MatrixXd& G, const Eigen::MatrixXd& covariance);
+
+constexpr auto describe(Type<ParameterUncertainty>) {
+  using S = ParameterUncertainty;
+  return fields<S>("ParameterUncertainty", "a fit's parameters with their standard errors",
+      field("names", &S::names, shown::kNone, "the parameters"),
+      field("value", &S::value, shown::kNone, "their values, natural units"),
+      field("standard_error", &S::standard_error, shown::kNone, "their standard errors, same units (inf: singular)"),
+      field("correlation", &S::correlation, shown::kNone, "correlation of the fitted parameters"),
+      field("condition_number", &S::condition_number, shown::kRatio, "of the scaled normal matrix"),
+      field("chi2_per_dof", &S::chi2_per_dof, shown::kRatio, "misfit per degree of freedom"),
+      field("from_data_variance", &S::from_data_variance, shown::kNone, "true: from the FRF's variance; false: the residuals' scatter"),
+      field("high_correlations", &S::high_correlations, shown::kNone, "\"wz/xz 0.97\" for the highly correlated pairs"));
+}
 
 }  // namespace piezobench::core

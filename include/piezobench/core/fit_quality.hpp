@@ -5,6 +5,7 @@
 // stderr with what to try, writes "quality": "poor" in JSON and exits with kPoorFitExitCode. A
 // parameter that cannot be physical (a negative stiffness, mass or damping, an unstable pole where
 // none can be) makes the fit `impossible`: its parameters are not printed as a result.
+#include "piezobench/core/fields.hpp"
 #include <string>
 #include <vector>
 
@@ -39,5 +40,14 @@ struct FitQuality {
   // "good" or "poor: PROBLEM; PROBLEM. Try: ADVICE".
   [[nodiscard]] std::string summary() const;
 };
+
+constexpr auto describe(Type<FitQuality>) {
+  using S = FitQuality;
+  return fields<S>("FitQuality", "a fit's verdict and what makes it poor",
+      field("verdict", &S::verdict, shown::kNone, "good or poor"),
+      field("impossible", &S::impossible, shown::kNone, "a parameter has an impossible value"),
+      field("problems", &S::problems, shown::kNone, "each names the output or parameter and its number"),
+      field("advice", &S::advice, shown::kNone, "what to try (empty when good)"));
+}
 
 }  // namespace piezobench::core

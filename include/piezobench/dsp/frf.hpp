@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/lti/freqresp.hpp"
 
 namespace piezobench::dsp {
@@ -84,5 +85,33 @@ struct FrequencyBand {
 // InputError (source: the FRF's) when no bin reaches min_coherence: "the input did not excite the
 // outputs; check the channels".
 FrequencyBand excited_band(const Frf& frf, double min_coherence = 0.5);
+
+constexpr auto describe(core::Type<FrfProvenance>) {
+  using S = FrfProvenance;
+  using namespace core::shown;
+  return core::fields<S>("FrfProvenance", "how an FRF was estimated",
+      core::field("source", &S::source, kNone, "file the time series came from").part_only(),
+      core::field("estimator", &S::estimator, kNone, "\"H1\" or \"H2\""),
+      core::field("window", &S::window, kNone, "e.g. \"hann-periodic\""),
+      core::field("nfft", &S::nfft, kNone, "segment length, samples"),
+      core::field("overlap", &S::overlap, kRatio, "fraction of nfft"),
+      core::field("detrend", &S::detrend, kNone, "\"none\", \"mean\", \"linear\""),
+      core::field("averages", &S::averages, kNone, "segments averaged"),
+      core::field("sample_rate", &S::sample_rate, kHertz, "of the time series").part_only(),
+      core::field("effective_averages", &S::effective_averages, kRatio, "Welch's independent averages n_d (0: unknown)").part_only());
+}
+
+constexpr auto describe(core::Type<Frf>) {
+  using S = Frf;
+  using namespace core::shown;
+  return core::fields<S>("Frf", "a measured frequency response: one input, named outputs",
+      core::field("freq_Hz", &S::freq_Hz, kHertz, "strictly increasing"),
+      core::field("input", &S::input, kNone, "input channel name"),
+      core::field("outputs", &S::outputs, kNone, "output channel names"),
+      core::field("H", &S::H, kNone, "H[i](k): output i / input at freq_Hz(k)"),
+      core::field("coherence", &S::coherence, kRatio, "same layout as H (empty: unknown)"),
+      core::field("std_H", &S::std_H, kNone, "standard deviation of H's random error, H's units"),
+      core::field("provenance", &S::provenance, kNone, "how it was estimated"));
+}
 
 }  // namespace piezobench::dsp

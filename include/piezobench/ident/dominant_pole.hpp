@@ -12,6 +12,7 @@
 // the report's second-order fit, this stays on the closed loop's pole once the controller's own
 // poles have moved into the band (large gains), where a second-order model misplaces it by 10 to
 // 50 %.
+#include "piezobench/core/fields.hpp"
 #include "piezobench/ident/vector_fitting.hpp"
 
 namespace piezobench::ident {
@@ -40,5 +41,16 @@ struct DominantPole {
 // omega, h as for vector_fit (one output). InputError as vector_fit; NumericalError when the fit
 // fails or has no complex pair in the band.
 DominantPole dominant_pole(const Vector& omega, const CVector& h, const DominantPoleOptions& options = {});
+
+constexpr auto describe(core::Type<DominantPole>) {
+  using S = DominantPole;
+  using namespace core::shown;
+  return core::fields<S>("DominantPole", "the dominant pole pair of a vector fit",
+      core::field("pole", &S::pole, kRadPerSecond, "Im > 0"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecondAsHz, "|pole|"),
+      core::field("damping", &S::damping, kRatio, "-Re pole / |pole|"),
+      core::field("peak", &S::peak, kNone, "its largest contribution on the data's frequencies, data units"),
+      core::field("fit", &S::fit, kNone, "the vector fit it comes from"));
+}
 
 }  // namespace piezobench::ident

@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/core/fit_quality.hpp"
 
 namespace piezobench::ident {
@@ -207,5 +208,66 @@ struct LoopMetrics {
 };
 // InputError for mismatched sizes, fewer than 2 samples, or a command that does not move.
 LoopMetrics loop_metrics(std::span<const double> command, std::span<const double> output);
+
+constexpr auto describe(core::Type<PrandtlIshlinskii>) {
+  using S = PrandtlIshlinskii;
+  using namespace core::shown;
+  return core::fields<S>("PrandtlIshlinskii", "a Prandtl-Ishlinskii operator",
+      core::field("linear_weight", &S::linear_weight, kNone, "w_0, output unit per input unit"),
+      core::field("thresholds", &S::thresholds, kNone, "r_i, input unit, strictly increasing"),
+      core::field("weights", &S::weights, kNone, "w_i, output unit per input unit"));
+}
+
+constexpr auto describe(core::Type<DeadZoneSuperposition>) {
+  using S = DeadZoneSuperposition;
+  using namespace core::shown;
+  return core::fields<S>("DeadZoneSuperposition", "the output map of Kuhnen's modified PI (empty knots: the identity)",
+      core::field("x", &S::x, kNone, "knots, input unit"),
+      core::field("y", &S::y, kNone, "S(x_k), output unit"),
+      core::field("slope_below", &S::slope_below, kRatio, "slope left of the first knot"),
+      core::field("slope_above", &S::slope_above, kRatio, "slope right of the last knot"));
+}
+
+constexpr auto describe(core::Type<HysteresisModel>) {
+  using S = HysteresisModel;
+  using namespace core::shown;
+  return core::fields<S>("HysteresisModel", "d_e = offset + gain S(H[Va] + sum_j c_j F_j[Va])",
+      core::field("hysteresis", &S::hysteresis, kNone, "the PI operator, V -> effective V"),
+      core::field("output", &S::output, kNone, "the dead-zone output map (identity for the plain PI)"),
+      core::field("creep_time_constants", &S::creep_time_constants, kSecond, "tau_j"),
+      core::field("creep_coefficients", &S::creep_coefficients, kRatio, "c_j, relative to the effective voltage"),
+      core::field("gain", &S::gain, kMetrePerVoltAsUmPerV, "m per effective V (< 0: the APA shortens)"),
+      core::field("offset", &S::offset, kMetreAsUm, "d_e at rest"),
+      core::field("reference_slope", &S::reference_slope, kRatio, "effective voltage per command volt of the compensated line"),
+      core::field("reference_intercept", &S::reference_intercept, kVolt, "effective voltage at zero command"),
+      core::field("input_min", &S::input_min, kVolt, "lowest Va of the identification record"),
+      core::field("input_max", &S::input_max, kVolt, "highest Va of the identification record"));
+}
+
+constexpr auto describe(core::Type<HysteresisFit>) {
+  using S = HysteresisFit;
+  using namespace core::shown;
+  return core::fields<S>("HysteresisFit", "a hysteresis model with how well it fits its record",
+      core::field("model", &S::model, kNone, "the identified model"),
+      core::field("rms_residual", &S::rms_residual, kMetreAsUm, "rms of d_e - model"),
+      core::field("relative_residual", &S::relative_residual, kRatio, "rms_residual / stroke"),
+      core::field("stroke", &S::stroke, kMetreAsUm, "max d_e - min d_e"),
+      core::field("samples", &S::samples, kNone, "samples fitted"),
+      core::field("quality", &S::quality, kNone, "the verdict"));
+}
+
+constexpr auto describe(core::Type<CreepFit>) {
+  using S = CreepFit;
+  using namespace core::shown;
+  return core::fields<S>("CreepFit", "a Prony-series creep y = offset + gain (x + sum_j c_j F_j[x])",
+      core::field("time_constants", &S::time_constants, kSecond, "tau_j"),
+      core::field("coefficients", &S::coefficients, kRatio, "c_j"),
+      core::field("gain", &S::gain, kNone, "instantaneous gain, output per input unit"),
+      core::field("offset", &S::offset, kNone, "output unit"),
+      core::field("creep_per_decade", &S::creep_per_decade, kRatio, "mean c_j: relative creep per decade of time"),
+      core::field("rms_residual", &S::rms_residual, kNone, "output unit"),
+      core::field("relative_residual", &S::relative_residual, kRatio, "rms / (max y - min y)"),
+      core::field("quality", &S::quality, kNone, "the verdict"));
+}
 
 }  // namespace piezobench::ident

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/plant/iff_plant.hpp"
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/fit_quality.hpp"
@@ -178,5 +179,43 @@ struct ActuatorPlants {
 ActuatorPlants fit_actuator_plants(const lti::Vector& omega, const lti::CVector& h_de, const lti::Vector& coh_de,
                                    const lti::CVector& h_vs, const lti::Vector& coh_vs,
                                    const ActuatorPlantOptions& options = {}, const std::string& source = "");
+
+constexpr auto describe(core::Type<DelayedSecondOrderFit>) {
+  using S = DelayedSecondOrderFit;
+  using namespace core::shown;
+  return core::fields<S>("DelayedSecondOrderFit", "k wn^2/(s^2 + 2 zeta wn s + wn^2) e^(-s delay) fitted to an FRF",
+      core::field("static_gain", &S::static_gain, kNone, "k, output units / input units (signed)"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecondAsHz, "wn"),
+      core::field("damping", &S::damping, kRatio, "zeta"),
+      core::field("delay", &S::delay, kSecond, "pure delay"),
+      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms |H_model / H - 1| over the points used"),
+      core::field("points", &S::points, kNone, "frequencies used"),
+      core::field("iterations", &S::iterations, kNone, "Levenberg-Marquardt steps"),
+      core::field("status", &S::status, kNone, "why Levenberg-Marquardt stopped"),
+      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("uncertainty", &S::uncertainty, kNone, "standard errors of static_gain, natural_frequency, damping, delay"));
+}
+
+constexpr auto describe(core::Type<IffPlantFit>) {
+  using S = IffPlantFit;
+  using namespace core::shown;
+  return core::fields<S>("IffPlantFit", "the IFF plant u -> Vs of eq. 2.3 with delay, fitted to an FRF",
+      core::field("g0", &S::g0, kVoltPerVolt, "static gain (signed)"),
+      core::field("wz", &S::wz, kRadPerSecondAsHz, "zero pair's natural frequency"),
+      core::field("xz", &S::xz, kRatio, "zero pair's damping (< 0: non-minimum phase)"),
+      core::field("wp", &S::wp, kRadPerSecondAsHz, "pole pair's natural frequency"),
+      core::field("xp", &S::xp, kRatio, "pole pair's damping"),
+      core::field("w_hpf", &S::w_hpf, kRadPerSecondAsHz, "high-pass corner of the read-out"),
+      core::field("delay", &S::delay, kSecond, "pure delay"),
+      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms |G/H - 1| over the points used"),
+      core::field("weighted_relative_rms_error", &S::weighted_relative_rms_error, kRatio, "the same with the per-decade weights"),
+      core::field("initial_relative_rms_error", &S::initial_relative_rms_error, kRatio, "weighted, at the better start"),
+      core::field("points", &S::points, kNone, "frequencies used"),
+      core::field("iterations", &S::iterations, kNone, "Levenberg-Marquardt steps"),
+      core::field("converged", &S::converged, kNone, "Levenberg-Marquardt converged"),
+      core::field("status", &S::status, kNone, "why Levenberg-Marquardt stopped"),
+      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("uncertainty", &S::uncertainty, kNone, "standard errors of g0, wz, xz, wp, xp, w_hpf, delay"));
+}
 
 }  // namespace piezobench::ident

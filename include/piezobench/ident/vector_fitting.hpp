@@ -19,6 +19,7 @@
 #include <complex>
 #include <string>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/lti/state_space.hpp"
 
@@ -152,5 +153,26 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data,
 // The verdict names the outputs and is also poor when an output's coherence is below 0.5 at more
 // than half of the points (a band the input did not excite).
 VectorFittingResult vector_fit(const dsp::Frf& frf, const VectorFittingOptions& options);
+
+// The state space `model` is not declared: it is rebuilt from the poles and residues (evaluate()
+// uses those), so part.json does not carry it.
+constexpr auto describe(core::Type<VectorFittingResult>) {
+  using S = VectorFittingResult;
+  using namespace core::shown;
+  return core::fields<S>("VectorFittingResult", "a rational model fitted by vector fitting",
+      core::field("poles", &S::poles, kRadPerSecond, "real poles first, then pairs (Im > 0 first)"),
+      core::field("residues", &S::residues, kNone, "outputs x poles"),
+      core::field("d", &S::d, kNone, "constant term per output"),
+      core::field("e", &S::e, kNone, "s term per output (s)"),
+      core::field("rms_error", &S::rms_error, kNone, "sqrt(mean |fit - data|^2), data units"),
+      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms_error / rms data"),
+      core::field("relative_rms_error_per_output", &S::relative_rms_error_per_output, kRatio, "the same per output"),
+      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("iterations", &S::iterations, kNone, "pole relocations"),
+      core::field("converged", &S::converged, kNone, "the poles settled"),
+      core::field("convergence", &S::convergence, kNone, "how the iteration ended"),
+      core::field("last_pole_change", &S::last_pole_change, kRatio, "relative, of the last relocation"),
+      core::field("frequency_scale", &S::frequency_scale, kRadPerSecond, "the scale used"));
+}
 
 }  // namespace piezobench::ident

@@ -30,6 +30,7 @@
 //
 // Stiffness from the resonance, k = m w^2 (eq. 2.2).
 // Units: SI (s, m, kg, N/m).
+#include "piezobench/core/fields.hpp"
 #include <Eigen/Dense>
 #include <array>
 #include <string>
@@ -80,5 +81,43 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const Eigen::VectorXd>& 
 
 // k = m w^2, N/m (mass kg > 0, resonance rad/s > 0; InputError naming "mass" / "resonance").
 double stiffness_from_resonance(double mass, double resonance_rad_s, const std::string& source = "");
+
+constexpr auto describe(core::Type<StaticStiffnessResult>) {
+  using S = StaticStiffnessResult;
+  using namespace core::shown;
+  return core::fields<S>("StaticStiffnessResult", "the static stiffness test: a mass put on and taken off",
+      core::field("t_on", &S::t_on, kSecond, "the mass put on"),
+      core::field("t_off", &S::t_off, kSecond, "the mass taken off"),
+      core::field("d_before", &S::d_before, kMetreAsUm, "reading before the mass").key("readings_um.before"),
+      core::field("d_loaded", &S::d_loaded, kMetreAsUm, "reading with the mass").key("readings_um.loaded"),
+      core::field("d_after", &S::d_after, kMetreAsUm, "reading after the mass").key("readings_um.after"),
+      core::field("k1", &S::k1, kNewtonPerMetreAsNPerUm, "m_a g / |d_before - d_loaded|"),
+      core::field("k2", &S::k2, kNewtonPerMetreAsNPerUm, "m_a g / |d_after - d_loaded|"),
+      core::field("deflection_on", &S::deflection_on, kMetreAsUm, "elastic deflection D_on (negative: compressed)").part_only(),
+      core::field("deflection_off", &S::deflection_off, kMetreAsUm, "elastic deflection D_off").part_only(),
+      core::field("k_elastic_on", &S::k_elastic_on, kNewtonPerMetreAsNPerUm, "m_a g / |D_on|").key("elastic_N_per_um.on"),
+      core::field("k_elastic_off", &S::k_elastic_off, kNewtonPerMetreAsNPerUm, "m_a g / |D_off|").key("elastic_N_per_um.off"),
+      core::field("creep_on", &S::creep_on, kMetreAsUm, "creep per decade of time after the mass is put on").key("creep_um_per_decade.on"),
+      core::field("creep_off", &S::creep_off, kMetreAsUm, "creep per decade after it is taken off").key("creep_um_per_decade.off"),
+      core::field("creep_time_constant", &S::creep_time_constant, kSecond, "tau of the creep model"),
+      core::field("rms_residual", &S::rms_residual, kMetreAsUm, "rms residual of the creep model's fit").key("fit_rms_um"),
+      core::field("fit", &S::fit, kNone, "the fitted curve at every sample (m)").part_only());
+}
+
+constexpr auto describe(core::Type<StaticStiffnessOptions>) {
+  using S = StaticStiffnessOptions;
+  using namespace core::shown;
+  return core::fields<S>("StaticStiffnessOptions", "how the static stiffness record is read",
+      core::field("added_mass", &S::added_mass, kKilogram, "m_a, the mass put on"),
+      core::field("gravity", &S::gravity, kMetrePerSecond2, "g"),
+      core::field("settle_s", &S::settle_s, kNone, "s, left out of the creep fit after each event").part_only(),
+      core::field("before_s", &S::before_s, kNone, "s, reading window before the mass, relative to t_on").key("reading_windows_s.before"),
+      core::field("loaded_s", &S::loaded_s, kNone, "s, reading window with the mass, relative to t_off").key("reading_windows_s.loaded"),
+      core::field("after_s", &S::after_s, kNone, "s, reading window after the mass, relative to t_off").key("reading_windows_s.after"),
+      core::field("t_on", &S::t_on, kSecond, "given event time (0: detected)").part_only(),
+      core::field("t_off", &S::t_off, kSecond, "given event time (0: detected)").part_only(),
+      core::field("min_time_constant", &S::min_time_constant, kSecond, "creep time-constant grid, lowest").part_only(),
+      core::field("max_time_constant", &S::max_time_constant, kSecond, "creep time-constant grid, highest").part_only());
+}
 
 }  // namespace piezobench::metrology

@@ -18,6 +18,7 @@
 //   stack follows its steady loop. Offset and amplitude are read from Va over that part:
 //   (max + min)/2 and (max - min)/2.
 // Units: V and m (SI); results in the same units.
+#include "piezobench/core/fields.hpp"
 #include <Eigen/Dense>
 #include <string>
 
@@ -62,5 +63,30 @@ struct HysteresisResult {
 HysteresisResult analyze_hysteresis(const Eigen::Ref<const Eigen::VectorXd>& va,
                                     const Eigen::Ref<const Eigen::VectorXd>& de, const HysteresisOptions& options = {},
                                     const std::string& source = "");
+
+constexpr auto describe(core::Type<StrokeResult>) {
+  using S = StrokeResult;
+  using namespace core::shown;
+  return core::fields<S>("StrokeResult", "stroke and sensitivity of a quasi-static record",
+      core::field("stroke", &S::stroke, kMetreAsUm, "max - min of the smoothed d_e (results.json: the unit's stroke_um)").part_only(),
+      core::field("va_min", &S::va_min, kVolt, "lowest Va of the record"),
+      core::field("va_max", &S::va_max, kVolt, "highest Va of the record"),
+      core::field("sensitivity", &S::sensitivity, kMetrePerVoltAsUmPerV, "slope of d_e against Va (negative: the APA shortens)"),
+      core::field("loop_width", &S::loop_width, kMetreAsUm, "largest distance between the rising and falling branches"));
+}
+
+constexpr auto describe(core::Type<HysteresisResult>) {
+  using S = HysteresisResult;
+  using namespace core::shown;
+  return core::fields<S>("HysteresisResult", "one hysteresis loop at an amplitude",
+      core::field("offset", &S::offset, kVolt, "offset of the sine on Va"),
+      core::field("amplitude", &S::amplitude, kVolt, "amplitude of the sine on Va"),
+      core::field("width", &S::width, kMetreAsUm, "|d_e rising - d_e falling| at the offset"),
+      core::field("loop_stroke", &S::loop_stroke, kMetreAsUm, "peak-to-peak d_e over the periods used"),
+      core::field("relative_width", &S::relative_width, kRatio, "width / loop_stroke"),
+      core::field("periods", &S::periods, kNone, "the fewer of the rising and falling crossings used"),
+      core::field("first_sample", &S::first_sample, kNone, "first sample analysed (the first maximum of Va)").part_only(),
+      core::field("samples", &S::samples, kNone, "samples analysed (to the last maximum)").part_only());
+}
 
 }  // namespace piezobench::metrology

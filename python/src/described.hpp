@@ -1,0 +1,109 @@
+#pragma once
+// Python classes derived from the field declarations beside the result structs (core/fields.hpp):
+// bind_described<S>(m) makes S a read-only class with one property per declared field (the field's
+// name, docstring "SI unit: meaning"), and does the same for every declared struct its fields hold,
+// so that every member of a result is reachable from Python with no list to keep in step.
+//
+// Values: numbers in SI as the struct holds them; lists of numbers as numpy arrays; enums by their
+// names; a declared struct as its class (a view that keeps its owner alive), or as the dict / Result
+// its module's bindings already give (dsp.Frf's provenance, apa's tuning and bench); lists and
+// optionals of those likewise (None when absent). fields(S) lists the declaration for the tests.
+#include <complex>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "common.hpp"
+#include "piezobench/apa/tuning.hpp"
+#include "piezobench/core/fields.hpp"
+#include "piezobench/dsp/frf.hpp"
+
+namespace piezobench::python {
+
+namespace described_detail {
+template <class T> struct IsOptional : std::false_type {};
+template <class T> struct IsOptional<std::optional<T>> : std::true_type {};
+template <class T> struct IsVector : std::false_type {};
+template <class T, class A> struct IsVector<std::vector<T, A>> : std::true_type {};
+template <class T> struct IsDescribedList : std::false_type {};
+template <class T, class A> struct IsDescribedList<std::vector<T, A>> : std::bool_constant<core::Described<T>> {};
+}  // namespace described_detail
+
+template <class S> void bind_described(py::module_& m);
+
+// The module's own converters of these declared structs (kept: the bindings of apa and dsp use them).
+inline py::object py_value(const dsp::FrfProvenance& p, py::handle) { return provenance_dict(p); }
+inline py::object py_value(const apa::TwoDofTuning& t, py::handle) { return tuning_result(t); }
+inline py::object py_value(const apa::TwoDofBench& b, py::handle) { return two_dof_bench_dict(b); }
+
+template <class T> py::object py_value(const T& v, py::handle owner) {
+  using namespace described_detail;
+  if constexpr (std::is_enum_v<T>) {
+    return py::str(to_string(v));
+  } else if constexpr (IsOptional<T>::value) {
+    return v ? py_value(*v, owner) : py::none();
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    return to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))));
+  } else if constexpr (std::is_same_v<T, std::vector<std::complex<double>>>) {
+    return to_numpy(Eigen::VectorXcd(Eigen::Map<const Eigen::VectorXcd>(v.data(), static_cast<Eigen::Index>(v.size()))));
+  } else if constexpr (std::is_base_of_v<Eigen::EigenBase<T>, T>) {
+    return to_numpy(v);  // a copy, as the other numeric arrays
+  } else if constexpr (IsDescribedList<T>::value) {
+    py::list l;
+    for (const auto& x : v) l.append(py_value(x, owner));
+    return l;
+  } else if constexpr (core::Described<T>) {
+    return py::cast(&v, py::return_value_policy::reference_internal, owner);
+  } else {
+    return py::cast(v);
+  }
+}
+
+// The declaration of S as [(name, SI unit, shown unit, meaning)] (what the tests enumerate).
+template <class S> py::list declared_fields() {
+  py::list out;
+  core::for_each_field<S>([&](const auto& f) {
+    out.append(py::make_tuple(std::string(f.name), std::string(f.shown.si), std::string(f.shown.unit), std::string(f.meaning)));
+  });
+  return out;
+}
+
+template <class S> void bind_described(py::module_& m) {
+  if (py::detail::get_type_info(typeid(S)) != nullptr) return;  // bound already (here or by its module)
+  constexpr auto& d = core::kFields<S>;
+  py::class_<S> c(m, std::string(d.name).c_str(), std::string(d.meaning).c_str());
+  core::for_each_field<S>([&](const auto& f) {
+    const auto member = f.member;
+    const std::string doc = f.shown.si.empty() ? std::string(f.meaning) : std::string(f.shown.si) + ": " + std::string(f.meaning);
+    c.def_property_readonly(
+        std::string(f.name).c_str(), [member](py::object self) { return py_value(self.cast<const S&>().*member, self); }, doc.c_str());
+  });
+  c.def_static("fields", [] { return declared_fields<S>(); }, "The field declaration: [(name, SI unit, shown unit, meaning)].");
+  c.def("__getitem__", [](py::object self, const std::string& name) { return self.attr(name.c_str()); }, "A field by name.");
+  typed(c);
+  core::for_each_field<S>([&](const auto& f) {
+    using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
+    if constexpr (core::Described<E>) bind_described<E>(m);
+  });
+}
+
+// {declared name: (Python class, [field names])} for S and every declared struct its fields hold;
+// a struct that is not bound raises (the tests' check that Python reaches every member).
+template <class S> void collect_declarations(py::dict& out) {
+  constexpr auto& d = core::kFields<S>;
+  const std::string name(d.name);
+  if (out.contains(name)) return;
+  py::list names;
+  core::for_each_field<S>([&](const auto& f) { names.append(std::string(f.name)); });
+  out[py::str(name)] = py::make_tuple(py::type::of<S>(), names);
+  core::for_each_field<S>([&](const auto& f) {
+    using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
+    if constexpr (core::Described<E>) collect_declarations<E>(out);
+  });
+}
+
+// The class of S as bound (to add its derived properties and methods).
+template <class S> py::class_<S> bound_class() { return py::reinterpret_borrow<py::class_<S>>(py::type::of<S>()); }
+
+}  // namespace piezobench::python

@@ -1,0 +1,32 @@
+#include "piezobench/campaign/field_reference.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace piezobench::campaign {
+namespace {
+
+TEST(FieldReference, DocsAreCurrent) {
+  std::ifstream in(std::string(PIEZOBENCH_SOURCE_DIR) + "/docs/fields.md");
+  ASSERT_TRUE(in) << "docs/fields.md is missing: piezobench fields --out docs/fields.md";
+  std::ostringstream text;
+  text << in.rdbuf();
+  EXPECT_TRUE(text.str() == field_reference_markdown())
+      << "docs/fields.md is stale: regenerate it with `build/app/piezobench fields --out docs/fields.md`";
+}
+
+TEST(FieldReference, EveryStructOnceWithUnitsKeysAndMeanings) {
+  const std::string doc = field_reference_markdown();
+  EXPECT_NE(doc.find("\n## UnitAnalysis\n"), std::string::npos);
+  EXPECT_NE(doc.find("\n## FrfAnalysis\n"), std::string::npos);
+  EXPECT_EQ(doc.find("\n## FitQuality\n"), doc.rfind("\n## FitQuality\n"));  // reached from many structs, written once
+  // A field's row: SI unit, the shown unit with its factor, its results.json key and meaning.
+  EXPECT_NE(doc.find("| `shell_stiffness` |  | N/m | N/um (SI x 1e-06) | `shell_stiffness_N_per_um` | m_sus w_z^2 (report table) |"),
+            std::string::npos);
+  EXPECT_NE(doc.find("\"nan\""), std::string::npos);  // the one encoding of non-finite numbers
+}
+
+}  // namespace
+}  // namespace piezobench::campaign
