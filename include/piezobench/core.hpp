@@ -8,6 +8,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/fit_covariance.hpp"
+#include "piezobench/core/field_types.hpp"
 #include "piezobench/core/fields.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/format.hpp"

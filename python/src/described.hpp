@@ -16,16 +16,13 @@
 
 #include "common.hpp"
 #include "piezobench/apa/tuning.hpp"
+#include "piezobench/core/field_types.hpp"
 #include "piezobench/core/fields.hpp"
 #include "piezobench/dsp/frf.hpp"
 
 namespace piezobench::python {
 
 namespace described_detail {
-template <class T> struct IsOptional : std::false_type {};
-template <class T> struct IsOptional<std::optional<T>> : std::true_type {};
-template <class T> struct IsVector : std::false_type {};
-template <class T, class A> struct IsVector<std::vector<T, A>> : std::true_type {};
 template <class T> struct IsDescribedList : std::false_type {};
 template <class T, class A> struct IsDescribedList<std::vector<T, A>> : std::bool_constant<core::Described<T>> {};
 }  // namespace described_detail
@@ -41,13 +38,13 @@ template <class T> py::object py_value(const T& v, py::handle owner) {
   using namespace described_detail;
   if constexpr (std::is_enum_v<T>) {
     return py::str(to_string(v));
-  } else if constexpr (IsOptional<T>::value) {
+  } else if constexpr (core::kIsOptional<T>) {
     return v ? py_value(*v, owner) : py::none();
   } else if constexpr (std::is_same_v<T, std::vector<double>>) {
     return to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))));
   } else if constexpr (std::is_same_v<T, std::vector<std::complex<double>>>) {
     return to_numpy(Eigen::VectorXcd(Eigen::Map<const Eigen::VectorXcd>(v.data(), static_cast<Eigen::Index>(v.size()))));
-  } else if constexpr (std::is_base_of_v<Eigen::EigenBase<T>, T>) {
+  } else if constexpr (core::kIsEigen<T>) {
     return to_numpy(v);  // a copy, as the other numeric arrays
   } else if constexpr (IsDescribedList<T>::value) {
     py::list l;

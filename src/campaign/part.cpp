@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/field_types.hpp"
 #include "piezobench/core/fields.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/json.hpp"
@@ -46,17 +47,7 @@ struct Where {
   throw InputError(w.file, w.path, expected, f);
 }
 
-template <class T> struct IsOptional : std::false_type {};
-template <class T> struct IsOptional<std::optional<T>> : std::true_type {};
-template <class T> struct IsVector : std::false_type {};
-template <class T, class A> struct IsVector<std::vector<T, A>> : std::true_type {};
-template <class T> struct IsStdArray : std::false_type {};
-template <class T, std::size_t N> struct IsStdArray<std::array<T, N>> : std::true_type {};
-template <class T> struct IsPair : std::false_type {};
-template <class A, class B> struct IsPair<std::pair<A, B>> : std::true_type {};
-template <class T> struct IsComplex : std::false_type {};
-template <class T> struct IsComplex<std::complex<T>> : std::true_type {};
-template <class T> constexpr bool kIsEigen = std::is_base_of_v<Eigen::EigenBase<T>, T>;
+using core::kIsComplex, core::kIsEigen, core::kIsOptional, core::kIsPair, core::kIsStdArray, core::kIsVector;
 
 // The enums, by the names their modules give them.
 #define PIEZOBENCH_PART_ENUM(Type, label, parse)                                   \
@@ -91,15 +82,15 @@ template <class T> json encode(const T& v) {
     return v;
   } else if constexpr (std::is_enum_v<T>) {
     return enum_name(v);
-  } else if constexpr (IsComplex<T>::value) {
+  } else if constexpr (kIsComplex<T>) {
     return json::array({encode(v.real()), encode(v.imag())});
-  } else if constexpr (IsOptional<T>::value) {
+  } else if constexpr (kIsOptional<T>) {
     return v ? encode(*v) : json(nullptr);
-  } else if constexpr (IsVector<T>::value || IsStdArray<T>::value) {
+  } else if constexpr (kIsVector<T> || kIsStdArray<T>) {
     json a = json::array();
     for (const auto& x : v) a.push_back(encode(x));
     return a;
-  } else if constexpr (IsPair<T>::value) {
+  } else if constexpr (kIsPair<T>) {
     return json::array({encode(v.first), encode(v.second)});
   } else if constexpr (kIsEigen<T>) {
     json a = json::array();
@@ -148,28 +139,28 @@ template <class T> void decode(const json& j, T& v, const Where& w) {
     } catch (const InputError&) {
       bad(w, std::string("a ") + enum_label(v) + " name", j);
     }
-  } else if constexpr (IsComplex<T>::value) {
+  } else if constexpr (kIsComplex<T>) {
     if (!j.is_array() || j.size() != 2) bad(w, "a complex number [re, im]", j);
     double re = 0.0, im = 0.0;
     decode(j[0], re, w.index(0));
     decode(j[1], im, w.index(1));
     v = T(re, im);
-  } else if constexpr (IsOptional<T>::value) {
+  } else if constexpr (kIsOptional<T>) {
     if (j.is_null()) {
       v.reset();
     } else {
       v = typename T::value_type{};  // not emplace(): clang 14 takes NmpEvidence::Zero for not default-constructible
       decode(j, *v, w);
     }
-  } else if constexpr (IsVector<T>::value) {
+  } else if constexpr (kIsVector<T>) {
     if (!j.is_array()) bad(w, "a list", j);
     v.clear();
     v.resize(j.size());
     for (std::size_t i = 0; i < j.size(); ++i) decode(j[i], v[i], w.index(i));
-  } else if constexpr (IsStdArray<T>::value) {
+  } else if constexpr (kIsStdArray<T>) {
     if (!j.is_array() || j.size() != v.size()) bad(w, fmt::format("a list of {}", v.size()), j);
     for (std::size_t i = 0; i < v.size(); ++i) decode(j[i], v[i], w.index(i));
-  } else if constexpr (IsPair<T>::value) {
+  } else if constexpr (kIsPair<T>) {
     if (!j.is_array() || j.size() != 2) bad(w, "a pair [first, second]", j);
     decode(j[0], v.first, w.index(0));
     decode(j[1], v.second, w.index(1));

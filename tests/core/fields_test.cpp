@@ -1,4 +1,5 @@
 #include "piezobench/core/fields.hpp"
+#include "piezobench/core/field_types.hpp"
 
 #include <gtest/gtest.h>
 
@@ -64,6 +65,17 @@ TEST(Fields, WhereAFieldAppears) {
   const auto& label = std::get<3>(kFields<Probe>.fields);
   EXPECT_FALSE(label.in(kResults));
   EXPECT_DOUBLE_EQ(shown::kRadPerSecondAsHz.per_si * 2.0 * 3.141592653589793, 1.0);
+}
+
+TEST(FieldTypes, TheKindsADocumentTellsApart) {
+  static_assert(kIsOptional<std::optional<double>> && !kIsOptional<double>);
+  static_assert(kIsVector<std::vector<int>> && !kIsVector<std::array<int, 2>>);
+  static_assert(kIsStdArray<std::array<int, 2>> && !kIsStdArray<std::vector<int>>);
+  static_assert(kIsPair<std::pair<int, double>> && kIsComplex<std::complex<double>>);
+  static_assert(kIsEigen<Eigen::VectorXd> && kIsEigen<Eigen::MatrixXd> && !kIsEigen<std::vector<double>>);
+  static_assert(kIsPairList<std::vector<std::pair<std::string, std::string>>> && kIsVector<std::vector<std::pair<std::string, std::string>>>);
+  static_assert(!kIsPairList<std::vector<double>>);
+  SUCCEED();
 }
 
 }  // namespace

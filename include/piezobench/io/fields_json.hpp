@@ -18,22 +18,13 @@
 #include <utility>
 #include <vector>
 
+#include "piezobench/core/field_types.hpp"
 #include "piezobench/core/fields.hpp"
 #include "piezobench/io/json.hpp"
 
 namespace piezobench::io {
 
 namespace fields_detail {
-template <class T> struct IsOptional : std::false_type {};
-template <class T> struct IsOptional<std::optional<T>> : std::true_type {};
-template <class T> struct IsVector : std::false_type {};
-template <class T, class A> struct IsVector<std::vector<T, A>> : std::true_type {};
-template <class T> struct IsStdArray : std::false_type {};
-template <class T, std::size_t N> struct IsStdArray<std::array<T, N>> : std::true_type {};
-template <class T> struct IsPairList : std::false_type {};
-template <class A, class B> struct IsPairList<std::vector<std::pair<A, B>>> : std::true_type {};
-template <class T> constexpr bool kIsEigen = std::is_base_of_v<Eigen::EigenBase<T>, T>;
-
 // Puts `value` at the dotted `key` of `object` ("." merges an object into it; null merges nothing).
 void put(nlohmann::json& object, std::string_view key, nlohmann::json value);
 }  // namespace fields_detail
@@ -47,7 +38,6 @@ void name_non_finite(nlohmann::json& document);
 // One value in the shown unit: its numbers times per_si, the dimensionless factor from SI to the
 // shown unit (core::Shown::per_si; 1 keeps SI).
 template <class T> nlohmann::json shown_json(const T& v, double per_si = 1.0) {
-  using namespace fields_detail;
   if constexpr (std::is_same_v<T, double> || std::is_same_v<T, float>) {
     return to_json(static_cast<double>(v) * per_si);
   } else if constexpr (std::is_same_v<T, bool> || std::is_integral_v<T> || std::is_same_v<T, std::string>) {
@@ -58,17 +48,17 @@ template <class T> nlohmann::json shown_json(const T& v, double per_si = 1.0) {
     return to_json(v * per_si);
   } else if constexpr (std::is_same_v<T, core::ParameterUncertainty>) {
     return to_json(v);
-  } else if constexpr (IsOptional<T>::value) {
+  } else if constexpr (core::kIsOptional<T>) {
     return v ? shown_json(*v, per_si) : nlohmann::json(nullptr);
-  } else if constexpr (IsPairList<T>::value) {
+  } else if constexpr (core::kIsPairList<T>) {
     nlohmann::json o = nlohmann::json::object();
     for (const auto& [k, x] : v) o[k] = shown_json(x, per_si);
     return o;
-  } else if constexpr (IsVector<T>::value || IsStdArray<T>::value) {
+  } else if constexpr (core::kIsVector<T> || core::kIsStdArray<T>) {
     nlohmann::json a = nlohmann::json::array();
     for (const auto& x : v) a.push_back(shown_json(x, per_si));
     return a;
-  } else if constexpr (kIsEigen<T>) {
+  } else if constexpr (core::kIsEigen<T>) {
     nlohmann::json a = nlohmann::json::array();
     for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(shown_json(v(i), per_si));
     return a;
