@@ -22,6 +22,8 @@
 #include "piezobench/core/error.hpp"
 
 #include "piezobench/apa/two_dof_file.hpp"
+#include "piezobench/bench/twin.hpp"
+#include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/fem/superelement.hpp"
 #include "piezobench/io/frf_file.hpp"
@@ -93,6 +95,20 @@ void read(std::string_view data) {
   if (reader == "lti_toml") (void)piezobench::io::parse_lti_toml(std::string(data), "input.toml");
   if (reader == "campaign_toml") (void)piezobench::campaign::parse_campaign(std::string(data), work_dir() / "campaign.toml", false);
   if (reader == "two_dof_toml") (void)piezobench::apa::parse_two_dof_params(std::string(data), "input.toml");
+  if (reader == "twin_toml") {
+    // As `simulate --twin` takes it: read, then the twin's bench built (its chain on the default
+    // switches) and its linear model formed; a twin read is written back and read the same.
+    const piezobench::bench::Twin twin = piezobench::bench::parse_twin(std::string(data), "twin.toml");
+    piezobench::bench::BenchOptions options;
+    piezobench::bench::apply_chain(twin, options);
+    const piezobench::bench::VirtualBench bench(twin.unit, options, 1);
+    (void)bench.linear_model();
+    const std::string written = piezobench::bench::twin_toml(twin);
+    if (piezobench::bench::twin_toml(piezobench::bench::parse_twin(written, "written.toml")) != written) {
+      std::fprintf(stderr, "piezobench fuzz: a twin written and read back differs\n");
+      std::abort();
+    }
+  }
   if (reader == "ansys_text") {
     // K, M, master DOF listing (with or without its node list).
     const auto p = split_parts(data, 3);
@@ -120,7 +136,7 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   const std::string name = fs::path((*argv)[0]).filename().string();
   const std::vector<std::string> known = {"mat_timeseries", "csv_timeseries", "mat_frf",       "csv_frf",
                                           "uff58",          "lti_toml",       "campaign_toml", "two_dof_toml",
-                                          "ansys_text",     "calculix",       "matrix_market"};
+                                          "ansys_text",     "calculix",       "matrix_market", "twin_toml"};
   reader() = name.rfind("fuzz_", 0) == 0 ? name.substr(5) : name;
   if (std::find(known.begin(), known.end(), reader()) == known.end()) {
     std::fprintf(stderr, "piezobench fuzz: unknown reader '%s' (the executable must be named fuzz_READER)\n", reader().c_str());

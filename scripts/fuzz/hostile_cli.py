@@ -39,8 +39,9 @@ def split(path, parts, names, workdir):
     return out
 
 
-# Corpora that are not files the CLI reads: the UDP target's datagrams (fuzz_udp_target replays them).
-NOT_FILES = {"udp_target"}
+# Corpora that are not files the CLI reads: the UDP target's datagrams (fuzz_udp_target replays them)
+# and the web server's requests (fuzz_http_request).
+NOT_FILES = {"udp_target", "http_request"}
 
 
 def command(reader, path, workdir):
@@ -62,6 +63,8 @@ def command(reader, path, workdir):
         answers = path if reader == "answers_toml" else os.path.join(examples, "station-answers.toml")
         return ["qualify", "--bench", os.path.join(examples, "bench-virtual.toml"), "--station", station, "--answers", answers,
                 "--serial", "H1", "--db", os.path.join(workdir, "station.db"), "--data", os.path.join(workdir, "data"), "--json"]
+    if reader == "twin_toml":
+        return ["simulate", "frf-noise", "--twin", path, "--duration", "0.2", "--out", os.path.join(workdir, "twin.mat")]
     if reader == "ansys_text":
         return ["superelement"] + split(path, 3, ["k.txt", "m.txt", "master.txt"], workdir) + ["--json"]
     if reader == "matrix_market":

@@ -22,7 +22,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="${1:?usage: run_fuzz.sh BUILD_DIR regression|fuzz [SECONDS [TARGET]]}"
 mode="${2:?usage: run_fuzz.sh BUILD_DIR regression|fuzz [SECONDS [TARGET]]}"
 readers=(mat_timeseries mat_frf csv_timeseries csv_frf uff58 lti_toml campaign_toml two_dof_toml ansys_text calculix matrix_market
-         udp_target station_toml answers_toml)
+         udp_target station_toml answers_toml twin_toml http_request)
 if [ -n "${4:-}" ]; then readers=("$4"); fi
 findings="${PIEZOBENCH_FUZZ_FINDINGS:-fail}"
 case "$findings" in fail|report) ;; *) echo "run_fuzz: PIEZOBENCH_FUZZ_FINDINGS must be fail or report" >&2; exit 2 ;; esac

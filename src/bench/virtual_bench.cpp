@@ -104,7 +104,9 @@ void UnitTruth::validate() const {
 
 void BenchOptions::validate() const {
   const std::string s = kOptionsSource;
-  require(std::isfinite(sample_rate) && sample_rate > 0.0, s, "sample_rate", "a rate > 0 Hz", sample_rate);
+  // At most 1 MHz, the real-time loop's limit (rt::kMaxSampleRate): the delay line holds up to 1 s
+  // of samples (a twin with sample_rate_Hz = 1e12 asked for 8 TB; fuzz/regression/twin_toml).
+  require(std::isfinite(sample_rate) && sample_rate > 0.0 && sample_rate <= 1e6, s, "sample_rate", "a rate in (0, 1e6] Hz", sample_rate);
   require(dac_bits >= 2 && dac_bits <= 32, s, "dac_bits", "2 to 32 bits", dac_bits);
   require(std::isfinite(dac_range) && dac_range > 0.0, s, "dac_range", "a range > 0 V", dac_range);
   require(std::isfinite(amplifier_gain) && amplifier_gain > 0.0, s, "amplifier_gain", "a gain > 0 V/V", amplifier_gain);

@@ -24,9 +24,18 @@ using Clock = std::chrono::steady_clock;
 
 HttpResponse json_response(int status, const std::string& json_text) { return {status, "application/json", json_text, {}}; }
 
-HttpResponse error_response(int status, const std::string& message) {
-  return json_response(status, nlohmann::json{{"error", message}}.dump());
+namespace {
+
+// {"error": message}. A message may quote the client's bytes (a path, a Host header) that are not
+// UTF-8: they are replaced (U+FFFD) rather than thrown on, which on the server's thread would end
+// the process (fuzz/regression/http_request/not_utf8_*).
+std::string error_json(const std::string& message) {
+  return nlohmann::json{{"error", message}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
+
+}  // namespace
+
+HttpResponse error_response(int status, const std::string& message) { return json_response(status, error_json(message)); }
 
 std::string random_token() {
   unsigned char bytes[16];
@@ -117,107 +126,60 @@ std::string reason_phrase(int status) { return std::string(http::obsolete_reason
 
 // A complete answer written on a raw socket, then closed (refusals before any parsing).
 std::string canned_response(int status, const std::string& message, const std::string& extra_headers = "") {
-  const std::string body = nlohmann::json{{"error", message}}.dump();
+  const std::string body = error_json(message);
   return fmt::format("HTTP/1.1 {} {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n{}\r\n{}", status,
                      reason_phrase(status), body.size(), extra_headers, body);
 }
 
-}  // namespace
-
-struct HttpServer::Impl {
-  // Counters first: Sessions destroyed with the io_context (below) still decrement them.
-  std::atomic<std::uint64_t> accepted{0}, refused_over_cap{0}, requests{0}, refused_requests{0}, streams_opened{0}, stream_bytes{0},
-      streams_dropped_slow{0};
-  std::atomic<std::size_t> connections{0}, streams{0};
+// The rules every request meets before the Site sees it: the options, whether the server listens on
+// a loopback address and the Host headers it then accepts (empty: any).
+struct RequestRules {
   const HttpServerOptions& opt;
-  Site& site;
   bool loopback = true;
-  std::vector<std::string> hosts;  // accepted Host headers (loopback); empty: any
-  asio::io_context io{1};
-  tcp::acceptor acceptor{io};
-  asio::steady_timer accept_retry{io};
-  std::thread thread;
-
-  Impl(const HttpServerOptions& o, Site& s) : opt(o), site(s) {}
-  void accept();
-  void refuse(tcp::socket socket, int status, const std::string& message, const std::string& headers = "");
+  std::vector<std::string> hosts;
 };
 
-namespace {
-
-class Session : public std::enable_shared_from_this<Session> {
- public:
-  Session(HttpServer::Impl& server, tcp::socket socket)
-      : s_(server), stream_(std::move(socket)), buffer_(server.opt.max_header_bytes + server.opt.max_body_bytes), timer_(s_.io) {
-    ++s_.connections;
-  }
-  ~Session() {
-    --s_.connections;
-    if (events_) --s_.streams;
-  }
-  Session(const Session&) = delete;
-  Session& operator=(const Session&) = delete;
-  void start() { read(); }
-
- private:
-  void read();
-  void on_read(beast::error_code ec);
-  void handle();
-  void refuse(int status, const std::string& message);
-  void write(HttpResponse r, bool keep_alive, bool head);
-  bool check_security(const http::request<http::string_body>& req, HttpRequest& out, int& status, std::string& why) const;
-  void start_stream(std::unique_ptr<EventStream> events);
-  void tick();
-  void send_event(std::string text);
-  void watch_close();
-  void close() {
-    closed_ = true;
-    beast::error_code ec;
-    timer_.cancel();
-    stream_.socket().shutdown(tcp::socket::shutdown_both, ec);
-    stream_.close();
-  }
-
-  HttpServer::Impl& s_;
-  beast::tcp_stream stream_;
-  beast::flat_buffer buffer_;
-  std::optional<http::request_parser<http::string_body>> parser_;
-  std::shared_ptr<http::response<http::string_body>> response_;
-  asio::steady_timer timer_;
-  std::unique_ptr<EventStream> events_;
-  std::string out_;           // the event being written
-  bool writing_ = false, closed_ = false;
-  double budget_ = 0.0;       // bytes the stream may send now
-  Clock::time_point last_tick_, last_write_;
-  char discard_[256];
-};
-
-void Session::read() {
-  parser_.emplace();
-  parser_->header_limit(static_cast<std::uint32_t>(s_.opt.max_header_bytes));
-  parser_->body_limit(s_.opt.max_body_bytes);
-  stream_.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s_.opt.request_timeout_s)));
-  http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+// The Host headers a server on `address`:`port` accepts (loopback: its own names; otherwise any,
+// the token guards it).
+std::vector<std::string> accepted_hosts(const asio::ip::address& address, const std::string& literal, unsigned short port) {
+  if (!address.is_loopback()) return {};
+  const std::string p = std::to_string(port);
+  const std::string name = address.is_v6() ? "[" + literal + "]" : literal;
+  return {name + ":" + p, "localhost:" + p, "127.0.0.1:" + p, "[::1]:" + p};
 }
 
-void Session::on_read(beast::error_code ec) {
+using Parser = http::request_parser<http::string_body>;
+
+// A parser of one request with the options' limits; the read buffer that goes with it.
+void limit(Parser& parser, const HttpServerOptions& o) {
+  parser.header_limit(static_cast<std::uint32_t>(o.max_header_bytes));
+  parser.body_limit(o.max_body_bytes);
+}
+std::size_t read_buffer_bytes(const HttpServerOptions& o) { return o.max_header_bytes + o.max_body_bytes; }
+
+// The answer to a read that failed: nothing when the connection is just closed (the client left,
+// or timed out), else the refusal.
+std::optional<HttpResponse> read_refusal(beast::error_code ec) {
   if (ec == http::error::end_of_stream || ec == beast::error::timeout || ec == asio::error::operation_aborted ||
       ec == asio::error::connection_reset || ec == asio::error::eof) {
-    return close();
+    return std::nullopt;
   }
-  if (ec == http::error::header_limit || ec == http::error::buffer_overflow) return refuse(431, "request line and headers too large");
-  if (ec == http::error::body_limit) return refuse(413, "request body too large");
-  if (ec) return refuse(400, "malformed request: " + ec.message());
-  handle();
+  if (ec == http::error::header_limit || ec == http::error::buffer_overflow) return error_response(431, "request line and headers too large");
+  if (ec == http::error::body_limit) return error_response(413, "request body too large");
+  return error_response(400, "malformed request: " + ec.message());
 }
 
-void Session::refuse(int status, const std::string& message) {
-  ++s_.refused_requests;
-  HttpResponse r = error_response(status, message);
-  write(std::move(r), false, false);
-}
+// What the server does with a request it has read.
+struct Handled {
+  HttpResponse response;
+  std::unique_ptr<EventStream> stream;  // set: the site's event stream, sent instead of `response`
+  bool refused = false;                 // answered by the server's rules; the site's handle() never saw it
+  bool keep_alive = false;              // false: the connection closes after the answer
+  bool head = false;                    // HEAD: the answer's headers without its body
+};
 
-bool Session::check_security(const http::request<http::string_body>& req, HttpRequest& out, int& status, std::string& why) const {
+// The checks of the path, query, Host, Origin and tokens (http_server.hpp); fills `out` or says why not.
+bool check_security(const RequestRules& s, const http::request<http::string_body>& req, HttpRequest& out, int& status, std::string& why) {
   const std::string target(req.target());
   const std::size_t q = target.find('?');
   const auto path = percent_decode(std::string_view(target).substr(0, q), false);
@@ -249,8 +211,8 @@ bool Session::check_security(const http::request<http::string_body>& req, HttpRe
     status = 400, why = "a Host header";
     return false;
   }
-  if (!s_.hosts.empty() && std::find(s_.hosts.begin(), s_.hosts.end(), host) == s_.hosts.end()) {
-    status = 421, why = "the station's own host name (" + s_.hosts.front() + "), not '" + host + "'";
+  if (!s.hosts.empty() && std::find(s.hosts.begin(), s.hosts.end(), host) == s.hosts.end()) {
+    status = 421, why = "the station's own host name (" + s.hosts.front() + "), not '" + host + "'";
     return false;
   }
   const std::string origin(req[http::field::origin]);
@@ -260,9 +222,9 @@ bool Session::check_security(const http::request<http::string_body>& req, HttpRe
   }
   const std::string authorization(req[http::field::authorization]);
   if (authorization.rfind("Bearer ", 0) == 0) token = authorization.substr(7);
-  out.operator_rights = equal_constant_time(token, s_.opt.operator_token);
-  const bool viewer = out.operator_rights || equal_constant_time(token, s_.opt.view_token);
-  if (!s_.loopback && !viewer) {
+  out.operator_rights = equal_constant_time(token, s.opt.operator_token);
+  const bool viewer = out.operator_rights || equal_constant_time(token, s.opt.view_token);
+  if (!s.loopback && !viewer) {
     status = 401, why = "the station's token (printed when it started)";
     return false;
   }
@@ -273,31 +235,176 @@ bool Session::check_security(const http::request<http::string_body>& req, HttpRe
   return true;
 }
 
-void Session::handle() {
-  ++s_.requests;
-  const http::request<http::string_body>& req = parser_->get();
+Handled refusal(int status, const std::string& message) { return {error_response(status, message), nullptr, true, false, false}; }
+
+// One request read in full, with `open_streams` event streams open: the rules, then the site.
+Handled handle_request(const RequestRules& rules, Site& site, const http::request<http::string_body>& req, std::size_t open_streams,
+                       HttpRequest* seen) {
   const http::verb m = req.method();
-  if (m != http::verb::get && m != http::verb::head && m != http::verb::post) return refuse(405, "GET, HEAD or POST");
+  if (m != http::verb::get && m != http::verb::head && m != http::verb::post) return refusal(405, "GET, HEAD or POST");
   HttpRequest r;
   r.method = std::string(req.method_string());
   int status = 0;
   std::string why;
-  if (!check_security(req, r, status, why)) return refuse(status, "expected " + why);
-  if (m == http::verb::post && !s_.site.accepts_post(r.path)) return refuse(405, "GET on " + r.path);
+  if (!check_security(rules, req, r, status, why)) return refusal(status, "expected " + why);
+  if (m == http::verb::post && !site.accepts_post(r.path)) return refusal(405, "GET on " + r.path);
   r.body = req.body();
-  const bool keep_alive = req.keep_alive();
+  if (seen != nullptr) *seen = r;
   if (m == http::verb::get) {
-    if (std::unique_ptr<EventStream> events = s_.site.open_stream(r)) {
-      if (s_.streams.load() >= s_.opt.max_streams) {
-        HttpResponse busy = error_response(503, fmt::format("at most {} pages may follow the station at once", s_.opt.max_streams));
-        busy.headers.emplace_back("Retry-After", "5");
-        ++s_.refused_requests;
-        return write(std::move(busy), false, false);
+    if (std::unique_ptr<EventStream> events = site.open_stream(r)) {
+      if (open_streams >= rules.opt.max_streams) {
+        Handled busy = refusal(503, fmt::format("at most {} pages may follow the station at once", rules.opt.max_streams));
+        busy.response.headers.emplace_back("Retry-After", "5");
+        return busy;
       }
-      return start_stream(std::move(events));
+      return {{}, std::move(events), false, false, false};
     }
   }
-  write(s_.site.handle(r), keep_alive, m == http::verb::head);
+  return {site.handle(r), nullptr, false, req.keep_alive(), m == http::verb::head};
+}
+
+// The client's bytes as a socket that has them all, then end of file (exchange_request).
+class BytesStream {
+ public:
+  explicit BytesStream(std::string_view bytes) : rest_(bytes) {}
+  template <class Buffers>
+  std::size_t read_some(const Buffers& buffers, beast::error_code& ec) {
+    if (rest_.empty()) {
+      ec = asio::error::eof;
+      return 0;
+    }
+    ec = {};
+    const std::size_t n = asio::buffer_copy(buffers, asio::buffer(rest_.data(), rest_.size()));
+    rest_.remove_prefix(n);
+    return n;
+  }
+  template <class Buffers>
+  std::size_t read_some(const Buffers& buffers) {
+    beast::error_code ec;
+    const std::size_t n = read_some(buffers, ec);
+    if (ec) throw beast::system_error(ec);
+    return n;
+  }
+
+ private:
+  std::string_view rest_;
+};
+
+}  // namespace
+
+HttpExchange exchange_request(const HttpServerOptions& options, Site& site, std::string_view bytes) {
+  options.validate();
+  beast::error_code ec;
+  const asio::ip::address address = asio::ip::make_address(options.address, ec);
+  if (ec) throw InputError("web", "address", "an IP address", "'" + options.address + "'");
+  const RequestRules rules{options, address.is_loopback(), accepted_hosts(address, options.address, options.port)};
+  BytesStream stream(bytes);
+  beast::flat_buffer buffer(read_buffer_bytes(options));
+  Parser parser;
+  limit(parser, options);
+  http::read(stream, buffer, parser, ec);
+  HttpExchange out;
+  if (ec) {
+    const std::optional<HttpResponse> refused = read_refusal(ec);
+    if (refused) out.outcome = HttpExchange::Outcome::kAnswered, out.response = *refused;
+    return out;
+  }
+  HttpRequest seen;
+  Handled h = handle_request(rules, site, parser.get(), 0, &seen);
+  out.outcome = h.stream ? HttpExchange::Outcome::kStream : HttpExchange::Outcome::kAnswered;
+  out.response = std::move(h.response);
+  out.by_site = !h.refused;
+  out.keep_alive = h.keep_alive;
+  if (out.by_site) out.request = std::move(seen);
+  return out;
+}
+
+struct HttpServer::Impl {
+  // Counters first: Sessions destroyed with the io_context (below) still decrement them.
+  std::atomic<std::uint64_t> accepted{0}, refused_over_cap{0}, requests{0}, refused_requests{0}, streams_opened{0}, stream_bytes{0},
+      streams_dropped_slow{0};
+  std::atomic<std::size_t> connections{0}, streams{0};
+  const HttpServerOptions& opt;
+  Site& site;
+  RequestRules rules;
+  asio::io_context io{1};
+  tcp::acceptor acceptor{io};
+  asio::steady_timer accept_retry{io};
+  std::thread thread;
+
+  Impl(const HttpServerOptions& o, Site& s, RequestRules r) : opt(o), site(s), rules(std::move(r)) {}
+  void accept();
+  void refuse(tcp::socket socket, int status, const std::string& message, const std::string& headers = "");
+};
+
+namespace {
+
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  Session(HttpServer::Impl& server, tcp::socket socket)
+      : s_(server), stream_(std::move(socket)), buffer_(read_buffer_bytes(server.opt)), timer_(s_.io) {
+    ++s_.connections;
+  }
+  ~Session() {
+    --s_.connections;
+    if (events_) --s_.streams;
+  }
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+  void start() { read(); }
+
+ private:
+  void read();
+  void on_read(beast::error_code ec);
+  void handle();
+  void write(HttpResponse r, bool keep_alive, bool head);
+  void start_stream(std::unique_ptr<EventStream> events);
+  void tick();
+  void send_event(std::string text);
+  void watch_close();
+  void close() {
+    closed_ = true;
+    beast::error_code ec;
+    timer_.cancel();
+    stream_.socket().shutdown(tcp::socket::shutdown_both, ec);
+    stream_.close();
+  }
+
+  HttpServer::Impl& s_;
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<Parser> parser_;
+  std::shared_ptr<http::response<http::string_body>> response_;
+  asio::steady_timer timer_;
+  std::unique_ptr<EventStream> events_;
+  std::string out_;           // the event being written
+  bool writing_ = false, closed_ = false;
+  double budget_ = 0.0;       // bytes the stream may send now
+  Clock::time_point last_tick_, last_write_;
+  char discard_[256];
+};
+
+void Session::read() {
+  parser_.emplace();
+  limit(*parser_, s_.opt);
+  stream_.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s_.opt.request_timeout_s)));
+  http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+}
+
+void Session::on_read(beast::error_code ec) {
+  if (!ec) return handle();
+  std::optional<HttpResponse> refused = read_refusal(ec);
+  if (!refused) return close();
+  ++s_.refused_requests;
+  write(std::move(*refused), false, false);
+}
+
+void Session::handle() {
+  ++s_.requests;
+  Handled h = handle_request(s_.rules, s_.site, parser_->get(), s_.streams.load(), nullptr);
+  if (h.stream) return start_stream(std::move(h.stream));
+  if (h.refused) ++s_.refused_requests;
+  write(std::move(h.response), h.keep_alive, h.head);
 }
 
 void Session::write(HttpResponse r, bool keep_alive, bool head) {
@@ -427,8 +534,7 @@ void HttpServer::start() {
   if (!loopback_ && options_.view_token.empty()) {
     throw InputError("--ui", "token", "a token on an address other than the loopback one", "none for " + options_.address);
   }
-  auto impl = std::make_unique<Impl>(options_, site_);
-  impl->loopback = loopback_;
+  auto impl = std::make_unique<Impl>(options_, site_, RequestRules{options_, loopback_, {}});
   const tcp::endpoint endpoint(address, options_.port);
   impl->acceptor.open(endpoint.protocol(), ec);
   if (!ec) impl->acceptor.set_option(asio::socket_base::reuse_address(true), ec);
@@ -437,11 +543,7 @@ void HttpServer::start() {
   if (ec) throw InputError("--ui", "address", "an address and port this process can listen on",
                            fmt::format("{}:{} ({})", options_.address, options_.port, ec.message()));
   port_ = impl->acceptor.local_endpoint().port();
-  if (loopback_) {
-    const std::string p = std::to_string(port_);
-    const std::string literal = address.is_v6() ? "[" + options_.address + "]" : options_.address;
-    impl->hosts = {literal + ":" + p, "localhost:" + p, "127.0.0.1:" + p, "[::1]:" + p};
-  }
+  impl->rules.hosts = accepted_hosts(address, options_.address, port_);
   impl->accept();
   Impl* raw = impl.get();
   impl->thread = std::thread([raw] { raw->io.run(); });

@@ -428,7 +428,7 @@ std::string LiveHub::state_json_locked() const {
                         {"verdict", verdict_}, {"deciding_phase", deciding_phase_}, {"deciding_measurement", deciding_measurement_},
                         {"certificate", certificate_}, {"started_ms", started_unix_ms_}, {"finished_ms", finished_unix_ms_},
                         {"now_ms", now_unix_ms()}, {"message", last_message_}, {"prompt", prompt}, {"phases", phases}}
-      .dump();
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // a text not UTF-8 (a file typed on the terminal) must not throw
 }
 
 std::unique_ptr<EventStream> LiveHub::mailbox() { return std::make_unique<Client>(*this); }

@@ -24,6 +24,10 @@ bool plausible_serial(const std::string& s) {
   return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'; });
 }
 
+// The document as JSON text; a database text that is not UTF-8 (an operator's name typed on the
+// command line) is replaced (U+FFFD), not thrown on (the exception would end the server's thread).
+std::string text_of(const nlohmann::json& doc) { return doc.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
+
 std::string query(const HttpRequest& r, const std::string& key) {
   const auto it = r.query.find(key);
   return it == r.query.end() ? "" : it->second;
@@ -77,9 +81,9 @@ HttpResponse StationSite::database(const HttpRequest& r) {
     if (p == "/api/qualifications") {
       nlohmann::json doc = nlohmann::json::array();
       for (const auto& q : store_.list(query(r, "batch"), 500)) doc.push_back(station::qualification_json(q, {}));
-      return json_response(200, doc.dump());
+      return json_response(200, text_of(doc));
     }
-    if (p == "/api/charts") return json_response(200, station::control_charts_json(station::control_charts(store_, query(r, "batch"))).dump());
+    if (p == "/api/charts") return json_response(200, text_of(station::control_charts_json(station::control_charts(store_, query(r, "batch")))));
     for (const std::string prefix : {"/api/units/", "/api/certificate/"}) {
       if (p.rfind(prefix, 0) != 0) continue;
       const std::string serial = p.substr(prefix.size());
@@ -90,7 +94,7 @@ HttpResponse StationSite::database(const HttpRequest& r) {
       if (prefix == "/api/units/") {
         nlohmann::json doc = station::qualification_json(*q, tries);
         doc["reasons"] = q->reasons;
-        return json_response(200, doc.dump());
+        return json_response(200, text_of(doc));
       }
       if (q->status != "complete") return error_response(404, "unit " + serial + " has no completed qualification");
       std::string html = station::certificate_html(*q, tries);

@@ -316,6 +316,7 @@ TEST(VirtualBench, RefusesBadOptionsAndUnits) {
   };
   bad([](BenchOptions& o) { o.sample_rate = 0.0; }, "sample_rate");
   bad([](BenchOptions& o) { o.sample_rate = std::nan(""); }, "sample_rate");
+  bad([](BenchOptions& o) { o.sample_rate = 1e12; }, "sample_rate");  // a 1 s delay line of 10^12 samples
   bad([](BenchOptions& o) { o.dac_bits = 1; }, "dac_bits");
   bad([](BenchOptions& o) { o.va_min = 5.0; }, "va_min");
   bad([](BenchOptions& o) { o.va_max = -30.0; }, "va_max");

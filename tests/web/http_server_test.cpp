@@ -134,6 +134,20 @@ TEST(HttpServer, ServesPagesAndRefusesUnknownOrEscapingPaths) {
   EXPECT_EQ(status_of(http_exchange(p, "NONSENSE\r\n\r\n")), 400);
 }
 
+// Issue 35 (fuzz_http_request's first finding): a refusal quoting a path or Host header that is not
+// UTF-8 threw from the JSON writer on the server's thread, which ended the process.
+TEST(HttpServer, BytesThatAreNotUtf8AreAnsweredAndTheServerStaysUp) {
+  Running r;
+  const unsigned short p = r.port;
+  const std::string foreign = http_exchange(p, "GET / HTTP/1.1\r\nHost: 127.0.0.1:\xff\xff\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(status_of(foreign), 421) << foreign;
+  EXPECT_NE(foreign.find("\xef\xbf\xbd"), std::string::npos);  // U+FFFD where the Host's bytes were
+  EXPECT_EQ(status_of(http_exchange(p, http_get(p, "/", "Origin: http://\xc3\x28\r\n"))), 403);
+  EXPECT_EQ(status_of(http_exchange(p, http_get(p, "/\xe2\xe2\xe2"))), 404);
+  EXPECT_EQ(status_of(http_exchange(p, http_get(p, "/%e2%ff"))), 404);
+  EXPECT_EQ(status_of(http_exchange(p, http_get(p, "/"))), 200);
+}
+
 TEST(HttpServer, RefusesOversizedRequests) {
   Running r;
   const HttpServerOptions& o = r.options;
@@ -287,6 +301,51 @@ TEST(HttpServer, StopsWithinASecondWithStreamsOpen) {
     read_all(fd, std::chrono::milliseconds(500));  // the server closed it: EOF, not a hang
     ::close(fd);
   }
+}
+
+// exchange_request: the server's handling of one request without a socket, as fuzz_http_request
+// drives it; the same answers as over a socket above.
+TEST(HttpServer, ExchangeRequestHandlesOneRequestAsTheServerDoes) {
+  TestSite site;
+  HttpServerOptions o = loopback_options();
+  o.port = 8080;
+  const auto get = [](const std::string& target, const std::string& extra = "") {
+    return fmt::format("GET {} HTTP/1.1\r\nHost: 127.0.0.1:8080\r\n{}\r\n", target, extra);
+  };
+  HttpExchange x = exchange_request(o, site, get("/"));
+  EXPECT_EQ(x.outcome, HttpExchange::Outcome::kAnswered);
+  EXPECT_EQ(x.response.status, 200);
+  EXPECT_EQ(x.response.body, "<p>station</p>");
+  EXPECT_TRUE(x.by_site);
+  EXPECT_TRUE(x.keep_alive);  // HTTP/1.1 without Connection: close
+  EXPECT_EQ(x.request.path, "/");
+  x = exchange_request(o, site, get("/a/%2e%2e/b"));
+  EXPECT_EQ(x.response.status, 400);
+  EXPECT_FALSE(x.by_site);
+  EXPECT_FALSE(x.keep_alive);
+  EXPECT_EQ(exchange_request(o, site, get("/", "X-Pad: " + std::string(o.max_header_bytes + 10, 'a') + "\r\n")).response.status, 431);
+  EXPECT_EQ(exchange_request(o, site, "GET / HTTP/1.1\r\nHost: 127.0.0.1:8081\r\n\r\n").response.status, 421);  // another port
+  EXPECT_EQ(exchange_request(o, site, "POST /api/answer HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nContent-Length: 100000000\r\n\r\n").response.status,
+            413);
+  const std::string post = "POST /api/answer?token=" + o.operator_token + " HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nContent-Length: 2\r\n\r\n{}";
+  x = exchange_request(o, site, post);
+  EXPECT_EQ(x.response.status, 200);
+  EXPECT_TRUE(x.request.operator_rights);
+  EXPECT_EQ(x.request.body, "{}");
+  EXPECT_TRUE(x.request.query.empty());  // the token is taken out
+  EXPECT_EQ(exchange_request(o, site, "POST /api/answer HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nContent-Length: 2\r\n\r\n{}").response.status, 403);
+  EXPECT_EQ(exchange_request(o, site, get("/events")).outcome, HttpExchange::Outcome::kStream);
+  // The bytes end: before a request (closed without an answer) or inside one (400, as a client
+  // that stops sending mid-request).
+  EXPECT_EQ(exchange_request(o, site, "").outcome, HttpExchange::Outcome::kClosed);
+  EXPECT_EQ(exchange_request(o, site, "GET / HTTP/1.1\r\nHost: 127.0").response.status, 400);
+  // Any other address: a token on every request.
+  o.address = "0.0.0.0";
+  o.view_token = "fedcba9876543210fedcba9876543210";
+  EXPECT_EQ(exchange_request(o, site, get("/")).response.status, 401);
+  EXPECT_EQ(exchange_request(o, site, get("/?token=" + o.view_token)).response.status, 200);
+  o.address = "not an address";
+  EXPECT_THROW((void)exchange_request(o, site, get("/")), InputError);
 }
 
 TEST(HttpServer, TokensAreRandomAndLoopbackIsRecognised) {

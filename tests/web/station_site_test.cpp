@@ -48,6 +48,12 @@ TEST(StationSite, ServesItsFixedFilesAndNothingElse) {
   EXPECT_EQ(site.open_stream(site_get("/api/events")), nullptr);  // no live qualification here
   EXPECT_TRUE(site.accepts_post("/api/answer"));
   EXPECT_FALSE(site.accepts_post("/"));
+  // A path that is not UTF-8 (fuzz_http_request): answered 404 in valid JSON, U+FFFD for its bytes.
+  const HttpResponse not_utf8 = site.handle(site_get("/\xe2\xff"));
+  EXPECT_EQ(not_utf8.status, 404);
+  const nlohmann::json body = nlohmann::json::parse(not_utf8.body, nullptr, false);
+  ASSERT_FALSE(body.is_discarded()) << not_utf8.body;
+  EXPECT_NE(body["error"].get<std::string>().find("\xef\xbf\xbd"), std::string::npos);
 }
 
 TEST(StationSite, BrowsesTheDatabase) {

@@ -123,7 +123,7 @@ std::string to_string(HysteresisLaw law);
 HysteresisLaw hysteresis_law_from_string(const std::string& name);  // InputError (field "hysteresis_law")
 
 struct BenchOptions {
-  double sample_rate = 10e3;                // Hz, the real-time target's rate
+  double sample_rate = 10e3;                // Hz, the real-time target's rate (at most 1e6)
   // DAC: 16 bit over +-10 V, zero-order hold.
   int dac_bits = 16;
   double dac_range = 10.0;                  // V

@@ -30,6 +30,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -117,6 +118,26 @@ class HttpServer {
   unsigned short port_ = 0;
   bool loopback_ = true;
 };
+
+// One request handled as the server handles it on a new connection, without a socket (the fuzz
+// target fuzz_http_request drives the server's request handling through it; docs/fuzzing.md):
+// `bytes` are what the client sent before it stopped sending (end of file), read by the same
+// parser with the same limits, checked by the same rules (sizes, method, path, query, Host, Origin,
+// tokens: the list above) and given to `site` the same way, for a server listening on
+// options.address:options.port (nothing is bound). The first request only; no stream is open yet.
+// InputError when the options are invalid (HttpServerOptions::validate) or the address is not an IP.
+struct HttpExchange {
+  enum class Outcome {
+    kClosed,    // closed without an answer (the bytes ended before any request started)
+    kAnswered,  // `response` answers
+    kStream,    // the site's event stream would follow
+  } outcome = Outcome::kClosed;
+  HttpResponse response;
+  bool by_site = false;     // the site answered (or opened the stream); false: refused by the server
+  bool keep_alive = false;  // the connection stays open for the next request
+  HttpRequest request;      // what the site saw (by_site)
+};
+HttpExchange exchange_request(const HttpServerOptions& options, Site& site, std::string_view bytes);
 
 // 128 random bits as 32 hexadecimal digits (getrandom).
 std::string random_token();
