@@ -34,19 +34,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A private folder for the files the path-based readers need (removed at exit).
+// A private folder for the files the path-based readers need (removed at exit). The path is never
+// destroyed: a function-local static path was destroyed before the exit handler that removes the
+// folder ran (registered first, run last), which then removed nothing and left a folder in /tmp
+// per run.
 const fs::path& work_dir() {
-  static const fs::path dir = [] {
+  static const fs::path* const dir = [] {
     const char* tmp = std::getenv("TMPDIR");
-    fs::path d = fs::path(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") / ("piezobench-fuzz-" + std::to_string(::getpid()));
-    fs::create_directories(d);
+    auto* d = new fs::path(fs::path(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") / ("piezobench-fuzz-" + std::to_string(::getpid())));
+    fs::create_directories(*d);
     std::atexit([] {
       std::error_code ec;
       fs::remove_all(work_dir(), ec);
     });
     return d;
   }();
-  return dir;
+  return *dir;
 }
 
 fs::path write_input(const std::string& name, std::string_view bytes) {
