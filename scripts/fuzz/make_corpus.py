@@ -303,6 +303,8 @@ def twin_regression():
     write("regression", "twin_toml", "name_bad_utf8.toml", key("name", '"APA \xff\xfe 9"').encode("latin-1"))
     write("regression", "twin_toml", "format_other.toml", key("format", '"piezobench-twin-2"'))
     write("regression", "twin_toml", "deep_arrays.toml", key("weights", "[" * 5000 + "]" * 5000))
+    # Found by the fuzzer: -0.0 was written back as "-0", a TOML integer read as 0 (valid: exit 0).
+    write("regression", "twin_toml", "valid_negative_zero.toml", key("ground_resistance_ohm", "-0.0"))
 
 
 # The station's web server (fuzz/http_request_fuzz.cpp): requests to a server on 127.0.0.1:8080 as

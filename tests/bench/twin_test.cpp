@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
@@ -53,6 +55,20 @@ TEST(TwinFile, RoundTripKeepsEveryParameter) {
   EXPECT_DOUBLE_EQ(o.hpf_resistance, 68e3);
   EXPECT_DOUBLE_EQ(o.ground_resistance, 0.1);
   EXPECT_FALSE(o.noise);
+}
+
+// fuzz_twin_toml: a twin read and written back reads the same; a file's -0.0 was written back as
+// "-0", a TOML integer that reads as 0.
+TEST(TwinFile, NegativeZeroIsReadAsZeroSoAWrittenTwinReadsTheSame) {
+  std::string text = twin_toml(example());
+  const std::string key = "ground_resistance_ohm = ";
+  const std::size_t at = text.find(key) + key.size();
+  text.replace(at, text.find('\n', at) - at, "-0.0");
+  const Twin r = parse_twin(text, "twin.toml");
+  EXPECT_EQ(r.options.ground_resistance, 0.0);
+  EXPECT_FALSE(std::signbit(r.options.ground_resistance));
+  const std::string written = twin_toml(r);
+  EXPECT_EQ(twin_toml(parse_twin(written, "twin.toml")), written);
 }
 
 TEST(TwinFile, RefusesUnknownMissingAndInvalidKeys) {
