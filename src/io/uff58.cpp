@@ -335,13 +335,13 @@ class UffReader {
       if (ascii_lines != 11) throw InputError(source_, field(d, "(58b number of ASCII lines)"), "11", std::to_string(ascii_lines));
       if (n_bytes < 0) throw InputError(source_, field(d, "(58b number of bytes)"), "a byte count >= 0", std::to_string(n_bytes));
     }
-    for (auto& id : d.id) id = std::string(text::trim(require_line(d, "ID lines")));
+    for (auto& id : d.id) id = text::utf8_from_legacy(text::trim(require_line(d, "ID lines")));
     const std::string_view r6 = require_line(d, "record 6");
     d.func_type = static_cast<int>(int_field(d, r6, 0, 5, "record 6 (function type)"));
-    d.rsp_entity = std::string(text::trim(column(r6, 30, 11)));
+    d.rsp_entity = text::utf8_from_legacy(text::trim(column(r6, 30, 11)));
     d.rsp_node = int_field(d, r6, 41, 10, "record 6 (response node)");
     d.rsp_dir = int_field(d, r6, 51, 4, "record 6 (response direction)");
-    d.ref_entity = std::string(text::trim(column(r6, 55, 11)));
+    d.ref_entity = text::utf8_from_legacy(text::trim(column(r6, 55, 11)));
     d.ref_node = int_field(d, r6, 66, 10, "record 6 (reference node)");
     d.ref_dir = int_field(d, r6, 76, 4, "record 6 (reference direction)");
     const std::string_view r7 = require_line(d, "record 7");
@@ -365,7 +365,7 @@ class UffReader {
       throw InputError(source_, field(d, "record 7 (abscissa increment)"), "> 0 for even spacing", format_number(d.abscissa_inc, 10));
     }
     const auto units_label = [](std::string_view record) {
-      std::string u(text::trim(column(record, 47, 20)));
+      std::string u = text::utf8_from_legacy(text::trim(column(record, 47, 20)));
       return u == "NONE" ? std::string() : u;
     };
     const std::string_view r8 = require_line(d, "record 8");
@@ -373,10 +373,10 @@ class UffReader {
     d.abscissa_unit = units_label(r8);
     const std::string_view r9 = require_line(d, "record 9");
     d.ord_spec = static_cast<int>(int_field(d, r9, 0, 10, "record 9 (ordinate data type)"));
-    d.ord_label = std::string(text::trim(column(r9, 26, 20)));
+    d.ord_label = text::utf8_from_legacy(text::trim(column(r9, 26, 20)));
     d.ord_unit = units_label(r9);
     const std::string_view r10 = require_line(d, "record 10");
-    d.denom_label = std::string(text::trim(column(r10, 26, 20)));
+    d.denom_label = text::utf8_from_legacy(text::trim(column(r10, 26, 20)));
     d.denom_unit = units_label(r10);
     (void)require_line(d, "record 11");
 

@@ -300,8 +300,10 @@ std::string to_string(Quantity q) {
   return "dimensionless";
 }
 
-std::optional<Unit> find_unit(std::string_view symbol) {
-  symbol = text::trim(symbol);
+std::optional<Unit> find_unit(std::string_view raw) {
+  // A Latin-1 label ("m/s\xB2" from a Windows-era UFF or CSV writer) is read as the UTF-8 it means.
+  const std::string decoded = text::utf8_from_legacy(text::trim(raw));
+  const std::string_view symbol = decoded;
   if (std::optional<Unit> u = table_unit(symbol)) return u;
   if (symbol.empty() || symbol.size() > 80) return std::nullopt;
   const std::optional<Product> p = CompoundParser(symbol).parse();

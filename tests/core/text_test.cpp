@@ -69,5 +69,24 @@ TEST(Quote, ShortensAndEscapes) {
   EXPECT_EQ(join({"a", "b", "c"}), "a, b, c");
 }
 
+TEST(Text, Utf8IsKeptAndLatin1IsDecoded) {
+  EXPECT_TRUE(is_utf8("m/s^2"));
+  EXPECT_TRUE(is_utf8("m/s\xC2\xB2"));            // U+00B2
+  EXPECT_TRUE(is_utf8("\xE2\x82\xAC"));           // U+20AC
+  EXPECT_TRUE(is_utf8("\xF0\x9F\x98\x80"));       // U+1F600
+  EXPECT_FALSE(is_utf8("m/s\xB2"));                // a Latin-1 byte alone
+  EXPECT_FALSE(is_utf8("\xC0\xAF"));               // overlong '/'
+  EXPECT_FALSE(is_utf8("\xE0\x80\xAF"));           // overlong, 3 bytes
+  EXPECT_FALSE(is_utf8("\xED\xA0\x80"));           // a surrogate
+  EXPECT_FALSE(is_utf8("\xF4\x90\x80\x80"));       // past U+10FFFF
+  EXPECT_FALSE(is_utf8("\xE2\x82"));               // truncated at the end
+  EXPECT_FALSE(is_utf8("\xE2\x28\xA1"));           // a bad continuation byte
+  EXPECT_EQ(utf8_from_legacy("m/s\xC2\xB2"), "m/s\xC2\xB2");
+  EXPECT_EQ(utf8_from_legacy("(1/N)*(m/s\xB2)"), "(1/N)*(m/s\xC2\xB2)");
+  EXPECT_EQ(utf8_from_legacy("\xB5m"), "\xC2\xB5m");
+  EXPECT_EQ(utf8_from_legacy("Kraft \xDC\xFF"), "Kraft \xC3\x9C\xC3\xBF");
+  EXPECT_EQ(utf8_from_legacy(""), "");
+}
+
 }  // namespace
 }  // namespace piezobench::text

@@ -25,9 +25,9 @@ namespace fs = std::filesystem;
 using test::all_near;
 using test::TempDir;
 using test::Tolerance;
+using test::kExact;
 using Eigen::Index;
 
-constexpr Tolerance kExact{0.0, 0.0};
 // UFF58 prints ordinates as E20.12 (13 significant digits): each part within 5e-13 relative.
 constexpr Tolerance kUffOrdinate{1e-12, 0.0};
 // ... and abscissae as E13.5 (6 significant digits), also min and increment of even grids.
@@ -195,7 +195,9 @@ TEST(FrfFiles, StandardDeviationRoundTrips) {
     const Tolerance tol = std::string(name) == "frf.uff" ? Tolerance{1e-10, 0.0} : kExact;
     for (size_t i = 0; i < 2; ++i) EXPECT_TRUE(all_near(back.std_H[i], frf.std_H[i], tol)) << frf.outputs[i];
     // CSV keeps no provenance; .mat stores n_d, UFF recomputes it from ID line 5.
-    if (std::string(name) != "frf.csv") EXPECT_NEAR(back.provenance.effective_averages, frf.provenance.effective_averages, 1e-9);
+    if (std::string(name) != "frf.csv") {
+      EXPECT_NEAR(back.provenance.effective_averages, frf.provenance.effective_averages, 1e-9);
+    }
   }
   // A CSV with std_ for one output of two is refused.
   write_bytes(dir.path() / "half.csv", "freq_Hz,re_a,im_a,std_a,re_b,im_b\n1,1,0,0.1,2,0\n");
@@ -300,6 +302,22 @@ TEST(FrfUff, UnitsLabelsAreHonouredOrRefused) {
   relabel(9, "s");  // a time abscissa
   write_lines();
   test::expect_input_error([&] { (void)read_frf(file); }, {"record 8 (abscissa units)", "a frequency unit"});
+}
+
+// pyuff's sample FRF (tests/fixtures/io/pyuff/README.md): its ordinate unit "(1/N)*(m/s\xB2)" is
+// Latin-1 text, read as (1/N)*(m/s^2): H stays in SI (the factor is 1) and is no longer refused.
+TEST(FrfUff, PyuffLatin1UnitLabel) {
+  const FrfFile f = read_frf_file(test::fixture_path("io/pyuff/non_ascii_header.uff"));
+  ASSERT_EQ(f.frf.H.size(), 1u);
+  ASSERT_EQ(f.units.size(), 1u);
+  EXPECT_EQ(f.units[0], "m/N/s^2");
+  EXPECT_TRUE(f.warnings.empty()) << text::join(f.warnings, "; ");
+  // The file's six complex values as printed (record 7: 6 values from 0 Hz, 0.1953125 Hz apart).
+  ASSERT_EQ(f.frf.freq_Hz.size(), 6);
+  EXPECT_TRUE(test::near(f.frf.freq_Hz(5), 5 * 1.95313e-01, {1e-6, 0.0}));
+  EXPECT_EQ(f.frf.H[0](0), std::complex<double>(4.07994e-01, 0.0));
+  EXPECT_EQ(f.frf.H[0](1), std::complex<double>(-5.99924e-02, -5.53260e-02));
+  EXPECT_EQ(f.frf.H[0](5), std::complex<double>(3.75037e+00, 2.93363e+00));
 }
 
 TEST(FrfCsv, LabDialectsAndScipysWelchFile) {

@@ -24,8 +24,8 @@ namespace fs = std::filesystem;
 using test::all_near;
 using test::TempDir;
 using test::Tolerance;
+using test::kExact;
 
-constexpr Tolerance kExact{0.0, 0.0};
 
 // A record with a time vector, three channels with units and two settings.
 TimeSeries sample_series(Eigen::Index n = 257) {
@@ -943,6 +943,35 @@ TEST(TimeSeriesUff58, TimeHistoriesSingleAndMultiRecordAsciiAndBinary) {
   o.channels = {"u", "x"};
   test::expect_input_error([&] { (void)read_timeseries(test::fixture_path("io/units/th_multi_ascii.uff"), o); },
                            {"th_multi_ascii.uff", "channel x", "Vs, d_e, u"});
+}
+
+// pyuff's sample time histories (tests/fixtures/io/pyuff/README.md), written by the programs pyuff's
+// authors collected: the same record in ASCII (6 printed digits) and binary 58b (float32), and a
+// float64 58b record in g with CR LF lines.
+TEST(TimeSeriesUff58, PyuffSampleFiles) {
+  const TimeSeries ascii = read_timeseries(test::fixture_path("io/pyuff/Sample_UFF58_ascii.uff"));
+  const TimeSeries binary = read_timeseries(test::fixture_path("io/pyuff/Sample_UFF58b_bin.uff"));
+  for (const TimeSeries* ts : {&ascii, &binary}) {
+    EXPECT_EQ(ts->names, (std::vector<std::string>{"Mic 01"}));
+    EXPECT_EQ(ts->units, (std::vector<std::string>{"Pa"}));
+    ASSERT_EQ(ts->data.rows(), 79292);
+    EXPECT_TRUE(test::near(ts->sample_rate, 1.0 / 1.52588e-05, {1e-5, 0.0})) << ts->sample_rate;
+  }
+  // The ASCII file's first line of values, as printed.
+  const double first[] = {-1.47553e-02, -1.72957e-02, -1.66101e-02, -1.61988e-02, -1.68925e-02, -1.53669e-02};
+  for (Eigen::Index k = 0; k < 6; ++k) EXPECT_EQ(ascii.data(k, 0), first[k]) << k;
+  // float32 against 6 printed digits: within half a unit of the 6th digit of each value.
+  const Eigen::ArrayXd diff = (ascii.data.col(0) - binary.data.col(0)).array().abs();
+  const Eigen::ArrayXd bound = 5e-6 * ascii.data.col(0).array().abs() + 1e-12;
+  EXPECT_TRUE((diff <= bound).all()) << "largest difference " << diff.maxCoeff();
+
+  const TimeSeries g = read_timeseries(test::fixture_path("io/pyuff/binary8byte.uff"));
+  EXPECT_EQ(g.names, (std::vector<std::string>{"sine 5 Hz"}));
+  EXPECT_EQ(g.units, (std::vector<std::string>{"m/s^2"}));  // g converted
+  ASSERT_EQ(g.data.rows(), 250);
+  EXPECT_EQ(g.sample_rate, 100.0);
+  // A 5 Hz sine sampled at 100 Hz: 20 samples per period.
+  EXPECT_TRUE(test::near(g.data(5, 0), g.data(25, 0), {1e-12, 1e-12}));
 }
 
 }  // namespace

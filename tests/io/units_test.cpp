@@ -44,6 +44,15 @@ TEST(Units, MicroIsWrittenThreeWaysAndCaseMatters) {
   EXPECT_FALSE(find_unit("M").has_value());
 }
 
+// Windows-era writers (UFF labels, CSV headers) store 8-bit Latin-1 text: byte 0xB5 is the micro
+// sign, 0xB2 the superscript two.
+TEST(Units, Latin1LabelsAreReadAsTheUnitTheyName) {
+  EXPECT_EQ(factor("\xB5m"), 1e-6);
+  EXPECT_EQ(find_unit("m/s\xB2")->si_symbol, "m/s^2");
+  EXPECT_EQ(find_unit("(1/N)*(m/s\xB2)")->si_symbol, "m/N/s^2");
+  EXPECT_FALSE(find_unit("\xB5").has_value());
+}
+
 TEST(Units, UnknownUnitNamesSourceFieldAndTheKnownUnits) {
   test::expect_input_error([] { (void)unit_from_string("furlong", "rec.csv", "column d_e"); },
                            {"rec.csv", "column d_e", "'furlong'", "nm, um, mm", "kHz", "uF"});

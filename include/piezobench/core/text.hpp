@@ -31,6 +31,13 @@ void for_each_line(std::string_view text, const std::function<bool(std::size_t, 
 [[nodiscard]] std::optional<double> parse_double(std::string_view token, bool fortran = false);
 [[nodiscard]] std::optional<long long> parse_int(std::string_view token);
 
+// True when `s` is well-formed UTF-8 (no overlong forms, surrogates or code points past U+10FFFF).
+[[nodiscard]] bool is_utf8(std::string_view s);
+// Text of a file as UTF-8: `s` itself when it is well-formed UTF-8, else every byte read as
+// ISO 8859-1 (Latin-1), the 8-bit text of Windows-era writers: UFF files and CSV headers with
+// "m/s\xB2" (m/s squared) or "\xB5m" (micrometres) become "m/s\u00B2" and "\u00B5m".
+[[nodiscard]] std::string utf8_from_legacy(std::string_view s);
+
 // Shows a piece of a file in an error message: quoted, at most 40 characters, non-printable bytes
 // as \xNN.
 [[nodiscard]] std::string quote(std::string_view text);
