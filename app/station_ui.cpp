@@ -94,12 +94,12 @@ std::map<std::string, double> expected_phase_durations(const station::RecordStor
 
 namespace {
 
-struct ServeCli {
+struct StationServeCli {
   std::string db = "station.db";
   UiCli ui;
 };
 
-int run_station_serve(const ServeCli& o) {
+int run_station_serve(const StationServeCli& o) {
   if (!std::filesystem::exists(o.db)) throw InputError(o.db, "database", "an existing station database (qualify writes it)", "no such file");
   StationUi ui(o.ui, o.db, nullptr);
   ui.linger(stop_on_sigint());
@@ -109,7 +109,7 @@ int run_station_serve(const ServeCli& o) {
 }  // namespace
 
 void add_station_commands(CLI::App& app, Action& action) {
-  auto o = std::make_shared<ServeCli>();
+  auto o = std::make_shared<StationServeCli>();
   CLI::App* st = app.add_subcommand("station", "The station's web page (docs/station.md)");
   st->require_subcommand(1);
   CLI::App* serve = st->add_subcommand("serve", "Serve the station database's page: units, batches, control charts, certificates");

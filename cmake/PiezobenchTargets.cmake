@@ -50,7 +50,16 @@ else()
   set(_pb_pch_default ON)
 endif()
 option(PIEZOBENCH_PCH "Precompile the third-party headers of the test programs once" ${_pb_pch_default})
-set(PIEZOBENCH_UNITY_BATCH_SIZE 4 CACHE STRING "Source files per unity batch")
+# Batch size: a cold build (CI) spends most of its time parsing Eigen and instantiating the same
+# templates in each batch, so big batches cost less CPU: lti_tests + ident_tests and what they link,
+# cold, 301 s of CPU with 4 files a batch, 225 s with 16, 227 s with 64 (docs/performance.md).
+# With ccache (a developer's tree) a small batch recompiles less after an edit.
+if(CMAKE_CXX_COMPILER_LAUNCHER MATCHES "ccache")
+  set(_pb_unity_batch_default 4)
+else()
+  set(_pb_unity_batch_default 16)
+endif()
+set(PIEZOBENCH_UNITY_BATCH_SIZE ${_pb_unity_batch_default} CACHE STRING "Source files per unity batch")
 
 # piezobench_unity_build(<target>)
 function(piezobench_unity_build target)

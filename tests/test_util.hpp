@@ -53,6 +53,8 @@ struct Tolerance {
   double rel = 0.0;
   double abs = 0.0;
 };
+// Bit-for-bit equality (two readers of one file, a round trip through an exact format).
+inline constexpr Tolerance kExact{0.0, 0.0};
 
 inline bool within(double actual, double expected, Tolerance tol) {
   if (std::isnan(expected)) return std::isnan(actual);

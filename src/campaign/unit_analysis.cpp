@@ -87,8 +87,8 @@ Record read_record(const Campaign& campaign, const FileSpec& spec, Experiment ex
     try {
       // LCR readings are one sample per channel, which read_timeseries refuses in a .mat file.
       if (experiment == Experiment::kCapacitance) {
-        if (std::optional<io::TimeSeries> readings = io::read_mat_readings(spec.path, read.channels)) {
-          r.ts = std::move(*readings);
+        if (std::optional<io::TimeSeries> lcr = io::read_mat_readings(spec.path, read.channels)) {
+          r.ts = std::move(*lcr);
           return r;
         }
       }

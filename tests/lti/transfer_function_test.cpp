@@ -8,6 +8,7 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "lti_test_util.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::lti {
@@ -15,12 +16,7 @@ namespace {
 
 using test::input_error;
 
-CVector cvec(std::initializer_list<Complex> v) {
-  CVector out(static_cast<Index>(v.size()));
-  Index k = 0;
-  for (const Complex& x : v) out(k++) = x;
-  return out;
-}
+using test::cvec;
 
 TEST(TransferFunction, ConstructionAndOrder) {
   const TransferFunction tf(Vector{{1.0, 2.0}}, Vector{{1.0, 3.0, 2.0}}, 0.0, 2e-4);
