@@ -51,8 +51,9 @@ else()
 endif()
 option(PIEZOBENCH_PCH "Precompile the third-party headers of the test programs once" ${_pb_pch_default})
 # Batch size: a cold build (CI) spends most of its time parsing Eigen and instantiating the same
-# templates in each batch, so big batches cost less CPU: lti_tests + ident_tests and what they link,
-# cold, 301 s of CPU with 4 files a batch, 225 s with 16, 227 s with 64 (docs/performance.md).
+# templates in each batch, so big batches cost less CPU: lti_tests + campaign_tests and what they
+# link, cold, built side by side, 534 s of CPU with 4 files a batch, 456 s with 16; 64 cost the
+# same as 16 and leave fewer jobs to run in parallel (docs/performance.md, "Build time").
 # With ccache (a developer's tree) a small batch recompiles less after an edit.
 if(CMAKE_CXX_COMPILER_LAUNCHER MATCHES "ccache")
   set(_pb_unity_batch_default 4)
