@@ -125,62 +125,33 @@ bool is_vector_shape(const MatValue& var) {
 std::string name_of(const MatValue& var, const std::string& field) { return field.empty() ? var.name : field; }
 }  // namespace
 
-std::u16string utf16_from_utf8(std::string_view text) {
+std::u16string utf16_from_utf8(std::string_view utf8) {
   std::u16string out;
-  for (size_t i = 0; i < text.size();) {
-    const auto b = static_cast<unsigned char>(text[i]);
-    const int more = b < 0x80 ? 0 : (b >> 5) == 0x6 ? 1 : (b >> 4) == 0xE ? 2 : (b >> 3) == 0x1E ? 3 : -1;
-    char32_t c = more == 0 ? b : more == 1 ? (b & 0x1Fu) : more == 2 ? (b & 0x0Fu) : (b & 0x07u);
-    bool ok = more >= 0 && i + static_cast<size_t>(std::max(more, 0)) < text.size();
-    for (int k = 1; ok && k <= more; ++k) {
-      const auto next = static_cast<unsigned char>(text[i + static_cast<size_t>(k)]);
-      ok = (next >> 6) == 0x2;
-      c = (c << 6) | (next & 0x3Fu);
-    }
-    static constexpr char32_t kMin[4] = {0, 0x80, 0x800, 0x10000};
-    if (!ok || c < kMin[std::max(more, 0)] || c > 0x10FFFF || (c >= 0xD800 && c <= 0xDFFF)) {
+  for (size_t i = 0; i < utf8.size();) {
+    const std::optional<char32_t> c = text::take_utf8(utf8, i);
+    if (!c) {
       out += u'\uFFFD';
       ++i;
-      continue;
-    }
-    if (c >= 0x10000) {
-      out += static_cast<char16_t>(0xD800 + ((c - 0x10000) >> 10));
-      out += static_cast<char16_t>(0xDC00 + ((c - 0x10000) & 0x3FF));
+    } else if (*c >= 0x10000) {
+      out += static_cast<char16_t>(0xD800 + ((*c - 0x10000) >> 10));
+      out += static_cast<char16_t>(0xDC00 + ((*c - 0x10000) & 0x3FF));
     } else {
-      out += static_cast<char16_t>(c);
+      out += static_cast<char16_t>(*c);
     }
-    i += static_cast<size_t>(more) + 1;
   }
   return out;
 }
 
 std::string utf8_from_units(const double* units, size_t n) {
   std::string out;
-  const auto put = [&](char32_t c) {
-    if (c < 0x80) {
-      out += static_cast<char>(c);
-    } else if (c < 0x800) {
-      out += static_cast<char>(0xC0 | (c >> 6));
-      out += static_cast<char>(0x80 | (c & 0x3F));
-    } else if (c < 0x10000) {
-      out += static_cast<char>(0xE0 | (c >> 12));
-      out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (c & 0x3F));
-    } else {
-      out += static_cast<char>(0xF0 | (c >> 18));
-      out += static_cast<char>(0x80 | ((c >> 12) & 0x3F));
-      out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (c & 0x3F));
-    }
-  };
   for (size_t i = 0; i < n; ++i) {
     const double u = units[i];
     const auto c = u >= 0.0 && u <= 0x10FFFF ? static_cast<char32_t>(u) : char32_t{0xFFFD};
     if (c >= 0xD800 && c <= 0xDBFF && i + 1 < n && units[i + 1] >= 0xDC00 && units[i + 1] <= 0xDFFF) {
-      put(0x10000 + ((c - 0xD800) << 10) + (static_cast<char32_t>(units[i + 1]) - 0xDC00));
+      text::append_utf8(out, 0x10000 + ((c - 0xD800) << 10) + (static_cast<char32_t>(units[i + 1]) - 0xDC00));
       ++i;
     } else {
-      put(c >= 0xD800 && c <= 0xDFFF ? char32_t{0xFFFD} : c);
+      text::append_utf8(out, c >= 0xD800 && c <= 0xDFFF ? char32_t{0xFFFD} : c);
     }
   }
   return out;

@@ -69,6 +69,24 @@ TEST(Quote, ShortensAndEscapes) {
   EXPECT_EQ(join({"a", "b", "c"}), "a, b, c");
 }
 
+TEST(Text, Utf8CodePointsAreTakenAndAppended) {
+  for (const char32_t c : {U'\x00', U'\x7F', U'\x80', U'\x7FF', U'\x800', U'\xFFFF', U'\x10000', U'\x10FFFF'}) {
+    std::string s;
+    append_utf8(s, c);
+    size_t i = 0;
+    EXPECT_EQ(take_utf8(s, i), std::optional<char32_t>(c)) << static_cast<unsigned>(c);
+    EXPECT_EQ(i, s.size());
+  }
+  const std::string emoji = "a\xF0\x9F\x98\x80";
+  size_t i = 1;
+  EXPECT_EQ(take_utf8(emoji, i), std::optional<char32_t>(0x1F600));
+  EXPECT_EQ(i, 5u);
+  i = 0;
+  const std::string overlong = "\xC0\xAF";
+  EXPECT_FALSE(take_utf8(overlong, i).has_value());
+  EXPECT_EQ(i, 0u);  // unchanged
+}
+
 TEST(Text, Utf8IsKeptAndLatin1IsDecoded) {
   EXPECT_TRUE(is_utf8("m/s^2"));
   EXPECT_TRUE(is_utf8("m/s\xC2\xB2"));            // U+00B2

@@ -31,7 +31,13 @@ void for_each_line(std::string_view text, const std::function<bool(std::size_t, 
 [[nodiscard]] std::optional<double> parse_double(std::string_view token, bool fortran = false);
 [[nodiscard]] std::optional<long long> parse_int(std::string_view token);
 
-// True when `s` is well-formed UTF-8 (no overlong forms, surrogates or code points past U+10FFFF).
+// The code point of the UTF-8 sequence at s[i], advancing i past it; nullopt (i unchanged) when
+// the bytes there are not a well-formed sequence (truncated, an overlong form, a surrogate or a
+// code point past U+10FFFF).
+[[nodiscard]] std::optional<char32_t> take_utf8(std::string_view s, std::size_t& i);
+// Appends the code point c (at most U+10FFFF) to `out` as UTF-8.
+void append_utf8(std::string& out, char32_t c);
+// True when `s` is well-formed UTF-8 (take_utf8 takes it whole).
 [[nodiscard]] bool is_utf8(std::string_view s);
 // Text of a file as UTF-8: `s` itself when it is well-formed UTF-8, else every byte read as
 // ISO 8859-1 (Latin-1), the 8-bit text of Windows-era writers: UFF files and CSV headers with
