@@ -409,8 +409,7 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
     row.gs = fit.gs;
     row.ga_relative_to_eq41 = std::abs(fit.ga) / eq41.ga - 1.0;
     row.gs_relative_to_eq41 = std::abs(fit.gs) / eq41.gs - 1.0;
-    row.band_lo_Hz = fit.band_lo_Hz;
-    row.band_hi_Hz = fit.band_hi_Hz;
+    row.band_Hz = {fit.band_lo_Hz, fit.band_hi_Hz};
     row.resonance_Hz = fit.resonance_Hz;
     if (fit.antiresonance_Hz > 0.0) row.antiresonance_Hz = fit.antiresonance_Hz;
     row.measured_resonance_Hz = u.resonance_Hz;

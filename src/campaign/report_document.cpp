@@ -1053,18 +1053,16 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
     text = fmt::format("The super element ({}, {} DOF) on the bench ({:.3g} kg on the moving interface), its sensitivities tuned "
                        "against each unit's measured FRFs (docs/apa300ml.md) and compared with eq. 4.1 for Table 4.1's "
                        "constants and the stacks' effective modulus {:.3g} GPa (Table 4.1: 48 GPa): ga {:.3g} N/V, gs {:.3g} V/um.",
-                       s->source, s->dofs, s->moving_mass, s->stack_modulus * 1e-9, s->eq41_ga, s->eq41_gs * 1e-6);
+                       s->source, s->dofs, s->moving_mass, s->stack_modulus * 1e-9, s->eq41_ga, s->eq41_gs * core::shown::kVoltPerMetreAsVPerUm.per_si);
     json rows = json::array();
     for (const SuperElementUnitFit& row : s->units) {
-      rows.push_back({row.name, io::to_json(row.ga), finite_scaled(row.ga_relative_to_eq41, 100.0), io::to_json(row.gs * 1e-6),
-                      finite_scaled(row.gs_relative_to_eq41, 100.0), io::to_json(row.resonance_Hz), io::to_json(row.measured_resonance_Hz),
-                      io::to_json(row.antiresonance_Hz), io::to_json(row.measured_antiresonance_Hz), io::to_json(row.de_error_dB),
-                      io::to_json(row.vs_error_dB)});
+      json cells = json::array();
+      report_cells(cells, row);
+      rows.push_back(cells);
     }
-    tables.push_back(table("ga and gs tuned per unit against eq. 4.1",
-                           {"unit", "ga [N/V]", "vs eq. 4.1 [%]", "gs [V/um]", "vs eq. 4.1 [%]", "resonance model [Hz]",
-                            "resonance measured [Hz]", "anti-resonance model [Hz]", "anti-resonance measured [Hz]",
-                            "u -> d_e error [dB]", "u -> V_s error [dB]"},
+    std::vector<std::string> columns;
+    report_columns<SuperElementUnitFit>(columns);
+    tables.push_back(table("ga and gs tuned per unit against eq. 4.1", columns,
                            rows,
                            "Errors: median |model / measured| in dB from the tuning band's start to 300 Hz. Signs: ga "
                            "and gs carry the signs that make the model's phases agree with the measurement in the super "

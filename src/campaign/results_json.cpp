@@ -28,40 +28,11 @@ std::string hysteresis_model_name(const ident::HysteresisModel& m) {
   return m.output.identity() ? "prandtl-ishlinskii" : "modified-prandtl-ishlinskii";
 }
 
+// The declared view (fit, alternative, loop_asymmetry, ...) with the chosen model's name.
 json hysteresis_model(const HysteresisModelFit& h) {
-  const ident::HysteresisModel& m = h.fit.model;
-  // Every model fitted (the chosen first), with its residual and verdict.
-  json candidates = json::array();
-  for (const ident::HysteresisFit* f : {&h.fit, h.alternative ? &*h.alternative : nullptr}) {
-    if (f == nullptr) continue;
-    candidates.push_back({{"model", hysteresis_model_name(f->model)},
-                          {"chosen", f == &h.fit},
-                          {"rms_residual_um", f->rms_residual * 1e6},
-                          {"relative_residual", f->relative_residual},
-                          {"quality", core::to_string(f->quality.verdict)}});
-  }
-  if (!h.alternative_error.empty()) candidates.push_back({{"model", "modified-prandtl-ishlinskii"}, {"chosen", false}, {"error", h.alternative_error}});
-  json j = {{"model", hysteresis_model_name(m)},
-            {"loop_asymmetry", h.asymmetry},
-            {"candidates", candidates},
-            {"amplitude_V", h.amplitude},
-            {"operators", m.hysteresis.thresholds.size()},
-            {"thresholds_V", m.hysteresis.thresholds},
-            {"weights", m.hysteresis.weights},
-            {"gain_um_per_V", m.gain * 1e6},
-            {"offset_um", m.offset * 1e6},
-            {"reference_slope", m.reference_slope},
-            {"reference_intercept_V", m.reference_intercept},
-            {"rms_residual_um", h.fit.rms_residual * 1e6},
-            {"relative_residual", h.fit.relative_residual},
-            {"hysteresis_width", h.width},
-            {"model_hysteresis_width", h.model_width},
-            {"quality", core::to_string(h.fit.quality.verdict)},
-            {"quality_problems", h.fit.quality.problems},
-            {"provenance", provenance(h.provenance)}};
-  if (!m.output.identity()) {
-    j["output_map"] = {{"x_V", m.output.x}, {"y_V", m.output.y}, {"slope_below", m.output.slope_below}, {"slope_above", m.output.slope_above}};
-  }
+  json j = io::results_object(h);
+  j["model"] = hysteresis_model_name(h.fit.model);
+  if (h.alternative) j["alternative"]["name"] = hysteresis_model_name(h.alternative->model);
   return j;
 }
 
@@ -72,47 +43,23 @@ json tracking(const TrackingAnalysis& t) {
   return out;
 }
 
-// The Prony creep of a stiffness record (input N, output m).
+// The Prony creep of a stiffness record: the declared view (SI: input N, output m), with the two
+// figures that only this record's units give a name to.
 json creep(const ident::CreepFit& c) {
-  return {{"time_constants_s", c.time_constants},
-          {"coefficients", c.coefficients},
-          {"compliance_um_per_N", num(c.gain * 1e6)},
-          {"instantaneous_stiffness_N_per_um", num(c.gain != 0.0 ? -1e-6 / c.gain : 0.0)},
-          {"creep_per_decade", num(c.creep_per_decade)},
-          {"rms_residual_um", num(c.rms_residual * 1e6)},
-          {"relative_residual", num(c.relative_residual)},
-          {"quality", core::to_string(c.quality.verdict)},
-          {"quality_problems", c.quality.problems}};
+  json j = io::results_object(c);
+  j["compliance_um_per_N"] = io::shown_json(c.gain, core::shown::kMetrePerNewtonAsUmPerN.per_si);
+  j["instantaneous_stiffness_N_per_um"] = io::shown_json(c.gain != 0.0 ? -1.0 / c.gain : 0.0, core::shown::kNewtonPerMetreAsNPerUm.per_si);
+  return j;
 }
 
 json frf(const FrfAnalysis& f) {
   json out = io::results_object(f);
   out["welch"] = welch(f.welch);
-  if (f.de_plant) {
-    const auto& p = *f.de_plant;
-    out["de_plant_fit"] = {{"static_gain_um_per_V", p.static_gain * 1e6},
-                           {"resonance_Hz", p.natural_frequency / kTwoPi},
-                           {"damping", p.damping},
-                           {"delay_s", p.delay},
-                           {"relative_rms_error", p.relative_rms_error},
-                           {"points", p.points},
-                           {"uncertainty", io::to_json(p.uncertainty)}};
-  }
+  if (f.de_plant) out["de_plant_fit"] = io::results_object(*f.de_plant);
   if (f.iff_plant) {
-    const auto& p = *f.iff_plant;
-    out["iff_plant_fit"] = {{"g0", p.g0},
-                            {"wz_Hz", p.wz / kTwoPi},
-                            {"xz", p.xz},
-                            {"wp_Hz", p.wp / kTwoPi},
-                            {"xp", p.xp},
-                            {"w_hpf_Hz", p.w_hpf / kTwoPi},
-                            {"w_hpf_from", f.iff_plant_w_hpf_measured ? "R C_sensor" : "fit"},
-                            {"delay_s", p.delay},
-                            {"band_Hz", {f.iff_plant_fmin_Hz, f.iff_plant_fmax_Hz}},
-                            {"relative_rms_error", p.relative_rms_error},
-                            {"points", p.points},
-                            {"iterations", p.iterations},
-                            {"uncertainty", io::to_json(p.uncertainty)}};
+    out["iff_plant_fit"] = io::results_object(*f.iff_plant);
+    out["iff_plant_fit"]["w_hpf_from"] = f.iff_plant_w_hpf_measured ? "R C_sensor" : "fit";
+    out["iff_plant_fit"]["band_Hz"] = {f.iff_plant_fmin_Hz, f.iff_plant_fmax_Hz};
   }
   return out;
 }
@@ -122,60 +69,45 @@ void model_2dof(const Model2DofFit& m, json& unit) {
   json params = json::object();
   for (const auto& name : apa::TwoDofParams::names()) params[name] = t.params.get(name);
   unit["model_2dof"] = params;
-  unit["model_2dof_fit"] = {{"status", apa::to_string(t.status)},
-                            {"iterations", t.iterations},
-                            {"relative_error_de", t.fit_error_de},
-                            {"relative_error_Vs", t.fit_error_vs},
-                            {"points", t.points},
-                            {"delay_s", m.bench.delay},
-                            {"band_Hz", {m.fmin_Hz, m.fmax_Hz}},
-                            {"units", "SI: kg, N/m, N s/m, N/V, V/m"},
-                            {"quality", core::to_string(t.quality.verdict)},
-                            {"undetermined", t.undetermined},
-                            {"uncertainty", io::to_json(t.uncertainty)}};
+  // The tuning's declared view without its parameters (model_2dof above, in SI), with the chain and band.
+  json fit = io::results_object(t);
+  fit.erase("params");
+  fit["delay_s"] = m.bench.delay;
+  fit["band_Hz"] = {m.fmin_Hz, m.fmax_Hz};
+  unit["model_2dof_fit"] = fit;
 }
 
+// Each damped plant's declared view (gain, provenance, fit, second_order_fit, delay_removed_s), with
+// the Welch settings, the band and how each pole was found.
 json damped_plants(const std::vector<DampedPlant>& plants) {
   json list = json::array();
   for (const DampedPlant& d : plants) {
-    json entry = {{"gain", d.gain}, {"provenance", provenance(d.provenance)}, {"welch", welch(d.frf.provenance)},
-                  {"delay_removed_s", d.delay_removed}, {"fit", nullptr}, {"second_order_fit", nullptr}};
+    json entry = io::results_object(d);
+    entry["welch"] = welch(d.frf.provenance);
     if (d.identified) {
-      entry["fit"] = {{"frequency_Hz", d.identified->frequency_Hz()},
-                      {"damping", d.identified->damping},
-                      {"pole", io::to_json(d.identified->pole)},
-                      {"order", d.identified_order},
-                      {"relative_rms_error", d.identified->fit.relative_rms_error},
-                      {"band_Hz", {d.fmin_Hz, d.fmax_Hz}},
-                      {"method", "vector fitting, the dominant pole pair (the largest contribution to the data) in the band; delay of d_e removed"}};
+      entry["fit"]["order"] = d.identified_order;
+      entry["fit"]["band_Hz"] = {d.fmin_Hz, d.fmax_Hz};
+      entry["fit"]["method"] = "vector fitting, the dominant pole pair (the largest contribution to the data) in the band; delay of d_e removed";
     }
     if (d.second_order) {
-      entry["second_order_fit"] = {{"frequency_Hz", d.second_order->natural_frequency / kTwoPi},
-                                   {"damping", d.second_order->damping},
-                                   {"pole", io::to_json(d.second_order->pole())},
-                                   {"relative_rms_error", d.second_order->relative_rms_error},
-                                   {"method", "the report's: k wn^2/(s^2 + 2 zeta wn s + wn^2), weighted Levenberg-Marquardt"}};
+      entry["second_order_fit"]["method"] = "the report's: k wn^2/(s^2 + 2 zeta wn s + wn^2), weighted Levenberg-Marquardt";
     }
     list.push_back(entry);
   }
   return list;
 }
 
+// The declared view with the Welch settings, the band, and the corner the unit is given (null when
+// the fitted one is not observable, with why).
 json low_frequency_vs(const LowFrequencyVs& v) {
-  json out = {{"provenance", provenance(v.provenance)}, {"welch", welch(v.frf.provenance)}, {"lowest_line_Hz", v.lowest_line_Hz},
-              {"band_Hz", {v.lowest_line_Hz, v.fmax_Hz}}, {"corner_Hz", nullptr}, {"observable", false}};
-  if (v.fitted_corner_Hz) {
-    out["observable"] = v.observable;
-    out["fitted_corner_Hz"] = *v.fitted_corner_Hz;
-    out["relative_rms_error"] = v.relative_rms_error;
-    out["points"] = v.points;
-    if (v.observable) {
-      out["corner_Hz"] = *v.fitted_corner_Hz;
-    } else {
-      out["below_Hz"] = v.lowest_line_Hz / 3.0;
-      out["note"] = fmt::format("not observable in this record: the fitted corner ({:.2g} Hz) is below a third of the lowest line "
-                                "({:.3g} Hz)", *v.fitted_corner_Hz, v.lowest_line_Hz);
-    }
+  json out = io::results_object(v);
+  out["welch"] = welch(v.frf.provenance);
+  out["band_Hz"] = {v.lowest_line_Hz, v.fmax_Hz};
+  out["corner_Hz"] = v.fitted_corner_Hz && v.observable ? json(*v.fitted_corner_Hz) : json(nullptr);
+  if (v.fitted_corner_Hz && !v.observable) {
+    out["below_Hz"] = v.lowest_line_Hz / 3.0;
+    out["note"] = fmt::format("not observable in this record: the fitted corner ({:.2g} Hz) is below a third of the lowest line "
+                              "({:.3g} Hz)", *v.fitted_corner_Hz, v.lowest_line_Hz);
   }
   return out;
 }
@@ -241,33 +173,7 @@ json iff(const IffStudy& s) {
 
 json superelement(const SuperElementComparison& s) {
   if (s.failed) return {{"failed", *s.failed}};
-  json units = json::array();
-  for (const auto& u : s.units) {
-    units.push_back({{"unit", u.unit},
-                     {"name", u.name},
-                     {"ga_N_per_V", num(u.ga)},
-                     {"gs_V_per_um", num(u.gs * 1e-6)},
-                     {"ga_relative_to_eq41", num(u.ga_relative_to_eq41)},
-                     {"gs_relative_to_eq41", num(u.gs_relative_to_eq41)},
-                     {"band_Hz", {num(u.band_lo_Hz), num(u.band_hi_Hz)}},
-                     {"resonance_Hz", num(u.resonance_Hz)},
-                     {"antiresonance_Hz", io::to_json(u.antiresonance_Hz)},
-                     {"measured_resonance_Hz", io::to_json(u.measured_resonance_Hz)},
-                     {"measured_antiresonance_Hz", io::to_json(u.measured_antiresonance_Hz)},
-                     {"de_error_dB", num(u.de_error_dB)},
-                     {"vs_error_dB", num(u.vs_error_dB)}});
-  }
-  json out = {{"source", s.source},
-              {"dofs", s.dofs},
-              {"modes_Hz", s.modes_Hz},
-              {"moving_mass_kg", num(s.moving_mass)},
-              {"eq41", {{"ga_N_per_V", num(s.eq41_ga)}, {"gs_V_per_um", num(s.eq41_gs * 1e-6)}, {"stack_modulus_Pa", num(s.stack_modulus)}}},
-              {"units", units},
-              {"ga_N_per_V", io::to_json(s.ga)},
-              {"gs_V_per_um", io::to_json(s.gs, 1e-6)},
-              {"resonance_Hz", io::to_json(s.resonance_Hz)},
-              {"measured_resonance_Hz", io::to_json(s.measured_resonance_Hz)},
-              {"warnings", s.warnings}};
+  json out = io::results_object(s);
   if (s.resonance_Hz && s.measured_resonance_Hz) out["relative_difference"] = num(*s.resonance_Hz / *s.measured_resonance_Hz - 1.0);
   return out;
 }

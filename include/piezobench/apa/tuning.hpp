@@ -167,7 +167,7 @@ constexpr auto describe(core::Type<TwoDofTuning>) {
       core::field("iterations", &S::iterations, kNone, "Levenberg-Marquardt steps"),
       core::field("status", &S::status, kNone, "how the refinement ended"),
       core::field("message", &S::message, kNone, "what stopped the refinement"),
-      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("quality", &S::quality, kNone, "the verdict").key("."),
       core::field("uncertainty", &S::uncertainty, kNone, "standard errors of the 9 parameters"),
       core::field("undetermined", &S::undetermined, kNone, "parameters the data do not determine"));
 }

@@ -7,6 +7,7 @@
 // An analysis that was not run (experiment not measured, or failed on valid data) is a nullopt;
 // its failure is one line of UnitAnalysis::failed.
 #include <Eigen/Core>
+#include <array>
 #include <complex>
 #include <optional>
 #include <string>
@@ -687,12 +688,31 @@ struct SuperElementUnitFit {
   double gs = 0.0;                   // V/m
   double ga_relative_to_eq41 = 0.0;  // |ga| / eq. 4.1's - 1
   double gs_relative_to_eq41 = 0.0;
-  double band_lo_Hz = 0.0, band_hi_Hz = 0.0;  // the tuning band
+  std::array<double, 2> band_Hz{};   // the tuning band
   double resonance_Hz = 0.0;                  // of the tuned model's u -> d_e
   std::optional<double> antiresonance_Hz;     // of the tuned model's u -> V_s (below the resonance)
   std::optional<double> measured_resonance_Hz, measured_antiresonance_Hz;  // the unit's (FrfAnalysis)
   double de_error_dB = 0.0, vs_error_dB = 0.0;  // median |model/measured| in dB (superelement_fit.hpp)
 };
+
+constexpr auto describe(core::Type<SuperElementUnitFit>) {
+  using S = SuperElementUnitFit;
+  using namespace core::shown;
+  return core::fields<S>("SuperElementUnitFit", "the super element's ga and gs tuned against one unit's FRFs (report 4)",
+      core::field("unit", &S::unit, kNone, "unit id"),
+      core::field("name", &S::name, kNone, "unit name").in_report(),
+      core::field("ga", &S::ga, kNewtonPerVolt, "signed: the sign that makes the phases agree").in_report(),
+      core::field("ga_relative_to_eq41", &S::ga_relative_to_eq41, kRatio, "|ga| / eq. 4.1's - 1").in_report(),
+      core::field("gs", &S::gs, kVoltPerMetreAsVPerUm, "signed, as ga").in_report(),
+      core::field("gs_relative_to_eq41", &S::gs_relative_to_eq41, kRatio, "|gs| / eq. 4.1's - 1").in_report(),
+      core::field("band_Hz", &S::band_Hz, kHertz, "the tuning band"),
+      core::field("resonance_Hz", &S::resonance_Hz, kHertz, "of the tuned model's u -> d_e").in_report(),
+      core::field("measured_resonance_Hz", &S::measured_resonance_Hz, kHertz, "the unit's").in_report(),
+      core::field("antiresonance_Hz", &S::antiresonance_Hz, kHertz, "of the tuned model's u -> V_s (below the resonance)").in_report(),
+      core::field("measured_antiresonance_Hz", &S::measured_antiresonance_Hz, kHertz, "the unit's").in_report(),
+      core::field("de_error_dB", &S::de_error_dB, kDecibel, "median |model / measured| of u -> d_e").in_report(),
+      core::field("vs_error_dB", &S::vs_error_dB, kDecibel, "the same of u -> V_s").in_report());
+}
 
 // The super element's comparison with the measurements: every unit with an FRF tuned, medians,
 // eq. 4.1's sensitivities for the bench's piezo constants, and the tuned model of the first such
@@ -720,6 +740,36 @@ struct SuperElementComparison {
   std::optional<Response> figure;
   std::optional<std::string> failed;
 };
+
+constexpr auto describe(core::Type<SuperElementComparison::Response>) {
+  using S = SuperElementComparison::Response;
+  using namespace core::shown;
+  return core::fields<S>("SuperElementResponse", "the first tuned unit's model at its measured frequencies (Figure 4.2)",
+      core::field("unit", &S::unit, kNone, "unit id"),
+      core::field("name", &S::name, kNone, "unit name"),
+      core::field("model", &S::model, kNone, "outputs de (m/V) and Vs (V/V)"));
+}
+
+constexpr auto describe(core::Type<SuperElementComparison>) {
+  using S = SuperElementComparison;
+  using namespace core::shown;
+  return core::fields<S>("SuperElementComparison", "the super element on the bench against the measured FRFs (report 4)",
+      core::field("source", &S::source, kNone, "as given in the campaign"),
+      core::field("dofs", &S::dofs, kNone, "degrees of freedom of the reduced model"),
+      core::field("modes_Hz", &S::modes_Hz, kHertz, "the first ten of the bench model"),
+      core::field("moving_mass", &S::moving_mass, kKilogram, "on the moving interface"),
+      core::field("eq41_ga", &S::eq41_ga, kNewtonPerVolt, "eq. 4.1 with Table 4.1's constants").key("eq41.ga_N_per_V"),
+      core::field("eq41_gs", &S::eq41_gs, kVoltPerMetreAsVPerUm, "eq. 4.1 with Table 4.1's constants").key("eq41.gs_V_per_um"),
+      core::field("stack_modulus", &S::stack_modulus, kPascal, "the stacks' effective modulus eq. 4.1 is evaluated with").key("eq41.stack_modulus_Pa"),
+      core::field("units", &S::units, kNone, "every unit with an FRF, tuned"),
+      core::field("ga", &S::ga, kNewtonPerVolt, "median |ga| over the units"),
+      core::field("gs", &S::gs, kVoltPerMetreAsVPerUm, "median |gs| over the units"),
+      core::field("resonance_Hz", &S::resonance_Hz, kHertz, "the first unit's tuned model"),
+      core::field("measured_resonance_Hz", &S::measured_resonance_Hz, kHertz, "median of the units'"),
+      core::field("warnings", &S::warnings, kNone, "disagreements with the measurements"),
+      core::field("figure", &S::figure, kNone, "Figure 4.2's model").part_only(),
+      core::field("failed", &S::failed, kNone, "a NumericalError of the comparison"));
+}
 
 struct CampaignResult {
   Campaign campaign;  // as read

@@ -41,13 +41,15 @@ struct FitQuality {
   [[nodiscard]] std::string summary() const;
 };
 
+// In results.json a fit's quality is merged into the fit (its field is declared with key "."):
+// "quality": "good" or "poor", "quality_problems", "quality_advice", "quality_impossible".
 constexpr auto describe(Type<FitQuality>) {
   using S = FitQuality;
   return fields<S>("FitQuality", "a fit's verdict and what makes it poor",
-      field("verdict", &S::verdict, shown::kNone, "good or poor"),
-      field("impossible", &S::impossible, shown::kNone, "a parameter has an impossible value"),
-      field("problems", &S::problems, shown::kNone, "each names the output or parameter and its number"),
-      field("advice", &S::advice, shown::kNone, "what to try (empty when good)"));
+      field("verdict", &S::verdict, shown::kNone, "good or poor").key("quality"),
+      field("impossible", &S::impossible, shown::kNone, "a parameter has an impossible value").key("quality_impossible"),
+      field("problems", &S::problems, shown::kNone, "each names the output or parameter and its number").key("quality_problems"),
+      field("advice", &S::advice, shown::kNone, "what to try (empty when good)").key("quality_advice"));
 }
 
 }  // namespace piezobench::core

@@ -253,7 +253,7 @@ constexpr auto describe(core::Type<HysteresisFit>) {
       core::field("relative_residual", &S::relative_residual, kRatio, "rms_residual / stroke"),
       core::field("stroke", &S::stroke, kMetreAsUm, "max d_e - min d_e"),
       core::field("samples", &S::samples, kNone, "samples fitted"),
-      core::field("quality", &S::quality, kNone, "the verdict"));
+      core::field("quality", &S::quality, kNone, "the verdict").key("."));
 }
 
 constexpr auto describe(core::Type<CreepFit>) {
@@ -267,7 +267,7 @@ constexpr auto describe(core::Type<CreepFit>) {
       core::field("creep_per_decade", &S::creep_per_decade, kRatio, "mean c_j: relative creep per decade of time"),
       core::field("rms_residual", &S::rms_residual, kNone, "output unit"),
       core::field("relative_residual", &S::relative_residual, kRatio, "rms / (max y - min y)"),
-      core::field("quality", &S::quality, kNone, "the verdict"));
+      core::field("quality", &S::quality, kNone, "the verdict").key("."));
 }
 
 }  // namespace piezobench::ident

@@ -192,7 +192,7 @@ constexpr auto describe(core::Type<DelayedSecondOrderFit>) {
       core::field("points", &S::points, kNone, "frequencies used"),
       core::field("iterations", &S::iterations, kNone, "Levenberg-Marquardt steps"),
       core::field("status", &S::status, kNone, "why Levenberg-Marquardt stopped"),
-      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("quality", &S::quality, kNone, "the verdict").key("."),
       core::field("uncertainty", &S::uncertainty, kNone, "standard errors of static_gain, natural_frequency, damping, delay"));
 }
 
@@ -214,7 +214,7 @@ constexpr auto describe(core::Type<IffPlantFit>) {
       core::field("iterations", &S::iterations, kNone, "Levenberg-Marquardt steps"),
       core::field("converged", &S::converged, kNone, "Levenberg-Marquardt converged"),
       core::field("status", &S::status, kNone, "why Levenberg-Marquardt stopped"),
-      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("quality", &S::quality, kNone, "the verdict").key("."),
       core::field("uncertainty", &S::uncertainty, kNone, "standard errors of g0, wz, xz, wp, xp, w_hpf, delay"));
 }
 

@@ -167,7 +167,7 @@ constexpr auto describe(core::Type<VectorFittingResult>) {
       core::field("rms_error", &S::rms_error, kNone, "sqrt(mean |fit - data|^2), data units"),
       core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms_error / rms data"),
       core::field("relative_rms_error_per_output", &S::relative_rms_error_per_output, kRatio, "the same per output"),
-      core::field("quality", &S::quality, kNone, "the verdict"),
+      core::field("quality", &S::quality, kNone, "the verdict").key("."),
       core::field("iterations", &S::iterations, kNone, "pole relocations"),
       core::field("converged", &S::converged, kNone, "the poles settled"),
       core::field("convergence", &S::convergence, kNone, "how the iteration ended"),
