@@ -1,5 +1,7 @@
 #include "cli_common.hpp"
 
+#include "piezobench/io/fields_json.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -15,6 +17,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/units.hpp"
 
 namespace piezobench::app {
@@ -56,12 +59,7 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
 
 void log_line(const std::string& message) { std::cerr << "piezobench: " << message << '\n'; }
 
-nlohmann::json quality_json(const core::FitQuality& quality) {
-  return {{"quality", core::to_string(quality.verdict)},
-          {"quality_problems", quality.problems},
-          {"physically_possible", !quality.impossible},
-          {"advice", quality.advice}};
-}
+nlohmann::json quality_json(const core::FitQuality& quality) { return io::results_object(quality); }
 
 int exit_code_for(const core::FitQuality& quality) {
   return quality.poor() ? core::kPoorFitExitCode : 0;

@@ -48,7 +48,8 @@ void log_line(const std::string& message);
 // its InputError becomes a command-line error, exit 2, before any computation.
 CLI::Validator parsed_by(const std::function<void(const std::string&)>& parse, const std::string& description);
 
-// A fit's verdict in JSON: "quality" ("good"/"poor"), "quality_problems", "advice".
+// A fit's verdict in JSON, its declared view (core/fit_quality.hpp): "quality" ("good"/"poor"),
+// "quality_problems", "quality_advice", "quality_impossible".
 nlohmann::json quality_json(const core::FitQuality& quality);
 // core::kPoorFitExitCode (6) for a poor fit, else 0.
 int exit_code_for(const core::FitQuality& quality);

@@ -12,6 +12,7 @@
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/ident/hysteresis.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
 
@@ -31,22 +32,6 @@ struct HysteresisFitArgs {
   std::string out;
   bool json = false;
 };
-
-nlohmann::json model_json(const ident::HysteresisModel& m) {
-  return {{"gain_m_per_V", m.gain},
-          {"offset_m", m.offset},
-          {"reference_slope", m.reference_slope},
-          {"reference_intercept_V", m.reference_intercept},
-          {"input_min_V", m.input_min},
-          {"input_max_V", m.input_max},
-          {"thresholds_V", m.hysteresis.thresholds},
-          {"weights", m.hysteresis.weights},
-          {"creep_time_constants_s", m.creep_time_constants},
-          {"creep_coefficients", m.creep_coefficients},
-          {"output_x_V", m.output.x},
-          {"output_y_V", m.output.y},
-          {"output_slopes", {m.output.slope_below, m.output.slope_above}}};
-}
 
 // What a command reads a record for: the kinds of record it analyses (a record's own
 // settings.experiment, when it says, must be one: issue 35) and the SI unit each channel must
@@ -111,16 +96,12 @@ int run_hysteresis_fit(const HysteresisFitArgs& o) {
     if (!o.json) log_line("wrote " + o.out);
   }
   if (o.json) {
-    nlohmann::json doc = {{"source", o.file},
-                {"samples", fit.samples},
-                {"sample_rate_Hz", ts.sample_rate},
-                {"model", model_json(fit.model)},
-                {"rms_residual_m", fit.rms_residual},
-                {"relative_residual", fit.relative_residual},
-                {"stroke_m", fit.stroke},
-                {"hysteresis_width", loop.width},
-                {"warnings", ts.warnings}};
-    doc.update(quality_json(fit.quality));
+    // The declared HysteresisFit (docs/fields.md), with the record it comes from.
+    nlohmann::json doc = io::results_object(fit);
+    doc["source"] = o.file;
+    doc["sample_rate_Hz"] = ts.sample_rate;
+    doc["hysteresis_width"] = loop.width;
+    doc["warnings"] = ts.warnings;
     print_json(doc);
   } else {
     const ident::HysteresisModel& m = fit.model;
@@ -161,17 +142,11 @@ int run_creep(const CreepOptions& o) {
   const ident::CreepFit c = ident::fit_creep({x.data(), static_cast<std::size_t>(x.size())}, {y.data(), static_cast<std::size_t>(y.size())},
                                              ts.sample_rate, tau, o.max_residual);
   if (o.json) {
-    nlohmann::json doc = {{"source", o.file},
-                {"time_constants_s", c.time_constants},
-                {"coefficients", c.coefficients},
-                {"gain", c.gain},
-                {"offset", c.offset},
-                {"creep_per_decade", c.creep_per_decade},
-                {"rms_residual", c.rms_residual},
-                {"relative_residual", c.relative_residual},
-                {"units", {{"input", ts.unit(o.input)}, {"output", ts.unit(o.output)}}},
-                {"warnings", ts.warnings}};
-    doc.update(quality_json(c.quality));
+    // The declared CreepFit (SI: the channels' units), with the record it comes from.
+    nlohmann::json doc = io::results_object(c);
+    doc["source"] = o.file;
+    doc["units"] = {{"input", ts.unit(o.input)}, {"output", ts.unit(o.output)}};
+    doc["warnings"] = ts.warnings;
     print_json(doc);
   } else {
     const std::string in_unit = shown_unit(ts, o.input, ""), out_unit = shown_unit(ts, o.output, "");

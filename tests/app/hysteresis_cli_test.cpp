@@ -24,8 +24,8 @@ TEST(HysteresisCli, FitWritesAModelThatTrackingAndRtUse) {
   EXPECT_EQ(j["quality"], "good");
   EXPECT_LT(j["relative_residual"].get<double>(), 0.01);
   EXPECT_GT(j["hysteresis_width"].get<double>(), 0.15);  // the Bouc-Wen loop at 80 V
-  EXPECT_LT(j["model"]["gain_m_per_V"].get<double>(), 0.0);  // the APA shortens with voltage
-  EXPECT_EQ(j["model"]["thresholds_V"].size(), 10u);
+  EXPECT_LT(j["model"]["gain_um_per_V"].get<double>(), 0.0);  // the APA shortens with voltage
+  EXPECT_EQ(j["model"]["hysteresis"]["thresholds"].size(), 10u);
 
   const test::CliRun tr = run_cli("simulate tracking --hysteresis-law bouc-wen --unit 2 --feedforward " + file("apa.toml") +
                                   " --out " + file("tr.mat") + " --json");
