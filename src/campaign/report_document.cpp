@@ -544,21 +544,25 @@ std::optional<json> iff_section(const std::vector<UnitCurves>& units, const IffS
                                        panel("Coherence", false, json::array({trace("measured", p.f, p.coh, "measured")}))}),
                           "u -> Vs of the unit whose IFF data make the batch's IFF result, against the fitted plant model."));
   }
+  // The fit's declared report columns, then half its 95 % interval of xz (the NMP verdict's).
   json prow = json::array();
   for (const auto& u : units) {
     if (!u.result->frf_analysis || !u.result->frf_analysis->iff_plant) continue;
     const ident::IffPlantFit& f = *u.result->frf_analysis->iff_plant;
     const double se_xz = f.uncertainty.standard_error_of("xz");
-    prow.push_back({u.name(), f.g0, f.wz / kTwoPi, f.xz, std::isfinite(se_xz) ? json(core::kCoverage95 * se_xz) : json(nullptr),
-                    f.wp / kTwoPi, f.xp, f.w_hpf / kTwoPi, f.delay * 1e6, f.relative_rms_error});
+    json row = json::array({u.name()});
+    report_cells(row, f);
+    row.push_back(std::isfinite(se_xz) ? json(core::kCoverage95 * se_xz) : json(nullptr));
+    prow.push_back(row);
   }
   if (!prow.empty()) {
-    tables.push_back(table("IFF plant (eq. 2.3) per unit",
-                           {"unit", "g0", "w_z [Hz]", "xi_z", "xi_z +- (95 %)", "w_p [Hz]", "xi_p", "w_HPF [Hz]", "delay [us]",
-                            "relative rms error"},
+    std::vector<std::string> columns{"unit"};
+    report_columns<ident::IffPlantFit>(columns);
+    columns.emplace_back("xz +- (95 %)");
+    tables.push_back(table("IFF plant (eq. 2.3) per unit", columns,
                            prow,
                            "The report's hand-tuned values: g0 0.64, w_z 42.7 Hz, xi_z 0.4 %, w_p 95.2 Hz, xi_p 2 %, "
-                           "w_HPF 0.4 Hz, 200 us. xi_z +-: half the 95 % interval; the zero is called non-minimum phase "
+                           "w_HPF 0.4 Hz, 200 us. xz +-: half the 95 % interval; the zero is called non-minimum phase "
                            "only when the whole interval is below 0 (docs/uncertainty.md)."));
   }
   if (s.plant && !s.failed) figs.push_back(root_locus_figure(s));
@@ -830,6 +834,14 @@ std::optional<json> flatness_section(const Campaign& c, const std::vector<UnitCu
 // results.json writes stiffness_N_per_um only when one of these is known.
 bool has_stiffness(const UnitAnalysis& u) { return u.k1 || u.k_resonance || u.k_oc; }
 
+// The Prony creep table's columns: the fit's declared ones, then the record's own.
+std::vector<std::string> creep_columns() {
+  std::vector<std::string> columns{"record"};
+  report_columns<ident::CreepFit>(columns);
+  for (const char* c : {"instantaneous stiffness [N/um]", "rms residual [um]", "fit"}) columns.emplace_back(c);
+  return columns;
+}
+
 std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitCurves>& units) {
   json traces = json::array(), rows = json::array(), creep_rows = json::array();
   for (const auto& u : units) {
@@ -850,11 +862,13 @@ std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitC
       const std::optional<StiffnessAnalysis>& a = open ? r.stiffness_open_analysis : r.stiffness_analysis;
       if (!a || !a->creep) continue;
       const ident::CreepFit& k = *a->creep;
-      creep_rows.push_back(json::array({u.name() + (open ? ", stacks open" : ""), fmt::format("{:.3g}", fmt::join(k.time_constants, ", ")),
-                                        fmt::format("{:.3g}", fmt::join(k.coefficients, ", ")), fmt::format("{:.3g}", -1e-6 / k.gain),
-                                        fmt::format("{:.2f}", 100.0 * k.creep_per_decade),
-                                        fmt::format("{:.3g} ({:.2f} %)", k.rms_residual * 1e6, 100.0 * k.relative_residual),
-                                        core::to_string(k.quality.verdict)}));
+      // The fit's declared report columns, then what only this record's units name (N in, m out).
+      json row = json::array({u.name() + (open ? ", stacks open" : "")});
+      report_cells(row, k);
+      row.push_back(io::shown_json(k.gain != 0.0 ? -1.0 / k.gain : 0.0, core::shown::kNewtonPerMetreAsNPerUm.per_si));
+      row.push_back(io::shown_json(k.rms_residual, core::shown::kMetreAsUm.per_si));
+      row.push_back(core::to_string(k.quality.verdict));
+      creep_rows.push_back(row);
     }
   }
   if (traces.empty() && rows.empty()) return std::nullopt;
@@ -868,9 +882,7 @@ std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitC
   if (!creep_rows.empty()) {
     tables.push_back(table("Creep, Prony series (d_e = offset + gain (F + sum c_j F_j), F the weight, F_j its "
                            "first-order lags of time constant tau_j)",
-                           {"record", "tau_j [s]", "c_j", "instantaneous stiffness [N/um]", "creep [% per decade]",
-                            "rms residual [um] (of the range)", "fit"},
-                           creep_rows, "The model piezobench hysteresis creep fits (docs/hysteresis.md); a poor fit says the record's creep is not a "
+                           creep_columns(), creep_rows, "The model piezobench hysteresis creep fits (docs/hysteresis.md); a poor fit says the record's creep is not a "
                                        "sum of these exponentials."));
   }
   return json{{"id", "stiffness"},

@@ -399,7 +399,10 @@ Table read_table(const json& t, const std::string& at) {
       fail(rat, std::to_string(columns.size()) + " cells (one per column)", std::to_string(rows[r].size()) + " cells");
     }
     for (std::size_t c = 0; c < rows[r].size(); ++c) {
-      if (rows[r][c].is_structured()) fail(element(rat, c), "a number, a string, true, false or null", describe(rows[r][c]));
+      // A cell is a scalar, or a flat list of them (a declared field holding several numbers).
+      const json& cell = rows[r][c];
+      const bool flat_list = cell.is_array() && std::none_of(cell.begin(), cell.end(), [](const json& x) { return x.is_structured(); });
+      if (cell.is_structured() && !flat_list) fail(element(rat, c), "a number, a string, true, false, null or a flat list of them", describe(cell));
     }
   }
   table.rows = &rows;
@@ -627,7 +630,18 @@ std::string readable(double value, int significant = 3) {
   return {buf.data(), r.ptr};
 }
 
+// A list of numbers (a declared field that holds several, e.g. time constants) in one cell.
+std::string cell_list(const json& v) {
+  std::string out;
+  for (const json& x : v) {
+    if (!out.empty()) out += ", ";
+    out += x.is_number_float() ? readable(x.get<double>()) : x.is_string() ? escape(x.get<std::string>()) : escape(x.dump());
+  }
+  return out;
+}
+
 std::string table_cell(const json& v) {
+  if (v.is_array()) return "<td class=\"num\">" + cell_list(v) + "</td>";
   if (v.is_null()) return "<td class=\"nm\" title=\"not available\">&ndash;</td>";
   if (v.is_boolean()) return std::string("<td>") + (v.get<bool>() ? "yes" : "no") + "</td>";
   if (v.is_number_integer() || v.is_number_unsigned()) return "<td class=\"num\">" + v.dump() + "</td>";

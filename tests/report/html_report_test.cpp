@@ -249,8 +249,14 @@ TEST(HtmlReport, TablesWarningsHoverLabelsAndACompactBatch) {
   bad["sections"][1]["tables"][0]["rows"][1].erase(0);
   (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].tables[0].rows[1]");
   bad = doc;
-  bad["sections"][1]["tables"][0]["rows"][0][1] = json::array();
+  bad["sections"][1]["tables"][0]["rows"][0][1] = json::object();
   (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].tables[0].rows[0][1]");
+  bad["sections"][1]["tables"][0]["rows"][0][1] = json::array({1.0, json::array()});  // a list of lists
+  (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].tables[0].rows[0][1]");
+  // A flat list of numbers is one cell, its items joined.
+  bad = doc;
+  bad["sections"][1]["tables"][0]["rows"][0][1] = json::array({1.0, 10.0});
+  EXPECT_TRUE(test::contains(render_html(bad), "<td class=\"num\">1.00, 10.0</td>"));
   bad = doc;
   bad["sections"][1]["figures"][0]["panels"][0]["traces"][0]["text"].erase(0);
   (void)test::input_error([&] { (void)render_html(bad); }, "sections[1].figures[0].panels[0].traces[0].text");

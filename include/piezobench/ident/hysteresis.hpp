@@ -260,13 +260,13 @@ constexpr auto describe(core::Type<CreepFit>) {
   using S = CreepFit;
   using namespace core::shown;
   return core::fields<S>("CreepFit", "a Prony-series creep y = offset + gain (x + sum_j c_j F_j[x])",
-      core::field("time_constants", &S::time_constants, kSecond, "tau_j"),
-      core::field("coefficients", &S::coefficients, kRatio, "c_j"),
+      core::field("time_constants", &S::time_constants, kSecond, "tau_j").in_report(),
+      core::field("coefficients", &S::coefficients, kRatio, "c_j").in_report(),
       core::field("gain", &S::gain, kNone, "instantaneous gain, output per input unit"),
       core::field("offset", &S::offset, kNone, "output unit"),
-      core::field("creep_per_decade", &S::creep_per_decade, kRatio, "mean c_j: relative creep per decade of time"),
+      core::field("creep_per_decade", &S::creep_per_decade, kRatio, "mean c_j: relative creep per decade of time").in_report(),
       core::field("rms_residual", &S::rms_residual, kNone, "output unit"),
-      core::field("relative_residual", &S::relative_residual, kRatio, "rms / (max y - min y)"),
+      core::field("relative_residual", &S::relative_residual, kRatio, "rms / (max y - min y)").in_report(),
       core::field("quality", &S::quality, kNone, "the verdict").key("."));
 }
 
