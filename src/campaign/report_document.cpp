@@ -20,6 +20,7 @@
 #include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
+#include "shown_units.hpp"
 
 namespace piezobench::campaign {
 
@@ -28,6 +29,8 @@ using Eigen::VectorXd;
 using nlohmann::json;
 
 namespace {
+
+using namespace shown_units;
 
 // ------------------------------------------------------------------------------------ curves
 // The figures' data, made from the typed results: thinned records and log-spaced FRF lines.
@@ -149,20 +152,20 @@ struct UnitCurves {
   [[nodiscard]] const std::string& name() const { return result->name; }
 };
 
-StiffnessCurves stiffness_curves(const StiffnessAnalysis& s) { return {values(s.de.x), values(s.de.y, 1e6), values(s.fit.y, 1e6)}; }
+StiffnessCurves stiffness_curves(const StiffnessAnalysis& s) { return {values(s.de.x), values(s.de.y, kUm), values(s.fit.y, kUm)}; }
 
 UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
   UnitCurves out;
   out.result = &u;
-  if (u.stroke_analysis) out.stroke = XY{values(u.stroke_analysis->de_vs_va.x), values(u.stroke_analysis->de_vs_va.y, 1e6)};
-  for (const auto& h : u.hysteresis) out.hysteresis.push_back({h.result.amplitude, {values(h.loop.x), values(h.loop.y, 1e6)}});
+  if (u.stroke_analysis) out.stroke = XY{values(u.stroke_analysis->de_vs_va.x), values(u.stroke_analysis->de_vs_va.y, kUm)};
+  for (const auto& h : u.hysteresis) out.hysteresis.push_back({h.result.amplitude, {values(h.loop.x), values(h.loop.y, kUm)}});
   if (u.hysteresis_model) {
     const HysteresisModelFit& h = *u.hysteresis_model;
-    out.hysteresis_model_record = XY{values(h.loop.x), values(h.loop.y, 1e6)};
-    out.hysteresis_model_um = values(h.model_loop.y, 1e6);
+    out.hysteresis_model_record = XY{values(h.loop.x), values(h.loop.y, kUm)};
+    out.hysteresis_model_um = values(h.model_loop.y, kUm);
   }
   if (u.tracking) {
-    const auto loop = [](const Curve& open, const Curve& ff) { return TrackingCurves{values(open.x), values(open.y, 1e6), values(ff.y, 1e6)}; };
+    const auto loop = [](const Curve& open, const Curve& ff) { return TrackingCurves{values(open.x), values(open.y, kUm), values(ff.y, kUm)}; };
     out.tracking_sine = loop(u.tracking->sine_open, u.tracking->sine_ff);
     out.tracking_triangle = loop(u.tracking->triangle_open, u.tracking->triangle_ff);
   }
@@ -183,10 +186,10 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
         mde.push_back(hm(k, 0));
         mvs.push_back(hm(k, 1));
       }
-      out.model_de = model_lines(fm, mde, 1e6);
+      out.model_de = model_lines(fm, mde, kUmPerV);
       out.model_vs = model_lines(fm, mvs, 1.0);
     }
-    out.de = frf_lines(frf, 0, idx, 1e6);
+    out.de = frf_lines(frf, 0, idx, kUmPerV);
     out.vs = frf_lines(frf, 1, idx, 1.0);
     if (u.iff_plant) {
       const Eigen::VectorXcd g = u.iff_plant->response(w);
@@ -228,7 +231,7 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
       hm.push_back(d.frf.H[0](idx[i]));
       hf.push_back(fit(k, 0) * std::exp(std::complex<double>(0.0, -om(k) * d.delay_removed)));
     }
-    out.damped.push_back({d.gain, model_lines(fd, hm, 1e6), model_lines(fd, hf, 1e6)});
+    out.damped.push_back({d.gain, model_lines(fd, hm, kUmPerV), model_lines(fd, hf, kUmPerV)});
   }
   if (u.flexible_modes) {
     const dsp::Frf& frf = u.flexible_modes->frf;
@@ -698,7 +701,7 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
     for (const double a : amplitudes) {
       json cell = nullptr;
       for (const auto& h : u.result->hysteresis) {
-        if (std::abs(h.result.amplitude - a) < 0.05) cell = fmt::format("{:.3g} ({:.1f} %)", h.result.width * 1e6, 100.0 * h.result.relative_width);
+        if (std::abs(h.result.amplitude - a) < 0.05) cell = fmt::format("{:.3g} ({:.1f} %)", h.result.width * kUm, 100.0 * h.result.relative_width);
       }
       row.push_back(cell);
     }
@@ -734,9 +737,9 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
       return f == kuhnen && !h.alternative_error.empty() ? "failed: " + h.alternative_error : std::string("not fitted");
     };
     model_rows.push_back(json::array({u.name(), modified ? "modified PI" : "PI", fmt::format("{:.2f} %", 100.0 * h.asymmetry),
-                                      fmt::format("{:.3g}", h.amplitude), fmt::format("{:.3g}", m.gain * 1e6),
+                                      fmt::format("{:.3g}", h.amplitude), fmt::format("{:.3g}", m.gain * kUmPerV),
                                       fmt::format("{}", fmt::join(weights, " ")),
-                                      fmt::format("{:.3g} ({:.2f} %)", h.fit.rms_residual * 1e6, 100.0 * h.fit.relative_residual),
+                                      fmt::format("{:.3g} ({:.2f} %)", h.fit.rms_residual * kUm, 100.0 * h.fit.relative_residual),
                                       residual(plain) + " / " + residual(kuhnen),
                                       fmt::format("{:.1f} % / {:.1f} %", 100.0 * h.width, 100.0 * h.model_width),
                                       core::to_string(h.fit.quality.verdict)}));
@@ -767,8 +770,8 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
     for (const auto& [w, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", t.sine}, {"triangle", t.triangle}}) {
       tracking_rows.push_back(json::array({u.name(), fmt::format("1 Hz {}, {:.3g} V", w, t.amplitude),
                                            fmt::format("{:.1f} % -> {:.2f} %", 100.0 * f.width_open, 100.0 * f.width_ff),
-                                           fmt::format("{:.2f} -> {:.2f} ({:.1f}x)", f.rms_open * 1e6, f.rms_ff * 1e6, f.rms_reduction()),
-                                           fmt::format("{:.0f}", f.stroke_open * 1e6),
+                                           fmt::format("{:.2f} -> {:.2f} ({:.1f}x)", f.rms_open * kUm, f.rms_ff * kUm, f.rms_reduction()),
+                                           fmt::format("{:.0f}", f.stroke_open * kUm),
                                            t.feedforward == "given" ? "the given model" : "identified from the open run"}));
     }
     json panels = json::array();
@@ -810,9 +813,9 @@ std::optional<json> flatness_section(const Campaign& c, const std::vector<UnitCu
     json x = json::array(), text = json::array();
     for (std::size_t i = 0; i < f->probe_xy.x.size() && i < f->deviation.size(); ++i) {
       x.push_back(static_cast<long>(i) + 1);
-      text.push_back(fmt::format("x {:.4g} mm, y {:.4g} mm: {:+.3g} um", f->probe_xy.x[i] * 1e3, f->probe_xy.y[i] * 1e3, f->deviation[i] * 1e6));
+      text.push_back(fmt::format("x {:.4g} mm, y {:.4g} mm: {:+.3g} um", f->probe_xy.x[i] * 1e3, f->probe_xy.y[i] * 1e3, f->deviation[i] * kUm));
     }
-    json dev = values(std::vector<double>(f->deviation.begin(), f->deviation.begin() + static_cast<std::ptrdiff_t>(x.size())), 1e6);
+    json dev = values(std::vector<double>(f->deviation.begin(), f->deviation.begin() + static_cast<std::ptrdiff_t>(x.size())), kUm);
     traces.push_back(with_text(trace(u.name(), x, dev, u.name(), false, "markers"), text));
     json row = json::array({u.name()});
     report_cells(row, *f);
@@ -854,9 +857,9 @@ std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitC
     }
     const UnitAnalysis& r = *u.result;
     if (has_stiffness(r)) {
-      rows.push_back({u.name(), io::to_json(r.k1, 1e-6), io::to_json(r.k2, 1e-6), io::to_json(r.k1, 1e-6), io::to_json(r.k_oc, 1e-6),
-                      io::to_json(r.k_resonance, 1e-6),
-                      r.stiffness_analysis ? json(r.stiffness_analysis->result.creep_on * 1e6) : json(nullptr)});
+      rows.push_back({u.name(), io::to_json(r.k1, kNPerUm), io::to_json(r.k2, kNPerUm), io::to_json(r.k1, kNPerUm), io::to_json(r.k_oc, kNPerUm),
+                      io::to_json(r.k_resonance, kNPerUm),
+                      r.stiffness_analysis ? json(r.stiffness_analysis->result.creep_on * kUm) : json(nullptr)});
     }
     for (const bool open : {false, true}) {
       const std::optional<StiffnessAnalysis>& a = open ? r.stiffness_open_analysis : r.stiffness_analysis;
@@ -972,10 +975,10 @@ json batch_section(const CampaignResult& result) {
     if (std::isfinite(r->max)) t.push_back(limit(what + " maximum", r->max * scale));
   };
   const auto capacitance = [](double CapacitanceAnalysis::*which) {
-    return [which](const UnitAnalysis& u) { return u.capacitance_analysis ? json((*u.capacitance_analysis).*which * 1e6) : json(nullptr); };
+    return [which](const UnitAnalysis& u) { return u.capacitance_analysis ? json((*u.capacitance_analysis).*which * kUf) : json(nullptr); };
   };
   const auto stiffness = [](std::optional<double> UnitAnalysis::*which) {
-    return [which](const UnitAnalysis& u) { return has_stiffness(u) ? io::to_json(u.*which, 1e-6) : json(nullptr); };
+    return [which](const UnitAnalysis& u) { return has_stiffness(u) ? io::to_json(u.*which, kNPerUm) : json(nullptr); };
   };
   json figs = json::array();
   std::vector<std::string> not_measured;
@@ -993,29 +996,29 @@ json batch_section(const CampaignResult& result) {
   {
     json t = json::array({bars("sensor stack", capacitance(&CapacitanceAnalysis::sensor)),
                           bars("actuator stacks", capacitance(&CapacitanceAnalysis::actuator))});
-    range(t, "sensor", c.specs.capacitance_sensor, 1e6);
-    range(t, "actuator", c.specs.capacitance_actuator, 1e6);
+    range(t, "sensor", c.specs.capacitance_sensor, kUf);
+    range(t, "actuator", c.specs.capacitance_actuator, kUf);
     add(t, "capacitance", figure("batch-capacitance", "Capacitance (Table 1.2)", "", false, json::array({panel("C [uF]", false, t)})));
   }
   {
     json t = json::array({bars("k1", stiffness(&UnitAnalysis::k1)), bars("k2", stiffness(&UnitAnalysis::k2)),
                           bars("k_oc", stiffness(&UnitAnalysis::k_oc)), bars("from the resonance", stiffness(&UnitAnalysis::k_resonance))});
-    range(t, "stiffness", c.specs.stiffness, 1e-6);
+    range(t, "stiffness", c.specs.stiffness, kNPerUm);
     add(t, "stiffness", figure("batch-stiffness", "Stiffness (Table 2.1)", "", false, json::array({panel("k [N/um]", false, t)})));
   }
   {
     json t = json::array({bars("flatness", [](const UnitAnalysis& u) {
-      return u.flatness_analysis ? json(u.flatness_analysis->flatness * 1e6) : json(nullptr);
+      return u.flatness_analysis ? json(u.flatness_analysis->flatness * kUm) : json(nullptr);
     })});
-    if (c.specs.flatness_max) t.push_back(limit("flatness maximum", *c.specs.flatness_max * 1e6));
+    if (c.specs.flatness_max) t.push_back(limit("flatness maximum", *c.specs.flatness_max * kUm));
     add(t, "flatness", figure("batch-flatness", "Flatness (Table 1.1, " + metrology::to_string(c.specs.flatness_method) + ")", "", false,
                           json::array({panel("flatness [um]", false, t)})));
   }
   {
     json t = json::array({bars("stroke", [](const UnitAnalysis& u) {
-      return u.stroke_analysis ? json(u.stroke_analysis->result.stroke * 1e6) : json(nullptr);
+      return u.stroke_analysis ? json(u.stroke_analysis->result.stroke * kUm) : json(nullptr);
     })});
-    if (c.specs.stroke_min) t.push_back(limit("stroke minimum", *c.specs.stroke_min * 1e6));
+    if (c.specs.stroke_min) t.push_back(limit("stroke minimum", *c.specs.stroke_min * kUm));
     add(t, "stroke", figure("batch-stroke", "Stroke (Figure 1.4)", "", false, json::array({panel("stroke [um]", false, t)}),
                           "The specification gives a minimum stroke only."));
   }
@@ -1046,7 +1049,7 @@ json superelement_section(const CampaignResult& r, const std::vector<UnitCurves>
         vs.push_back(m.model.H[1](k));
       }
     }
-    const Bode se_de = model_lines(fm, de, 1e6), se_vs = model_lines(fm, vs, 1.0);
+    const Bode se_de = model_lines(fm, de, kUmPerV), se_vs = model_lines(fm, vs, 1.0);
     json de_mag = json::array(), de_ph = json::array(), vs_mag = json::array(), vs_ph = json::array();
     for (const auto& u : units) {
       if (u.name() != m.name || !u.de) continue;

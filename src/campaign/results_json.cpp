@@ -6,12 +6,15 @@
 #include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
+#include "shown_units.hpp"
 
 namespace piezobench::campaign {
 
 using nlohmann::json;
 
 namespace {
+
+using namespace shown_units;
 
 json num(double v) { return io::to_json(v); }
 
@@ -224,12 +227,12 @@ json results_json(const CampaignResult& r) {
   for (const auto& u : r.units) units.push_back(unit_json(u));
   const auto& a = c.analysis;
   const Specs& sp = c.specs;
-  json specs = {{"flatness_um", sp.flatness_max ? json(*sp.flatness_max * 1e6) : json(nullptr)},
+  json specs = {{"flatness_um", sp.flatness_max ? json(*sp.flatness_max * kUm) : json(nullptr)},
                 {"flatness_method", metrology::to_string(sp.flatness_method)},
-                {"capacitance_sensor_uF", range(sp.capacitance_sensor, 1e6)},
-                {"capacitance_actuator_uF", range(sp.capacitance_actuator, 1e6)},
-                {"stroke_min_um", sp.stroke_min ? json(*sp.stroke_min * 1e6) : json(nullptr)},
-                {"stiffness_N_per_um", range(sp.stiffness, 1e-6)},
+                {"capacitance_sensor_uF", range(sp.capacitance_sensor, kUf)},
+                {"capacitance_actuator_uF", range(sp.capacitance_actuator, kUf)},
+                {"stroke_min_um", sp.stroke_min ? json(*sp.stroke_min * kUm) : json(nullptr)},
+                {"stiffness_N_per_um", range(sp.stiffness, kNPerUm)},
                 {"reject_outliers", sp.reject_outliers}};
   json doc = {{"title", c.title},
           {"campaign", c.file.string()},
@@ -251,7 +254,7 @@ json results_json(const CampaignResult& r) {
             {"fit_order", a.fit_order},
             {"bench", {{"amplifier_gain", c.bench.amplifier_gain}, {"suspended_mass_kg", c.bench.suspended_mass},
                        {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},
-                       {"hpf_resistance_ohm", io::to_json(c.bench.hpf_resistance)}, {"probe_accuracy_um", c.bench.probe_accuracy * 1e6}}},
+                       {"hpf_resistance_ohm", io::to_json(c.bench.hpf_resistance)}, {"probe_accuracy_um", c.bench.probe_accuracy * kUm}}},
             {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
   io::name_non_finite(doc);  // the one encoding of non-finite numbers (docs/formats.md)
   return doc;
