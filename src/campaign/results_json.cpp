@@ -143,33 +143,15 @@ json batch(const BatchAnalysis& b) {
                             {"rejects", b.rejects}}}};
 }
 
+// The declared study, with how the locus was computed and what the controller and plant are.
 json iff(const IffStudy& s) {
-  if (s.failed) return {{"gains", json::array()}, {"damped_poles", json::array()}, {"optimal_gain", nullptr}, {"failed", *s.failed}};
-  const control::IffControllerParams& k = s.controller;
-  json out = {{"unit", s.unit ? json(*s.unit) : json(nullptr)}, {"gains", s.gains}, {"damped_poles", json::array()}, {"optimal_gain", io::to_json(s.optimal_gain)}};
-  out["controller"] = {{"gain", k.gain}, {"hpf_Hz", k.w_hpf / kTwoPi}, {"lpf_Hz", k.w_lpf / kTwoPi}, {"robust_Hz", k.w_robust / kTwoPi},
-                       {"formula", "K(s) = gain g s/(s + w_hpf) 1/(s + w_lpf) 1/(s + w_robust) (eq. 2.4)"}};
-  if (!s.plant) {
-    out["note"] = s.note;
-    return out;
-  }
-  const ident::IffPlantFit& p = *s.plant;
-  out["plant"] = {{"g0", p.g0}, {"wz_Hz", p.wz / kTwoPi}, {"xz", p.xz}, {"wp_Hz", p.wp / kTwoPi}, {"xp", p.xp},
-                  {"w_hpf_Hz", p.w_hpf / kTwoPi}, {"delay_s", p.delay}, {"source", "IFF plant fit of unit " + std::to_string(*s.unit)}};
-  out["max_damping"] = io::to_json(s.max_damping);
-  out["optimal_pole"] = io::to_json(s.optimal_pole);
-  out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)| (plots), branch from the "
-                        "resonance pole; maximum damping on the adaptive root locus from g = 0 refined by golden section "
-                        "(lti::max_damping_on_branch, as `iff rlocus`; delay as a 6th-order Pade approximant)";
-  for (const auto& pole : s.damped_poles) out["damped_poles"].push_back(io::to_json(pole));
-  if (!s.damped_poles.empty()) {
-    json model = json::array();
-    for (const auto& pole : s.model_poles) model.push_back(io::to_json(pole));
-    out["model_poles"] = model;
-    out["relative_pole_distance"] = s.relative_pole_distance;
-    out["max_relative_pole_distance"] = s.max_relative_pole_distance;
-    out["pole_distance_tolerance"] = s.pole_distance_tolerance;
-    if (s.warning) out["warning"] = *s.warning;
+  json out = io::results_object(s);
+  out["controller"]["formula"] = "K(s) = gain g s/(s + w_hpf) 1/(s + w_lpf) 1/(s + w_robust) (eq. 2.4)";
+  if (s.plant && s.unit) out["plant"]["source"] = "IFF plant fit of unit " + std::to_string(*s.unit);
+  if (s.plant && !s.failed) {
+    out["locus_method"] = "closed-loop poles of 1 - g K G = 0 on 401 log-spaced gains around 1/|K G(j wp)| (plots), branch from the "
+                          "resonance pole; maximum damping on the adaptive root locus from g = 0 refined by golden section "
+                          "(lti::max_damping_on_branch, as `iff rlocus`; delay as a 6th-order Pade approximant)";
   }
   return out;
 }

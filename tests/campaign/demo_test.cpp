@@ -76,7 +76,7 @@ TEST(Demo, ResultsAgreeWithTheBenchTruth) {
   // up to the optimum and beyond: within 5 %, so no warning.
   ASSERT_EQ(iff["relative_pole_distance"].size(), 4u);
   for (const auto& d : iff["relative_pole_distance"]) EXPECT_LT(d.get<double>(), 0.05);
-  EXPECT_FALSE(iff.contains("warning"));
+  EXPECT_TRUE(iff["warning"].is_null());
   // k_oc > k_sc on every unit.
   for (const auto& u : results["units"]) {
     EXPECT_GT(u["stiffness_N_per_um"]["k_oc"].get<double>(), u["stiffness_N_per_um"]["k_sc"].get<double>());

@@ -679,6 +679,39 @@ struct IffStudy {
   Curve open_loop_poles, open_loop_zeros;  // x Re, y Im [rad/s]
 };
 
+constexpr auto describe(core::Type<IffStudy::Branch>) {
+  using S = IffStudy::Branch;
+  using namespace core::shown;
+  return core::fields<S>("IffLocusBranch", "one branch of the IFF root locus, for the plot",
+      core::field("re_im", &S::re_im, kNone, "x Re, y Im [rad/s]"),
+      core::field("gains", &S::gains, kNone, "the controller gain at each point"),
+      core::field("resonance_branch", &S::resonance_branch, kNone, "the branch from the resonance pole"));
+}
+
+constexpr auto describe(core::Type<IffStudy>) {
+  using S = IffStudy;
+  using namespace core::shown;
+  return core::fields<S>("IffStudy", "the IFF root locus of the fitted plant against the measured damped plants (report 2.6)",
+      core::field("controller", &S::controller, kNone, "the report's controller, eq. 2.4"),
+      core::field("unit", &S::unit, kNone, "the unit whose plant is used"),
+      core::field("plant", &S::plant, kNone, "that unit's IFF plant fit"),
+      core::field("gains", &S::gains, kNone, "of the damped plants with an identified pole"),
+      core::field("damped_poles", &S::damped_poles, kRadPerSecond, "identified on the damped plants").key("damped_poles"),
+      core::field("model_poles", &S::model_poles, kRadPerSecond, "the root locus at the same gains").key("model_poles"),
+      core::field("relative_pole_distance", &S::relative_pole_distance, kRatio, "|model - damped| / |damped| per gain"),
+      core::field("max_relative_pole_distance", &S::max_relative_pole_distance, kRatio, "the largest"),
+      core::field("pole_distance_tolerance", &S::pole_distance_tolerance, kRatio, "above it: warning"),
+      core::field("warning", &S::warning, kNone, "the model misses the damped poles"),
+      core::field("optimal_gain", &S::optimal_gain, kNone, "the gain of maximum damping of the resonance branch"),
+      core::field("max_damping", &S::max_damping, kRatio, "that damping"),
+      core::field("optimal_pole", &S::optimal_pole, kRadPerSecond, "the pole there").key("optimal_pole"),
+      core::field("note", &S::note, kNone, "why there is no study"),
+      core::field("failed", &S::failed, kNone, "a NumericalError of the study"),
+      core::field("branches", &S::branches, kNone, "the root locus for the plot (Figure 2.10b)").part_only(),
+      core::field("open_loop_poles", &S::open_loop_poles, kNone, "x Re, y Im [rad/s]").part_only(),
+      core::field("open_loop_zeros", &S::open_loop_zeros, kNone, "x Re, y Im [rad/s]").part_only());
+}
+
 // Report section 4: the super element on the bench, ga and gs tuned against one unit's measured
 // FRFs (superelement_fit.hpp).
 struct SuperElementUnitFit {

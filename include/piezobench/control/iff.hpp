@@ -13,6 +13,7 @@
 #include "piezobench/lti/rlocus.hpp"
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/plant/iff_plant.hpp"
 
@@ -33,6 +34,17 @@ struct IffControllerParams {
   void validate() const;
 };
 lti::Zpk iff_controller(const IffControllerParams& params = {});
+
+// results.json's keys are the campaign file's (iff_controller = { gain, hpf_Hz, lpf_Hz, robust_Hz }).
+constexpr auto describe(core::Type<IffControllerParams>) {
+  using S = IffControllerParams;
+  using namespace core::shown;
+  return core::fields<S>("IffControllerParams", "the report's IFF controller K(s) = g s/(s + w_hpf) 1/(s + w_lpf) 1/(s + w_robust) (eq. 2.4)",
+      core::field("gain", &S::gain, kNone, "g, 1/s^2 scaling"),
+      core::field("w_hpf", &S::w_hpf, kRadPerSecondAsHz, "high-pass that limits the low-frequency gain").key("hpf_Hz"),
+      core::field("w_lpf", &S::w_lpf, kRadPerSecondAsHz, "integral action above it").key("lpf_Hz"),
+      core::field("w_robust", &S::w_robust, kRadPerSecondAsHz, "roll-off for robustness to high-frequency modes").key("robust_Hz"));
+}
 
 struct IffLoopOptions {
   // Pade order used for a delay of the plant or controller (root loci need finite states).
