@@ -3,21 +3,25 @@
 #include <map>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/io/toml_reader.hpp"
 #include "piezobench/io/toml_table.hpp"
 
 namespace piezobench::apa {
 namespace {
 
 TwoDofParams from_table(const toml::table& table, const std::string& source) {
+  const io::TomlReader r(table, source);
   std::map<std::string, double> values;
   for (const auto& [key, node] : table) {
     const std::string name(key.str());
     // Unknown keys first, so that a misspelt key is reported as such whatever its value.
     TwoDofParams probe;
-    probe.set(name, 0.0, source);
-    const auto value = io::toml_number(node);
-    if (!value) throw InputError(source, name, "a number (SI units)", io::describe_toml(node));
-    values[name] = *value;
+    try {
+      probe.set(name, 0.0, source);
+    } catch (const InputError& e) {
+      throw e.with_source(r.where(&node));
+    }
+    values[name] = r.number_at(node, name);  // SI units
   }
   return two_dof_params_from_map(values, source);
 }

@@ -5,157 +5,106 @@
 #include <cmath>
 #include <fstream>
 #include <numbers>
-#include <set>
+#include <limits>
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "piezobench/io/toml_describe.hpp"
+#include "piezobench/io/toml_reader.hpp"
 #include "piezobench/io/toml_table.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 
 namespace piezobench::bench::detail {
 namespace {
 
-using io::describe_toml;
+using io::NumberBounds;
 
-class Keys {
- public:
-  Keys(const toml::table& t, std::string source) : t_(t), source_(std::move(source)) {}
+// fix = NODE or [NODE, ...]: at least one.
+std::vector<long> read_fix_nodes(const io::TomlReader& keys) {
+  const toml::node* n = keys.get("fix");
+  if (n == nullptr) keys.fail("fix", "a node number or an array of node numbers", "nothing (the key is required)");
+  constexpr std::int64_t lo = std::numeric_limits<long>::min(), hi = std::numeric_limits<long>::max();
+  if (n->is_integer()) return {static_cast<long>(*keys.integer("fix", lo, hi))};
+  if (!n->is_array()) keys.fail("fix", "a node number or an array of node numbers", io::describe_toml(*n));
+  std::vector<long> out;
+  for (const std::int64_t node : *keys.integers("fix", lo, hi)) out.push_back(static_cast<long>(node));
+  if (out.empty()) keys.fail("fix", "at least one node", "an empty array");
+  return out;
+}
 
-  const toml::node* find(const char* key) {
-    used_.insert(key);
-    return t_.get(key);
+// The element's files, resolved against the folder of the description, each checked to exist.
+void read_files(const io::TomlReader& keys, const std::filesystem::path& dir, fem::SuperElementSetup& setup) {
+  const auto resolve = [&](const std::string& p) -> std::filesystem::path {
+    if (p.empty()) return {};
+    const std::filesystem::path path(p);
+    return path.is_absolute() ? path : dir / path;
+  };
+  setup.k_file = resolve(keys.required_string("k_file"));
+  setup.m_file = resolve(keys.required_string("m_file"));
+  setup.nodes_file = resolve(keys.required_string("nodes_file"));
+  setup.coordinates_file = resolve(keys.string("coordinates_file").value_or(""));
+  setup.format = keys.string("format").value_or("auto");
+  for (const auto& [key, path] : {std::pair{"k_file", setup.k_file}, {"m_file", setup.m_file}, {"nodes_file", setup.nodes_file}}) {
+    if (!std::filesystem::is_regular_file(path)) keys.fail(key, "an existing file", "'" + path.string() + "'");
   }
-  const toml::node& required(const char* key) {
-    const toml::node* n = find(key);
-    if (n == nullptr) throw InputError(source_, key, "a value (required key)", "nothing");
-    return *n;
+  (void)setup.resolved_format();  // an unknown format name is refused here, naming the key
+  if (!setup.coordinates_file.empty() && !std::filesystem::is_regular_file(setup.coordinates_file)) {
+    keys.fail("coordinates_file", "an existing file", "'" + setup.coordinates_file.string() + "'");
   }
-  std::string string(const char* key, bool required, const std::string& fallback = "") {
-    const toml::node* n = required ? &this->required(key) : find(key);
-    if (n == nullptr) return fallback;
-    if (!n->is_string()) throw InputError(source_, key, "a string", describe_toml(*n));
-    return *n->value<std::string>();
-  }
-  double number(const char* key, double fallback) {
-    const toml::node* n = find(key);
-    if (n == nullptr) return fallback;
-    const auto number = io::toml_number(*n);
-    if (!number) throw InputError(source_, key, "a number", describe_toml(*n));
-    const double v = *number;
-    if (!std::isfinite(v)) throw InputError(source_, key, "a finite number", fmt::format("{}", v));
-    return v;
-  }
-  bool boolean(const char* key, bool fallback) {
-    const toml::node* n = find(key);
-    if (n == nullptr) return fallback;
-    if (!n->is_boolean()) throw InputError(source_, key, "true or false", describe_toml(*n));
-    return *n->value<bool>();
-  }
-  std::vector<long> nodes(const char* key) {
-    const toml::node& n = required(key);
-    std::vector<long> out;
-    if (n.is_integer()) {
-      out.push_back(static_cast<long>(*n.value<std::int64_t>()));
-    } else if (const toml::array* a = n.as_array()) {
-      for (std::size_t i = 0; i < a->size(); ++i) {
-        const toml::node& e = *a->get(i);
-        if (!e.is_integer()) throw InputError(source_, fmt::format("{}[{}]", key, i), "a node number", describe_toml(e));
-        out.push_back(static_cast<long>(*e.value<std::int64_t>()));
-      }
-    } else {
-      throw InputError(source_, key, "a node number or an array of node numbers", describe_toml(n));
+}
+
+// actuator, sensor and output in fem's syntax, checked to be a pair, a pair and one translation.
+void read_ports(const io::TomlReader& keys, fem::SuperElementSetup& setup) {
+  const auto sourced = [&](const char* key, auto parse) {
+    try {
+      return parse(keys.required_string(key), key);
+    } catch (const InputError& e) {
+      throw e.with_source(keys.where(keys.get(key)));
     }
-    if (out.empty()) throw InputError(source_, key, "at least one node", "an empty array");
-    return out;
-  }
-  void check_unknown() const {
-    for (const auto& [k, v] : t_) {
-      (void)v;
-      if (used_.count(std::string(k.str())) == 0) {
-        throw InputError(source_, std::string(k.str()),
-                         "one of k_file, m_file, nodes_file, coordinates_file, format, fix, actuator, sensor, output, ga, gs, "
-                         "modal_damping, max_mode_Hz, guided, stack_modulus_Pa",
-                         "an unknown key");
-      }
-    }
-  }
-
- private:
-  const toml::table& t_;
-  std::string source_;
-  std::set<std::string> used_;
-};
+  };
+  const fem::ForcePair act = sourced("actuator", [](const std::string& t, const char* k) { return fem::ForcePair::parse(t, k); });
+  if (act.node_a < 0) keys.fail("actuator", "a force pair A:B:DIR", "a single node");
+  const auto output = [](const std::string& t, const char* k) { return fem::DisplacementOutput::parse(t, k); };
+  const fem::DisplacementOutput sen = sourced("sensor", output);
+  if (sen.node_a < 0) keys.fail("sensor", "a node pair A:B:DIR", "a single node");
+  const fem::DisplacementOutput out = sourced("output", output);
+  if (out.node_a >= 0) keys.fail("output", "one node NODE:DIR (the moving interface)", "a node pair");
+  if (fem::is_rotation(out.direction)) keys.fail("output", "a translation (x, y or z)", "a rotation");
+  setup.model.forces = {act};
+  setup.model.outputs = {out, sen};
+  setup.force_fields = {"actuator"};
+  setup.output_fields = {"output", "sensor"};
+}
 
 }  // namespace
 
 SuperElementBench read_superelement_spec(const std::filesystem::path& file) {
   const std::string source = file.string();
   const toml::table table = io::read_toml_file(file);
-  Keys keys(table, source);
+  const io::TomlReader keys(table, source);
+  keys.only({"k_file", "m_file", "nodes_file", "coordinates_file", "format", "fix", "actuator", "sensor", "output", "ga", "gs",
+             "modal_damping", "max_mode_Hz", "guided", "stack_modulus_Pa"});
   SuperElementBench s;
   s.file = file;
   fem::SuperElementSetup& setup = s.setup;
   setup.source = source;
-  const std::filesystem::path dir = file.parent_path();
-  const auto resolve = [&](const std::string& p) -> std::filesystem::path {
-    if (p.empty()) return {};
-    const std::filesystem::path path(p);
-    return path.is_absolute() ? path : dir / path;
-  };
-  setup.k_file = resolve(keys.string("k_file", true));
-  setup.m_file = resolve(keys.string("m_file", true));
-  setup.nodes_file = resolve(keys.string("nodes_file", true));
-  setup.coordinates_file = resolve(keys.string("coordinates_file", false));
-  setup.format = keys.string("format", false, "auto");
-  for (const auto& [key, path] : {std::pair{"k_file", setup.k_file}, {"m_file", setup.m_file}, {"nodes_file", setup.nodes_file}}) {
-    if (!std::filesystem::is_regular_file(path)) throw InputError(source, key, "an existing file", "'" + path.string() + "'");
-  }
-  (void)setup.resolved_format();  // an unknown format name is refused here, naming the key
-  if (!setup.coordinates_file.empty() && !std::filesystem::is_regular_file(setup.coordinates_file)) {
-    throw InputError(source, "coordinates_file", "an existing file", "'" + setup.coordinates_file.string() + "'");
-  }
-  setup.model.fixed_nodes = keys.nodes("fix");
-  const auto sourced = [&](auto parse) {
-    try {
-      return parse();
-    } catch (const InputError& e) {
-      throw e.with_source(source);
-    }
-  };
-  const std::string actuator = keys.string("actuator", true);
-  const fem::ForcePair act = sourced([&] { return fem::ForcePair::parse(actuator, "actuator"); });
-  if (act.node_a < 0) throw InputError(source, "actuator", "a force pair A:B:DIR", "a single node");
-  const std::string sensor = keys.string("sensor", true);
-  const fem::DisplacementOutput sen = sourced([&] { return fem::DisplacementOutput::parse(sensor, "sensor"); });
-  if (sen.node_a < 0) throw InputError(source, "sensor", "a node pair A:B:DIR", "a single node");
-  const std::string output = keys.string("output", true);
-  const fem::DisplacementOutput out = sourced([&] { return fem::DisplacementOutput::parse(output, "output"); });
-  if (out.node_a >= 0) throw InputError(source, "output", "one node NODE:DIR (the moving interface)", "a node pair");
-  if (fem::is_rotation(out.direction)) throw InputError(source, "output", "a translation (x, y or z)", "a rotation");
-  setup.model.forces = {act};
-  setup.model.outputs = {out, sen};
-  setup.force_fields = {"actuator"};
-  setup.output_fields = {"output", "sensor"};
-  s.ga = keys.number("ga", s.ga);
-  s.gs = keys.number("gs", s.gs);
-  if (s.ga == 0.0) throw InputError(source, "ga", "a nonzero actuator sensitivity (N/V)", "0");
-  if (s.gs == 0.0) throw InputError(source, "gs", "a nonzero sensor sensitivity (V/m)", "0");
-  s.modal_damping = keys.number("modal_damping", s.modal_damping);
-  if (!(s.modal_damping > 0.0 && s.modal_damping < 1.0)) {
-    throw InputError(source, "modal_damping", "a damping ratio in (0, 1)", fmt::format("{:g}", s.modal_damping));
-  }
-  s.max_mode_Hz = keys.number("max_mode_Hz", s.max_mode_Hz);
-  if (!(s.max_mode_Hz > 0.0)) throw InputError(source, "max_mode_Hz", "a frequency > 0 Hz", fmt::format("{:g}", s.max_mode_Hz));
-  s.guided = keys.boolean("guided", s.guided);
+  read_files(keys, file.parent_path(), setup);
+  setup.model.fixed_nodes = read_fix_nodes(keys);
+  read_ports(keys, setup);
+  s.ga = keys.number("ga").value_or(s.ga);
+  s.gs = keys.number("gs").value_or(s.gs);
+  if (s.ga == 0.0) keys.fail("ga", "a nonzero actuator sensitivity (N/V)", "0");
+  if (s.gs == 0.0) keys.fail("gs", "a nonzero sensor sensitivity (V/m)", "0");
+  s.modal_damping = keys.number("modal_damping", NumberBounds::open(0.0, 1.0)).value_or(s.modal_damping);
+  s.max_mode_Hz = keys.number("max_mode_Hz", NumberBounds::positive()).value_or(s.max_mode_Hz);
+  s.guided = keys.boolean("guided").value_or(s.guided);
   // The stacks' effective modulus the element was built with: information for the campaign's eq. 4.1
   // (campaign_file.hpp's stack_modulus_Pa), ga and gs above already include it.
-  if (const double e = keys.number("stack_modulus_Pa", 48e9); !(e > 0.0 && e < 1e13)) {
-    throw InputError(source, "stack_modulus_Pa", "a modulus in (0, 1e13) Pa", fmt::format("{:g}", e));
-  }
-  keys.check_unknown();
+  (void)keys.number("stack_modulus_Pa", NumberBounds::open(0.0, 1e13));
   for (long n : setup.model.fixed_nodes) {
-    if (n == out.node_b) throw InputError(source, "fix", "nodes other than the output node", std::to_string(n));
+    if (n == setup.model.outputs[0].node_b) keys.fail("fix", "nodes other than the output node", std::to_string(n));
   }
   return s;
 }
@@ -186,13 +135,13 @@ ContinuousPlant superelement_plant(const SuperElementMechanics& mech, double mov
   const fem::Index f = model.size();
   if (!(modes.frequencies_Hz(0) > 0.0)) {
     throw InputError(source, "fix", "a structure held by its fixed nodes (every mode above 0 Hz)",
-                     fmt::format("a mode at {:.4g} Hz", modes.frequencies_Hz(0)));
+                     "a mode at " + format_number(modes.frequencies_Hz(0), 4) + " Hz");
   }
   fem::Index nk = 0;
   while (nk < f && modes.frequencies_Hz(nk) <= s.max_mode_Hz) ++nk;
   if (nk == 0) {
-    throw InputError(source, "max_mode_Hz", fmt::format("at least the first mode ({:.6g} Hz)", modes.frequencies_Hz(0)),
-                     fmt::format("{:g} Hz", s.max_mode_Hz));
+    throw InputError(source, "max_mode_Hz", "at least the first mode (" + format_number(modes.frequencies_Hz(0)) + " Hz)",
+                     format_number(s.max_mode_Hz) + " Hz");
   }
   const Eigen::MatrixXd phi = modes.shapes.leftCols(nk);
   const Eigen::VectorXd w = kTwoPi * modes.frequencies_Hz.head(nk);

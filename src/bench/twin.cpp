@@ -3,13 +3,13 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <set>
 #include <sstream>
 #include <toml++/toml.h>
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/atomic_file.hpp"
-#include "piezobench/io/toml_describe.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/io/toml_reader.hpp"
 #include "piezobench/io/toml_table.hpp"
 
 namespace piezobench::bench {
@@ -28,65 +28,40 @@ std::string quoted(const std::string& text) {
   return out.str();
 }
 
-// One table of the file: its keys checked against a list, numbers read with the key named.
-class Table {
- public:
-  Table(const toml::table& t, std::string source, std::string prefix) : t_(t), source_(std::move(source)), prefix_(std::move(prefix)) {}
-  void only(const std::set<std::string>& keys) const {
-    for (const auto& [k, v] : t_) {
-      if (keys.count(std::string(k.str())) == 0) {
-        throw InputError(source_, prefix_ + std::string(k.str()), "a key of the twin file (docs/twin.md)", "an unknown key");
-      }
-    }
-  }
-  [[nodiscard]] const toml::node* find(const std::string& key) const { return t_.get(key); }
-  [[nodiscard]] const toml::node& node(const std::string& key) const {
-    const toml::node* n = t_.get(key);
-    if (n == nullptr) throw InputError(source_, prefix_ + key, "a value", "nothing (missing)");
-    return *n;
-  }
-  [[nodiscard]] double number(const std::string& key) const { return number(prefix_ + key, node(key)); }
-  [[nodiscard]] std::vector<double> numbers(const std::string& key) const {
-    const toml::node& n = node(key);
-    const toml::array* a = n.as_array();
-    if (a == nullptr) throw InputError(source_, prefix_ + key, "an array of numbers", io::describe_toml(n));
-    std::vector<double> v;
-    for (std::size_t i = 0; i < a->size(); ++i) v.push_back(number(fmt::format("{}{}[{}]", prefix_, key, i), (*a)[i]));
-    return v;
-  }
-  [[nodiscard]] std::string text(const std::string& key) const {
-    const toml::node& n = node(key);
-    if (!n.is_string()) throw InputError(source_, prefix_ + key, "a string", io::describe_toml(n));
-    return *n.value<std::string>();
-  }
-  [[nodiscard]] Table table(const std::string& key) const {
-    const toml::node& n = node(key);
-    if (!n.is_table()) throw InputError(source_, prefix_ + key, "a table [" + key + "]", io::describe_toml(n));
-    return {*n.as_table(), source_, key + "."};
-  }
-  [[nodiscard]] const toml::table& raw() const { return t_; }
+// A number of the twin file. -0.0 is read as 0: written back it would be "-0", a TOML integer, which
+// reads as 0, so a twin read and written would not read the same
+// (fuzz/regression/twin_toml/valid_negative_zero.toml).
+double twin_number(const io::TomlReader& t, const char* key) {
+  const double v = t.required_number(key);
+  return v == 0.0 ? 0.0 : v;
+}
 
- private:
-  [[nodiscard]] double number(const std::string& key, const toml::node& n) const {
-    const std::optional<double> value = io::toml_number(n);
-    if (!value) throw InputError(source_, key, "a number", io::describe_toml(n));
-    if (!std::isfinite(*value)) throw InputError(source_, key, "a finite number", fmt::format("{}", *value));
-    // -0.0 is read as 0: written back it would be "-0", a TOML integer, which reads as 0, so a twin
-    // read and written would not read the same (fuzz/regression/twin_toml/valid_negative_zero.toml).
-    return *value == 0.0 ? 0.0 : *value;
-  }
-  const toml::table& t_;
-  std::string source_, prefix_;
-};
+std::vector<double> twin_numbers(const io::TomlReader& t, const char* key) {
+  std::vector<double> v = t.required_numbers(key);
+  for (double& x : v) x = x == 0.0 ? 0.0 : x;
+  return v;
+}
 
-void read_spectrum(const Table& noise, const std::string& key, const std::vector<double>& freq, NoiseSpectrum& out,
-                   const std::string& source) {
-  if (noise.find(key) == nullptr) return;
+void read_spectrum(const io::TomlReader& noise, const char* key, const std::vector<double>& freq, NoiseSpectrum& out) {
+  if (!noise.has(key)) return;
   out.freq_Hz = freq;
-  out.psd = noise.numbers(key);
-  if (out.psd.size() != freq.size()) {
-    throw InputError(source, "noise." + key, fmt::format("{} values (as noise.freq_Hz)", freq.size()), fmt::format("{}", out.psd.size()));
-  }
+  out.psd = twin_numbers(noise, key);
+  if (out.psd.size() != freq.size()) noise.fail(key, fmt::format("{} values (as noise.freq_Hz)", freq.size()), std::to_string(out.psd.size()));
+}
+
+void read_chain(const io::TomlReader& chain, Twin& t) {
+  chain.only({"amplifier_gain_V_per_V", "suspended_mass_kg", "delay_s", "hpf_resistance_ohm", "ground_resistance_ohm", "adc_bandwidth_Hz",
+              "sample_rate_Hz", "capacitance_sensor_F", "capacitance_actuator_F"});
+  t.options.amplifier_gain = twin_number(chain, "amplifier_gain_V_per_V");
+  t.options.suspended_mass = twin_number(chain, "suspended_mass_kg");
+  t.unit.model.m = t.options.suspended_mass;
+  t.options.delay = twin_number(chain, "delay_s");
+  t.options.hpf_resistance = twin_number(chain, "hpf_resistance_ohm");
+  t.options.ground_resistance = twin_number(chain, "ground_resistance_ohm");
+  t.options.adc_bandwidth_Hz = twin_number(chain, "adc_bandwidth_Hz");
+  t.options.sample_rate = twin_number(chain, "sample_rate_Hz");
+  t.unit.capacitance_sensor = twin_number(chain, "capacitance_sensor_F");
+  t.unit.capacitance_actuator = twin_number(chain, "capacitance_actuator_F");
 }
 
 }  // namespace
@@ -153,58 +128,42 @@ void write_twin(const std::filesystem::path& path, const Twin& twin) { io::write
 
 Twin parse_twin(const std::string& text, const std::string& source) {
   const toml::table root = io::parse_toml(text, source);
-  const Table top(root, source, "");
+  const io::TomlReader top(root, source);
   top.only({"format", "name", "unit", "model", "chain", "hysteresis", "creep", "noise", "sources"});
-  const toml::node& format = top.node("format");
-  if (format.value<std::string>() != std::string(kTwinFormat)) {
-    throw InputError(source, "format", std::string("\"") + kTwinFormat + "\"", io::describe_toml(format));
-  }
+  const std::string format_words = std::string("\"") + kTwinFormat + "\"";
+  if (const std::string format = top.required_string("format", format_words); format != kTwinFormat) top.fail("format", format_words, "'" + format + "'");
   Twin t;
-  t.name = top.text("name");
-  const double id = top.number("unit");
-  if (!(id == std::floor(id) && id >= 0.0 && id < 1e9)) throw InputError(source, "unit", "a unit id (integer >= 0)", fmt::format("{}", id));
+  t.name = top.required_string("name");
+  const double id = twin_number(top, "unit");
+  if (!(id == std::floor(id) && id >= 0.0 && id < 1e9)) top.fail("unit", "a unit id (integer >= 0)", format_number_exact(id));
   t.unit.id = static_cast<int>(id);
 
-  const Table model = top.table("model");
+  const io::TomlReader model = top.required_table("model");
   model.only({"k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs"});
-  for (const char* k : {"k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs"}) t.unit.model.set(k, model.number(k), source);
+  for (const char* k : {"k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs"}) t.unit.model.set(k, twin_number(model, k), source);
+  read_chain(top.required_table("chain"), t);
 
-  const Table chain = top.table("chain");
-  chain.only({"amplifier_gain_V_per_V", "suspended_mass_kg", "delay_s", "hpf_resistance_ohm", "ground_resistance_ohm", "adc_bandwidth_Hz",
-              "sample_rate_Hz", "capacitance_sensor_F", "capacitance_actuator_F"});
-  t.options.amplifier_gain = chain.number("amplifier_gain_V_per_V");
-  t.options.suspended_mass = chain.number("suspended_mass_kg");
-  t.unit.model.m = t.options.suspended_mass;
-  t.options.delay = chain.number("delay_s");
-  t.options.hpf_resistance = chain.number("hpf_resistance_ohm");
-  t.options.ground_resistance = chain.number("ground_resistance_ohm");
-  t.options.adc_bandwidth_Hz = chain.number("adc_bandwidth_Hz");
-  t.options.sample_rate = chain.number("sample_rate_Hz");
-  t.unit.capacitance_sensor = chain.number("capacitance_sensor_F");
-  t.unit.capacitance_actuator = chain.number("capacitance_actuator_F");
-
-  const Table hysteresis = top.table("hysteresis");
+  const io::TomlReader hysteresis = top.required_table("hysteresis");
   hysteresis.only({"thresholds_V", "weights"});
-  t.unit.hysteresis_thresholds = hysteresis.numbers("thresholds_V");
-  t.unit.hysteresis_weights = hysteresis.numbers("weights");
+  t.unit.hysteresis_thresholds = twin_numbers(hysteresis, "thresholds_V");
+  t.unit.hysteresis_weights = twin_numbers(hysteresis, "weights");
 
-  const Table creep = top.table("creep");
+  const io::TomlReader creep = top.required_table("creep");
   creep.only({"voltage_per_decade", "load_per_decade"});
-  t.unit.creep_coefficient = creep.number("voltage_per_decade");
-  t.unit.load_creep_coefficient = creep.number("load_per_decade");
+  t.unit.creep_coefficient = twin_number(creep, "voltage_per_decade");
+  t.unit.load_creep_coefficient = twin_number(creep, "load_per_decade");
 
-  const Table noise = top.table("noise");
+  const io::TomlReader noise = top.required_table("noise");
   noise.only({"de_m_rms", "Vs_V_rms", "freq_Hz", "de_psd_m2_per_Hz", "Vs_psd_V2_per_Hz"});
-  t.options.encoder_noise = noise.number("de_m_rms");
-  t.options.vs_noise = noise.number("Vs_V_rms");
-  if (noise.find("freq_Hz") != nullptr) {
-    const std::vector<double> f = noise.numbers("freq_Hz");
-    read_spectrum(noise, "de_psd_m2_per_Hz", f, t.de_noise, source);
-    read_spectrum(noise, "Vs_psd_V2_per_Hz", f, t.vs_noise, source);
+  t.options.encoder_noise = twin_number(noise, "de_m_rms");
+  t.options.vs_noise = twin_number(noise, "Vs_V_rms");
+  if (noise.has("freq_Hz")) {
+    const std::vector<double> f = twin_numbers(noise, "freq_Hz");
+    read_spectrum(noise, "de_psd_m2_per_Hz", f, t.de_noise);
+    read_spectrum(noise, "Vs_psd_V2_per_Hz", f, t.vs_noise);
   }
-  if (top.find("sources") != nullptr) {
-    const Table sources = top.table("sources");
-    for (const auto& [k, v] : sources.raw()) t.sources.emplace_back(std::string(k.str()), sources.text(std::string(k.str())));
+  if (const auto sources = top.table("sources")) {
+    for (const auto& [k, v] : sources->table()) t.sources.emplace_back(std::string(k.str()), sources->required_string(k.str()));
   }
   t.validate(source);
   return t;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace piezobench {
 
@@ -12,6 +13,15 @@ std::string format_number(double value, int significant_digits) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.*g", digits, value);
   return buf;
+}
+
+std::string format_number_exact(double value) {
+  if (!std::isfinite(value)) return format_number(value);
+  for (int digits = 1; digits < 17; ++digits) {
+    std::string text = format_number(value, digits);
+    if (std::strtod(text.c_str(), nullptr) == value) return text;
+  }
+  return format_number(value, 17);
 }
 
 }  // namespace piezobench

@@ -3,20 +3,21 @@
 #include <fmt/format.h>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/io/toml_table.hpp"
-#include "toml_reader.hpp"
+#include "piezobench/io/toml_reader.hpp"
 
 namespace piezobench::station {
 
 namespace fs = std::filesystem;
-using detail::TableReader;
+using io::TomlReader;
 
 namespace {
 
-PhaseAnswers read_phase_answers(const TableReader& r, const PhaseSpec& phase, const fs::path& folder) {
+PhaseAnswers read_phase_answers(const TomlReader& r, const PhaseSpec& phase, const fs::path& folder) {
   r.only({"steps", "on_check_fail", "sensor_uF", "actuator_uF", "file"});
   PhaseAnswers a;
-  const std::vector<std::string> steps = r.texts("steps");
+  const std::vector<std::string> steps = r.strings("steps");
   for (std::size_t i = 0; i < steps.size(); ++i) {
     if (steps[i] == "confirm") {
       a.steps.push_back(StepAnswer::kConfirm);
@@ -31,7 +32,7 @@ PhaseAnswers read_phase_answers(const TableReader& r, const PhaseSpec& phase, co
                                 phase.name, phase.line),
            fmt::format("{} answers", a.steps.size()));
   }
-  const std::vector<std::string> checks = r.texts("on_check_fail");
+  const std::vector<std::string> checks = r.strings("on_check_fail");
   for (std::size_t i = 0; i < checks.size(); ++i) {
     if (checks[i] == "retry") {
       a.on_check_fail.push_back(CheckAnswer::kRetry);
@@ -49,9 +50,9 @@ PhaseAnswers read_phase_answers(const TableReader& r, const PhaseSpec& phase, co
   if ((a.sensor_uF || a.actuator_uF) && !typed) r.fail("sensor_uF", "no typed values (phase '" + phase.name + "' is not source = \"typed\")", "a value");
   for (const auto& [key, v] : {std::pair{"sensor_uF", a.sensor_uF}, std::pair{"actuator_uF", a.actuator_uF}}) {
     if (typed && !v) r.fail(key, "the capacitance typed in for phase '" + phase.name + "', uF", "nothing");
-    if (v && !(*v > 0.0)) r.fail(key, "a capacitance > 0 uF", fmt::format("{:g}", *v));
+    if (v && !(*v > 0.0)) r.fail(key, "a capacitance > 0 uF", format_number_exact(*v));
   }
-  if (const auto f = r.text("file")) {
+  if (const auto f = r.string("file")) {
     if (phase.source != ValueSource::kFile) r.fail("file", "no file (phase '" + phase.name + "' is not source = \"file\")", "'" + *f + "'");
     const fs::path p(*f);
     a.file = p.is_absolute() ? p : folder / p;
@@ -69,13 +70,13 @@ bool needs_answers(const PhaseSpec& p) { return !p.steps.empty() || p.source != 
 
 Answers parse_answers(const std::string& text, const fs::path& file, const StationFile& station) {
   const toml::table root = io::parse_toml(text, file.string());
-  const TableReader r(root, file.string(), "");
+  const TomlReader r(root, file.string(), "");
   r.only({"operator", "phases"});
   Answers a;
   a.file = file;
-  a.operator_name = r.text("operator").value_or("");
+  a.operator_name = r.string("operator").value_or("");
   const fs::path folder = file.parent_path();
-  if (const auto phases = r.sub("phases")) {
+  if (const auto phases = r.table("phases")) {
     for (const auto& [k, node] : phases->table()) {
       const std::string name(k.str());
       const PhaseSpec* p = station.phase(name);
@@ -84,7 +85,7 @@ Answers parse_answers(const std::string& text, const fs::path& file, const Stati
         for (const PhaseSpec& s : station.phases) names += (names.empty() ? "" : ", ") + s.name;
         phases->fail(name, "a phase of " + station.file.string() + " (" + names + ")", "'" + name + "'", &node);
       }
-      const auto sub = phases->sub(name);
+      const auto sub = phases->table(name);
       a.phases[name] = read_phase_answers(*sub, *p, folder);
     }
   }

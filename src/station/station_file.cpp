@@ -8,13 +8,14 @@
 
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/io/toml_table.hpp"
-#include "toml_reader.hpp"
+#include "piezobench/io/toml_reader.hpp"
 
 namespace piezobench::station {
 
 namespace fs = std::filesystem;
-using detail::TableReader;
+using io::TomlReader;
 
 const PhaseSpec* StationFile::phase(const std::string& phase_name) const {
   const auto it = std::find_if(phases.begin(), phases.end(), [&](const PhaseSpec& p) { return p.name == phase_name; });
@@ -44,10 +45,10 @@ bool valid_name(const std::string& s) {
          std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'; });
 }
 
-MeasurementSpec read_measurement(const TableReader& r, const PhaseSpec& p) {
+MeasurementSpec read_measurement(const TomlReader& r, const PhaseSpec& p) {
   r.only({"name", "min", "max", "stop_on_fail"});
   MeasurementSpec m;
-  m.name = r.required_text("name");
+  m.name = r.required_string("name");
   m.line = static_cast<int>(r.table().source().begin.line);
   const MeasurementKind* kind = find_measurement(m.name);
   if (kind == nullptr || kind->experiment != p.record) {
@@ -60,18 +61,18 @@ MeasurementSpec read_measurement(const TableReader& r, const PhaseSpec& p) {
   m.limit.min = r.number("min");
   m.limit.max = r.number("max");
   if (m.limit.min && m.limit.max && *m.limit.min > *m.limit.max) {
-    r.fail("max", fmt::format("a maximum >= the minimum {:g}", *m.limit.min), fmt::format("{:g}", *m.limit.max));
+    r.fail("max", "a maximum >= the minimum " + format_number_exact(*m.limit.min), format_number_exact(*m.limit.max));
   }
-  m.stop_on_fail = r.flag("stop_on_fail").value_or(false);
+  m.stop_on_fail = r.boolean("stop_on_fail").value_or(false);
   return m;
 }
 
-void read_settings(const TableReader& r, PhaseSpec& p) {
+void read_settings(const TomlReader& r, PhaseSpec& p) {
   p.amplitude_V = r.number("amplitude_V");
   p.duration_s = r.number("duration_s");
   p.gain = r.number("gain");
-  p.open_circuit = r.flag("open_circuit").value_or(false);
-  p.no_resistor = r.flag("no_resistor").value_or(false);
+  p.open_circuit = r.boolean("open_circuit").value_or(false);
+  p.no_resistor = r.boolean("no_resistor").value_or(false);
   if (p.open_circuit && p.experiment != "stiffness") r.fail("open_circuit", "only in a stiffness phase", "experiment " + p.experiment);
   if (p.no_resistor && p.experiment != "frf-noise") r.fail("no_resistor", "only in a frf-noise phase", "experiment " + p.experiment);
   if (p.experiment == "iff" && !p.gain) r.fail("gain", "the IFF gain g of the phase (the campaign needs it)", "nothing");
@@ -88,7 +89,7 @@ void read_settings(const TableReader& r, PhaseSpec& p) {
   } else if (p.amplitude_V || p.duration_s || p.gain) {
     r.fail("amplitude_V", "no amplitude, duration or gain for " + p.experiment, "one of them");
   }
-  const auto source = r.text("source");
+  const auto source = r.string("source");
   if (source) {
     if (p.experiment != "flatness" && p.experiment != "capacitance") r.fail("source", "only in flatness and capacitance phases", *source);
     if (*source == "bench") {
@@ -101,43 +102,41 @@ void read_settings(const TableReader& r, PhaseSpec& p) {
       r.fail("source", p.experiment == "capacitance" ? "bench, file or typed" : "bench or file", "'" + *source + "'");
     }
   }
-  p.retries = r.integer("retries", 0).value_or(2);
   // Each try is a whole experiment the operator sits through, kept in the record: a bound an
   // operator could reach, not a counter that never ends.
   constexpr long kMaxRetries = 20;
-  if (p.retries > kMaxRetries) r.fail("retries", fmt::format("at most {} tries after the first", kMaxRetries), fmt::format("{}", p.retries));
-  p.min_coherence = r.number("min_coherence").value_or(0.0);
-  if (p.min_coherence < 0.0 || p.min_coherence > 1.0) r.fail("min_coherence", "a coherence in [0, 1]", fmt::format("{:g}", p.min_coherence));
+  p.retries = static_cast<long>(r.integer("retries", 0, kMaxRetries).value_or(2));
+  p.min_coherence = r.number("min_coherence", io::NumberBounds::closed(0.0, 1.0)).value_or(0.0);
   if (p.min_coherence > 0.0 && p.record != campaign::Experiment::kFrf) r.fail("min_coherence", "only in a frf-noise phase with the resistor", p.experiment);
-  p.max_clamped_samples = r.integer("max_clamped_samples", 0).value_or(0);
+  p.max_clamped_samples = static_cast<long>(r.integer("max_clamped_samples", 0).value_or(0));
 }
 
-PhaseSpec read_phase(const TableReader& r) {
+PhaseSpec read_phase(const TomlReader& r) {
   r.only({"name", "experiment", "amplitude_V", "duration_s", "gain", "open_circuit", "no_resistor", "source", "steps", "retries",
           "min_coherence", "max_clamped_samples", "measurements"});
   PhaseSpec p;
   p.line = static_cast<int>(r.table().source().begin.line);
-  p.name = r.required_text("name");
+  p.name = r.required_string("name");
   if (!valid_name(p.name)) r.fail("name", "a name of letters, digits, '-' and '_' (at most 64)", "'" + p.name + "'");
-  p.experiment = r.required_text("experiment");
+  p.experiment = r.required_string("experiment");
   if (std::find(kExperiments.begin(), kExperiments.end(), p.experiment) == kExperiments.end()) {
     r.fail("experiment", "one of flatness, capacitance, stroke, hysteresis, stiffness, frf-noise, iff, hammer, tracking",
            "'" + p.experiment + "'");
   }
-  p.open_circuit = r.flag("open_circuit").value_or(false);
-  p.no_resistor = r.flag("no_resistor").value_or(false);
+  p.open_circuit = r.boolean("open_circuit").value_or(false);
+  p.no_resistor = r.boolean("no_resistor").value_or(false);
   p.record = record_of(p);
   read_settings(r, p);
-  p.steps = r.texts("steps");
-  for (const TableReader& m : r.tables("measurements")) p.measurements.push_back(read_measurement(m, p));
+  p.steps = r.strings("steps");
+  for (const TomlReader& m : r.tables("measurements")) p.measurements.push_back(read_measurement(m, p));
   return p;
 }
 
-std::string campaign_tables(const TableReader& r) {
+std::string campaign_tables(const TomlReader& r) {
   r.only({"bench", "analysis"});
   toml::table out;
   for (const char* k : {"bench", "analysis"}) {
-    if (const auto sub = r.sub(k)) out.insert(k, sub->table());
+    if (const auto sub = r.table(k)) out.insert(k, sub->table());
   }
   std::ostringstream s;
   s << toml::toml_formatter(out) << "\n";
@@ -183,18 +182,15 @@ std::string StationFile::campaign_specs() const {
 
 StationFile parse_station_file(const std::string& text, const fs::path& file) {
   const toml::table root = io::parse_toml(text, file.string());
-  const TableReader r(root, file.string(), "");
+  const TomlReader r(root, file.string(), "");
   r.only({"name", "margin_relative", "campaign", "phases"});
   StationFile st;
   st.file = file;
-  st.name = r.required_text("name");
-  st.margin_relative = r.number("margin_relative").value_or(0.01);
-  if (!(st.margin_relative >= 0.0 && st.margin_relative < 0.5)) {
-    r.fail("margin_relative", "a relative margin in [0, 0.5)", fmt::format("{:g}", st.margin_relative));
-  }
-  if (const auto c = r.sub("campaign")) st.campaign_tables = campaign_tables(*c);
+  st.name = r.required_string("name");
+  st.margin_relative = r.number("margin_relative", io::NumberBounds::half_open(0.0, 0.5)).value_or(0.01);
+  if (const auto c = r.table("campaign")) st.campaign_tables = campaign_tables(*c);
   std::map<campaign::Experiment, std::string> single;
-  for (const TableReader& pr : r.tables("phases")) {
+  for (const TomlReader& pr : r.tables("phases")) {
     PhaseSpec p = read_phase(pr);
     if (st.phase(p.name) != nullptr) pr.fail("name", "a phase name not used before", "'" + p.name + "' twice");
     if (p.record != campaign::Experiment::kHysteresis && p.record != campaign::Experiment::kIff) {

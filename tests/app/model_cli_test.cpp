@@ -100,8 +100,8 @@ TEST(ModelCli, BadParamsExitWithThreeAndNameTheKey) {
     const char* text;
     const char* needle;
   } cases[] = {
-      {"m = 5.7\nkk = 1.0\n", "kk"},
-      {"k1 = \"stiff\"\n", "k1"},
+      {"m = 5.7\nkk = 1.0\n", "line 2: kk"},
+      {"k1 = \"stiff\"\n", "line 1: k1"},
       {"m = -1.0\n", "m"},
       {"m = [1.0\n", "line"},
   };

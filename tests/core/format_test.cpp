@@ -33,5 +33,16 @@ TEST(FormatNumber, NonFiniteAndClampedDigits) {
   EXPECT_EQ(format_number(0.1, 40), format_number(0.1, 17));
 }
 
+TEST(FormatNumberExact, FewestDigitsThatReadBack) {
+  EXPECT_EQ(format_number_exact(1e-12), "1e-12");  // std::to_string gave "0.000000"
+  EXPECT_EQ(format_number_exact(0.1), "0.1");
+  EXPECT_EQ(format_number_exact(1.0000001), "1.0000001");
+  EXPECT_EQ(format_number_exact(-2.5), "-2.5");
+  EXPECT_EQ(format_number_exact(1e13), "1e+13");
+  EXPECT_EQ(format_number_exact(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(format_number_exact(std::numeric_limits<double>::infinity()), "inf");
+  EXPECT_EQ(format_number_exact(std::numeric_limits<double>::quiet_NaN()), "nan");
+}
+
 }  // namespace
 }  // namespace piezobench

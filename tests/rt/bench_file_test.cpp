@@ -118,7 +118,7 @@ TEST(BenchFile, LimitsArePlausibleForTheNamedActuator) {
 
 TEST(BenchFile, IntegersAndDurationsAreRangeCheckedBeforeConversion) {
   std::string e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nstale_cycles = 9223372036854775807\n"));
-  EXPECT_TRUE(test::contains(e, "bench.toml: limits.stale_cycles: expected an integer in 0 .. 1000, found 9223372036854775807")) << e;
+  EXPECT_TRUE(test::contains(e, "bench.toml: line 14: limits.stale_cycles: expected an integer in 0 .. 1000, found 9223372036854775807")) << e;
   e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nwatchdog_s = 1e300\n"));
   EXPECT_TRUE(test::contains(e, "limits.watchdog_s: expected a duration in [1e-06, 60] s")) << e;
   e = error_of(test::replace_once(kComedi, "[limits]\n", "[limits]\nstale_cycles = 3.5e20\n"));

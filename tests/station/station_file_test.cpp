@@ -49,7 +49,7 @@ TEST(StationFile, ProblemsNameTheLine) {
   expect_input_error([&] { parse_station_file(base + "[[phases]]\nname = \"s2\"\nexperiment = \"stroke\"\nduration_s = 3\n", f); },
                      {"phases[3].settings", "duration"});
   expect_input_error([&] { parse_station_file(base + "[[phases]]\nname = \"h\"\nexperiment = \"hysteresis\"\namplitude_V = 3\nretries = 9223372036854775807\n", f); },
-                     {"phases[3].retries", "at most 20 tries after the first", "9223372036854775807"});
+                     {"line 40", "phases[3].retries", "an integer in 0 .. 20", "9223372036854775807"});
   expect_input_error([&] { parse_station_file("name = \"x\"\n[campaign.bench]\namplifier_gane = 3\n[[phases]]\nname = \"a\"\nexperiment = \"stroke\"\n", f); },
                      {"st.toml: campaign", "amplifier_gane"});
 }

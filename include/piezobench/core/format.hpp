@@ -1,5 +1,6 @@
 #pragma once
 // Numbers in messages (errors, warnings, progress): the one formatter of the project.
+// Units: the caller's (a number is printed as given; the message names its unit).
 #include <string>
 
 namespace piezobench {
@@ -8,5 +9,10 @@ namespace piezobench {
 // 10 tells neighbouring values apart (sample times, delays); 17 round-trips a double. "nan", "inf"
 // and "-inf" for the non-finite values. significant_digits is clamped to [1, 17].
 std::string format_number(double value, int significant_digits = 6);
+
+// The fewest significant digits (%g style) that read back as exactly `value`: what a user wrote in
+// a file, shown back in an error ("1e-12", "0.1", "1.0000001", where format_number(v) gives "1"
+// for the last). "nan", "inf", "-inf" for the non-finite values.
+std::string format_number_exact(double value);
 
 }  // namespace piezobench
