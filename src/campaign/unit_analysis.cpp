@@ -17,6 +17,7 @@
 #include "piezobench/core/timestamp.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/welch.hpp"
+#include "piezobench/ident/actuator_frf.hpp"
 #include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/ident/modal.hpp"
@@ -228,27 +229,12 @@ struct Band {
 };
 
 Band band(const dsp::Frf& frf, Index output, double fmin, double fmax, double min_coherence = 0.0) {
-  dsp::BandSelection selection;
-  selection.fmin_Hz = fmin;
-  selection.fmax_Hz = fmax;
-  selection.exclude_dc = true;
-  selection.min_coherence = min_coherence;
-  selection.outputs = {output};
-  dsp::Frf part = dsp::select_band(frf, selection);
+  dsp::Frf part = dsp::select_band(frf, dsp::BandSelection{fmin, fmax, /*exclude_dc=*/true, min_coherence, {output}});
   Band b;
   b.omega = kTwoPi * part.freq_Hz;
   b.h = std::move(part.H[0]);
   b.coherence = part.coherence.empty() ? VectorXd::Ones(b.omega.size()) : std::move(part.coherence[0]);
   return b;
-}
-
-// Index of the largest |h| (min_w < omega), -1 if none.
-Index peak_index(const Band& b, double min_w) {
-  Index peak = -1;
-  for (Index k = 0; k < b.omega.size(); ++k) {
-    if (b.omega(k) > min_w && (peak < 0 || std::abs(b.h(k)) > std::abs(b.h(peak)))) peak = k;
-  }
-  return peak;
 }
 
 void record_failure(UnitAnalysis& u, const std::string& what, const Error& e) {
@@ -443,272 +429,58 @@ StiffnessAnalysis stiffness(const Campaign& c, const Record& r, UnitAnalysis& u,
   return out;
 }
 
-// Chooses the feature nearest in frequency to `target` (rad/s).
-template <typename T>
-const T* nearest(const std::vector<T>& features, double target) {
-  const T* best = nullptr;
-  for (const T& f : features) {
-    if (!best || std::abs(std::log(f.natural_frequency / target)) < std::abs(std::log(best->natural_frequency / target))) best = &f;
-  }
-  return best;
-}
-
-// The unit's corner: 1/(2 pi R C_sensor) when the bench has a resistor and C_sensor is measured;
-// else the IFF plant fit's, else the first-order fit's, each only when observable in the record (at
-// least a third of its lowest line, as LowFrequencyVs): a bench without the resistor has no
-// high-pass the record can show, and a default resistance must not invent one.
-void choose_high_pass_corner(const Campaign& c, double lowest_line_Hz, double w_rc, HighPassCorner& hpf) {
-  hpf.observable_above_Hz = lowest_line_Hz / 3.0;
-  const std::string bench = c.bench.hpf_resistance ? fmt::format("R = {:g} Ohm from [bench]", *c.bench.hpf_resistance)
-                                                   : "no resistor in [bench] (hpf_resistance_ohm)";
-  if (w_rc > 0.0) {
-    hpf.corner_Hz = w_rc / kTwoPi;
-    hpf.method = "1/(2 pi R C_sensor), " + bench + ", C_sensor measured";
-    return;
-  }
-  for (const auto& [fit, name] : {std::pair{hpf.iff_plant_fit_Hz, "IFF plant fit (eq. 2.3) down to the lowest frequency"},
-                                  std::pair{hpf.first_order_fit_Hz, "first-order fit below hpf_fmax_Hz"}}) {
-    if (!fit) continue;
-    if (*fit >= hpf.observable_above_Hz) {
-      hpf.corner_Hz = fit;
-      hpf.method = std::string(name) + "; " + bench;
-    } else {
-      hpf.method = fmt::format("{}; the fitted corner {:.3g} Hz is below a third of the lowest line ({:.3g} Hz): not observable, "
-                               "no corner reported",
-                               bench, *fit, hpf.observable_above_Hz);
-    }
-    return;
-  }
-  hpf.method = bench + "; no fit of the corner";
-}
-
-// The cross-checks of the corner that disagree by more than kHighPassCrossCheckRatio: 1/(2 pi R C)
-// against each fit, and the two fits against each other when both are observable.
-std::vector<std::string> high_pass_warnings(const HighPassCorner& hpf) {
-  std::vector<std::string> out;
-  const auto apart = [](double a, double b) { return std::max(a, b) / std::min(a, b) > kHighPassCrossCheckRatio; };
-  const std::string limit = fmt::format("more than a factor {:g} apart", kHighPassCrossCheckRatio);
-  if (hpf.r_c_Hz) {
-    for (const auto& [fit, name] : {std::pair{hpf.iff_plant_fit_Hz, "the IFF plant fit"}, std::pair{hpf.first_order_fit_Hz, "the first-order fit"}}) {
-      if (fit && *fit > 0.0 && apart(*hpf.r_c_Hz, *fit)) {
-        out.push_back(fmt::format("high-pass corner: 1/(2 pi R C_sensor) = {:.3g} Hz but {} of u -> Vs gives {:.3g} Hz ({}): is the "
-                                  "resistor of [bench] hpf_resistance_ohm on the bench, and is C_sensor right? The report uses {:.3g} Hz",
-                                  *hpf.r_c_Hz, name, *fit, limit, *hpf.r_c_Hz));
-      }
-    }
-  } else if (hpf.iff_plant_fit_Hz && hpf.first_order_fit_Hz && *hpf.iff_plant_fit_Hz >= hpf.observable_above_Hz &&
-             *hpf.first_order_fit_Hz >= hpf.observable_above_Hz && apart(*hpf.iff_plant_fit_Hz, *hpf.first_order_fit_Hz)) {
-    out.push_back(fmt::format("high-pass corner: the IFF plant fit gives {:.3g} Hz, the first-order fit {:.3g} Hz ({}); the report uses "
-                              "the IFF plant fit's",
-                              *hpf.iff_plant_fit_Hz, *hpf.first_order_fit_Hz, limit));
-  }
-  return out;
-}
-
-// A feature read two ways (the reported value and its cross-check) that differ by more than
-// `tolerance` (relative): a warning naming both.
-void cross_check(UnitAnalysis& u, const std::string& what, const std::string& unit, const std::optional<double>& reported,
-                 const std::string& reported_from, const std::optional<double>& check, const std::string& check_from, double tolerance) {
-  if (!reported || !check || *reported == 0.0) return;
-  const double d = std::abs(*check / *reported - 1.0);
-  if (d <= tolerance) return;
-  u.warnings.push_back(fmt::format("{}: {} {:.4g} {} but {} {:.4g} {} ({:.0f} % apart, more than {:.0f} %); the report uses the {}", what,
-                                   reported_from, *reported, unit, check_from, *check, unit, 100.0 * d, 100.0 * tolerance, reported_from));
-}
-
-void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
-  const AnalysisSettings& a = c.analysis;
-  const long nfft = frf_segment_length(a, static_cast<long>(r.ts.samples()), r.ts.sample_rate);
-  const dsp::Frf frf = welch(r, "u", {"de", "Vs"}, a, nfft);
-  u.frf = frf;
-  FrfAnalysis out;
-  out.provenance = provenance(r, {"u", "de", "Vs"});
-  out.provenance.input = "u";
-  out.provenance.outputs = {"de", "Vs"};
-  out.welch = frf.provenance;
-  const Band de = band(frf, 0, a.fmin_Hz, a.fmax_Hz);
-  const Band vs = band(frf, 1, a.fmin_Hz, a.fmax_Hz);
-  if (de.omega.size() < 20) {
-    throw InputError(c.file.string(), r.spec.key, fmt::format("at least 20 FRF points in [{}, {}] Hz", a.fmin_Hz, a.fmax_Hz),
-                     fmt::format("{} (resolution {} Hz)", de.omega.size(), r.ts.sample_rate / static_cast<double>(nfft)));
-  }
-  ident::FrfFeatureOptions fo;
-  fo.fit.order = a.fit_order;
-  fo.fit.fail_if_not_converged = false;
-  // u -> d_e: static gain and resonance.
-  std::optional<double> res_w, res_z;
-  try {
-    const ident::FrfFeatures f = ident::frf_features(de.omega, de.h, fo);
-    const Index pk = peak_index(de, 0.0);
-    const ident::ModalFeature* m = nearest(f.resonances, de.omega(pk));
-    u.static_gain = f.static_gain;
-    out.static_gain_vector_fit = f.static_gain;
-    out.static_gain = f.static_gain;
-    out.static_gain_source = ident::to_string(f.static_gain_source);
-    if (m) {
-      res_w = m->natural_frequency;
-      res_z = m->damping;
-    }
-    out.fit_de = VectorFitSummary{a.fit_order, f.fit.relative_rms_error, f.fit.converged};
-  } catch (const NumericalError& e) {
-    record_failure(u, "frf u -> d_e features", e);
-  }
-  // u -> d_e as a mass-spring-damper with its own delay (the tuning and the damped plants use it),
-  // and u -> Vs as the IFF plant (eq. 2.3 with delay): one procedure with `model tune`.
-  // The resistor high-pass: its corner is 1 / (2 pi R C_sensor) (report section 2.5) when the
-  // capacitance is measured; the FRF below a few Hz is dominated by the stacks' creep and
-  // hysteresis, so the corner fitted to it is a cross-check only.
-  // rad/s; 0 when the capacitance is not measured or the bench has no resistor.
-  const double w_rc = u.capacitance_sensor && c.bench.hpf_resistance ? 1.0 / (*c.bench.hpf_resistance * *u.capacitance_sensor) : 0.0;
-  const std::string fit_source = c.file.string() + ": " + r.spec.key;
-  ident::ActuatorPlantOptions po;
-  po.fmin_Hz = a.fmin_Hz;
-  po.fmax_Hz = a.fmax_Hz;
-  po.iff_fmin_Hz = w_rc > 0.0 ? a.fmin_Hz : 0.0;
-  po.hpf_fmax_Hz = a.hpf_fmax_Hz;
-  po.fixed_w_hpf = w_rc;
-  po.min_coherence = 0.5;
-  po.effective_averages = frf.provenance.effective_averages;
-  const ident::ActuatorPlants plants =
-      ident::fit_actuator_plants(kTwoPi * frf.freq_Hz, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1], po, fit_source);
-  for (const auto& f : plants.failures) u.failed.push_back(f);
-  if (plants.de) {
-    u.de_plant = *plants.de;
-    out.de_plant = u.de_plant;
-  }
-  // u -> Vs: anti-resonance and the NMP verdict.
-  std::optional<double> anti_w, anti_z;
-  std::optional<ident::AntiResonance> zero;
-  try {
-    const ident::FrfFeatures f = ident::frf_features(vs.omega, vs.h, fo);
-    const Index pk = peak_index(vs, 0.0);
-    // The dip below the resonance.
-    Index dip = -1;
-    for (Index k = 0; k < pk; ++k) {
-      if (dip < 0 || std::abs(vs.h(k)) < std::abs(vs.h(dip))) dip = k;
-    }
-    const ident::AntiResonance* z = dip >= 0 ? nearest(f.antiresonances, vs.omega(dip)) : nullptr;
-    if (z) {
-      anti_w = z->natural_frequency;
-      anti_z = z->damping;
-      zero = *z;
-      out.nmp.zero = NmpEvidence::Zero{z->phase_verdict, z->phase_change_deg, z->root, z->nonminimum_phase_model};
-    }
-    out.static_gain_vs = f.static_gain;
-    out.fit_vs = VectorFitSummary{a.fit_order, f.fit.relative_rms_error, f.fit.converged};
-  } catch (const NumericalError& e) {
-    record_failure(u, "frf u -> Vs features", e);
-  }
-  // High-pass corner (first-order fit at low frequency) and the IFF plant fit (eq. 2.3).
-  const Band low = band(frf, 1, 0.0, a.hpf_fmax_Hz, 0.5);
-  HighPassCorner& hpf = out.hpf;
-  if (low.omega.size() >= 3) {
-    const ident::HighPassFit h = ident::fit_high_pass(low.omega, low.h);
-    hpf.first_order_fit_Hz = h.corner_Hz();
-    hpf.first_order_fit_points = static_cast<long>(low.omega.size());
-  }
-  if (w_rc > 0.0) hpf.r_c_Hz = w_rc / kTwoPi;
-  const VectorXd& coh = frf.coherence[1];
-  if (plants.vs) {
-    u.iff_plant = *plants.vs;
-    out.iff_plant = u.iff_plant;
-    out.iff_plant_fmin_Hz = plants.vs_options.fmin_Hz;
-    out.iff_plant_fmax_Hz = plants.vs_options.fmax_Hz;
-    out.iff_plant_w_hpf_measured = w_rc > 0.0;
-    out.nmp.iff_plant_fit_xz = u.iff_plant->xz;
-    if (const double se = u.iff_plant->uncertainty.standard_error_of("xz"); std::isfinite(se)) out.nmp.iff_plant_fit_xz_standard_error = se;
-    if (w_rc <= 0.0) hpf.iff_plant_fit_Hz = u.iff_plant->w_hpf / kTwoPi;
-  }
-  if (w_rc > 0.0) {
-    // Cross-check: the corner fitted with the rest of eq. 2.3 down to the lowest frequencies.
-    try {
-      ident::IffPlantFitOptions free;
-      free.fmin_Hz = 0.0;
-      free.fmax_Hz = a.fmax_Hz;
-      free.hpf_fmax_Hz = a.hpf_fmax_Hz;
-      free.min_coherence = 0.5;
-      hpf.iff_plant_fit_Hz = ident::fit_iff_plant(kTwoPi * frf.freq_Hz, frf.H[1], coh, free, fit_source).w_hpf / kTwoPi;
-    } catch (const Error& e) {
-      hpf.iff_plant_fit_error = e.what();
-    }
-  }
-  choose_high_pass_corner(c, frf.freq_Hz.size() > 1 ? frf.freq_Hz(1) : 0.0, w_rc, hpf);
-  for (auto& w : high_pass_warnings(hpf)) u.warnings.push_back(std::move(w));
-
-  // The verdict: the 95 % interval of xz in the IFF plant fit (weighted by the FRF's variance):
-  // non-minimum-phase, minimum-phase or undetermined; without a plant fit, the phase of the data,
-  // else the vector fit's zero (ident::zero_phase_verdict).
-  const ident::ZeroPhaseVerdict zv = ident::zero_phase_verdict(zero ? &*zero : nullptr, u.iff_plant ? &*u.iff_plant : nullptr);
-  const std::optional<bool> verdict = zv.nonminimum_phase;
-  out.nmp.verdict_from = zv.from;
-  out.nmp.verdict_reason = zv.reason;
-  // Static gain, resonance and its damping: from the mass-spring-damper fit of u -> d_e with its
-  // delay (else the vector fit, else the IFF plant fit). Anti-resonance: from the IFF plant fit,
-  // whose zero pair is exactly the model's (the order-N vector fit spreads the narrow notch over
-  // its poles). The vector fits are kept as cross-checks.
-  if (anti_w) {
-    out.antiresonance_vector_fit_Hz = *anti_w / kTwoPi;
-    out.antiresonance_vector_fit_damping = *anti_z;
-  }
-  if (res_w) {
-    out.resonance_vector_fit_Hz = *res_w / kTwoPi;
-    out.resonance_vector_fit_damping = *res_z;
-  }
-  if (u.de_plant) {
-    res_w = u.de_plant->natural_frequency;
-    res_z = u.de_plant->damping;
-    u.static_gain = u.de_plant->static_gain;
-    out.static_gain = u.de_plant->static_gain;
-    out.static_gain_source = "second-order fit of u -> d_e with delay";
-  }
-  if (!res_w && u.iff_plant) {
-    res_w = u.iff_plant->wp;
-    res_z = u.iff_plant->xp;
-  }
-  if (u.iff_plant) {
-    anti_w = u.iff_plant->wz;
-    anti_z = std::abs(u.iff_plant->xz);
-  }
-  if (res_w) {
-    u.resonance_Hz = *res_w / kTwoPi;
-    u.k_resonance = metrology::stiffness_from_resonance(c.bench.suspended_mass, *res_w, c.file.string());
-  }
-  if (anti_w) u.antiresonance_Hz = *anti_w / kTwoPi;
-  out.resonance_Hz = u.resonance_Hz;
-  out.resonance_damping = res_z;
-  out.antiresonance_Hz = u.antiresonance_Hz;
-  // Signed as in the truth: negative for a non-minimum-phase zero pair; the plant fit's own sign when
-  // the verdict is undetermined (its best estimate, whose interval contains 0).
-  if (anti_z) {
-    const double sign = verdict ? (*verdict ? -1.0 : 1.0) : (u.iff_plant && u.iff_plant->xz < 0.0 ? -1.0 : 1.0);
-    out.antiresonance_damping = sign * *anti_z;
-  }
-  out.zero_is_nonminimum_phase = verdict;
-  if (anti_w) out.shell_stiffness = c.bench.suspended_mass * *anti_w * *anti_w;
-  // The features read two ways (results.hpp: kFeatureCrossCheckTolerance).
-  cross_check(u, "resonance", "Hz", out.resonance_Hz, "second-order fit of u -> d_e", out.resonance_vector_fit_Hz, "the vector fit",
-              kFeatureCrossCheckTolerance);
-  cross_check(u, "anti-resonance", "Hz", out.antiresonance_Hz, "IFF plant fit", out.antiresonance_vector_fit_Hz, "the vector fit",
-              kFeatureCrossCheckTolerance);
-  cross_check(u, "static gain u -> d_e", "m/V", out.static_gain, out.static_gain_source, out.static_gain_vector_fit, "the vector fit",
-              kFeatureCrossCheckTolerance);
-  u.frf_analysis = std::move(out);
-
-  // The tuned 2-DoF model (report section 3) with the fitted measurement chain.
+// The tuned 2-DoF model (report section 3) with the fitted measurement chain (apa/tuning.hpp).
+void tune_model(const Campaign& c, UnitAnalysis& u) {
   try {
     apa::TuningOptions t;
     t.mass = c.bench.suspended_mass;
     t.bench.amplifier_gain = c.bench.amplifier_gain;
     if (u.iff_plant) t.bench.hpf_resistance = c.bench.hpf_resistance.value_or(0.0);
-    t.fmin_Hz = a.fmin_Hz;
-    t.fmax_Hz = a.fmax_Hz;
+    t.fmin_Hz = c.analysis.fmin_Hz;
+    t.fmax_Hz = c.analysis.fmax_Hz;
     t.min_coherence = 0.5;
-    const apa::TwoDofTuning tuned = apa::tune_two_dof_measured(frf, t, u.de_plant ? &*u.de_plant : nullptr,
+    const apa::TwoDofTuning tuned = apa::tune_two_dof_measured(*u.frf, t, u.de_plant ? &*u.de_plant : nullptr,
                                                                u.iff_plant ? &*u.iff_plant : nullptr);
     u.model_2dof = Model2DofFit{tuned, tuned.bench, t.fmin_Hz, t.fmax_Hz};
   } catch (const NumericalError& e) {
     record_failure(u, "2-DoF tuning", e);
   }
+}
+
+// The FRFs u -> [d_e, Vs] (ident::analyze_actuator_frf with the campaign's band, fit order and
+// bench), the stiffness from the resonance k = m_sus w^2, and the tuned 2-DoF model.
+void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
+  const AnalysisSettings& a = c.analysis;
+  const long nfft = frf_segment_length(a, static_cast<long>(r.ts.samples()), r.ts.sample_rate);
+  u.frf = welch(r, "u", {"de", "Vs"}, a, nfft);
+  ident::ActuatorFrfOptions o;
+  o.fmin_Hz = a.fmin_Hz;
+  o.fmax_Hz = a.fmax_Hz;
+  o.hpf_fmax_Hz = a.hpf_fmax_Hz;
+  o.fit_order = a.fit_order;
+  o.min_coherence = 0.5;
+  o.hpf_resistance_ohm = c.bench.hpf_resistance;
+  o.sensor_capacitance_F = u.capacitance_sensor;
+  o.suspended_mass_kg = c.bench.suspended_mass;
+  o.source = c.file.string();
+  o.field = r.spec.key;
+  ident::ActuatorFrfResult result = ident::analyze_actuator_frf(*u.frf, o);
+  for (auto& f : result.failed) u.failed.push_back(std::move(f));
+  for (auto& w : result.warnings) u.warnings.push_back(std::move(w));
+  FrfAnalysis out;
+  static_cast<ident::ActuatorFrfAnalysis&>(out) = std::move(result.analysis);
+  out.provenance = provenance(r, {"u", "de", "Vs"});
+  out.provenance.input = "u";
+  out.provenance.outputs = {"de", "Vs"};
+  // The numbers the acceptance and the batch read.
+  u.static_gain = out.static_gain;
+  u.resonance_Hz = out.resonance_Hz;
+  u.antiresonance_Hz = out.antiresonance_Hz;
+  u.de_plant = out.de_plant;
+  u.iff_plant = out.iff_plant;
+  if (result.resonance_rad_s) u.k_resonance = metrology::stiffness_from_resonance(c.bench.suspended_mass, *result.resonance_rad_s, o.source);
+  u.frf_analysis = std::move(out);
+  tune_model(c, u);
 }
 
 // The low-frequency u -> Vs with or without the resistor across the sensor stack (report section

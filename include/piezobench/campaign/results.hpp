@@ -11,6 +11,7 @@
 #include <complex>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -19,8 +20,9 @@
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/core/fields.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
-#include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/ident/actuator_frf.hpp"
+#include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/hysteresis.hpp"
@@ -257,148 +259,27 @@ constexpr auto describe(core::Type<StiffnessAnalysis>) {
       core::field("creep", &S::creep, kNone, "Prony-series creep, weight (N) in, d_e (m) out (results.json: creep_prony)").part_only());
 }
 
-// A vector fit's summary (ident/vector_fitting.hpp).
-struct VectorFitSummary {
-  long order = 0;
-  double relative_rms_error = 0.0;
-  bool converged = false;
-};
+// The FRF analysis' parts and cross-check limits (ident/actuator_frf.hpp, where they are declared).
+using ident::HighPassCorner;
+using ident::kFeatureCrossCheckTolerance;
+using ident::kHighPassCrossCheckRatio;
+using ident::NmpEvidence;
+using ident::VectorFitSummary;
 
-constexpr auto describe(core::Type<VectorFitSummary>) {
-  using S = VectorFitSummary;
-  using namespace core::shown;
-  return core::fields<S>("VectorFitSummary", "a vector fit's summary",
-      core::field("order", &S::order, kNone, "poles"),
-      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms |fit - data| / rms |data|"),
-      core::field("converged", &S::converged, kNone, "the poles settled"));
-}
-
-// Evidence of a non-minimum-phase zero pair in u -> Vs.
-struct NmpEvidence {
-  struct Zero {
-    ident::PhaseVerdict phase_verdict = ident::PhaseVerdict::kUndetermined;
-    double phase_change_deg = 0.0;
-    std::complex<double> fitted_zero;  // rad/s
-    bool fitted_zero_nonminimum_phase = false;
-  };
-  std::optional<Zero> zero;              // the vector fit's zero nearest the dip
-  std::optional<double> iff_plant_fit_xz;
-  std::optional<double> iff_plant_fit_xz_standard_error;  // the verdict's 95 % interval is xz +- 1.96 of it
-  std::string verdict_from;              // "phase", "iff-plant-fit", "fitted-zero" or "none"
-  std::string verdict_reason;            // why (ident::ZeroPhaseVerdict::reason)
-};
-
-constexpr auto describe(core::Type<NmpEvidence::Zero>) {
-  using S = NmpEvidence::Zero;
-  using namespace core::shown;
-  return core::fields<S>("NmpZero", "the vector fit's zero of u -> Vs nearest the dip, with the phase verdict",
-      core::field("phase_verdict", &S::phase_verdict, kNone, "from the measured phase change"),
-      core::field("phase_change_deg", &S::phase_change_deg, kDegree, "across the dip"),
-      core::field("fitted_zero", &S::fitted_zero, kRadPerSecond, "the vector fit's zero").key("fitted_zero"),
-      core::field("fitted_zero_nonminimum_phase", &S::fitted_zero_nonminimum_phase, kNone, "Re > 0"));
-}
-
-constexpr auto describe(core::Type<NmpEvidence>) {
-  using S = NmpEvidence;
-  using namespace core::shown;
-  return core::fields<S>("NmpEvidence", "evidence of a non-minimum-phase zero pair in u -> Vs (report 2.3)",
-      core::field("zero", &S::zero, kNone, "the vector fit's zero nearest the dip").key("."),
-      core::field("iff_plant_fit_xz", &S::iff_plant_fit_xz, kRatio, "xz of the IFF plant fit (< 0: non-minimum phase)"),
-      core::field("iff_plant_fit_xz_standard_error", &S::iff_plant_fit_xz_standard_error, kRatio, "its standard error"),
-      core::field("verdict_from", &S::verdict_from, kNone, "\"phase\", \"iff-plant-fit\", \"fitted-zero\" or \"none\""),
-      core::field("verdict_reason", &S::verdict_reason, kNone, "why"));
-}
-
-// The resistor high-pass of the force sensor's read-out.
-struct HighPassCorner {
-  std::optional<double> first_order_fit_Hz;  // first-order fit below hpf_fmax_Hz
-  long first_order_fit_points = 0;
-  std::optional<double> r_c_Hz;              // 1 / (2 pi R C_sensor) when C_sensor is measured
-  std::optional<double> iff_plant_fit_Hz;    // eq. 2.3 fitted down to the lowest frequency
-  std::optional<std::string> iff_plant_fit_error;  // the cross-check's failure (with r_c_Hz)
-  std::string method;                        // how corner_Hz was chosen, or why there is none
-  double observable_above_Hz = 0.0;          // a third of the FRF's lowest line: a fitted corner below is not observable
-  // The unit's corner: r_c (a resistor in [bench] and C_sensor measured), else the IFF fit's, else
-  // the first-order fit's when observable; nullopt otherwise (no resistor: no high-pass to report).
-  std::optional<double> corner_Hz;
-};
-
-constexpr auto describe(core::Type<HighPassCorner>) {
-  using S = HighPassCorner;
-  using namespace core::shown;
-  return core::fields<S>("HighPassCorner", "the resistor high-pass of the force sensor's read-out",
-      core::field("first_order_fit_Hz", &S::first_order_fit_Hz, kHertz, "first-order fit below hpf_fmax_Hz"),
-      core::field("first_order_fit_points", &S::first_order_fit_points, kNone, "its points"),
-      core::field("r_c_Hz", &S::r_c_Hz, kHertz, "1 / (2 pi R C_sensor) when C_sensor is measured").key("R_C_Hz"),
-      core::field("iff_plant_fit_Hz", &S::iff_plant_fit_Hz, kHertz, "eq. 2.3 fitted down to the lowest frequency"),
-      core::field("iff_plant_fit_error", &S::iff_plant_fit_error, kNone, "the cross-check's failure"),
-      core::field("method", &S::method, kNone, "how corner_Hz was chosen, or why there is none"),
-      core::field("observable_above_Hz", &S::observable_above_Hz, kHertz, "a third of the FRF's lowest line"),
-      core::field("corner_Hz", &S::corner_Hz, kHertz, "the unit's corner (results.json: the unit's hpf_corner_Hz)").part_only());
-}
-
-// Cross-checks of a unit's FRF features (UnitAnalysis::warnings when they disagree): the high-pass
-// corner's (1/(2 pi R C), the IFF plant fit, the first-order fit) by more than this ratio (the
-// free IFF plant fit of an 8 s record lands up to a factor 1.6 below 1/(2 pi R C); a bench
-// without the resistor read with the default 80.6 kOhm is a factor 50 to 100 off) ...
-inline constexpr double kHighPassCrossCheckRatio = 2.0;
-// ... and the resonance, anti-resonance and static gain of the fits against the vector fit's by
-// more than this relative difference (the demo's anti-resonances differ by up to 7 %: the vector
-// fit spreads the narrow notch over its poles).
-inline constexpr double kFeatureCrossCheckTolerance = 0.10;
-
-// The FRFs u -> [d_e, Vs] and what is read from them.
-struct FrfAnalysis {
+// The FRFs u -> [d_e, Vs] of a unit's record and what is read from them (ident::analyze_actuator_frf).
+struct FrfAnalysis : ident::ActuatorFrfAnalysis {
   RecordProvenance provenance;
-  dsp::FrfProvenance welch;
-  std::optional<VectorFitSummary> fit_de, fit_vs;
-  std::optional<double> static_gain_vector_fit;  // m/V, vector fit of u -> d_e
-  std::optional<double> static_gain;             // m/V, the unit's (second-order fit, else vector fit)
-  std::string static_gain_source;                // "" when there is none
-  std::optional<double> static_gain_vs;          // V/V, vector fit of u -> Vs
-  std::optional<ident::DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
-  std::optional<ident::IffPlantFit> iff_plant;          // u -> Vs, eq. 2.3 with delay
-  double iff_plant_fmin_Hz = 0.0, iff_plant_fmax_Hz = 0.0;  // its band
-  bool iff_plant_w_hpf_measured = false;         // w_hpf from R C_sensor (else fitted)
-  NmpEvidence nmp;
-  HighPassCorner hpf;
-  std::optional<double> resonance_vector_fit_Hz, resonance_vector_fit_damping;
-  std::optional<double> antiresonance_vector_fit_Hz, antiresonance_vector_fit_damping;
-  std::optional<double> resonance_Hz, resonance_damping;
-  std::optional<double> antiresonance_Hz, antiresonance_damping;  // damping < 0: non-minimum-phase
-  std::optional<bool> zero_is_nonminimum_phase;
-  std::optional<double> shell_stiffness;         // N/m, m_sus w_z^2
 };
 
+// The record's provenance, then ident::ActuatorFrfAnalysis's own declaration.
 constexpr auto describe(core::Type<FrfAnalysis>) {
   using S = FrfAnalysis;
-  using namespace core::shown;
-  return core::fields<S>("FrfAnalysis", "the FRFs u -> [d_e, Vs] and what is read from them (report 2.3-2.5)",
-      core::field("provenance", &S::provenance, kNone, "the record"),
-      core::field("welch", &S::welch, kNone, "the Welch estimate's settings"),
-      core::field("fit_de", &S::fit_de, kNone, "vector fit of u -> d_e"),
-      core::field("fit_vs", &S::fit_vs, kNone, "vector fit of u -> Vs").key("fit_Vs"),
-      core::field("static_gain_vector_fit", &S::static_gain_vector_fit, kMetrePerVoltAsUmPerV, "vector fit of u -> d_e"),
-      core::field("static_gain", &S::static_gain, kMetrePerVoltAsUmPerV, "the unit's (second-order fit, else vector fit)").in_report(),
-      core::field("static_gain_source", &S::static_gain_source, kNone, "which fit gave static_gain"),
-      core::field("static_gain_vs", &S::static_gain_vs, kVoltPerVolt, "vector fit of u -> Vs").key("static_gain_Vs_V_per_V"),
-      core::field("de_plant", &S::de_plant, kNone, "u -> d_e, mass-spring-damper with delay (results.json: de_plant_fit)").part_only(),
-      core::field("iff_plant", &S::iff_plant, kNone, "u -> Vs, eq. 2.3 with delay (results.json: iff_plant_fit)").part_only(),
-      core::field("iff_plant_fmin_Hz", &S::iff_plant_fmin_Hz, kHertz, "band of the IFF plant fit, low end").part_only(),
-      core::field("iff_plant_fmax_Hz", &S::iff_plant_fmax_Hz, kHertz, "band of the IFF plant fit, high end").part_only(),
-      core::field("iff_plant_w_hpf_measured", &S::iff_plant_w_hpf_measured, kNone, "w_hpf from R C_sensor (else fitted)").part_only(),
-      core::field("nmp", &S::nmp, kNone, "evidence of a non-minimum-phase zero pair").key("nmp_evidence"),
-      core::field("hpf", &S::hpf, kNone, "the high-pass corner (results.json: the unit's hpf)").part_only(),
-      core::field("resonance_vector_fit_Hz", &S::resonance_vector_fit_Hz, kHertz, "resonance of the vector fit"),
-      core::field("resonance_vector_fit_damping", &S::resonance_vector_fit_damping, kRatio, "its damping"),
-      core::field("antiresonance_vector_fit_Hz", &S::antiresonance_vector_fit_Hz, kHertz, "anti-resonance of the vector fit"),
-      core::field("antiresonance_vector_fit_damping", &S::antiresonance_vector_fit_damping, kRatio, "its damping"),
-      core::field("resonance_Hz", &S::resonance_Hz, kHertz, "resonance of u -> d_e").in_report(),
-      core::field("resonance_damping", &S::resonance_damping, kRatio, "its damping ratio").in_report(),
-      core::field("antiresonance_Hz", &S::antiresonance_Hz, kHertz, "anti-resonance of u -> Vs").in_report(),
-      core::field("antiresonance_damping", &S::antiresonance_damping, kRatio, "its damping (< 0: non-minimum phase)").in_report(),
-      core::field("zero_is_nonminimum_phase", &S::zero_is_nonminimum_phase, kNone, "the verdict on the zero pair"),
-      core::field("shell_stiffness", &S::shell_stiffness, kNewtonPerMetreAsNPerUm, "m_sus w_z^2").in_report());
+  return std::apply(
+      [](const auto&... analysis) {
+        return core::fields<S>("FrfAnalysis", "the FRFs u -> [d_e, Vs] and what is read from them (report 2.3-2.5)",
+                               core::field("provenance", &S::provenance, core::shown::kNone, "the record"), analysis...);
+      },
+      core::kFields<ident::ActuatorFrfAnalysis>.fields);
 }
 
 // The tuned 2-DoF model (report section 3) with the fitted measurement chain.

@@ -7,7 +7,8 @@
 //   stroke        slow ramp (metrology/stroke.hpp)
 //   hysteresis    one result per amplitude (loop width at the offset relative to the loop's stroke)
 //   stiffness     k1, k2 at the report's reading times, creep fitted (metrology/stiffness.hpp)
-//   frf           Welch H1 u -> d_e and u -> Vs with coherence; features of both by vector fitting
+//   frf           Welch H1 u -> d_e and u -> Vs with coherence, read by ident::analyze_actuator_frf
+//                 (ident/actuator_frf.hpp): features of both by vector fitting
 //                 (ident/features.hpp): static gain, resonance and damping, anti-resonance and
 //                 damping, the non-minimum-phase verdict (phase of the data across the zero, the
 //                 fitted zero, and the sign of xz in the IFF plant fit); the high-pass corner; the
