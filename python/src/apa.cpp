@@ -123,9 +123,11 @@ py::object tuning_result(const TwoDofTuning& r) {
   return result("TwoDofTuning", d);
 }
 
-void bind_apa(py::module_& m) {
-  using py::arg;
+namespace {
 
+// two_dof_actuator, two_dof_bench and two_dof_response (apa/two_dof.hpp).
+void bind_two_dof_models(py::module_& m) {
+  using py::arg;
   m.def(
       "two_dof_actuator",
       [](const py::kwargs& kw) { return two_dof_actuator(params_options().from_kwargs(kwargs_dict(kw), "apa.two_dof_actuator")); },
@@ -151,6 +153,10 @@ void bind_apa(py::module_& m) {
       arg("omega"),
       ("Closed-form response of two_dof_bench at j omega (rad/s): (len(omega), 2) complex, columns d_e (m/V)\n"
        "and Vs (V/V)." + model_doc()).c_str());
+}
+
+// characterize, default_params and piezo_sensitivities.
+void bind_characterization(py::module_& m) {
   m.def(
       "characterize",
       [](const py::kwargs& kw) {
@@ -187,6 +193,11 @@ void bind_apa(py::module_& m) {
        "Defaults: Table 4.1 (ga = 26.11 N/V, gs = 5.06e6 V/m, ka = 2.4e8 N/m).\n\nKeywords (PiezoConstants):\n" +
        piezo_options().doc())
           .c_str());
+}
+
+// tune_two_dof and tune_two_dof_measured (apa/tuning.hpp).
+void bind_tuning(py::module_& m) {
+  using py::arg;
   m.def(
       "tune_two_dof",
       [](py::object frf, const py::kwargs& kw) {
@@ -231,6 +242,14 @@ void bind_apa(py::module_& m) {
        "keyword's part as given. Returns the same Result as tune_two_dof (bench = the chain removed).\n\n"
        "Keywords (TuningOptions):\n" + tuning_options().doc())
           .c_str());
+}
+
+}  // namespace
+
+void bind_apa(py::module_& m) {
+  bind_two_dof_models(m);
+  bind_characterization(m);
+  bind_tuning(m);
 }
 
 }  // namespace piezobench::python

@@ -66,11 +66,9 @@ py::array real_array(const std::vector<double>& v) {
   return to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))));
 }
 
-// The typed results of campaign/results.hpp as read-only classes (SI unless the name ends in a
-// unit). Nested results are views that keep the run alive.
-void bind_result_classes(py::module_& m) {
-  // Every struct a UnitAnalysis holds, from the field declarations beside them (results.hpp and the
-  // modules' headers), then the derived figures that are not fields.
+// Every struct a UnitAnalysis holds, from the field declarations beside them (results.hpp and the
+// modules' headers), then the derived figures that are not fields.
+void bind_unit_analysis(py::module_& m) {
   bind_described<UnitAnalysis>(m);
   bound_class<bench::TrackingFigures>().def_property_readonly("rms_reduction", &bench::TrackingFigures::rms_reduction, "rms_open / rms_ff");
   bound_class<ident::DominantPole>()
@@ -85,112 +83,127 @@ void bind_result_classes(py::module_& m) {
     collect_declarations<UnitAnalysis>(out);
     return out;
   }, "{declared struct: (its Python class, [field names])} for every struct a UnitAnalysis holds (docs/fields.md).");
-  {
-    py::class_<QuantitySpread> c(m, "QuantitySpread", "Spread of one quantity over the batch (values in the unit its name says).");
-    c.def_readonly("quantity", &QuantitySpread::quantity, "results key, e.g. \"capacitance_sensor_uF\"")
-        .def_readonly("units", &QuantitySpread::units, "number of units with a value")
-        .def_readonly("min", &QuantitySpread::min)
-        .def_readonly("max", &QuantitySpread::max)
-        .def_readonly("median", &QuantitySpread::median)
-        .def_readonly("relative_spread", &QuantitySpread::relative_spread, "(max - min) / median")
-        .def_readonly("mad", &QuantitySpread::mad, "median absolute deviation");
-    typed(c);
-    py::class_<BatchOutlier> o(m, "BatchOutlier", "A unit whose quantity is an outlier of the batch (robust z-score).");
-    o.def_readonly("unit", &BatchOutlier::unit)
-        .def_readonly("quantity", &BatchOutlier::quantity)
-        .def_readonly("value", &BatchOutlier::value)
-        .def_readonly("median", &BatchOutlier::median)
-        .def_readonly("robust_z", &BatchOutlier::robust_z);
-    typed(o);
-    py::class_<FrfSimilarity::Unit> su(m, "FrfSimilarityUnit", "rms distance in dB of one unit's FRFs from the batch median.");
-    su.def_readonly("unit", &FrfSimilarity::Unit::unit)
-        .def_readonly("de_rms_dB", &FrfSimilarity::Unit::de_rms_dB, "dB (NaN when no point compares)")
-        .def_readonly("vs_rms_dB", &FrfSimilarity::Unit::vs_rms_dB, "dB");
-    typed(su);
-    py::class_<FrfSimilarity> sim(m, "FrfSimilarity", "Unit-to-unit similarity of the FRFs.");
-    sim.def_readonly("fmin_Hz", &FrfSimilarity::fmin_Hz, "Hz")
-        .def_readonly("fmax_Hz", &FrfSimilarity::fmax_Hz, "Hz")
-        .def_readonly("units", &FrfSimilarity::units)
-        .def_readonly("max_rms_dB", &FrfSimilarity::max_rms_dB, "dB");
-    typed(sim);
-    py::class_<BatchAnalysis> b(m, "BatchAnalysis", "The batch summary: outliers, spread of the key figures, FRF similarity.");
-    b.def_readonly("outliers", &BatchAnalysis::outliers, "list of campaign.BatchOutlier")
-        .def_readonly("spread", &BatchAnalysis::spread, "list of campaign.QuantitySpread")
-        .def_readonly("similarity", &BatchAnalysis::similarity, "campaign.FrfSimilarity or None")
-        .def_readonly("rejects", &BatchAnalysis::rejects, "outliers in capacitance or stroke reject a unit")
-        .def("spread_of", [](const BatchAnalysis& a, const std::string& q) -> py::object {
-          for (const auto& s : a.spread)
-            if (s.quantity == q) return py::cast(s);
-          return py::none();
-        }, py::arg("quantity"), "The QuantitySpread of `quantity` (None when not in the batch).");
-    typed(b);
-  }
-  {
-    py::class_<IffStudy::Branch> br(m, "RootLocusBranch", "A branch of the IFF root locus (rad/s).");
-    br.def_readonly("re_im", &IffStudy::Branch::re_im, "campaign.Curve: x Re, y Im (rad/s)")
-        .def_property_readonly("gains", [](const IffStudy::Branch& b) { return real_array(b.gains); }, "at each point")
-        .def_readonly("resonance_branch", &IffStudy::Branch::resonance_branch);
-    typed(br);
-    py::class_<IffStudy> c(m, "IffStudy", R"(The IFF study: root locus of the fitted plant with the report's controller against
+}
+
+// campaign.BatchAnalysis and the classes it holds.
+void bind_batch_analysis(py::module_& m) {
+  py::class_<QuantitySpread> c(m, "QuantitySpread", "Spread of one quantity over the batch (values in the unit its name says).");
+  c.def_readonly("quantity", &QuantitySpread::quantity, "results key, e.g. \"capacitance_sensor_uF\"")
+      .def_readonly("units", &QuantitySpread::units, "number of units with a value")
+      .def_readonly("min", &QuantitySpread::min)
+      .def_readonly("max", &QuantitySpread::max)
+      .def_readonly("median", &QuantitySpread::median)
+      .def_readonly("relative_spread", &QuantitySpread::relative_spread, "(max - min) / median")
+      .def_readonly("mad", &QuantitySpread::mad, "median absolute deviation");
+  typed(c);
+  py::class_<BatchOutlier> o(m, "BatchOutlier", "A unit whose quantity is an outlier of the batch (robust z-score).");
+  o.def_readonly("unit", &BatchOutlier::unit)
+      .def_readonly("quantity", &BatchOutlier::quantity)
+      .def_readonly("value", &BatchOutlier::value)
+      .def_readonly("median", &BatchOutlier::median)
+      .def_readonly("robust_z", &BatchOutlier::robust_z);
+  typed(o);
+  py::class_<FrfSimilarity::Unit> su(m, "FrfSimilarityUnit", "rms distance in dB of one unit's FRFs from the batch median.");
+  su.def_readonly("unit", &FrfSimilarity::Unit::unit)
+      .def_readonly("de_rms_dB", &FrfSimilarity::Unit::de_rms_dB, "dB (NaN when no point compares)")
+      .def_readonly("vs_rms_dB", &FrfSimilarity::Unit::vs_rms_dB, "dB");
+  typed(su);
+  py::class_<FrfSimilarity> sim(m, "FrfSimilarity", "Unit-to-unit similarity of the FRFs.");
+  sim.def_readonly("fmin_Hz", &FrfSimilarity::fmin_Hz, "Hz")
+      .def_readonly("fmax_Hz", &FrfSimilarity::fmax_Hz, "Hz")
+      .def_readonly("units", &FrfSimilarity::units)
+      .def_readonly("max_rms_dB", &FrfSimilarity::max_rms_dB, "dB");
+  typed(sim);
+  py::class_<BatchAnalysis> b(m, "BatchAnalysis", "The batch summary: outliers, spread of the key figures, FRF similarity.");
+  b.def_readonly("outliers", &BatchAnalysis::outliers, "list of campaign.BatchOutlier")
+      .def_readonly("spread", &BatchAnalysis::spread, "list of campaign.QuantitySpread")
+      .def_readonly("similarity", &BatchAnalysis::similarity, "campaign.FrfSimilarity or None")
+      .def_readonly("rejects", &BatchAnalysis::rejects, "outliers in capacitance or stroke reject a unit")
+      .def("spread_of", [](const BatchAnalysis& a, const std::string& q) -> py::object {
+        for (const auto& s : a.spread)
+          if (s.quantity == q) return py::cast(s);
+        return py::none();
+      }, py::arg("quantity"), "The QuantitySpread of `quantity` (None when not in the batch).");
+  typed(b);
+}
+
+// campaign.IffStudy and its root-locus branches.
+void bind_iff_study(py::module_& m) {
+  py::class_<IffStudy::Branch> br(m, "RootLocusBranch", "A branch of the IFF root locus (rad/s).");
+  br.def_readonly("re_im", &IffStudy::Branch::re_im, "campaign.Curve: x Re, y Im (rad/s)")
+      .def_property_readonly("gains", [](const IffStudy::Branch& b) { return real_array(b.gains); }, "at each point")
+      .def_readonly("resonance_branch", &IffStudy::Branch::resonance_branch);
+  typed(br);
+  py::class_<IffStudy> c(m, "IffStudy", R"(The IFF study: root locus of the fitted plant with the report's controller against
 the poles of the measured damped plants, and the optimal gain (rad/s, SI).)");
-    c.def_property_readonly("controller", [](const IffStudy& s) {
-          py::dict d;
-          d["gain"] = s.controller.gain;
-          d["w_hpf"] = s.controller.w_hpf;
-          d["w_lpf"] = s.controller.w_lpf;
-          d["w_robust"] = s.controller.w_robust;
-          return d;
-        }, "the controller (control.iff_controller keywords, rad/s)")
-        .def_readonly("unit", &IffStudy::unit, "the unit whose plant is used")
-        .def_readonly("plant", &IffStudy::plant, "ident.IffPlantFit or None")
-        .def_property_readonly("gains", [](const IffStudy& s) { return real_array(s.gains); }, "of the damped plants with an identified pole")
-        .def_property_readonly("damped_poles", [](const IffStudy& s) { return complex_array(s.damped_poles); }, "rad/s, measured")
-        .def_property_readonly("model_poles", [](const IffStudy& s) { return complex_array(s.model_poles); }, "rad/s, of the root locus at those gains")
-        .def_property_readonly("relative_pole_distance", [](const IffStudy& s) { return real_array(s.relative_pole_distance); })
-        .def_readonly("max_relative_pole_distance", &IffStudy::max_relative_pole_distance)
-        .def_readonly("pole_distance_tolerance", &IffStudy::pole_distance_tolerance, "above it: warning")
-        .def_readonly("warning", &IffStudy::warning)
-        .def_readonly("optimal_gain", &IffStudy::optimal_gain, "the gain of maximum damping")
-        .def_readonly("max_damping", &IffStudy::max_damping, "damping ratio at optimal_gain")
-        .def_readonly("optimal_pole", &IffStudy::optimal_pole, "rad/s")
-        .def_readonly("note", &IffStudy::note, "why there is no study")
-        .def_readonly("failed", &IffStudy::failed, "a NumericalError of the study")
-        .def_readonly("branches", &IffStudy::branches, "list of campaign.RootLocusBranch (Figure 2.10b)")
-        .def_readonly("open_loop_poles", &IffStudy::open_loop_poles, "campaign.Curve x Re, y Im (rad/s)")
-        .def_readonly("open_loop_zeros", &IffStudy::open_loop_zeros, "campaign.Curve x Re, y Im (rad/s)");
-    typed(c);
-  }
-  {
-    py::class_<CampaignRun> c(m, "CampaignResult", R"(The results of campaign.run (campaign/results.hpp): units (campaign.UnitAnalysis),
+  c.def_property_readonly("controller", [](const IffStudy& s) {
+        py::dict d;
+        d["gain"] = s.controller.gain;
+        d["w_hpf"] = s.controller.w_hpf;
+        d["w_lpf"] = s.controller.w_lpf;
+        d["w_robust"] = s.controller.w_robust;
+        return d;
+      }, "the controller (control.iff_controller keywords, rad/s)")
+      .def_readonly("unit", &IffStudy::unit, "the unit whose plant is used")
+      .def_readonly("plant", &IffStudy::plant, "ident.IffPlantFit or None")
+      .def_property_readonly("gains", [](const IffStudy& s) { return real_array(s.gains); }, "of the damped plants with an identified pole")
+      .def_property_readonly("damped_poles", [](const IffStudy& s) { return complex_array(s.damped_poles); }, "rad/s, measured")
+      .def_property_readonly("model_poles", [](const IffStudy& s) { return complex_array(s.model_poles); }, "rad/s, of the root locus at those gains")
+      .def_property_readonly("relative_pole_distance", [](const IffStudy& s) { return real_array(s.relative_pole_distance); })
+      .def_readonly("max_relative_pole_distance", &IffStudy::max_relative_pole_distance)
+      .def_readonly("pole_distance_tolerance", &IffStudy::pole_distance_tolerance, "above it: warning")
+      .def_readonly("warning", &IffStudy::warning)
+      .def_readonly("optimal_gain", &IffStudy::optimal_gain, "the gain of maximum damping")
+      .def_readonly("max_damping", &IffStudy::max_damping, "damping ratio at optimal_gain")
+      .def_readonly("optimal_pole", &IffStudy::optimal_pole, "rad/s")
+      .def_readonly("note", &IffStudy::note, "why there is no study")
+      .def_readonly("failed", &IffStudy::failed, "a NumericalError of the study")
+      .def_readonly("branches", &IffStudy::branches, "list of campaign.RootLocusBranch (Figure 2.10b)")
+      .def_readonly("open_loop_poles", &IffStudy::open_loop_poles, "campaign.Curve x Re, y Im (rad/s)")
+      .def_readonly("open_loop_zeros", &IffStudy::open_loop_zeros, "campaign.Curve x Re, y Im (rad/s)");
+  typed(c);
+}
+
+// campaign.CampaignResult, what campaign.run returns.
+void bind_campaign_result(py::module_& m) {
+  py::class_<CampaignRun> c(m, "CampaignResult", R"(The results of campaign.run (campaign/results.hpp): units (campaign.UnitAnalysis),
 batch (campaign.BatchAnalysis), iff (campaign.IffStudy), accepted and rejected (counts), written (the
 files, when out_dir was given). results is the results.json document as Results (every analysis,
 the report's units: _um, _uF, _Hz, ...); to_dict() is that document as plain dicts.)");
-    c.def_property_readonly("units", [](const CampaignRun& r) -> const std::vector<UnitAnalysis>& { return r.result.units; },
-                            py::return_value_policy::reference_internal, "list of campaign.UnitAnalysis")
-        .def_property_readonly("batch", [](const CampaignRun& r) -> const BatchAnalysis& { return r.result.batch; },
-                               py::return_value_policy::reference_internal, "campaign.BatchAnalysis")
-        .def_property_readonly("iff", [](const CampaignRun& r) -> const IffStudy& { return r.result.iff; },
-                               py::return_value_policy::reference_internal, "campaign.IffStudy")
-        .def_property_readonly("accepted", [](const CampaignRun& r) { return r.result.accepted; }, "units accepted")
-        .def_property_readonly("rejected", [](const CampaignRun& r) { return r.result.rejected; }, "units rejected")
-        .def_property_readonly("not_analysed", [](const CampaignRun& r) { return r.result.not_analysed; },
-                               "units whose data could not be analysed (neither accepted nor rejected)")
-        .def_readonly("written", &CampaignRun::written, "files written (empty without out_dir)")
-        .def_property_readonly("results", [](const CampaignRun& r) {
-          return from_json(results_json(r.result), "CampaignResults", true);
-        }, "results.json as Results (r.results.units[0].frf.resonance_Hz)")
-        .def("to_dict", [](const CampaignRun& r) { return from_json(results_json(r.result), "CampaignResults", false); },
-             "results.json as plain dicts and lists (number arrays as numpy arrays)")
-        .def("unit", [](const CampaignRun& r, int id) -> const UnitAnalysis& {
-          for (const auto& u : r.result.units)
-            if (u.id == id) return u;
-          throw InputError("campaign.CampaignResult.unit", "id", "the id of a unit of the campaign", std::to_string(id));
-        }, py::arg("id"), py::return_value_policy::reference_internal, "The UnitAnalysis of unit `id`.")
-        .def("__repr__", [](const CampaignRun& r) {
-          return "CampaignResult(units=" + std::to_string(r.result.units.size()) + ", accepted=" + std::to_string(r.result.accepted) +
-                 ", rejected=" + std::to_string(r.result.rejected) + ")";
-        });
-  }
+  c.def_property_readonly("units", [](const CampaignRun& r) -> const std::vector<UnitAnalysis>& { return r.result.units; },
+                          py::return_value_policy::reference_internal, "list of campaign.UnitAnalysis")
+      .def_property_readonly("batch", [](const CampaignRun& r) -> const BatchAnalysis& { return r.result.batch; },
+                             py::return_value_policy::reference_internal, "campaign.BatchAnalysis")
+      .def_property_readonly("iff", [](const CampaignRun& r) -> const IffStudy& { return r.result.iff; },
+                             py::return_value_policy::reference_internal, "campaign.IffStudy")
+      .def_property_readonly("accepted", [](const CampaignRun& r) { return r.result.accepted; }, "units accepted")
+      .def_property_readonly("rejected", [](const CampaignRun& r) { return r.result.rejected; }, "units rejected")
+      .def_property_readonly("not_analysed", [](const CampaignRun& r) { return r.result.not_analysed; },
+                             "units whose data could not be analysed (neither accepted nor rejected)")
+      .def_readonly("written", &CampaignRun::written, "files written (empty without out_dir)")
+      .def_property_readonly("results", [](const CampaignRun& r) {
+        return from_json(results_json(r.result), "CampaignResults", true);
+      }, "results.json as Results (r.results.units[0].frf.resonance_Hz)")
+      .def("to_dict", [](const CampaignRun& r) { return from_json(results_json(r.result), "CampaignResults", false); },
+           "results.json as plain dicts and lists (number arrays as numpy arrays)")
+      .def("unit", [](const CampaignRun& r, int id) -> const UnitAnalysis& {
+        for (const auto& u : r.result.units)
+          if (u.id == id) return u;
+        throw InputError("campaign.CampaignResult.unit", "id", "the id of a unit of the campaign", std::to_string(id));
+      }, py::arg("id"), py::return_value_policy::reference_internal, "The UnitAnalysis of unit `id`.")
+      .def("__repr__", [](const CampaignRun& r) {
+        return "CampaignResult(units=" + std::to_string(r.result.units.size()) + ", accepted=" + std::to_string(r.result.accepted) +
+               ", rejected=" + std::to_string(r.result.rejected) + ")";
+      });
+}
+
+// The typed results of campaign/results.hpp as read-only classes (SI unless the name ends in a
+// unit). Nested results are views that keep the run alive.
+void bind_result_classes(py::module_& m) {
+  bind_unit_analysis(m);
+  bind_batch_analysis(m);
+  bind_iff_study(m);
+  bind_campaign_result(m);
 }
 
 }  // namespace

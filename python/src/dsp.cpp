@@ -242,9 +242,14 @@ const Frf& frf_arg(py::handle obj, const std::string& source, const std::string&
   return obj.cast<const Frf&>();
 }
 
-void bind_dsp(py::module_& m) {
-  using py::arg;
+namespace {
 
+// The keywords of every Welch estimate, for their docstrings.
+std::string welch_keywords() { return "\nKeywords (WelchOptions):\n" + welch_options().doc(); }
+
+// dsp.Frf (dsp/frf.hpp).
+void bind_frf_class(py::module_& m) {
+  using py::arg;
   py::class_<Frf>(m, "Frf", R"(A frequency response: one input, named outputs, a common grid (dsp/frf.hpp).
 
 H[i][k] = output i / input at freq_Hz[k]; coherence where known; std_H the standard deviation of the
@@ -304,11 +309,15 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
         for (const auto& o : f.outputs) outs += (outs.empty() ? "" : ", ") + o;
         return "Frf(input=" + f.input + ", outputs=[" + outs + "], points=" + std::to_string(f.freq_Hz.size()) + ")";
       });
+}
 
+// window, and the spectra of dsp/welch.hpp: welch, csd and frf.
+void bind_spectra(py::module_& m) {
+  using py::arg;
   m.def("window", [](const std::string& type, Index length) { return to_numpy(make_window(window_type_from_string(type), length)); },
         arg("type"), arg("length"), "The window of `length` samples, sample for sample scipy.signal.get_window's.");
 
-  const std::string keywords = "\nKeywords (WelchOptions):\n" + welch_options().doc();
+  const std::string keywords = welch_keywords();
   m.def(
       "welch",
       [](py::object x, double fs, const py::kwargs& kw) {
@@ -362,6 +371,12 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
        "or (outputs, samples); fs: Hz; outputs: names. Returns a Result: freq_Hz, H, coherence,\n"
        "Suu, Syy, Suy (1-D for one output, else (outputs, points)), averages, and frf (a dsp.Frf)." + keywords)
           .c_str());
+}
+
+// h1, h2 and coherence (dsp/welch.hpp).
+void bind_frf_estimators(py::module_& m) {
+  using py::arg;
+  const std::string keywords = welch_keywords();
   m.def(
       "h1",
       [](py::object u, py::object y, double fs, const py::kwargs& kw) {
@@ -395,7 +410,10 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
       },
       arg("u"), arg("y"), arg("fs"),
       ("(f, Cuy): magnitude-squared coherence |Suy|^2 / (Suu Syy), as scipy.signal.coherence." + keywords).c_str());
+}
 
+// The excitations of dsp/excitation.hpp.
+void bind_excitations(py::module_& m) {
   def_excitation(m, "band_limited_noise", noise_options(), &band_limited_noise,
                  "Gaussian noise, white on the DFT lines inside [f_low, f_high] (periodic over `samples`).");
   def_excitation(m, "multisine", multisine_options(), &multisine,
@@ -404,6 +422,15 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
   def_excitation(m, "offset_sine", offset_sine_options(), &offset_sine,
                  "Quasi-static offset sine (hysteresis, stroke tests), ramped in and out from `rest`.");
   def_excitation(m, "steps", step_options(), &steps, "Staircase of held levels with linear ramps.");
+}
+
+}  // namespace
+
+void bind_dsp(py::module_& m) {
+  bind_frf_class(m);
+  bind_spectra(m);
+  bind_frf_estimators(m);
+  bind_excitations(m);
 }
 
 }  // namespace piezobench::python

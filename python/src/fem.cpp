@@ -117,9 +117,10 @@ SparseMatrix sparse_arg(py::handle obj, const std::string& source, const std::st
 
 }  // namespace
 
-void bind_fem(py::module_& m) {
-  using py::arg;
+namespace {
 
+// fem.SuperElement (fem/superelement.hpp).
+void bind_super_element(py::module_& m) {
   py::class_<SuperElement>(m, "SuperElement", R"(A small dense structural model (fem/superelement.hpp): stiffness K (N/m),
 mass M (kg), one label per row ("NODE.UX" .. "NODE.ROTZ" for interface DOF, then "mode k"), node
 coordinates (m), the source files and warnings.)")
@@ -137,7 +138,11 @@ coordinates (m), the source files and warnings.)")
         return "SuperElement(size=" + std::to_string(s.size()) + ", nodal_dofs=" + std::to_string(s.nodal_dofs()) +
                ", modal_dofs=" + std::to_string(s.modal_dofs()) + ", source=" + s.source + ")";
       });
+}
 
+// fem.SparseModel (fem/matrix_io.hpp) and fem.StructuralModel (fem/structural_model.hpp).
+void bind_sparse_and_structural_models(py::module_& m) {
+  using py::arg;
   py::class_<SparseModel>(m, "SparseModel", "A large sparse FE model (fem/matrix_io.hpp): K (N/m), M (kg), nodal DOF labels.")
       .def(py::init([](py::object K, py::object M, py::object dofs, py::object coordinates) {
              const std::string src = "fem.SparseModel";
@@ -184,7 +189,11 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
             return response_array(h, false);
           },
           arg("omega"), "T (K - w^2 M + j w C)^-1 F at every omega (rad/s): (len(omega), outputs, inputs).");
+}
 
+// read_super_element and read_calculix_model.
+void bind_readers(py::module_& m) {
+  using py::arg;
   m.def(
       "read_super_element",
       [](const std::string& k_file, const std::string& m_file, const std::string& nodes_file,
@@ -213,6 +222,11 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
       },
       arg("sti_file"), arg("mas_file"), arg("dof_file"), arg("nodes_inp") = "",
       "A large model from CalculiX MATRIXSTORAGE dumps, as a fem.SparseModel (for craig_bampton).");
+}
+
+// modes, assemble and check_rigid_body_modes.
+void bind_analyses(py::module_& m) {
+  using py::arg;
   m.def(
       "modes",
       [](py::object K, py::object M) {
@@ -258,6 +272,11 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
         return result("RigidBodyCheck", d);
       },
       arg("se"), arg("relative_threshold") = 1e-3, "Are the six free-free rigid-body modes at ~0 Hz?");
+}
+
+// craig_bampton (fem/craig_bampton.hpp).
+void bind_reduction(py::module_& m) {
+  using py::arg;
   m.def(
       "craig_bampton",
       [](const SparseModel& model, py::object interface, const py::kwargs& kw) {
@@ -287,6 +306,16 @@ element (fem/structural_model.hpp), made by fem.assemble.)")
        "(int or \"NODE\") or \"REF:ROT\" rigid bodies. Result(reduced (SuperElement), fixed_interface_Hz, ...).\n\n"
        "Keywords (CraigBamptonOptions):\n" + cb_options().doc())
           .c_str());
+}
+
+}  // namespace
+
+void bind_fem(py::module_& m) {
+  bind_super_element(m);
+  bind_sparse_and_structural_models(m);
+  bind_readers(m);
+  bind_analyses(m);
+  bind_reduction(m);
 }
 
 }  // namespace piezobench::python

@@ -225,11 +225,37 @@ std::pair<Vector, CMatrix> data_args(py::handle omega, py::handle h, const std::
   return {to_vector(omega, source, "omega"), to_complex_matrix(h, source, "h")};
 }
 
-}  // namespace
+// The modes and the stabilization diagram (as arrays) of an LSCF run.
+py::object lscf_result(const LscfResult& r) {
+  py::list modes;
+  for (const auto& md : r.modes) modes.append(mode_result(md));
+  const auto n = static_cast<Index>(r.diagram.size());
+  Eigen::VectorXd order(n), wn(n), zeta(n), stable(n);
+  Eigen::VectorXcd pole(n);
+  for (Index i = 0; i < n; ++i) {
+    const auto& p = r.diagram[static_cast<std::size_t>(i)];
+    order(i) = static_cast<double>(p.order);
+    pole(i) = p.pole;
+    wn(i) = p.natural_frequency;
+    zeta(i) = p.damping;
+    stable(i) = p.stable ? 1.0 : 0.0;
+  }
+  py::dict diag;
+  diag["order"] = to_numpy(std::move(order));
+  diag["pole"] = to_numpy(std::move(pole));
+  diag["natural_frequency"] = to_numpy(std::move(wn));
+  diag["damping"] = to_numpy(std::move(zeta));
+  diag["stable"] = to_numpy(std::move(stable));
+  py::dict d;
+  d["modes"] = modes;
+  d["diagram"] = result("StabilizationDiagram", diag);
+  d["quality"] = py::cast(r.quality);
+  return result("LscfResult", d);
+}
 
-void bind_ident(py::module_& m) {
+// ident.FitQuality and ident.ParameterUncertainty, the verdict and the standard errors every fit carries.
+void bind_fit_quality(py::module_& m) {
   using py::arg;
-
   {
     py::class_<core::FitQuality> c(m, "FitQuality", R"(The quality verdict of a fit (core/fit_quality.hpp).
 
@@ -260,6 +286,11 @@ residuals' scatter. A 95 % interval is value +- 1.96 standard_error.)");
         .def_readonly("high_correlations", &core::ParameterUncertainty::high_correlations, "\"a/b 0.97\" for |correlation| > 0.95")
         .def("standard_error_of", &core::ParameterUncertainty::standard_error_of, arg("name"), "NaN when unknown");
   }
+}
+
+// ident.IffPlantFit and ident.DelayedSecondOrderFit (ident/plant_fit.hpp).
+void bind_plant_fit_classes(py::module_& m) {
+  using py::arg;
   {
     py::class_<IffPlantFit> c(m, "IffPlantFit", R"(The IFF plant of eq. 2.3 fitted to a u -> Vs FRF (ident/plant_fit.hpp):
 
@@ -318,7 +349,11 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         }, arg("omega"), "H(j omega) at omega (rad/s), complex.");
     typed(c);
   }
+}
 
+// fit_iff_plant, fit_delayed_second_order and fit_actuator_plants.
+void bind_plant_fits(py::module_& m) {
+  using py::arg;
   m.def(
       "fit_iff_plant",
       [](py::object omega_or_frf, py::object h_or_output, py::object coherence, const py::kwargs& kw) {
@@ -377,7 +412,11 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
        "failures (a fit that failed numerically)). Pass de and vs to apa.tune_two_dof_measured.\n\n"
        "Keywords (ActuatorPlantOptions):\n" + actuator_plant_options().doc())
           .c_str());
+}
 
+// vector_fit and frf_features (ident/vector_fitting.hpp, ident/features.hpp).
+void bind_vector_fitting(py::module_& m) {
+  using py::arg;
   m.def(
       "vector_fit",
       [](py::object omega_or_frf, py::object data, py::object weights, const py::kwargs& kw) {
@@ -419,6 +458,11 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
        "plateau_frequency, resonances, antiresonances (phase_verdict, nonminimum_phase_model), fit.\n\n"
        "Keywords:\n" + feature_options().doc())
           .c_str());
+}
+
+// fit_high_pass and fit_second_order (ident/features.hpp).
+void bind_low_order_fits(py::module_& m) {
+  using py::arg;
   m.def(
       "fit_high_pass",
       [](py::object omega, py::object h, double max_omega) {
@@ -459,6 +503,11 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
        "natural_frequency (rad/s), frequency_Hz, damping, poles, feedthrough, relative_rms_error, iterations).\n\n"
        "Keywords:\n" + second_order_options().doc())
           .c_str());
+}
+
+// peak_picking and lscf (ident/modal.hpp).
+void bind_modal(py::module_& m) {
+  using py::arg;
   m.def(
       "peak_picking",
       [](py::object omega, py::object h, const py::kwargs& kw) {
@@ -481,37 +530,24 @@ xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant ke
         const std::string src = "ident.lscf";
         auto o = lscf_options().from_kwargs(kwargs_dict(kw), src);
         auto [w, hm] = data_args(omega, h, src);
-        auto r = without_gil([&] { return lscf(w, hm, o); });
-        py::list modes;
-        for (const auto& md : r.modes) modes.append(mode_result(md));
-        const auto n = static_cast<Index>(r.diagram.size());
-        Eigen::VectorXd order(n), wn(n), zeta(n), stable(n);
-        Eigen::VectorXcd pole(n);
-        for (Index i = 0; i < n; ++i) {
-          const auto& p = r.diagram[static_cast<std::size_t>(i)];
-          order(i) = static_cast<double>(p.order);
-          pole(i) = p.pole;
-          wn(i) = p.natural_frequency;
-          zeta(i) = p.damping;
-          stable(i) = p.stable ? 1.0 : 0.0;
-        }
-        py::dict diag;
-        diag["order"] = to_numpy(std::move(order));
-        diag["pole"] = to_numpy(std::move(pole));
-        diag["natural_frequency"] = to_numpy(std::move(wn));
-        diag["damping"] = to_numpy(std::move(zeta));
-        diag["stable"] = to_numpy(std::move(stable));
-        py::dict d;
-        d["modes"] = modes;
-        d["diagram"] = result("StabilizationDiagram", diag);
-        d["quality"] = py::cast(r.quality);
-        return result("LscfResult", d);
+        return lscf_result(without_gil([&] { return lscf(w, hm, o); }));
       },
       arg("omega"), arg("h"),
       ("Least-squares complex-frequency estimator (PolyMAX-like, single reference) over a range of\n"
        "orders with a stabilization diagram: Result(modes, diagram (order, pole, natural_frequency,\n"
        "damping, stable as arrays), quality (ident.FitQuality)).\n\nKeywords:\n" + lscf_options().doc())
           .c_str());
+}
+
+}  // namespace
+
+void bind_ident(py::module_& m) {
+  bind_fit_quality(m);
+  bind_plant_fit_classes(m);
+  bind_plant_fits(m);
+  bind_vector_fitting(m);
+  bind_low_order_fits(m);
+  bind_modal(m);
 }
 
 }  // namespace piezobench::python

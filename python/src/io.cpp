@@ -57,48 +57,54 @@ py::dict settings_dict(const std::map<std::string, Setting>& s) {
 
 }  // namespace
 
-void bind_io(py::module_& m) {
-  using py::arg;
+namespace {
 
+// A TimeSeries from Python: channels (dict name -> 1-D array), sample rate, t, units and settings.
+TimeSeries timeseries_from_python(py::dict channels, double sample_rate, py::object t, py::object units,
+                                  py::object settings) {
+  const std::string src = "io.TimeSeries";
+  TimeSeries ts;
+  ts.sample_rate = sample_rate;
+  std::vector<Eigen::VectorXd> cols;
+  for (auto item : channels) {
+    const std::string name = string_arg(item.first, src, "channels");
+    ts.names.push_back(name);
+    cols.push_back(to_vector(item.second, src, name));
+  }
+  const Eigen::Index n = cols.empty() ? 0 : cols.front().size();
+  ts.data.resize(n, static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t j = 0; j < cols.size(); ++j) {
+    if (cols[j].size() != n) {
+      throw InputError(src, ts.names[j], std::to_string(n) + " samples", std::to_string(cols[j].size()));
+    }
+    ts.data.col(static_cast<Eigen::Index>(j)) = cols[j];
+  }
+  if (!t.is_none()) ts.t = to_vector(t, src, "t");
+  if (!units.is_none()) {
+    auto u = py::reinterpret_borrow<py::dict>(units);
+    for (const auto& name : ts.names) ts.units.push_back(u.contains(name) ? string_arg(u[py::str(name)], src, "units") : "");
+  }
+  if (!settings.is_none()) {
+    for (auto item : py::reinterpret_borrow<py::dict>(settings)) {
+      const std::string key = string_arg(item.first, src, "settings");
+      if (py::isinstance<py::str>(item.second)) {
+        ts.settings[key] = item.second.cast<std::string>();
+      } else {
+        ts.settings[key] = number_arg(item.second, src, "settings." + key);
+      }
+    }
+  }
+  ts.validate();
+  return ts;
+}
+
+// io.TimeSeries (io/timeseries.hpp).
+void bind_timeseries(py::module_& m) {
+  using py::arg;
   py::class_<TimeSeries>(m, "TimeSeries", R"(A sampled measurement record (io/timeseries.hpp): named channels of
 equal length (SI units), the sample rate (Hz), the time vector t (s) when known, units and settings.
 data is samples x channels; channel(name) / ts[name] give one channel without a copy.)")
-      .def(py::init([](py::dict channels, double sample_rate, py::object t, py::object units, py::object settings) {
-             const std::string src = "io.TimeSeries";
-             TimeSeries ts;
-             ts.sample_rate = sample_rate;
-             std::vector<Eigen::VectorXd> cols;
-             for (auto item : channels) {
-               const std::string name = string_arg(item.first, src, "channels");
-               ts.names.push_back(name);
-               cols.push_back(to_vector(item.second, src, name));
-             }
-             const Eigen::Index n = cols.empty() ? 0 : cols.front().size();
-             ts.data.resize(n, static_cast<Eigen::Index>(cols.size()));
-             for (std::size_t j = 0; j < cols.size(); ++j) {
-               if (cols[j].size() != n) {
-                 throw InputError(src, ts.names[j], std::to_string(n) + " samples", std::to_string(cols[j].size()));
-               }
-               ts.data.col(static_cast<Eigen::Index>(j)) = cols[j];
-             }
-             if (!t.is_none()) ts.t = to_vector(t, src, "t");
-             if (!units.is_none()) {
-               auto u = py::reinterpret_borrow<py::dict>(units);
-               for (const auto& name : ts.names) ts.units.push_back(u.contains(name) ? string_arg(u[py::str(name)], src, "units") : "");
-             }
-             if (!settings.is_none()) {
-               for (auto item : py::reinterpret_borrow<py::dict>(settings)) {
-                 const std::string key = string_arg(item.first, src, "settings");
-                 if (py::isinstance<py::str>(item.second)) {
-                   ts.settings[key] = item.second.cast<std::string>();
-                 } else {
-                   ts.settings[key] = number_arg(item.second, src, "settings." + key);
-                 }
-               }
-             }
-             ts.validate();
-             return ts;
-           }),
+      .def(py::init(&timeseries_from_python),
            arg("channels"), arg("sample_rate"), arg("t") = py::none(), arg("units") = py::none(),
            arg("settings") = py::none(),
            "channels: dict name -> 1-D array (SI); sample_rate: Hz; t: s (optional); units: dict name -> unit; "
@@ -138,7 +144,11 @@ data is samples x channels; channel(name) / ts[name] give one channel without a 
         return "TimeSeries([" + names + "], samples=" + std::to_string(ts.samples()) +
                ", sample_rate=" + std::to_string(ts.sample_rate) + ")";
       });
+}
 
+// read_timeseries, write_timeseries, read_frf and write_frf.
+void bind_files(py::module_& m) {
+  using py::arg;
   m.def(
       "read_timeseries",
       [](const std::string& file, const py::kwargs& kw) {
@@ -174,6 +184,13 @@ data is samples x channels; channel(name) / ts[name] give one channel without a 
       ("Writes a dsp.Frf as .csv, .mat or UFF 58 (from the extension), atomically.\n\nKeywords (FrfWriteOptions):\n" +
        frf_write_options().doc())
           .c_str());
+}
+
+}  // namespace
+
+void bind_io(py::module_& m) {
+  bind_timeseries(m);
+  bind_files(m);
 }
 
 }  // namespace piezobench::python

@@ -91,9 +91,11 @@ StateSpace state_space_arg(py::handle obj, const std::string& source, const std:
   throw InputError(source, field, "an lti.StateSpace, lti.TransferFunction or lti.Zpk", short_repr(obj));
 }
 
-void bind_lti(py::module_& m) {
-  using py::arg;
+namespace {
 
+// lti.StateSpace (lti/state_space.hpp).
+void bind_state_space(py::module_& m) {
+  using py::arg;
   py::class_<StateSpace>(m, "StateSpace", R"(Linear time-invariant system in state-space form (lti/state_space.hpp).
 
 continuous (sample_time == 0): dx/dt = A x + B u(t - input_delay),  y = C x + D u
@@ -126,7 +128,11 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
       .def_property_readonly("outputs", &StateSpace::outputs)
       .def_property_readonly("is_discrete", &StateSpace::is_discrete)
       .def("__repr__", &ss_repr);
+}
 
+// lti.TransferFunction and lti.Zpk (lti/transfer_function.hpp).
+void bind_siso_forms(py::module_& m) {
+  using py::arg;
   py::class_<TransferFunction>(m, "TransferFunction", R"(SISO transfer function num(s)/den(s) exp(-s delay)
 (lti/transfer_function.hpp). Coefficients in descending powers of s (z when discrete), as MATLAB's tf.)")
       .def(py::init([](py::object num, py::object den, double ts, double delay) {
@@ -158,7 +164,11 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
         return "Zpk(zeros=" + std::to_string(z.zeros.size()) + ", poles=" + std::to_string(z.poles.size()) +
                ", gain=" + std::to_string(z.gain) + ")";
       });
+}
 
+// ss, tf and zpk: one form from another.
+void bind_conversions(py::module_& m) {
+  using py::arg;
   m.def("ss", [](py::object sys) { return state_space_arg(sys, "lti.ss", "sys"); }, arg("sys"),
         "The state space of a StateSpace, TransferFunction or Zpk (cascade of real sections from the zpk form).");
   m.def(
@@ -178,7 +188,11 @@ poles in rad/s (continuous) or the z-plane (discrete).)")
       },
       arg("sys"), arg("output") = 0, arg("input") = 0,
       "Zeros, poles and gain of one channel (output, input): poles of A, transmission zeros, gain from H.");
+}
 
+// freqresp, logspace, poles, zeros, dc_gain and damp.
+void bind_frequency_analysis(py::module_& m) {
+  using py::arg;
   m.def(
       "freqresp",
       [](py::object sys, py::object omega, int threads) -> py::array {
@@ -226,7 +240,11 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
         return result("Damping", d);
       },
       arg("sys"), "Poles with natural frequency (rad/s) and damping ratio (as MATLAB's damp).");
+}
 
+// c2d, lsim, step, impulse, expm and pade.
+void bind_time_domain(py::module_& m) {
+  using py::arg;
   m.def(
       "c2d",
       [](py::object sys, double ts, const py::kwargs& kw) -> py::object {
@@ -268,7 +286,11 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
         "Matrix exponential (scaling and squaring, [13/13] Pade; Higham 2005).");
   m.def("pade", [](double delay, int order) { return lti::pade(delay, order); }, arg("delay"), arg("order"),
         "[order/order] Pade approximant of exp(-s delay) (delay in s), as MATLAB's pade(T, N).");
+}
 
+// series, parallel and feedback.
+void bind_interconnections(py::module_& m) {
+  using py::arg;
   m.def("series", [](py::object a, py::object b) {
     return lti::series(state_space_arg(a, "lti.series", "first"), state_space_arg(b, "lti.series", "second"));
   }, arg("first"), arg("second"), "y = second(first(u)).");
@@ -284,7 +306,11 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
       },
       arg("forward"), arg("back"), arg("sign") = -1,
       "Closed loop r -> y of y = forward(u), u = r + sign back(y) (MATLAB feedback with sign -1).");
+}
 
+// closed_loop_poles, rlocus and max_damping_on_branch.
+void bind_root_locus(py::module_& m) {
+  using py::arg;
   m.def(
       "closed_loop_poles",
       [](py::object sys, double gain) {
@@ -322,6 +348,18 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
       ("The gain of maximum damping on the branch starting at the open-loop pole nearest start_pole\n"
        "(golden section to 1e-6): Result(gain, damping, pole).\n\nKeywords:\n" + rlocus_options().doc())
           .c_str());
+}
+
+}  // namespace
+
+void bind_lti(py::module_& m) {
+  bind_state_space(m);
+  bind_siso_forms(m);
+  bind_conversions(m);
+  bind_frequency_analysis(m);
+  bind_time_domain(m);
+  bind_interconnections(m);
+  bind_root_locus(m);
 }
 
 }  // namespace piezobench::python
