@@ -188,62 +188,65 @@ void write_frf_csv(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
 }
 
 namespace {
-detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& options) {
-  const detail::CsvTable table(file, {options.delimiter, options.decimal});
-  const std::string& source = table.source();
-  const auto& columns = table.columns();
-
-  // Header: the frequency column, then which output and which part each other column holds.
-  const std::string first = text::to_lower(columns[0].name);
-  double freq_factor = 1.0;
-  if (first == "freq_hz" && columns[0].unit.empty()) {
-    freq_factor = 1.0;
-  } else if ((first == "freq" || first == "f" || first == "frequency") && !columns[0].unit.empty()) {
-    const Unit u = unit_from_string(columns[0].unit, source, "header column 1");
-    if (u.quantity != Quantity::kFrequency) throw InputError(source, "header column 1", "a frequency in Hz or kHz", "unit " + quote(columns[0].unit));
-    freq_factor = u.to_si;
-  } else {
-    throw InputError(source, "header column 1", "freq_Hz (or freq [Hz], freq [kHz])", quote(columns[0].name));
+// The factor to Hz of the frequency column: freq_Hz, or freq / f / frequency with a frequency unit.
+double csv_frequency_factor(const detail::CsvColumn& column, const std::string& source) {
+  const std::string first = text::to_lower(column.name);
+  if (first == "freq_hz" && column.unit.empty()) return 1.0;
+  if ((first == "freq" || first == "f" || first == "frequency") && !column.unit.empty()) {
+    const Unit u = unit_from_string(column.unit, source, "header column 1");
+    if (u.quantity != Quantity::kFrequency) throw InputError(source, "header column 1", "a frequency in Hz or kHz", "unit " + quote(column.unit));
+    return u.to_si;
   }
-  enum class Part { kRe, kIm, kCoh, kStd };
-  dsp::Frf frf;
+  throw InputError(source, "header column 1", "freq_Hz (or freq [Hz], freq [kHz])", quote(column.name));
+}
+
+enum class FrfPart { kRe, kIm, kCoh, kStd };
+
+// The part and output a header cell names: re_NAME, im_NAME, coh_NAME or std_NAME.
+std::pair<FrfPart, std::string> frf_column_part(const std::string& cell, const std::string& source, const std::string& where) {
+  std::pair<FrfPart, std::string> out;
+  if (cell.rfind("re_", 0) == 0) {
+    out = {FrfPart::kRe, cell.substr(3)};
+  } else if (cell.rfind("im_", 0) == 0) {
+    out = {FrfPart::kIm, cell.substr(3)};
+  } else if (cell.rfind("coh_", 0) == 0) {
+    out = {FrfPart::kCoh, cell.substr(4)};
+  } else if (cell.rfind("std_", 0) == 0) {
+    out = {FrfPart::kStd, cell.substr(4)};
+  } else {
+    throw InputError(source, where, "re_NAME, im_NAME, coh_NAME or std_NAME", quote(cell));
+  }
+  if (out.second.empty()) throw InputError(source, where, "a channel name after the prefix", quote(cell));
+  return out;
+}
+
+// What the header of an FRF CSV says: the outputs in order, the unit stated for each, and the
+// column of each output's re, im, coh and std (-1 when absent).
+struct FrfCsvHeader {
+  std::vector<std::string> outputs;
   std::vector<std::string> stated_units;  // per output, as written
-  std::vector<int> target(columns.size(), -1);
-  std::map<std::string, std::array<int, 4>> seen;  // output -> column index of re, im, coh, std
-  target[0] = 0;
+  std::map<std::string, std::array<int, 4>> seen;
+  size_t with_coh = 0, with_std = 0;  // outputs with a coherence, a standard deviation
+};
+
+FrfCsvHeader read_frf_csv_header(const std::vector<detail::CsvColumn>& columns, const std::string& source) {
+  FrfCsvHeader h;
   for (size_t c = 1; c < columns.size(); ++c) {
     const std::string& cell = columns[c].name;
     const std::string where = "header column " + std::to_string(c + 1);
-    Part part;
-    std::string name;
-    if (cell.rfind("re_", 0) == 0) {
-      part = Part::kRe;
-      name = cell.substr(3);
-    } else if (cell.rfind("im_", 0) == 0) {
-      part = Part::kIm;
-      name = cell.substr(3);
-    } else if (cell.rfind("coh_", 0) == 0) {
-      part = Part::kCoh;
-      name = cell.substr(4);
-    } else if (cell.rfind("std_", 0) == 0) {
-      part = Part::kStd;
-      name = cell.substr(4);
-    } else {
-      throw InputError(source, where, "re_NAME, im_NAME, coh_NAME or std_NAME", quote(cell));
-    }
-    if (name.empty()) throw InputError(source, where, "a channel name after the prefix", quote(cell));
-    auto [it, inserted] = seen.try_emplace(name, std::array<int, 4>{-1, -1, -1, -1});
+    const auto [part, name] = frf_column_part(cell, source, where);
+    auto [it, inserted] = h.seen.try_emplace(name, std::array<int, 4>{-1, -1, -1, -1});
     if (inserted) {
-      frf.outputs.push_back(name);
-      stated_units.emplace_back();
+      h.outputs.push_back(name);
+      h.stated_units.emplace_back();
     }
     // The unit of H on re_, im_ and std_ (`re_de [um/V]`): the same on all; coherence has none.
     const std::string& unit = columns[c].unit;
-    std::string& stated = stated_units[static_cast<size_t>(std::find(frf.outputs.begin(), frf.outputs.end(), name) - frf.outputs.begin())];
-    if (part == Part::kCoh) {
+    std::string& stated = h.stated_units[static_cast<size_t>(std::find(h.outputs.begin(), h.outputs.end(), name) - h.outputs.begin())];
+    if (part == FrfPart::kCoh) {
       if (!unit.empty() && unit != "-" && unit != "1") throw InputError(source, where, "no unit for a coherence (or - or 1)", "unit " + quote(unit));
     } else if (!unit.empty() || !stated.empty()) {
-      const bool first_part = seen[name][0] < 0 && seen[name][1] < 0;
+      const bool first_part = h.seen[name][0] < 0 && h.seen[name][1] < 0;
       if (first_part) stated = unit;
       else if (stated != unit) throw InputError(source, where, "the unit of the other part of " + name + " (" + quote(stated) + ")", "unit " + quote(unit));
     }
@@ -251,44 +254,63 @@ detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& opt
     if (slot >= 0) throw InputError(source, where, "each column once", quote(cell) + " twice");
     slot = static_cast<int>(c);
   }
-  if (frf.outputs.empty()) throw InputError(source, "header", "at least one output (re_NAME,im_NAME)", "only freq_Hz");
-  size_t with_coh = 0, with_std = 0;
-  for (const std::string& name : frf.outputs) {
-    const auto& slots = seen[name];
-    if (slots[3] >= 0) ++with_std;
+  return h;
+}
+
+// Every output has re and im; coherence and standard deviation for every output or for none.
+void check_frf_csv_parts(FrfCsvHeader& h, const std::string& source) {
+  if (h.outputs.empty()) throw InputError(source, "header", "at least one output (re_NAME,im_NAME)", "only freq_Hz");
+  for (const std::string& name : h.outputs) {
+    const auto& slots = h.seen[name];
+    if (slots[3] >= 0) ++h.with_std;
     if (slots[0] < 0) throw InputError(source, "header", "a column re_" + name, "im_" + name + " or coh_" + name + " without it");
     if (slots[1] < 0) throw InputError(source, "header", "a column im_" + name, "re_" + name + " without it");
-    if (slots[2] >= 0) ++with_coh;
+    if (slots[2] >= 0) ++h.with_coh;
   }
-  if (with_coh != 0 && with_coh != frf.outputs.size()) {
+  if (h.with_coh != 0 && h.with_coh != h.outputs.size()) {
     throw InputError(source, "header", "coh_NAME columns for every output or for none",
-                     std::to_string(with_coh) + " of " + std::to_string(frf.outputs.size()));
+                     std::to_string(h.with_coh) + " of " + std::to_string(h.outputs.size()));
   }
-  if (with_std != 0 && with_std != frf.outputs.size()) {
+  if (h.with_std != 0 && h.with_std != h.outputs.size()) {
     throw InputError(source, "header", "std_NAME columns for every output or for none",
-                     std::to_string(with_std) + " of " + std::to_string(frf.outputs.size()));
+                     std::to_string(h.with_std) + " of " + std::to_string(h.outputs.size()));
   }
+}
+
+detail::StatedFrf stated_frf_csv(const fs::path& file, const FrfReadOptions& options) {
+  const detail::CsvTable table(file, {options.delimiter, options.decimal});
+  const std::string& source = table.source();
+  const auto& columns = table.columns();
+
+  // Header: the frequency column, then which output and which part each other column holds.
+  const double freq_factor = csv_frequency_factor(columns[0], source);
+  FrfCsvHeader h = read_frf_csv_header(columns, source);
+  check_frf_csv_parts(h, source);
   // Table columns: freq, then re, im, coh, std per output in output order (the absent ones unread).
   const int per_output = 4;
-  for (size_t i = 0; i < frf.outputs.size(); ++i) {
-    const auto& slots = seen[frf.outputs[i]];
+  std::vector<int> target(columns.size(), -1);
+  target[0] = 0;
+  for (size_t i = 0; i < h.outputs.size(); ++i) {
+    const auto& slots = h.seen[h.outputs[i]];
     for (int p = 0; p < per_output; ++p) {
       if (slots[static_cast<size_t>(p)] >= 0) target[static_cast<size_t>(slots[static_cast<size_t>(p)])] = 1 + static_cast<int>(i) * per_output + p;
     }
   }
-  const Eigen::MatrixXd data = table.read(target, 1 + static_cast<Index>(frf.outputs.size()) * per_output);
+  const Eigen::MatrixXd data = table.read(target, 1 + static_cast<Index>(h.outputs.size()) * per_output);
+  dsp::Frf frf;
+  frf.outputs = std::move(h.outputs);
   frf.freq_Hz = data.col(0) * freq_factor;
   for (size_t i = 0; i < frf.outputs.size(); ++i) {
     const Index base = 1 + static_cast<Index>(i) * per_output;
-    Eigen::VectorXcd h(data.rows());
-    h.real() = data.col(base);
-    h.imag() = data.col(base + 1);
-    frf.H.push_back(std::move(h));
-    if (with_coh != 0) frf.coherence.emplace_back(data.col(base + 2));
-    if (with_std != 0) frf.std_H.emplace_back(data.col(base + 3));
+    Eigen::VectorXcd hv(data.rows());
+    hv.real() = data.col(base);
+    hv.imag() = data.col(base + 1);
+    frf.H.push_back(std::move(hv));
+    if (h.with_coh != 0) frf.coherence.emplace_back(data.col(base + 2));
+    if (h.with_std != 0) frf.std_H.emplace_back(data.col(base + 3));
   }
   frf.provenance.source = source;
-  return {std::move(frf), std::move(stated_units)};
+  return {std::move(frf), std::move(h.stated_units)};
 }
 }  // namespace
 
@@ -340,107 +362,131 @@ void write_frf_mat(const dsp::Frf& frf, const fs::path& file, const FrfWriteOpti
 }
 
 namespace {
-detail::StatedFrf stated_frf_mat(const fs::path& file) {
-  const std::string source = file.string();
-  detail::MatFilePtr mat = detail::open_mat_for_reading(file);
-  const std::vector<detail::MatVarInfo> vars = detail::list_mat_variables(mat.get(), file);
-  std::vector<std::string> names;
-  for (const auto& v : vars) names.push_back(v.name);
-  const auto has = [&](const std::string& n) { return std::find(names.begin(), names.end(), n) != names.end(); };
-  if (!has(kFreq)) {
-    throw InputError(source, kFreq, "a frequency vector in Hz", "no such variable (variables: " + text::join(names) + ")");
-  }
-  dsp::Frf frf;
-  frf.freq_Hz = detail::to_real_vector(detail::read_mat_variable(mat.get(), file, kFreq), source, kFreq);
-  if (has("input")) frf.input = detail::to_text(detail::read_mat_variable(mat.get(), file, "input"), source, "input");
-  if (has("outputs")) {
-    const std::string list = detail::to_text(detail::read_mat_variable(mat.get(), file, "outputs"), source, "outputs");
+// An FRF MAT file open for reading, with its variables.
+struct FrfMatSource {
+  const fs::path& file;
+  std::string source;
+  detail::MatFilePtr mat;
+  std::vector<detail::MatVarInfo> vars;
+  std::vector<std::string> names;  // of the variables
+
+  [[nodiscard]] bool has(const std::string& n) const { return std::find(names.begin(), names.end(), n) != names.end(); }
+  [[nodiscard]] detail::MatValue read(const std::string& n) const { return detail::read_mat_variable(mat.get(), file, n); }
+};
+
+// The outputs: the `outputs` list, else every H_NAME variable.
+std::vector<std::string> frf_mat_outputs(const FrfMatSource& m) {
+  std::vector<std::string> outputs;
+  if (m.has("outputs")) {
+    const std::string list = detail::to_text(m.read("outputs"), m.source, "outputs");
     for (std::string_view part : text::split(list, ',')) {
-      if (!text::trim(part).empty()) frf.outputs.emplace_back(text::trim(part));
+      if (!text::trim(part).empty()) outputs.emplace_back(text::trim(part));
     }
   } else {
-    for (const std::string& n : names) {
-      if (n.rfind("H_", 0) == 0 && n.size() > 2) frf.outputs.push_back(n.substr(2));
+    for (const std::string& n : m.names) {
+      if (n.rfind("H_", 0) == 0 && n.size() > 2) outputs.push_back(n.substr(2));
     }
   }
-  if (frf.outputs.empty()) throw InputError(source, "H_<name>", "at least one FRF variable", "none (variables: " + text::join(names) + ")");
+  if (outputs.empty()) throw InputError(m.source, "H_<name>", "at least one FRF variable", "none (variables: " + text::join(m.names) + ")");
+  return outputs;
+}
+
+// H of every output, and its coherence and standard deviation (for every output or for none).
+void read_frf_mat_responses(const FrfMatSource& m, dsp::Frf& frf) {
   size_t with_coh = 0, with_std = 0;
   for (const std::string& o : frf.outputs) {
-    if (has("std_" + o)) ++with_std;
+    if (m.has("std_" + o)) ++with_std;
     const std::string hname = "H_" + o;
-    if (!has(hname)) throw InputError(source, hname, "the FRF of output " + o + " (listed in outputs)", "no such variable");
-    frf.H.push_back(detail::to_complex_vector(detail::read_mat_variable(mat.get(), file, hname), source, hname));
-    if (has("coh_" + o)) ++with_coh;
+    if (!m.has(hname)) throw InputError(m.source, hname, "the FRF of output " + o + " (listed in outputs)", "no such variable");
+    frf.H.push_back(detail::to_complex_vector(m.read(hname), m.source, hname));
+    if (m.has("coh_" + o)) ++with_coh;
   }
   if (with_coh != 0 && with_coh != frf.outputs.size()) {
-    throw InputError(source, "coh_<name>", "coherence for every output or for none",
+    throw InputError(m.source, "coh_<name>", "coherence for every output or for none",
                      std::to_string(with_coh) + " of " + std::to_string(frf.outputs.size()));
   }
   if (with_coh != 0) {
-    for (const std::string& o : frf.outputs) {
-      frf.coherence.push_back(detail::to_real_vector(detail::read_mat_variable(mat.get(), file, "coh_" + o), source, "coh_" + o));
-    }
+    for (const std::string& o : frf.outputs) frf.coherence.push_back(detail::to_real_vector(m.read("coh_" + o), m.source, "coh_" + o));
   }
   if (with_std != 0 && with_std != frf.outputs.size()) {
-    throw InputError(source, "std_<name>", "a standard deviation for every output or for none",
+    throw InputError(m.source, "std_<name>", "a standard deviation for every output or for none",
                      std::to_string(with_std) + " of " + std::to_string(frf.outputs.size()));
   }
   for (size_t i = 0; i < frf.outputs.size() && with_std != 0; ++i) {
-    frf.std_H.push_back(detail::to_real_vector(detail::read_mat_variable(mat.get(), file, "std_" + frf.outputs[i]), source, "std_" + frf.outputs[i]));
+    frf.std_H.push_back(detail::to_real_vector(m.read("std_" + frf.outputs[i]), m.source, "std_" + frf.outputs[i]));
   }
-  if (has("provenance")) {
-    const detail::MatValue p = detail::read_mat_variable(mat.get(), file, "provenance");
-    if (p.class_type == MAT_C_STRUCT && p.count() == 1) {
-      const auto text = [&](const char* field) {
-        const detail::MatValue* f = p.field(field);
-        return f != nullptr ? detail::to_text(*f, source, std::string("provenance.") + field) : std::string();
-      };
-      const auto number = [&](const char* field) {
-        const detail::MatValue* f = p.field(field);
-        if (f == nullptr) return 0.0;
-        const Eigen::VectorXd v = detail::to_real_vector(*f, source, std::string("provenance.") + field);
-        if (v.size() != 1 || !std::isfinite(v(0))) {
-          throw InputError(source, std::string("provenance.") + field, "a finite scalar", detail::describe(*f));
-        }
-        return v(0);
-      };
-      frf.provenance.source = text("source");
-      frf.provenance.estimator = text("estimator");
-      frf.provenance.window = text("window");
-      frf.provenance.detrend = text("detrend");
-      frf.provenance.nfft = static_cast<Index>(number("nfft"));
-      frf.provenance.overlap = number("overlap");
-      frf.provenance.averages = static_cast<Index>(number("averages"));
-      frf.provenance.sample_rate = number("sample_rate_Hz");
-      frf.provenance.effective_averages = number("effective_averages");
+}
+
+// The `provenance` struct's fields (a 1x1 struct; anything else is ignored).
+void read_frf_mat_provenance(const detail::MatValue& p, const std::string& source, dsp::FrfProvenance& out) {
+  if (p.class_type != MAT_C_STRUCT || p.count() != 1) return;
+  const auto text = [&](const char* field) {
+    const detail::MatValue* f = p.field(field);
+    return f != nullptr ? detail::to_text(*f, source, std::string("provenance.") + field) : std::string();
+  };
+  const auto number = [&](const char* field) {
+    const detail::MatValue* f = p.field(field);
+    if (f == nullptr) return 0.0;
+    const Eigen::VectorXd v = detail::to_real_vector(*f, source, std::string("provenance.") + field);
+    if (v.size() != 1 || !std::isfinite(v(0))) {
+      throw InputError(source, std::string("provenance.") + field, "a finite scalar", detail::describe(*f));
     }
+    return v(0);
+  };
+  out.source = text("source");
+  out.estimator = text("estimator");
+  out.window = text("window");
+  out.detrend = text("detrend");
+  out.nfft = static_cast<Index>(number("nfft"));
+  out.overlap = number("overlap");
+  out.averages = static_cast<Index>(number("averages"));
+  out.sample_rate = number("sample_rate_Hz");
+  out.effective_averages = number("effective_averages");
+}
+
+// Units of H: a `units` struct (field H_NAME or NAME, e.g. 'um/V'), else (v7.3) the `units`
+// attribute of the H_NAME dataset. A field naming no output is an InputError.
+std::vector<std::string> frf_mat_units(const FrfMatSource& m, const std::vector<std::string>& outputs) {
+  std::vector<std::string> units(outputs.size());
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const auto info = std::find_if(m.vars.begin(), m.vars.end(), [&](const auto& v) { return v.name == "H_" + outputs[i]; });
+    if (info != m.vars.end()) units[i] = info->unit;
   }
-  if (frf.provenance.source.empty()) frf.provenance.source = source;
-  // Units of H: a `units` struct (field H_NAME or NAME, e.g. 'um/V'), else (v7.3) the `units`
-  // attribute of the H_NAME dataset. A field naming no output is an InputError.
-  std::vector<std::string> units(frf.outputs.size());
-  for (size_t i = 0; i < frf.outputs.size(); ++i) {
-    const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == "H_" + frf.outputs[i]; });
-    if (info != vars.end()) units[i] = info->unit;
-  }
-  const auto units_var = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return text::to_lower(v.name) == "units"; });
-  if (units_var != vars.end()) {
-    const detail::MatValue u = detail::read_mat_variable(mat.get(), file, units_var->name);
-    if (u.class_type != MAT_C_STRUCT || u.count() != 1) throw InputError(source, units_var->name, "a 1x1 struct of units (H_NAME = 'um/V')", detail::describe(u));
-    for (const std::string& f : u.field_names) {
-      const std::string where = units_var->name + "." + f;
-      const std::string name = f.rfind("H_", 0) == 0 ? f.substr(2) : f;
-      const auto it = std::find(frf.outputs.begin(), frf.outputs.end(), name);
-      if (it == frf.outputs.end()) {
-        if (f == kFreq || f == "freq" || f.rfind("coh_", 0) == 0) continue;
-        throw InputError(source, where, "the unit of an output (H_" + text::join(frf.outputs, ", H_") + ")", quote(f) + ", which names no output");
-      }
-      const std::string unit(text::trim(detail::to_text(*u.field(f), source, where)));
-      std::string& slot = units[static_cast<size_t>(it - frf.outputs.begin())];
-      if (!slot.empty() && slot != unit) throw InputError(source, where, "the unit the H_" + name + " attribute gives (" + slot + ")", quote(unit));
-      slot = unit;
+  const auto units_var = std::find_if(m.vars.begin(), m.vars.end(), [](const auto& v) { return text::to_lower(v.name) == "units"; });
+  if (units_var == m.vars.end()) return units;
+  const detail::MatValue u = m.read(units_var->name);
+  if (u.class_type != MAT_C_STRUCT || u.count() != 1) throw InputError(m.source, units_var->name, "a 1x1 struct of units (H_NAME = 'um/V')", detail::describe(u));
+  for (const std::string& f : u.field_names) {
+    const std::string where = units_var->name + "." + f;
+    const std::string name = f.rfind("H_", 0) == 0 ? f.substr(2) : f;
+    const auto it = std::find(outputs.begin(), outputs.end(), name);
+    if (it == outputs.end()) {
+      if (f == kFreq || f == "freq" || f.rfind("coh_", 0) == 0) continue;
+      throw InputError(m.source, where, "the unit of an output (H_" + text::join(outputs, ", H_") + ")", quote(f) + ", which names no output");
     }
+    const std::string unit(text::trim(detail::to_text(*u.field(f), m.source, where)));
+    std::string& slot = units[static_cast<size_t>(it - outputs.begin())];
+    if (!slot.empty() && slot != unit) throw InputError(m.source, where, "the unit the H_" + name + " attribute gives (" + slot + ")", quote(unit));
+    slot = unit;
   }
+  return units;
+}
+
+detail::StatedFrf stated_frf_mat(const fs::path& file) {
+  FrfMatSource m{file, file.string(), detail::open_mat_for_reading(file), {}, {}};
+  m.vars = detail::list_mat_variables(m.mat.get(), file);
+  for (const auto& v : m.vars) m.names.push_back(v.name);
+  if (!m.has(kFreq)) {
+    throw InputError(m.source, kFreq, "a frequency vector in Hz", "no such variable (variables: " + text::join(m.names) + ")");
+  }
+  dsp::Frf frf;
+  frf.freq_Hz = detail::to_real_vector(m.read(kFreq), m.source, kFreq);
+  if (m.has("input")) frf.input = detail::to_text(m.read("input"), m.source, "input");
+  frf.outputs = frf_mat_outputs(m);
+  read_frf_mat_responses(m, frf);
+  if (m.has("provenance")) read_frf_mat_provenance(m.read("provenance"), m.source, frf.provenance);
+  if (frf.provenance.source.empty()) frf.provenance.source = m.source;
+  std::vector<std::string> units = frf_mat_units(m, frf.outputs);
   return {std::move(frf), std::move(units)};
 }
 }  // namespace

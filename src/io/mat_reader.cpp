@@ -192,50 +192,14 @@ class V5Checker {
       return;
     }
     const unsigned long long end = src_.position() + bytes;
-    const Tag flags = read_tag(path + " (array flags)");
-    std::uint32_t flag_word = 0;
-    if (flags.small) {
-      std::memcpy(&flag_word, flags.payload, 4);
-    } else {
-      if (flags.bytes < 8) fail(path + " (array flags)", "8 bytes", bytes_text(flags.bytes));
-      unsigned char raw[8];
-      need(raw, 8, path + " (array flags)");
-      std::memcpy(&flag_word, raw, 4);
-      skip(padded(flags.bytes) - 8, path);
-    }
-    flag_word = fix(flag_word);
+    const std::uint32_t flag_word = read_array_flags(path);
     const unsigned cls = flag_word & 0xffu;
     const bool complex = (flag_word & 0x800u) != 0;
-
-    const Tag dims_tag = read_tag(path + " (dimensions)");
-    const unsigned long long rank = dims_tag.bytes / 4;
-    if (dims_tag.bytes % 4 != 0 || rank < 1 || rank > 32) {
-      fail(path + " (dimensions)", "1 to 32 dimensions of 4 bytes", bytes_text(dims_tag.bytes));
-    }
-    std::array<unsigned char, 128> dim_bytes{};
-    read_payload(dims_tag, dim_bytes.data(), path + " (dimensions)");
     unsigned long long count = 1;
-    std::vector<std::uint32_t> dims;
-    for (unsigned long long i = 0; i < rank; ++i) {
-      std::uint32_t d;
-      std::memcpy(&d, dim_bytes.data() + 4 * i, 4);
-      d = fix(d);
-      dims.push_back(d);
-      count = d == 0 || count == 0 ? 0 : (count > (1ull << 50) / d ? (1ull << 50) : count * d);
-    }
+    const std::vector<std::uint32_t> dims = read_dimensions(path, count);
     const std::string shape = shape_text(dims);
     const matio_classes class_type = cls <= 17 ? static_cast<matio_classes>(cls) : MAT_C_EMPTY;
-    const Tag name_tag = read_tag(path + " (name)");
-    std::string name;
-    if (name_tag.small) {
-      name.assign(reinterpret_cast<const char*>(name_tag.payload), name_tag.bytes);
-    } else if (name_tag.bytes <= 256) {
-      name.resize(name_tag.bytes);
-      need(name.data(), name_tag.bytes, path + " (name)");
-      skip(padded(name_tag.bytes) - name_tag.bytes, path + " (name)");
-    } else {
-      skip(padded(name_tag.bytes), path + " (name)");
-    }
+    const std::string name = read_name(path);
     if (depth == 0) {
       plain_.name = name;
       plain_.class_type = class_type;
@@ -250,40 +214,8 @@ class V5Checker {
 
     if (cls == 1) {  // cell: one matrix element per cell
       check_children(count, end, depth, path, what, out);
-    } else if (cls == 2) {  // struct: field name length, names, then fields x elements
-      const Tag len_tag = read_tag(path + " (field name length)");
-      std::uint32_t len = 0;
-      if (len_tag.small) {
-        std::memcpy(&len, len_tag.payload, 4);
-      } else {
-        unsigned char raw[8] = {};
-        if (len_tag.bytes < 4) fail(path + " (field name length)", "4 bytes", bytes_text(len_tag.bytes));
-        need(raw, 4, path);
-        skip(padded(len_tag.bytes) - 4, path);
-        std::memcpy(&len, raw, 4);
-      }
-      len = fix(len);
-      const Tag names_tag = read_tag(path + " (field names)");
-      const unsigned long long fields = len == 0 ? 0 : names_tag.bytes / len;
-      if (out != nullptr) {
-        const unsigned long long left = end - std::min(end, src_.position());
-        if (!names_tag.small && names_tag.bytes > left) {
-          fail(path + " (field names)", "names inside the variable", bytes_text(names_tag.bytes) + " declared, " + bytes_text(left) + " left");
-        }
-        std::string names(std::max<unsigned long long>(names_tag.bytes, 4), '\0');  // a small element copies 4 bytes
-        read_payload(names_tag, reinterpret_cast<unsigned char*>(names.data()), path + " (field names)");
-        for (unsigned long long f = 0; f < fields; ++f) {
-          const std::string_view field(names.data() + f * len, len);
-          out->field_names.emplace_back(field.substr(0, std::min(field.size(), field.find('\0'))));
-        }
-      } else if (!names_tag.small) {
-        skip(padded(names_tag.bytes), path + " (field names)");
-      }
-      const unsigned long long children = fields == 0 || count == 0 ? 0 : (count > (1ull << 50) / fields ? (1ull << 50) : count * fields);
-      check_children(children, end, depth, path, what, out);
-      if (out != nullptr) {
-        for (size_t i = 0; i < out->items.size(); ++i) out->items[i].name = out->field_names[i % out->field_names.size()];
-      }
+    } else if (cls == 2) {
+      check_struct(count, end, depth, path, what, out);
     } else if (cls == 4 || (cls >= 6 && cls <= 15)) {  // char and numeric classes
       const Tag real = check_data(count, end, path + " (real part)", what, out, false);
       constexpr unsigned kDoubleClass = 6, kLogicalFlag = 0x200u;
@@ -302,6 +234,96 @@ class V5Checker {
   }
 
  private:
+  // The array flags sub-element: class in the low byte, 0x800 complex, 0x200 logical.
+  std::uint32_t read_array_flags(const std::string& path) {
+    const Tag flags = read_tag(path + " (array flags)");
+    std::uint32_t flag_word = 0;
+    if (flags.small) {
+      std::memcpy(&flag_word, flags.payload, 4);
+    } else {
+      if (flags.bytes < 8) fail(path + " (array flags)", "8 bytes", bytes_text(flags.bytes));
+      unsigned char raw[8];
+      need(raw, 8, path + " (array flags)");
+      std::memcpy(&flag_word, raw, 4);
+      skip(padded(flags.bytes) - 8, path);
+    }
+    return fix(flag_word);
+  }
+
+  // The dimensions sub-element (1 to 32 of them); `count` gets their product, capped at 2^50.
+  std::vector<std::uint32_t> read_dimensions(const std::string& path, unsigned long long& count) {
+    const Tag dims_tag = read_tag(path + " (dimensions)");
+    const unsigned long long rank = dims_tag.bytes / 4;
+    if (dims_tag.bytes % 4 != 0 || rank < 1 || rank > 32) {
+      fail(path + " (dimensions)", "1 to 32 dimensions of 4 bytes", bytes_text(dims_tag.bytes));
+    }
+    std::array<unsigned char, 128> dim_bytes{};
+    read_payload(dims_tag, dim_bytes.data(), path + " (dimensions)");
+    std::vector<std::uint32_t> dims;
+    for (unsigned long long i = 0; i < rank; ++i) {
+      std::uint32_t d;
+      std::memcpy(&d, dim_bytes.data() + 4 * i, 4);
+      d = fix(d);
+      dims.push_back(d);
+      count = d == 0 || count == 0 ? 0 : (count > (1ull << 50) / d ? (1ull << 50) : count * d);
+    }
+    return dims;
+  }
+
+  // The array name sub-element ("" when it is longer than 256 bytes: skipped).
+  std::string read_name(const std::string& path) {
+    const Tag name_tag = read_tag(path + " (name)");
+    std::string name;
+    if (name_tag.small) {
+      name.assign(reinterpret_cast<const char*>(name_tag.payload), name_tag.bytes);
+    } else if (name_tag.bytes <= 256) {
+      name.resize(name_tag.bytes);
+      need(name.data(), name_tag.bytes, path + " (name)");
+      skip(padded(name_tag.bytes) - name_tag.bytes, path + " (name)");
+    } else {
+      skip(padded(name_tag.bytes), path + " (name)");
+    }
+    return name;
+  }
+
+  // A struct: field name length, names, then fields x elements.
+  void check_struct(unsigned long long count, unsigned long long end, int depth, const std::string& path, const std::string& what,
+                    MatValue* out) {
+    const Tag len_tag = read_tag(path + " (field name length)");
+    std::uint32_t len = 0;
+    if (len_tag.small) {
+      std::memcpy(&len, len_tag.payload, 4);
+    } else {
+      unsigned char raw[8] = {};
+      if (len_tag.bytes < 4) fail(path + " (field name length)", "4 bytes", bytes_text(len_tag.bytes));
+      need(raw, 4, path);
+      skip(padded(len_tag.bytes) - 4, path);
+      std::memcpy(&len, raw, 4);
+    }
+    len = fix(len);
+    const Tag names_tag = read_tag(path + " (field names)");
+    const unsigned long long fields = len == 0 ? 0 : names_tag.bytes / len;
+    if (out != nullptr) {
+      const unsigned long long left = end - std::min(end, src_.position());
+      if (!names_tag.small && names_tag.bytes > left) {
+        fail(path + " (field names)", "names inside the variable", bytes_text(names_tag.bytes) + " declared, " + bytes_text(left) + " left");
+      }
+      std::string names(std::max<unsigned long long>(names_tag.bytes, 4), '\0');  // a small element copies 4 bytes
+      read_payload(names_tag, reinterpret_cast<unsigned char*>(names.data()), path + " (field names)");
+      for (unsigned long long f = 0; f < fields; ++f) {
+        const std::string_view field(names.data() + f * len, len);
+        out->field_names.emplace_back(field.substr(0, std::min(field.size(), field.find('\0'))));
+      }
+    } else if (!names_tag.small) {
+      skip(padded(names_tag.bytes), path + " (field names)");
+    }
+    const unsigned long long children = fields == 0 || count == 0 ? 0 : (count > (1ull << 50) / fields ? (1ull << 50) : count * fields);
+    check_children(children, end, depth, path, what, out);
+    if (out != nullptr) {
+      for (size_t i = 0; i < out->items.size(); ++i) out->items[i].name = out->field_names[i % out->field_names.size()];
+    }
+  }
+
   void check_children(unsigned long long n, unsigned long long end, int depth, const std::string& path, const std::string& what,
                       MatValue* out) {
     // Each child is at least an 8-byte tag.

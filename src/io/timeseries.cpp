@@ -709,66 +709,100 @@ std::optional<std::vector<std::pair<std::string, std::string>>> unit_pairs(const
 // datasets (top level or in a group) and a group's or the file's (root group's) attributes (`units` = "u=V, de=um", `de_units`,
 // `units_de`, or an attribute named as the channel). Two places that disagree, a units cell that
 // cannot be matched to names, or an entry that names no variable of the file are InputErrors.
-std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::path& file, const std::vector<detail::MatVarInfo>& vars,
-                                             const MatLayout& layout) {
-  const std::string source = file.string();
-  std::map<std::string, std::string> units, place_of;
-  std::vector<std::string> known;  // every variable and field a unit may name
-  for (const auto& v : vars) known.push_back(v.name);
-  if (layout.group_var) known.insert(known.end(), layout.group_var->field_names.begin(), layout.group_var->field_names.end());
-  const auto add = [&](const std::string& name, const std::string& unit, const std::string& place, bool check_name) {
+class MatUnits {
+ public:
+  MatUnits(detail::MatInput* mat, const fs::path& file, const std::vector<detail::MatVarInfo>& vars, const MatLayout& layout)
+      : mat_(mat), file_(file), source_(file.string()), vars_(vars), layout_(layout) {
+    for (const auto& v : vars) known_.push_back(v.name);
+    if (layout.group_var) known_.insert(known_.end(), layout.group_var->field_names.begin(), layout.group_var->field_names.end());
+  }
+
+  std::map<std::string, std::string> collect() {
+    // v7.3 attributes of the datasets themselves, and of the file.
+    for (const auto& v : vars_) add(v.name, v.unit, v.name + " (attribute units)", false);
+    std::vector<std::string> top_level;
+    for (const auto& v : vars_) top_level.push_back(v.name);
+    from_attributes(detail::mat_file_attributes(mat_), "file", top_level);
+    if (layout_.group_var) {
+      const detail::MatValue& g = *layout_.group_var;
+      for (size_t f = 0; f < g.field_names.size(); ++f) {
+        const detail::MatValue* field = g.field(g.field_names[f]);
+        if (field != nullptr) add(g.field_names[f], field->unit, layout_.group + "." + g.field_names[f] + " (attribute units)", false);
+      }
+      from_attributes(g.attributes, layout_.group, g.field_names);
+      for (const std::string& f : g.field_names) {
+        if (is_units_name(f)) from_value(*g.field(f), layout_.group + "." + f, &g);
+      }
+    }
+    for (const auto& v : vars_) {
+      if (is_units_name(v.name)) from_value(detail::read_mat_variable(mat_, file_, v.name), v.name, nullptr);
+    }
+    return units_;
+  }
+
+ private:
+  // One name's unit from `place`: a second place must agree.
+  void add(const std::string& name, const std::string& unit, const std::string& place, bool check_name) {
     const std::string u(text::trim(unit));
     if (u.empty()) return;
-    if (check_name) check_unit_names(source, place + ": ", {name}, known);
-    const auto [it, inserted] = units.emplace(name, u);
+    if (check_name) check_unit_names(source_, place + ": ", {name}, known_);
+    const auto [it, inserted] = units_.emplace(name, u);
     if (inserted) {
-      place_of[name] = place;
+      place_of_[name] = place;
     } else if (it->second != u) {
-      throw InputError(source, place, "the unit " + place_of[name] + " gives " + name + " (" + it->second + ")", "unit " + quote(u));
+      throw InputError(source_, place, "the unit " + place_of_[name] + " gives " + name + " (" + it->second + ")", "unit " + quote(u));
     }
-  };
+  }
+
   // Names a units cell of one row or column pairs with: `channels`, `names`, `labels` (a cell of
   // char rows, or a char row of comma-separated names) beside it.
-  const auto names_beside = [&](const detail::MatValue* group) -> std::optional<std::vector<std::string>> {
+  std::optional<std::vector<std::string>> names_beside(const detail::MatValue* group) const {
     for (const char* candidate : {"channels", "names", "channel_names", "labels"}) {
       std::optional<detail::MatValue> value;
       if (group != nullptr) {
         if (const detail::MatValue* f = group->field(candidate)) value = *f;
-      } else if (std::any_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == candidate; })) {
-        value = detail::read_mat_variable(mat, file, candidate);
+      } else if (std::any_of(vars_.begin(), vars_.end(), [&](const auto& v) { return v.name == candidate; })) {
+        value = detail::read_mat_variable(mat_, file_, candidate);
       }
       if (!value) continue;
-      if (value->class_type == MAT_C_CELL) return cell_texts(*value, source, candidate);
+      if (value->class_type == MAT_C_CELL) return cell_texts(*value, source_, candidate);
       std::vector<std::string> out;
-      for (std::string_view part : text::split(detail::to_text(*value, source, candidate), ',')) out.emplace_back(text::trim(part));
+      for (std::string_view part : text::split(detail::to_text(*value, source_, candidate), ',')) out.emplace_back(text::trim(part));
       return out;
     }
     return std::nullopt;
-  };
-  const auto from_value = [&](const detail::MatValue& uv, const std::string& place, const detail::MatValue* group) {
+  }
+
+  // A `units` variable or field: a struct, a char row of NAME=UNIT pairs, or a cell.
+  void from_value(const detail::MatValue& uv, const std::string& place, const detail::MatValue* group) {
     if (uv.class_type == MAT_C_STRUCT) {
-      for (const auto& [name, value] : read_struct_settings(uv, source, place)) {
+      for (const auto& [name, value] : read_struct_settings(uv, source_, place)) {
         if (std::holds_alternative<std::string>(value)) add(name, std::get<std::string>(value), place + "." + name, true);
       }
       return;
     }
     if (uv.class_type == MAT_C_CHAR) {
-      const std::string t = detail::to_text(uv, source, place);
+      const std::string t = detail::to_text(uv, source_, place);
       const auto pairs = unit_pairs(t);
-      if (!pairs) throw InputError(source, place, "units as NAME=UNIT pairs (\"u=V, de=um\"), a struct or a cell", quote(t));
+      if (!pairs) throw InputError(source_, place, "units as NAME=UNIT pairs (\"u=V, de=um\"), a struct or a cell", quote(t));
       for (const auto& [name, unit] : *pairs) add(name, unit, place + " (" + name + ")", true);
       return;
     }
-    if (uv.class_type != MAT_C_CELL) throw InputError(source, place, "a struct, a cell or a char row of units", detail::describe(uv));
+    if (uv.class_type != MAT_C_CELL) throw InputError(source_, place, "a struct, a cell or a char row of units", detail::describe(uv));
     if (!uv.has_data) {
-      throw InputError(source, place, "units as a cell of texts (a cell of structs or cells is not read)", detail::describe(uv));
+      throw InputError(source_, place, "units as a cell of texts (a cell of structs or cells is not read)", detail::describe(uv));
     }
-    const std::vector<std::string> texts = cell_texts(uv, source, place);
+    from_cell(uv, place, group);
+  }
+
+  // A units cell: NAME/UNIT pairs (N x 2 or 2 x N), or one unit per name of a list beside it.
+  void from_cell(const detail::MatValue& uv, const std::string& place, const detail::MatValue* group) {
+    const std::vector<std::string> texts = cell_texts(uv, source_, place);
     const size_t rows = uv.dims.empty() ? 0 : uv.dims[0], cols = texts.size() / std::max<size_t>(rows, 1);
     const auto all_known = [&](size_t first, size_t stride, size_t count) {
       for (size_t i = 0; i < count; ++i) {
         const std::string& n = texts[first + i * stride];
-        if (std::find(known.begin(), known.end(), n) == known.end() && !is_time_name(n)) return false;
+        if (std::find(known_.begin(), known_.end(), n) == known_.end() && !is_time_name(n)) return false;
       }
       return true;
     };
@@ -783,23 +817,24 @@ std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::pa
     }
     const std::optional<std::vector<std::string>> names = vector ? names_beside(group) : std::nullopt;
     if (!names || names->size() != texts.size()) {
-      throw InputError(source, place,
+      throw InputError(source_, place,
                        "units a channel can be matched to: NAME/UNIT pairs (an N x 2 cell) or one unit per name of a "
                        "`channels`, `names` or `labels` list of the same length",
                        detail::describe(uv) + (names ? " beside " + std::to_string(names->size()) + " names" : " without names"));
     }
     for (size_t i = 0; i < texts.size(); ++i) add((*names)[i], texts[i], place + "{" + std::to_string(i + 1) + "}", true);
-  };
+  }
+
   // A group's attributes (the record group's, or the file's own root group's): `units` =
   // "u=V, de=um", `de_units`, `de_unit`, `units_de`, or an attribute named as a member.
-  const auto from_attributes = [&](const std::vector<std::pair<std::string, std::string>>& attributes, const std::string& group,
-                                   const std::vector<std::string>& members) {
+  void from_attributes(const std::vector<std::pair<std::string, std::string>>& attributes, const std::string& group,
+                       const std::vector<std::string>& members) {
     for (const auto& [key, value] : attributes) {
       const std::string place = group + " (attribute " + key + ")";
       const std::string l = text::to_lower(key);
       if (is_units_name(key)) {
         const auto pairs = unit_pairs(value);
-        if (!pairs) throw InputError(source, place, "units as NAME=UNIT pairs (\"u=V, de=um\")", quote(value));
+        if (!pairs) throw InputError(source_, place, "units as NAME=UNIT pairs (\"u=V, de=um\")", quote(value));
         for (const auto& [name, unit] : *pairs) add(name, unit, place, true);
       } else if (l.size() > 6 && l.compare(l.size() - 6, 6, "_units") == 0) {
         add(key.substr(0, key.size() - 6), value, place, true);
@@ -811,27 +846,246 @@ std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::pa
         add(key, value, place, false);
       }
     }
-  };
-  // v7.3 attributes of the datasets themselves, and of the file.
-  for (const auto& v : vars) add(v.name, v.unit, v.name + " (attribute units)", false);
-  std::vector<std::string> top_level;
-  for (const auto& v : vars) top_level.push_back(v.name);
-  from_attributes(detail::mat_file_attributes(mat), "file", top_level);
-  if (layout.group_var) {
-    const detail::MatValue& g = *layout.group_var;
-    for (size_t f = 0; f < g.field_names.size(); ++f) {
-      const detail::MatValue* field = g.field(g.field_names[f]);
-      if (field != nullptr) add(g.field_names[f], field->unit, layout.group + "." + g.field_names[f] + " (attribute units)", false);
+  }
+
+  detail::MatInput* mat_;
+  const fs::path& file_;
+  const std::string source_;
+  const std::vector<detail::MatVarInfo>& vars_;
+  const MatLayout& layout_;
+  std::map<std::string, std::string> units_, place_of_;
+  std::vector<std::string> known_;  // every variable and field a unit may name
+};
+
+std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::path& file, const std::vector<detail::MatVarInfo>& vars,
+                                             const MatLayout& layout) {
+  return MatUnits(mat, file, vars, layout).collect();
+}
+
+// A MAT file open for read_mat: its variables and where the channels are.
+struct MatSource {
+  const fs::path& file;
+  std::string source;
+  detail::MatFilePtr mat;
+  std::vector<detail::MatVarInfo> vars;
+  MatLayout layout;
+
+  // The record struct's field `name` (nullptr at the top level).
+  [[nodiscard]] const detail::MatValue* field(const std::string& name) const {
+    return layout.group_var ? layout.group_var->field(name) : nullptr;
+  }
+};
+
+// The time vector as read: in ts.t, or in the file's mapping (view only).
+struct MatTime {
+  std::string name;                             // "" when the file has none
+  Eigen::Index length = -1;
+  bool prechecked = false;                      // its samples checked as they were read
+  std::optional<detail::MappedDoubles> mapped;  // the time vector in the mapping (view only)
+};
+
+size_t stored_elements(const detail::MatVarInfo& v) {
+  size_t count = 1;
+  for (size_t d : v.dims) count *= d;
+  return count;
+}
+
+// A requested channel that exists but is not a numeric vector gets its own message.
+void check_requested_channels(const MatSource& m, const ReadOptions& options) {
+  for (const std::string& c : options.channels) {
+    if (std::find(m.layout.channels.begin(), m.layout.channels.end(), c) != m.layout.channels.end()) continue;
+    const detail::MatValue* found = nullptr;
+    std::optional<detail::MatValue> top;
+    if (m.layout.group_var) {
+      found = m.layout.group_var->field(c);
+    } else if (std::any_of(m.vars.begin(), m.vars.end(), [&](const auto& v) { return v.name == c; })) {
+      top = detail::read_mat_variable(m.mat.get(), m.file, c);
+      found = &*top;
     }
-    from_attributes(g.attributes, layout.group, g.field_names);
-    for (const std::string& f : g.field_names) {
-      if (is_units_name(f)) from_value(*g.field(f), layout.group + "." + f, &g);
+    if (found != nullptr) {
+      const std::string field = m.layout.group.empty() ? c : m.layout.group + "." + c;
+      throw InputError(m.source, field, "a real numeric vector (2 samples or more)", detail::describe(*found));
     }
   }
-  for (const auto& v : vars) {
-    if (is_units_name(v.name)) from_value(detail::read_mat_variable(mat, file, v.name), v.name, nullptr);
+}
+
+// Lengths come from the variables' headers, so the matrix is allocated once and every channel
+// is copied straight into its column (records reach 10^7 samples: no second copy).
+std::vector<Eigen::Index> channel_lengths(const MatSource& m, const std::vector<std::string>& names) {
+  std::vector<Eigen::Index> lengths;
+  for (const std::string& name : names) {
+    if (m.layout.group_var) {
+      lengths.push_back(static_cast<Eigen::Index>(m.field(name)->count()));
+    } else {
+      const auto info = std::find_if(m.vars.begin(), m.vars.end(), [&](const auto& v) { return v.name == name; });
+      lengths.push_back(static_cast<Eigen::Index>(stored_elements(*info)));
+    }
   }
-  return units;
+  return lengths;
+}
+
+// A top-level time vector. A plain double vector as long as the channels is read straight into
+// place (and checked chunk by chunk, see time_samples_ok); anything else through a copy and the
+// full checks.
+void read_top_level_time(const MatSource& m, const detail::MatVarInfo& info, Eigen::Index channel_length, bool viewing,
+                         TimeSeries& ts, MatTime& time) {
+  const auto n = static_cast<Eigen::Index>(stored_elements(info));
+  if (viewing && n >= 2 && n == channel_length) time.mapped = detail::map_double_vector(m.mat.get(), time.name, stored_elements(info));
+  const std::optional<double> t_last = time.mapped ? std::nullopt :
+      n >= 2 && n == channel_length && is_numeric_vector(info) && info.class_type == MAT_C_DOUBLE
+          ? detail::read_double_element(m.mat.get(), time.name, n, n - 1)
+          : std::nullopt;
+  bool read = false;
+  if (time.mapped) {
+    const double* t = time.mapped->data;
+    const double dt = (t[n - 1] - t[0]) / static_cast<double>(n - 1);  // as sample_rate_from_time
+    bool ok = true;
+    for (Eigen::Index first = 0; first < n && ok; first += kReadChunk) {
+      ok = time_samples_ok(t, n, first, std::min(kReadChunk, n - first), dt, kExactTime);
+    }
+    time.prechecked = ok;
+    read = true;
+  } else if (t_last) {
+    ts.t.resize(n);
+    advise_huge_pages(ts.t.data(), n);
+    bool ok = true;
+    double dt = 0.0;
+    const auto check = [&](Eigen::Index first, Eigen::Index piece) {
+      if (first == 0) dt = (*t_last - ts.t(0)) / static_cast<double>(n - 1);  // as sample_rate_from_time
+      ok = ok && time_samples_ok(ts.t.data(), n, first, piece, dt, kExactTime);
+    };
+    read = detail::read_double_vector_into(m.mat.get(), time.name, ts.t, kReadChunk, check);
+    time.prechecked = read && ok && ts.t(n - 1) == *t_last;
+  }
+  if (!read) {
+    ts.t = detail::to_real_vector(detail::read_mat_variable(m.mat.get(), m.file, time.name), m.source, time.name);
+  }
+  time.length = time.mapped ? n : ts.t.size();
+}
+
+// The time vector, `t` or `time` in any case (MATLAB scripts write `time`, `Time`): inside the
+// group if it has one, else at the top level.
+MatTime read_mat_time(const MatSource& m, Eigen::Index channel_length, bool viewing, TimeSeries& ts) {
+  MatTime time;
+  const detail::MatValue* t_in_group = nullptr;
+  if (m.layout.group_var) {
+    for (const std::string& f : m.layout.group_var->field_names) {
+      if (is_time_name(f)) {
+        time.name = f;
+        t_in_group = m.field(f);
+        break;
+      }
+    }
+  }
+  const auto t_info = t_in_group != nullptr ? m.vars.end()
+                                            : std::find_if(m.vars.begin(), m.vars.end(), [](const auto& v) { return is_time_name(v.name); });
+  if (t_info != m.vars.end()) time.name = t_info->name;
+  if (t_in_group != nullptr) {
+    ts.t = detail::to_real_vector(*t_in_group, m.source, m.layout.group + "." + time.name);
+    time.length = ts.t.size();
+  } else if (t_info != m.vars.end()) {
+    read_top_level_time(m, *t_info, channel_length, viewing, ts, time);
+  }
+  return time;
+}
+
+// The sample rate as a scalar `fs`, `Fs`, `sample_rate` or `sample_rate_Hz` (any case).
+std::optional<double> mat_sample_rate(const MatSource& m) {
+  const auto fs_info = std::find_if(m.vars.begin(), m.vars.end(), [](const auto& v) { return is_rate_name(v.name); });
+  if (fs_info == m.vars.end()) return std::nullopt;
+  const detail::MatValue fv = detail::read_mat_variable(m.mat.get(), m.file, fs_info->name);
+  const Eigen::VectorXd f = detail::to_real_vector(fv, m.source, fs_info->name);
+  if (f.size() != 1) throw InputError(m.source, fs_info->name, "a scalar sample rate in Hz", detail::describe(fv));
+  return f(0);
+}
+
+// The time stamps in seconds (a mapped vector in another unit is copied to be scaled); returns
+// the seconds per unit of the stored stamps.
+double time_to_seconds(const MatSource& m, const std::string& unit, MatTime& time, TimeSeries& ts) {
+  if (ts.t.size() == 0 && !time.mapped) return 1.0;
+  const double factor = time_unit_factor(unit, m.source, std::string(kUnits) + "." + time.name);
+  if (time.mapped && factor != 1.0) {
+    ts.t = Eigen::Map<const Eigen::VectorXd>(time.mapped->data, time.length) * factor;
+    time.mapped.reset();
+  } else if (factor != 1.0) {
+    ts.t *= factor;
+  }
+  return factor;
+}
+
+// What the channels need besides their samples: the time vector where it is (in the mapping or
+// in ts.t), its scale and checks, the file's sample rate and units.
+struct MatChannelContext {
+  Eigen::Map<const Eigen::VectorXd> t_samples;
+  double t_scale;
+  bool t_prechecked;
+  std::optional<double> fs_file;
+  const std::map<std::string, std::string>& units;
+
+  [[nodiscard]] std::string unit_of(const std::string& name) const {
+    const auto it = units.find(name);
+    return it != units.end() ? it->second : std::string();
+  }
+};
+
+// In place: every channel a plain double vector at the top level, in SI units already; false
+// (and `view` untouched but for warnings) when one is not.
+bool map_mat_channels(const MatSource& m, const std::vector<std::string>& names, Eigen::Index n, const ReadOptions& options,
+                      const MatChannelContext& c, FiniteCheck finite_check, TimeSeriesView& view) {
+  std::vector<std::string> units;
+  for (const std::string& name : names) units.push_back(c.unit_of(name));
+  const std::vector<double> factors = to_si_units(m.source, names, units, options, view.warnings);
+  std::vector<detail::MappedDoubles> mapped;
+  if (std::all_of(factors.begin(), factors.end(), [](double f) { return f == 1.0; })) {
+    for (const std::string& name : names) {
+      std::optional<detail::MappedDoubles> md = detail::map_double_vector(m.mat.get(), name, static_cast<size_t>(n));
+      if (!md) break;
+      mapped.push_back(std::move(*md));
+    }
+  }
+  if (mapped.size() != names.size()) return false;
+  for (size_t j = 0; j < names.size(); ++j) {
+    bool finite = true;
+    for (Eigen::Index first = 0; first < n && finite && finite_check == FiniteCheck::kReader; first += kReadChunk) {
+      finite = all_finite(mapped[j].data + first, std::min(kReadChunk, n - first));
+    }
+    if (!finite) check_finite(m.source, names[j], Eigen::Map<const Eigen::VectorXd>(mapped[j].data, n));
+    view.columns.push_back(mapped[j].data);
+  }
+  view.sample_rate =
+      resolve_sample_rate(m.source, c.t_samples, options.fs, c.fs_file, options.time_tolerance, view.warnings, c.t_prechecked, c.t_scale);
+  view.names = names;
+  view.units = std::move(units);
+  view.samples = n;
+  view.source = m.source;
+  view.storage = mapped.front().file;
+  view.mapped = true;
+  return true;
+}
+
+// Every channel copied into its column of ts.data, checked for NaN/Inf piece by piece as it
+// arrives (the exact message comes from check_finite, which runs only when there is something to
+// report).
+void read_mat_channels(const MatSource& m, const std::vector<std::string>& names, Eigen::Index n, TimeSeries& ts) {
+  ts.names = names;
+  ts.data.resize(n, static_cast<Eigen::Index>(names.size()));
+  advise_huge_pages(ts.data.data(), ts.data.size());
+  for (size_t j = 0; j < names.size(); ++j) {
+    const std::string field = m.layout.group.empty() ? names[j] : m.layout.group + "." + names[j];
+    const auto col = static_cast<Eigen::Index>(j);
+    bool finite = true;
+    if (m.layout.group_var) {
+      detail::copy_real_vector(*m.field(names[j]), m.source, field, ts.data.col(col));
+      finite = all_finite(ts.data.col(col).data(), ts.data.rows());
+    } else if (!detail::read_double_vector_into(m.mat.get(), names[j], ts.data.col(col), kReadChunk,
+                                                [&](Eigen::Index first, Eigen::Index count) {
+                                                  finite = finite && all_finite(ts.data.col(col).data() + first, count);
+                                                })) {
+      detail::copy_real_vector(detail::read_mat_variable(m.mat.get(), m.file, names[j]), m.source, field, ts.data.col(col));
+      finite = all_finite(ts.data.col(col).data(), ts.data.rows());
+    }
+    if (!finite) check_finite(m.source, field, ts.data.col(col));
+  }
 }
 
 // read_timeseries_mat, and read_timeseries_view's use of a MAT file: with `view`, a time vector and
@@ -841,212 +1095,43 @@ std::map<std::string, std::string> mat_units(detail::MatInput* mat, const fs::pa
 TimeSeries read_mat(const fs::path& file, const ReadOptions& options, TimeSeriesView* view,
                     FiniteCheck finite_check = FiniteCheck::kReader) {
   options.validate();
-  const std::string source = file.string();
-  detail::MatFilePtr mat = detail::open_mat_for_reading(file);
-  const std::vector<detail::MatVarInfo> vars = detail::list_mat_variables(mat.get(), file);
-  if (vars.empty()) throw InputError(source, "variables", "at least one variable", "an empty MAT file");
-
-  MatLayout layout = mat_layout(mat.get(), file, options, vars);
-  // A requested channel that exists but is not a numeric vector gets its own message.
-  if (!options.channels.empty()) {
-    for (const std::string& c : options.channels) {
-      if (std::find(layout.channels.begin(), layout.channels.end(), c) != layout.channels.end()) continue;
-      const detail::MatValue* found = nullptr;
-      std::optional<detail::MatValue> top;
-      if (layout.group_var) {
-        found = layout.group_var->field(c);
-      } else if (std::any_of(vars.begin(), vars.end(), [&](const auto& v) { return v.name == c; })) {
-        top = detail::read_mat_variable(mat.get(), file, c);
-        found = &*top;
-      }
-      if (found != nullptr) {
-        const std::string field = layout.group.empty() ? c : layout.group + "." + c;
-        throw InputError(source, field, "a real numeric vector (2 samples or more)", detail::describe(*found));
-      }
-    }
-  }
-  std::vector<std::string> available = layout.channels;
-  const std::vector<std::string> names = select_channels(source, options, available);
-
-  // Lengths come from the variables' headers, so the matrix is allocated once and every channel
-  // is copied straight into its column (records reach 10^7 samples: no second copy).
-  const auto field_of = [&](const std::string& name) {
-    return layout.group_var ? layout.group_var->field(name) : nullptr;
-  };
-  std::vector<Eigen::Index> lengths;
-  for (const std::string& name : names) {
-    if (layout.group_var) {
-      lengths.push_back(static_cast<Eigen::Index>(field_of(name)->count()));
-    } else {
-      const auto info = std::find_if(vars.begin(), vars.end(), [&](const auto& v) { return v.name == name; });
-      size_t count = 1;
-      for (size_t d : info->dims) count *= d;
-      lengths.push_back(static_cast<Eigen::Index>(count));
-    }
-  }
+  MatSource m{file, file.string(), detail::open_mat_for_reading(file), {}, {}};
+  m.vars = detail::list_mat_variables(m.mat.get(), file);
+  if (m.vars.empty()) throw InputError(m.source, "variables", "at least one variable", "an empty MAT file");
+  m.layout = mat_layout(m.mat.get(), file, options, m.vars);
+  if (!options.channels.empty()) check_requested_channels(m, options);
+  std::vector<std::string> available = m.layout.channels;
+  const std::vector<std::string> names = select_channels(m.source, options, available);
+  const std::vector<Eigen::Index> lengths = channel_lengths(m, names);
 
   TimeSeries ts;
-  ts.source = source;
-  // The time vector: inside the group if it has one, else at the top level. A plain double vector
-  // as long as the channels is read straight into place (and checked chunk by chunk, see
-  // time_samples_ok); anything else through a copy and the full checks.
-  Eigen::Index t_length = -1;
-  bool t_prechecked = false;
-  std::optional<detail::MappedDoubles> t_mapped;  // the time vector in the mapping (view only)
-  // `t` or `time` in any case (MATLAB scripts write `time`, `Time`).
-  std::string t_name;
-  const detail::MatValue* t_in_group = nullptr;
-  if (layout.group_var) {
-    for (const std::string& f : layout.group_var->field_names) {
-      if (is_time_name(f)) {
-        t_name = f;
-        t_in_group = field_of(f);
-        break;
-      }
-    }
-  }
-  const auto t_info = t_in_group != nullptr ? vars.end()
-                                            : std::find_if(vars.begin(), vars.end(), [](const auto& v) { return is_time_name(v.name); });
-  if (t_info != vars.end()) t_name = t_info->name;
-  if (t_in_group != nullptr) {
-    ts.t = detail::to_real_vector(*t_in_group, source, layout.group + "." + t_name);
-    t_length = ts.t.size();
-  } else if (t_info != vars.end()) {
-    size_t count = 1;
-    for (size_t d : t_info->dims) count *= d;
-    const auto n = static_cast<Eigen::Index>(count);
-    if (view != nullptr && n >= 2 && n == lengths.front()) t_mapped = detail::map_double_vector(mat.get(), t_name, count);
-    const std::optional<double> t_last = t_mapped ? std::nullopt :
-        n >= 2 && n == lengths.front() && is_numeric_vector(*t_info) && t_info->class_type == MAT_C_DOUBLE
-            ? detail::read_double_element(mat.get(), t_name, n, n - 1)
-            : std::nullopt;
-    bool read = false;
-    if (t_mapped) {
-      const double* t = t_mapped->data;
-      const double dt = (t[n - 1] - t[0]) / static_cast<double>(n - 1);  // as sample_rate_from_time
-      bool ok = true;
-      for (Eigen::Index first = 0; first < n && ok; first += kReadChunk) {
-        ok = time_samples_ok(t, n, first, std::min(kReadChunk, n - first), dt, kExactTime);
-      }
-      t_prechecked = ok;
-      read = true;
-    } else if (t_last) {
-      ts.t.resize(n);
-      advise_huge_pages(ts.t.data(), n);
-      bool ok = true;
-      double dt = 0.0;
-      const auto check = [&](Eigen::Index first, Eigen::Index piece) {
-        if (first == 0) dt = (*t_last - ts.t(0)) / static_cast<double>(n - 1);  // as sample_rate_from_time
-        ok = ok && time_samples_ok(ts.t.data(), n, first, piece, dt, kExactTime);
-      };
-      read = detail::read_double_vector_into(mat.get(), t_name, ts.t, kReadChunk, check);
-      t_prechecked = read && ok && ts.t(n - 1) == *t_last;
-    }
-    if (!read) {
-      ts.t = detail::to_real_vector(detail::read_mat_variable(mat.get(), file, t_name), source, t_name);
-    }
-    t_length = t_mapped ? n : ts.t.size();
-  }
-  check_lengths(source, names, lengths, t_length);
-
-  // The sample rate as a scalar `fs`, `Fs`, `sample_rate` or `sample_rate_Hz` (any case).
-  std::optional<double> fs_file;
-  const auto fs_info = std::find_if(vars.begin(), vars.end(), [](const auto& v) { return is_rate_name(v.name); });
-  if (fs_info != vars.end()) {
-    const detail::MatValue fv = detail::read_mat_variable(mat.get(), file, fs_info->name);
-    const Eigen::VectorXd f = detail::to_real_vector(fv, source, fs_info->name);
-    if (f.size() != 1) throw InputError(source, fs_info->name, "a scalar sample rate in Hz", detail::describe(fv));
-    fs_file = f(0);
-  }
-
+  ts.source = m.source;
+  MatTime time = read_mat_time(m, lengths.front(), view != nullptr, ts);
+  check_lengths(m.source, names, lengths, time.length);
+  const std::optional<double> fs_file = mat_sample_rate(m);
   // Units from every place a writer puts them (mat_units).
-  const std::map<std::string, std::string> file_units = mat_units(mat.get(), file, vars, layout);
-  const auto unit_of = [&](const std::string& name) {
-    const auto it = file_units.find(name);
-    return it != file_units.end() ? it->second : std::string();
-  };
+  const std::map<std::string, std::string> file_units = mat_units(m.mat.get(), file, m.vars, m.layout);
   {
-    std::vector<std::string> all = layout.channels;
-    if (!t_name.empty()) all.push_back(t_name);
-    check_unit_names(source, "--units ", override_keys(options), all);
+    std::vector<std::string> all = m.layout.channels;
+    if (!time.name.empty()) all.push_back(time.name);
+    check_unit_names(m.source, "--units ", override_keys(options), all);
   }
-  double t_scale = 1.0;  // seconds per unit of the stored stamps
-  if (ts.t.size() > 0 || t_mapped) {
-    const double factor = time_unit_factor(unit_of(t_name), source, std::string(kUnits) + "." + t_name);
-    t_scale = factor;
-    if (t_mapped && factor != 1.0) {
-      ts.t = Eigen::Map<const Eigen::VectorXd>(t_mapped->data, t_length) * factor;
-      t_mapped.reset();
-    } else if (factor != 1.0) {
-      ts.t *= factor;
-    }
-  }
-  // The time vector where it is: in the mapping or in ts.t.
-  const Eigen::Map<const Eigen::VectorXd> t_samples(t_mapped ? t_mapped->data : ts.t.data(), t_mapped ? t_length : ts.t.size());
+  const auto time_unit = file_units.find(time.name);
+  const double t_scale = time_to_seconds(m, time_unit != file_units.end() ? time_unit->second : std::string(), time, ts);
+  const MatChannelContext c{
+      Eigen::Map<const Eigen::VectorXd>(time.mapped ? time.mapped->data : ts.t.data(), time.mapped ? time.length : ts.t.size()),
+      t_scale, time.prechecked, fs_file, file_units};
+  if (view != nullptr && !m.layout.group_var && map_mat_channels(m, names, lengths.front(), options, c, finite_check, *view)) return ts;
 
-  // In place: every channel a plain double vector at the top level, in SI units already.
-  if (view != nullptr && !layout.group_var) {
-    std::vector<std::string> units;
-    for (const std::string& name : names) units.push_back(unit_of(name));
-    const std::vector<double> factors = to_si_units(source, names, units, options, view->warnings);
-    std::vector<detail::MappedDoubles> mapped;
-    if (std::all_of(factors.begin(), factors.end(), [](double f) { return f == 1.0; })) {
-      for (const std::string& name : names) {
-        std::optional<detail::MappedDoubles> m = detail::map_double_vector(mat.get(), name, static_cast<size_t>(lengths.front()));
-        if (!m) break;
-        mapped.push_back(std::move(*m));
-      }
-    }
-    if (mapped.size() == names.size()) {
-      const Eigen::Index n = lengths.front();
-      for (size_t j = 0; j < names.size(); ++j) {
-        bool finite = true;
-        for (Eigen::Index first = 0; first < n && finite && finite_check == FiniteCheck::kReader; first += kReadChunk) {
-          finite = all_finite(mapped[j].data + first, std::min(kReadChunk, n - first));
-        }
-        if (!finite) check_finite(source, names[j], Eigen::Map<const Eigen::VectorXd>(mapped[j].data, n));
-        view->columns.push_back(mapped[j].data);
-      }
-      view->sample_rate =
-          resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, view->warnings, t_prechecked, t_scale);
-      view->names = names;
-      view->units = std::move(units);
-      view->samples = n;
-      view->source = source;
-      view->storage = mapped.front().file;
-      view->mapped = true;
-      return ts;
-    }
-  }
-
-  ts.names = names;
-  ts.data.resize(lengths.front(), static_cast<Eigen::Index>(names.size()));
-  advise_huge_pages(ts.data.data(), ts.data.size());
-  for (size_t j = 0; j < names.size(); ++j) {
-    const std::string field = layout.group.empty() ? names[j] : layout.group + "." + names[j];
-    const auto col = static_cast<Eigen::Index>(j);
-    // Checked for NaN/Inf piece by piece as it arrives (the exact message comes from
-    // check_finite, which runs only when there is something to report).
-    bool finite = true;
-    if (layout.group_var) {
-      detail::copy_real_vector(*field_of(names[j]), source, field, ts.data.col(col));
-      finite = all_finite(ts.data.col(col).data(), ts.data.rows());
-    } else if (!detail::read_double_vector_into(mat.get(), names[j], ts.data.col(col), kReadChunk,
-                                                [&](Eigen::Index first, Eigen::Index count) {
-                                                  finite = finite && all_finite(ts.data.col(col).data() + first, count);
-                                                })) {
-      detail::copy_real_vector(detail::read_mat_variable(mat.get(), file, names[j]), source, field, ts.data.col(col));
-      finite = all_finite(ts.data.col(col).data(), ts.data.rows());
-    }
-    if (!finite) check_finite(source, field, ts.data.col(col));
-  }
-  ts.sample_rate = resolve_sample_rate(source, t_samples, options.fs, fs_file, options.time_tolerance, ts.warnings, t_prechecked, t_scale);
+  read_mat_channels(m, names, lengths.front(), ts);
+  ts.sample_rate = resolve_sample_rate(m.source, c.t_samples, options.fs, fs_file, options.time_tolerance, ts.warnings, c.t_prechecked,
+                                       t_scale);
   ts.units.assign(names.size(), "");
-  for (size_t j = 0; j < names.size(); ++j) ts.units[j] = unit_of(names[j]);
+  for (size_t j = 0; j < names.size(); ++j) ts.units[j] = c.unit_of(names[j]);
   convert_to_si(ts, options);
-  if (std::any_of(vars.begin(), vars.end(), [](const auto& v) { return v.name == kSettings; })) {
-    const detail::MatValue sv = detail::read_mat_variable(mat.get(), file, kSettings);
-    if (sv.class_type == MAT_C_STRUCT) ts.settings = read_struct_settings(sv, source, kSettings);
+  if (std::any_of(m.vars.begin(), m.vars.end(), [](const auto& v) { return v.name == kSettings; })) {
+    const detail::MatValue sv = detail::read_mat_variable(m.mat.get(), file, kSettings);
+    if (sv.class_type == MAT_C_STRUCT) ts.settings = read_struct_settings(sv, m.source, kSettings);
   }
   // The samples were checked above (finite channels, and t by resolve_sample_rate).
   validate_series(ts, /*samples=*/false);
