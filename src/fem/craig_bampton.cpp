@@ -296,17 +296,134 @@ void CraigBamptonOptions::validate() const {
 
 namespace {
 
+void check_model_sizes(const SparseModel& model) {
+  if (model.K.rows() != model.K.cols() || model.M.rows() != model.K.rows() || model.M.cols() != model.K.cols() ||
+      static_cast<Index>(model.dofs.size()) != model.K.rows()) {
+    throw InputError(model.source, "size", "K, M and the DOF list of the same size",
+                     std::to_string(model.K.rows()) + ", " + std::to_string(model.M.rows()) + " and " + std::to_string(model.dofs.size()));
+  }
+}
+
+void factorize_interior(Factor& factor, const Blocks& k, const ProgressCallback& progress, CraigBamptonResult& out) {
+  report(progress, "factorizing K_ii (CHOLMOD)", 0.0);
+  factor.compute(k.ii);
+  if (factor.info() != Eigen::Success) {
+    throw NumericalError("Craig-Bampton (CHOLMOD Cholesky of K_ii)",
+                         "K_ii is not positive definite: the interior is not held by the interface DOF (retain more "
+                         "DOF, e.g. a whole interface face)",
+                         false);
+  }
+  out.factor_nonzeros = factor.stored_entries();
+  report(progress, "factorizing K_ii (CHOLMOD)", 1.0);
+}
+
+// Static constraint modes Psi = -K_ii^-1 K_ib.
+Eigen::MatrixXd constraint_modes(Factor& factor, const Blocks& k, const ProgressCallback& progress) {
+  report(progress, "constraint modes", 0.0);
+  Eigen::MatrixXd Psi = -factor.solve(Eigen::MatrixXd(k.ib));
+  if (factor.info() != Eigen::Success || !Psi.allFinite()) {
+    throw NumericalError("Craig-Bampton (constraint modes)", "the solve with the factor of K_ii failed", false);
+  }
+  report(progress, "constraint modes", 1.0);
+  return Psi;
+}
+
+// The fixed-interface modes: eigenvalues (rad^2/s^2) and mode shapes of the interior.
+struct FixedInterfaceModes {
+  Eigen::VectorXd lambda;
+  Eigen::MatrixXd Phi;
+};
+
+// Small interiors: the dense generalized eigenproblem (the solver reads the lower triangles only).
+void dense_fixed_interface_modes(const Blocks& k, const Blocks& m, Index nm, FixedInterfaceModes& modes) {
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(k.ii), Eigen::MatrixXd(m.ii));
+  if (es.info() != Eigen::Success) {
+    throw NumericalError("Craig-Bampton (dense fixed-interface eigenproblem)", "M_ii is not positive definite", false);
+  }
+  modes.lambda = es.eigenvalues().head(nm);
+  modes.Phi = es.eigenvectors().leftCols(nm);
+}
+
+// Large interiors: Spectra's shift-invert Lanczos with the factor of K_ii, then the modes in
+// ascending order, the columns swapped in place (no second n x N matrix).
+void lanczos_fixed_interface_modes(const Blocks& k, const Blocks& m, const Factor& factor, const CraigBamptonOptions& options,
+                                   Index ni, FixedInterfaceModes& modes, CraigBamptonResult& out) {
+  const Index nm = options.modes;
+  ShiftInvertOp op(k.ii, m.ii, factor, options.progress);
+  LowerSymmetricProduct bop(m.ii);
+  const Index ncv = std::min<Index>(ni, options.ncv > 0 ? std::max<Index>(options.ncv, nm + 1) : std::max<Index>(2 * nm + 1, nm + 20));
+  Spectra::SymGEigsShiftSolver<ShiftInvertOp, LowerSymmetricProduct, Spectra::GEigsMode::ShiftInvert> eigs(
+      op, bop, nm, ncv, options.shift);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestMagn, options.max_iterations, options.tolerance, Spectra::SortRule::SmallestAlge);
+  out.eigensolver_iterations = eigs.num_iterations();
+  out.eigensolver_operations = op.operations();
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw NumericalError("Craig-Bampton (Spectra shift-invert Lanczos)",
+                         "the " + std::to_string(nm) + " fixed-interface modes did not converge in " +
+                             std::to_string(options.max_iterations) + " restarts (ncv " + std::to_string(ncv) + ")",
+                         true);
+  }
+  modes.lambda = eigs.eigenvalues();
+  modes.Phi = eigs.eigenvectors();
+  for (Index i = 0; i < nm; ++i) {
+    Index smallest = i;
+    for (Index j = i + 1; j < nm; ++j) smallest = modes.lambda(j) < modes.lambda(smallest) ? j : smallest;
+    std::swap(modes.lambda(i), modes.lambda(smallest));
+    modes.Phi.col(i).swap(modes.Phi.col(smallest));
+  }
+}
+
+// The reduced K and M over the interface DOF then the modal DOF, symmetrized.
+void reduced_matrices(const Blocks& k, const Blocks& m, const Eigen::MatrixXd& Psi, const FixedInterfaceModes& modes, Index nb, Index nm,
+                      SuperElement& se) {
+  const Index n = nb + nm;
+  se.K = Eigen::MatrixXd::Zero(n, n);
+  se.M = Eigen::MatrixXd::Zero(n, n);
+  se.K.topLeftCorner(nb, nb) = k.bb + k.ib.transpose() * Psi;
+  const Eigen::MatrixXd MiiPsi = m.ii.selfadjointView<Eigen::Lower>() * Psi;
+  const Eigen::MatrixXd Mib = Eigen::MatrixXd(m.ib);
+  const Eigen::MatrixXd MibtPsi = Mib.transpose() * Psi;
+  se.M.topLeftCorner(nb, nb) = m.bb + MibtPsi + MibtPsi.transpose() + Psi.transpose() * MiiPsi;
+  if (nm > 0) {
+    se.K.bottomRightCorner(nm, nm) = modes.lambda.asDiagonal();
+    se.M.bottomRightCorner(nm, nm).setIdentity();
+    const Eigen::MatrixXd Mbq = (Mib + MiiPsi).transpose() * modes.Phi;
+    se.M.topRightCorner(nb, nm) = Mbq;
+    se.M.bottomLeftCorner(nm, nb) = Mbq.transpose();
+  }
+  se.K = 0.5 * (se.K + se.K.transpose()).eval();
+  se.M = 0.5 * (se.M + se.M.transpose()).eval();
+}
+
+// The super element's labels, coordinates and source; validated and its rigid-body modes checked.
+void finish_super_element(const SparseModel& model, const Partition& p, Index nb, Index nm, SuperElement& se) {
+  se.dofs = p.labels;
+  for (Index i = 0; i < nm; ++i) se.dofs.push_back(DofLabel::modal(static_cast<int>(i + 1)));
+  for (long node : p.point_nodes) {
+    const auto it = model.coordinates.find(node);
+    if (it != model.coordinates.end()) se.coordinates[node] = it->second;
+  }
+  se.source = model.source + " (Craig-Bampton: " + std::to_string(nb) + " interface DOF, " + std::to_string(nm) + " modes)";
+}
+
+void check_super_element(SuperElement& se) {
+  try {
+    se.validate();
+  } catch (const InputError& e) {
+    throw NumericalError("Craig-Bampton (reduced matrices)", e.what(), false);
+  }
+  const RigidBodyCheck check = check_rigid_body_modes(se);
+  if (check.spoiled) se.warnings.push_back(check.message);
+}
+
 // craig_bampton; with `release` (the same object as `model`), its K and M are freed as soon as
 // their blocks are copied.
 CraigBamptonResult reduce(const SparseModel& model, SparseModel* release, const std::vector<InterfacePoint>& interface,
                           const CraigBamptonOptions& options) {
   options.validate();
   const auto start = std::chrono::steady_clock::now();
-  if (model.K.rows() != model.K.cols() || model.M.rows() != model.K.rows() || model.M.cols() != model.K.cols() ||
-      static_cast<Index>(model.dofs.size()) != model.K.rows()) {
-    throw InputError(model.source, "size", "K, M and the DOF list of the same size",
-                     std::to_string(model.K.rows()) + ", " + std::to_string(model.M.rows()) + " and " + std::to_string(model.dofs.size()));
-  }
+  check_model_sizes(model);
   const Partition p = partition(model, interface);
   const auto ni = static_cast<Index>(p.interior.size());
   const auto nb = static_cast<Index>(p.boundary.size());
@@ -328,109 +445,33 @@ CraigBamptonResult reduce(const SparseModel& model, SparseModel* release, const 
   Blocks m = split(model.M, p);
   if (release != nullptr) release_storage(release->M);
   return_free_memory();
-
-  report(options.progress, "factorizing K_ii (CHOLMOD)", 0.0);
   Factor factor;
-  factor.compute(k.ii);
-  if (factor.info() != Eigen::Success) {
-    throw NumericalError("Craig-Bampton (CHOLMOD Cholesky of K_ii)",
-                         "K_ii is not positive definite: the interior is not held by the interface DOF (retain more "
-                         "DOF, e.g. a whole interface face)",
-                         false);
-  }
-  out.factor_nonzeros = factor.stored_entries();
-  report(options.progress, "factorizing K_ii (CHOLMOD)", 1.0);
-
-  // Static constraint modes Psi = -K_ii^-1 K_ib.
-  report(options.progress, "constraint modes", 0.0);
-  const Eigen::MatrixXd Psi = -factor.solve(Eigen::MatrixXd(k.ib));
-  if (factor.info() != Eigen::Success || !Psi.allFinite()) {
-    throw NumericalError("Craig-Bampton (constraint modes)", "the solve with the factor of K_ii failed", false);
-  }
-  report(options.progress, "constraint modes", 1.0);
+  factorize_interior(factor, k, options.progress, out);
+  const Eigen::MatrixXd Psi = constraint_modes(factor, k, options.progress);
   const bool dense_interior = ni <= kDenseInterior;
   if (options.shift == 0.0 && !dense_interior) release_storage(k.ii);
   return_free_memory();
 
-  // Fixed-interface modes.
-  Eigen::VectorXd lambda(nm);
-  Eigen::MatrixXd Phi;
+  FixedInterfaceModes modes;
+  modes.lambda.resize(nm);
   if (nm > 0) {
     report(options.progress, "fixed-interface modes", 0.0);
     if (dense_interior) {
-      // The solver reads the lower triangles only.
-      const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(k.ii), Eigen::MatrixXd(m.ii));
-      if (es.info() != Eigen::Success) {
-        throw NumericalError("Craig-Bampton (dense fixed-interface eigenproblem)", "M_ii is not positive definite", false);
-      }
-      lambda = es.eigenvalues().head(nm);
-      Phi = es.eigenvectors().leftCols(nm);
+      dense_fixed_interface_modes(k, m, nm, modes);
     } else {
-      ShiftInvertOp op(k.ii, m.ii, factor, options.progress);
-      LowerSymmetricProduct bop(m.ii);
-      const Index ncv = std::min<Index>(ni, options.ncv > 0 ? std::max<Index>(options.ncv, nm + 1) : std::max<Index>(2 * nm + 1, nm + 20));
-      Spectra::SymGEigsShiftSolver<ShiftInvertOp, LowerSymmetricProduct, Spectra::GEigsMode::ShiftInvert> eigs(
-          op, bop, nm, ncv, options.shift);
-      eigs.init();
-      eigs.compute(Spectra::SortRule::LargestMagn, options.max_iterations, options.tolerance, Spectra::SortRule::SmallestAlge);
-      out.eigensolver_iterations = eigs.num_iterations();
-      out.eigensolver_operations = op.operations();
-      if (eigs.info() != Spectra::CompInfo::Successful) {
-        throw NumericalError("Craig-Bampton (Spectra shift-invert Lanczos)",
-                             "the " + std::to_string(nm) + " fixed-interface modes did not converge in " +
-                                 std::to_string(options.max_iterations) + " restarts (ncv " + std::to_string(ncv) + ")",
-                             true);
-      }
-      lambda = eigs.eigenvalues();
-      Phi = eigs.eigenvectors();
-      // Ascending order, the columns swapped in place (no second n x N matrix).
-      for (Index i = 0; i < nm; ++i) {
-        Index smallest = i;
-        for (Index j = i + 1; j < nm; ++j) smallest = lambda(j) < lambda(smallest) ? j : smallest;
-        std::swap(lambda(i), lambda(smallest));
-        Phi.col(i).swap(Phi.col(smallest));
-      }
+      lanczos_fixed_interface_modes(k, m, factor, options, ni, modes, out);
     }
     // Mass-normalize explicitly (whatever the solver's convention).
-    const Eigen::MatrixXd MPhi = m.ii.selfadjointView<Eigen::Lower>() * Phi;
-    for (Index i = 0; i < nm; ++i) Phi.col(i) /= std::sqrt(Phi.col(i).dot(MPhi.col(i)));
+    const Eigen::MatrixXd MPhi = m.ii.selfadjointView<Eigen::Lower>() * modes.Phi;
+    for (Index i = 0; i < nm; ++i) modes.Phi.col(i) /= std::sqrt(modes.Phi.col(i).dot(MPhi.col(i)));
     report(options.progress, "fixed-interface modes", 1.0);
   }
 
   report(options.progress, "reduced matrices", 0.0);
-  const Index n = nb + nm;
-  SuperElement& se = out.reduced;
-  se.K = Eigen::MatrixXd::Zero(n, n);
-  se.M = Eigen::MatrixXd::Zero(n, n);
-  se.K.topLeftCorner(nb, nb) = k.bb + k.ib.transpose() * Psi;
-  const Eigen::MatrixXd MiiPsi = m.ii.selfadjointView<Eigen::Lower>() * Psi;
-  const Eigen::MatrixXd Mib = Eigen::MatrixXd(m.ib);
-  const Eigen::MatrixXd MibtPsi = Mib.transpose() * Psi;
-  se.M.topLeftCorner(nb, nb) = m.bb + MibtPsi + MibtPsi.transpose() + Psi.transpose() * MiiPsi;
-  if (nm > 0) {
-    se.K.bottomRightCorner(nm, nm) = lambda.asDiagonal();
-    se.M.bottomRightCorner(nm, nm).setIdentity();
-    const Eigen::MatrixXd Mbq = (Mib + MiiPsi).transpose() * Phi;
-    se.M.topRightCorner(nb, nm) = Mbq;
-    se.M.bottomLeftCorner(nm, nb) = Mbq.transpose();
-  }
-  se.K = 0.5 * (se.K + se.K.transpose()).eval();
-  se.M = 0.5 * (se.M + se.M.transpose()).eval();
-  se.dofs = p.labels;
-  for (Index i = 0; i < nm; ++i) se.dofs.push_back(DofLabel::modal(static_cast<int>(i + 1)));
-  for (long node : p.point_nodes) {
-    const auto it = model.coordinates.find(node);
-    if (it != model.coordinates.end()) se.coordinates[node] = it->second;
-  }
-  se.source = model.source + " (Craig-Bampton: " + std::to_string(nb) + " interface DOF, " + std::to_string(nm) + " modes)";
-  out.fixed_interface_Hz = lambda.unaryExpr([](double l) { return eigenvalue_Hz(l); });
-  try {
-    se.validate();
-  } catch (const InputError& e) {
-    throw NumericalError("Craig-Bampton (reduced matrices)", e.what(), false);
-  }
-  const RigidBodyCheck check = check_rigid_body_modes(se);
-  if (check.spoiled) se.warnings.push_back(check.message);
+  reduced_matrices(k, m, Psi, modes, nb, nm, out.reduced);
+  finish_super_element(model, p, nb, nm, out.reduced);
+  out.fixed_interface_Hz = modes.lambda.unaryExpr([](double l) { return eigenvalue_Hz(l); });
+  check_super_element(out.reduced);
   report(options.progress, "reduced matrices", 1.0);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -485,383 +485,463 @@ void FromStepOptions::validate() const {
 
 // ---- the chain -------------------------------------------------------------------------------
 
-FromStepResult superelement_from_step(const fs::path& step_file, const FromStepOptions& o) {
-  o.validate();
-  const auto t_start = std::chrono::steady_clock::now();
-  FromStepResult r;
-  Runner run(o);
-  const auto step_done = [&](const std::string& step, double seconds) { r.seconds.emplace_back(step, seconds); };
+namespace {
 
-  std::error_code ec;
-  if (!fs::is_regular_file(step_file, ec)) {
-    throw InputError(step_file.string(), "file", "an existing STEP file", fs::exists(step_file, ec) ? "not a regular file" : "no such file");
+using PointSurfaces = std::vector<std::pair<std::string, std::vector<int>>>;  // remote point -> its faces
+
+// The run's state from one step to the next: the result being filled, the work folder and what
+// each step hands to the next (geometry, faces, mesh, interface points, the ccx dump).
+class Chain {
+ public:
+  Chain(const fs::path& step_file, const FromStepOptions& o) : step_file_(step_file), o_(o), run_(o) {}
+
+  void step_done(const std::string& step, double seconds) { r_.seconds.emplace_back(step, seconds); }
+
+  // The STEP file, the output and work folders, the tools: everything checked before gmsh runs.
+  void prepare() {
+    std::error_code ec;
+    if (!fs::is_regular_file(step_file_, ec)) {
+      throw InputError(step_file_.string(), "file", "an existing STEP file", fs::exists(step_file_, ec) ? "not a regular file" : "no such file");
+    }
+    fs::create_directories(o_.out, ec);
+    if (ec || !fs::is_directory(o_.out)) throw InputError(o_.out.string(), "--out", "a folder that can be created", ec.message());
+    stem_ = sanitize_stem(o_.stem.empty() ? step_file_.stem().string() : o_.stem);
+    work_.emplace(o_.out / kWorkDir, o_.keep_temp);
+    w_ = work_->path();
+    if (o_.keep_temp) r_.work_dir = w_;
+    r_.gmsh = run_.check_tool(o_.gmsh, "gmsh", "--version", kMinGmsh, "gmsh", w_);
+    r_.ccx = run_.check_tool(o_.ccx, "ccx", "-v", kMinCcx, "calculix-ccx", w_);
+    run_.log("gmsh " + r_.gmsh.version + " (" + r_.gmsh.path + "), ccx " + r_.ccx.version + " (" + r_.ccx.path + ")");
   }
-  fs::create_directories(o.out, ec);
-  if (ec || !fs::is_directory(o.out)) throw InputError(o.out.string(), "--out", "a folder that can be created", ec.message());
-  const std::string stem = sanitize_stem(o.stem.empty() ? step_file.stem().string() : o.stem);
-  WorkFolder work(o.out / kWorkDir, o.keep_temp);
-  const fs::path& w = work.path();
-  if (o.keep_temp) r.work_dir = w;
 
-  r.gmsh = run.check_tool(o.gmsh, "gmsh", "--version", kMinGmsh, "gmsh", w);
-  r.ccx = run.check_tool(o.ccx, "ccx", "-v", kMinCcx, "calculix-ccx", w);
-  run.log("gmsh " + r.gmsh.version + " (" + r.gmsh.path + "), ccx " + r.ccx.version + " (" + r.ccx.path + ")");
-  if (text::to_lower(step_file.extension().string()) == ".geo") {
-    // A gmsh script (e.g. apa300ml.geo): exported to STEP with its parameters, then as any STEP file.
-    copy_into(step_file, w / "model.geo");
+  // model.step in the work folder: the STEP file, or a gmsh script (e.g. apa300ml.geo) exported to
+  // STEP with its parameters, then as any STEP file.
+  void import_model() {
+    if (text::to_lower(step_file_.extension().string()) != ".geo") {
+      if (!o_.geo_parameters.empty()) throw InputError(step_file_.string(), "--geo-parameter", "a .geo input (gmsh script)", "a STEP file");
+      copy_into(step_file_, w_ / "model.step");
+      return;
+    }
+    copy_into(step_file_, w_ / "model.geo");
     std::vector<std::string> args = {"-0", "model.geo"};
     std::string text;
-    for (const auto& [name, value] : o.geo_parameters) {
+    for (const auto& [name, value] : o_.geo_parameters) {
       args.insert(args.end(), {"-setnumber", name, format_number(value, 17)});
       text += " " + name + "=" + format_number(value, 17);
     }
     args.insert(args.end(), {"-o", "model.step"});
-    run.log("[0/6] exporting the gmsh script to STEP:" + (text.empty() ? std::string(" default parameters") : text));
-    const fs::path export_log = o.out / "gmsh_export.log";
-    const auto e_run = run.run(r.gmsh, "gmsh", args, w, export_log, [](std::string_view l) { return l.find("Error") != std::string_view::npos; });
+    run_.log("[0/6] exporting the gmsh script to STEP:" + (text.empty() ? std::string(" default parameters") : text));
+    const fs::path export_log = o_.out / "gmsh_export.log";
+    const auto e_run = run_.run(r_.gmsh, "gmsh", args, w_, export_log, [](std::string_view l) { return l.find("Error") != std::string_view::npos; });
     step_done("gmsh export", e_run.seconds);
-    if (e_run.exit_code != 0 || !fs::exists(w / "model.step")) {
-      throw InputError(step_file.string(), "geo", "a gmsh script that gmsh exports to STEP",
+    if (e_run.exit_code != 0 || !fs::exists(w_ / "model.step")) {
+      throw InputError(step_file_.string(), "geo", "a gmsh script that gmsh exports to STEP",
                        "exit code " + std::to_string(e_run.exit_code) + ": " + detail::last_lines(read_file(export_log), "rror", 3) +
                            " (log: " + export_log.string() + ")");
     }
-  } else {
-    if (!o.geo_parameters.empty()) throw InputError(step_file.string(), "--geo-parameter", "a .geo input (gmsh script)", "a STEP file");
-    copy_into(step_file, w / "model.step");
   }
 
-  // 1. The geometry: volumes and faces with their bounding boxes.
-  run.log("[1/6] reading the geometry (gmsh, OpenCASCADE): " + step_file.string());
-  const std::string prelude = detail::geometry_script("model.step", o.regions, o.geometry_tolerance_mm);
-  write_text(w / "geometry.geo", prelude + detail::report_script("geometry.txt"));
-  const fs::path geometry_log = o.out / "gmsh_geometry.log";
-  const auto g_run = run.run(r.gmsh, "gmsh", {"-0", "geometry.geo", "-o", "geometry.geo_unrolled"}, w, geometry_log,
-                             [](std::string_view l) { return l.find("Error") != std::string_view::npos; });
-  step_done("gmsh geometry", g_run.seconds);
-  const std::string g_log = read_file(geometry_log);
-  if (!fs::exists(w / "geometry.txt")) {
-    // gmsh writes its report even when the STEP file does not load: this is not gmsh running a .geo script.
-    throw InputError("--gmsh", "gmsh", "gmsh running the geometry script (it writes geometry.txt)",
-                     "no report from " + r.gmsh.path + " (exit code " + std::to_string(g_run.exit_code) + "; log: " +
-                         geometry_log.string() + ")");
-  }
-  if (g_run.exit_code != 0) {
-    const std::string errors = detail::last_lines(g_log, "Err", 3);
-    throw InputError(step_file.string(), "STEP", "a STEP file that gmsh loads (OpenCASCADE)",
-                     "gmsh exit code " + std::to_string(g_run.exit_code) + (errors.empty() ? "" : ": " + errors) + " (log: " +
-                         geometry_log.string() + ")");
-  }
-  const detail::GeometryReport geometry = detail::parse_geometry_report(read_file(w / "geometry.txt"), (w / "geometry.txt").string());
-  if (geometry.volumes.empty()) {
-    const std::string errors = detail::last_lines(g_log, "ERR", 2);
-    throw InputError(step_file.string(), "STEP", "a STEP file with at least one solid",
-                     "no volume" + (errors.empty() ? std::string() : " (" + errors + ")"));
-  }
-  copy_into(w / "geometry.txt", o.out / "geometry.txt");
-  auto region_volumes = detail::assign_regions(geometry, o.regions, o.geometry_tolerance_mm);
-  {
-    std::string msg = "  " + std::to_string(geometry.volumes.size()) + " volume(s), " + std::to_string(geometry.surfaces.size()) + " faces;";
-    for (const auto& [name, vols] : region_volumes) {
-      msg += " " + name + ": " + std::to_string(vols.size()) + " volume(s)" + (o.materials.at(name).removed ? " (removed)" : "") + ";";
+  // 1. The geometry: volumes and faces with their bounding boxes, the volumes of each region.
+  void read_geometry() {
+    run_.log("[1/6] reading the geometry (gmsh, OpenCASCADE): " + step_file_.string());
+    prelude_ = detail::geometry_script("model.step", o_.regions, o_.geometry_tolerance_mm);
+    write_text(w_ / "geometry.geo", prelude_ + detail::report_script("geometry.txt"));
+    const fs::path geometry_log = o_.out / "gmsh_geometry.log";
+    const auto g_run = run_.run(r_.gmsh, "gmsh", {"-0", "geometry.geo", "-o", "geometry.geo_unrolled"}, w_, geometry_log,
+                                [](std::string_view l) { return l.find("Error") != std::string_view::npos; });
+    step_done("gmsh geometry", g_run.seconds);
+    const std::string g_log = read_file(geometry_log);
+    if (!fs::exists(w_ / "geometry.txt")) {
+      // gmsh writes its report even when the STEP file does not load: this is not gmsh running a .geo script.
+      throw InputError("--gmsh", "gmsh", "gmsh running the geometry script (it writes geometry.txt)",
+                       "no report from " + r_.gmsh.path + " (exit code " + std::to_string(g_run.exit_code) + "; log: " +
+                           geometry_log.string() + ")");
     }
-    run.log(msg + " " + elapsed(g_run.seconds));
-  }
-  for (auto it = region_volumes.begin(); it != region_volumes.end();) {
-    it = o.materials.at(it->first).removed ? region_volumes.erase(it) : std::next(it);
+    if (g_run.exit_code != 0) {
+      const std::string errors = detail::last_lines(g_log, "Err", 3);
+      throw InputError(step_file_.string(), "STEP", "a STEP file that gmsh loads (OpenCASCADE)",
+                       "gmsh exit code " + std::to_string(g_run.exit_code) + (errors.empty() ? "" : ": " + errors) + " (log: " +
+                           geometry_log.string() + ")");
+    }
+    geometry_ = detail::parse_geometry_report(read_file(w_ / "geometry.txt"), (w_ / "geometry.txt").string());
+    if (geometry_.volumes.empty()) {
+      const std::string errors = detail::last_lines(g_log, "ERR", 2);
+      throw InputError(step_file_.string(), "STEP", "a STEP file with at least one solid",
+                       "no volume" + (errors.empty() ? std::string() : " (" + errors + ")"));
+    }
+    copy_into(w_ / "geometry.txt", o_.out / "geometry.txt");
+    assign_regions(g_run.seconds);
   }
 
-  // What the mesh would cost, before gmsh starts on it.
-  r.estimate = estimate_mesh(geometry.volume_mm3, geometry.area_mm2, o.mesh_size_mm, o.element_order);
-  {
-    const double limit = o.max_memory_GB > 0.0 ? o.max_memory_GB : default_max_memory_GB();
+  // What the mesh would cost, before gmsh starts on it: a UsageError naming the smallest mesh size
+  // within the memory limit when it is over.
+  void check_mesh_estimate() {
+    r_.estimate = estimate_mesh(geometry_.volume_mm3, geometry_.area_mm2, o_.mesh_size_mm, o_.element_order);
+    const double limit = o_.max_memory_GB > 0.0 ? o_.max_memory_GB : default_max_memory_GB();
     char buf[160];
-    std::snprintf(buf, sizeof buf, "  estimate at %g mm: ", o.mesh_size_mm);
-    run.log(buf + r.estimate.to_string() + "; memory limit " + format_number(limit, 17) + " GB");
-    if (r.estimate.memory_GB > limit) {
-      // The smallest mesh size within the limit (the estimate falls as h grows).
-      double lo = o.mesh_size_mm, hi = std::max(1.0, o.mesh_size_mm);
-      while (estimate_mesh(geometry.volume_mm3, geometry.area_mm2, hi, o.element_order).memory_GB > limit && hi < 1e6) hi *= 2.0;
-      for (int k = 0; k < 60; ++k) {
-        const double mid = 0.5 * (lo + hi);
-        (estimate_mesh(geometry.volume_mm3, geometry.area_mm2, mid, o.element_order).memory_GB > limit ? lo : hi) = mid;
+    std::snprintf(buf, sizeof buf, "  estimate at %g mm: ", o_.mesh_size_mm);
+    run_.log(buf + r_.estimate.to_string() + "; memory limit " + format_number(limit, 17) + " GB");
+    if (r_.estimate.memory_GB <= limit) return;
+    // The smallest mesh size within the limit (the estimate falls as h grows).
+    double lo = o_.mesh_size_mm, hi = std::max(1.0, o_.mesh_size_mm);
+    while (estimate_mesh(geometry_.volume_mm3, geometry_.area_mm2, hi, o_.element_order).memory_GB > limit && hi < 1e6) hi *= 2.0;
+    for (int k = 0; k < 60; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (estimate_mesh(geometry_.volume_mm3, geometry_.area_mm2, mid, o_.element_order).memory_GB > limit ? lo : hi) = mid;
+    }
+    char hint[64];
+    std::snprintf(hint, sizeof hint, "%.2g", hi * 1.05);
+    std::snprintf(buf, sizeof buf, "--mesh-size %g mm: ", o_.mesh_size_mm);
+    throw UsageError("superelement from-step: " + std::string(buf) + r_.estimate.to_string() + ", more than the limit of " +
+                     format_number(limit, 17) + " GB for this machine. The mesh size is in millimetres: give --mesh-size " + hint +
+                     " or more, or raise the limit with --max-memory GB (gmsh was not started)");
+  }
+
+  // 2. Remote points: the faces of each, a face belonging to one only.
+  void select_remote_point_faces() {
+    std::map<int, std::string> owner;
+    for (const RemotePointSpec& p : o_.remote_points) {
+      const std::vector<int> faces = detail::select_faces(p.selector, geometry_, o_.geometry_tolerance_mm);
+      if (faces.empty()) {
+        throw InputError("--remote-point " + p.name, "selector", "'" + p.selector.to_string() + "' to select at least one face",
+                         "no face; " + detail::describe_planar_faces(geometry_, o_.geometry_tolerance_mm) +
+                             " (all faces with their bounding boxes: " + (o_.out / "geometry.txt").string() + ")");
       }
-      char hint[64];
-      std::snprintf(hint, sizeof hint, "%.2g", hi * 1.05);
-      std::snprintf(buf, sizeof buf, "--mesh-size %g mm: ", o.mesh_size_mm);
-      throw UsageError("superelement from-step: " + std::string(buf) + r.estimate.to_string() + ", more than the limit of " +
-                       format_number(limit, 17) + " GB for this machine. The mesh size is in millimetres: give --mesh-size " + hint +
-                       " or more, or raise the limit with --max-memory GB (gmsh was not started)");
-    }
-  }
-
-  // 2. Remote points: faces.
-  std::vector<std::pair<std::string, std::vector<int>>> point_surfaces;
-  std::map<int, std::string> owner;
-  for (const RemotePointSpec& p : o.remote_points) {
-    const std::vector<int> faces = detail::select_faces(p.selector, geometry, o.geometry_tolerance_mm);
-    if (faces.empty()) {
-      throw InputError("--remote-point " + p.name, "selector", "'" + p.selector.to_string() + "' to select at least one face",
-                       "no face; " + detail::describe_planar_faces(geometry, o.geometry_tolerance_mm) +
-                           " (all faces with their bounding boxes: " + (o.out / "geometry.txt").string() + ")");
-    }
-    for (const int f : faces) {
-      const auto [it, fresh] = owner.emplace(f, p.name);
-      if (!fresh) {
-        throw InputError("--remote-point " + p.name, "selector", "faces of no other remote point",
-                         "surface " + std::to_string(f) + " also selected by " + it->second);
+      for (const int f : faces) {
+        const auto [it, fresh] = owner.emplace(f, p.name);
+        if (!fresh) {
+          throw InputError("--remote-point " + p.name, "selector", "faces of no other remote point",
+                           "surface " + std::to_string(f) + " also selected by " + it->second);
+        }
       }
-    }
-    point_surfaces.emplace_back(p.name, faces);
-    std::string list;
-    for (const int f : faces) {
-      list += list.empty() ? "" : ",";
-      list += std::to_string(f);
-    }
-    run.log("  remote point " + p.name + " (" + p.selector.to_string() + "): surface " + list);
-  }
-
-  // 3. The mesh.
-  const char* const element = o.element_order == 2 ? "C3D10" : "C3D4";
-  {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "[2/6] meshing (gmsh, at most %g mm, %s)", o.mesh_size_mm, element);
-    run.log(buf);
-  }
-  const std::string mesh_geo = prelude + detail::mesh_script(region_volumes, point_surfaces, o.mesh_size_mm, o.element_order);
-  write_text(w / "mesh.geo", mesh_geo);
-  write_text(o.out / "mesh.geo", mesh_geo);
-  const fs::path mesh_log = o.out / "gmsh_mesh.log";
-  const auto m_run = run.run(r.gmsh, "gmsh", {"-3", "mesh.geo", "-format", "inp", "-o", "gmsh.inp"}, w, mesh_log, keep_gmsh_line);
-  step_done("gmsh mesh", m_run.seconds);
-  if (m_run.exit_code != 0 || !fs::exists(w / "gmsh.inp")) {
-    throw NumericalError("gmsh meshing", "exit code " + std::to_string(m_run.exit_code) + ": " +
-                                             detail::last_lines(read_file(mesh_log), "Error", 3) + " (log: " + mesh_log.string() + ")",
-                         true);
-  }
-  const detail::GmshMesh mesh = detail::read_gmsh_inp(w / "gmsh.inp");
-  r.element_type = mesh.volume_type;
-  long max_node = 0;
-  for (const auto& [id, p] : mesh.nodes) max_node = std::max(max_node, id);
-  std::set<long> used_nodes;
-  for (const auto& [tag, elements] : mesh.volume_elements) {
-    r.mesh_elements += static_cast<Index>(elements.size());
-    for (const auto& e : elements) used_nodes.insert(e.begin() + 1, e.end());
-  }
-  r.mesh_nodes = static_cast<Index>(used_nodes.size());
-  for (const auto& [name, vols] : region_volumes) {
-    Index n = 0;
-    for (const int v : vols) {
-      const auto it = mesh.volume_elements.find(v);
-      if (it != mesh.volume_elements.end()) n += static_cast<Index>(it->second.size());
-    }
-    r.region_elements[name] = n;
-  }
-  std::vector<detail::DeckPoint> points;
-  std::map<long, std::string> node_owner;
-  for (std::size_t k = 0; k < point_surfaces.size(); ++k) {
-    const auto& [name, faces] = point_surfaces[k];
-    const detail::FacePatch patch = detail::face_patch(mesh, faces);
-    if (patch.nodes.size() < 3 || !(patch.area > 0.0)) {
-      throw InputError("--remote-point " + name, "faces", "meshed faces with at least 3 nodes",
-                       std::to_string(patch.nodes.size()) + " nodes (log: " + mesh_log.string() + ")");
-    }
-    for (const long n : patch.nodes) {
-      const auto [it, fresh] = node_owner.emplace(n, name);
-      if (!fresh) {
-        throw InputError("--remote-point " + name, "faces", "faces that do not touch the faces of another remote point",
-                         "node " + std::to_string(n) + " shared with " + it->second + " (a *RIGID BODY node can belong to one only)");
+      point_surfaces_.emplace_back(p.name, faces);
+      std::string list;
+      for (const int f : faces) {
+        list += list.empty() ? "" : ",";
+        list += std::to_string(f);
       }
-    }
-    detail::DeckPoint dp;
-    dp.name = name;
-    dp.ref = max_node + 1 + 2 * static_cast<long>(k);
-    dp.rot = dp.ref + 1;
-    dp.position_m = 1e-3 * patch.centroid;
-    dp.nodes = patch.nodes;
-    points.push_back(dp);
-    RemotePointResult rp;
-    rp.name = name;
-    rp.selector = o.remote_points[k].selector;
-    rp.surfaces = faces;
-    rp.node = dp.ref;
-    rp.rot_node = dp.rot;
-    rp.position_m = dp.position_m;
-    rp.area_m2 = 1e-6 * patch.area;
-    rp.face_nodes = static_cast<Index>(patch.nodes.size());
-    r.remote_points.push_back(rp);
-  }
-  detail::write_mesh_inp(w / "mesh.inp", mesh, region_volumes, points);
-  copy_into(w / "mesh.inp", o.out / "mesh.inp");
-  {
-    std::string msg = "  " + std::to_string(r.mesh_nodes) + " nodes, " + std::to_string(r.mesh_elements) + " " + r.element_type +
-                      " elements (about " + std::to_string(3 * r.mesh_nodes) + " DOF);";
-    for (const auto& [name, n] : r.region_elements) msg += " " + name + " " + std::to_string(n) + ";";
-    run.log(msg + " " + elapsed(m_run.seconds));
-    for (const RemotePointResult& rp : r.remote_points) {
-      char buf[200];
-      std::snprintf(buf, sizeof buf, "  remote point %s: node %ld (rotations on node %ld) at (%.6g, %.6g, %.6g) m, %lld face nodes",
-                    rp.name.c_str(), rp.node, rp.rot_node, rp.position_m.x(), rp.position_m.y(), rp.position_m.z(),
-                    static_cast<long long>(rp.face_nodes));
-      run.log(buf);
+      run_.log("  remote point " + p.name + " (" + p.selector.to_string() + "): surface " + list);
     }
   }
 
-  // 4. K and M from ccx.
-  std::vector<std::string> region_names;
-  for (const auto& [name, vols] : region_volumes) region_names.push_back(name);
-  const std::string deck = detail::ccx_deck("mesh.inp", o.materials, region_names, points, nullptr, 0,
-                                            "free-free K and M of " + step_file.filename().string() + " (*FREQUENCY,SOLVER=MATRIXSTORAGE)");
-  write_text(w / "matrices.inp", deck);
-  write_text(o.out / "matrices.inp", deck);
-  run.log("[3/6] assembling K and M (ccx *FREQUENCY,SOLVER=MATRIXSTORAGE)");
-  const fs::path ccx_log = o.out / "ccx_matrices.log";
-  const auto c_run = run.run(r.ccx, "ccx", {"-i", "matrices"}, w, ccx_log, keep_ccx_line);
-  step_done("ccx matrices", c_run.seconds);
-  if (c_run.exit_code != 0 || !fs::exists(w / "matrices.sti") || !fs::exists(w / "matrices.mas") || !fs::exists(w / "matrices.dof")) {
-    throw NumericalError("ccx (*FREQUENCY,SOLVER=MATRIXSTORAGE)",
-                         "exit code " + std::to_string(c_run.exit_code) + ": " + detail::last_lines(read_file(ccx_log), "ERROR", 3) +
-                             " (log: " + ccx_log.string() + ", deck: " + (o.out / "matrices.inp").string() + ")",
-                         false);
-  }
-  run.log("  " + elapsed(c_run.seconds));
-
-  // 5. Reading and reduction.
-  run.log("[4/6] reading the matrices");
-  auto t0 = std::chrono::steady_clock::now();
-  double last_report = -1.0;
-  std::string last_step;
-  const ProgressCallback progress = [&](const std::string& step, double fraction) {
-    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const std::string key = step.substr(0, step.find(" ("));
-    if (key == last_step && (fraction >= 1.0 || now - last_report < 1.0)) return;
-    last_step = key;
-    last_report = now;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "  %6.1f s  %s", now, step.c_str());
-    run.log(buf);
-  };
-  SparseModel model = read_calculix_model(w / "matrices.sti", w / "matrices.mas", w / "matrices.dof", w / "mesh.inp", progress);
-  r.model_dofs = model.size();
-  step_done("read matrices", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  if (!o.keep_temp) {
-    // The dumps are the largest files (hundreds of MB at 2 mm); they are read now.
-    fs::remove(w / "matrices.sti", ec);
-    fs::remove(w / "matrices.mas", ec);
-  }
-  run.log("  " + std::to_string(model.size()) + " DOF, K with " + std::to_string(model.K.nonZeros()) + " nonzeros");
-
-  run.log("[5/6] Craig-Bampton reduction: " + std::to_string(6 * points.size()) + " interface DOF, " + std::to_string(o.modes) + " modes");
-  std::vector<InterfacePoint> interface;
-  for (const detail::DeckPoint& p : points) interface.push_back({p.ref, p.rot});
-  CraigBamptonOptions cb;
-  cb.modes = o.modes;
-  t0 = std::chrono::steady_clock::now();
-  last_step.clear();
-  cb.progress = progress;
-  r.reduction = craig_bampton(std::move(model), interface, cb);  // K and M freed once split
-  model = SparseModel{};  // free the large matrices
-  r.reduced = std::move(r.reduction.reduced);
-  r.reduction.reduced = SuperElement{};
-  r.reduced.source = step_file.filename().string() + " (gmsh " + r.element_type + " mesh, ccx " + r.ccx.version + ", Craig-Bampton: " +
-                     std::to_string(r.reduction.interface_dofs) + " interface DOF, " + std::to_string(o.modes) + " modes)";
-  step_done("craig-bampton", r.reduction.seconds);
-  run.log("  " + elapsed(r.reduction.seconds));
-
-  // Clamped and free modes of the reduced model.
-  const detail::DeckPoint* clamp = nullptr;
-  for (const detail::DeckPoint& p : points) {
-    if (detail::upper(p.name) == detail::upper(o.clamp)) clamp = &p;
-  }
-  r.clamp = clamp->name;
-  ModelOptions bc;
-  bc.fixed_nodes = {clamp->ref};
-  const auto clamped_modes_of = [&](const SuperElement& se) {
-    const Modes m = modes(assemble(se, bc));
-    return Eigen::VectorXd(m.frequencies_Hz.head(std::min<Index>(o.clamped_modes, m.frequencies_Hz.size())));
-  };
-  r.shell_modes_clamped_Hz = clamped_modes_of(r.reduced);
-  // Static stiffness at `axial`, clamp fixed: 1 / (K_ff^-1)_jj (the modal DOF are uncoupled from the
-  // interface in K, so this is the full model's static stiffness there).
-  const auto axial_stiffness_of = [&](const SuperElement& se) {
-    if (o.axial.empty()) return 0.0;
-    const auto colon = o.axial.find(':');
-    long node = -1;
-    for (const detail::DeckPoint& p : points) {
-      if (detail::upper(p.name) == detail::upper(o.axial.substr(0, colon))) node = p.ref;
+  // 3. The mesh (gmsh), its counts, the remote points' nodes, and mesh.inp for ccx.
+  void mesh() {
+    const char* const element = o_.element_order == 2 ? "C3D10" : "C3D4";
+    {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "[2/6] meshing (gmsh, at most %g mm, %s)", o_.mesh_size_mm, element);
+      run_.log(buf);
     }
-    ModelOptions mo = bc;
-    mo.forces = {ForcePair{-1, node, *direction_from_string(o.axial.substr(colon + 1))}};
-    mo.outputs = {DisplacementOutput{-1, node, mo.forces[0].direction}};
-    const StructuralModel sm = assemble(se, mo);
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(sm.K);
-    const double compliance = (sm.T * ldlt.solve(sm.F))(0, 0);
-    return compliance > 0.0 ? 1.0 / compliance : 0.0;
-  };
-  r.shell_axial_stiffness = axial_stiffness_of(r.reduced);
-
-  // Joints and stacks: nodes and beams added to the reduced model (exact: their ends are interface DOF).
-  if (!o.joints.empty() || !o.stacks.empty()) {
-    std::map<std::string, std::pair<long, Eigen::Vector3d>> at;  // upper-case name -> node, position (m)
-    for (const detail::DeckPoint& p : points) at[detail::upper(p.name)] = {p.ref, p.position_m};
-    long next = points.back().rot + 1;
-    for (const JointSpec& j : o.joints) {
-      const auto& a = at.at(detail::upper(j.from));
-      const auto& b = at.at(detail::upper(j.to));
-      const Eigen::Vector3d x = a.second + j.fraction * (b.second - a.second);
-      add_node(r.reduced, next, x);
-      at[detail::upper(j.name)] = {next, x};
-      r.joints.push_back({j.name, next, x});
-      run.log("  joint " + j.name + ": node " + std::to_string(next) + " at " + format_number(j.fraction, 17) + " of " + j.from + " -> " + j.to);
-      ++next;
+    const std::string mesh_geo = prelude_ + detail::mesh_script(region_volumes_, point_surfaces_, o_.mesh_size_mm, o_.element_order);
+    write_text(w_ / "mesh.geo", mesh_geo);
+    write_text(o_.out / "mesh.geo", mesh_geo);
+    const fs::path mesh_log = o_.out / "gmsh_mesh.log";
+    const auto m_run = run_.run(r_.gmsh, "gmsh", {"-3", "mesh.geo", "-format", "inp", "-o", "gmsh.inp"}, w_, mesh_log, keep_gmsh_line);
+    step_done("gmsh mesh", m_run.seconds);
+    if (m_run.exit_code != 0 || !fs::exists(w_ / "gmsh.inp")) {
+      throw NumericalError("gmsh meshing", "exit code " + std::to_string(m_run.exit_code) + ": " +
+                                               detail::last_lines(read_file(mesh_log), "Error", 3) + " (log: " + mesh_log.string() + ")",
+                           true);
     }
-    for (const StackSpec& st : o.stacks) {
-      const long a = at.at(detail::upper(st.from)).first, b = at.at(detail::upper(st.to)).first;
-      const BeamMatrices bm = add_beam(r.reduced, a, b, st.section, "--stack " + st.from + ":" + st.to);
-      r.stacks.push_back({st.from, st.to, a, b, bm.length, bm.axial_stiffness, st.section.density * st.section.area * bm.length});
-      char buf[200];
-      std::snprintf(buf, sizeof buf, "  stack %s -> %s: beam of %.4g mm, E A / L = %.4g N/um, %.3g g", st.from.c_str(), st.to.c_str(),
-                    1e3 * bm.length, 1e-6 * bm.axial_stiffness, 1e3 * r.stacks.back().mass);
-      run.log(buf);
-    }
-    r.reduced.source += ", " + std::to_string(o.stacks.size()) + " stack beam(s)";
-  }
-  r.axial_stiffness = axial_stiffness_of(r.reduced);
-  const Modes clamped = modes(assemble(r.reduced, bc));
-  r.modes_clamped_Hz = clamped.frequencies_Hz.head(std::min<Index>(o.clamped_modes, clamped.frequencies_Hz.size()));
-  const Modes free = modes(r.reduced.K, r.reduced.M);
-  r.free_modes_Hz = free.frequencies_Hz.head(std::min<Index>(6 + o.clamped_modes, free.frequencies_Hz.size()));
-
-  // 6. Outputs.
-  run.log("[6/6] writing the super element into " + o.out.string());
-  r.files = write_super_element(o.out, stem, r.reduced);
-  r.files.push_back(write_simscape(o.out, stem, r.reduced));
-  for (const char* f : {"geometry.txt", "mesh.geo", "mesh.inp", "matrices.inp", "gmsh_geometry.log", "gmsh_mesh.log", "ccx_matrices.log"}) {
-    r.files.push_back(o.out / f);
+    const detail::GmshMesh gmsh_mesh = detail::read_gmsh_inp(w_ / "gmsh.inp");
+    count_mesh(gmsh_mesh);
+    place_remote_points(gmsh_mesh, mesh_log);
+    detail::write_mesh_inp(w_ / "mesh.inp", gmsh_mesh, region_volumes_, points_);
+    copy_into(w_ / "mesh.inp", o_.out / "mesh.inp");
+    log_mesh(m_run.seconds);
   }
 
-  if (o.verify) {
-    const std::string ref_deck = detail::ccx_deck("mesh.inp", o.materials, region_names, points, clamp, o.clamped_modes,
-                                                  "reference: remote point " + clamp->name + " clamped, ccx *FREQUENCY on the full mesh");
-    write_text(w / "reference.inp", ref_deck);
-    write_text(o.out / "reference.inp", ref_deck);
-    run.log("[verify] ccx *FREQUENCY on the full mesh, " + clamp->name + " clamped, " + std::to_string(o.clamped_modes) + " modes");
-    const fs::path ref_log = o.out / "ccx_reference.log";
-    const auto v_run = run.run(r.ccx, "ccx", {"-i", "reference"}, w, ref_log, keep_ccx_line);
+  // 4. K and M from ccx (*FREQUENCY,SOLVER=MATRIXSTORAGE).
+  void assemble_matrices() {
+    for (const auto& [name, vols] : region_volumes_) region_names_.push_back(name);
+    const std::string deck = detail::ccx_deck("mesh.inp", o_.materials, region_names_, points_, nullptr, 0,
+                                              "free-free K and M of " + step_file_.filename().string() + " (*FREQUENCY,SOLVER=MATRIXSTORAGE)");
+    write_text(w_ / "matrices.inp", deck);
+    write_text(o_.out / "matrices.inp", deck);
+    run_.log("[3/6] assembling K and M (ccx *FREQUENCY,SOLVER=MATRIXSTORAGE)");
+    const fs::path ccx_log = o_.out / "ccx_matrices.log";
+    const auto c_run = run_.run(r_.ccx, "ccx", {"-i", "matrices"}, w_, ccx_log, keep_ccx_line);
+    step_done("ccx matrices", c_run.seconds);
+    if (c_run.exit_code != 0 || !fs::exists(w_ / "matrices.sti") || !fs::exists(w_ / "matrices.mas") || !fs::exists(w_ / "matrices.dof")) {
+      throw NumericalError("ccx (*FREQUENCY,SOLVER=MATRIXSTORAGE)",
+                           "exit code " + std::to_string(c_run.exit_code) + ": " + detail::last_lines(read_file(ccx_log), "ERROR", 3) +
+                               " (log: " + ccx_log.string() + ", deck: " + (o_.out / "matrices.inp").string() + ")",
+                           false);
+    }
+    run_.log("  " + elapsed(c_run.seconds));
+  }
+
+  // 5. Reading the dump and the Craig-Bampton reduction onto the remote points.
+  void reduce() {
+    run_.log("[4/6] reading the matrices");
+    progress_start_ = std::chrono::steady_clock::now();
+    const ProgressCallback progress = [this](const std::string& step, double fraction) { report_progress(step, fraction); };
+    SparseModel model = read_calculix_model(w_ / "matrices.sti", w_ / "matrices.mas", w_ / "matrices.dof", w_ / "mesh.inp", progress);
+    r_.model_dofs = model.size();
+    step_done("read matrices", std::chrono::duration<double>(std::chrono::steady_clock::now() - progress_start_).count());
+    if (!o_.keep_temp) {
+      // The dumps are the largest files (hundreds of MB at 2 mm); they are read now.
+      std::error_code ec;
+      fs::remove(w_ / "matrices.sti", ec);
+      fs::remove(w_ / "matrices.mas", ec);
+    }
+    run_.log("  " + std::to_string(model.size()) + " DOF, K with " + std::to_string(model.K.nonZeros()) + " nonzeros");
+
+    run_.log("[5/6] Craig-Bampton reduction: " + std::to_string(6 * points_.size()) + " interface DOF, " + std::to_string(o_.modes) + " modes");
+    std::vector<InterfacePoint> interface;
+    for (const detail::DeckPoint& p : points_) interface.push_back({p.ref, p.rot});
+    CraigBamptonOptions cb;
+    cb.modes = o_.modes;
+    progress_start_ = std::chrono::steady_clock::now();
+    last_step_.clear();
+    cb.progress = progress;
+    r_.reduction = craig_bampton(std::move(model), interface, cb);  // K and M freed once split
+    model = SparseModel{};  // free the large matrices
+    r_.reduced = std::move(r_.reduction.reduced);
+    r_.reduction.reduced = SuperElement{};
+    r_.reduced.source = step_file_.filename().string() + " (gmsh " + r_.element_type + " mesh, ccx " + r_.ccx.version +
+                        ", Craig-Bampton: " + std::to_string(r_.reduction.interface_dofs) + " interface DOF, " +
+                        std::to_string(o_.modes) + " modes)";
+    step_done("craig-bampton", r_.reduction.seconds);
+    run_.log("  " + elapsed(r_.reduction.seconds));
+  }
+
+  // Clamped modes and axial stiffness of the reduced shell, then of the model with its joints and
+  // stacks (nodes and beams added to the reduced model, exact: their ends are interface DOF).
+  void clamped_properties() {
+    for (const detail::DeckPoint& p : points_) {
+      if (detail::upper(p.name) == detail::upper(o_.clamp)) clamp_ = &p;
+    }
+    r_.clamp = clamp_->name;
+    bc_.fixed_nodes = {clamp_->ref};
+    const Modes shell = modes(assemble(r_.reduced, bc_));
+    r_.shell_modes_clamped_Hz = Eigen::VectorXd(shell.frequencies_Hz.head(std::min<Index>(o_.clamped_modes, shell.frequencies_Hz.size())));
+    r_.shell_axial_stiffness = axial_stiffness_of(r_.reduced);
+    if (!o_.joints.empty() || !o_.stacks.empty()) add_joints_and_stacks();
+    r_.axial_stiffness = axial_stiffness_of(r_.reduced);
+    const Modes clamped = modes(assemble(r_.reduced, bc_));
+    r_.modes_clamped_Hz = clamped.frequencies_Hz.head(std::min<Index>(o_.clamped_modes, clamped.frequencies_Hz.size()));
+    const Modes free = modes(r_.reduced.K, r_.reduced.M);
+    r_.free_modes_Hz = free.frequencies_Hz.head(std::min<Index>(6 + o_.clamped_modes, free.frequencies_Hz.size()));
+  }
+
+  // 6. Outputs: the super element, its Simscape form and the inputs and logs of the tools.
+  void write_outputs() {
+    run_.log("[6/6] writing the super element into " + o_.out.string());
+    r_.files = write_super_element(o_.out, stem_, r_.reduced);
+    r_.files.push_back(write_simscape(o_.out, stem_, r_.reduced));
+    for (const char* f : {"geometry.txt", "mesh.geo", "mesh.inp", "matrices.inp", "gmsh_geometry.log", "gmsh_mesh.log", "ccx_matrices.log"}) {
+      r_.files.push_back(o_.out / f);
+    }
+  }
+
+  // The reference: ccx *FREQUENCY on the full mesh with the same clamp.
+  void verify() {
+    const std::string ref_deck = detail::ccx_deck("mesh.inp", o_.materials, region_names_, points_, clamp_, o_.clamped_modes,
+                                                  "reference: remote point " + clamp_->name + " clamped, ccx *FREQUENCY on the full mesh");
+    write_text(w_ / "reference.inp", ref_deck);
+    write_text(o_.out / "reference.inp", ref_deck);
+    run_.log("[verify] ccx *FREQUENCY on the full mesh, " + clamp_->name + " clamped, " + std::to_string(o_.clamped_modes) + " modes");
+    const fs::path ref_log = o_.out / "ccx_reference.log";
+    const auto v_run = run_.run(r_.ccx, "ccx", {"-i", "reference"}, w_, ref_log, keep_ccx_line);
     step_done("ccx reference", v_run.seconds);
-    if (v_run.exit_code != 0 || !fs::exists(w / "reference.dat")) {
+    if (v_run.exit_code != 0 || !fs::exists(w_ / "reference.dat")) {
       throw NumericalError("ccx (*FREQUENCY, reference)",
                            "exit code " + std::to_string(v_run.exit_code) + ": " + detail::last_lines(read_file(ref_log), "ERROR", 3) +
                                " (log: " + ref_log.string() + ")",
                            false);
     }
-    const std::vector<double> f = detail::read_ccx_frequencies(w / "reference.dat");
-    copy_into(w / "reference.dat", o.out / "reference.dat");
-    r.reference_modes_Hz = Eigen::Map<const Eigen::VectorXd>(f.data(), static_cast<Index>(f.size()));
-    for (const char* name : {"reference.inp", "reference.dat", "ccx_reference.log"}) r.files.push_back(o.out / name);
-    run.log("  " + elapsed(v_run.seconds));
+    const std::vector<double> f = detail::read_ccx_frequencies(w_ / "reference.dat");
+    copy_into(w_ / "reference.dat", o_.out / "reference.dat");
+    r_.reference_modes_Hz = Eigen::Map<const Eigen::VectorXd>(f.data(), static_cast<Index>(f.size()));
+    for (const char* name : {"reference.inp", "reference.dat", "ccx_reference.log"}) r_.files.push_back(o_.out / name);
+    run_.log("  " + elapsed(v_run.seconds));
   }
-  step_done("total", std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count());
-  return r;
+
+  FromStepResult take_result() { return std::move(r_); }
+
+ private:
+  // The volumes of each region, logged; the removed regions are left out of the mesh.
+  void assign_regions(double geometry_seconds) {
+    region_volumes_ = detail::assign_regions(geometry_, o_.regions, o_.geometry_tolerance_mm);
+    std::string msg = "  " + std::to_string(geometry_.volumes.size()) + " volume(s), " + std::to_string(geometry_.surfaces.size()) + " faces;";
+    for (const auto& [name, vols] : region_volumes_) {
+      msg += " " + name + ": " + std::to_string(vols.size()) + " volume(s)" + (o_.materials.at(name).removed ? " (removed)" : "") + ";";
+    }
+    run_.log(msg + " " + elapsed(geometry_seconds));
+    for (auto it = region_volumes_.begin(); it != region_volumes_.end();) {
+      it = o_.materials.at(it->first).removed ? region_volumes_.erase(it) : std::next(it);
+    }
+  }
+
+  // Elements and nodes of the mesh, in all and per region; the highest node number.
+  void count_mesh(const detail::GmshMesh& mesh) {
+    r_.element_type = mesh.volume_type;
+    for (const auto& [id, p] : mesh.nodes) max_node_ = std::max(max_node_, id);
+    std::set<long> used_nodes;
+    for (const auto& [tag, elements] : mesh.volume_elements) {
+      r_.mesh_elements += static_cast<Index>(elements.size());
+      for (const auto& e : elements) used_nodes.insert(e.begin() + 1, e.end());
+    }
+    r_.mesh_nodes = static_cast<Index>(used_nodes.size());
+    for (const auto& [name, vols] : region_volumes_) {
+      Index n = 0;
+      for (const int v : vols) {
+        const auto it = mesh.volume_elements.find(v);
+        if (it != mesh.volume_elements.end()) n += static_cast<Index>(it->second.size());
+      }
+      r_.region_elements[name] = n;
+    }
+  }
+
+  // Each remote point on the meshed nodes of its faces (a node belonging to one only): its
+  // reference and rotation nodes after the mesh's, at the faces' centroid.
+  void place_remote_points(const detail::GmshMesh& mesh, const fs::path& mesh_log) {
+    std::map<long, std::string> node_owner;
+    for (std::size_t k = 0; k < point_surfaces_.size(); ++k) {
+      const auto& [name, faces] = point_surfaces_[k];
+      const detail::FacePatch patch = detail::face_patch(mesh, faces);
+      if (patch.nodes.size() < 3 || !(patch.area > 0.0)) {
+        throw InputError("--remote-point " + name, "faces", "meshed faces with at least 3 nodes",
+                         std::to_string(patch.nodes.size()) + " nodes (log: " + mesh_log.string() + ")");
+      }
+      for (const long n : patch.nodes) {
+        const auto [it, fresh] = node_owner.emplace(n, name);
+        if (!fresh) {
+          throw InputError("--remote-point " + name, "faces", "faces that do not touch the faces of another remote point",
+                           "node " + std::to_string(n) + " shared with " + it->second + " (a *RIGID BODY node can belong to one only)");
+        }
+      }
+      detail::DeckPoint dp;
+      dp.name = name;
+      dp.ref = max_node_ + 1 + 2 * static_cast<long>(k);
+      dp.rot = dp.ref + 1;
+      dp.position_m = 1e-3 * patch.centroid;
+      dp.nodes = patch.nodes;
+      points_.push_back(dp);
+      RemotePointResult rp;
+      rp.name = name;
+      rp.selector = o_.remote_points[k].selector;
+      rp.surfaces = faces;
+      rp.node = dp.ref;
+      rp.rot_node = dp.rot;
+      rp.position_m = dp.position_m;
+      rp.area_m2 = 1e-6 * patch.area;
+      rp.face_nodes = static_cast<Index>(patch.nodes.size());
+      r_.remote_points.push_back(rp);
+    }
+  }
+
+  void log_mesh(double mesh_seconds) const {
+    std::string msg = "  " + std::to_string(r_.mesh_nodes) + " nodes, " + std::to_string(r_.mesh_elements) + " " + r_.element_type +
+                      " elements (about " + std::to_string(3 * r_.mesh_nodes) + " DOF);";
+    for (const auto& [name, n] : r_.region_elements) msg += " " + name + " " + std::to_string(n) + ";";
+    run_.log(msg + " " + elapsed(mesh_seconds));
+    for (const RemotePointResult& rp : r_.remote_points) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "  remote point %s: node %ld (rotations on node %ld) at (%.6g, %.6g, %.6g) m, %lld face nodes",
+                    rp.name.c_str(), rp.node, rp.rot_node, rp.position_m.x(), rp.position_m.y(), rp.position_m.z(),
+                    static_cast<long long>(rp.face_nodes));
+      run_.log(buf);
+    }
+  }
+
+  // A progress line per step of the reader and the reduction, at most one a second per step.
+  void report_progress(const std::string& step, double fraction) {
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - progress_start_).count();
+    const std::string key = step.substr(0, step.find(" ("));
+    if (key == last_step_ && (fraction >= 1.0 || now - last_report_ < 1.0)) return;
+    last_step_ = key;
+    last_report_ = now;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "  %6.1f s  %s", now, step.c_str());
+    run_.log(buf);
+  }
+
+  // Static stiffness at `axial`, clamp fixed: 1 / (K_ff^-1)_jj (the modal DOF are uncoupled from the
+  // interface in K, so this is the full model's static stiffness there).
+  double axial_stiffness_of(const SuperElement& se) const {
+    if (o_.axial.empty()) return 0.0;
+    const auto colon = o_.axial.find(':');
+    long node = -1;
+    for (const detail::DeckPoint& p : points_) {
+      if (detail::upper(p.name) == detail::upper(o_.axial.substr(0, colon))) node = p.ref;
+    }
+    ModelOptions mo = bc_;
+    mo.forces = {ForcePair{-1, node, *direction_from_string(o_.axial.substr(colon + 1))}};
+    mo.outputs = {DisplacementOutput{-1, node, mo.forces[0].direction}};
+    const StructuralModel sm = assemble(se, mo);
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(sm.K);
+    const double compliance = (sm.T * ldlt.solve(sm.F))(0, 0);
+    return compliance > 0.0 ? 1.0 / compliance : 0.0;
+  }
+
+  void add_joints_and_stacks() {
+    std::map<std::string, std::pair<long, Eigen::Vector3d>> at;  // upper-case name -> node, position (m)
+    for (const detail::DeckPoint& p : points_) at[detail::upper(p.name)] = {p.ref, p.position_m};
+    long next = points_.back().rot + 1;
+    for (const JointSpec& j : o_.joints) {
+      const auto& a = at.at(detail::upper(j.from));
+      const auto& b = at.at(detail::upper(j.to));
+      const Eigen::Vector3d x = a.second + j.fraction * (b.second - a.second);
+      add_node(r_.reduced, next, x);
+      at[detail::upper(j.name)] = {next, x};
+      r_.joints.push_back({j.name, next, x});
+      run_.log("  joint " + j.name + ": node " + std::to_string(next) + " at " + format_number(j.fraction, 17) + " of " + j.from + " -> " + j.to);
+      ++next;
+    }
+    for (const StackSpec& st : o_.stacks) {
+      const long a = at.at(detail::upper(st.from)).first, b = at.at(detail::upper(st.to)).first;
+      const BeamMatrices bm = add_beam(r_.reduced, a, b, st.section, "--stack " + st.from + ":" + st.to);
+      r_.stacks.push_back({st.from, st.to, a, b, bm.length, bm.axial_stiffness, st.section.density * st.section.area * bm.length});
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "  stack %s -> %s: beam of %.4g mm, E A / L = %.4g N/um, %.3g g", st.from.c_str(), st.to.c_str(),
+                    1e3 * bm.length, 1e-6 * bm.axial_stiffness, 1e3 * r_.stacks.back().mass);
+      run_.log(buf);
+    }
+    r_.reduced.source += ", " + std::to_string(o_.stacks.size()) + " stack beam(s)";
+  }
+
+  const fs::path& step_file_;
+  const FromStepOptions& o_;
+  FromStepResult r_;
+  Runner run_;
+  std::optional<WorkFolder> work_;  // removed with the Chain unless keep_temp
+  fs::path w_;                      // its path
+  std::string stem_;
+  detail::GeometryReport geometry_;
+  std::string prelude_;             // the geometry script, which the mesh script continues
+  std::map<std::string, std::vector<int>> region_volumes_;  // the meshed regions' volumes
+  PointSurfaces point_surfaces_;
+  long max_node_ = 0;               // the mesh's highest node number
+  std::vector<detail::DeckPoint> points_;
+  std::vector<std::string> region_names_;
+  const detail::DeckPoint* clamp_ = nullptr;
+  ModelOptions bc_;                 // the clamp fixed
+  std::chrono::steady_clock::time_point progress_start_;
+  double last_report_ = -1.0;
+  std::string last_step_;
+};
+
+}  // namespace
+
+FromStepResult superelement_from_step(const fs::path& step_file, const FromStepOptions& o) {
+  o.validate();
+  const auto t_start = std::chrono::steady_clock::now();
+  Chain chain(step_file, o);
+  chain.prepare();
+  chain.import_model();
+  chain.read_geometry();
+  chain.check_mesh_estimate();
+  chain.select_remote_point_faces();
+  chain.mesh();
+  chain.assemble_matrices();
+  chain.reduce();
+  chain.clamped_properties();
+  chain.write_outputs();
+  if (o.verify) chain.verify();
+  chain.step_done("total", std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count());
+  return chain.take_result();
 }
 
 }  // namespace piezobench::fem
