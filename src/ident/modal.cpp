@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "piezobench/core/error.hpp"
@@ -161,21 +162,17 @@ std::vector<Mode> peak_picking(const Vector& omega, const CMatrix& h, const Peak
   return modes;
 }
 
-LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& options) {
-  const char* src = "lscf";
-  options.validate();
-  check_data(src, omega, h);
-  const auto [first, last] = band(src, omega, options.min_omega, options.max_omega, options.max_order + 1);
-  const Index nf = last - first + 1;
-  const Index no = h.cols();
-  const Index nmax = options.max_order;
-  const double w_lo = omega(first), w_hi = omega(last);
-  // Ts maps the top of the band to the Nyquist frequency, as in PolyMAX.
-  const double ts = std::numbers::pi / w_hi;
+namespace {
 
-  // X(k, r) = Omega_k^r; the reduced normal equations only need Re(X^H X), Re(X^H diag(h) X) and
-  // Re(X^H diag(|h|^2) X), computed once at the highest order: the lower orders use their leading
-  // blocks.
+// The reduced normal equations of LSCF. X(k, r) = Omega_k^r; they only need Re(X^H X),
+// Re(X^H diag(h) X) and Re(X^H diag(|h|^2) X), computed once at the highest order: the lower
+// orders use their leading blocks.
+struct LscfNormalEquations {
+  Matrix rr;
+  std::vector<Matrix> ss, tt;  // per output
+};
+
+LscfNormalEquations lscf_normal_equations(const Vector& omega, const CMatrix& h, Index first, Index nf, Index nmax, double ts) {
   CMatrix x(nf, nmax + 1);
   for (Index k = 0; k < nf; ++k) {
     const Complex z = std::exp(Complex(0.0, omega(first + k) * ts));
@@ -186,96 +183,146 @@ LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& option
     }
   }
   const CMatrix xh = x.adjoint();
-  const Matrix rr = (xh * x).real();
-  std::vector<Matrix> ss, tt;
-  for (Index o = 0; o < no; ++o) {
+  LscfNormalEquations e;
+  e.rr = (xh * x).real();
+  for (Index o = 0; o < h.cols(); ++o) {
     const CVector ho = h.col(o).segment(first, nf);
-    ss.push_back(-(xh * (ho.asDiagonal() * x)).real());
-    tt.push_back((xh * (ho.cwiseAbs2().cast<Complex>().asDiagonal() * x)).real());
+    e.ss.push_back(-(xh * (ho.asDiagonal() * x)).real());
+    e.tt.push_back((xh * (ho.cwiseAbs2().cast<Complex>().asDiagonal() * x)).real());
   }
+  return e;
+}
 
-  LscfResult result;
-  std::vector<StabilizationPole> previous;
-  std::vector<Index> previous_chain;
-  struct Candidate {
-    StabilizationPole pole;
-    Index chain;
-  };
-  std::vector<Candidate> candidates;
-  for (Index n = options.min_order; n <= nmax; ++n) {
-    const Index m1 = n + 1;
-    Eigen::LLT<Matrix> rllt(rr.topLeftCorner(m1, m1));
-    if (rllt.info() != Eigen::Success) {
-      throw NumericalError(src, "the basis Gram matrix is not positive definite at order " + std::to_string(n) +
-                                    " (too many orders for the band)",
-                           /*retry_may_help=*/true);
-    }
-    Matrix mm = Matrix::Zero(m1, m1);
-    for (Index o = 0; o < no; ++o) {
-      const Matrix s = ss[static_cast<size_t>(o)].topLeftCorner(m1, m1);
-      mm += tt[static_cast<size_t>(o)].topLeftCorner(m1, m1) - s.transpose() * rllt.solve(s);
-    }
-    // Denominator with alpha_n = 1: M(0:n, 0:n) alpha = -M(0:n, n).
-    const Vector alpha = mm.topLeftCorner(n, n).colPivHouseholderQr().solve(-mm.col(n).head(n));
-    if (!alpha.allFinite()) continue;
-    Matrix companion = Matrix::Zero(n, n);
-    for (Index i = 1; i < n; ++i) companion(i, i - 1) = 1.0;
-    companion.col(n - 1) = -alpha;
-    Eigen::EigenSolver<Matrix> eig(companion, /*computeEigenvectors=*/false);
-    if (eig.info() != Eigen::Success) continue;
+// The roots (z-domain) of the order-n denominator, alpha_n = 1; nullopt when it cannot be solved.
+std::optional<Eigen::VectorXcd> lscf_denominator_roots(const LscfNormalEquations& e, Index n, const char* src) {
+  const Index m1 = n + 1;
+  Eigen::LLT<Matrix> rllt(e.rr.topLeftCorner(m1, m1));
+  if (rllt.info() != Eigen::Success) {
+    throw NumericalError(src, "the basis Gram matrix is not positive definite at order " + std::to_string(n) +
+                                  " (too many orders for the band)",
+                         /*retry_may_help=*/true);
+  }
+  Matrix mm = Matrix::Zero(m1, m1);
+  for (size_t o = 0; o < e.ss.size(); ++o) {
+    const Matrix s = e.ss[o].topLeftCorner(m1, m1);
+    mm += e.tt[o].topLeftCorner(m1, m1) - s.transpose() * rllt.solve(s);
+  }
+  // Denominator with alpha_n = 1: M(0:n, 0:n) alpha = -M(0:n, n).
+  const Vector alpha = mm.topLeftCorner(n, n).colPivHouseholderQr().solve(-mm.col(n).head(n));
+  if (!alpha.allFinite()) return std::nullopt;
+  Matrix companion = Matrix::Zero(n, n);
+  for (Index i = 1; i < n; ++i) companion(i, i - 1) = 1.0;
+  companion.col(n - 1) = -alpha;
+  Eigen::EigenSolver<Matrix> eig(companion, /*computeEigenvectors=*/false);
+  if (eig.info() != Eigen::Success) return std::nullopt;
+  return Eigen::VectorXcd(eig.eigenvalues());
+}
 
+// A physical pole with the number of consecutive orders it has been stable over.
+struct LscfCandidate {
+  StabilizationPole pole;
+  Index chain;
+};
+
+// The stabilization diagram, order by order: each physical pole in the band is linked to the
+// nearest pole of the order below within the tolerances.
+class StabilizationTracker {
+ public:
+  StabilizationTracker(const LscfOptions& options, double ts, double w_lo, double w_hi)
+      : options_(options), ts_(ts), w_lo_(w_lo), w_hi_(w_hi) {}
+
+  void add_order(Index n, const Eigen::VectorXcd& roots, LscfResult& result) {
     std::vector<StabilizationPole> current;
     std::vector<Index> chain;
     for (Index i = 0; i < n; ++i) {
-      const Complex z = eig.eigenvalues()(i);
+      const Complex z = roots(i);
       if (std::abs(z) == 0.0) continue;
-      const Complex lambda = std::log(z) / ts;
+      const Complex lambda = std::log(z) / ts_;
       if (lambda.imag() <= 0.0 || lambda.real() >= 0.0) continue;
       StabilizationPole p;
       p.order = n;
       p.pole = lambda;
       p.natural_frequency = std::abs(lambda);
       p.damping = -lambda.real() / p.natural_frequency;
-      if (p.damping >= options.max_damping || lambda.imag() < w_lo || lambda.imag() > w_hi) continue;
-      Index link = 0;
-      double best = 2.0;
-      for (size_t j = 0; j < previous.size(); ++j) {
-        const double df = std::abs(p.natural_frequency - previous[j].natural_frequency) / previous[j].natural_frequency;
-        const double dz = std::abs(p.damping - previous[j].damping) / previous[j].damping;
-        if (df < options.frequency_tolerance && dz < options.damping_tolerance && df < best) {
-          best = df;
-          link = previous_chain[j];
-        }
-      }
+      if (p.damping >= options_.max_damping || lambda.imag() < w_lo_ || lambda.imag() > w_hi_) continue;
+      const Index link = link_of(p);
       p.stable = link > 0;
       current.push_back(p);
       chain.push_back(link + 1);
       result.diagram.push_back(p);
-      if (link + 1 >= options.min_stable_orders) candidates.push_back({p, link + 1});
+      if (link + 1 >= options_.min_stable_orders) candidates_.push_back({p, link + 1});
     }
-    previous = std::move(current);
-    previous_chain = std::move(chain);
+    previous_ = std::move(current);
+    previous_chain_ = std::move(chain);
   }
 
-  // Group the candidates by frequency; in each group keep the longest chain (then the highest order).
-  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+  [[nodiscard]] std::vector<LscfCandidate>& candidates() { return candidates_; }
+
+ private:
+  // The chain length of the nearest pole of the order below within the tolerances (0: none).
+  [[nodiscard]] Index link_of(const StabilizationPole& p) const {
+    Index link = 0;
+    double best = 2.0;
+    for (size_t j = 0; j < previous_.size(); ++j) {
+      const double df = std::abs(p.natural_frequency - previous_[j].natural_frequency) / previous_[j].natural_frequency;
+      const double dz = std::abs(p.damping - previous_[j].damping) / previous_[j].damping;
+      if (df < options_.frequency_tolerance && dz < options_.damping_tolerance && df < best) {
+        best = df;
+        link = previous_chain_[j];
+      }
+    }
+    return link;
+  }
+
+  const LscfOptions& options_;
+  double ts_, w_lo_, w_hi_;
+  std::vector<StabilizationPole> previous_;
+  std::vector<Index> previous_chain_;
+  std::vector<LscfCandidate> candidates_;
+};
+
+// Groups the candidates by frequency; in each group keeps the longest chain (then the highest order).
+std::vector<Mode> stable_modes(std::vector<LscfCandidate>& candidates, double frequency_tolerance) {
+  std::sort(candidates.begin(), candidates.end(), [](const LscfCandidate& a, const LscfCandidate& b) {
     return a.pole.natural_frequency < b.pole.natural_frequency;
   });
+  std::vector<Mode> modes;
   for (size_t i = 0; i < candidates.size();) {
     size_t j = i + 1;
-    Candidate best = candidates[i];
+    LscfCandidate best = candidates[i];
     while (j < candidates.size() &&
            candidates[j].pole.natural_frequency - candidates[j - 1].pole.natural_frequency <
-               options.frequency_tolerance * candidates[j - 1].pole.natural_frequency) {
-      const Candidate& c = candidates[j];
+               frequency_tolerance * candidates[j - 1].pole.natural_frequency) {
+      const LscfCandidate& c = candidates[j];
       if (c.chain > best.chain || (c.chain == best.chain && c.pole.order > best.pole.order)) best = c;
       ++j;
     }
     Mode m = mode_from_pole(best.pole.pole);
     m.stable_orders = best.chain;
-    result.modes.push_back(m);
+    modes.push_back(m);
     i = j;
   }
+  return modes;
+}
+
+}  // namespace
+
+LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& options) {
+  const char* src = "lscf";
+  options.validate();
+  check_data(src, omega, h);
+  const auto [first, last] = band(src, omega, options.min_omega, options.max_omega, options.max_order + 1);
+  const double w_lo = omega(first), w_hi = omega(last);
+  // Ts maps the top of the band to the Nyquist frequency, as in PolyMAX.
+  const double ts = std::numbers::pi / w_hi;
+  const LscfNormalEquations normal = lscf_normal_equations(omega, h, first, last - first + 1, options.max_order, ts);
+
+  LscfResult result;
+  StabilizationTracker tracker(options, ts, w_lo, w_hi);
+  for (Index n = options.min_order; n <= options.max_order; ++n) {
+    if (const auto roots = lscf_denominator_roots(normal, n, src)) tracker.add_order(n, *roots, result);
+  }
+  result.modes = stable_modes(tracker.candidates(), options.frequency_tolerance);
   // Quality: a mode must be stable over min_stable_orders orders and lie inside the band.
   if (result.modes.empty()) {
     result.quality.add_problem("no mode stayed stable over " + std::to_string(options.min_stable_orders) + " orders");

@@ -254,160 +254,213 @@ ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit
   return v;
 }
 
-IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
-                          const std::string& source) {
-  options.validate();
+namespace {
+
+// The points of the band a fit uses: omega (rad/s), H and the coherence (empty when unknown).
+struct FitBand {
   Vector w, c;
   CVector d;
-  select_band(omega, h, coherence, options, source, w, d, c);
-  if (w.size() < 12) throw InputError(source, "H", "at least 12 usable points in the band", std::to_string(w.size()));
-  // Starting values.
+};
+
+FitBand fit_band(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
+                 const std::string& source) {
+  FitBand b;
+  select_band(omega, h, coherence, options, source, b.w, b.d, b.c);
+  return b;
+}
+
+// Half the width between the half-power points around `peak` over its frequency, clamped to
+// [lo_clamp, hi_clamp]; the lower point is searched down to `lowest`.
+double half_power_damping(const FitBand& b, Index peak, Index lowest, double lo_clamp, double hi_clamp) {
+  const double half = std::abs(b.d(peak)) / std::sqrt(2.0);
+  Index lo = peak, hi = peak;
+  while (lo > lowest && std::abs(b.d(lo)) > half) --lo;
+  while (hi + 1 < b.w.size() && std::abs(b.d(hi)) > half) ++hi;
+  return std::clamp((b.w(hi) - b.w(lo)) / (2.0 * b.w(peak)), lo_clamp, hi_clamp);
+}
+
+// The high-pass corner and a first gain from the points below hpf_fmax (fit_high_pass when there
+// are three), else from the first point.
+void iff_start_high_pass(const FitBand& b, double w_hpf_band, IffPlantFit& start) {
+  std::vector<Index> low;
+  for (Index k = 0; k < b.w.size(); ++k) {
+    if (b.w(k) <= w_hpf_band) low.push_back(k);
+  }
+  Vector w_low(static_cast<Index>(low.size()));
+  CVector d_low(static_cast<Index>(low.size()));
+  for (std::size_t i = 0; i < low.size(); ++i) {
+    w_low(static_cast<Index>(i)) = b.w(low[i]);
+    d_low(static_cast<Index>(i)) = b.d(low[i]);
+  }
+  if (w_low.size() >= 3) {
+    const ident::HighPassFit hp = ident::fit_high_pass(w_low, d_low);
+    start.w_hpf = std::clamp(hp.corner, b.w(0) / 100.0, w_hpf_band);
+    start.g0 = hp.gain;
+  } else {
+    start.w_hpf = b.w(0) / 10.0;
+    start.g0 = b.d(0).real() >= 0.0 ? std::abs(b.d(0)) : -std::abs(b.d(0));
+  }
+}
+
+// g0 from the points below the anti-resonance with the model's other factors divided out (the
+// median ratio, robust to a noisy point).
+double iff_start_gain(const FitBand& b, Index dip, const IffPlantFit& start) {
+  IffPlantFit unit_gain = start;
+  unit_gain.g0 = 1.0;
+  std::vector<double> re, mag;
+  for (Index k = 0; k < dip; ++k) {
+    const Complex g = b.d(k) / model(unit_gain, b.w(k));
+    re.push_back(g.real());
+    mag.push_back(std::abs(g));
+  }
+  if (mag.empty()) {
+    const Complex g = b.d(0) / model(unit_gain, b.w(0));
+    re.push_back(g.real());
+    mag.push_back(std::abs(g));
+  }
+  std::sort(mag.begin(), mag.end());
+  double sum_re = 0.0;
+  for (const double x : re) sum_re += x;
+  return (sum_re >= 0.0 ? 1.0 : -1.0) * mag[mag.size() / 2];
+}
+
+// The delay from the slope of the unwrapped phase of H / G(delay = 0) against omega (straight
+// line with an intercept), above 1.5 wp where the model's own phase is smooth (all points above
+// the anti-resonance when fewer than 10 are that high); unchanged with fewer than 3 points.
+void iff_start_delay(const FitBand& b, IffPlantFit& start) {
+  std::vector<Index> use_k;
+  for (Index k = 0; k < b.w.size(); ++k) {
+    if (b.w(k) > 1.5 * start.wp) use_k.push_back(k);
+  }
+  if (use_k.size() < 10) {
+    use_k.clear();
+    for (Index k = 0; k < b.w.size(); ++k) {
+      if (b.w(k) > 1.2 * start.wz) use_k.push_back(k);
+    }
+  }
+  if (use_k.size() < 3) return;
+  std::vector<double> x, phase;
+  for (const Index k : use_k) {
+    x.push_back(b.w(k));
+    phase.push_back(std::arg(b.d(k) / model(start, b.w(k))));
+  }
+  if (const auto delay = delay_from_phase(x, phase)) start.delay = *delay;
+}
+
+// Starting values: the resonance at the highest peak above the high-pass band, the anti-resonance
+// at the lowest dip below it, then the high-pass corner, the gain and the delay.
+IffPlantFit iff_start(const FitBand& b, const IffPlantFitOptions& options, const std::string& source) {
   const double w_hpf_band = kTwoPi * options.hpf_fmax_Hz;
   Index peak = -1;
-  for (Index k = 0; k < w.size(); ++k) {
-    if (w(k) > w_hpf_band && (peak < 0 || std::abs(d(k)) > std::abs(d(peak)))) peak = k;
+  for (Index k = 0; k < b.w.size(); ++k) {
+    if (b.w(k) > w_hpf_band && (peak < 0 || std::abs(b.d(k)) > std::abs(b.d(peak)))) peak = k;
   }
   Index dip = -1;
   for (Index k = 0; k < peak; ++k) {
-    if (w(k) > w_hpf_band && (dip < 0 || std::abs(d(k)) < std::abs(d(dip)))) dip = k;
+    if (b.w(k) > w_hpf_band && (dip < 0 || std::abs(b.d(k)) < std::abs(b.d(dip)))) dip = k;
   }
   if (peak < 0 || dip < 0) {
     throw InputError(source, "H", "a resonance above an anti-resonance inside the band", "none found");
   }
   IffPlantFit start;
-  start.wp = w(peak);
-  start.wz = w(dip);
-  {
-    const double half = std::abs(d(peak)) / std::sqrt(2.0);
-    Index lo = peak, hi = peak;
-    while (lo > dip && std::abs(d(lo)) > half) --lo;
-    while (hi + 1 < w.size() && std::abs(d(hi)) > half) ++hi;
-    start.xp = std::clamp((w(hi) - w(lo)) / (2.0 * w(peak)), 0.002, 0.3);
-  }
+  start.wp = b.w(peak);
+  start.wz = b.w(dip);
+  start.xp = half_power_damping(b, peak, dip, 0.002, 0.3);
   start.xz = 0.005;
-  Vector w_low;
-  CVector d_low;
-  {
-    std::vector<Index> low;
-    for (Index k = 0; k < w.size(); ++k) {
-      if (w(k) <= w_hpf_band) low.push_back(k);
-    }
-    w_low.resize(static_cast<Index>(low.size()));
-    d_low.resize(static_cast<Index>(low.size()));
-    for (std::size_t i = 0; i < low.size(); ++i) {
-      w_low(static_cast<Index>(i)) = w(low[i]);
-      d_low(static_cast<Index>(i)) = d(low[i]);
-    }
-  }
-  if (w_low.size() >= 3) {
-    const ident::HighPassFit hp = ident::fit_high_pass(w_low, d_low);
-    start.w_hpf = std::clamp(hp.corner, w(0) / 100.0, w_hpf_band);
-    start.g0 = hp.gain;
-  } else {
-    start.w_hpf = w(0) / 10.0;
-    start.g0 = d(0).real() >= 0.0 ? std::abs(d(0)) : -std::abs(d(0));
-  }
+  iff_start_high_pass(b, w_hpf_band, start);
   if (options.fixed_w_hpf > 0.0) start.w_hpf = options.fixed_w_hpf;
-  // g0 from the points below the anti-resonance with the model's other factors divided out (the
-  // median ratio, robust to a noisy point), then the delay from the slope of the remaining phase.
-  {
-    IffPlantFit unit_gain = start;
-    unit_gain.g0 = 1.0;
-    std::vector<double> re, mag;
-    for (Index k = 0; k < dip; ++k) {
-      const Complex g = d(k) / model(unit_gain, w(k));
-      re.push_back(g.real());
-      mag.push_back(std::abs(g));
-    }
-    if (mag.empty()) {
-      const Complex g = d(0) / model(unit_gain, w(0));
-      re.push_back(g.real());
-      mag.push_back(std::abs(g));
-    }
-    std::sort(mag.begin(), mag.end());
-    double sum_re = 0.0;
-    for (const double x : re) sum_re += x;
-    start.g0 = (sum_re >= 0.0 ? 1.0 : -1.0) * mag[mag.size() / 2];
-    if (options.fit_delay) {
-      // Slope of the unwrapped phase of H / G(delay = 0) against omega (straight line with an
-      // intercept), above 1.5 wp where the model's own phase is smooth (all points above the
-      // anti-resonance when fewer than 10 are that high).
-      std::vector<Index> use_k;
-      for (Index k = 0; k < w.size(); ++k) {
-        if (w(k) > 1.5 * start.wp) use_k.push_back(k);
-      }
-      if (use_k.size() < 10) {
-        use_k.clear();
-        for (Index k = 0; k < w.size(); ++k) {
-          if (w(k) > 1.2 * start.wz) use_k.push_back(k);
-        }
-      }
-      if (use_k.size() >= 3) {
-        std::vector<double> x, phase;
-        for (const Index k : use_k) {
-          x.push_back(w(k));
-          phase.push_back(std::arg(d(k) / model(start, w(k))));
-        }
-        if (const auto delay = delay_from_phase(x, phase)) start.delay = *delay;
-      }
-    }
-  }
-  const Layout layout{options.fixed_w_hpf == 0.0, options.fit_delay};
-  if (start.g0 == 0.0) start.g0 = 1.0;
-  const double sign = start.g0 > 0.0 ? 1.0 : -1.0;
+  start.g0 = iff_start_gain(b, dip, start);
+  if (options.fit_delay) iff_start_delay(b, start);
+  return start;
+}
 
-  const PointWeights pw = point_weights(w, c, options.effective_averages);
-  const Vector& weight = pw.weight;
-  const auto residual = [&](const Eigen::VectorXd& x) {
-    const IffPlantFit p = from_x(x, sign, layout, options.fixed_w_hpf);
-    Eigen::VectorXd r(2 * w.size());
-    for (Index k = 0; k < w.size(); ++k) {
-      const Complex e = (model(p, w(k)) / d(k) - 1.0) * weight(k);
+// The weighted relative complex error of the IFF plant at the solver's parameters x.
+struct IffResidual {
+  const FitBand& b;
+  const Vector& weight;
+  double sign;
+  Layout layout;
+  double fixed_w_hpf;
+
+  Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
+    const IffPlantFit p = from_x(x, sign, layout, fixed_w_hpf);
+    Eigen::VectorXd r(2 * b.w.size());
+    for (Index k = 0; k < b.w.size(); ++k) {
+      const Complex e = (model(p, b.w(k)) / b.d(k) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
     return r;
-  };
-  const double n = static_cast<double>(w.size());
+  }
+};
+
+// The better of the two Levenberg-Marquardt runs from xz = +-start.xz; `initial_cost` gets the
+// lower starting cost.
+core::LmResult best_iff_solution(const IffResidual& residual, const IffPlantFit& start, int max_iterations, double& initial_cost,
+                                 const std::string& source) {
   core::LmResult best;
   best.cost = std::numeric_limits<double>::infinity();
-  double initial_cost = std::numeric_limits<double>::infinity();
+  initial_cost = std::numeric_limits<double>::infinity();
   for (const double zs : {1.0, -1.0}) {
     IffPlantFit s0 = start;
     s0.xz = zs * start.xz;
-    const Eigen::VectorXd x0 = to_x(s0, layout);
+    const Eigen::VectorXd x0 = to_x(s0, residual.layout);
     const Eigen::VectorXd r0 = residual(x0);
     if (!r0.allFinite()) continue;
     initial_cost = std::min(initial_cost, r0.squaredNorm());
-    const core::LmResult o = least_squares(residual, x0, options.max_iterations);
+    const core::LmResult o = least_squares(residual, x0, max_iterations);
     if (o.cost < best.cost) best = o;
   }
   if (!std::isfinite(best.cost)) {
     throw NumericalError("IFF plant fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
   }
-  IffPlantFit fit = from_x(best.x, sign, layout, options.fixed_w_hpf);
+  return best;
+}
+
+// Standard errors of the plant's parameters, linearized at the solution.
+core::ParameterUncertainty iff_uncertainty(const IffResidual& residual, const core::LmResult& best, const IffPlantFit& fit,
+                                           const Vector& residual_std) {
+  const core::FitCovariance cov = covariance_at(residual, best.x, residual_std);
+  // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
+  const Layout& layout = residual.layout;
+  const int hpf = layout.hpf ? 5 : -1, delay = layout.delay ? (layout.hpf ? 6 : 5) : -1;
+  Eigen::VectorXd value(7), deriv(7);
+  value << fit.g0, fit.wz, fit.xz, fit.wp, fit.xp, fit.w_hpf, fit.delay;
+  deriv << fit.g0, fit.wz, kXzScale, fit.wp, fit.xp, layout.hpf ? fit.w_hpf : 0.0, layout.delay ? kDelayScale : 0.0;
+  return core::parameter_uncertainty({"g0", "wz", "xz", "wp", "xp", "w_hpf", "delay"}, value, deriv, {0, 1, 2, 3, 4, hpf, delay}, cov,
+                                     residual_std.size() > 0);
+}
+
+}  // namespace
+
+IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& coherence, const IffPlantFitOptions& options,
+                          const std::string& source) {
+  options.validate();
+  const FitBand b = fit_band(omega, h, coherence, options, source);
+  if (b.w.size() < 12) throw InputError(source, "H", "at least 12 usable points in the band", std::to_string(b.w.size()));
+  IffPlantFit start = iff_start(b, options, source);
+  if (start.g0 == 0.0) start.g0 = 1.0;
+  const double sign = start.g0 > 0.0 ? 1.0 : -1.0;
+  const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
+  const IffResidual residual{b, pw.weight, sign, Layout{options.fixed_w_hpf == 0.0, options.fit_delay}, options.fixed_w_hpf};
+  double initial_cost = 0.0;
+  const core::LmResult best = best_iff_solution(residual, start, options.max_iterations, initial_cost, source);
+
+  const double n = static_cast<double>(b.w.size());
+  IffPlantFit fit = from_x(best.x, sign, residual.layout, options.fixed_w_hpf);
   double plain = 0.0;
-  for (Index k = 0; k < w.size(); ++k) plain += std::norm(model(fit, w(k)) / d(k) - 1.0);
+  for (Index k = 0; k < b.w.size(); ++k) plain += std::norm(model(fit, b.w(k)) / b.d(k) - 1.0);
   fit.relative_rms_error = std::sqrt(plain / n);
   fit.weighted_relative_rms_error = std::sqrt(2.0 * best.cost / n);
   fit.initial_relative_rms_error = std::sqrt(initial_cost / n);
-  fit.points = w.size();
+  fit.points = b.w.size();
   fit.iterations = best.iterations;
   fit.converged = best.converged();
   fit.status = best.status;
-  {
-    const core::FitCovariance cov = covariance_at(residual, best.x, pw.residual_std);
-    // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
-    const int hpf = layout.hpf ? 5 : -1, delay = layout.delay ? (layout.hpf ? 6 : 5) : -1;
-    Eigen::VectorXd value(7), deriv(7);
-    value << fit.g0, fit.wz, fit.xz, fit.wp, fit.xp, fit.w_hpf, fit.delay;
-    deriv << fit.g0, fit.wz, kXzScale, fit.wp, fit.xp, layout.hpf ? fit.w_hpf : 0.0, layout.delay ? kDelayScale : 0.0;
-    fit.uncertainty = core::parameter_uncertainty({"g0", "wz", "xz", "wp", "xp", "w_hpf", "delay"}, value, deriv,
-                                                  {0, 1, 2, 3, 4, hpf, delay}, cov, pw.residual_std.size() > 0);
-  }
+  fit.uncertainty = iff_uncertainty(residual, best, fit, pw.residual_std);
   fit.quality.check_error("u -> Vs (IFF plant, eq. 2.3)", fit.relative_rms_error);
-  check_in_band(fit.quality, "anti-resonance wz", fit.wz, w);
-  check_in_band(fit.quality, "resonance wp", fit.wp, w);
+  check_in_band(fit.quality, "anti-resonance wz", fit.wz, b.w);
+  check_in_band(fit.quality, "resonance wp", fit.wp, b.w);
   check_lm(fit.quality, best.status);
   if (fit.delay < 0.0) fit.quality.add_problem(fmt::format("delay {:.3g} s < 0 (acausal)", fit.delay), false);
   fit.quality.advise("a band around the anti-resonance and the resonance where the coherence is high");
@@ -420,6 +473,40 @@ Complex second_order(const DelayedSecondOrderFit& p, double w) {
   const Complex s(0.0, w);
   const double wn = p.natural_frequency;
   return p.static_gain * wn * wn / (s * s + 2.0 * p.damping * wn * s + wn * wn) * std::exp(-s * p.delay);
+}
+
+// Starting values: the natural frequency at the peak, the damping from its half-power points, the
+// gain as the median ratio below half the peak's frequency, and the delay from the phase above
+// 1.5 wn.
+DelayedSecondOrderFit second_order_start(const FitBand& b, Index peak, bool fit_delay) {
+  const Vector& w = b.w;
+  const CVector& d = b.d;
+  DelayedSecondOrderFit start;
+  start.natural_frequency = w(peak);
+  start.damping = half_power_damping(b, peak, 0, 0.002, 0.9);
+  DelayedSecondOrderFit unit = start;
+  unit.static_gain = 1.0;
+  std::vector<double> mag;
+  double sum_re = 0.0;
+  for (Index k = 0; k < std::max<Index>(1, peak / 2); ++k) {
+    const Complex g = d(k) / second_order(unit, w(k));
+    mag.push_back(std::abs(g));
+    sum_re += g.real();
+  }
+  std::sort(mag.begin(), mag.end());
+  start.static_gain = (sum_re >= 0.0 ? 1.0 : -1.0) * mag[mag.size() / 2];
+  if (fit_delay) {
+    std::vector<double> x, phase;
+    for (Index k = 0; k < w.size(); ++k) {
+      if (w(k) <= 1.5 * start.natural_frequency) continue;
+      x.push_back(w(k));
+      phase.push_back(std::arg(d(k) / second_order(start, w(k))));
+    }
+    if (x.size() >= 3) {
+      if (const auto delay = delay_from_phase(x, phase)) start.delay = *delay;
+    }
+  }
+  return start;
 }
 
 }  // namespace
@@ -436,79 +523,81 @@ CVector DelayedSecondOrderFit::response(const Vector& omega) const {
   return h;
 }
 
-DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVector& h, const Vector& coherence,
-                                               const IffPlantFitOptions& options, const std::string& source) {
-  options.validate();
-  Vector w, c;
-  CVector d;
-  select_band(omega, h, coherence, options, source, w, d, c);
-  if (w.size() < 8) throw InputError(source, "H", "at least 8 usable points in the band", std::to_string(w.size()));
+namespace {
+
+// The resonance peak, inside the band.
+Index second_order_peak(const FitBand& b, const std::string& source) {
   Index peak = 0;
-  for (Index k = 1; k < w.size(); ++k) {
-    if (std::abs(d(k)) > std::abs(d(peak))) peak = k;
+  for (Index k = 1; k < b.w.size(); ++k) {
+    if (std::abs(b.d(k)) > std::abs(b.d(peak))) peak = k;
   }
-  if (peak == 0 || peak == w.size() - 1) {
-    throw InputError(source, "H", "a resonance peak inside the band", fmt::format("the largest |H| at the band's edge ({:.4g} Hz)", w(peak) / kTwoPi));
+  if (peak == 0 || peak == b.w.size() - 1) {
+    throw InputError(source, "H", "a resonance peak inside the band",
+                     fmt::format("the largest |H| at the band's edge ({:.4g} Hz)", b.w(peak) / kTwoPi));
   }
-  DelayedSecondOrderFit start;
-  start.natural_frequency = w(peak);
-  {
-    const double half = std::abs(d(peak)) / std::sqrt(2.0);
-    Index lo = peak, hi = peak;
-    while (lo > 0 && std::abs(d(lo)) > half) --lo;
-    while (hi + 1 < w.size() && std::abs(d(hi)) > half) ++hi;
-    start.damping = std::clamp((w(hi) - w(lo)) / (2.0 * w(peak)), 0.002, 0.9);
-  }
-  {
-    DelayedSecondOrderFit unit = start;
-    unit.static_gain = 1.0;
-    std::vector<double> mag;
-    double sum_re = 0.0;
-    for (Index k = 0; k < std::max<Index>(1, peak / 2); ++k) {
-      const Complex g = d(k) / second_order(unit, w(k));
-      mag.push_back(std::abs(g));
-      sum_re += g.real();
-    }
-    std::sort(mag.begin(), mag.end());
-    start.static_gain = (sum_re >= 0.0 ? 1.0 : -1.0) * mag[mag.size() / 2];
-    if (options.fit_delay) {
-      std::vector<double> x, phase;
-      for (Index k = 0; k < w.size(); ++k) {
-        if (w(k) <= 1.5 * start.natural_frequency) continue;
-        x.push_back(w(k));
-        phase.push_back(std::arg(d(k) / second_order(start, w(k))));
-      }
-      if (x.size() >= 3) {
-        if (const auto delay = delay_from_phase(x, phase)) start.delay = *delay;
-      }
-    }
-  }
-  const double sign = start.static_gain >= 0.0 ? 1.0 : -1.0;
-  const PointWeights pw = point_weights(w, c, options.effective_averages);
-  const Vector& weight = pw.weight;
-  const auto unpack = [&](const Eigen::VectorXd& x) {
+  return peak;
+}
+
+// The weighted relative complex error of the delayed second order at the solver's parameters x:
+// log|k|, log wn, log zeta, [delay / 1e-4].
+struct SecondOrderResidual {
+  const FitBand& b;
+  const Vector& weight;
+  double sign;
+  bool fit_delay;
+
+  [[nodiscard]] DelayedSecondOrderFit unpack(const Eigen::VectorXd& x) const {
     DelayedSecondOrderFit p;
     p.static_gain = sign * std::exp(x(0));
     p.natural_frequency = std::exp(x(1));
     p.damping = std::exp(x(2));
-    p.delay = options.fit_delay ? x(3) * kDelayScale : 0.0;
+    p.delay = fit_delay ? x(3) * kDelayScale : 0.0;
     return p;
-  };
-  const auto residual = [&](const Eigen::VectorXd& x) {
+  }
+
+  Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
     const DelayedSecondOrderFit p = unpack(x);
-    Eigen::VectorXd r(2 * w.size());
-    for (Index k = 0; k < w.size(); ++k) {
-      const Complex e = (second_order(p, w(k)) / d(k) - 1.0) * weight(k);
+    Eigen::VectorXd r(2 * b.w.size());
+    for (Index k = 0; k < b.w.size(); ++k) {
+      const Complex e = (second_order(p, b.w(k)) / b.d(k) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
     return r;
-  };
-  Eigen::VectorXd x0(options.fit_delay ? 4 : 3);
+  }
+};
+
+Eigen::VectorXd second_order_x0(const DelayedSecondOrderFit& start, bool fit_delay) {
+  Eigen::VectorXd x0(fit_delay ? 4 : 3);
   x0(0) = std::log(std::abs(start.static_gain));
   x0(1) = std::log(start.natural_frequency);
   x0(2) = std::log(start.damping);
-  if (options.fit_delay) x0(3) = start.delay / kDelayScale;
+  if (fit_delay) x0(3) = start.delay / kDelayScale;
+  return x0;
+}
+
+// Standard errors of static_gain, natural_frequency, damping and delay, linearized at the solution.
+core::ParameterUncertainty second_order_uncertainty(const SecondOrderResidual& residual, const core::LmResult& o,
+                                                    const DelayedSecondOrderFit& fit, const Vector& residual_std) {
+  const core::FitCovariance cov = covariance_at(residual, o.x, residual_std);
+  Eigen::VectorXd value(4), deriv(4);
+  value << fit.static_gain, fit.natural_frequency, fit.damping, fit.delay;
+  deriv << fit.static_gain, fit.natural_frequency, fit.damping, residual.fit_delay ? kDelayScale : 0.0;
+  return core::parameter_uncertainty({"static_gain", "natural_frequency", "damping", "delay"}, value, deriv,
+                                     {0, 1, 2, residual.fit_delay ? 3 : -1}, cov, residual_std.size() > 0);
+}
+
+}  // namespace
+
+DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVector& h, const Vector& coherence,
+                                               const IffPlantFitOptions& options, const std::string& source) {
+  options.validate();
+  const FitBand b = fit_band(omega, h, coherence, options, source);
+  if (b.w.size() < 8) throw InputError(source, "H", "at least 8 usable points in the band", std::to_string(b.w.size()));
+  const DelayedSecondOrderFit start = second_order_start(b, second_order_peak(b, source), options.fit_delay);
+  const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
+  const SecondOrderResidual residual{b, pw.weight, start.static_gain >= 0.0 ? 1.0 : -1.0, options.fit_delay};
+  const Eigen::VectorXd x0 = second_order_x0(start, options.fit_delay);
   if (!residual(x0).allFinite()) {
     throw NumericalError("second-order fit (" + source + ")", "the starting point gives a non-finite error", true);
   }
@@ -516,23 +605,16 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   if (!std::isfinite(o.cost)) {
     throw NumericalError("second-order fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
   }
-  DelayedSecondOrderFit fit = unpack(o.x);
+  DelayedSecondOrderFit fit = residual.unpack(o.x);
   double plain = 0.0;
-  for (Index k = 0; k < w.size(); ++k) plain += std::norm(second_order(fit, w(k)) / d(k) - 1.0);
-  fit.relative_rms_error = std::sqrt(plain / static_cast<double>(w.size()));
-  fit.points = w.size();
+  for (Index k = 0; k < b.w.size(); ++k) plain += std::norm(second_order(fit, b.w(k)) / b.d(k) - 1.0);
+  fit.relative_rms_error = std::sqrt(plain / static_cast<double>(b.w.size()));
+  fit.points = b.w.size();
   fit.iterations = o.iterations;
   fit.status = o.status;
-  {
-    const core::FitCovariance cov = covariance_at(residual, o.x, pw.residual_std);
-    Eigen::VectorXd value(4), deriv(4);
-    value << fit.static_gain, fit.natural_frequency, fit.damping, fit.delay;
-    deriv << fit.static_gain, fit.natural_frequency, fit.damping, options.fit_delay ? kDelayScale : 0.0;
-    fit.uncertainty = core::parameter_uncertainty({"static_gain", "natural_frequency", "damping", "delay"}, value, deriv,
-                                                  {0, 1, 2, options.fit_delay ? 3 : -1}, cov, pw.residual_std.size() > 0);
-  }
+  fit.uncertainty = second_order_uncertainty(residual, o, fit, pw.residual_std);
   fit.quality.check_error("second-order fit", fit.relative_rms_error);
-  check_in_band(fit.quality, "natural frequency", fit.natural_frequency, w);
+  check_in_band(fit.quality, "natural frequency", fit.natural_frequency, b.w);
   check_lm(fit.quality, o.status);
   if (fit.delay < 0.0) fit.quality.add_problem(fmt::format("delay {:.3g} s < 0 (acausal)", fit.delay), false);
   fit.quality.advise("a band around the resonance where the coherence is high");
