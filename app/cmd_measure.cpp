@@ -118,20 +118,18 @@ bench::HysteresisLaw hysteresis_law_option(const std::string& name) {
   }
 }
 
-int run_measurement(const MeasureRequest& r) {
-  bench::Experiment experiment{};
+namespace {
+
+bench::Experiment requested_experiment(const MeasureRequest& r) {
   try {
-    experiment = bench::experiment_from_string(r.experiment);
+    return bench::experiment_from_string(r.experiment);
   } catch (const InputError& e) {
     throw UsageError(e.what());  // "experiment: expected one of stroke, ..., found 'frf'"
   }
-  bench::ExperimentOptions eo = r.options;
-  try {
-    eo.validate(experiment);
-  } catch (const InputError& e) {
-    throw_as_option_error(e);
-  }
-  const bool hardware = r.bench && r.bench->hardware();
+}
+
+// The unit measured: a real unit (only its number is known), the twin's, or one of the batch.
+bench::UnitTruth unit_under_test(const MeasureRequest& r, bool hardware) {
   bench::UnitTruth unit;
   if (hardware) {
     if (r.unit < 1) throw UsageError("--unit", "the number of the unit under test (>= 1)", std::to_string(r.unit));
@@ -145,9 +143,19 @@ int run_measurement(const MeasureRequest& r) {
       throw UsageError("--" + std::string(e.what()));  // "--unit: expected a unit of the batch, 1 to 7, ..."
     }
   }
-  const std::string out = r.out.empty() ? fmt::format("{}-unit{}.mat", r.experiment, r.unit) : r.out;
+  return unit;
+}
 
-  // Progress for the long simulations, every quarter.
+// The record, and on hardware the backend and the runner that took it (their report).
+struct Measurement {
+  io::TimeSeries ts;
+  std::unique_ptr<rt::Backend> backend;
+  std::unique_ptr<rt::BackendRunner> runner;
+};
+
+// The virtual bench's record, with progress every quarter for the long simulations.
+io::TimeSeries simulate_measurement(const MeasureRequest& r, bench::Experiment experiment, const bench::UnitTruth& unit,
+                                    const bench::ExperimentOptions& eo) {
   int quarter = 0;
   const bench::Progress progress = [&quarter](double fraction) {
     if (fraction >= 0.25 * (quarter + 1) && fraction < 1.0) {
@@ -155,73 +163,126 @@ int run_measurement(const MeasureRequest& r) {
       log_line(fmt::format("simulating: {:.0f} %", 100.0 * fraction));
     }
   };
-  io::TimeSeries ts;
-  std::unique_ptr<rt::Backend> backend;
-  std::unique_ptr<rt::BackendRunner> runner;
-  if (!hardware) {
-    const bool long_run = eo.duration.value_or(0.0) >= 50.0;
-    try {
-      ts = bench::simulate(experiment, unit, eo, r.seed, long_run ? progress : bench::Progress{});
-    } catch (const InputError& e) {
-      throw_as_option_error(e);
-    }
-  } else {
-    if (!bench::runs_on_bench(experiment)) {
-      throw UsageError("experiment",
-                       "an experiment that runs on the bench's I/O (stroke, hysteresis, stiffness, frf-noise, frf-sweep, "
-                       "iff, tracking); record " + r.experiment + " with its own instruments and give the file to `piezobench run`",
-                       "'" + r.experiment + "'");
-    }
-    backend = make_backend(*r.bench, r.reset_target);
-    rt::MeasureOptions mo;
-    mo.bench = *r.bench;
-    mo.realtime_priority = r.realtime;
-    mo.stop = stop_on_sigint();
-    if (!r.log.empty()) mo.raw_log = r.log;
-    mo.on_warning = [](const std::string& w) { log_line("warning: " + w); };
-    runner = std::make_unique<rt::BackendRunner>(*backend, mo);
-    log_line(fmt::format("measure: {} on unit {} through the {} backend ({}), {:g} Hz", r.experiment, r.unit,
-                         backend->name(), r.bench->source, r.bench->sample_rate));
-    try {
-      ts = bench::run_experiment(experiment, *runner, unit, eo, r.seed);
-    } catch (const InputError& e) {
-      throw_as_option_error(e);
-    }
+  const bool long_run = eo.duration.value_or(0.0) >= 50.0;
+  try {
+    return bench::simulate(experiment, unit, eo, r.seed, long_run ? progress : bench::Progress{});
+  } catch (const InputError& e) {
+    throw_as_option_error(e);
   }
-  if (!r.serial.empty()) ts.settings["serial"] = r.serial;  // checked by `run` against the campaign's units[].serial
-  io::write_timeseries(ts, out);
-  std::optional<bench::TrackingSummary> tracking;
-  if (experiment == bench::Experiment::kTracking) tracking = bench::tracking_summary(ts);
-  if (!r.json) {
-    // Every channel with its unit (issue 33: a summary prints the unit of every number).
-    std::vector<std::string> channels;
-    for (const std::string& name : ts.names) {
-      const std::string u = ts.unit(name);
-      channels.push_back(name + " [" + (u.empty() ? "no unit" : u) + "]");
-    }
-    fmt::print("wrote {}: {} on unit {}{} ({} samples at {:g} Hz; channels {}{})\n", out, r.experiment, r.unit,
-               unit.defective ? " (defective)" : "", ts.samples(), ts.sample_rate, ts.t.size() > 0 ? "t [s], " : "",
-               fmt::join(channels, ", "));
-    if (tracking) {
-      for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking->sine},
-                                    {"triangle", tracking->triangle}}) {
-        fmt::print("{:8} hysteresis width {:.2f} % -> {:.2f} % of the stroke ({:.1f} um); rms tracking error {:.3f} um -> "
-                   "{:.3f} um ({:.1f}x)\n",
-                   name, 100.0 * f.width_open, 100.0 * f.width_ff, 1e6 * f.stroke_open, 1e6 * f.rms_open, 1e6 * f.rms_ff,
-                   f.rms_reduction());
-      }
-      fmt::print("feedforward: {}{}; {} samples clamped to the stack range\n",
-                 tracking->identified ? "identified from the open run" : "the given model",
-                 tracking->identified ? fmt::format(" (fit residual {:.3g} % of the stroke)", 100.0 * tracking->fit_relative_residual) : "",
-                 tracking->clamped_samples);
-    }
-    if (runner) {
-      const rt::IoStats io = runner->report().io();
-      fmt::print("I/O: {} exchanges, {} lost, {} late, {} stale inputs, {} errors; round trip p50 {:.1f} us, p99 {:.1f} us\n",
-                 io.exchanges, io.lost, io.late, io.timeouts, io.errors, io.round_trip_us.p50, io.round_trip_us.p99);
-    }
-    return 0;
+}
+
+// The experiment run through the bench file's backend.
+void measure_on_bench(const MeasureRequest& r, bench::Experiment experiment, const bench::UnitTruth& unit,
+                      const bench::ExperimentOptions& eo, Measurement& m) {
+  if (!bench::runs_on_bench(experiment)) {
+    throw UsageError("experiment",
+                     "an experiment that runs on the bench's I/O (stroke, hysteresis, stiffness, frf-noise, frf-sweep, "
+                     "iff, tracking); record " + r.experiment + " with its own instruments and give the file to `piezobench run`",
+                     "'" + r.experiment + "'");
   }
+  m.backend = make_backend(*r.bench, r.reset_target);
+  rt::MeasureOptions mo;
+  mo.bench = *r.bench;
+  mo.realtime_priority = r.realtime;
+  mo.stop = stop_on_sigint();
+  if (!r.log.empty()) mo.raw_log = r.log;
+  mo.on_warning = [](const std::string& w) { log_line("warning: " + w); };
+  m.runner = std::make_unique<rt::BackendRunner>(*m.backend, mo);
+  log_line(fmt::format("measure: {} on unit {} through the {} backend ({}), {:g} Hz", r.experiment, r.unit,
+                       m.backend->name(), r.bench->source, r.bench->sample_rate));
+  try {
+    m.ts = bench::run_experiment(experiment, *m.runner, unit, eo, r.seed);
+  } catch (const InputError& e) {
+    throw_as_option_error(e);
+  }
+}
+
+void print_tracking(const bench::TrackingSummary& tracking) {
+  for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking.sine},
+                                {"triangle", tracking.triangle}}) {
+    fmt::print("{:8} hysteresis width {:.2f} % -> {:.2f} % of the stroke ({:.1f} um); rms tracking error {:.3f} um -> "
+               "{:.3f} um ({:.1f}x)\n",
+               name, 100.0 * f.width_open, 100.0 * f.width_ff, 1e6 * f.stroke_open, 1e6 * f.rms_open, 1e6 * f.rms_ff,
+               f.rms_reduction());
+  }
+  fmt::print("feedforward: {}{}; {} samples clamped to the stack range\n",
+             tracking.identified ? "identified from the open run" : "the given model",
+             tracking.identified ? fmt::format(" (fit residual {:.3g} % of the stroke)", 100.0 * tracking.fit_relative_residual) : "",
+             tracking.clamped_samples);
+}
+
+// The text summary: the file with every channel and its unit (issue 33: a summary prints the unit
+// of every number), the tracking figures, the I/O.
+void print_measurement(const MeasureRequest& r, const std::string& out, const bench::UnitTruth& unit, const Measurement& m,
+                       const std::optional<bench::TrackingSummary>& tracking) {
+  const io::TimeSeries& ts = m.ts;
+  std::vector<std::string> channels;
+  for (const std::string& name : ts.names) {
+    const std::string u = ts.unit(name);
+    channels.push_back(name + " [" + (u.empty() ? "no unit" : u) + "]");
+  }
+  fmt::print("wrote {}: {} on unit {}{} ({} samples at {:g} Hz; channels {}{})\n", out, r.experiment, r.unit,
+             unit.defective ? " (defective)" : "", ts.samples(), ts.sample_rate, ts.t.size() > 0 ? "t [s], " : "",
+             fmt::join(channels, ", "));
+  if (tracking) print_tracking(*tracking);
+  if (m.runner) {
+    const rt::IoStats io = m.runner->report().io();
+    fmt::print("I/O: {} exchanges, {} lost, {} late, {} stale inputs, {} errors; round trip p50 {:.1f} us, p99 {:.1f} us\n",
+               io.exchanges, io.lost, io.late, io.timeouts, io.errors, io.round_trip_us.p50, io.round_trip_us.p99);
+  }
+}
+
+nlohmann::json tracking_json(const bench::TrackingSummary& tracking) {
+  nlohmann::json t = nlohmann::json::object();
+  for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking.sine},
+                                {"triangle", tracking.triangle}}) {
+    t[name] = {{"width_open", f.width_open}, {"width_ff", f.width_ff}, {"rms_open_m", f.rms_open}, {"rms_ff_m", f.rms_ff},
+               {"stroke_open_m", f.stroke_open}, {"rms_reduction", f.rms_reduction()}};
+  }
+  t["identified"] = tracking.identified;
+  t["fit_relative_residual"] = tracking.fit_relative_residual;
+  t["clamped_samples"] = tracking.clamped_samples;
+  return t;
+}
+
+// What the hardware run reports: backend, I/O, the loop runs and the operator's steps.
+void add_hardware_json(const MeasureRequest& r, const Measurement& m, nlohmann::json& doc) {
+  const rt::MeasureReport& rep = m.runner->report();
+  const rt::IoStats io = rep.io();
+  doc["backend"] = m.backend->name();
+  doc["bench_file"] = r.bench->source;
+  doc["cycles"] = rep.cycles();
+  doc["io"] = {{"exchanges", io.exchanges}, {"replies", io.replies}, {"lost", io.lost},       {"late", io.late},
+               {"stale_inputs", io.timeouts}, {"errors", io.errors}, {"rejected", io.rejected},
+               {"round_trip_us", timing_json(io.round_trip_us)}};
+  nlohmann::json runs = nlohmann::json::array();
+  for (const rt::LoopReport& lr : rep.runs) {
+    nlohmann::json run = loop_timing_json(lr);
+    run.update({{"cycles", lr.cycles},
+                {"feedforward", lr.feedforward},
+                {"clamped_samples", lr.clamped_samples},
+                {"slew_limited_samples", lr.slew_limited_samples},
+                {"stale_sensor_samples", lr.stale_sensor_samples},
+                {"safe_state_reason", lr.safe_state_reason},
+                {"sched_fifo", lr.sched_fifo},
+                {"memory_locked", lr.memory_locked},
+                {"warnings", lr.warnings}});
+    runs.push_back(std::move(run));
+  }
+  doc["runs"] = runs;
+  nlohmann::json steps = nlohmann::json::array();
+  for (const rt::OperatorConfirmation& c : rep.operator_steps) {
+    steps.push_back({{"prompt", c.prompt}, {"asked_s", c.asked_s}, {"confirmed_s", c.confirmed_s}});
+  }
+  doc["operator_steps"] = steps;
+}
+
+// The --json document: the file, its channels and settings, the tracking figures, and the truth
+// (virtual bench) or the hardware run's report.
+nlohmann::json measurement_json(const MeasureRequest& r, const std::string& out, const bench::UnitTruth& unit,
+                                const bench::ExperimentOptions& eo, const Measurement& m,
+                                const std::optional<bench::TrackingSummary>& tracking, bool hardware) {
+  const io::TimeSeries& ts = m.ts;
   nlohmann::json units = nlohmann::json::object();
   for (std::size_t i = 0; i < ts.names.size(); ++i) units[ts.names[i]] = i < ts.units.size() ? ts.units[i] : "";
   nlohmann::json doc = {{"file", out},
@@ -233,51 +294,43 @@ int run_measurement(const MeasureRequest& r) {
                         {"channels", ts.names},
                         {"units", units},
                         {"settings", settings_json(ts)}};
-  if (tracking) {
-    nlohmann::json t = nlohmann::json::object();
-    for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking->sine},
-                                  {"triangle", tracking->triangle}}) {
-      t[name] = {{"width_open", f.width_open}, {"width_ff", f.width_ff}, {"rms_open_m", f.rms_open}, {"rms_ff_m", f.rms_ff},
-                 {"stroke_open_m", f.stroke_open}, {"rms_reduction", f.rms_reduction()}};
-    }
-    t["identified"] = tracking->identified;
-    t["fit_relative_residual"] = tracking->fit_relative_residual;
-    t["clamped_samples"] = tracking->clamped_samples;
-    doc["tracking"] = t;
-  }
+  if (tracking) doc["tracking"] = tracking_json(*tracking);
   if (!hardware) {
     doc["truth"] = bench::truth_json(unit, eo.bench);
   } else {
-    const rt::MeasureReport& rep = runner->report();
-    const rt::IoStats io = rep.io();
-    doc["backend"] = backend->name();
-    doc["bench_file"] = r.bench->source;
-    doc["cycles"] = rep.cycles();
-    doc["io"] = {{"exchanges", io.exchanges}, {"replies", io.replies}, {"lost", io.lost},       {"late", io.late},
-                 {"stale_inputs", io.timeouts}, {"errors", io.errors}, {"rejected", io.rejected},
-                 {"round_trip_us", timing_json(io.round_trip_us)}};
-    nlohmann::json runs = nlohmann::json::array();
-    for (const rt::LoopReport& lr : rep.runs) {
-      nlohmann::json run = loop_timing_json(lr);
-      run.update({{"cycles", lr.cycles},
-                  {"feedforward", lr.feedforward},
-                  {"clamped_samples", lr.clamped_samples},
-                  {"slew_limited_samples", lr.slew_limited_samples},
-                  {"stale_sensor_samples", lr.stale_sensor_samples},
-                  {"safe_state_reason", lr.safe_state_reason},
-                  {"sched_fifo", lr.sched_fifo},
-                  {"memory_locked", lr.memory_locked},
-                  {"warnings", lr.warnings}});
-      runs.push_back(std::move(run));
-    }
-    doc["runs"] = runs;
-    nlohmann::json steps = nlohmann::json::array();
-    for (const rt::OperatorConfirmation& c : rep.operator_steps) {
-      steps.push_back({{"prompt", c.prompt}, {"asked_s", c.asked_s}, {"confirmed_s", c.confirmed_s}});
-    }
-    doc["operator_steps"] = steps;
+    add_hardware_json(r, m, doc);
   }
-  print_json(doc);
+  return doc;
+}
+
+}  // namespace
+
+int run_measurement(const MeasureRequest& r) {
+  const bench::Experiment experiment = requested_experiment(r);
+  bench::ExperimentOptions eo = r.options;
+  try {
+    eo.validate(experiment);
+  } catch (const InputError& e) {
+    throw_as_option_error(e);
+  }
+  const bool hardware = r.bench && r.bench->hardware();
+  const bench::UnitTruth unit = unit_under_test(r, hardware);
+  const std::string out = r.out.empty() ? fmt::format("{}-unit{}.mat", r.experiment, r.unit) : r.out;
+  Measurement m;
+  if (!hardware) {
+    m.ts = simulate_measurement(r, experiment, unit, eo);
+  } else {
+    measure_on_bench(r, experiment, unit, eo, m);
+  }
+  if (!r.serial.empty()) m.ts.settings["serial"] = r.serial;  // checked by `run` against the campaign's units[].serial
+  io::write_timeseries(m.ts, out);
+  std::optional<bench::TrackingSummary> tracking;
+  if (experiment == bench::Experiment::kTracking) tracking = bench::tracking_summary(m.ts);
+  if (!r.json) {
+    print_measurement(r, out, unit, m, tracking);
+    return 0;
+  }
+  print_json(measurement_json(r, out, unit, eo, m, tracking, hardware));
   return 0;
 }
 

@@ -49,66 +49,117 @@ struct RtOptions {
   bool json = false;
 };
 
-int run_rt(const RtOptions& o) {
-  if (o.controller != "iff" && o.controller != "off") {
-    throw UsageError("--controller", "iff or off", "'" + o.controller + "'");
-  }
-  if (!(std::isfinite(o.rate) && o.rate > 0.0)) throw UsageError("--rate", "a rate > 0 Hz", std::to_string(o.rate));
-  o.limits.validate();
+// The loop's backend with what the output records of it, and the limits that apply.
+struct RtBench {
   std::unique_ptr<rt::Backend> backend;
   nlohmann::json source;
-  rt::ActuatorLimits limits = o.limits;
-  limits.ramp_in = limits.ramp_out = o.ramp;
-  const bool bench_file = o.bench.size() > 5 && o.bench.substr(o.bench.size() - 5) == ".toml";
-  if (bench_file) {
-    // A bench file: its backend, rate and limits (a hardware backend never starts without them).
-    if (!o.replay.empty()) throw UsageError("--replay", "only with --bench replay", "'" + o.replay + "'");
-    const rt::BenchDescription desc = rt::read_bench_file(o.bench);
-    if (o.limits_given) {
-      throw UsageError("--va-min/--va-max/--slew-rate/--watchdog/--ramp",
-                       "no limit options with a bench file (its [limits] apply)", "limit options");
-    }
-    if (o.rate_given && std::abs(o.rate - desc.sample_rate) > 1e-9 * desc.sample_rate) {
-      throw InputError(o.bench, "--rate", fmt::format("the bench file's rate {:g} Hz", desc.sample_rate), fmt::format("{:g} Hz", o.rate));
-    }
-    limits = desc.limits;
-    if (desc.backend == "comedi" && !o.realtime) {
-      throw UsageError("--realtime", "true with a card (its I/O is paced by the loop)", "false");
-    }
-    backend = make_backend(desc);
-    source = {{"bench", desc.backend}, {"bench_file", o.bench}};
-    if (!desc.hardware()) source.update({{"unit", desc.unit}, {"seed", desc.seed}});
+  rt::ActuatorLimits limits;
+  bool bench_file = false;  // the backend, rate and limits come from a bench file
+};
+
+// A bench file: its backend, rate and limits (a hardware backend never starts without them).
+void open_bench_file(const RtOptions& o, RtBench& b) {
+  if (!o.replay.empty()) throw UsageError("--replay", "only with --bench replay", "'" + o.replay + "'");
+  const rt::BenchDescription desc = rt::read_bench_file(o.bench);
+  if (o.limits_given) {
+    throw UsageError("--va-min/--va-max/--slew-rate/--watchdog/--ramp",
+                     "no limit options with a bench file (its [limits] apply)", "limit options");
+  }
+  if (o.rate_given && std::abs(o.rate - desc.sample_rate) > 1e-9 * desc.sample_rate) {
+    throw InputError(o.bench, "--rate", fmt::format("the bench file's rate {:g} Hz", desc.sample_rate), fmt::format("{:g} Hz", o.rate));
+  }
+  b.limits = desc.limits;
+  if (desc.backend == "comedi" && !o.realtime) {
+    throw UsageError("--realtime", "true with a card (its I/O is paced by the loop)", "false");
+  }
+  b.backend = make_backend(desc);
+  b.source = {{"bench", desc.backend}, {"bench_file", o.bench}};
+  if (!desc.hardware()) b.source.update({{"unit", desc.unit}, {"seed", desc.seed}});
+}
+
+void open_virtual_bench(const RtOptions& o, RtBench& b) {
+  if (!o.replay.empty()) throw UsageError("--replay", "only with --bench replay", "'" + o.replay + "'");
+  bench::BenchOptions bo;
+  bo.sample_rate = o.rate;
+  bo.va_min = o.limits.va_min;
+  bo.va_max = o.limits.va_max;
+  bo.amplifier_gain = o.limits.amplifier_gain;
+  bo.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
+  b.backend = std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(o.unit, o.seed), bo, o.seed);
+  b.source = {{"bench", "virtual"}, {"unit", o.unit}, {"seed", o.seed}};
+}
+
+void open_replay(const RtOptions& o, RtBench& b) {
+  if (o.replay.empty()) throw UsageError("--replay", "a recorded file (.mat or .csv with de and Vs)", "nothing");
+  auto replay = std::make_unique<rt::ReplayBackend>(std::filesystem::path(o.replay));
+  if (o.rate_given && std::abs(o.rate - replay->sample_rate()) > 1e-6 * replay->sample_rate()) {
+    throw InputError(o.replay, "--rate", "the record's sample rate " + std::to_string(replay->sample_rate()) + " Hz",
+                     std::to_string(o.rate) + " Hz");
+  }
+  b.source = {{"bench", "replay"}, {"file", o.replay}, {"samples", replay->samples()}};
+  b.backend = std::move(replay);
+}
+
+RtBench open_bench(const RtOptions& o) {
+  RtBench b;
+  b.limits = o.limits;
+  b.limits.ramp_in = b.limits.ramp_out = o.ramp;
+  b.bench_file = o.bench.size() > 5 && o.bench.substr(o.bench.size() - 5) == ".toml";
+  if (b.bench_file) {
+    open_bench_file(o, b);
   } else if (o.bench == "virtual") {
-    if (!o.replay.empty()) throw UsageError("--replay", "only with --bench replay", "'" + o.replay + "'");
-    bench::BenchOptions bo;
-    bo.sample_rate = o.rate;
-    bo.va_min = o.limits.va_min;
-    bo.va_max = o.limits.va_max;
-    bo.amplifier_gain = o.limits.amplifier_gain;
-    bo.hysteresis_law = hysteresis_law_option(o.hysteresis_law);
-    backend = std::make_unique<rt::VirtualBenchBackend>(bench::batch_unit(o.unit, o.seed), bo, o.seed);
-    source = {{"bench", "virtual"}, {"unit", o.unit}, {"seed", o.seed}};
+    open_virtual_bench(o, b);
   } else if (o.bench == "replay") {
-    if (o.replay.empty()) throw UsageError("--replay", "a recorded file (.mat or .csv with de and Vs)", "nothing");
-    auto replay = std::make_unique<rt::ReplayBackend>(std::filesystem::path(o.replay));
-    if (o.rate_given && std::abs(o.rate - replay->sample_rate()) > 1e-6 * replay->sample_rate()) {
-      throw InputError(o.replay, "--rate", "the record's sample rate " + std::to_string(replay->sample_rate()) + " Hz",
-                       std::to_string(o.rate) + " Hz");
-    }
-    source = {{"bench", "replay"}, {"file", o.replay}, {"samples", replay->samples()}};
-    backend = std::move(replay);
+    open_replay(o, b);
   } else {
     throw UsageError("--bench", "virtual, replay or a bench file (.toml)", "'" + o.bench + "'");
   }
+  return b;
+}
 
+// Band-limited noise of --amplitude V rms: one period of at most 65,536 samples, played cyclically.
+void add_noise_excitation(const RtOptions& o, double sample_rate, rt::LoopOptions& lo) {
+  const std::vector<double> band = parse_number_list(o.band, "--band");
+  if (band.size() != 2) throw UsageError("--band", "two frequencies LO,HI in Hz", "'" + o.band + "'");
+  dsp::NoiseOptions no;
+  no.sample_rate = sample_rate;
+  const double cycles = std::max(2.0, std::round(o.duration * no.sample_rate));
+  no.samples = static_cast<Eigen::Index>(std::min(cycles, 65536.0));  // one period, played cyclically
+  no.f_low = band[0];
+  no.f_high = band[1];
+  no.rms = o.amplitude;
+  no.seed = o.seed;
+  dsp::VoltageBounds unlimited;  // the loop's safety layer limits the output, not the generator
+  unlimited.min = -1e6;
+  unlimited.max = 1e6;
+  lo.excitation = dsp::band_limited_noise(no, unlimited).u;
+  lo.log_settings["amplitude_rms"] = o.amplitude;
+}
+
+// A sine of --frequency Hz around --offset V: one period (rounded to whole samples), played cyclically.
+void add_sine_excitation(const RtOptions& o, double sample_rate, rt::LoopOptions& lo) {
+  if (!(std::isfinite(o.frequency) && o.frequency > 0.0 && o.frequency < 0.5 * sample_rate)) {
+    throw UsageError("--frequency", "a frequency in (0, rate / 2) Hz", fmt::format("{:g}", o.frequency));
+  }
+  const auto n = static_cast<Eigen::Index>(std::max(2.0, std::round(sample_rate / o.frequency)));
+  lo.excitation.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    lo.excitation(k) = o.offset + o.amplitude * std::sin(kTwoPi * static_cast<double>(k) / static_cast<double>(n));
+  }
+  lo.log_settings["amplitude"] = o.amplitude;
+  lo.log_settings["offset"] = o.offset;
+  lo.log_settings["frequency_Hz"] = sample_rate / static_cast<double>(n);
+}
+
+rt::LoopOptions loop_options(const RtOptions& o, const RtBench& b) {
   rt::LoopOptions lo;
   lo.duration = o.duration;
   lo.realtime = o.realtime;
   lo.priority = o.priority;
-  if (bench_file && !o.fifo) lo.sched_fifo = lo.lock_memory = false;  // --fifo asks for them
+  if (b.bench_file && !o.fifo) lo.sched_fifo = lo.lock_memory = false;  // --fifo asks for them
   lo.controller = o.controller == "iff";
   lo.gain = o.gain;
-  lo.limits = limits;
+  lo.limits = b.limits;
   lo.stop = stop_on_sigint();  // Ctrl-C: the output ramps to the safe value, the log is written
   if (!o.log.empty()) lo.log_file = std::filesystem::path(o.log);
   lo.log_settings["command"] = std::string("rt");
@@ -120,34 +171,9 @@ int run_rt(const RtOptions& o) {
   lo.log_settings["excitation"] = o.excitation;
   lo.on_warning = [](const std::string& w) { log_line("warning: " + w); };
   if (o.excitation == "noise") {
-    const std::vector<double> band = parse_number_list(o.band, "--band");
-    if (band.size() != 2) throw UsageError("--band", "two frequencies LO,HI in Hz", "'" + o.band + "'");
-    dsp::NoiseOptions no;
-    no.sample_rate = backend->sample_rate();
-    const double cycles = std::max(2.0, std::round(o.duration * no.sample_rate));
-    no.samples = static_cast<Eigen::Index>(std::min(cycles, 65536.0));  // one period, played cyclically
-    no.f_low = band[0];
-    no.f_high = band[1];
-    no.rms = o.amplitude;
-    no.seed = o.seed;
-    dsp::VoltageBounds unlimited;  // the loop's safety layer limits the output, not the generator
-    unlimited.min = -1e6;
-    unlimited.max = 1e6;
-    lo.excitation = dsp::band_limited_noise(no, unlimited).u;
-    lo.log_settings["amplitude_rms"] = o.amplitude;
+    add_noise_excitation(o, b.backend->sample_rate(), lo);
   } else if (o.excitation == "sine") {
-    if (!(std::isfinite(o.frequency) && o.frequency > 0.0 && o.frequency < 0.5 * backend->sample_rate())) {
-      throw UsageError("--frequency", "a frequency in (0, rate / 2) Hz", fmt::format("{:g}", o.frequency));
-    }
-    // One period (rounded to whole samples), played cyclically.
-    const auto n = static_cast<Eigen::Index>(std::max(2.0, std::round(backend->sample_rate() / o.frequency)));
-    lo.excitation.resize(n);
-    for (Eigen::Index k = 0; k < n; ++k) {
-      lo.excitation(k) = o.offset + o.amplitude * std::sin(kTwoPi * static_cast<double>(k) / static_cast<double>(n));
-    }
-    lo.log_settings["amplitude"] = o.amplitude;
-    lo.log_settings["offset"] = o.offset;
-    lo.log_settings["frequency_Hz"] = backend->sample_rate() / static_cast<double>(n);
+    add_sine_excitation(o, b.backend->sample_rate(), lo);
   } else if (o.excitation != "none") {
     throw UsageError("--excitation", "none, noise or sine", "'" + o.excitation + "'");
   }
@@ -157,77 +183,80 @@ int run_rt(const RtOptions& o) {
   }
   // The signals are kept in memory for the summary unless the run is long.
   lo.keep_log = o.duration <= 120.0;
+  return lo;
+}
 
-  if (!o.json) {
-    log_line(fmt::format("rt: {} backend, controller {}, g = {:g}, {:g} Hz, {:g} s, {}", backend->name(), o.controller,
-                         o.gain, backend->sample_rate(), o.duration, o.realtime ? "real time" : "lockstep (as fast as possible)"));
-  }
-  io::TimeSeries log;
-  const rt::LoopReport r = rt::run_loop(*backend, lo, &log);
+// Extremes and rms of the logged signals (null when the log was not kept).
+nlohmann::json signal_summary(const rt::LoopOptions& lo, const io::TimeSeries& log) {
+  if (!lo.keep_log || log.samples() == 0) return nullptr;
+  const auto rms = [](const Eigen::Ref<const Eigen::VectorXd>& v) { return std::sqrt(v.squaredNorm() / static_cast<double>(v.size())); };
+  return {{"Va_min_V", log.channel("Va").minCoeff()},
+          {"Va_max_V", log.channel("Va").maxCoeff()},
+          {"Va_rms_V", rms(log.channel("Va"))},
+          {"de_rms_um", rms(log.channel("de")) * 1e6},
+          {"Vs_rms_V", rms(log.channel("Vs"))},
+          {"u_prime_rms_V", rms(log.channel("u_prime"))},
+          {"y_rms_V", rms(log.channel("y"))}};
+}
 
-  nlohmann::json signals = nullptr;
-  if (lo.keep_log && log.samples() > 0) {
-    const auto rms = [](const Eigen::Ref<const Eigen::VectorXd>& v) { return std::sqrt(v.squaredNorm() / static_cast<double>(v.size())); };
-    signals = {{"Va_min_V", log.channel("Va").minCoeff()},
-               {"Va_max_V", log.channel("Va").maxCoeff()},
-               {"Va_rms_V", rms(log.channel("Va"))},
-               {"de_rms_um", rms(log.channel("de")) * 1e6},
-               {"Vs_rms_V", rms(log.channel("Vs"))},
-               {"u_prime_rms_V", rms(log.channel("u_prime"))},
-               {"y_rms_V", rms(log.channel("y"))}};
-  }
-  if (o.json) {
-    nlohmann::json doc = loop_timing_json(r);
-    doc.update({{"source", source},
-                {"controller", o.controller},
-                {"gain", o.gain},
-                {"rate_Hz", r.sample_rate},
-                {"duration_s", o.duration},
-                {"realtime", r.realtime},
-                {"sched_fifo", r.sched_fifo},
-                {"memory_locked", r.memory_locked},
-                {"cycles", r.cycles},
-                {"wind_down_cycles", r.wind_down_cycles},
-                {"period_jitter_us", r.realtime ? timing_json(r.period_jitter_us) : nlohmann::json(nullptr)},
-                {"wake_latency_us", r.realtime ? timing_json(r.wake_latency_us) : nlohmann::json(nullptr)},
-                {"clamped_samples", r.clamped_samples},
-                {"slew_limited_samples", r.slew_limited_samples},
-                {"safe_state_events", r.safe_state_events},
-                {"safe_state_reason", r.safe_state_reason},
-                {"safe_state_cycle", r.safe_state_cycle},
-                {"watchdog_trips", r.watchdog_trips},
-                {"nonfinite_sensor_samples", r.nonfinite_sensor_samples},
-                {"stale_sensor_samples", r.stale_sensor_samples},
-                {"feedforward", r.feedforward},
-                {"va_cmd_min_V", r.va_cmd_min},
-                {"va_cmd_max_V", r.va_cmd_max},
-                {"io",
-                 {{"exchanges", r.io.exchanges},
-                  {"replies", r.io.replies},
-                  {"lost", r.io.lost},
-                  {"late", r.io.late},
-                  {"stale_inputs", r.io.timeouts},
-                  {"errors", r.io.errors},
-                  {"round_trip_us", timing_json(r.io.round_trip_us)}}},
-                {"max_va_cmd_step_V", r.max_va_cmd_step},
-                {"limits",
-                 {{"actuator", limits.actuator},
-                  {"va_min_V", limits.va_min},
-                  {"va_max_V", limits.va_max},
-                  {"amplifier_gain", limits.amplifier_gain},
-                  {"slew_rate_V_per_s", limits.slew_rate},
-                  {"ramp_s", limits.ramp_in},
-                  {"watchdog_s", limits.watchdog_timeout},
-                  {"saturation_time_s", limits.saturation_time},
-                  {"stale_cycles", limits.stale_cycles}}},
-                {"log", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
-                {"logged_samples", r.logged_samples},
-                {"dropped_log_samples", r.dropped_log_samples},
-                {"signals", signals},
-                {"warnings", r.warnings}});
-    print_json(doc);
-    return 0;
-  }
+nlohmann::json limits_json(const rt::ActuatorLimits& limits) {
+  return {{"actuator", limits.actuator},
+          {"va_min_V", limits.va_min},
+          {"va_max_V", limits.va_max},
+          {"amplifier_gain", limits.amplifier_gain},
+          {"slew_rate_V_per_s", limits.slew_rate},
+          {"ramp_s", limits.ramp_in},
+          {"watchdog_s", limits.watchdog_timeout},
+          {"saturation_time_s", limits.saturation_time},
+          {"stale_cycles", limits.stale_cycles}};
+}
+
+// The --json document of a run.
+nlohmann::json rt_json(const RtOptions& o, const RtBench& b, const rt::LoopReport& r, const nlohmann::json& signals) {
+  nlohmann::json doc = loop_timing_json(r);
+  doc.update({{"source", b.source},
+              {"controller", o.controller},
+              {"gain", o.gain},
+              {"rate_Hz", r.sample_rate},
+              {"duration_s", o.duration},
+              {"realtime", r.realtime},
+              {"sched_fifo", r.sched_fifo},
+              {"memory_locked", r.memory_locked},
+              {"cycles", r.cycles},
+              {"wind_down_cycles", r.wind_down_cycles},
+              {"period_jitter_us", r.realtime ? timing_json(r.period_jitter_us) : nlohmann::json(nullptr)},
+              {"wake_latency_us", r.realtime ? timing_json(r.wake_latency_us) : nlohmann::json(nullptr)},
+              {"clamped_samples", r.clamped_samples},
+              {"slew_limited_samples", r.slew_limited_samples},
+              {"safe_state_events", r.safe_state_events},
+              {"safe_state_reason", r.safe_state_reason},
+              {"safe_state_cycle", r.safe_state_cycle},
+              {"watchdog_trips", r.watchdog_trips},
+              {"nonfinite_sensor_samples", r.nonfinite_sensor_samples},
+              {"stale_sensor_samples", r.stale_sensor_samples},
+              {"feedforward", r.feedforward},
+              {"va_cmd_min_V", r.va_cmd_min},
+              {"va_cmd_max_V", r.va_cmd_max},
+              {"io",
+               {{"exchanges", r.io.exchanges},
+                {"replies", r.io.replies},
+                {"lost", r.io.lost},
+                {"late", r.io.late},
+                {"stale_inputs", r.io.timeouts},
+                {"errors", r.io.errors},
+                {"round_trip_us", timing_json(r.io.round_trip_us)}}},
+              {"max_va_cmd_step_V", r.max_va_cmd_step},
+              {"limits", limits_json(b.limits)},
+              {"log", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
+              {"logged_samples", r.logged_samples},
+              {"dropped_log_samples", r.dropped_log_samples},
+              {"signals", signals},
+              {"warnings", r.warnings}});
+  return doc;
+}
+
+// The timing of the run: the cycles, where overruns come from, the latency percentiles.
+void print_rt_timing(const rt::LoopReport& r) {
   fmt::print("real-time loop: {} backend, {:g} Hz, {} ({}SCHED_FIFO, {}mlockall)\n", r.backend, r.sample_rate,
              r.realtime ? "real time" : "lockstep", r.sched_fifo ? "" : "no ", r.memory_locked ? "" : "no ");
   fmt::print("cycles {}   overruns {}   skipped deadlines {}\n", r.cycles, r.overruns, r.skipped_deadlines);
@@ -248,6 +277,10 @@ int run_rt(const RtOptions& o) {
     row("wake latency", r.wake_latency_us);
   }
   row("step time", r.step_time_us);
+}
+
+// The output and safety figures of the run, the I/O and the log.
+void print_rt_outputs(const RtOptions& o, const rt::ActuatorLimits& limits, const rt::LoopReport& r) {
   fmt::print("output: Va commanded {:.2f} .. {:.2f} V (limits {:g} .. {:g} V), largest step {:.3g} V\n", r.va_cmd_min,
              r.va_cmd_max, limits.va_min, limits.va_max, r.max_va_cmd_step);
   fmt::print("clamped samples {}   slew-limited samples {}   safe state: {}{}   watchdog trips {}\n", r.clamped_samples,
@@ -263,6 +296,29 @@ int run_rt(const RtOptions& o) {
                limits.saturation_time);
   }
   if (!o.log.empty()) fmt::print("log: {} ({} samples, {} dropped)\n", o.log, r.logged_samples, r.dropped_log_samples);
+}
+
+int run_rt(const RtOptions& o) {
+  if (o.controller != "iff" && o.controller != "off") {
+    throw UsageError("--controller", "iff or off", "'" + o.controller + "'");
+  }
+  if (!(std::isfinite(o.rate) && o.rate > 0.0)) throw UsageError("--rate", "a rate > 0 Hz", std::to_string(o.rate));
+  o.limits.validate();
+  const RtBench b = open_bench(o);
+  const rt::LoopOptions lo = loop_options(o, b);
+  if (!o.json) {
+    log_line(fmt::format("rt: {} backend, controller {}, g = {:g}, {:g} Hz, {:g} s, {}", b.backend->name(), o.controller,
+                         o.gain, b.backend->sample_rate(), o.duration, o.realtime ? "real time" : "lockstep (as fast as possible)"));
+  }
+  io::TimeSeries log;
+  const rt::LoopReport r = rt::run_loop(*b.backend, lo, &log);
+  const nlohmann::json signals = signal_summary(lo, log);
+  if (o.json) {
+    print_json(rt_json(o, b, r, signals));
+    return 0;
+  }
+  print_rt_timing(r);
+  print_rt_outputs(o, b.limits, r);
   return 0;
 }
 
