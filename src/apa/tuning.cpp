@@ -358,45 +358,47 @@ void mark_undetermined(TwoDofTuning& t, const TuningOptions& o) {
   }
 }
 
-}  // namespace
+// What the report's procedure reads off the FRFs: the resonance of u -> d_e and the
+// anti-resonance of u -> Vs (rad/s), their damping, and the static levels.
+struct ReportFeatures {
+  double wp = 0.0, peak = 0.0, zeta_p = 0.0;  // resonance, |H| there, damping
+  double wz = 0.0, dip = 0.0, zeta_z = 0.0;   // anti-resonance, |Vs| there, damping
+  double de0 = 0.0, vs0 = 0.0;                // static levels of d_e and Vs
+};
 
-TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
-  o.validate();
-  const std::string source = frf.provenance.source.empty() ? "FRF" : frf.provenance.source;
-  frf.validate(source);
-  const FitData d = prepare(frf, o, source);
+ReportFeatures report_features(const FitData& d) {
   const Index n = d.omega.size();
-  const double m = o.mass;
-  const double rk = o.stack_stiffness_ratio > 0.0 ? o.stack_stiffness_ratio : 2.0;
-  const double rc = o.stack_damping_ratio > 0.0 ? o.stack_damping_ratio : 2.0;
-
-  // ---- Step 1: the report's procedure.
-  TwoDofTuning out;
-  out.bench = o.bench;
-  out.points = n;
-  const auto [wp, peak] = extremum(d.omega, d.de, 0, n - 1, /*maximum=*/true, "resonance peak of u -> d_e");
+  ReportFeatures f;
+  std::tie(f.wp, f.peak) = extremum(d.omega, d.de, 0, n - 1, /*maximum=*/true, "resonance peak of u -> d_e");
+  const double wp = f.wp;
   // The lowest frequency, corrected for the resonance's static amplification 1/(1 - w^2/wp^2).
   const double w0 = d.omega(0);
-  const double de0 = std::abs(d.de(0)) * std::abs(1.0 - (w0 / wp) * (w0 / wp));
+  f.de0 = std::abs(d.de(0)) * std::abs(1.0 - (w0 / wp) * (w0 / wp));
   // Peak over static = quality factor 1/(2 zeta) (exact at the undamped natural frequency).
-  const double zeta_p = std::clamp(de0 / (2.0 * peak), 1e-5, 0.5);
+  f.zeta_p = std::clamp(f.de0 / (2.0 * f.peak), 1e-5, 0.5);
   // The dip of Vs must lie below the resonance.
   Index below = 0;
   while (below + 1 < n && d.omega(below + 1) < wp) ++below;
-  const auto [wz, dip] = extremum(d.omega, d.vs, 0, below, /*maximum=*/false, "anti-resonance of u -> Vs below the resonance");
+  std::tie(f.wz, f.dip) = extremum(d.omega, d.vs, 0, below, /*maximum=*/false, "anti-resonance of u -> Vs below the resonance");
+  const double wz = f.wz;
   // Near the zero, Vs ~ K (1 - w^2/wz^2 + 2 j zeta_z w/wz) / (1 - w^2/wp^2): the depth gives zeta_z.
-  const double vs0 = std::abs(d.vs(0)) * std::abs(1.0 - (w0 / wp) * (w0 / wp)) / std::abs(1.0 - (w0 / wz) * (w0 / wz));
-  const double zeta_z = std::clamp(dip * std::abs(1.0 - (wz / wp) * (wz / wp)) / (2.0 * vs0), 1e-6, 0.5);
+  f.vs0 = std::abs(d.vs(0)) * std::abs(1.0 - (w0 / wp) * (w0 / wp)) / std::abs(1.0 - (w0 / wz) * (w0 / wz));
+  f.zeta_z = std::clamp(f.dip * std::abs(1.0 - (wz / wp) * (wz / wp)) / (2.0 * f.vs0), 1e-6, 0.5);
+  return f;
+}
 
+// The report's procedure: the shell from the anti-resonance, the stacks from the resonance with
+// ke = rk ka and ce = rc ca.
+TwoDofParams report_stiffness_and_damping(const ReportFeatures& f, double m, double rk, double rc) {
   TwoDofParams p;
   p.m = m;
-  p.k1 = m * wz * wz;
-  p.c1 = 2.0 * zeta_z * std::sqrt(p.k1 * m);
-  const double ktot = m * wp * wp;
+  p.k1 = m * f.wz * f.wz;
+  p.c1 = 2.0 * f.zeta_z * std::sqrt(p.k1 * m);
+  const double ktot = m * f.wp * f.wp;
   if (!(ktot > p.k1)) {
     throw NumericalError("2-DoF tuning",
                          fmt::format("the resonance ({:.4g} Hz) is not above the anti-resonance ({:.4g} Hz) of u -> Vs",
-                                     wp / kTwoPi, wz / kTwoPi),
+                                     f.wp / kTwoPi, f.wz / kTwoPi),
                          /*retry_may_help=*/true);
   }
   const double series = rk / (1.0 + rk);  // ke ka/(ke + ka) = series ka when ke = rk ka
@@ -406,50 +408,43 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
   // a first guess that the refinement corrects. A floor keeps the damping positive when the
   // estimate of zeta_p is below the shell's share.
   const double c_crit = 2.0 * std::sqrt(ktot * m);
-  p.ca = std::max(zeta_p * c_crit - p.c1, 1e-3 * c_crit) * (1.0 + rc) / rc;
+  p.ca = std::max(f.zeta_p * c_crit - p.c1, 1e-3 * c_crit) * (1.0 + rc) / rc;
   p.ce = rc * p.ca;
-  // Gains: linear least squares of the relative error with unit gains.
+  return p;
+}
+
+// Gains: linear least squares of the relative error with unit gains.
+void fit_gains(const FitData& d, TwoDofParams& p) {
+  const Index n = d.omega.size();
   p.ga = 1.0;
   p.gs = 1.0;
-  {
-    TwoDofBench bare;
-    bare.amplifier_gain = 1.0;
-    const lti::CMatrix h = two_dof_response(p, bare, d.omega);
-    double num = 0.0, den = 0.0;
-    for (Index k = 0; k < n; ++k) {
-      const Complex a = h(k, kOutputDe) / d.de(k);
-      num += a.real();
-      den += std::norm(a);
-    }
-    p.ga = num / den;
-    num = den = 0.0;
-    for (Index k = 0; k < n; ++k) {
-      const Complex b = p.ga * h(k, kOutputVs) / d.vs(k);
-      num += b.real();
-      den += std::norm(b);
-    }
-    p.gs = num / den;
+  TwoDofBench bare;
+  bare.amplifier_gain = 1.0;
+  const lti::CMatrix h = two_dof_response(p, bare, d.omega);
+  double num = 0.0, den = 0.0;
+  for (Index k = 0; k < n; ++k) {
+    const Complex a = h(k, kOutputDe) / d.de(k);
+    num += a.real();
+    den += std::norm(a);
   }
+  p.ga = num / den;
+  num = den = 0.0;
+  for (Index k = 0; k < n; ++k) {
+    const Complex b = p.ga * h(k, kOutputVs) / d.vs(k);
+    num += b.real();
+    den += std::norm(b);
+  }
+  p.gs = num / den;
   if (!usable(p) || p.ga == 0.0 || p.gs == 0.0) {
     throw NumericalError("2-DoF tuning", "the initial gains ga, gs came out zero or not finite", /*retry_may_help=*/false);
   }
-  const double g = o.bench.amplifier_gain;
-  out.features = {wp, zeta_p, wz, zeta_z, g * std::copysign(de0, d.de(0).real()), g * std::copysign(vs0, d.vs(0).real())};
-  out.initial = p;
-  std::tie(out.initial_fit_error_de, out.initial_fit_error_vs) = fit_errors(p, d);
-  out.params = p;
-  out.fit_error_de = out.initial_fit_error_de;
-  out.fit_error_vs = out.initial_fit_error_vs;
-  out.status = TuningStatus::kNotRefined;
-  out.message = "report's procedure only (refinement disabled)";
-  if (!o.refine) {
-    out.quality = assess(out, d);
-    return out;
-  }
+}
 
-  // ---- Step 2: Levenberg-Marquardt on the log-parameters.
+// Step 2: Levenberg-Marquardt on the log-parameters from the report's procedure's.
+void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) {
+  const TwoDofParams& p = out.initial;
   Layout layout;
-  layout.mass = m;
+  layout.mass = o.mass;
   layout.ga_sign = p.ga > 0.0 ? 1.0 : -1.0;
   layout.gs_sign = p.gs > 0.0 ? 1.0 : -1.0;
   layout.ke_ratio = o.stack_stiffness_ratio;
@@ -472,6 +467,39 @@ TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
                                                               : TuningStatus::kNoProgress;
   out.message = fmt::format("Levenberg-Marquardt: {} after {} steps ({} evaluations), cost {:.4g} -> {:.4g}",
                             core::to_string(r.status), r.iterations, r.evaluations, r.initial_cost, r.cost);
+}
+
+}  // namespace
+
+TwoDofTuning tune_two_dof(const dsp::Frf& frf, const TuningOptions& o) {
+  o.validate();
+  const std::string source = frf.provenance.source.empty() ? "FRF" : frf.provenance.source;
+  frf.validate(source);
+  const FitData d = prepare(frf, o, source);
+  const double rk = o.stack_stiffness_ratio > 0.0 ? o.stack_stiffness_ratio : 2.0;
+  const double rc = o.stack_damping_ratio > 0.0 ? o.stack_damping_ratio : 2.0;
+
+  // ---- Step 1: the report's procedure.
+  TwoDofTuning out;
+  out.bench = o.bench;
+  out.points = d.omega.size();
+  const ReportFeatures f = report_features(d);
+  TwoDofParams p = report_stiffness_and_damping(f, o.mass, rk, rc);
+  fit_gains(d, p);
+  const double g = o.bench.amplifier_gain;
+  out.features = {f.wp, f.zeta_p, f.wz, f.zeta_z, g * std::copysign(f.de0, d.de(0).real()), g * std::copysign(f.vs0, d.vs(0).real())};
+  out.initial = p;
+  std::tie(out.initial_fit_error_de, out.initial_fit_error_vs) = fit_errors(p, d);
+  out.params = p;
+  out.fit_error_de = out.initial_fit_error_de;
+  out.fit_error_vs = out.initial_fit_error_vs;
+  out.status = TuningStatus::kNotRefined;
+  out.message = "report's procedure only (refinement disabled)";
+  if (!o.refine) {
+    out.quality = assess(out, d);
+    return out;
+  }
+  refine_tuning(d, o, out);
   out.quality = assess(out, d);
   mark_undetermined(out, o);
   return out;

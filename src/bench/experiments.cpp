@@ -356,27 +356,34 @@ io::TimeSeries iff(BenchRunner& runner, const UnitTruth& unit, const ExperimentO
   return ts;
 }
 
-// The tracking experiment (bench/tracking.hpp).
-io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
-                        const Progress& progress) {
-  const BenchOptions& b = o.bench;
-  const double fs = b.sample_rate;
-  const double amplitude = o.amplitude.value_or(80.0);
-  const double offset = 0.5 * (b.va_min + b.va_max);
+// The tracking experiment's waveform: a raised-cosine ramp to the offset, `kTrackingPeriods` sine
+// periods, as many triangle periods, a ramp back to 0 V.
+constexpr double kTrackingFrequency = 1.0;  // Hz
+constexpr double kTrackingRamp = 1.0;       // s
+constexpr int kTrackingPeriods = 3;
+
+void check_tracking_amplitude(const BenchOptions& b, double amplitude, double offset) {
   if (offset - amplitude < b.va_min - 1e-12 || offset + amplitude > b.va_max + 1e-12) {
     throw InputError(kSource, "amplitude",
                      fmt::format("an amplitude <= {:g} V (offset {:g} V, stack range {:g} V .. {:g} V)",
                                  std::min(offset - b.va_min, b.va_max - offset), offset, b.va_min, b.va_max),
                      fmt::format("{:g} V", amplitude));
   }
-  const double frequency = 1.0, ramp = 1.0;
-  const int periods = 3;
+}
+
+// Command (V at the stacks) and the weight of the feedforward: the raised-cosine ramps' w.
+struct TrackingCommand {
+  std::vector<double> c;
+  Eigen::VectorXd weight;
+};
+
+TrackingCommand tracking_command(double offset, double amplitude, double fs) {
+  const double frequency = kTrackingFrequency, ramp = kTrackingRamp;
+  const int periods = kTrackingPeriods;
   const auto n_ramp = static_cast<Eigen::Index>(std::llround(ramp * fs));
   const auto n_wave = static_cast<Eigen::Index>(std::llround(periods / frequency * fs));
   const Eigen::Index n = 2 * n_ramp + 2 * n_wave;
-  // Command (V at the stacks) and the weight of the feedforward: the raised-cosine ramps' w.
-  std::vector<double> c(static_cast<std::size_t>(n));
-  Eigen::VectorXd weight = Eigen::VectorXd::Ones(n);
+  TrackingCommand cmd{std::vector<double>(static_cast<std::size_t>(n)), Eigen::VectorXd::Ones(n)};
   for (Eigen::Index k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) / fs;
     double v = 0.0, w = 1.0;
@@ -395,55 +402,24 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
       w = 0.5 + 0.5 * std::cos(std::numbers::pi * (t - ramp - 2.0 * periods / frequency) / ramp);
       v = offset * w;
     }
-    c[static_cast<std::size_t>(k)] = v;
-    weight(k) = w;
+    cmd.c[static_cast<std::size_t>(k)] = v;
+    cmd.weight(k) = w;
   }
-  auto progress_part = [&](double from, double span) -> Progress {
-    if (!progress) return {};
-    return [&progress, from, span](double p) { progress(from + span * p); };
-  };
-  Eigen::VectorXd u(n);
-  for (Eigen::Index k = 0; k < n; ++k) u(k) = c[static_cast<std::size_t>(k)] / b.amplifier_gain;
-  Eigen::MatrixXd open, comp;  // u, Va, de, Vs
-  runner.open_loop(u, experiment_bench_seed(Experiment::kTracking, seed), open, progress_part(0.0, 0.5));
+  return cmd;
+}
 
-  ident::HysteresisModel model;
-  double fit_residual = 0.0;
-  const bool identified = !o.feedforward.has_value();
-  if (identified) {
-    const Eigen::VectorXd va = open.col(1), de = open.col(2);
-    ident::HysteresisFitOptions fo;
-    fo.creep_time_constants = {1.0, 10.0};
-    const ident::HysteresisFit fit = ident::fit_hysteresis({va.data(), static_cast<std::size_t>(n)},
-                                                           {de.data(), static_cast<std::size_t>(n)}, fs, fo);
-    model = fit.model;
-    fit_residual = fit.relative_residual;
-  } else {
-    model = *o.feedforward;
-  }
-  // The compensated run: the same command through the runner's live feedforward stage, blended in
-  // and out over the ramps (the run starts and ends at 0 V).
-  const std::uint64_t clamped = runner.open_loop_feedforward(u, weight, model, detail::derive_seed(seed, stream(Experiment::kTracking, 1)),
-                                                             comp, progress_part(0.5, 0.5));
+// The hysteresis model of the open run (its fit's relative residual in fit_residual).
+ident::HysteresisModel identify_tracking_model(const Eigen::MatrixXd& open, std::size_t n, double fs, double& fit_residual) {
+  const Eigen::VectorXd va = open.col(1), de = open.col(2);
+  ident::HysteresisFitOptions fo;
+  fo.creep_time_constants = {1.0, 10.0};
+  const ident::HysteresisFit fit = ident::fit_hysteresis({va.data(), n}, {de.data(), n}, fs, fo);
+  fit_residual = fit.relative_residual;
+  return fit.model;
+}
 
-  io::TimeSeries ts = make_record({"c", "Va_open", "de_open", "Va_ff", "de_ff"}, {"V", "V", "m", "V", "m"}, n, fs, true);
-  ts.data.col(0) = Eigen::Map<const Eigen::VectorXd>(c.data(), n);
-  ts.data.col(1) = open.col(1);
-  ts.data.col(2) = open.col(2);
-  ts.data.col(3) = comp.col(1);
-  ts.data.col(4) = comp.col(2);
-  common_settings(ts, Experiment::kTracking, unit, b, seed, &runner);
-  ts.settings["amplitude_V"] = amplitude;
-  ts.settings["offset_V"] = offset;
-  ts.settings["frequency_Hz"] = frequency;
-  ts.settings["periods"] = static_cast<double>(periods);
-  ts.settings["ramp_s"] = ramp;
-  ts.settings["feedforward"] = std::string(identified ? "identified" : "given");
-  if (identified) ts.settings["fit_relative_residual"] = fit_residual;
-  ts.settings["clamped_samples"] = static_cast<double>(clamped);
-  ts.settings["target_slope_m_per_V"] = model.gain * model.reference_slope;
-  ts.settings["target_intercept_m"] = model.offset + model.gain * model.reference_intercept;
-  // The figures over the last periods - 1 periods of each waveform (the first one settles the loop).
+// The figures over the last periods - 1 periods of each waveform (the first one settles the loop).
+void add_tracking_figures(io::TimeSeries& ts) {
   const TrackingLayout layout = tracking_layout(ts);
   const auto figures = [&](Eigen::Index begin, Eigen::Index end) {
     const auto col = [&](Eigen::Index j) { return std::span<const double>(ts.data.col(j).data() + begin, static_cast<std::size_t>(end - begin)); };
@@ -461,6 +437,53 @@ io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const Experi
   }
   ts.settings["window_sine_samples"] = fmt::format("{}..{}", layout.sine_begin, layout.sine_end);
   ts.settings["window_triangle_samples"] = fmt::format("{}..{}", layout.triangle_begin, layout.triangle_end);
+}
+
+// The tracking experiment (bench/tracking.hpp).
+io::TimeSeries tracking(BenchRunner& runner, const UnitTruth& unit, const ExperimentOptions& o, std::uint64_t seed,
+                        const Progress& progress) {
+  const BenchOptions& b = o.bench;
+  const double fs = b.sample_rate;
+  const double amplitude = o.amplitude.value_or(80.0);
+  const double offset = 0.5 * (b.va_min + b.va_max);
+  check_tracking_amplitude(b, amplitude, offset);
+  const TrackingCommand cmd = tracking_command(offset, amplitude, fs);
+  const auto n = static_cast<Eigen::Index>(cmd.c.size());
+  auto progress_part = [&](double from, double span) -> Progress {
+    if (!progress) return {};
+    return [&progress, from, span](double p) { progress(from + span * p); };
+  };
+  Eigen::VectorXd u(n);
+  for (Eigen::Index k = 0; k < n; ++k) u(k) = cmd.c[static_cast<std::size_t>(k)] / b.amplifier_gain;
+  Eigen::MatrixXd open, comp;  // u, Va, de, Vs
+  runner.open_loop(u, experiment_bench_seed(Experiment::kTracking, seed), open, progress_part(0.0, 0.5));
+
+  double fit_residual = 0.0;
+  const bool identified = !o.feedforward.has_value();
+  const ident::HysteresisModel model = identified ? identify_tracking_model(open, static_cast<std::size_t>(n), fs, fit_residual) : *o.feedforward;
+  // The compensated run: the same command through the runner's live feedforward stage, blended in
+  // and out over the ramps (the run starts and ends at 0 V).
+  const std::uint64_t clamped = runner.open_loop_feedforward(u, cmd.weight, model, detail::derive_seed(seed, stream(Experiment::kTracking, 1)),
+                                                             comp, progress_part(0.5, 0.5));
+
+  io::TimeSeries ts = make_record({"c", "Va_open", "de_open", "Va_ff", "de_ff"}, {"V", "V", "m", "V", "m"}, n, fs, true);
+  ts.data.col(0) = Eigen::Map<const Eigen::VectorXd>(cmd.c.data(), n);
+  ts.data.col(1) = open.col(1);
+  ts.data.col(2) = open.col(2);
+  ts.data.col(3) = comp.col(1);
+  ts.data.col(4) = comp.col(2);
+  common_settings(ts, Experiment::kTracking, unit, b, seed, &runner);
+  ts.settings["amplitude_V"] = amplitude;
+  ts.settings["offset_V"] = offset;
+  ts.settings["frequency_Hz"] = kTrackingFrequency;
+  ts.settings["periods"] = static_cast<double>(kTrackingPeriods);
+  ts.settings["ramp_s"] = kTrackingRamp;
+  ts.settings["feedforward"] = std::string(identified ? "identified" : "given");
+  if (identified) ts.settings["fit_relative_residual"] = fit_residual;
+  ts.settings["clamped_samples"] = static_cast<double>(clamped);
+  ts.settings["target_slope_m_per_V"] = model.gain * model.reference_slope;
+  ts.settings["target_intercept_m"] = model.offset + model.gain * model.reference_intercept;
+  add_tracking_figures(ts);
   return ts;
 }
 

@@ -181,12 +181,9 @@ double window_mean(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const V
   return n > 0 ? s / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
 }
 
-}  // namespace
+using Signal = Eigen::Ref<const VectorXd>;
 
-StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de,
-                                       const Eigen::Ref<const VectorXd>& mass_log, const StaticStiffnessOptions& options,
-                                       const std::string& source) {
-  options.validate();
+void check_stiffness_record(const Signal& t, const Signal& de, const Signal& mass_log, const std::string& source) {
   detail::require_signal(t, source, "t", 10);
   detail::require_signal(de, source, "de", 10);
   detail::require_same_length(t.size(), de.size(), source, "de");
@@ -199,55 +196,61 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
       throw InputError(source, "t", "strictly increasing times", fmt::format("t[{}] = {} after {}", k, t(k), t(k - 1)));
     }
   }
-  const Index n = t.size();
-  const double dt = (t(n - 1) - t(0)) / static_cast<double>(n - 1);
+}
 
-  StaticStiffnessResult r;
-  if (options.t_on > 0.0) {
-    r.t_on = options.t_on;
-    r.t_off = options.t_off;
-  } else if (mass_log.size() > 0) {
-    const double top = mass_log.maxCoeff();
-    if (!(top > 0.0)) throw InputError(source, "added_mass", "a log showing the mass put on (> 0 kg)", "no mass");
-    Index on = 0;
-    while (on < n && !(mass_log(on) > 0.01 * top)) ++on;
-    Index off = on;
-    while (off < n && !(mass_log(off) >= 0.99 * top)) ++off;  // fully loaded
-    while (off < n && mass_log(off) >= 0.99 * top) ++off;     // then unloading starts
-    if (on == 0 || off >= n) {
-      throw InputError(source, "added_mass", "a log with the mass put on after the start and taken off before the end",
-                       on == 0 ? "the mass on from the first sample" : "the mass never taken off");
-    }
-    r.t_on = 0.5 * (t(on - 1) + t(on));
-    r.t_off = 0.5 * (t(off - 1) + t(off));
-  } else {
-    // The two largest changes over settle_s, opposite in sign.
-    const Index w = std::max<Index>(1, static_cast<Index>(std::lround(options.settle_s / dt)));
-    if (n <= w + 1) throw InputError(source, "de", "a record longer than settle_s", fmt::format("{} samples", n));
-    Index kmin = 0, kmax = 0;
-    for (Index k = 0; k + w < n; ++k) {
-      const double g = de(k + w) - de(k);
-      if (g < de(kmin + w) - de(kmin)) kmin = k;
-      if (g > de(kmax + w) - de(kmax)) kmax = k;
-    }
-    // The mass starts moving at the event: the first sample of the window that has left the
-    // level before it (mean over the preceding w/5 samples) by 2 % of the change over the window.
-    auto start_of_motion = [&](Index k0) {
-      const Index m = std::max<Index>(1, w / 5);
-      const Index from = std::max<Index>(0, k0 - m);
-      const double level = de.segment(from, k0 - from + 1).mean();
-      const double change = de(k0 + w) - level;
-      Index k = k0 + 1;
-      while (k < k0 + w && std::abs(de(k) - level) <= 0.02 * std::abs(change)) ++k;
-      return k;
-    };
-    const Index a = start_of_motion(std::min(kmin, kmax));
-    const Index b = start_of_motion(std::max(kmin, kmax));
-    if (b - a <= w) throw InputError(source, "de", "two separate steps (mass on, mass off)", "no second step");
-    r.t_on = 0.5 * (t(a - 1) + t(a));
-    r.t_off = 0.5 * (t(b - 1) + t(b));
+// t_on and t_off from the mass log: the first sample above 1 % of the mass, the first below 99 %
+// after the full load.
+void events_from_mass_log(const Signal& t, const Signal& mass_log, const std::string& source, StaticStiffnessResult& r) {
+  const Index n = t.size();
+  const double top = mass_log.maxCoeff();
+  if (!(top > 0.0)) throw InputError(source, "added_mass", "a log showing the mass put on (> 0 kg)", "no mass");
+  Index on = 0;
+  while (on < n && !(mass_log(on) > 0.01 * top)) ++on;
+  Index off = on;
+  while (off < n && !(mass_log(off) >= 0.99 * top)) ++off;  // fully loaded
+  while (off < n && mass_log(off) >= 0.99 * top) ++off;     // then unloading starts
+  if (on == 0 || off >= n) {
+    throw InputError(source, "added_mass", "a log with the mass put on after the start and taken off before the end",
+                     on == 0 ? "the mass on from the first sample" : "the mass never taken off");
   }
-  // Every window and the settling times inside the record, in order.
+  r.t_on = 0.5 * (t(on - 1) + t(on));
+  r.t_off = 0.5 * (t(off - 1) + t(off));
+}
+
+// t_on and t_off from the deflection: the two largest changes over settle_s, opposite in sign.
+void events_from_deflection(const Signal& t, const Signal& de, double settle_s, double dt, const std::string& source,
+                            StaticStiffnessResult& r) {
+  const Index n = t.size();
+  const Index w = std::max<Index>(1, static_cast<Index>(std::lround(settle_s / dt)));
+  if (n <= w + 1) throw InputError(source, "de", "a record longer than settle_s", fmt::format("{} samples", n));
+  Index kmin = 0, kmax = 0;
+  for (Index k = 0; k + w < n; ++k) {
+    const double g = de(k + w) - de(k);
+    if (g < de(kmin + w) - de(kmin)) kmin = k;
+    if (g > de(kmax + w) - de(kmax)) kmax = k;
+  }
+  // The mass starts moving at the event: the first sample of the window that has left the
+  // level before it (mean over the preceding w/5 samples) by 2 % of the change over the window.
+  auto start_of_motion = [&](Index k0) {
+    const Index m = std::max<Index>(1, w / 5);
+    const Index from = std::max<Index>(0, k0 - m);
+    const double level = de.segment(from, k0 - from + 1).mean();
+    const double change = de(k0 + w) - level;
+    Index k = k0 + 1;
+    while (k < k0 + w && std::abs(de(k) - level) <= 0.02 * std::abs(change)) ++k;
+    return k;
+  };
+  const Index a = start_of_motion(std::min(kmin, kmax));
+  const Index b = start_of_motion(std::max(kmin, kmax));
+  if (b - a <= w) throw InputError(source, "de", "two separate steps (mass on, mass off)", "no second step");
+  r.t_on = 0.5 * (t(a - 1) + t(a));
+  r.t_off = 0.5 * (t(b - 1) + t(b));
+}
+
+// Every window and the settling times inside the record, in order.
+void check_windows(const Signal& t, const StaticStiffnessResult& r, const StaticStiffnessOptions& options, double dt,
+                   const std::string& source) {
+  const Index n = t.size();
   const double settle = options.settle_s;
   auto inside = [&](double from, double to, const char* field, const char* what) {
     if (from < t(0) || to > t(n - 1) + dt) {
@@ -266,7 +269,15 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
     throw InputError(source, "t_off", fmt::format("at least settle_s + 0.5 s = {} s of record after the mass is taken off", format_number(settle + 0.5)),
                      fmt::format("{} s", format_number(t(n - 1) - r.t_off)));
   }
+}
 
+// The creep model fitted to the rows outside the settling times: a grid over log10(tau), then a
+// parabola through the best point and its neighbours (kept when it does better than the grid).
+// Sets r's creep time constant, deflections, creeps, rms residual and fit.
+void fit_creep_model(const Signal& t, const Signal& de, const StaticStiffnessOptions& options, const std::string& source,
+                     StaticStiffnessResult& r) {
+  const Index n = t.size();
+  const double settle = options.settle_s;
   std::vector<Index> rows;
   for (Index k = 0; k < n; ++k) {
     const double tk = t(k);
@@ -274,7 +285,6 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
     if (!settling) rows.push_back(k);
   }
   const CreepRows split = split_rows(t, de, rows, r.t_on, r.t_off);
-  // Grid over log10(tau), then a parabola through the best point and its neighbours.
   constexpr int kGrid = 41;
   const double l0 = std::log10(options.min_time_constant);
   const double l1 = std::log10(options.max_time_constant);
@@ -312,6 +322,11 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
     r.fit(k) = 0.0;
     for (int j = 0; j < 5; ++j) r.fit(k) += row[j] * f.coef(j);
   }
+}
+
+// The stiffnesses: elastic from the fitted deflections, k1 and k2 from the reading windows.
+void stiffnesses(const Signal& t, const Signal& de, const StaticStiffnessOptions& options, const std::string& source,
+                 StaticStiffnessResult& r) {
   const double weight = options.added_mass * options.gravity;
   if (r.deflection_on == 0.0 || r.deflection_off == 0.0) {
     throw InputError(source, "de", "a deflection when the mass is put on and taken off", "none");
@@ -329,6 +344,29 @@ StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, cons
   }
   r.k1 = weight / std::abs(r.d_before - r.d_loaded);
   r.k2 = weight / std::abs(r.d_after - r.d_loaded);
+}
+
+}  // namespace
+
+StaticStiffnessResult static_stiffness(const Eigen::Ref<const VectorXd>& t, const Eigen::Ref<const VectorXd>& de,
+                                       const Eigen::Ref<const VectorXd>& mass_log, const StaticStiffnessOptions& options,
+                                       const std::string& source) {
+  options.validate();
+  check_stiffness_record(t, de, mass_log, source);
+  const Index n = t.size();
+  const double dt = (t(n - 1) - t(0)) / static_cast<double>(n - 1);
+  StaticStiffnessResult r;
+  if (options.t_on > 0.0) {
+    r.t_on = options.t_on;
+    r.t_off = options.t_off;
+  } else if (mass_log.size() > 0) {
+    events_from_mass_log(t, mass_log, source, r);
+  } else {
+    events_from_deflection(t, de, options.settle_s, dt, source, r);
+  }
+  check_windows(t, r, options, dt, source);
+  fit_creep_model(t, de, options, source, r);
+  stiffnesses(t, de, options, source, r);
   return r;
 }
 
