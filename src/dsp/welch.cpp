@@ -168,18 +168,29 @@ Channel channel(std::string name, const Eigen::VectorXd& samples) {
   return Channel{std::move(name), std::span<const double>(samples.data(), static_cast<std::size_t>(samples.size()))};
 }
 
-CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_Hz,
-                           const WelchOptions& options, const std::string& source) {
+namespace {
+
+// How a record is cut: nseg segments of nfft samples, `step` apart, summed in `chunks` chunks
+// (the unit of work of a thread).
+struct SegmentPlan {
+  Index n = 0, nfft = 0, noverlap = 0, step = 0, nseg = 0, nout = 0, chunks = 0;
+};
+
+// The preconditions of cross_spectra and the segments. Finite samples are not checked in a pass of
+// their own (records reach 10^7 samples per channel): a NaN or Inf in a segment makes every bin of
+// that segment's spectrum non-finite, so the sums are checked at the end, and the samples after the
+// last segment up front. Only when either shows a problem (or a length differs) are the channels
+// scanned in order for the message.
+SegmentPlan plan_segments(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_Hz, const WelchOptions& options,
+                          const std::string& source) {
   options.validate(source);
   if (!(std::isfinite(sample_rate_Hz) && sample_rate_Hz > 0.0)) {
     throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_Hz));
   }
-  // Finite samples are not checked in a pass of their own (records reach 10^7 samples per
-  // channel): a NaN or Inf in a segment makes every bin of that segment's spectrum non-finite, so
-  // the sums are checked at the end, and the samples after the last segment up front. Only when
-  // either shows a problem (or a length differs) are the channels scanned in order for the message.
-  const auto n = static_cast<Index>(input.samples.size());
-  const Index nfft = options.nfft;
+  SegmentPlan p;
+  p.n = static_cast<Index>(input.samples.size());
+  p.nfft = options.nfft;
+  const Index n = p.n, nfft = p.nfft;
   const bool lengths_ok = std::all_of(outputs.begin(), outputs.end(),
                                       [&](const Channel& out) { return static_cast<Index>(out.samples.size()) == n; });
   if (!lengths_ok || n < nfft) check_channels(input, outputs, source);
@@ -187,76 +198,96 @@ CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& out
     throw InputError(source, input.name, "a record of at least nfft = " + std::to_string(nfft) + " samples",
                      std::to_string(n) + " samples");
   }
+  p.noverlap = options.noverlap();
+  p.step = nfft - p.noverlap;
+  p.nseg = (n - nfft) / p.step + 1;
+  const Index covered = (p.nseg - 1) * p.step + nfft;  // segments overlap or touch: no gap before this
+  bool tail_ok = all_finite(input.samples.data() + covered, n - covered);
+  for (const auto& out : outputs) tail_ok = tail_ok && all_finite(out.samples.data() + covered, n - covered);
+  if (!tail_ok) check_channels(input, outputs, source);
+  p.nout = static_cast<Index>(outputs.size());
+  p.chunks = std::min(kChunks, p.nseg);
+  return p;
+}
 
-  const Index noverlap = options.noverlap();
-  const Index step = nfft - noverlap;
-  const Index nseg = (n - nfft) / step + 1;
-  {
-    const Index covered = (nseg - 1) * step + nfft;  // segments overlap or touch: no gap before this
-    bool tail_ok = all_finite(input.samples.data() + covered, n - covered);
-    for (const auto& out : outputs) tail_ok = tail_ok && all_finite(out.samples.data() + covered, n - covered);
-    if (!tail_ok) check_channels(input, outputs, source);
+// Per-chunk sums, allocated once: [chunk][bin] and [chunk][output][bin].
+struct ChunkSums {
+  std::vector<double> uu, yy;
+  std::vector<Complex> uy;
+};
+
+// A thread's FFT buffers.
+struct SegmentBuffers {
+  detail::FftwBuffer<double> segment;
+  detail::FftwBuffer<Complex> u;
+  detail::FftwBuffer<Complex> y;
+};
+
+// |U|^2 added to suu. Written out on (re, im) pairs: std::complex's operator* checks for NaN/Inf
+// (C99 Annex G) and would not vectorize; the spectra here are finite by construction.
+inline void add_auto_spectrum(const double* U, Index nbins, double* suu) {
+  for (Index k = 0; k < nbins; ++k) suu[k] += U[2 * k] * U[2 * k] + U[2 * k + 1] * U[2 * k + 1];
+}
+
+// |Y|^2 added to syy and conj(U) Y to suy (re, im pairs).
+inline void add_cross_spectrum(const double* U, const double* Y, Index nbins, double* syy, double* suy) {
+  for (Index k = 0; k < nbins; ++k) {
+    const double ur = U[2 * k], ui = U[2 * k + 1], yr = Y[2 * k], yi = Y[2 * k + 1];
+    syy[k] += yr * yr + yi * yi;
+    suy[2 * k] += ur * yr + ui * yi;      // Re(conj(U) Y)
+    suy[2 * k + 1] += ur * yi - ui * yr;  // Im(conj(U) Y)
   }
-  const Index nout = static_cast<Index>(outputs.size());
-  const Index chunks = std::min(kChunks, nseg);
+}
 
-  const Eigen::VectorXd window = make_window(options.window, nfft);
-  const SegmentLoader loader(window, options.detrend);
-  const detail::RealForwardFft fft(nfft);
+// The segments of chunk c, transformed and summed into its sums.
+inline void sum_chunk(Index c, const SegmentPlan& plan, const Channel& input, const std::vector<Channel>& outputs,
+                      const SegmentLoader& loader, const detail::RealForwardFft& fft, SegmentBuffers& ws, ChunkSums& sums) {
   const Index nbins = fft.bins();
+  const Index first = c * plan.nseg / plan.chunks;
+  const Index last = (c + 1) * plan.nseg / plan.chunks;
+  double* suu = sums.uu.data() + c * nbins;
+  for (Index s = first; s < last; ++s) {
+    const Index start = s * plan.step;
+    prefetch_next_segment(input, outputs, start + plan.nfft, std::min(start + plan.step + plan.nfft, plan.n));
+    loader.load(input.samples.data() + start, ws.segment.data());
+    fft.execute(ws.segment.data(), ws.u.data());
+    const double* U = reinterpret_cast<const double*>(ws.u.data());
+    add_auto_spectrum(U, nbins, suu);
+    for (Index o = 0; o < plan.nout; ++o) {
+      loader.load(outputs[static_cast<std::size_t>(o)].samples.data() + start, ws.segment.data());
+      fft.execute(ws.segment.data(), ws.y.data());
+      add_cross_spectrum(U, reinterpret_cast<const double*>(ws.y.data()), nbins, sums.yy.data() + (c * plan.nout + o) * nbins,
+                         reinterpret_cast<double*>(sums.uy.data() + (c * plan.nout + o) * nbins));
+    }
+  }
+}
 
-  // Per-chunk sums, allocated once: [chunk][bin] and [chunk][output][bin].
-  std::vector<double> acc_uu(static_cast<std::size_t>(chunks * nbins), 0.0);
-  std::vector<double> acc_yy(static_cast<std::size_t>(chunks * nout * nbins), 0.0);
-  std::vector<Complex> acc_uy(static_cast<std::size_t>(chunks * nout * nbins), Complex(0.0, 0.0));
-
+int spectra_threads(const WelchOptions& options, const SegmentPlan& plan) {
   int threads = options.threads == 0 ? static_cast<int>(std::max(1U, std::thread::hardware_concurrency()))
                                      : options.threads;
-  const double work = static_cast<double>(nseg) * static_cast<double>(nfft) * static_cast<double>(1 + nout);
+  const double work = static_cast<double>(plan.nseg) * static_cast<double>(plan.nfft) * static_cast<double>(1 + plan.nout);
   if (work < kMinWorkForThreads) threads = 1;
-  threads = static_cast<int>(std::min<Index>(threads, chunks));
+  return static_cast<int>(std::min<Index>(threads, plan.chunks));
+}
 
-  struct Workspace {
-    detail::FftwBuffer<double> segment;
-    detail::FftwBuffer<Complex> u;
-    detail::FftwBuffer<Complex> y;
-  };
-  std::vector<Workspace> workspaces;
+// Every chunk summed, the chunks shared out among the threads as they come free.
+ChunkSums sum_chunks(const SegmentPlan& plan, const Channel& input, const std::vector<Channel>& outputs, const WelchOptions& options,
+                     const SegmentLoader& loader, const detail::RealForwardFft& fft) {
+  const Index nbins = fft.bins();
+  ChunkSums sums{std::vector<double>(static_cast<std::size_t>(plan.chunks * nbins), 0.0),
+                 std::vector<double>(static_cast<std::size_t>(plan.chunks * plan.nout * nbins), 0.0),
+                 std::vector<Complex>(static_cast<std::size_t>(plan.chunks * plan.nout * nbins), Complex(0.0, 0.0))};
+  const int threads = spectra_threads(options, plan);
+  std::vector<SegmentBuffers> workspaces;
   workspaces.reserve(static_cast<std::size_t>(threads));
   for (int t = 0; t < threads; ++t) {
-    workspaces.push_back(Workspace{detail::FftwBuffer<double>(nfft), detail::FftwBuffer<Complex>(nbins),
-                                   detail::FftwBuffer<Complex>(nbins)});
+    workspaces.push_back(SegmentBuffers{detail::FftwBuffer<double>(plan.nfft), detail::FftwBuffer<Complex>(nbins),
+                                        detail::FftwBuffer<Complex>(nbins)});
   }
-
   std::atomic<Index> next_chunk{0};
-  auto worker = [&](Workspace& ws) {
-    for (Index c = next_chunk.fetch_add(1); c < chunks; c = next_chunk.fetch_add(1)) {
-      const Index first = c * nseg / chunks;
-      const Index last = (c + 1) * nseg / chunks;
-      double* suu = acc_uu.data() + c * nbins;
-      for (Index s = first; s < last; ++s) {
-        const Index start = s * step;
-        prefetch_next_segment(input, outputs, start + nfft, std::min(start + step + nfft, n));
-        loader.load(input.samples.data() + start, ws.segment.data());
-        fft.execute(ws.segment.data(), ws.u.data());
-        // Written out on (re, im) pairs: std::complex's operator* checks for NaN/Inf (C99 Annex G)
-        // and would not vectorize; the spectra here are finite by construction.
-        const double* U = reinterpret_cast<const double*>(ws.u.data());
-        for (Index k = 0; k < nbins; ++k) suu[k] += U[2 * k] * U[2 * k] + U[2 * k + 1] * U[2 * k + 1];
-        for (Index o = 0; o < nout; ++o) {
-          loader.load(outputs[static_cast<std::size_t>(o)].samples.data() + start, ws.segment.data());
-          fft.execute(ws.segment.data(), ws.y.data());
-          const double* Y = reinterpret_cast<const double*>(ws.y.data());
-          double* syy = acc_yy.data() + (c * nout + o) * nbins;
-          double* suy = reinterpret_cast<double*>(acc_uy.data() + (c * nout + o) * nbins);
-          for (Index k = 0; k < nbins; ++k) {
-            const double ur = U[2 * k], ui = U[2 * k + 1], yr = Y[2 * k], yi = Y[2 * k + 1];
-            syy[k] += yr * yr + yi * yi;
-            suy[2 * k] += ur * yr + ui * yi;      // Re(conj(U) Y)
-            suy[2 * k + 1] += ur * yi - ui * yr;  // Im(conj(U) Y)
-          }
-        }
-      }
+  auto worker = [&](SegmentBuffers& ws) {
+    for (Index c = next_chunk.fetch_add(1); c < plan.chunks; c = next_chunk.fetch_add(1)) {
+      sum_chunk(c, plan, input, outputs, loader, fft, ws, sums);
     }
   };
   if (threads == 1) {
@@ -267,53 +298,68 @@ CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& out
     for (int t = 1; t < threads; ++t) pool.emplace_back([&, t] { worker(workspaces[static_cast<std::size_t>(t)]); });
     worker(workspaces[0]);
   }  // jthreads join here
+  return sums;
+}
 
-  {
-    bool sums_ok = all_finite(acc_uu.data(), static_cast<Index>(acc_uu.size())) &&
-                   all_finite(acc_yy.data(), static_cast<Index>(acc_yy.size())) &&
-                   all_finite(reinterpret_cast<const double*>(acc_uy.data()), 2 * static_cast<Index>(acc_uy.size()));
-    // Non-finite sums from finite samples (overflow of values near 1e154) are returned as they are.
-    if (!sums_ok) check_channels(input, outputs, source);
-  }
-
-  CrossSpectra result;
-  result.input = input.name;
-  for (const auto& out : outputs) result.outputs.push_back(out.name);
-  result.window = options.window;
-  result.detrend = options.detrend;
-  result.nfft = nfft;
-  result.noverlap = noverlap;
-  result.averages = nseg;
-  result.sample_rate = sample_rate_Hz;
-  result.freq_Hz.resize(nbins);
-  for (Index k = 0; k < nbins; ++k) {
-    result.freq_Hz(k) = static_cast<double>(k) * sample_rate_Hz / static_cast<double>(nfft);
-  }
-
-  // Density scaling 1 / (fs sum w^2), averaged over the segments, one-sided: every bin that has a
-  // negative-frequency twin (all but DC and, for even nfft, Nyquist) counts twice.
-  const double scale = 1.0 / (sample_rate_Hz * window.squaredNorm() * static_cast<double>(nseg));
+// The chunks' sums added up and scaled to densities: 1 / (fs sum w^2), averaged over the segments,
+// one-sided: every bin that has a negative-frequency twin (all but DC and, for even nfft, Nyquist)
+// counts twice.
+void scale_spectra(const ChunkSums& sums, const SegmentPlan& plan, const Eigen::VectorXd& window, Index nbins, double sample_rate_Hz,
+                   CrossSpectra& result) {
+  const double scale = 1.0 / (sample_rate_Hz * window.squaredNorm() * static_cast<double>(plan.nseg));
   Eigen::VectorXd factor = Eigen::VectorXd::Constant(nbins, 2.0 * scale);
   factor(0) = scale;
-  if (nfft % 2 == 0) factor(nbins - 1) = scale;
+  if (plan.nfft % 2 == 0) factor(nbins - 1) = scale;
 
   result.Suu = Eigen::VectorXd::Zero(nbins);
-  for (Index c = 0; c < chunks; ++c) {
-    result.Suu += Eigen::Map<const Eigen::VectorXd>(acc_uu.data() + c * nbins, nbins);
+  for (Index c = 0; c < plan.chunks; ++c) {
+    result.Suu += Eigen::Map<const Eigen::VectorXd>(sums.uu.data() + c * nbins, nbins);
   }
   result.Suu.array() *= factor.array();
-  for (Index o = 0; o < nout; ++o) {
+  for (Index o = 0; o < plan.nout; ++o) {
     Eigen::VectorXd syy = Eigen::VectorXd::Zero(nbins);
     Eigen::VectorXcd suy = Eigen::VectorXcd::Zero(nbins);
-    for (Index c = 0; c < chunks; ++c) {
-      syy += Eigen::Map<const Eigen::VectorXd>(acc_yy.data() + (c * nout + o) * nbins, nbins);
-      suy += Eigen::Map<const Eigen::VectorXcd>(acc_uy.data() + (c * nout + o) * nbins, nbins);
+    for (Index c = 0; c < plan.chunks; ++c) {
+      syy += Eigen::Map<const Eigen::VectorXd>(sums.yy.data() + (c * plan.nout + o) * nbins, nbins);
+      suy += Eigen::Map<const Eigen::VectorXcd>(sums.uy.data() + (c * plan.nout + o) * nbins, nbins);
     }
     syy.array() *= factor.array();
     suy.array() *= factor.array().cast<Complex>();
     result.Syy.push_back(std::move(syy));
     result.Suy.push_back(std::move(suy));
   }
+}
+
+}  // namespace
+
+CrossSpectra cross_spectra(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_Hz,
+                           const WelchOptions& options, const std::string& source) {
+  const SegmentPlan plan = plan_segments(input, outputs, sample_rate_Hz, options, source);
+  const Eigen::VectorXd window = make_window(options.window, plan.nfft);
+  const SegmentLoader loader(window, options.detrend);
+  const detail::RealForwardFft fft(plan.nfft);
+  const Index nbins = fft.bins();
+  const ChunkSums sums = sum_chunks(plan, input, outputs, options, loader, fft);
+  // Non-finite sums from finite samples (overflow of values near 1e154) are returned as they are.
+  const bool sums_ok = all_finite(sums.uu.data(), static_cast<Index>(sums.uu.size())) &&
+                       all_finite(sums.yy.data(), static_cast<Index>(sums.yy.size())) &&
+                       all_finite(reinterpret_cast<const double*>(sums.uy.data()), 2 * static_cast<Index>(sums.uy.size()));
+  if (!sums_ok) check_channels(input, outputs, source);
+
+  CrossSpectra result;
+  result.input = input.name;
+  for (const auto& out : outputs) result.outputs.push_back(out.name);
+  result.window = options.window;
+  result.detrend = options.detrend;
+  result.nfft = plan.nfft;
+  result.noverlap = plan.noverlap;
+  result.averages = plan.nseg;
+  result.sample_rate = sample_rate_Hz;
+  result.freq_Hz.resize(nbins);
+  for (Index k = 0; k < nbins; ++k) {
+    result.freq_Hz(k) = static_cast<double>(k) * sample_rate_Hz / static_cast<double>(plan.nfft);
+  }
+  scale_spectra(sums, plan, window, nbins, sample_rate_Hz, result);
   return result;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -903,57 +904,52 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const V
   return vector_fit(omega, data, Matrix(), options);
 }
 
-VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const Matrix& user_weights,
-                               const VectorFittingOptions& options) {
-  options.validate();
-  check_input(omega, data, user_weights, options);
-  const Matrix weights = make_weights(data, user_weights, options);
-  const double scale = options.frequency_scale > 0.0 ? options.frequency_scale : omega(omega.size() - 1);
+namespace {
 
+// The starting poles (the options' or automatic ones), user pairs snapped to exact conjugates
+// (validate() accepted them within 1e-9), each pair upper then lower.
+CVector snapped_starting_poles(const Vector& omega, const VectorFittingOptions& options) {
   CVector start = options.starting_poles.size() > 0 ? options.starting_poles
                                                      : automatic_starting_poles(omega, options);
-  // Snap user pairs to exact conjugates (validate() accepted them within 1e-9).
   for (Index i = 0; i < start.size(); ++i) {
     if (std::abs(start(i).imag()) <= 1e-15 * std::abs(start(i))) start(i) = Complex(start(i).real(), 0.0);
   }
-  {
-    CVector snapped(start.size());
-    Index k = 0;
-    std::vector<bool> used(static_cast<size_t>(start.size()), false);
-    for (Index i = 0; i < start.size(); ++i) {
-      if (used[static_cast<size_t>(i)]) continue;
-      used[static_cast<size_t>(i)] = true;
-      if (start(i).imag() == 0.0) {
-        snapped(k++) = start(i);
-        continue;
-      }
-      Index best = -1;
-      for (Index j = 0; j < start.size(); ++j) {
-        if (used[static_cast<size_t>(j)]) continue;
-        if (best < 0 || std::abs(start(j) - std::conj(start(i))) < std::abs(start(best) - std::conj(start(i)))) {
-          best = j;
-        }
-      }
-      assert(best >= 0);
-      used[static_cast<size_t>(best)] = true;
-      const Complex upper(start(i).real(), std::abs(start(i).imag()));
-      snapped(k++) = upper;
-      snapped(k++) = std::conj(upper);
+  CVector snapped(start.size());
+  Index k = 0;
+  std::vector<bool> used(static_cast<size_t>(start.size()), false);
+  for (Index i = 0; i < start.size(); ++i) {
+    if (used[static_cast<size_t>(i)]) continue;
+    used[static_cast<size_t>(i)] = true;
+    if (start(i).imag() == 0.0) {
+      snapped(k++) = start(i);
+      continue;
     }
-    start = snapped;
+    Index best = -1;
+    for (Index j = 0; j < start.size(); ++j) {
+      if (used[static_cast<size_t>(j)]) continue;
+      if (best < 0 || std::abs(start(j) - std::conj(start(i))) < std::abs(start(best) - std::conj(start(i)))) {
+        best = j;
+      }
+    }
+    assert(best >= 0);
+    used[static_cast<size_t>(best)] = true;
+    const Complex upper(start(i).real(), std::abs(start(i).imag()));
+    snapped(k++) = upper;
+    snapped(k++) = std::conj(upper);
   }
-  CVector poles = canonical_poles(start / scale);
+  return snapped;
+}
 
-  Fitter fitter(omega, data, weights, options, scale);
-  VectorFittingResult result;
-  result.frequency_scale = scale;
-  // Each relocation is first judged on all poles (cheap). When that has not settled, the residues
-  // for the new poles are identified (one linear least-squares problem) so that poles the data do
-  // not determine can be left out, and the fit error can be compared with the previous one.
+// The pole relocations until they settle (or the iterations run out). Each relocation is first
+// judged on all poles (cheap). When that has not settled, the residues for the new poles are
+// identified (one linear least-squares problem) so that poles the data do not determine can be
+// left out, and the fit error can be compared with the previous one. Returns the residues'
+// solution for the final poles when the last step identified it (empty otherwise).
+std::optional<Matrix> relocate_until_settled(Fitter& fitter, const VectorFittingOptions& options, CVector& poles,
+                                             VectorFittingResult& result) {
   const bool assess_each = options.significance_floor > 0.0 || options.residual_tolerance > 0.0;
   double previous_error = -1.0;
-  Matrix x;
-  bool x_current = false;
+  std::optional<Matrix> x;
   Vector significance;
   for (int it = 0; it < options.max_iterations; ++it) {
     const CVector relocated = fitter.relocate(poles);
@@ -962,7 +958,7 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
     poles = relocated;
     result.iterations = it + 1;
     result.last_pole_change = raw_change;
-    x_current = false;
+    x.reset();
     if (raw_change < options.pole_tolerance) {
       result.converged = true;
       result.convergence = Convergence::kPolesSettled;
@@ -970,8 +966,7 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
     }
     if (!assess_each) continue;
     x = fitter.identify(poles);
-    x_current = true;
-    const double error = fitter.assess(poles, x, significance);
+    const double error = fitter.assess(poles, *x, significance);
     result.last_pole_change = pole_change(poles, before, significance, options.significance_floor);
     if (result.last_pole_change < options.pole_tolerance) {
       result.converged = true;
@@ -986,18 +981,14 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
     }
     previous_error = error;
   }
-  if (!result.converged && options.max_iterations > 0 && options.fail_if_not_converged) {
-    throw NumericalError(kSource,
-                         "poles did not settle after " + std::to_string(result.iterations) +
-                             " relocations (last relative change " + format_number(result.last_pole_change) +
-                             ", tolerance " + format_number(options.pole_tolerance) +
-                             "); try another order, more iterations, weights or a looser tolerance",
-                         /*retry_may_help=*/true);
-  }
+  return x;
+}
 
-  if (!x_current) x = fitter.identify(poles);
+// Poles (scaled back), residues and the asymptote terms d, e from the solution x of the scaled
+// problem (a complex pair's residue as its real and imaginary part in two rows).
+void unpack_solution(const Matrix& x, const CVector& poles, double scale, const VectorFittingOptions& options, Index nc,
+                     VectorFittingResult& result) {
   const Index n = options.order;
-  const Index nc = data.cols();
   const Index offs = asymptote_terms(options.asymptote);
   result.poles = poles * scale;
   result.residues.resize(nc, n);
@@ -1021,8 +1012,12 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
     throw NumericalError(kSource, "the residue least-squares problem gave non-finite values",
                          /*retry_may_help=*/true);
   }
+}
 
-  // Real state space of the proper part.
+// Real state space of the proper part.
+void realize(VectorFittingResult& result) {
+  const Index nc = result.residues.rows();
+  const Index n = result.residues.cols();
   lti::StateSpace& m = result.model;
   Vector b;
   real_realization(result.poles, m.A, b);
@@ -1041,22 +1036,30 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
   }
   m.D = result.d;
   m.sample_time = 0.0;
+}
 
+// The errors, then every output's own relative error (a small output is not hidden by a large
+// one); returns whether an output's error is too large (too few poles for its modes).
+bool fit_errors(const Vector& omega, const CMatrix& data, VectorFittingResult& result) {
   const CMatrix fit = result.evaluate(omega);
   const double count = static_cast<double>(data.size());
   result.rms_error = std::sqrt((fit - data).squaredNorm() / count);
   result.relative_rms_error = result.rms_error / std::sqrt(data.squaredNorm() / count);
-  // Quality: every output's own relative error (a small output is not hidden by a large one), and
-  // no pole far outside the band of the data (such a pole fits noise or an unexcited band).
   result.relative_rms_error_per_output.resize(data.cols());
-  bool misses = false;  // an output's error is too large: too few poles for its modes
+  bool misses = false;
   for (Index i = 0; i < data.cols(); ++i) {
     const double e = std::sqrt((fit.col(i) - data.col(i)).squaredNorm() / data.col(i).squaredNorm());
     result.relative_rms_error_per_output(i) = e;
     result.quality.check_error("output " + std::to_string(i + 1), e);
     misses = misses || !(e <= core::kPoorRelativeError);
   }
-  bool spurious = false;  // poles that fit noise: outside the band, or unstable
+  return misses;
+}
+
+// Poles that fit noise: a resonance far outside the band of the data, or unstable. Returns
+// whether there is one.
+bool spurious_poles(const Vector& omega, VectorFittingResult& result) {
+  bool spurious = false;
   const double w_lo = omega.minCoeff() > 0.0 ? omega.minCoeff() : (omega.size() > 1 ? omega(1) : omega(0));
   const double w_hi = omega.maxCoeff();
   for (Index k = 0; k < result.poles.size(); ++k) {
@@ -1075,9 +1078,15 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
       spurious = true;
     }
   }
+  return spurious;
+}
+
+// The quality verdict. The advice points the way the problems do: a large error with every pole
+// in the band means modes the order cannot hold; poles outside the band or unstable fit noise.
+void assess_quality(const Vector& omega, const CMatrix& data, Index n, VectorFittingResult& result) {
+  const bool misses = fit_errors(omega, data, result);
+  const bool spurious = spurious_poles(omega, result);
   if (!result.converged) result.quality.add_problem("the poles did not settle (not converged)");
-  // The advice points the way the problems do: a large error with every pole in the band means
-  // modes the order cannot hold; poles outside the band or unstable fit noise.
   const std::string order = std::to_string(n);
   if (misses && !spurious) {
     result.quality.advise("a higher order than " + order + " (--order " + std::to_string(n + 4) +
@@ -1089,6 +1098,34 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
     result.quality.advise("a band where the coherence is high (--fmin/--fmax), another order than " + order +
                           ", or --weighting output-scale");
   }
+}
+
+}  // namespace
+
+VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const Matrix& user_weights,
+                               const VectorFittingOptions& options) {
+  options.validate();
+  check_input(omega, data, user_weights, options);
+  const Matrix weights = make_weights(data, user_weights, options);
+  const double scale = options.frequency_scale > 0.0 ? options.frequency_scale : omega(omega.size() - 1);
+  CVector poles = canonical_poles(snapped_starting_poles(omega, options) / scale);
+
+  Fitter fitter(omega, data, weights, options, scale);
+  VectorFittingResult result;
+  result.frequency_scale = scale;
+  std::optional<Matrix> x = relocate_until_settled(fitter, options, poles, result);
+  if (!result.converged && options.max_iterations > 0 && options.fail_if_not_converged) {
+    throw NumericalError(kSource,
+                         "poles did not settle after " + std::to_string(result.iterations) +
+                             " relocations (last relative change " + format_number(result.last_pole_change) +
+                             ", tolerance " + format_number(options.pole_tolerance) +
+                             "); try another order, more iterations, weights or a looser tolerance",
+                         /*retry_may_help=*/true);
+  }
+  if (!x) x = fitter.identify(poles);
+  unpack_solution(*x, poles, scale, options, data.cols(), result);
+  realize(result);
+  assess_quality(omega, data, options.order, result);
   return result;
 }
 

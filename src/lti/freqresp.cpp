@@ -55,6 +55,173 @@ struct Workspace {
 #define PIEZOBENCH_KERNEL_CLONES
 #endif
 
+// The steps of the kernel below are inlined into each of its clones (so they get the clone's
+// instruction set): they are always_inline, not just inline.
+#if defined(__GNUC__)
+#define PIEZOBENCH_KERNEL_STEP inline __attribute__((always_inline))
+#else
+#define PIEZOBENCH_KERNEL_STEP inline
+#endif
+
+// One frequency point's sweep of hessenberg_response: the system's arrays (H row-major n x n,
+// G = Q^T B column-major n x m, CQ row-major p x n), s, and the workspace's arrays (the carried
+// row cr/ci and its right-hand side rr/ri, T = tr/ti, the result hr/hi).
+struct Sweep {
+  const double* __restrict h;
+  const double* __restrict g;
+  const double* __restrict cq;
+  Index n, m, p;
+  double sr, si;
+  double* __restrict cr;
+  double* __restrict ci;
+  double* __restrict rr;
+  double* __restrict ri;
+  double* __restrict tr;
+  double* __restrict ti;
+  double* __restrict hr;
+  double* __restrict hi;
+};
+
+// Carried row: row 0 of s I - H, with right-hand side G(0, :); T = 0; the result starts at D
+// (column-major, p x m).
+PIEZOBENCH_KERNEL_STEP void start_sweep(const Sweep& e, const double* d) {
+  const Index n = e.n, m = e.m, p = e.p;
+  for (Index j = 0; j < n; ++j) {
+    e.cr[j] = -e.h[j];
+    e.ci[j] = 0.0;
+  }
+  e.cr[0] += e.sr;
+  e.ci[0] += e.si;
+  for (Index c = 0; c < m; ++c) {
+    e.rr[c] = e.g[c * n];
+    e.ri[c] = 0.0;
+  }
+  for (Index i = 0; i < p * n; ++i) {
+    e.tr[i] = 0.0;
+    e.ti[i] = 0.0;
+  }
+  for (Index r = 0; r < p; ++r) {
+    for (Index c = 0; c < m; ++c) {
+      e.hr[r * m + c] = d[c * p + r];
+      e.hi[r * m + c] = 0.0;
+    }
+  }
+}
+
+// Step k with the carried row as pivot: U row k is the carried row, Y row k its right-hand side;
+// then the new carried row is the fresh row (row k + 1 of s I - H, `hrow` the row of H) minus l
+// times the carried one.
+PIEZOBENCH_KERNEL_STEP void eliminate_with_carried_pivot(const Sweep& e, Index k, bool last, const double* hrow_in, double fresh_pivot,
+                                                         double carried_mag2) {
+  const Index n = e.n, m = e.m, p = e.p;
+  const double sr = e.sr, si = e.si;
+  const double* __restrict hrow = hrow_in;
+  const double inv_r = e.cr[k] / carried_mag2;  // 1 / U(k, k)
+  const double inv_i = -e.ci[k] / carried_mag2;
+  // l = fresh_pivot / carried(k) (unused on the last row).
+  const double lr = fresh_pivot * inv_r;
+  const double li = fresh_pivot * inv_i;
+  for (Index r = 0; r < p; ++r) {
+    double* __restrict trow_r = e.tr + r * n;
+    double* __restrict trow_i = e.ti + r * n;
+    const double ar = e.cq[r * n + k] - trow_r[k];
+    const double ai = -trow_i[k];
+    const double zr = ar * inv_r - ai * inv_i;
+    const double zi = ar * inv_i + ai * inv_r;
+    for (Index c = 0; c < m; ++c) {
+      e.hr[r * m + c] += zr * e.rr[c] - zi * e.ri[c];
+      e.hi[r * m + c] += zr * e.ri[c] + zi * e.rr[c];
+    }
+    if (p == 1 && !last) {
+      // Single output: T update and elimination in one pass over the row.
+      for (Index j = k + 1; j < n; ++j) {
+        const double xr = e.cr[j];
+        const double xi = e.ci[j];
+        trow_r[j] += zr * xr - zi * xi;
+        trow_i[j] += zr * xi + zi * xr;
+        e.cr[j] = -hrow[j] - (lr * xr - li * xi);
+        e.ci[j] = -(lr * xi + li * xr);
+      }
+    } else {
+      for (Index j = k + 1; j < n; ++j) {
+        trow_r[j] += zr * e.cr[j] - zi * e.ci[j];
+        trow_i[j] += zr * e.ci[j] + zi * e.cr[j];
+      }
+    }
+  }
+  if (last) return;
+  if (p != 1) {
+    for (Index j = k + 1; j < n; ++j) {
+      const double ar = e.cr[j];
+      const double ai = e.ci[j];
+      e.cr[j] = -hrow[j] - (lr * ar - li * ai);
+      e.ci[j] = -(lr * ai + li * ar);
+    }
+  }
+  e.cr[k + 1] += sr;
+  e.ci[k + 1] += si;
+  for (Index c = 0; c < m; ++c) {
+    const double ar = e.rr[c];
+    const double ai = e.ri[c];
+    e.rr[c] = e.g[c * n + k + 1] - (lr * ar - li * ai);
+    e.ri[c] = -(lr * ai + li * ar);
+  }
+}
+
+// Step k with the fresh row as pivot: U row k is the fresh row (-H(k+1, :) plus s in column k + 1),
+// Y row k is G(k + 1, :); then the new carried row is the carried row minus l times the fresh one.
+PIEZOBENCH_KERNEL_STEP void eliminate_with_fresh_pivot(const Sweep& e, Index k, const double* hrow_in, double fresh_pivot) {
+  const Index n = e.n, m = e.m, p = e.p;
+  const double sr = e.sr, si = e.si;
+  const double* __restrict hrow = hrow_in;
+  const double inv = 1.0 / fresh_pivot;
+  // l = carried(k) / fresh_pivot
+  const double lr = e.cr[k] * inv;
+  const double li = e.ci[k] * inv;
+  for (Index r = 0; r < p; ++r) {
+    double* __restrict trow_r = e.tr + r * n;
+    double* __restrict trow_i = e.ti + r * n;
+    const double zr = (e.cq[r * n + k] - trow_r[k]) * inv;
+    const double zi = -trow_i[k] * inv;
+    for (Index c = 0; c < m; ++c) {
+      const double gv = e.g[c * n + k + 1];
+      e.hr[r * m + c] += zr * gv;
+      e.hi[r * m + c] += zi * gv;
+    }
+    if (p == 1) {
+      // Single output: T update and elimination in one pass (carried + l * h).
+      for (Index j = k + 1; j < n; ++j) {
+        const double f = hrow[j];
+        trow_r[j] -= zr * f;
+        trow_i[j] -= zi * f;
+        e.cr[j] += lr * f;
+        e.ci[j] += li * f;
+      }
+    } else {
+      for (Index j = k + 1; j < n; ++j) {
+        trow_r[j] -= zr * hrow[j];
+        trow_i[j] -= zi * hrow[j];
+      }
+    }
+    trow_r[k + 1] += zr * sr - zi * si;
+    trow_i[k + 1] += zr * si + zi * sr;
+  }
+  if (p != 1) {
+    for (Index j = k + 1; j < n; ++j) {
+      const double f = hrow[j];  // carried - l * (-h) = carried + l * h
+      e.cr[j] += lr * f;
+      e.ci[j] += li * f;
+    }
+  }
+  e.cr[k + 1] -= lr * sr - li * si;  // the fresh row also holds s in column k + 1
+  e.ci[k + 1] -= lr * si + li * sr;
+  for (Index c = 0; c < m; ++c) {
+    const double gv = e.g[c * n + k + 1];
+    e.rr[c] -= lr * gv;
+    e.ri[c] -= li * gv;
+  }
+}
+
 // Computes C Q (s I - H)^-1 G + D for upper Hessenberg H (row-major, n x n), real G = Q^T B
 // (column-major, n x m), CQ (row-major, p x n) and D (column-major, p x m) into w.hr/w.hi.
 //
@@ -71,150 +238,22 @@ PIEZOBENCH_KERNEL_CLONES
 bool hessenberg_response(const double* h, const double* g, const double* cq, const double* d, Complex s,
                          double scale, Workspace& w) {
   const Index n = w.n;
-  const Index m = w.m;
-  const Index p = w.p;
-  const double sr = s.real();
-  const double si = s.imag();
+  const Sweep e{h,         g,         cq,        n,         w.m,       w.p,       s.real(),  s.imag(),
+                w.cr.data(), w.ci.data(), w.rr.data(), w.ri.data(), w.tr.data(), w.ti.data(), w.hr.data(), w.hi.data()};
   const double tiny = std::numeric_limits<double>::epsilon() * (scale + std::abs(s));
-  double* __restrict cr = w.cr.data();
-  double* __restrict ci = w.ci.data();
-  double* __restrict rr = w.rr.data();
-  double* __restrict ri = w.ri.data();
-  double* __restrict tr = w.tr.data();
-  double* __restrict ti = w.ti.data();
-  double* __restrict hr = w.hr.data();
-  double* __restrict hi = w.hi.data();
-  // Carried row: row 0 of s I - H, with right-hand side G(0, :).
-  for (Index j = 0; j < n; ++j) {
-    cr[j] = -h[j];
-    ci[j] = 0.0;
-  }
-  cr[0] += sr;
-  ci[0] += si;
-  for (Index c = 0; c < m; ++c) {
-    rr[c] = g[c * n];
-    ri[c] = 0.0;
-  }
-  for (Index i = 0; i < p * n; ++i) {
-    tr[i] = 0.0;
-    ti[i] = 0.0;
-  }
-  for (Index r = 0; r < p; ++r) {
-    for (Index c = 0; c < m; ++c) {
-      hr[r * m + c] = d[c * p + r];
-      hi[r * m + c] = 0.0;
-    }
-  }
+  start_sweep(e, d);
   for (Index k = 0; k < n; ++k) {
     const bool last = k + 1 == n;
-    const double* __restrict hrow = last ? nullptr : h + (k + 1) * n;  // row k + 1 of H
-    const double fresh_pivot = last ? 0.0 : -hrow[k];                  // (s I - H)(k + 1, k), real
-    const double carried_mag2 = cr[k] * cr[k] + ci[k] * ci[k];
+    const double* hrow = last ? nullptr : h + (k + 1) * n;  // row k + 1 of H
+    const double fresh_pivot = last ? 0.0 : -hrow[k];       // (s I - H)(k + 1, k), real
+    const double carried_mag2 = e.cr[k] * e.cr[k] + e.ci[k] * e.ci[k];
     const bool swap = !last && fresh_pivot * fresh_pivot > carried_mag2;
     if (!swap) {
-      // U row k is the carried row, Y row k its right-hand side.
       if (carried_mag2 <= tiny * tiny) return false;  // column k vanishes from row k down
-      const double inv_r = cr[k] / carried_mag2;       // 1 / U(k, k)
-      const double inv_i = -ci[k] / carried_mag2;
-      // l = fresh_pivot / carried(k) (unused on the last row).
-      const double lr = fresh_pivot * inv_r;
-      const double li = fresh_pivot * inv_i;
-      for (Index r = 0; r < p; ++r) {
-        double* __restrict trow_r = tr + r * n;
-        double* __restrict trow_i = ti + r * n;
-        const double ar = cq[r * n + k] - trow_r[k];
-        const double ai = -trow_i[k];
-        const double zr = ar * inv_r - ai * inv_i;
-        const double zi = ar * inv_i + ai * inv_r;
-        for (Index c = 0; c < m; ++c) {
-          hr[r * m + c] += zr * rr[c] - zi * ri[c];
-          hi[r * m + c] += zr * ri[c] + zi * rr[c];
-        }
-        if (p == 1 && !last) {
-          // Single output: T update and elimination in one pass over the row.
-          for (Index j = k + 1; j < n; ++j) {
-            const double xr = cr[j];
-            const double xi = ci[j];
-            trow_r[j] += zr * xr - zi * xi;
-            trow_i[j] += zr * xi + zi * xr;
-            cr[j] = -hrow[j] - (lr * xr - li * xi);
-            ci[j] = -(lr * xi + li * xr);
-          }
-        } else {
-          for (Index j = k + 1; j < n; ++j) {
-            trow_r[j] += zr * cr[j] - zi * ci[j];
-            trow_i[j] += zr * ci[j] + zi * cr[j];
-          }
-        }
-      }
-      if (last) break;
-      // New carried row: fresh row minus l times the carried one.
-      if (p != 1) {
-        for (Index j = k + 1; j < n; ++j) {
-          const double ar = cr[j];
-          const double ai = ci[j];
-          cr[j] = -hrow[j] - (lr * ar - li * ai);
-          ci[j] = -(lr * ai + li * ar);
-        }
-      }
-      cr[k + 1] += sr;
-      ci[k + 1] += si;
-      for (Index c = 0; c < m; ++c) {
-        const double ar = rr[c];
-        const double ai = ri[c];
-        rr[c] = g[c * n + k + 1] - (lr * ar - li * ai);
-        ri[c] = -(lr * ai + li * ar);
-      }
+      eliminate_with_carried_pivot(e, k, last, hrow, fresh_pivot, carried_mag2);
     } else {
-      // U row k is the fresh row (-H(k+1, :) plus s in column k + 1), Y row k is G(k + 1, :).
       if (fresh_pivot * fresh_pivot <= tiny * tiny) return false;
-      const double inv = 1.0 / fresh_pivot;
-      // l = carried(k) / fresh_pivot
-      const double lr = cr[k] * inv;
-      const double li = ci[k] * inv;
-      for (Index r = 0; r < p; ++r) {
-        double* __restrict trow_r = tr + r * n;
-        double* __restrict trow_i = ti + r * n;
-        const double zr = (cq[r * n + k] - trow_r[k]) * inv;
-        const double zi = -trow_i[k] * inv;
-        for (Index c = 0; c < m; ++c) {
-          const double gv = g[c * n + k + 1];
-          hr[r * m + c] += zr * gv;
-          hi[r * m + c] += zi * gv;
-        }
-        if (p == 1) {
-          // Single output: T update and elimination in one pass (carried + l * h).
-          for (Index j = k + 1; j < n; ++j) {
-            const double f = hrow[j];
-            trow_r[j] -= zr * f;
-            trow_i[j] -= zi * f;
-            cr[j] += lr * f;
-            ci[j] += li * f;
-          }
-        } else {
-          for (Index j = k + 1; j < n; ++j) {
-            trow_r[j] -= zr * hrow[j];
-            trow_i[j] -= zi * hrow[j];
-          }
-        }
-        trow_r[k + 1] += zr * sr - zi * si;
-        trow_i[k + 1] += zr * si + zi * sr;
-      }
-      // New carried row: carried row minus l times the fresh one.
-      if (p != 1) {
-        for (Index j = k + 1; j < n; ++j) {
-          const double f = hrow[j];  // carried - l * (-h) = carried + l * h
-          cr[j] += lr * f;
-          ci[j] += li * f;
-        }
-      }
-      cr[k + 1] -= lr * sr - li * si;  // the fresh row also holds s in column k + 1
-      ci[k + 1] -= lr * si + li * sr;
-      for (Index c = 0; c < m; ++c) {
-        const double gv = g[c * n + k + 1];
-        rr[c] -= lr * gv;
-        ri[c] -= li * gv;
-      }
+      eliminate_with_fresh_pivot(e, k, hrow, fresh_pivot);
     }
   }
   return true;

@@ -131,59 +131,163 @@ void Loop::watchdog_trip() noexcept {
 
 std::uint64_t Loop::heartbeat() const noexcept { return shared_->heartbeat.load(std::memory_order_acquire); }
 
+// The steps of Loop::cycle(), inlined there: noexcept and allocation-free as it is.
+struct Loop::Cycle {
+  struct Clock {
+    bool timed = false;         // real-time mode with a wake-up time
+    bool late = false;          // woken after the watchdog timeout since the last cycle's end
+    std::int64_t start_ns = 0;  // CLOCK_MONOTONIC
+    double latency_us = 0.0;    // wake-up after the deadline
+  };
+
+  // Wind-down: bring the output to the safe value at the slew limit (the ramp out normally ends
+  // there already; not after an early end of the backend or a trip mid-slew).
+  static bool wind_down(Loop& l, double u_safe) noexcept {
+    if (l.guard_.last_output() == u_safe) return false;
+    const SafetyGuard::Output out = l.guard_.limit(u_safe);
+    l.backend_.write(out.u);
+    ++l.wind_down_;
+    l.shared_->heartbeat.fetch_add(1, std::memory_order_release);
+    return true;
+  }
+
+  // The cycle's start, and in real-time mode the jitter, the wake-up latency and whether the cycle
+  // woke too late for the watchdog.
+  static Clock wake_up(Loop& l, std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
+    Clock c;
+    c.timed = l.options_.realtime && wake_ns != 0;
+    c.start_ns = c.timed ? wake_ns : monotonic_ns();
+    if (c.timed) {
+      if (l.cycle_ > 0) {
+        l.jitter_.add(std::abs(static_cast<double>(wake_ns - l.last_wake_ns_ - l.period_ns_)));
+        c.late = wake_ns - l.last_end_ns_ > l.watchdog_ns_;
+      }
+      c.latency_us = static_cast<double>(wake_ns - deadline_ns) * 1e-3;
+      l.latency_.add(static_cast<double>(wake_ns - deadline_ns));
+      l.last_wake_ns_ = wake_ns;
+    }
+    return c;
+  }
+
+  // The sample's checks, the watchdog and a stop request; a fault latches the safe state and
+  // resets the controller.
+  static void check_faults(Loop& l, const SensorSample& s, bool late) noexcept {
+    Fault fault = l.guard_.check(s);
+    if (fault == Fault::kNone && (late || l.shared_->watchdog.load(std::memory_order_acquire))) {
+      fault = Fault::kWatchdog;
+      if (late && !l.shared_->watchdog.exchange(true, std::memory_order_acq_rel)) {
+        l.shared_->watchdog_trips.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+    if (l.options_.stop != nullptr && l.options_.stop->load(std::memory_order_relaxed)) {
+      l.stopping_ = true;
+      if (fault == Fault::kNone) fault = Fault::kInterrupted;
+    }
+    if (fault != Fault::kNone && !l.guard_.safe_state()) {
+      l.guard_.trip(fault, l.cycle_);
+      l.iff_.reset();
+    }
+  }
+
+  // Ramp factor: 0 -> 1 over the first ramp_in cycles, 1 -> 0 over the last ramp_out cycles.
+  static double ramp_factor(const Loop& l) noexcept {
+    double r = 1.0;
+    if (l.ramp_in_cycles_ > 0) r = std::min(r, static_cast<double>(l.cycle_) / static_cast<double>(l.ramp_in_cycles_));
+    if (l.ramp_out_cycles_ > 0) {
+      r = std::min(r, static_cast<double>(l.total_cycles_ - 1 - l.cycle_) / static_cast<double>(l.ramp_out_cycles_));
+    }
+    return r;
+  }
+
+  // The controller's output y, the request u_safe + r (u_ff + y - u_safe) through the safety guard
+  // (a trip on a non-finite controller output or a saturation too long), anti-windup, and the
+  // command written to the backend.
+  static SafetyGuard::Output command(Loop& l, const SensorSample& s, double r, double u_ff, double u_safe, double& y) noexcept {
+    double request = u_safe;
+    if (!l.guard_.safe_state()) {
+      if (l.options_.controller) {
+        l.iff_.set_gain(r * l.options_.gain);
+        y = l.iff_.step(s.vs);
+        if (l.iff_.nonfinite_inputs() != l.controller_nonfinite_seen_) {
+          l.controller_nonfinite_seen_ = l.iff_.nonfinite_inputs();
+          l.guard_.trip(Fault::kNonFiniteController, l.cycle_);
+          l.iff_.reset();
+          y = 0.0;
+        }
+      }
+      if (!l.guard_.safe_state()) request = u_safe + r * (u_ff + y - u_safe);
+    }
+    const SafetyGuard::Output out = l.guard_.limit(request);
+    if (!l.guard_.safe_state() && l.guard_.saturated_too_long()) {
+      l.guard_.trip(Fault::kSaturation, l.cycle_);  // from the next cycle on
+      l.iff_.reset();
+    }
+    if (!l.guard_.safe_state() && l.options_.controller && r > 0.0 && (out.clamped || out.slew_limited)) {
+      // Anti-windup: the controller's share of what was really applied.
+      l.iff_.applied((out.u - u_safe) / r + u_safe - u_ff);
+    }
+    l.backend_.write(out.u);
+    return out;
+  }
+
+  static void record_command(Loop& l, double va_cmd) noexcept {
+    l.va_cmd_min_ = std::min(l.va_cmd_min_, va_cmd);
+    l.va_cmd_max_ = std::max(l.va_cmd_max_, va_cmd);
+    l.max_step_ = std::max(l.max_step_, std::abs(va_cmd - l.last_va_cmd_));
+    l.last_va_cmd_ = va_cmd;
+  }
+
+  // The step time, and an overrun (a cycle ending after the next deadline) by its cause.
+  static void record_timing(Loop& l, const Clock& clock, std::int64_t deadline_ns, std::int64_t wake_ns, std::int64_t end_ns) noexcept {
+    l.step_time_.add(static_cast<double>(end_ns - clock.start_ns));
+    if (clock.timed && end_ns > deadline_ns + l.period_ns_) {
+      ++l.overruns_;
+      if (wake_ns - deadline_ns >= end_ns - wake_ns) {
+        ++l.overruns_late_wakeup_;
+      } else {
+        ++l.overruns_long_step_;
+      }
+    }
+    l.last_end_ns_ = end_ns;
+  }
+
+  static void log_cycle(Loop& l, const SensorSample& s, const SafetyGuard::Output& out, double u_prime, double y, double r,
+                          const Clock& clock, std::int64_t end_ns) noexcept {
+    LogRecord rec;
+    rec.t = static_cast<double>(l.cycle_) / l.rate_;
+    rec.u_prime = u_prime;
+    rec.u = out.u;
+    rec.va_cmd = l.last_va_cmd_;
+    rec.va = std::isfinite(s.va) ? s.va : rec.va_cmd;
+    const bool sensor_ok = std::isfinite(s.de) && std::isfinite(s.vs);
+    rec.de = sensor_ok ? s.de : 0.0;
+    rec.vs = sensor_ok ? s.vs : 0.0;
+    rec.y = y;
+    rec.latency_us = clock.latency_us;
+    rec.step_us = static_cast<double>(end_ns - clock.start_ns) * 1e-3;
+    rec.measured_ns = clock.start_ns;
+    rec.flags = (out.clamped ? kFlagClamped : 0u) | (out.slew_limited ? kFlagSlewLimited : 0u) |
+                (l.guard_.safe_state() ? kFlagSafeState : 0u) | (r < 1.0 ? kFlagRamping : 0u) |
+                (sensor_ok ? 0u : kFlagSensorFault);
+    if (l.options_.realtime) {
+      l.logger_->push(rec);
+    } else {
+      l.logger_->push_wait(rec);
+    }
+  }
+};
+
 bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
   if (!started_ || finished_) return false;
   const double u_safe = guard_.limits().u_safe();
   const double amp = guard_.limits().amplifier_gain;
   // A stop request ends the run once the safe state has brought the output to the safe value.
   if (stopping_ && guard_.last_output() == u_safe) total_cycles_ = std::min(total_cycles_, cycle_);
-  if (cycle_ >= total_cycles_ || backend_.finished()) {
-    // Wind-down: bring the output to the safe value at the slew limit (the ramp out normally
-    // ends there already; not after an early end of the backend or a trip mid-slew).
-    if (guard_.last_output() == u_safe) return false;
-    const SafetyGuard::Output out = guard_.limit(u_safe);
-    backend_.write(out.u);
-    ++wind_down_;
-    shared_->heartbeat.fetch_add(1, std::memory_order_release);
-    return true;
-  }
-  const bool timed = options_.realtime && wake_ns != 0;
-  const std::int64_t start_ns = timed ? wake_ns : monotonic_ns();
-  double latency_us = 0.0;
-  bool late = false;
-  if (timed) {
-    if (cycle_ > 0) {
-      jitter_.add(std::abs(static_cast<double>(wake_ns - last_wake_ns_ - period_ns_)));
-      late = wake_ns - last_end_ns_ > watchdog_ns_;
-    }
-    latency_us = static_cast<double>(wake_ns - deadline_ns) * 1e-3;
-    latency_.add(static_cast<double>(wake_ns - deadline_ns));
-    last_wake_ns_ = wake_ns;
-  }
-
+  if (cycle_ >= total_cycles_ || backend_.finished()) return Cycle::wind_down(*this, u_safe);
+  const Cycle::Clock clock = Cycle::wake_up(*this, deadline_ns, wake_ns);
   const SensorSample s = backend_.read();
-  Fault fault = guard_.check(s);
-  if (fault == Fault::kNone && (late || shared_->watchdog.load(std::memory_order_acquire))) {
-    fault = Fault::kWatchdog;
-    if (late && !shared_->watchdog.exchange(true, std::memory_order_acq_rel)) {
-      shared_->watchdog_trips.fetch_add(1, std::memory_order_relaxed);
-    }
-  }
-  if (options_.stop != nullptr && options_.stop->load(std::memory_order_relaxed)) {
-    stopping_ = true;
-    if (fault == Fault::kNone) fault = Fault::kInterrupted;
-  }
-  if (fault != Fault::kNone && !guard_.safe_state()) {
-    guard_.trip(fault, cycle_);
-    iff_.reset();
-  }
-
-  // Ramp factor: 0 -> 1 over the first ramp_in cycles, 1 -> 0 over the last ramp_out cycles.
-  double r = 1.0;
-  if (ramp_in_cycles_ > 0) r = std::min(r, static_cast<double>(cycle_) / static_cast<double>(ramp_in_cycles_));
-  if (ramp_out_cycles_ > 0) {
-    r = std::min(r, static_cast<double>(total_cycles_ - 1 - cycle_) / static_cast<double>(ramp_out_cycles_));
-  }
+  Cycle::check_faults(*this, s, clock.late);
+  const double r = Cycle::ramp_factor(*this);
   const auto played = static_cast<Eigen::Index>(options_.excitation.size() > 0 ? cycle_ % static_cast<std::uint64_t>(options_.excitation.size()) : 0);
   const double u_prime = options_.excitation.size() > 0 ? options_.excitation(played) : 0.0;
   // The feedforward's share of the request (V at the DAC): u' through the inverse hysteresis,
@@ -193,74 +297,12 @@ bool Loop::cycle(std::int64_t deadline_ns, std::int64_t wake_ns) noexcept {
     const double w = options_.feedforward_weight.size() > 0 ? options_.feedforward_weight(played) : 1.0;
     u_ff = feedforward_->step(u_prime * amp, w) / amp;
   }
-
   double y = 0.0;
-  double request = u_safe;
-  if (!guard_.safe_state()) {
-    if (options_.controller) {
-      iff_.set_gain(r * options_.gain);
-      y = iff_.step(s.vs);
-      if (iff_.nonfinite_inputs() != controller_nonfinite_seen_) {
-        controller_nonfinite_seen_ = iff_.nonfinite_inputs();
-        guard_.trip(Fault::kNonFiniteController, cycle_);
-        iff_.reset();
-        y = 0.0;
-      }
-    }
-    if (!guard_.safe_state()) request = u_safe + r * (u_ff + y - u_safe);
-  }
-  const SafetyGuard::Output out = guard_.limit(request);
-  if (!guard_.safe_state() && guard_.saturated_too_long()) {
-    guard_.trip(Fault::kSaturation, cycle_);  // from the next cycle on
-    iff_.reset();
-  }
-  if (!guard_.safe_state() && options_.controller && r > 0.0 && (out.clamped || out.slew_limited)) {
-    // Anti-windup: the controller's share of what was really applied.
-    iff_.applied((out.u - u_safe) / r + u_safe - u_ff);
-  }
-  backend_.write(out.u);
-
-  const double va_cmd = out.u * amp;
-  va_cmd_min_ = std::min(va_cmd_min_, va_cmd);
-  va_cmd_max_ = std::max(va_cmd_max_, va_cmd);
-  max_step_ = std::max(max_step_, std::abs(va_cmd - last_va_cmd_));
-  last_va_cmd_ = va_cmd;
-
+  const SafetyGuard::Output out = Cycle::command(*this, s, r, u_ff, u_safe, y);
+  Cycle::record_command(*this, out.u * amp);
   const std::int64_t end_ns = monotonic_ns();
-  step_time_.add(static_cast<double>(end_ns - start_ns));
-  if (timed && end_ns > deadline_ns + period_ns_) {
-    ++overruns_;
-    if (wake_ns - deadline_ns >= end_ns - wake_ns) {
-      ++overruns_late_wakeup_;
-    } else {
-      ++overruns_long_step_;
-    }
-  }
-  last_end_ns_ = end_ns;
-
-  if (logger_) {
-    LogRecord rec;
-    rec.t = static_cast<double>(cycle_) / rate_;
-    rec.u_prime = u_prime;
-    rec.u = out.u;
-    rec.va_cmd = va_cmd;
-    rec.va = std::isfinite(s.va) ? s.va : va_cmd;
-    const bool sensor_ok = std::isfinite(s.de) && std::isfinite(s.vs);
-    rec.de = sensor_ok ? s.de : 0.0;
-    rec.vs = sensor_ok ? s.vs : 0.0;
-    rec.y = y;
-    rec.latency_us = latency_us;
-    rec.step_us = static_cast<double>(end_ns - start_ns) * 1e-3;
-    rec.measured_ns = start_ns;
-    rec.flags = (out.clamped ? kFlagClamped : 0u) | (out.slew_limited ? kFlagSlewLimited : 0u) |
-                (guard_.safe_state() ? kFlagSafeState : 0u) | (r < 1.0 ? kFlagRamping : 0u) |
-                (sensor_ok ? 0u : kFlagSensorFault);
-    if (options_.realtime) {
-      logger_->push(rec);
-    } else {
-      logger_->push_wait(rec);
-    }
-  }
+  Cycle::record_timing(*this, clock, deadline_ns, wake_ns, end_ns);
+  if (logger_) Cycle::log_cycle(*this, s, out, u_prime, y, r, clock, end_ns);
   ++cycle_;
   shared_->heartbeat.fetch_add(1, std::memory_order_release);
   return true;

@@ -177,6 +177,7 @@ class Loop {
 
  private:
   struct Shared;
+  struct Cycle;  // the steps of cycle() (loop.cpp)
   Backend& backend_;
   LoopOptions options_;
   double rate_;
