@@ -669,8 +669,17 @@ json normalized(const json& v) {
   return out;
 }
 
-std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
-  json figs = json::array(), rows = json::array();
+// A report section's figures and tables, filled by its parts in order.
+struct SectionParts {
+  json figs = json::array();
+  json tables = json::array();
+};
+
+// Figure 2.3 (every amplitude of the first unit), each unit's normalized loops, and the table of
+// the loops' widths per amplitude.
+void add_hysteresis_loops(const std::vector<UnitCurves>& units, SectionParts& out) {
+  json& figs = out.figs;
+  json rows = json::array();
   bool absolute = false;
   std::vector<double> amplitudes;
   for (const auto& u : units) {
@@ -707,6 +716,16 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
     }
     rows.push_back(row);
   }
+  if (!rows.empty()) {
+    std::vector<std::string> columns = {"unit"};
+    for (const double a : amplitudes) columns.push_back(fmt::format("width at {:.3g} V [um] (of the stroke)", a));
+    out.tables.push_back(table("Hysteresis: loop width at the offset per amplitude", columns, rows));
+  }
+}
+
+// Figure 1.4b: the stroke of every unit.
+void add_stroke(const std::vector<UnitCurves>& units, SectionParts& out) {
+  json& figs = out.figs;
   json stroke = json::array();
   for (const auto& u : units) {
     if (u.stroke) stroke.push_back(trace(u.name(), u.stroke->x, u.stroke->y, u.name()));
@@ -715,13 +734,11 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
     figs.push_back(figure("stroke", "Fig. 1.4b: stroke, displacement against the stack voltage (slow ramp)", "Va [V]", false,
                           json::array({panel("d_e [um]", false, stroke)})));
   }
-  json tables = json::array();
-  if (!rows.empty()) {
-    std::vector<std::string> columns = {"unit"};
-    for (const double a : amplitudes) columns.push_back(fmt::format("width at {:.3g} V [um] (of the stroke)", a));
-    tables.push_back(table("Hysteresis: loop width at the offset per amplitude", columns, rows));
-  }
-  // The Prandtl-Ishlinskii model of the largest loop (docs/hysteresis.md): its fit and the loop it draws.
+}
+
+// The Prandtl-Ishlinskii model of the largest loop (docs/hysteresis.md): its fit and the loop it draws.
+void add_hysteresis_models(const std::vector<UnitCurves>& units, SectionParts& out) {
+  json& figs = out.figs;
   json model_rows = json::array();
   for (const auto& u : units) {
     if (!u.result->hysteresis_model) continue;
@@ -753,7 +770,7 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
                           "experiment (docs/hysteresis.md)."));
   }
   if (!model_rows.empty()) {
-    tables.push_back(table(fmt::format("Hysteresis model of the largest loop (Prandtl-Ishlinskii, thresholds (i - 1/2) R / n; Kuhnen's "
+    out.tables.push_back(table(fmt::format("Hysteresis model of the largest loop (Prandtl-Ishlinskii, thresholds (i - 1/2) R / n; Kuhnen's "
                                        "modified PI, {} dead zones per side, fitted too when the loop's asymmetry exceeds {:.0f} % "
                                        "of the stroke, kept when better)",
                                        kCampaignDeadZones, 100.0 * kHysteresisAsymmetryLimit),
@@ -761,8 +778,12 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
                             "residual: PI / modified PI", "width (steady loop, from the best line): record / model", "fit"},
                            model_rows));
   }
-  // The tracking experiment (bench/tracking.hpp): d_e against the command without and with the
-  // inverse of the model as a feedforward.
+}
+
+// The tracking experiment (bench/tracking.hpp): d_e against the command without and with the
+// inverse of the model as a feedforward.
+void add_tracking(const std::vector<UnitCurves>& units, SectionParts& out) {
+  json& figs = out.figs;
   json tracking_rows = json::array();
   for (const auto& u : units) {
     if (!u.result->tracking) continue;
@@ -788,14 +809,22 @@ std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
                           "(docs/hysteresis.md)."));
   }
   if (!tracking_rows.empty()) {
-    tables.push_back(table("Tracking without -> with the inverse hysteresis feedforward",
+    out.tables.push_back(table("Tracking without -> with the inverse hysteresis feedforward",
                            {"unit", "command", "hysteresis width (of the stroke)", "rms tracking error [um]", "stroke [um]", "feedforward"},
                            tracking_rows,
                            "Hysteresis width: peak-to-peak deviation of d_e from its best straight line against the command, over the "
                            "stroke. rms tracking error: against the straight line the compensated actuator follows (the record's target)."));
   }
-  if (figs.empty()) return std::nullopt;
-  return json{{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", tables}, {"figures", figs}};
+}
+
+std::optional<json> quasi_static_section(const std::vector<UnitCurves>& units) {
+  SectionParts parts;
+  add_hysteresis_loops(units, parts);
+  add_stroke(units, parts);
+  add_hysteresis_models(units, parts);
+  add_tracking(units, parts);
+  if (parts.figs.empty()) return std::nullopt;
+  return json{{"id", "quasi-static"}, {"title", "Stroke and hysteresis (report 1.3, 2.1)"}, {"tables", parts.tables}, {"figures", parts.figs}};
 }
 
 std::vector<std::string> flatness_columns() {
