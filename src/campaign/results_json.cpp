@@ -121,26 +121,18 @@ json resistor(const ResistorComparison& r) {
           {"method", "first-order high-pass g s/(s + wc) fitted to u -> Vs below hpf_fmax_Hz (Welch, segments of half the record)"}};
 }
 
+// The declared batch, its spreads keyed by quantity and the similarity's band and reference.
 json batch(const BatchAnalysis& b) {
-  json outliers = json::array();
-  for (const auto& o : b.outliers) {
-    outliers.push_back({{"unit", o.unit}, {"quantity", o.quantity}, {"value", o.value}, {"median", o.median}, {"robust_z", num(o.robust_z)}});
-  }
-  json spread = json::object();
-  for (const auto& s : b.spread) {
-    spread[s.quantity] = {{"units", s.units}, {"min", s.min}, {"max", s.max}, {"median", s.median},
-                          {"relative_spread", s.relative_spread}, {"mad", s.mad}};
-  }
-  json similarity = json::object();
+  json out = io::results_object(b);
+  out["spread"] = json::object();
+  for (const auto& s : b.spread) out["spread"][s.quantity] = io::results_object(s);
+  out["similarity"] = json::object();
   if (b.similarity) {
-    const FrfSimilarity& s = *b.similarity;
-    json per_unit = json::array();
-    for (const auto& u : s.units) per_unit.push_back({{"unit", u.unit}, {"de_rms_dB", num(u.de_rms_dB)}, {"Vs_rms_dB", num(u.vs_rms_dB)}});
-    similarity = {{"reference", "median |H| of the batch"}, {"band_Hz", {s.fmin_Hz, s.fmax_Hz}}, {"units", per_unit}, {"max_rms_dB", s.max_rms_dB}};
+    out["similarity"] = io::results_object(*b.similarity);
+    out["similarity"]["reference"] = "median |H| of the batch";
+    out["similarity"]["band_Hz"] = {b.similarity->fmin_Hz, b.similarity->fmax_Hz};
   }
-  return {{"outliers", outliers}, {"spread", spread}, {"similarity", similarity},
-          {"outlier_rule", {{"robust_z_threshold", b.rule.threshold}, {"min_relative_deviation", b.rule.min_relative_deviation},
-                            {"rejects", b.rejects}}}};
+  return out;
 }
 
 // The declared study, with how the locus was computed and what the controller and plant are.

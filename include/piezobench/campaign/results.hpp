@@ -534,6 +534,62 @@ struct BatchAnalysis {
   bool rejects = false;  // outliers in capacitance or stroke reject a unit
 };
 
+constexpr auto describe(core::Type<QuantitySpread>) {
+  using S = QuantitySpread;
+  using namespace core::shown;
+  return core::fields<S>("QuantitySpread", "one quantity over the batch (values in its results.json unit)",
+      core::field("quantity", &S::quantity, kNone, "results key, e.g. capacitance_sensor_uF"),
+      core::field("label", &S::label, kNone, "for people"),
+      core::field("unit", &S::unit, kNone, "of the values"),
+      core::field("units", &S::units, kNone, "units measured"),
+      core::field("min", &S::min, kNone, "in the quantity's unit"),
+      core::field("max", &S::max, kNone, "in the quantity's unit"),
+      core::field("median", &S::median, kNone, "in the quantity's unit"),
+      core::field("relative_spread", &S::relative_spread, kRatio, "(max - min) / |median|"),
+      core::field("mad", &S::mad, kNone, "median absolute deviation, in the quantity's unit"));
+}
+
+constexpr auto describe(core::Type<BatchOutlier>) {
+  using S = BatchOutlier;
+  using namespace core::shown;
+  return core::fields<S>("BatchOutlier", "a unit whose quantity is an outlier of the batch",
+      core::field("unit", &S::unit, kNone, "unit id"),
+      core::field("quantity", &S::quantity, kNone, "as in QuantitySpread"),
+      core::field("value", &S::value, kNone, "in the quantity's unit"),
+      core::field("median", &S::median, kNone, "of the batch"),
+      core::field("robust_z", &S::robust_z, kRatio, "modified z-score"));
+}
+
+constexpr auto describe(core::Type<FrfSimilarity::Unit>) {
+  using S = FrfSimilarity::Unit;
+  using namespace core::shown;
+  return core::fields<S>("FrfSimilarityUnit", "one unit's rms distance from the batch median |H|",
+      core::field("unit", &S::unit, kNone, "unit id"),
+      core::field("de_rms_dB", &S::de_rms_dB, kDecibel, "u -> d_e (NaN when no point compares)"),
+      core::field("vs_rms_dB", &S::vs_rms_dB, kDecibel, "u -> Vs").key("Vs_rms_dB"));
+}
+
+constexpr auto describe(core::Type<FrfSimilarity>) {
+  using S = FrfSimilarity;
+  using namespace core::shown;
+  return core::fields<S>("FrfSimilarity", "unit-to-unit similarity of the FRFs",
+      core::field("fmin_Hz", &S::fmin_Hz, kHertz, "band compared, low end").part_only(),
+      core::field("fmax_Hz", &S::fmax_Hz, kHertz, "band compared, high end").part_only(),
+      core::field("units", &S::units, kNone, "per unit"),
+      core::field("max_rms_dB", &S::max_rms_dB, kDecibel, "the largest"));
+}
+
+constexpr auto describe(core::Type<BatchAnalysis>) {
+  using S = BatchAnalysis;
+  using namespace core::shown;
+  return core::fields<S>("BatchAnalysis", "the batch: spreads, outliers and FRF similarity",
+      core::field("outliers", &S::outliers, kNone, "units whose quantity is an outlier"),
+      core::field("spread", &S::spread, kNone, "each quantity over the batch (results.json: an object by quantity)").part_only(),
+      core::field("similarity", &S::similarity, kNone, "of the FRFs (two units with an FRF or more)"),
+      core::field("rule", &S::rule, kNone, "the outlier rule").key("outlier_rule"),
+      core::field("rejects", &S::rejects, kNone, "outliers in capacitance or stroke reject a unit").key("outlier_rule.rejects"));
+}
+
 // The IFF study: root locus of the fitted plant with the report's controller against the poles of
 // the measured damped plants.
 struct IffStudy {

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
+
 namespace piezobench::metrology {
 
 // A closed interval [min, max]; either end may be infinite.
@@ -60,5 +62,13 @@ struct OutlierAnalysis {
 // field) for a non-finite value (its index named).
 OutlierAnalysis robust_outliers(const std::vector<double>& values, const OutlierOptions& options = {},
                                 const std::string& source = "", const std::string& field = "values");
+
+constexpr auto describe(core::Type<OutlierOptions>) {
+  using S = OutlierOptions;
+  using namespace core::shown;
+  return core::fields<S>("OutlierOptions", "the batch's outlier rule",
+      core::field("threshold", &S::threshold, kRatio, "|modified z| above this ...").key("robust_z_threshold"),
+      core::field("min_relative_deviation", &S::min_relative_deviation, kRatio, "... and |x - median| > this * |median|"));
+}
 
 }  // namespace piezobench::metrology
