@@ -18,8 +18,6 @@ using namespace shown_units;
 
 json num(double v) { return io::to_json(v); }
 
-json provenance(const RecordProvenance& p) { return io::results_object(p); }
-
 // The Welch settings with the line spacing they give.
 json welch(const dsp::FrfProvenance& p) {
   json out = io::results_object(p);
@@ -169,7 +167,7 @@ json unit_json(const UnitAnalysis& u) {
   r["model_2dof"] = nullptr;
   if (u.capacitance_analysis) {
     const auto& c = *u.capacitance_analysis;
-    r["capacitance_provenance"] = c.provenance ? provenance(*c.provenance) : json({{"key", c.key}});
+    r["capacitance_provenance"] = c.provenance ? io::results_object(*c.provenance) : json({{"key", c.key}});
   }
   if (u.hysteresis_model) r["hysteresis_model"] = hysteresis_model(*u.hysteresis_model);
   if (u.tracking) r["tracking"] = tracking(*u.tracking);
