@@ -29,7 +29,9 @@ std::vector<long> read_fix_nodes(const io::TomlReader& keys) {
   if (n->is_integer()) return {static_cast<long>(*keys.integer("fix", lo, hi))};
   if (!n->is_array()) keys.fail("fix", "a node number or an array of node numbers", io::describe_toml(*n));
   std::vector<long> out;
-  for (const std::int64_t node : *keys.integers("fix", lo, hi)) out.push_back(static_cast<long>(node));
+  // The optional is kept by name: a range-for over `*keys.integers(...)` would read a destroyed temporary.
+  const std::vector<std::int64_t> nodes = keys.integers("fix", lo, hi).value_or(std::vector<std::int64_t>{});
+  for (const std::int64_t node : nodes) out.push_back(static_cast<long>(node));
   if (out.empty()) keys.fail("fix", "at least one node", "an empty array");
   return out;
 }
