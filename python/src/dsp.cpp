@@ -3,6 +3,7 @@
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/dsp/window.hpp"
 
@@ -300,7 +301,11 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
       .def_property_readonly("std_H", [](const Frf& f) -> py::object {
         if (f.std_H.empty()) return py::none();
         return stack(f.std_H, f.std_H.size() == 1);
-      }, "standard deviation of Re H and of Im H, H's units, like H (None when unknown); 95 % band |H| +- 1.96 std_H")
+      }, "standard deviation of Re H and of Im H, H's units, like H (None when unknown); 95 % band |H| +- band_factor std_H")
+      .def_property_readonly("band_factor", [](const Frf& f) -> py::object {
+        if (!(f.provenance.effective_averages > 1.0)) return py::none();
+        return py::float_(frf_band_factor(f.provenance.effective_averages));
+      }, "k of the 95 % band H +- k std_H from the estimate's n_d (Student's t, dsp/frf_variance.hpp; None when n_d is unknown)")
       .def_property_readonly("provenance", [](const Frf& f) { return provenance_dict(f.provenance); })
       .def("response", [](const Frf& f, const std::string& name) { return to_numpy(f.H[static_cast<std::size_t>(f.output_index(name))]); },
            arg("output"), "H of the named output (InputError listing the names when unknown).")
@@ -314,6 +319,9 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
 // window, and the spectra of dsp/welch.hpp: welch, csd and frf.
 void bind_spectra(py::module_& m) {
   using py::arg;
+  m.def("band_factor", [](double effective_averages, double level) { return frf_band_factor(effective_averages, level); },
+        arg("effective_averages"), arg("level") = 0.95,
+        "k of the band H +- k std_H at `level` for n_d effective averages: sqrt(n_d / (n_d - 1)) t(2 n_d - 2) (Goodman 1963).");
   m.def("window", [](const std::string& type, Index length) { return to_numpy(make_window(window_type_from_string(type), length)); },
         arg("type"), arg("length"), "The window of `length` samples, sample for sample scipy.signal.get_window's.");
 

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 import scipy.signal as ss
+from scipy.stats import t as ss_t
 
 import piezobench as pb
 from piezobench import dsp
@@ -74,6 +75,13 @@ def test_frf_std_is_bendat_piersol_with_welchs_effective_averages():
     np.testing.assert_array_equal(est.frf.std_H, est.std_H)
     f = dsp.Frf(est.freq_Hz, est.H, coherence=est.coherence, std_H=est.std_H)
     np.testing.assert_array_equal(f.std_H, est.std_H)
+    # The 95 % band's factor k = sqrt(n_d / (n_d - 1)) t(2 n_d - 2), checked through scipy's t.cdf
+    # (exact to ~1e-16; its t.ppf is ~1e-9 off at these degrees of freedom).
+    c, dof = np.sqrt(n_d / (n_d - 1)), 2 * n_d - 2
+    assert ss_t.cdf(est.frf.band_factor / c, dof) == pytest.approx(0.975, abs=1e-13)
+    assert dsp.band_factor(n_d) == est.frf.band_factor
+    assert ss_t.cdf(dsp.band_factor(n_d, level=0.99) / c, dof) == pytest.approx(0.995, abs=1e-13)
+    assert f.band_factor is None  # built without provenance: n_d unknown
 
 
 def test_arrays_are_read_in_place_and_results_are_numpy():

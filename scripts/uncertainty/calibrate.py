@@ -7,18 +7,25 @@ For each noise seed, unit `--unit` of the batch drawn from that seed runs the fr
     (Bendat & Piersol with Welch's n_d, dsp/frf_variance.hpp);
   - the plant fits (ident.fit_actuator_plants, weighted by that variance) with their standard errors;
   - the 2-DoF tuning (apa.tune_two_dof_measured, ratios 2) with its standard errors.
-The truth is the bench's own: its linear model u -> [d_e, Vs] (bench.linear_model), its resonance,
-anti-resonance and damping ratios (bench.truth) and the unit's 2-DoF parameters.
+Two references (the bench knows both):
+  - truth: the bench's own linear model u -> [d_e, Vs] (bench.linear_model), its resonance,
+    anti-resonance and damping ratios (bench.truth) and the unit's 2-DoF parameters;
+  - ideal: the same analysis of the same seed's record without noise or quantization (IDEAL below):
+    what the estimates scatter around. The random error (the FRF band, the standard errors) is
+    calibrated against it; truth - ideal is the bias (the window's resolution at the resonance, the
+    hold, a model's structure), which no random-error interval covers.
 
-Coverage measured (docs/uncertainty.md):
-  - band: fraction of (seed, output, line) with coherence > 0.5 inside the excited band whose true
-    |H| lies within |H_est| +- 1.96 std_H (the drawn 95 % band); the phase band likewise;
-  - intervals: fraction of seeds whose 95 % interval (value +- 1.96 se) covers the truth, for the
-    resonance (d_e fit), its damping, the anti-resonance (Vs fit), its damping |xz|, and each tuned
-    2-DoF parameter.
+Coverage measured (docs/uncertainty.md, section 6):
+  - band: fraction of (seed, output, line) with coherence > 0.5 in 1-2000 Hz whose reference |H|
+    lies within |H_est| +- k std_H (the drawn 95 % band, k = dsp.band_factor(n_d)); the phase band
+    likewise;
+  - intervals: fraction of seeds whose 95 % interval (value +- 1.96 se) covers the reference, for
+    the resonance (d_e fit), its damping, the anti-resonance (Vs fit), its damping xz, and each tuned
+    2-DoF parameter; with the mean and spread of z = (value - reference) / se (0 and 1 when right).
 
 Usage (minutes; not run in CI):
-    PYTHONPATH=build/python python3 scripts/uncertainty/calibrate.py --seeds 200 [--unit 1] [--json out.json]
+    PYTHONPATH=build/python /usr/bin/python3 scripts/uncertainty/calibrate.py --seeds 200 \
+        [--bench hysteresis=false creep=false] [--band-factor 1.96] [--unit 1] [--json out.json]
 """
 
 import argparse
@@ -35,74 +42,114 @@ from piezobench import apa, bench, dsp, ident, lti
 Z95 = 1.959963984540054
 
 
-def one_seed(seed, unit=1, duration=20.0, fmin=20.0, fmax=500.0):
-    """Coverage counts and interval checks of one noise seed."""
-    ts = bench.simulate("frf-noise", unit, seed, duration=duration)
+# The same bench without any random error: no noise, no quantization (the DAC, the ADC and the
+# encoder at a resolution far below every signal). Measured with the same excitation (same seed) and
+# the same estimator, it is what the noisy estimate scatters around: the reference of the random
+# error the FRF band and the standard errors describe.
+IDEAL = {"noise": False, "encoder_resolution": 1e-15, "dac_bits": 30, "adc_bits": 30}
+
+
+# None: each FRF's own band factor (dsp.band_factor of its n_d, as the report draws); a number: that
+# factor instead (--band-factor 1.96 measures the Gaussian band the report drew before).
+BAND_FACTOR = None
+
+
+def welch(ts):
     fs = ts.sample_rate
-    nfft = int(round(4.0 * fs))
-    est = dsp.frf(ts["u"], np.vstack([ts["de"], ts["Vs"]]), fs, outputs=["de", "Vs"],
-                  nfft=nfft, overlap=0.5, window="hann-periodic", detrend="mean")
-    frf = est.frf
+    return dsp.frf(ts["u"], np.vstack([ts["de"], ts["Vs"]]), fs, outputs=["de", "Vs"],
+                   nfft=int(round(4.0 * fs)), overlap=0.5, window="hann-periodic", detrend="mean").frf
+
+
+def frf_rate(frf):
+    """The sample rate of the record an FRF was estimated from (its provenance)."""
+    return float(frf.provenance["sample_rate"])
+
+
+def band_counts(frf, reference):
+    """(inside |H| band, inside phase band, lines) per output, lines with coherence > 0.5 in 1-2000 Hz."""
     f = frf.freq_Hz
-    truth_sys = bench.linear_model(unit, seed)
-    h_true = lti.freqresp(truth_sys, 2 * math.pi * f)  # (points, outputs, inputs) or similar
-    h_true = np.asarray(h_true)
-    if h_true.ndim == 3:
-        h_true = np.stack([h_true[:, 0, 0], h_true[:, 1, 0]])
-    out = {"seed": seed, "band": {}, "phase": {}, "intervals": {}}
-    sel = (f >= 1.0) & (f <= 2000.0)
+    k = frf.band_factor if BAND_FACTOR is None else BAND_FACTOR  # the drawn band: H +- k std_H
+    out = {}
     for i, name in enumerate(["de", "Vs"]):
         h, s, c = frf.H[i], frf.std_H[i], frf.coherence[i]
-        use = sel & (c > 0.5)
-        inside = np.abs(np.abs(h[use]) - np.abs(h_true[i][use])) <= Z95 * s[use]
-        dphi = np.angle(h[use] / h_true[i][use])
-        inside_ph = np.abs(dphi) <= Z95 * s[use] / np.abs(h[use])
-        out["band"][name] = [int(inside.sum()), int(use.sum())]
-        out["phase"][name] = [int(inside_ph.sum()), int(use.sum())]
-    t = bench.truth(unit, seed)
+        use = (f >= 1.0) & (f <= 2000.0) & (c > 0.5)
+        mag = np.abs(np.abs(h[use]) - np.abs(reference[i][use])) <= k * s[use]
+        ph = np.abs(np.angle(h[use] / reference[i][use])) <= k * s[use] / np.abs(h[use])
+        out[name] = [int(mag.sum()), int(ph.sum()), int(use.sum())]
+    return out
+
+
+def fitted(frf, fmin, fmax):
+    """{name: (value, standard error)} of the plant fits and the 2-DoF tuning on one FRF."""
     plants = ident.fit_actuator_plants(frf, "de", "Vs", fmin_Hz=fmin, fmax_Hz=fmax)
-
-    def check(key, value, se, true):
-        if value is None or se is None or not math.isfinite(se) or true is None:
-            return
-        out["intervals"][key] = bool(abs(value - true) <= Z95 * se)
-
+    v = {}
     if plants.de is not None:
         u = plants.de.uncertainty
-        check("resonance_Hz", plants.de.natural_frequency / (2 * math.pi),
-              u.standard_error_of("natural_frequency") / (2 * math.pi), t.resonance_Hz)
-        check("resonance_damping", plants.de.damping, u.standard_error_of("damping"), t.resonance_damping)
+        v["resonance_Hz"] = (plants.de.natural_frequency / (2 * math.pi), u.standard_error_of("natural_frequency") / (2 * math.pi))
+        v["resonance_damping"] = (plants.de.damping, u.standard_error_of("damping"))
     if plants.vs is not None:
         u = plants.vs.uncertainty
-        check("antiresonance_Hz", plants.vs.wz / (2 * math.pi), u.standard_error_of("wz") / (2 * math.pi), t.antiresonance_Hz)
-        if t.antiresonance_damping is not None:
-            check("antiresonance_damping", plants.vs.xz, u.standard_error_of("xz"), t.antiresonance_damping)
-        out["nmp_verdict"] = None
-        lo, hi = plants.vs.xz - Z95 * u.standard_error_of("xz"), plants.vs.xz + Z95 * u.standard_error_of("xz")
-        out["nmp_verdict"] = "nmp" if hi < 0 else ("mp" if lo > 0 else "undetermined")
-        out["nmp_truth"] = "nmp" if t.zero_is_nonminimum_phase else "mp"
+        v["antiresonance_Hz"] = (plants.vs.wz / (2 * math.pi), u.standard_error_of("wz") / (2 * math.pi))
+        v["antiresonance_damping"] = (plants.vs.xz, u.standard_error_of("xz"))
+    undetermined = []
     if plants.de is not None and plants.vs is not None:
-        tuned = apa.tune_two_dof_measured(frf, plants.de, plants.vs, fmin_Hz=fmin, fmax_Hz=fmax, min_coherence=0.5,
-                                          amplifier_gain=20.0)
-        true_params = t.model_2dof
-        if tuned.uncertainty is not None and true_params is not None:
+        tuned = apa.tune_two_dof_measured(frf, plants.de, plants.vs, fmin_Hz=fmin, fmax_Hz=fmax, min_coherence=0.5, mass=5.7)
+        if tuned.uncertainty is not None:
             for name in ["k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs"]:
-                check("tuned_" + name, tuned.params[name], tuned.uncertainty.standard_error_of(name), true_params[name])
-        out["tuned_undetermined"] = list(tuned.undetermined)
+                v["tuned_" + name] = (tuned.params[name], tuned.uncertainty.standard_error_of(name))
+        undetermined = list(tuned.undetermined)
+    return v, undetermined
+
+
+def one_seed(seed, unit=1, duration=20.0, fmin=20.0, fmax=500.0, kw=None):
+    """Coverage counts and interval checks of one noise seed, against two references: the bench's
+    own parameters ("truth": its linear model, its resonance, anti-resonance and 2-DoF parameters)
+    and the same analysis of the ideal record ("ideal": what the estimate scatters around; it differs
+    from the truth by the bias errors: the window's resolution bias, the models' structure)."""
+    kw = kw or {}
+    frf = welch(bench.simulate("frf-noise", unit, seed, duration=duration, **kw))
+    ideal = welch(bench.simulate("frf-noise", unit, seed, duration=duration, **{**kw, **IDEAL}))
+    h_true = np.asarray(lti.freqresp(bench.linear_model(unit, seed, **kw), 2 * math.pi * frf.freq_Hz))
+    # The sampled bench holds u for a sample (zero-order hold): its response is the continuous one
+    # times the hold's sinc(f / fs) (the half-sample delay is in the model's input delay already).
+    h_true = np.stack([h_true[:, 0, 0], h_true[:, 1, 0]]) * np.sinc(frf.freq_Hz / frf_rate(frf))
+    out = {"seed": seed, "band": {"truth": band_counts(frf, h_true), "ideal": band_counts(frf, ideal.H)},
+           "intervals": {"truth": {}, "ideal": {}}}
+    est, undetermined = fitted(frf, fmin, fmax)
+    ref, _ = fitted(ideal, fmin, fmax)
+    t = bench.truth(unit, seed, **kw)
+    truth = {"resonance_Hz": t.resonance_Hz, "resonance_damping": t.resonance_damping,
+             "antiresonance_Hz": t.antiresonance_Hz, "antiresonance_damping": t.antiresonance_damping}
+    if t.model_2dof is not None:
+        truth.update({"tuned_" + n: t.model_2dof[n] for n in ["k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs"]})
+    for key, (value, se) in est.items():
+        if not (se is not None and math.isfinite(se)):
+            continue
+        for name, reference in (("truth", truth.get(key)), ("ideal", ref.get(key, (None,))[0])):
+            if reference is not None:
+                out["intervals"][name][key] = [value, se, reference]
+    if "antiresonance_damping" in est:
+        xz, se = est["antiresonance_damping"]
+        out["nmp_verdict"] = "nmp" if xz + Z95 * se < 0 else ("mp" if xz - Z95 * se > 0 else "undetermined")
+        out["nmp_truth"] = "nmp" if t.zero_is_nonminimum_phase else "mp"
+    out["tuned_undetermined"] = undetermined
     return out
 
 
 def summarize(results):
-    s = {"seeds": len(results), "band": {}, "phase": {}, "intervals": {}}
-    for kind in ("band", "phase"):
+    s = {"seeds": len(results), "band": {}, "intervals": {}}
+    for ref in ("truth", "ideal"):
+        s["band"][ref] = {}
         for name in ("de", "Vs"):
-            hit = sum(r[kind][name][0] for r in results)
-            n = sum(r[kind][name][1] for r in results)
-            s[kind][name] = hit / n if n else float("nan")
-    keys = sorted({k for r in results for k in r["intervals"]})
-    for k in keys:
-        v = [r["intervals"][k] for r in results if k in r["intervals"]]
-        s["intervals"][k] = {"coverage": sum(v) / len(v), "seeds": len(v)}
+            c = np.sum([r["band"][ref][name] for r in results], axis=0)
+            s["band"][ref][name] = {"magnitude": c[0] / c[2], "phase": c[1] / c[2], "lines": int(c[2])}
+        s["intervals"][ref] = {}
+        for k in sorted({k for r in results for k in r["intervals"][ref]}):
+            rows = np.array([r["intervals"][ref][k] for r in results if k in r["intervals"][ref]], dtype=float)
+            z = (rows[:, 0] - rows[:, 2]) / rows[:, 1]
+            s["intervals"][ref][k] = {"coverage": float(np.mean(np.abs(z) <= Z95)), "seeds": len(rows),
+                                      "mean_z": float(np.mean(z)), "std_z": float(np.std(z, ddof=1)) if len(z) > 1 else float("nan"),
+                                      "median_relative_bias": float(np.median(rows[:, 2] / rows[:, 0] - 1.0) * -1.0)}
     verdicts = [(r.get("nmp_verdict"), r.get("nmp_truth")) for r in results if r.get("nmp_verdict")]
     s["nmp"] = {"wrong": sum(1 for v, t in verdicts if v != "undetermined" and v != t),
                 "undetermined": sum(1 for v, _ in verdicts if v == "undetermined"), "seeds": len(verdicts)}
@@ -116,19 +163,34 @@ def main():
     p.add_argument("--unit", type=int, default=1)
     p.add_argument("--duration", type=float, default=20.0)
     p.add_argument("--json", help="write the per-seed results and the summary here")
+    p.add_argument("--band-factor", type=float, help="k of the FRF band (default: each FRF's dsp.band_factor)")
+    p.add_argument("--bench", nargs="*", default=[], metavar="KEY=VALUE",
+                   help="bench options (e.g. hysteresis=false creep=false)")
     a = p.parse_args()
+    global BAND_FACTOR
+    BAND_FACTOR = a.band_factor
+    kw = {}
+    for item in a.bench:
+        k, v = item.split("=", 1)
+        kw[k] = {"true": True, "false": False}.get(v.lower(), None)
+        if kw[k] is None:
+            kw[k] = float(v) if any(c in v for c in ".e") else int(v)
     results = []
     start = time.time()
     for k, seed in enumerate(range(a.first_seed, a.first_seed + a.seeds)):
-        results.append(one_seed(seed, a.unit, a.duration))
+        results.append(one_seed(seed, a.unit, a.duration, kw=kw))
         print(f"\rseed {seed} ({k + 1}/{a.seeds}, {time.time() - start:.0f} s)", end="", file=sys.stderr, flush=True)
     print(file=sys.stderr)
     s = summarize(results)
-    print(f"{s['seeds']} seeds, unit {a.unit}, pb {pb.__version__ if hasattr(pb, '__version__') else ''}")
-    for kind in ("band", "phase"):
-        print(f"95 % {kind} coverage (coherence > 0.5): " + ", ".join(f"{n} {100 * v:.1f} %" for n, v in s[kind].items()))
-    for k, v in s["intervals"].items():
-        print(f"95 % interval of {k}: covers the truth in {100 * v['coverage']:.1f} % of {v['seeds']} seeds")
+    print(f"{s['seeds']} seeds, unit {a.unit}, bench {kw or 'default'}")
+    for ref in ("truth", "ideal"):
+        print(f"-- against the {ref}" + (" (the bench's own model and parameters)" if ref == "truth" else
+                                          " (the same analysis of the noise- and quantization-free record)"))
+        print("95 % FRF band (coherence > 0.5, 1-2000 Hz): " + ", ".join(
+            f"{n} |H| {100 * v['magnitude']:.1f} % phase {100 * v['phase']:.1f} % of {v['lines']} lines" for n, v in s["band"][ref].items()))
+        for k, v in s["intervals"][ref].items():
+            print(f"  {k:24s} 95 % interval covers in {100 * v['coverage']:5.1f} % of {v['seeds']} seeds;"
+                  f" z mean {v['mean_z']:+6.2f} std {v['std_z']:5.2f}; median bias {100 * v['median_relative_bias']:+.2f} %")
     print(f"NMP verdict: {s['nmp']['wrong']} wrong, {s['nmp']['undetermined']} undetermined of {s['nmp']['seeds']}")
     if a.json:
         with open(a.json, "w") as f:

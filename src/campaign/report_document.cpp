@@ -15,6 +15,7 @@
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/fit_covariance.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/core/fields.hpp"
 #include "piezobench/io/fields_json.hpp"
@@ -68,9 +69,9 @@ std::vector<Index> log_indices(const VectorXd& f, double fmin, double fmax, int 
 // degrees and, for measurements, the coherence (null where there is none).
 struct Bode {
   json f = json::array(), abs = json::array(), phase = json::array(), coh = json::array();
-  // The 95 % band of a measurement (dsp/frf_variance.hpp): |H| +- 1.96 std_H (scaled; the lower edge
-  // kept above |H| / 1000 for the log axis) and phase +- 1.96 std_H / |H| (deg, at most 180); empty
-  // when the FRF has no std_H.
+  // The 95 % band of a measurement (dsp/frf_variance.hpp): |H| +- k std_H (scaled; the lower edge
+  // kept above |H| / 1000 for the log axis) and phase +- k std_H / |H| (deg, at most 180), k the
+  // band factor of the FRF's n_d (1.96 when its n_d is unknown); empty when the FRF has no std_H.
   json abs_lo = json::array(), abs_hi = json::array(), phase_lo = json::array(), phase_hi = json::array();
 };
 
@@ -87,8 +88,10 @@ Bode frf_lines(const dsp::Frf& frf, Index output, const std::vector<Index>& idx,
   }
   p.phase = unwrapped_degrees(h);
   if (frf.std_H.size() > o) {
+    const double n_d = frf.provenance.effective_averages;
+    const double k = n_d > 1.0 ? dsp::frf_band_factor(n_d) : core::kCoverage95;
     for (std::size_t i = 0; i < idx.size(); ++i) {
-      const double mag = std::abs(h[i]), s = core::kCoverage95 * frf.std_H[o](idx[i]);
+      const double mag = std::abs(h[i]), s = k * frf.std_H[o](idx[i]);
       const double dphi = mag > 0.0 ? std::min(180.0, s / mag * 180.0 / std::numbers::pi) : 180.0;
       p.abs_lo.push_back(std::max(mag - s, 1e-3 * mag) * scale);
       p.abs_hi.push_back((mag + s) * scale);
@@ -401,7 +404,7 @@ json frf_section(const std::vector<UnitCurves>& units) {
   return {{"id", "frf"}, {"title", "Frequency responses (report 2.3)"}, {"warnings", warnings},
           {"text", "FRFs from the DAC voltage u to the encoder d_e and to the force-sensor voltage Vs, all units "
                    "overlaid, with the coherence. The shaded bands are 95 % intervals of each measurement's random "
-                   "error (|H| +- 1.96 std, phase +- 1.96 std / |H|; Bendat & Piersol, docs/uncertainty.md)."},
+                   "error (|H| +- k std, phase +- k std / |H|, k the Student factor of each FRF's averages; Bendat & Piersol, Goodman, docs/uncertainty.md)."},
           {"tables", tables}, {"figures", figs}};
 }
 

@@ -5,6 +5,8 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/statistics.hpp"
 
 namespace piezobench::dsp {
 
@@ -36,6 +38,16 @@ double frf_relative_std(double coherence, double effective_averages) {
   }
   const double g2 = std::clamp(coherence, 1e-12, 1.0);
   return std::sqrt((1.0 - g2) / (2.0 * effective_averages * g2));
+}
+
+double frf_band_factor(double effective_averages, double level) {
+  if (!(effective_averages > 1.0 && std::isfinite(effective_averages))) {
+    throw InputError("frf variance", "effective averages", "a number > 1 (a band needs at least two averages)",
+                     format_number(effective_averages));
+  }
+  if (!(level > 0.0 && level < 1.0)) throw InputError("frf variance", "level", "a probability in (0, 1)", format_number(level));
+  const double n = effective_averages;
+  return std::sqrt(n / (n - 1.0)) * core::student_t_quantile(0.5 * (1.0 + level), 2.0 * n - 2.0);
 }
 
 Eigen::VectorXd frf_standard_deviation(const Eigen::VectorXcd& H, const Eigen::VectorXd& coherence, double effective_averages) {

@@ -95,6 +95,50 @@ TEST(FrfVariance, MonteCarloSpreadMatchesTheClosedFormsPhaseSignIncluded) {
   EXPECT_NEAR(predicted / eps, 1.0, 0.1) << predicted << " vs " << eps;
 }
 
+// The band H +- frf_band_factor(n_d) std_H, each record with its own estimated coherence, covers the
+// true H at 95 % of the lines even with few averages (n_d = 4.8 here, where the Gaussian's 1.96
+// covers only ~89 %): y = a u + noise as above, gamma^2 = 0.8.
+TEST(FrfVariance, BandFactorCoversTheTrueResponseAtNinetyFivePercentWithFewAverages) {
+  const Index nfft = 64, segments = 5;
+  const double a = 2.0, sigma_n = 1.0;
+  const Index n = nfft / 2 * (segments + 1);
+  WelchOptions o;
+  o.nfft = nfft;
+  o.overlap = 0.5;
+  o.threads = 1;
+  const double n_d = effective_averages(WindowType::kHannPeriodic, nfft, nfft / 2, segments);
+  const double k = frf_band_factor(n_d);
+  std::mt19937_64 rng(31);
+  std::normal_distribution<double> normal;
+  long inside = 0, inside_gauss = 0, lines = 0;
+  for (int r = 0; r < 1000; ++r) {
+    Eigen::VectorXd u(n), y(n);
+    for (Index i = 0; i < n; ++i) u(i) = normal(rng);
+    for (Index i = 0; i < n; ++i) y(i) = a * u(i) + sigma_n * normal(rng);
+    const FrfEstimate e = estimate_frf(channel("u", u), {channel("y", y)}, 1.0, o);
+    for (Index l = 1; l < nfft / 2; ++l) {
+      const double err = std::abs(std::abs(e.frf.H[0](l)) - a), s = e.frf.std_H[0](l);
+      inside += err <= k * s ? 1 : 0;
+      inside_gauss += err <= 1.959963984540054 * s ? 1 : 0;
+      ++lines;
+    }
+  }
+  const double coverage = static_cast<double>(inside) / static_cast<double>(lines);
+  const double gauss = static_cast<double>(inside_gauss) / static_cast<double>(lines);
+  EXPECT_NEAR(n_d, 5.0 / (1.0 + 2.0 * 0.8 / 36.0), 1e-12);  // rho(1) = 1/6 for hann at 50 %
+  EXPECT_NEAR(coverage, 0.95, 0.01) << "factor " << k;  // 31,000 lines: the binomial sd is 0.13 %
+  EXPECT_LT(gauss, 0.915);                                // what 1.96 would have claimed as 95 %
+}
+
+TEST(FrfVariance, BandFactorIsStudentsTWithTwoNdMinusTwoDegreesOfFreedom) {
+  // scipy: sqrt(8.6 / 7.6) * stats.t.ppf(0.975, 15.2) = 2.2647487225643146
+  EXPECT_NEAR(frf_band_factor(8.6), 2.2647487225643146, 1e-12);
+  EXPECT_NEAR(frf_band_factor(1e6), 1.959964, 1e-5);  // many averages: the Gaussian's factor
+  EXPECT_GT(frf_band_factor(8.6, 0.99), frf_band_factor(8.6));
+  EXPECT_THROW((void)frf_band_factor(1.0), InputError);
+  EXPECT_THROW((void)frf_band_factor(8.6, 1.0), InputError);
+}
+
 TEST(FrfVariance, ValidateRejectsANegativeOrMisSizedStd) {
   Frf f;
   f.freq_Hz = Eigen::Vector2d(1.0, 2.0);

@@ -47,6 +47,19 @@ inline constexpr double kMinFitRelativeStd = 1e-4;
 // pure 1/eps weighting lets the model's misfit where eps is smallest decide the fit).
 inline constexpr double kFitModelRelativeError = 0.05;
 
+// The coverage factor k of the 95 % (or `level`) band H +- k std_H with n_d effective averages:
+//
+//   k = sqrt(n_d / (n_d - 1)) t_{(1 + level) / 2}(2 n_d - 2)
+//
+// (N. R. Goodman, "Statistical analysis based on a certain multivariate complex Gaussian
+// distribution", Ann. Math. Stat. 34, 1963; B&P ch. 9: with the coherence and the spectra
+// themselves estimated from n_d averages, each part of H_est - H over its estimated standard
+// deviation is Student's t with 2 n_d - 2 degrees of freedom, the estimate's variance having
+// 2 n_d - 2 where eps counts 2 n_d). 2.27 at n_d = 8.6 (a 20 s record in 4 s segments), where 1.96
+// covers 92.5 %; it tends to 1.96 as n_d grows. InputError for n_d <= 1 (no band: one average
+// gives a coherence of 1) or a level outside (0, 1).
+[[nodiscard]] double frf_band_factor(double effective_averages, double level = 0.95);
+
 // std_H (per part, H's units) at each line: |H(k)| frf_relative_std(coherence(k), n_d). Sizes must
 // agree (InputError).
 [[nodiscard]] Eigen::VectorXd frf_standard_deviation(const Eigen::VectorXcd& H, const Eigen::VectorXd& coherence,
