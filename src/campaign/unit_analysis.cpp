@@ -18,11 +18,13 @@
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/ident/actuator_frf.hpp"
-#include "piezobench/ident/dominant_pole.hpp"
+#include "piezobench/ident/added_mass.hpp"
+#include "piezobench/ident/damped_plant.hpp"
+#include "piezobench/ident/flexible_modes.hpp"
 #include "piezobench/ident/hysteresis.hpp"
-#include "piezobench/ident/modal.hpp"
+#include "piezobench/ident/low_frequency_high_pass.hpp"
 #include "piezobench/metrology/capacitance.hpp"
-#include "piezobench/metrology/flatness.hpp"
+#include "piezobench/metrology/interface_flatness.hpp"
 #include "piezobench/metrology/stiffness.hpp"
 #include "piezobench/metrology/stroke.hpp"
 
@@ -222,72 +224,35 @@ dsp::Frf welch(const Record& r, const std::string& input, const std::vector<std:
   return std::move(e.frf);
 }
 
-struct Band {
-  VectorXd omega;
-  Eigen::VectorXcd h;
-  VectorXd coherence;
-};
-
-Band band(const dsp::Frf& frf, Index output, double fmin, double fmax, double min_coherence = 0.0) {
-  dsp::Frf part = dsp::select_band(frf, dsp::BandSelection{fmin, fmax, /*exclude_dc=*/true, min_coherence, {output}});
-  Band b;
-  b.omega = kTwoPi * part.freq_Hz;
-  b.h = std::move(part.H[0]);
-  b.coherence = part.coherence.empty() ? VectorXd::Ones(b.omega.size()) : std::move(part.coherence[0]);
-  return b;
-}
-
 void record_failure(UnitAnalysis& u, const std::string& what, const Error& e) {
   u.failed.push_back(what + ": " + e.what());
 }
 
 // ------------------------------------------------------------------------------------ analyses
 
+// The probe points' flatness (metrology::analyze_flatness) with the record's provenance and curves.
 FlatnessAnalysis flatness(const Campaign& c, const Record& r) {
   const VectorXd x = r.channel("x"), y = r.channel("y"), z = r.channel("z");
   Eigen::Matrix3Xd p(3, x.size());
   p.row(0) = x.transpose();
   p.row(1) = y.transpose();
   p.row(2) = z.transpose();
-  const std::string src = c.file.string() + ": " + r.spec.key + " (" + r.spec.given + ")";
-  const metrology::FlatnessResult ls = metrology::flatness(p, {metrology::FlatnessMethod::kLeastSquares}, src);
-  std::optional<metrology::FlatnessResult> mz;
-  if (p.cols() <= 100) mz = metrology::flatness(p, {metrology::FlatnessMethod::kMinimumZone}, src);
-  if (c.specs.flatness_method == metrology::FlatnessMethod::kMinimumZone && !mz) {
-    throw InputError(c.file.string(), r.spec.key, "at most 100 points for the minimum-zone flatness of the specification",
-                     std::to_string(p.cols()));
-  }
-  const metrology::FlatnessResult& chosen = c.specs.flatness_method == metrology::FlatnessMethod::kMinimumZone ? *mz : ls;
+  metrology::FlatnessAnalysisOptions o;
+  o.method = c.specs.flatness_method;
+  o.source = c.file.string();
+  o.field = r.spec.key;
+  const metrology::FlatnessAnalysisResult a = metrology::analyze_flatness(p, r.has("interface") ? r.channel("interface") : VectorXd(), o);
   FlatnessAnalysis out;
-  out.method = c.specs.flatness_method;
-  out.flatness = chosen.flatness;
-  out.least_squares = ls.flatness;
-  if (mz) out.minimum_zone = mz->flatness;
-  out.points = static_cast<long>(p.cols());
+  out.method = a.method;
+  out.flatness = a.flatness_m;
+  out.least_squares = a.least_squares_m;
+  out.minimum_zone = a.minimum_zone_m;
+  out.points = a.points;
+  for (const metrology::InterfaceFlatness& i : a.per_interface) out.per_interface.push_back({i.id, i.least_squares_m});
   out.probe_accuracy = c.bench.probe_accuracy;
   out.provenance = provenance(r, {"x", "y", "z", "interface"});
-  out.deviation = thin(chosen.deviations);
+  out.deviation = thin(a.deviations_m);
   out.probe_xy = Curve{thin(x), thin(y)};
-  if (r.has("interface")) {
-    const VectorXd itf = r.channel("interface");
-    std::vector<double> ids(itf.data(), itf.data() + itf.size());
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    for (const double id : ids) {
-      std::vector<Index> cols;
-      for (Index k = 0; k < itf.size(); ++k) {
-        if (itf(k) == id) cols.push_back(k);
-      }
-      if (cols.size() < 3) continue;
-      Eigen::Matrix3Xd q(3, static_cast<Index>(cols.size()));
-      for (std::size_t i = 0; i < cols.size(); ++i) q.col(static_cast<Index>(i)) = p.col(cols[i]);
-      try {
-        out.per_interface.push_back({id, metrology::flatness(q, {}, src).flatness});
-      } catch (const InputError&) {
-        // an interface whose points are collinear has no flatness of its own; the whole set still does
-      }
-    }
-  }
   return out;
 }
 
@@ -397,31 +362,24 @@ std::vector<HysteresisLoop> hysteresis(const Campaign& c, const std::vector<Reco
   return out;
 }
 
-// The added-mass test (report section 2.2): with the stacks on the amplifier and the resistor (k1,
-// k2; k_sc = k1) or with every stack open (k_oc); the same readings and creep fit either way.
+// The added-mass test (report section 2.2; ident::analyze_added_mass): with the stacks on the
+// amplifier and the resistor (k1, k2; k_sc = k1) or with every stack open (k_oc); the same readings
+// and creep fit either way.
 StiffnessAnalysis stiffness(const Campaign& c, const Record& r, UnitAnalysis& u, const std::string& what) {
   const VectorXd t = r.time();
   const VectorXd de = r.channel("de");
-  const VectorXd mass = r.has("added_mass") ? r.channel("added_mass") : VectorXd();
+  ident::AddedMassOptions o;
+  o.stiffness.added_mass = c.bench.added_mass;
+  o.stiffness.gravity = c.bench.gravity;
+  o.source = c.file.string() + ": " + r.spec.key;
+  ident::AddedMassAnalysis a = ident::analyze_added_mass(t, de, r.has("added_mass") ? r.channel("added_mass") : VectorXd(), r.ts.sample_rate, o);
+  for (const auto& f : a.failed) u.failed.push_back(what + ": " + f);
   StiffnessAnalysis out;
-  out.options.added_mass = c.bench.added_mass;
-  out.options.gravity = c.bench.gravity;
-  out.result = metrology::static_stiffness(t, de, mass, out.options, c.file.string() + ": " + r.spec.key);
-  out.mass_log = r.has("added_mass");
+  out.options = o.stiffness;
+  out.result = std::move(a.stiffness);
+  out.mass_log = a.mass_log;
+  out.creep = std::move(a.creep);
   out.provenance = provenance(r, {"de", "added_mass"});
-  // The Prony creep of the record (ident::fit_creep, as `hysteresis creep`): the weight carried (N)
-  // in, d_e out; without a mass log, the weight as a step over [t_on, t_off).
-  VectorXd weight(de.size());
-  for (Index k = 0; k < de.size(); ++k) {
-    const double m = out.mass_log ? mass(k) : (t(k) >= out.result.t_on && t(k) < out.result.t_off ? out.options.added_mass : 0.0);
-    weight(k) = m * out.options.gravity;
-  }
-  try {
-    out.creep = ident::fit_creep({weight.data(), static_cast<std::size_t>(weight.size())}, {de.data(), static_cast<std::size_t>(de.size())},
-                                 r.ts.sample_rate);
-  } catch (const NumericalError& e) {
-    record_failure(u, what + ": creep fit", e);
-  }
   const std::vector<double> tt = thin(t);
   out.de = {tt, thin(de)};
   out.fit = {tt, thin(out.result.fit)};
@@ -484,10 +442,9 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
 }
 
 // The low-frequency u -> Vs with or without the resistor across the sensor stack (report section
-// 2.5, Figure 2.7): Welch with segments of half the record (the lowest lines matter here), a
-// first-order high-pass fitted below hpf_fmax_Hz (ident::fit_high_pass). A corner below a third of
-// the lowest line (where it would change |H| there by less than 5 %) is not observable in the
-// record: it is reported as an upper bound, not as a number.
+// 2.5, Figure 2.7): Welch with segments of half the record (the lowest lines matter here), then
+// ident::fit_low_frequency_high_pass below hpf_fmax_Hz (a corner it finds not observable is an
+// upper bound, not a number).
 LowFrequencyVs low_frequency_vs(const Campaign& c, const Record& r) {
   const AnalysisSettings& a = c.analysis;
   long nfft = static_cast<long>(r.ts.samples()) / 2;
@@ -495,16 +452,17 @@ LowFrequencyVs low_frequency_vs(const Campaign& c, const Record& r) {
   LowFrequencyVs out;
   out.frf = welch(r, "u", {"Vs"}, a, std::max(256L, nfft));
   out.provenance = provenance(r, {"u", "Vs"});
-  out.lowest_line_Hz = out.frf.freq_Hz.size() > 1 ? out.frf.freq_Hz(1) : 0.0;
-  out.fmax_Hz = a.hpf_fmax_Hz;
-  const Band low = band(out.frf, 0, 0.0, a.hpf_fmax_Hz);
-  if (low.omega.size() >= 3) {
-    const ident::HighPassFit h = ident::fit_high_pass(low.omega, low.h);
-    out.fitted_corner_Hz = h.corner_Hz();
-    out.observable = h.corner_Hz() >= out.lowest_line_Hz / 3.0;
-    out.relative_rms_error = h.relative_rms_error;
-    out.points = static_cast<long>(low.omega.size());
-  }
+  ident::LowFrequencyHighPassOptions o;
+  o.output = "Vs";
+  o.fmax_Hz = a.hpf_fmax_Hz;
+  o.source = c.file.string() + ": " + r.spec.key;
+  const ident::LowFrequencyHighPass h = ident::fit_low_frequency_high_pass(out.frf, o);
+  out.lowest_line_Hz = h.lowest_line_Hz;
+  out.fmax_Hz = h.fmax_Hz;
+  out.fitted_corner_Hz = h.corner_Hz;
+  out.relative_rms_error = h.relative_rms_error;
+  out.points = h.points;
+  out.observable = h.observable;
   return out;
 }
 
@@ -530,61 +488,44 @@ std::vector<DampedPlant> iff(const Campaign& c, const std::vector<Record>& recor
     d.file = r.spec.given;
     d.provenance = provenance(r, {"u_prime", "de"});
     d.frf = welch(r, "u_prime", {"de"}, a, nfft);
-    d.delay_removed = delay;
-    Band b = band(d.frf, 0, a.damped_fmin_Hz, a.damped_fmax_Hz);
-    for (Index k = 0; k < b.omega.size(); ++k) b.h(k) *= std::exp(std::complex<double>(0.0, b.omega(k) * delay));
-    d.fmin_Hz = a.damped_fmin_Hz;
-    d.fmax_Hz = a.damped_fmax_Hz;
-    try {
-      // The damped pole: the dominant pair of a vector fit (ident/dominant_pole.hpp, the method of
-      // `iff study`), not the report's second-order fit, which misplaces it by up to 50 % once the
-      // controller's poles have moved into the band.
-      ident::DominantPoleOptions po;
-      po.fit.order = a.fit_order;
-      po.omega_min = kTwoPi * a.damped_fmin_Hz;
-      po.omega_max = kTwoPi * a.damped_fmax_Hz;
-      d.identified_order = po.fit.order;
-      d.identified = ident::dominant_pole(b.omega, b.h, po);
-    } catch (const NumericalError& e) {
-      record_failure(u, fmt::format("damped plant g = {}", gain), e);
-    }
-    // The report's second-order fit, for comparison only.
-    try {
-      ident::IffPlantFitOptions so;
-      so.fit_delay = false;
-      d.second_order = ident::fit_delayed_second_order(b.omega, b.h, b.coherence, so, c.file.string() + ": " + r.spec.key);
-    } catch (const NumericalError&) {
-      // left out of results.json (null)
-    }
+    ident::DampedPlantOptions o;
+    o.fmin_Hz = a.damped_fmin_Hz;
+    o.fmax_Hz = a.damped_fmax_Hz;
+    o.delay_s = delay;
+    o.fit_order = a.fit_order;
+    o.source = c.file.string();
+    o.field = r.spec.key;
+    ident::DampedPlantAnalysis p = ident::analyze_damped_plant(d.frf, o);
+    for (const auto& f : p.failed) u.failed.push_back(fmt::format("damped plant g = {}: {}", gain, f));
+    d.identified = std::move(p.dominant);
+    d.identified_order = p.dominant_fit_order;
+    d.second_order = std::move(p.second_order);  // its failure: left out of results.json (null)
+    d.delay_removed = p.delay_removed_s;
+    d.fmin_Hz = p.fmin_Hz;
+    d.fmax_Hz = p.fmax_Hz;
     out.push_back(std::move(d));
   }
   std::stable_sort(out.begin(), out.end(), [](const DampedPlant& x, const DampedPlant& y) { return x.gain < y.gain; });
   return out;
 }
 
+// The hammer test F -> v (Welch with 1 s segments) and its modes (ident::identify_flexible_modes).
 FlexibleModes hammer(const Campaign& c, const Record& r, UnitAnalysis& u) {
   const AnalysisSettings& a = c.analysis;
   const long nfft = std::min<long>(std::lround(r.ts.sample_rate), static_cast<long>(r.ts.samples()) / 2);
-  const dsp::Frf frf = welch(r, "F", {"v"}, a, nfft);
-  const Band b = band(frf, 0, a.hammer_fmin_Hz, a.hammer_fmax_Hz);
   FlexibleModes out;
+  out.frf = welch(r, "F", {"v"}, a, nfft);
   out.provenance = provenance(r, {"F", "v"});
-  out.welch = frf.provenance;
-  try {
-    ident::PeakPickingOptions po;
-    po.max_modes = 6;
-    for (const auto& m : ident::peak_picking(b.omega, b.h, po)) out.peak_picking.push_back({m.frequency_Hz(), m.damping, 0});
-  } catch (const NumericalError& e) {
-    record_failure(u, "hammer peak picking", e);
-  }
-  try {
-    ident::LscfOptions lo;
-    lo.max_order = std::min<Index>(24, b.omega.size() - 1);
-    for (const auto& m : ident::lscf(b.omega, b.h, lo).modes) out.lscf.push_back({m.frequency_Hz(), m.damping, m.stable_orders});
-  } catch (const NumericalError& e) {
-    record_failure(u, "hammer LSCF", e);
-  }
-  out.frf = frf;
+  out.welch = out.frf.provenance;
+  ident::FlexibleModeOptions o;
+  o.output = "v";
+  o.fmin_Hz = a.hammer_fmin_Hz;
+  o.fmax_Hz = a.hammer_fmax_Hz;
+  o.source = c.file.string() + ": " + r.spec.key;
+  const ident::FlexibleModeAnalysis m = ident::identify_flexible_modes(out.frf, o);
+  for (const auto& f : m.failed) u.failed.push_back("hammer " + f);
+  for (const auto& p : m.peak_picking) out.peak_picking.push_back({p.frequency_Hz(), p.damping, 0});
+  for (const auto& l : m.lscf) out.lscf.push_back({l.frequency_Hz(), l.damping, l.stable_orders});
   return out;
 }
 

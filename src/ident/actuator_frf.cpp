@@ -8,6 +8,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/ident/low_frequency_high_pass.hpp"
 
 namespace piezobench::ident {
 
@@ -117,10 +118,9 @@ void fit_plants(const dsp::Frf& frf, Index de, Index vs, const ActuatorFrfOption
 
 // The unit's corner: 1/(2 pi R C_sensor) when the bench has a resistor and C_sensor is measured;
 // else the IFF plant fit's, else the first-order fit's, each only when observable in the record (at
-// least a third of its lowest line, as LowFrequencyVs): a bench without the resistor has no
-// high-pass the record can show, and a default resistance must not invent one.
-void choose_high_pass_corner(const ActuatorFrfOptions& o, double lowest_line_Hz, double w_rc, HighPassCorner& hpf) {
-  hpf.observable_above_Hz = lowest_line_Hz / 3.0;
+// least hpf.observable_above_Hz, low_frequency_high_pass.hpp's rule): a bench without the resistor
+// has no high-pass the record can show, and a default resistance must not invent one.
+void choose_high_pass_corner(const ActuatorFrfOptions& o, double w_rc, HighPassCorner& hpf) {
   const std::string bench = o.hpf_resistance_ohm ? fmt::format("R = {:g} Ohm from [bench]", *o.hpf_resistance_ohm)
                                              : "no resistor in [bench] (hpf_resistance_ohm)";
   if (w_rc > 0.0) {
@@ -171,12 +171,15 @@ void high_pass_warnings(const HighPassCorner& hpf, std::vector<std::string>& out
 // IFF plant fit's own corner. Then the choice and the cross-checks that disagree.
 void high_pass(const dsp::Frf& frf, Index vs, const ActuatorFrfOptions& o, double w_rc, ActuatorFrfResult& r) {
   HighPassCorner& hpf = r.analysis.hpf;
-  const dsp::Frf low = output_band(frf, vs, 0.0, o.hpf_fmax_Hz, o.min_coherence);
-  if (low.freq_Hz.size() >= 3) {
-    const HighPassFit h = fit_high_pass(kTwoPi * low.freq_Hz, low.H[0]);
-    hpf.first_order_fit_Hz = h.corner_Hz();
-    hpf.first_order_fit_points = static_cast<long>(low.freq_Hz.size());
-  }
+  LowFrequencyHighPassOptions lo;
+  lo.output = o.vs_output;
+  lo.fmax_Hz = o.hpf_fmax_Hz;
+  lo.min_coherence = o.min_coherence;
+  lo.source = fit_source(o);
+  const LowFrequencyHighPass low = fit_low_frequency_high_pass(frf, lo);
+  hpf.first_order_fit_Hz = low.corner_Hz;
+  hpf.first_order_fit_points = low.points;
+  hpf.observable_above_Hz = low.observable_above_Hz;
   if (w_rc > 0.0) {
     hpf.r_c_Hz = w_rc / kTwoPi;
     try {
@@ -194,7 +197,7 @@ void high_pass(const dsp::Frf& frf, Index vs, const ActuatorFrfOptions& o, doubl
   } else if (r.analysis.iff_plant) {
     hpf.iff_plant_fit_Hz = r.analysis.iff_plant->w_hpf / kTwoPi;
   }
-  choose_high_pass_corner(o, frf.freq_Hz.size() > 1 ? frf.freq_Hz(1) : 0.0, w_rc, hpf);
+  choose_high_pass_corner(o, w_rc, hpf);
   high_pass_warnings(hpf, r.warnings);
 }
 

@@ -1,12 +1,13 @@
 #pragma once
 // Every analysis of the report for one unit of a campaign (report sections 1 and 2):
 //
-//   flatness      least-squares and minimum-zone (metrology/flatness.hpp); the spec's method is the
-//                 unit's flatness_um
+//   flatness      least-squares and minimum-zone, per interface too (metrology::analyze_flatness,
+//                 metrology/interface_flatness.hpp); the spec's method is the unit's flatness_um
 //   capacitance   mean of the LCR readings (or the values typed into the campaign)
 //   stroke        slow ramp (metrology/stroke.hpp)
 //   hysteresis    one result per amplitude (loop width at the offset relative to the loop's stroke)
-//   stiffness     k1, k2 at the report's reading times, creep fitted (metrology/stiffness.hpp)
+//   stiffness     k1, k2 at the report's reading times, creep fitted, and the Prony creep of the
+//                 record (ident::analyze_added_mass, ident/added_mass.hpp)
 //   frf           Welch H1 u -> d_e and u -> Vs with coherence, read by ident::analyze_actuator_frf
 //                 (ident/actuator_frf.hpp): features of both by vector fitting
 //                 (ident/features.hpp): static gain, resonance and damping, anti-resonance and
@@ -19,10 +20,16 @@
 //                 (ident/plant_fit.hpp): the d_e and Vs read-outs lag differently
 //   stiffness_open_circuit  the same with every stack open: k_oc (k_sc = k1)
 //   frf_without_resistor    u -> Vs without the resistor: the high-pass corner with and without it
+//                 (ident::fit_low_frequency_high_pass, ident/low_frequency_high_pass.hpp)
 //   iff           per gain g: the damped plant u' -> d_e (Welch) and its pole, the dominant pair of
 //                 a vector fit (after removing the delay of d_e found on the open-loop FRF); the
-//                 report's second-order fit for comparison
-//   hammer        F -> v (Welch), flexible modes by peak picking and by LSCF (ident/modal.hpp)
+//                 report's second-order fit for comparison (ident::analyze_damped_plant,
+//                 ident/damped_plant.hpp)
+//   hammer        F -> v (Welch), flexible modes by peak picking and by LSCF
+//                 (ident::identify_flexible_modes, ident/flexible_modes.hpp)
+// The campaign reads the records, estimates the FRFs (Welch) and wires these domain functions,
+// which take the measurement (samples, or the dsp::Frf in Hz) and return typed results; it adds the
+// records' provenance and the report's curves.
 //
 // Data problems (a file missing or unreadable, a channel that is not in a file, NaN, too short a
 // record, a dead sensor's constant signal, ...) are InputErrors naming the campaign file and the key
