@@ -207,7 +207,7 @@ RecordProvenance provenance(const Record& r, const std::vector<std::string>& rol
   return p;
 }
 
-dsp::Frf welch(const Record& r, const std::string& input, const std::vector<std::string>& outputs,
+dsp::Frf estimate_record_frf(const Record& r, const std::string& input, const std::vector<std::string>& outputs,
                const AnalysisSettings& settings, long nfft) {
   // The settings `frf` uses too (mean removed per segment, H1), with the campaign's window and overlap.
   dsp::WelchOptions w = dsp::welch_options_for_record(r.ts.samples(), r.ts.sample_rate);
@@ -291,7 +291,7 @@ StrokeAnalysis stroke(const Campaign& c, const Record& r) {
 // Kuhnen's modified PI too, the better one kept (HysteresisModelFit::fit). The widths and the
 // asymmetry are those of the steady loop `loop` analysed (between its first and last maxima): the
 // ramp from rest and back would add the virgin curve.
-HysteresisModelFit hysteresis_model(const Record& r, const metrology::HysteresisResult& loop) {
+HysteresisModelFit fit_hysteresis_model(const Record& r, const metrology::HysteresisResult& loop) {
   const VectorXd va = r.channel("Va"), de = r.channel("de");
   const std::span<const double> v(va.data(), static_cast<std::size_t>(va.size())), d(de.data(), static_cast<std::size_t>(de.size()));
   const auto steady = [&](std::span<const double> x) { return x.subspan(static_cast<std::size_t>(loop.first_sample), static_cast<std::size_t>(loop.samples)); };
@@ -323,7 +323,7 @@ HysteresisModelFit hysteresis_model(const Record& r, const metrology::Hysteresis
 }
 
 // The tracking record: its figures recomputed from the samples over the record's windows.
-TrackingAnalysis tracking(const Record& r) {
+TrackingAnalysis analyze_tracking(const Record& r) {
   const bench::TrackingLayout l = bench::tracking_layout(r.ts);
   const VectorXd c = r.channel("c"), open = r.channel("de_open"), ff = r.channel("de_ff");
   TrackingAnalysis out;
@@ -407,10 +407,10 @@ void tune_model(const Campaign& c, UnitAnalysis& u) {
 
 // The FRFs u -> [d_e, Vs] (ident::analyze_actuator_frf with the campaign's band, fit order and
 // bench), the stiffness from the resonance k = m_sus w^2, and the tuned 2-DoF model.
-void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
+void analyze_frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   const AnalysisSettings& a = c.analysis;
   const long nfft = frf_segment_length(a, static_cast<long>(r.ts.samples()), r.ts.sample_rate);
-  u.frf = welch(r, "u", {"de", "Vs"}, a, nfft);
+  u.frf = estimate_record_frf(r, "u", {"de", "Vs"}, a, nfft);
   ident::ActuatorFrfOptions o;
   o.fmin_Hz = a.fmin_Hz;
   o.fmax_Hz = a.fmax_Hz;
@@ -445,12 +445,12 @@ void frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
 // 2.5, Figure 2.7): Welch with segments of half the record (the lowest lines matter here), then
 // ident::fit_low_frequency_high_pass below hpf_fmax_Hz (a corner it finds not observable is an
 // upper bound, not a number).
-LowFrequencyVs low_frequency_vs(const Campaign& c, const Record& r) {
+LowFrequencyVs analyze_low_frequency_vs(const Campaign& c, const Record& r) {
   const AnalysisSettings& a = c.analysis;
   long nfft = static_cast<long>(r.ts.samples()) / 2;
   nfft -= nfft % 2;
   LowFrequencyVs out;
-  out.frf = welch(r, "u", {"Vs"}, a, std::max(256L, nfft));
+  out.frf = estimate_record_frf(r, "u", {"Vs"}, a, std::max(256L, nfft));
   out.provenance = provenance(r, {"u", "Vs"});
   ident::LowFrequencyHighPassOptions o;
   o.output = "Vs";
@@ -466,7 +466,7 @@ LowFrequencyVs low_frequency_vs(const Campaign& c, const Record& r) {
   return out;
 }
 
-std::vector<DampedPlant> iff(const Campaign& c, const std::vector<Record>& records, UnitAnalysis& u) {
+std::vector<DampedPlant> analyze_damped_plants(const Campaign& c, const std::vector<Record>& records, UnitAnalysis& u) {
   const AnalysisSettings& a = c.analysis;
   std::vector<DampedPlant> out;
   // The loop does not change the delay of d_e: the open-loop u -> d_e fit's is removed first.
@@ -487,7 +487,7 @@ std::vector<DampedPlant> iff(const Campaign& c, const std::vector<Record>& recor
     d.gain = gain;
     d.file = r.spec.given;
     d.provenance = provenance(r, {"u_prime", "de"});
-    d.frf = welch(r, "u_prime", {"de"}, a, nfft);
+    d.frf = estimate_record_frf(r, "u_prime", {"de"}, a, nfft);
     ident::DampedPlantOptions o;
     o.fmin_Hz = a.damped_fmin_Hz;
     o.fmax_Hz = a.damped_fmax_Hz;
@@ -514,7 +514,7 @@ FlexibleModes hammer(const Campaign& c, const Record& r, UnitAnalysis& u) {
   const AnalysisSettings& a = c.analysis;
   const long nfft = std::min<long>(std::lround(r.ts.sample_rate), static_cast<long>(r.ts.samples()) / 2);
   FlexibleModes out;
-  out.frf = welch(r, "F", {"v"}, a, nfft);
+  out.frf = estimate_record_frf(r, "F", {"v"}, a, nfft);
   out.provenance = provenance(r, {"F", "v"});
   out.welch = out.frf.provenance;
   ident::FlexibleModeOptions o;
@@ -571,7 +571,7 @@ void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& lo
       }
     }
     try {
-      u.hysteresis_model = hysteresis_model(records[largest], u.hysteresis[largest].result);
+      u.hysteresis_model = fit_hysteresis_model(records[largest], u.hysteresis[largest].result);
     } catch (const NumericalError& e) {
       record_failure(u, "hysteresis model", e);
     }
@@ -580,7 +580,7 @@ void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& lo
   }
   if (spec.tracking) {
     say("tracking without and with the hysteresis feedforward", *spec.tracking);
-    u.tracking = tracking(load_record(c, spec, *spec.tracking, Experiment::kTracking));
+    u.tracking = analyze_tracking(load_record(c, spec, *spec.tracking, Experiment::kTracking));
   }
   if (spec.stiffness) {
     say("static stiffness", *spec.stiffness);
@@ -606,14 +606,14 @@ void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& lo
   if (spec.frf) {
     say("FRFs u -> d_e, Vs", *spec.frf);
     frf_record = load_record(c, spec, *spec.frf, Experiment::kFrf);
-    frf(c, *frf_record, u);
+    analyze_frf(c, *frf_record, u);
   }
   if (spec.frf_no_resistor) {
     say("u -> Vs without the resistor", *spec.frf_no_resistor);
     try {
       ResistorComparison rc;
-      if (frf_record) rc.with_resistor = low_frequency_vs(c, *frf_record);
-      rc.without_resistor = low_frequency_vs(c, load_record(c, spec, *spec.frf_no_resistor, Experiment::kFrfNoResistor));
+      if (frf_record) rc.with_resistor = analyze_low_frequency_vs(c, *frf_record);
+      rc.without_resistor = analyze_low_frequency_vs(c, load_record(c, spec, *spec.frf_no_resistor, Experiment::kFrfNoResistor));
       u.resistor = std::move(rc);
     } catch (const NumericalError& e) {
       record_failure(u, "high-pass corner with and without the resistor", e);
@@ -626,7 +626,7 @@ void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& lo
       say("IFF damped plant", f);
       records.push_back(load_record(c, spec, f, Experiment::kIff));
     }
-    u.damped = iff(c, records, u);
+    u.damped = analyze_damped_plants(c, records, u);
   }
   if (spec.hammer) {
     say("hammer test", *spec.hammer);
