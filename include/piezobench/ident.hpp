@@ -11,6 +11,7 @@
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/flexible_modes.hpp"
 #include "piezobench/ident/hysteresis.hpp"
+#include "piezobench/ident/hysteresis_model_choice.hpp"
 #include "piezobench/ident/low_frequency_high_pass.hpp"
 #include "piezobench/ident/modal.hpp"
 #include "piezobench/ident/plant_fit.hpp"

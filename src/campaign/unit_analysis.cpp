@@ -22,6 +22,7 @@
 #include "piezobench/ident/damped_plant.hpp"
 #include "piezobench/ident/flexible_modes.hpp"
 #include "piezobench/ident/hysteresis.hpp"
+#include "piezobench/ident/hysteresis_model_choice.hpp"
 #include "piezobench/ident/low_frequency_high_pass.hpp"
 #include "piezobench/metrology/capacitance.hpp"
 #include "piezobench/metrology/interface_flatness.hpp"
@@ -286,39 +287,29 @@ StrokeAnalysis stroke(const Campaign& c, const Record& r) {
   return out;
 }
 
-// The hysteresis model of the largest-amplitude record (it starts at rest, as the identification
-// needs: the fit takes the whole record): the plain PI and, when the steady loop is asymmetric,
-// Kuhnen's modified PI too, the better one kept (HysteresisModelFit::fit). The widths and the
-// asymmetry are those of the steady loop `loop` analysed (between its first and last maxima): the
-// ramp from rest and back would add the virgin curve.
+// The hysteresis model of the largest-amplitude record (ident::identify_hysteresis_model: the plain
+// PI and, when the steady loop is asymmetric, Kuhnen's modified PI too, the better one kept); the
+// loop's figures are those of the steady loop `loop` analysed (between its first and last maxima).
 HysteresisModelFit fit_hysteresis_model(const Record& r, const metrology::HysteresisResult& loop) {
   const VectorXd va = r.channel("Va"), de = r.channel("de");
   const std::span<const double> v(va.data(), static_cast<std::size_t>(va.size())), d(de.data(), static_cast<std::size_t>(de.size()));
-  const auto steady = [&](std::span<const double> x) { return x.subspan(static_cast<std::size_t>(loop.first_sample), static_cast<std::size_t>(loop.samples)); };
+  ident::HysteresisModelChoiceOptions o;
+  o.steady_first_sample = static_cast<long>(loop.first_sample);
+  o.steady_samples = static_cast<long>(loop.samples);
+  o.asymmetry_limit = kHysteresisAsymmetryLimit;
+  o.dead_zones = kCampaignDeadZones;
+  ident::HysteresisModelChoice m = ident::identify_hysteresis_model(v, d, r.ts.sample_rate, o);
   HysteresisModelFit out;
-  const ident::LoopMetrics record = ident::loop_metrics(steady(v), steady(d));
-  out.width = record.width;
-  out.asymmetry = record.asymmetry;
-  out.fit = ident::fit_hysteresis(v, d, r.ts.sample_rate);
-  if (out.asymmetry > kHysteresisAsymmetryLimit) {
-    ident::HysteresisFitOptions o;
-    o.dead_zones = kCampaignDeadZones;
-    try {
-      ident::HysteresisFit modified = ident::fit_hysteresis(v, d, r.ts.sample_rate, o);
-      const bool better = modified.quality.poor() != out.fit.quality.poor() ? out.fit.quality.poor()
-                                                                            : modified.relative_residual < out.fit.relative_residual;
-      if (better) std::swap(modified, out.fit);
-      out.alternative = std::move(modified);
-    } catch (const NumericalError& e) {
-      out.alternative_error = e.what();  // the plain PI stays; results.json and the report say why
-    }
-  }
+  out.fit = std::move(m.fit);
+  out.alternative = std::move(m.alternative);
+  out.alternative_error = std::move(m.alternative_error);  // results.json and the report say why
+  out.asymmetry = m.asymmetry;
+  out.width = m.width;
+  out.model_width = m.model_width;
   out.amplitude = loop.amplitude;
   out.provenance = provenance(r, {"Va", "de"});
-  const std::vector<double> predicted = out.fit.model.predict(v, r.ts.sample_rate);
-  out.model_width = ident::loop_metrics(steady(v), steady(predicted)).width;
   out.loop = {thin(va, 1200), thin(de, 1200)};
-  out.model_loop = {out.loop.x, thin(Eigen::Map<const VectorXd>(predicted.data(), va.size()), 1200)};
+  out.model_loop = {out.loop.x, thin(Eigen::Map<const VectorXd>(m.predicted_m.data(), va.size()), 1200)};
   return out;
 }
 

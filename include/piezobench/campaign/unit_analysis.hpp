@@ -6,6 +6,8 @@
 //   capacitance   mean of the LCR readings (or the values typed into the campaign)
 //   stroke        slow ramp (metrology/stroke.hpp)
 //   hysteresis    one result per amplitude (loop width at the offset relative to the loop's stroke)
+//                 and the hysteresis model of the largest loop (ident::identify_hysteresis_model,
+//                 ident/hysteresis_model_choice.hpp)
 //   stiffness     k1, k2 at the report's reading times, creep fitted, and the Prony creep of the
 //                 record (ident::analyze_added_mass, ident/added_mass.hpp)
 //   frf           Welch H1 u -> d_e and u -> Vs with coherence, read by ident::analyze_actuator_frf
