@@ -59,13 +59,6 @@ struct CampaignRun {
   std::vector<std::string> written;
 };
 
-py::array complex_array(const std::vector<std::complex<double>>& v) {
-  return to_numpy(Eigen::VectorXcd(Eigen::Map<const Eigen::VectorXcd>(v.data(), static_cast<Eigen::Index>(v.size()))));
-}
-py::array real_array(const std::vector<double>& v) {
-  return to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))));
-}
-
 // Every struct a UnitAnalysis holds, from the field declarations beside them (results.hpp and the
 // modules' headers), then the derived figures that are not fields.
 void bind_unit_analysis(py::module_& m) {
@@ -78,104 +71,36 @@ void bind_unit_analysis(py::module_& m) {
       .def_property_readonly("quality", [](const ident::DominantPole& p) { return p.fit.quality; }, "the vector fit's ident.FitQuality");
   bound_class<UnitAnalysis>().def("json", [](const UnitAnalysis& u) { return from_json(unit_json(u), "UnitResults", true); },
                                   "The unit's entry of results.json as Results (values in the units their keys name).");
-  m.def("declarations", [] {
-    py::dict out;
-    collect_declarations<UnitAnalysis>(out);
-    return out;
-  }, "{declared struct: (its Python class, [field names])} for every struct a UnitAnalysis holds (docs/fields.md).");
 }
 
-// campaign.BatchAnalysis and the classes it holds.
-void bind_batch_analysis(py::module_& m) {
-  py::class_<QuantitySpread> c(m, "QuantitySpread", "Spread of one quantity over the batch (values in the unit its name says).");
-  c.def_readonly("quantity", &QuantitySpread::quantity, "results key, e.g. \"capacitance_sensor_uF\"")
-      .def_readonly("units", &QuantitySpread::units, "number of units with a value")
-      .def_readonly("min", &QuantitySpread::min)
-      .def_readonly("max", &QuantitySpread::max)
-      .def_readonly("median", &QuantitySpread::median)
-      .def_readonly("relative_spread", &QuantitySpread::relative_spread, "(max - min) / median")
-      .def_readonly("mad", &QuantitySpread::mad, "median absolute deviation");
-  typed(c);
-  py::class_<BatchOutlier> o(m, "BatchOutlier", "A unit whose quantity is an outlier of the batch (robust z-score).");
-  o.def_readonly("unit", &BatchOutlier::unit)
-      .def_readonly("quantity", &BatchOutlier::quantity)
-      .def_readonly("value", &BatchOutlier::value)
-      .def_readonly("median", &BatchOutlier::median)
-      .def_readonly("robust_z", &BatchOutlier::robust_z);
-  typed(o);
-  py::class_<FrfSimilarity::Unit> su(m, "FrfSimilarityUnit", "rms distance in dB of one unit's FRFs from the batch median.");
-  su.def_readonly("unit", &FrfSimilarity::Unit::unit)
-      .def_readonly("de_rms_dB", &FrfSimilarity::Unit::de_rms_dB, "dB (NaN when no point compares)")
-      .def_readonly("vs_rms_dB", &FrfSimilarity::Unit::vs_rms_dB, "dB");
-  typed(su);
-  py::class_<FrfSimilarity> sim(m, "FrfSimilarity", "Unit-to-unit similarity of the FRFs.");
-  sim.def_readonly("fmin_Hz", &FrfSimilarity::fmin_Hz, "Hz")
-      .def_readonly("fmax_Hz", &FrfSimilarity::fmax_Hz, "Hz")
-      .def_readonly("units", &FrfSimilarity::units)
-      .def_readonly("max_rms_dB", &FrfSimilarity::max_rms_dB, "dB");
-  typed(sim);
-  py::class_<BatchAnalysis> b(m, "BatchAnalysis", "The batch summary: outliers, spread of the key figures, FRF similarity.");
-  b.def_readonly("outliers", &BatchAnalysis::outliers, "list of campaign.BatchOutlier")
-      .def_readonly("spread", &BatchAnalysis::spread, "list of campaign.QuantitySpread")
-      .def_readonly("similarity", &BatchAnalysis::similarity, "campaign.FrfSimilarity or None")
-      .def_readonly("rejects", &BatchAnalysis::rejects, "outliers in capacitance or stroke reject a unit")
-      .def("spread_of", [](const BatchAnalysis& a, const std::string& q) -> py::object {
-        for (const auto& s : a.spread)
-          if (s.quantity == q) return py::cast(s);
-        return py::none();
-      }, py::arg("quantity"), "The QuantitySpread of `quantity` (None when not in the batch).");
-  typed(b);
-}
-
-// campaign.IffStudy and its root-locus branches.
-void bind_iff_study(py::module_& m) {
-  py::class_<IffStudy::Branch> br(m, "RootLocusBranch", "A branch of the IFF root locus (rad/s).");
-  br.def_readonly("re_im", &IffStudy::Branch::re_im, "campaign.Curve: x Re, y Im (rad/s)")
-      .def_property_readonly("gains", [](const IffStudy::Branch& b) { return real_array(b.gains); }, "at each point")
-      .def_readonly("resonance_branch", &IffStudy::Branch::resonance_branch);
-  typed(br);
-  py::class_<IffStudy> c(m, "IffStudy", R"(The IFF study: root locus of the fitted plant with the report's controller against
-the poles of the measured damped plants, and the optimal gain (rad/s, SI).)");
-  c.def_property_readonly("controller", [](const IffStudy& s) {
-        py::dict d;
-        d["gain"] = s.controller.gain;
-        d["w_hpf"] = s.controller.w_hpf;
-        d["w_lpf"] = s.controller.w_lpf;
-        d["w_robust"] = s.controller.w_robust;
-        return d;
-      }, "the controller (control.iff_controller keywords, rad/s)")
-      .def_readonly("unit", &IffStudy::unit, "the unit whose plant is used")
-      .def_readonly("plant", &IffStudy::plant, "ident.IffPlantFit or None")
-      .def_property_readonly("gains", [](const IffStudy& s) { return real_array(s.gains); }, "of the damped plants with an identified pole")
-      .def_property_readonly("damped_poles", [](const IffStudy& s) { return complex_array(s.damped_poles); }, "rad/s, measured")
-      .def_property_readonly("model_poles", [](const IffStudy& s) { return complex_array(s.model_poles); }, "rad/s, of the root locus at those gains")
-      .def_property_readonly("relative_pole_distance", [](const IffStudy& s) { return real_array(s.relative_pole_distance); })
-      .def_readonly("max_relative_pole_distance", &IffStudy::max_relative_pole_distance)
-      .def_readonly("pole_distance_tolerance", &IffStudy::pole_distance_tolerance, "above it: warning")
-      .def_readonly("warning", &IffStudy::warning)
-      .def_readonly("optimal_gain", &IffStudy::optimal_gain, "the gain of maximum damping")
-      .def_readonly("max_damping", &IffStudy::max_damping, "damping ratio at optimal_gain")
-      .def_readonly("optimal_pole", &IffStudy::optimal_pole, "rad/s")
-      .def_readonly("note", &IffStudy::note, "why there is no study")
-      .def_readonly("failed", &IffStudy::failed, "a NumericalError of the study")
-      .def_readonly("branches", &IffStudy::branches, "list of campaign.RootLocusBranch (Figure 2.10b)")
-      .def_readonly("open_loop_poles", &IffStudy::open_loop_poles, "campaign.Curve x Re, y Im (rad/s)")
-      .def_readonly("open_loop_zeros", &IffStudy::open_loop_zeros, "campaign.Curve x Re, y Im (rad/s)");
-  typed(c);
+// campaign.BatchAnalysis and campaign.IffStudy from their declarations (results.hpp), with the
+// batch's look-up of a spread by quantity.
+void bind_batch_and_iff(py::module_& m) {
+  bind_described<BatchAnalysis>(m);
+  bound_class<BatchAnalysis>().def("spread_of", [](const BatchAnalysis& a, const std::string& q) -> py::object {
+    for (const auto& s : a.spread)
+      if (s.quantity == q) return py::cast(s);
+    return py::none();
+  }, py::arg("quantity"), "The QuantitySpread of `quantity` (None when not in the batch).");
+  bind_described<IffStudy>(m);
+  bind_described<SuperElementComparison>(m);
 }
 
 // campaign.CampaignResult, what campaign.run returns.
 void bind_campaign_result(py::module_& m) {
   py::class_<CampaignRun> c(m, "CampaignResult", R"(The results of campaign.run (campaign/results.hpp): units (campaign.UnitAnalysis),
-batch (campaign.BatchAnalysis), iff (campaign.IffStudy), accepted and rejected (counts), written (the
-files, when out_dir was given). results is the results.json document as Results (every analysis,
-the report's units: _um, _uF, _Hz, ...); to_dict() is that document as plain dicts.)");
+batch (campaign.BatchAnalysis), iff (campaign.IffStudy), superelement (campaign.SuperElementComparison
+or None), accepted and rejected (counts), written (the files, when out_dir was given). results is the
+results.json document as Results (every analysis, the report's units: _um, _uF, _Hz, ...); to_dict()
+is that document as plain dicts.)");
   c.def_property_readonly("units", [](const CampaignRun& r) -> const std::vector<UnitAnalysis>& { return r.result.units; },
                           py::return_value_policy::reference_internal, "list of campaign.UnitAnalysis")
       .def_property_readonly("batch", [](const CampaignRun& r) -> const BatchAnalysis& { return r.result.batch; },
                              py::return_value_policy::reference_internal, "campaign.BatchAnalysis")
       .def_property_readonly("iff", [](const CampaignRun& r) -> const IffStudy& { return r.result.iff; },
                              py::return_value_policy::reference_internal, "campaign.IffStudy")
+      .def_property_readonly("superelement", [](py::object self) { return py_value(self.cast<const CampaignRun&>().result.superelement, self); },
+                             "campaign.SuperElementComparison (None when the campaign gives no super element)")
       .def_property_readonly("accepted", [](const CampaignRun& r) { return r.result.accepted; }, "units accepted")
       .def_property_readonly("rejected", [](const CampaignRun& r) { return r.result.rejected; }, "units rejected")
       .def_property_readonly("not_analysed", [](const CampaignRun& r) { return r.result.not_analysed; },
@@ -201,9 +126,10 @@ the report's units: _um, _uF, _Hz, ...); to_dict() is that document as plain dic
 // unit). Nested results are views that keep the run alive.
 void bind_result_classes(py::module_& m) {
   bind_unit_analysis(m);
-  bind_batch_analysis(m);
-  bind_iff_study(m);
+  bind_batch_and_iff(m);
   bind_campaign_result(m);
+  m.def("declarations", [] { return declarations_of<UnitAnalysis, BatchAnalysis, IffStudy, SuperElementComparison>(); }, "{declared struct: (its Python class, [field names])} for every declared struct a CampaignResult holds\n"
+     "(its units, batch, iff and superelement; docs/fields.md).");
 }
 
 }  // namespace

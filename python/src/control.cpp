@@ -1,5 +1,6 @@
 // piezobench.control: include/piezobench/control/{iff,discrete_iff}.hpp
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/control/discrete_iff.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/lti/conversions.hpp"
@@ -159,6 +160,8 @@ anti-windup. y[k] = g K0(z) Vs[k]; a non-finite input resets the states and give
       .def("reset", &DiscreteIff::reset, "Zero states; the gain is kept.")
       .def_property_readonly("nonfinite_inputs", &DiscreteIff::nonfinite_inputs)
       .def("model", &DiscreteIff::model, "The discrete controller at gain 1 as an lti.StateSpace (input Vs, output y).");
+  // The controller a result holds (campaign.IffStudy.controller), from its declaration (control/iff.hpp).
+  bind_described<IffControllerParams>(m);
 }
 
 }  // namespace piezobench::python

@@ -100,6 +100,14 @@ template <class S> void collect_declarations(py::dict& out) {
   });
 }
 
+// {declared name: (Python class, [field names])} for the structs S... and those they hold (a module's
+// `declarations()`).
+template <class... S> py::dict declarations_of() {
+  py::dict out;
+  (collect_declarations<S>(out), ...);
+  return out;
+}
+
 // The class of S as bound (to add its derived properties and methods).
 template <class S> py::class_<S> bound_class() { return py::reinterpret_borrow<py::class_<S>>(py::type::of<S>()); }
 

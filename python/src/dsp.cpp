@@ -1,5 +1,6 @@
 // piezobench.dsp: include/piezobench/dsp/*.hpp
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/dsp/frf.hpp"
@@ -292,6 +293,9 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
       .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_Hz)); }, "rad/s")
       .def_readonly("input", &Frf::input)
       .def_readonly("outputs", &Frf::outputs)
+      .def_static("fields", [] { return declared_fields<Frf>(); },
+                  "The field declaration (dsp/frf.hpp): [(name, SI unit, shown unit, meaning)]; H, coherence and std_H "
+                  "are stacked here as arrays.")
       .def_property_readonly("H", [](const Frf& f) { return stack(f.H, f.H.size() == 1); },
                              "1-D complex array for one output, else (outputs, points)")
       .def_property_readonly("coherence", [](const Frf& f) -> py::object {

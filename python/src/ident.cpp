@@ -3,10 +3,12 @@
 #include <cmath>
 
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/ident/features.hpp"
+#include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/ident/modal.hpp"
 #include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/ident/vector_fitting.hpp"
@@ -158,27 +160,7 @@ PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle
   return d;
 }
 
-py::object vf_result(const VectorFittingResult& r) {
-  py::dict d;
-  d["poles"] = to_numpy(r.poles);
-  d["residues"] = to_numpy(r.residues);
-  d["d"] = to_numpy(r.d);
-  d["e"] = to_numpy(r.e);
-  d["model"] = py::cast(r.model);
-  d["rms_error"] = r.rms_error;
-  d["relative_rms_error"] = r.relative_rms_error;
-  d["iterations"] = r.iterations;
-  d["converged"] = r.converged;
-  d["convergence"] = to_string(r.convergence);
-  d["last_pole_change"] = r.last_pole_change;
-  d["frequency_scale"] = r.frequency_scale;
-  d["quality"] = py::cast(r.quality);
-  d["brief_report"] = r.brief_report();
-  d["evaluate"] = py::cpp_function(
-      [r](py::object omega) { return to_numpy(r.evaluate(to_vector(omega, "VectorFittingResult.evaluate", "omega"))); },
-      py::arg("omega"), "The fitted model at j omega (rad/s): (len(omega), outputs) complex.");
-  return result("VectorFittingResult", d);
-}
+py::object vf_result(VectorFittingResult r) { return py::cast(std::move(r)); }
 
 py::dict modal(const ModalFeature& f) {
   py::dict d;
@@ -253,102 +235,79 @@ py::object lscf_result(const LscfResult& r) {
   return result("LscfResult", d);
 }
 
-// ident.FitQuality and ident.ParameterUncertainty, the verdict and the standard errors every fit carries.
+// ident.FitQuality and ident.ParameterUncertainty, the verdict and the standard errors every fit
+// carries, from their declarations (core/fit_quality.hpp, core/fit_covariance.hpp).
 void bind_fit_quality(py::module_& m) {
   using py::arg;
-  {
-    py::class_<core::FitQuality> c(m, "FitQuality", R"(The quality verdict of a fit (core/fit_quality.hpp).
+  bind_described<core::FitQuality>(m);
+  auto q = bound_class<core::FitQuality>();
+  q.attr("__doc__") = R"(The quality verdict of a fit (core/fit_quality.hpp).
 
 verdict is "good" or "poor" (an output's relative rms error above 0.2, a resonance outside the band,
 the iterations exhausted, ...); impossible: a parameter has a value no actuator can have (negative
 stiffness, delay, ...), so the fit's parameters are not a result. problems name the output or
-parameter and its number; advice says what to try.)");
-    c.def_property_readonly("verdict", [](const core::FitQuality& q) { return core::to_string(q.verdict); },
-                            "\"good\" or \"poor\"")
-        .def_property_readonly("poor", &core::FitQuality::poor, "verdict == \"poor\"")
-        .def_readonly("impossible", &core::FitQuality::impossible, "a parameter has an impossible value")
-        .def_readonly("problems", &core::FitQuality::problems, "one line per problem (list of str)")
-        .def_readonly("advice", &core::FitQuality::advice, "what to try (\"\" when good)")
-        .def_property_readonly("summary", &core::FitQuality::summary, "\"good\" or \"poor: PROBLEM; ... Try: ADVICE\"");
-    typed(c);
-  }
-  {
-    py::class_<core::ParameterUncertainty> c(m, "ParameterUncertainty", R"(A fit's parameters with their standard errors
-(core/fit_covariance.hpp): linearized at the solution, from the FRF's variance when known, else from the
-residuals' scatter. A 95 % interval is value +- 1.96 standard_error.)");
-    c.def_readonly("names", &core::ParameterUncertainty::names)
-        .def_property_readonly("value", [](const core::ParameterUncertainty& u) { return to_numpy(u.value); }, "natural units")
-        .def_property_readonly("standard_error", [](const core::ParameterUncertainty& u) { return to_numpy(u.standard_error); }, "same units")
-        .def_property_readonly("correlation", [](const core::ParameterUncertainty& u) { return to_numpy(u.correlation); })
-        .def_readonly("condition_number", &core::ParameterUncertainty::condition_number)
-        .def_readonly("chi2_per_dof", &core::ParameterUncertainty::chi2_per_dof)
-        .def_readonly("from_data_variance", &core::ParameterUncertainty::from_data_variance)
-        .def_readonly("high_correlations", &core::ParameterUncertainty::high_correlations, "\"a/b 0.97\" for |correlation| > 0.95")
-        .def("standard_error_of", &core::ParameterUncertainty::standard_error_of, arg("name"), "NaN when unknown");
-  }
+parameter and its number; advice says what to try.)";
+  q.def_property_readonly("poor", &core::FitQuality::poor, "verdict == \"poor\"")
+      .def_property_readonly("summary", &core::FitQuality::summary, "\"good\" or \"poor: PROBLEM; ... Try: ADVICE\"");
+  bind_described<core::ParameterUncertainty>(m);
+  auto u = bound_class<core::ParameterUncertainty>();
+  u.attr("__doc__") = R"(A fit's parameters with their standard errors (core/fit_covariance.hpp): linearized at
+the solution, from the FRF's variance when known, else from the residuals' scatter. A 95 % interval is
+value +- 1.96 standard_error.)";
+  u.def("standard_error_of", &core::ParameterUncertainty::standard_error_of, arg("name"), "NaN when unknown")
+      .def("relative_standard_error_of", &core::ParameterUncertainty::relative_standard_error_of, arg("name"),
+           "standard_error / |value| (inf for a zero value)");
 }
 
-// ident.IffPlantFit and ident.DelayedSecondOrderFit (ident/plant_fit.hpp).
+// ident.IffPlantFit and ident.DelayedSecondOrderFit (ident/plant_fit.hpp): one property per declared
+// field (described.hpp), then the derived figures and methods that are not fields.
 void bind_plant_fit_classes(py::module_& m) {
   using py::arg;
-  {
-    py::class_<IffPlantFit> c(m, "IffPlantFit", R"(The IFF plant of eq. 2.3 fitted to a u -> Vs FRF (ident/plant_fit.hpp):
+  bind_described<IffPlantFit>(m);
+  auto iff = bound_class<IffPlantFit>();
+  iff.attr("__doc__") = R"(The IFF plant of eq. 2.3 fitted to a u -> Vs FRF (ident/plant_fit.hpp):
 
   G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) * s / (w_hpf + s) * exp(-s delay)
 
-xz < 0 is a non-minimum-phase zero pair. params() gives the control.iff_plant keywords.)");
-    c.def_readonly("g0", &IffPlantFit::g0, "V/V, gain (signed)")
-        .def_readonly("wz", &IffPlantFit::wz, "rad/s, anti-resonance")
-        .def_readonly("xz", &IffPlantFit::xz, "damping ratio of the zero pair (< 0: non-minimum phase)")
-        .def_readonly("wp", &IffPlantFit::wp, "rad/s, resonance")
-        .def_readonly("xp", &IffPlantFit::xp, "damping ratio of the pole pair")
-        .def_readonly("w_hpf", &IffPlantFit::w_hpf, "rad/s, high-pass corner")
-        .def_readonly("delay", &IffPlantFit::delay, "s")
-        .def_property_readonly("wz_Hz", [](const IffPlantFit& f) { return f.wz / kTwoPi; }, "Hz, anti-resonance")
-        .def_property_readonly("wp_Hz", [](const IffPlantFit& f) { return f.wp / kTwoPi; }, "Hz, resonance")
-        .def_property_readonly("w_hpf_Hz", [](const IffPlantFit& f) { return f.w_hpf / kTwoPi; }, "Hz, high-pass corner")
-        .def_readonly("relative_rms_error", &IffPlantFit::relative_rms_error, "rms |G/H - 1| over the points used")
-        .def_readonly("weighted_relative_rms_error", &IffPlantFit::weighted_relative_rms_error, "the same with the fit's per-decade weights")
-        .def_readonly("initial_relative_rms_error", &IffPlantFit::initial_relative_rms_error, "weighted, at the better start")
-        .def_readonly("points", &IffPlantFit::points, "frequencies used")
-        .def_readonly("iterations", &IffPlantFit::iterations, "Levenberg-Marquardt steps")
-        .def_readonly("converged", &IffPlantFit::converged)
-        .def_property_readonly("status", [](const IffPlantFit& f) { return core::to_string(f.status); }, "Levenberg-Marquardt's stop")
-        .def_readonly("quality", &IffPlantFit::quality, "ident.FitQuality")
-        .def_property_readonly("zero_is_nonminimum_phase", &IffPlantFit::zero_is_nonminimum_phase, "xz < 0")
-        .def_readonly("uncertainty", &IffPlantFit::uncertainty, "ident.ParameterUncertainty of g0, wz, xz, wp, xp, w_hpf, delay")
-        .def("params", [](const IffPlantFit& f) {
-          py::dict d;
-          d["g0"] = f.g0; d["wz"] = f.wz; d["xz"] = f.xz; d["wp"] = f.wp; d["xp"] = f.xp; d["w_hpf"] = f.w_hpf; d["delay"] = f.delay;
-          return d;
-        }, "The plant's parameters as the keywords of control.iff_plant / control.iff_root_locus (SI, rad/s).")
-        .def("transfer_function", &IffPlantFit::transfer_function, "G(s) with its delay (lti.TransferFunction).")
-        .def("response", [](const IffPlantFit& f, py::object omega) {
-          return to_numpy(f.response(to_vector(omega, "IffPlantFit.response", "omega")));
-        }, arg("omega"), "G(j omega) at omega (rad/s), complex.");
-    typed(c);
-  }
-  {
-    py::class_<DelayedSecondOrderFit> c(m, "DelayedSecondOrderFit", R"(The mass-spring-damper u -> d_e with the measurement delay
-(ident/plant_fit.hpp): H(s) = k wn^2 / (s^2 + 2 zeta wn s + wn^2) * exp(-s delay).)");
-    c.def_readonly("static_gain", &DelayedSecondOrderFit::static_gain, "k, output / input units (m/V for u -> d_e), signed")
-        .def_readonly("natural_frequency", &DelayedSecondOrderFit::natural_frequency, "wn, rad/s")
-        .def_property_readonly("frequency_Hz", [](const DelayedSecondOrderFit& f) { return f.natural_frequency / kTwoPi; }, "wn in Hz")
-        .def_readonly("damping", &DelayedSecondOrderFit::damping, "zeta")
-        .def_readonly("delay", &DelayedSecondOrderFit::delay, "s")
-        .def_readonly("relative_rms_error", &DelayedSecondOrderFit::relative_rms_error, "rms |H_model / H - 1| over the points used")
-        .def_readonly("points", &DelayedSecondOrderFit::points, "frequencies used")
-        .def_readonly("iterations", &DelayedSecondOrderFit::iterations, "Levenberg-Marquardt steps")
-        .def_property_readonly("status", [](const DelayedSecondOrderFit& f) { return core::to_string(f.status); }, "Levenberg-Marquardt's stop")
-        .def_readonly("quality", &DelayedSecondOrderFit::quality, "ident.FitQuality")
-        .def_property_readonly("pole", &DelayedSecondOrderFit::pole, "rad/s, -zeta wn + j wn sqrt(1 - zeta^2)")
-        .def_readonly("uncertainty", &DelayedSecondOrderFit::uncertainty,
-                      "ident.ParameterUncertainty of static_gain, natural_frequency, damping, delay")
-        .def("response", [](const DelayedSecondOrderFit& f, py::object omega) {
-          return to_numpy(f.response(to_vector(omega, "DelayedSecondOrderFit.response", "omega")));
-        }, arg("omega"), "H(j omega) at omega (rad/s), complex.");
-    typed(c);
-  }
+xz < 0 is a non-minimum-phase zero pair. Fields in SI (rad/s, s); params() gives the control.iff_plant
+keywords; fields() lists the declaration.)";
+  iff.def_property_readonly("wz_Hz", [](const IffPlantFit& f) { return f.wz / kTwoPi; }, "Hz, anti-resonance")
+      .def_property_readonly("wp_Hz", [](const IffPlantFit& f) { return f.wp / kTwoPi; }, "Hz, resonance")
+      .def_property_readonly("w_hpf_Hz", [](const IffPlantFit& f) { return f.w_hpf / kTwoPi; }, "Hz, high-pass corner")
+      .def_property_readonly("zero_is_nonminimum_phase", &IffPlantFit::zero_is_nonminimum_phase, "xz < 0")
+      .def("params", [](const IffPlantFit& f) {
+        py::dict d;
+        d["g0"] = f.g0; d["wz"] = f.wz; d["xz"] = f.xz; d["wp"] = f.wp; d["xp"] = f.xp; d["w_hpf"] = f.w_hpf; d["delay"] = f.delay;
+        return d;
+      }, "The plant's parameters as the keywords of control.iff_plant / control.iff_root_locus (SI, rad/s).")
+      .def("transfer_function", &IffPlantFit::transfer_function, "G(s) with its delay (lti.TransferFunction).")
+      .def("response", [](const IffPlantFit& f, py::object omega) {
+        return to_numpy(f.response(to_vector(omega, "IffPlantFit.response", "omega")));
+      }, arg("omega"), "G(j omega) at omega (rad/s), complex.");
+
+  bind_described<DelayedSecondOrderFit>(m);
+  auto so = bound_class<DelayedSecondOrderFit>();
+  so.attr("__doc__") = R"(The mass-spring-damper u -> d_e with the measurement delay (ident/plant_fit.hpp):
+H(s) = k wn^2 / (s^2 + 2 zeta wn s + wn^2) * exp(-s delay). Fields in SI (natural_frequency in rad/s);
+fields() lists the declaration.)";
+  so.def_property_readonly("frequency_Hz", [](const DelayedSecondOrderFit& f) { return f.natural_frequency / kTwoPi; }, "wn in Hz")
+      .def_property_readonly("pole", &DelayedSecondOrderFit::pole, "rad/s, -zeta wn + j wn sqrt(1 - zeta^2)")
+      .def("response", [](const DelayedSecondOrderFit& f, py::object omega) {
+        return to_numpy(f.response(to_vector(omega, "DelayedSecondOrderFit.response", "omega")));
+      }, arg("omega"), "H(j omega) at omega (rad/s), complex.");
+}
+
+// ident.VectorFittingResult (ident/vector_fitting.hpp) from its declaration, with the state space
+// (not declared: rebuilt from the poles and residues) and the model's evaluation.
+void bind_vector_fitting_result(py::module_& m) {
+  using py::arg;
+  bind_described<VectorFittingResult>(m);
+  bound_class<VectorFittingResult>()
+      .def_readonly("model", &VectorFittingResult::model, "the proper part as an lti.StateSpace (the s e term left out)")
+      .def("evaluate", [](const VectorFittingResult& r, py::object omega) {
+        return to_numpy(r.evaluate(to_vector(omega, "VectorFittingResult.evaluate", "omega")));
+      }, arg("omega"), "The fitted model at j omega (rad/s): (len(omega), outputs) complex.")
+      .def("brief_report", &VectorFittingResult::brief_report, "One line: order, iterations, converged, rms.");
 }
 
 // fit_iff_plant, fit_delayed_second_order and fit_actuator_plants.
@@ -543,11 +502,15 @@ void bind_modal(py::module_& m) {
 
 void bind_ident(py::module_& m) {
   bind_fit_quality(m);
+  bind_vector_fitting_result(m);
   bind_plant_fit_classes(m);
   bind_plant_fits(m);
   bind_vector_fitting(m);
   bind_low_order_fits(m);
   bind_modal(m);
+  m.def("declarations", [] {
+    return declarations_of<IffPlantFit, DelayedSecondOrderFit, VectorFittingResult, HysteresisFit, CreepFit, LoopMetrics>();
+  }, "{declared struct: (its Python class, [field names])} for every declared result ident returns (ident/*.hpp).");
 }
 
 }  // namespace piezobench::python

@@ -76,9 +76,11 @@ PYBIND11_MODULE(_core, m) {
   bind_fem(fem);
   auto io = m.def_submodule("io", "Time-series and FRF files (.mat, .csv, .uff)");
   bind_io(io);
+  // ident's hysteresis classes before the campaign's results that hold them (described.hpp binds a
+  // declared struct in the first module that asks).
+  bind_hysteresis(ident, control, io);
   auto bench = m.def_submodule("bench", "The virtual test bench: units, experiments, linear models");
   bind_bench(bench);
   auto campaign = m.def_submodule("campaign", "Run a campaign file and get its results");
   bind_campaign(campaign);
-  bind_hysteresis(ident, control, io);
 }

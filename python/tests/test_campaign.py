@@ -107,7 +107,15 @@ def test_typed_results_equal_the_results_json_of_the_command_line(demo):
         for field in ("min", "max", "median", "relative_spread", "mad"):
             assert same(getattr(s, field), js[field]), (s.quantity, field)
     assert sorted(s.quantity for s in r.batch.spread) == sorted(j["batch"]["spread"])
-    assert len(r.batch.outliers) == len(j["batch"]["outliers"])
+    k1 = r.batch.spread_of("k1_N_per_um")
+    assert isinstance(k1, campaign.QuantitySpread) and k1.unit == "N/um" and same(k1.median, u.k1 / 1e6)
+    assert r.batch.spread_of("no_such_quantity") is None
+    assert [(o.unit, o.quantity) for o in r.batch.outliers] == [(o["unit"], o["quantity"]) for o in j["batch"]["outliers"]]
+    for o, jo in zip(r.batch.outliers, j["batch"]["outliers"]):
+        assert same(o.value, jo["value"]) and same(o.median, jo["median"]) and same(o.robust_z, jo["robust_z"])
+    rule = j["batch"]["outlier_rule"]
+    assert r.batch.rejects == rule["rejects"] and same(r.batch.rule.threshold, rule["robust_z_threshold"])
+    assert same(r.batch.rule.min_relative_deviation, rule["min_relative_deviation"])
     # The IFF study.
     iff, ji = r.iff, j["iff"]
     assert iff.unit == ji["unit"]
@@ -119,6 +127,27 @@ def test_typed_results_equal_the_results_json_of_the_command_line(demo):
     assert same(iff.max_relative_pole_distance, ji["max_relative_pole_distance"])
     assert same(iff.plant.wz_Hz, ji["plant"]["wz_Hz"]) and same(iff.plant.xz, ji["plant"]["xz"])
     assert same(iff.plant.delay, ji["plant"]["delay_s"])
+    # The controller (control.IffControllerParams): rad/s in Python, Hz in results.json.
+    c = iff.controller
+    assert isinstance(c, pb.control.IffControllerParams) and c.gain == ji["controller"]["gain"]
+    assert same(c.w_hpf / (2 * np.pi), ji["controller"]["hpf_Hz"]) and same(c.w_lpf / (2 * np.pi), ji["controller"]["lpf_Hz"])
+    assert same(c.w_robust / (2 * np.pi), ji["controller"]["robust_Hz"]) and c["w_hpf"] == c.w_hpf
+    np.testing.assert_allclose(iff.relative_pole_distance, ji["relative_pole_distance"], rtol=1e-12)
+    np.testing.assert_allclose(iff.relative_pole_distance, abs(iff.model_poles - iff.damped_poles) / abs(iff.model_poles),
+                               rtol=1e-12)
+    assert iff.warning == ji["warning"] and iff.failed == ji["failed"] and iff.note == ji["note"]
+    # The root locus for the plot: the resonance branch passes through the optimal pole.
+    res = [b for b in iff.branches if b.resonance_branch]
+    assert len(res) == 1 and isinstance(res[0], campaign.IffLocusBranch) and len(res[0].gains) == len(res[0].re_im.x)
+    nearest = np.min(abs(res[0].re_im.x + 1j * res[0].re_im.y - iff.optimal_pole))
+    assert nearest < 0.05 * abs(iff.optimal_pole)
+    # The super element comparison, when the campaign has one.
+    if r.superelement is not None:
+        se, jse = r.superelement, j["superelement"]
+        assert se.dofs == jse["dofs"] and same(se.ga, jse["ga_N_per_V"]) and same(se.gs * 1e-6, jse["gs_V_per_um"])
+        np.testing.assert_allclose(se.modes_Hz, jse["modes_Hz"], rtol=1e-12)
+    else:
+        assert j.get("superelement") is None
 
 
 def test_missing_campaign_file():
@@ -128,12 +157,17 @@ def test_missing_campaign_file():
 
 def test_every_declared_result_member_is_reachable_from_python(demo):
     """Each result struct declares its fields once (core/fields.hpp); Python binds them all from the
-    declaration: every declared field is an attribute of the struct's class, and walking a unit's
-    results reaches a value for every field of every struct the demo fills."""
+    declaration: every declared field is an attribute of the struct's class (fields() is that
+    declaration), and walking the campaign's results (units, batch, iff, superelement) reaches a value
+    for every field of every struct the demo fills."""
     _, _, r = demo
     decl = campaign.declarations()
-    assert "UnitAnalysis" in decl and "FrfAnalysis" in decl and "StrokeResult" in decl
+    assert {"UnitAnalysis", "FrfAnalysis", "StrokeResult", "BatchAnalysis", "QuantitySpread", "BatchOutlier",
+            "FrfSimilarity", "FrfSimilarityUnit", "OutlierOptions", "IffStudy", "IffLocusBranch", "IffControllerParams",
+            "IffPlantFit", "DelayedSecondOrderFit", "HysteresisFit", "HysteresisModel", "CreepFit",
+            "SuperElementComparison", "SuperElementUnitFit"} <= set(decl)
     for name, (cls, fields) in decl.items():
+        assert cls.__name__ == name and [f[0] for f in cls.fields()] == fields, name
         missing = [f for f in fields if not hasattr(cls, f)]
         assert not missing, (name, missing)
     by_class = {cls: fields for cls, fields in decl.values()}
@@ -150,7 +184,45 @@ def test_every_declared_result_member_is_reachable_from_python(demo):
         for f in fields:
             walk(getattr(obj, f))  # every declared member is readable
 
-    walk(r.units[0])
-    assert {"UnitAnalysis", "FrfAnalysis", "StrokeAnalysis", "StaticStiffnessResult", "HysteresisLoop", "DampedPlant"} <= reached
+    for part in (r.units, r.batch, r.iff, r.superelement):
+        walk(part)
+    assert {"UnitAnalysis", "FrfAnalysis", "StrokeAnalysis", "StaticStiffnessResult", "HysteresisLoop", "DampedPlant",
+            "HysteresisFit", "HysteresisModel", "BatchAnalysis", "QuantitySpread", "OutlierOptions", "IffStudy",
+            "IffLocusBranch", "IffControllerParams", "IffPlantFit", "DelayedSecondOrderFit"} <= reached
     assert r.units[0].stroke_analysis.result.sensitivity == pytest.approx(
         r.units[0].json()["stroke"]["sensitivity_um_per_V"] * 1e-6, rel=1e-12)
+
+
+def test_batch_classes_hold_the_batch_figures_recomputed_with_numpy(tmp_path):
+    """campaign.BatchAnalysis of three units (unit 3 of the demo has undersized stacks): each spread
+    and outlier recomputed with numpy from the units' own SI values, the FRF similarity's maximum."""
+    files = campaign.write_demo(str(tmp_path), fast=True, units=[1, 2, 3], iff_gains=[60e3])
+    r = campaign.run(files.campaign)
+    b = r.batch
+    assert isinstance(b, campaign.BatchAnalysis) and isinstance(b.rule, campaign.OutlierOptions)
+    values = {"capacitance_sensor_uF": [u.capacitance_sensor * 1e6 for u in r.units],
+              "stroke_um": [u.stroke * 1e6 for u in r.units],
+              "k1_N_per_um": [u.k1 * 1e-6 for u in r.units],
+              "resonance_Hz": [u.resonance_Hz for u in r.units]}
+    for q, x in values.items():
+        s = b.spread_of(q)
+        med = np.median(x)
+        assert s.units == 3 and s.min == pytest.approx(min(x), rel=1e-12) and s.max == pytest.approx(max(x), rel=1e-12)
+        assert s.median == pytest.approx(med, rel=1e-12)
+        assert s.mad == pytest.approx(np.median(np.abs(np.array(x) - med)), rel=1e-9)
+        assert s.relative_spread == pytest.approx((max(x) - min(x)) / abs(med), rel=1e-9)
+    out = {(o.unit, o.quantity): o for o in b.outliers}
+    assert (3, "capacitance_sensor_uF") in out and (3, "stroke_um") in out
+    for (unit, q), o in out.items():
+        assert isinstance(o, campaign.BatchOutlier) and abs(o.robust_z) > b.rule.threshold
+        if q in values:
+            s = b.spread_of(q)
+            assert o.value == pytest.approx(values[q][unit - 1], rel=1e-12) and o.median == s.median
+            assert o.robust_z == pytest.approx(0.6745 * (o.value - s.median) / s.mad, rel=1e-9)
+    assert b.rejects and not r.unit(3).accepted and r.unit(1).accepted
+    sim = b.similarity
+    assert isinstance(sim, campaign.FrfSimilarity) and [s.unit for s in sim.units] == [1, 2, 3]
+    assert all(isinstance(s, campaign.FrfSimilarityUnit) for s in sim.units)
+    assert sim.max_rms_dB == max(max(s.de_rms_dB, s.vs_rms_dB) for s in sim.units)
+    assert sim.fmin_Hz < sim.fmax_Hz
+    assert max(sim.units, key=lambda s: s.vs_rms_dB).unit == 3  # the odd unit is the farthest from the median

@@ -170,3 +170,47 @@ def test_actuator_plants_of_a_scipy_welch_frf_and_the_vector_fit_verdicts(welch_
     assert poor.quality.poor and poor.quality.verdict == "poor" and poor.quality.advice
     assert any("output 1" in p for p in poor.quality.problems), poor.quality.problems
     assert poor.to_dict()["quality"]["verdict"] == "poor"
+
+
+def test_each_declared_ident_result_is_a_class_with_every_declared_field():
+    """ident's results declare their fields once (ident/*.hpp); Python binds them from the declaration:
+    ident.declarations() lists each with its class, every declared field is an attribute, and the
+    classes live in ident (not in the module that first held them)."""
+    decl = ident.declarations()
+    assert {"IffPlantFit", "DelayedSecondOrderFit", "VectorFittingResult", "HysteresisFit", "HysteresisModel",
+            "PrandtlIshlinskii", "DeadZoneSuperposition", "CreepFit", "LoopMetrics"} <= set(decl)
+    for name, (cls, fields) in decl.items():
+        assert getattr(ident, name) is cls, name
+        assert [f[0] for f in cls.fields()] == fields, name
+        missing = [f for f in fields if not hasattr(cls, f)]
+        assert not missing, (name, missing)
+    units = {f[0]: f[1] for f in ident.IffPlantFit.fields()}
+    assert units["wz"] == "rad/s" and units["delay"] == "s" and units["xz"] == "1"
+
+
+def test_every_declared_field_of_the_plant_fits_holds_the_fits_value():
+    from scipy import signal
+    k, wn, zeta = -1.68e-5, 2 * np.pi * 95.4, 0.0056
+    w = 2 * np.pi * np.arange(20.0, 500.0, 0.5)
+    _, h = signal.freqs([k * wn**2], [1.0, 2 * zeta * wn, wn**2], worN=w)
+    fit = ident.fit_delayed_second_order(w, h)
+    assert fit.points == len(w) and fit.iterations > 0
+    assert fit.status in ("cost-converged", "step-converged", "gradient-converged")  # an enum by its name
+    # The relative rms error recomputed from the fit's own response.
+    rel = np.sqrt(np.mean(np.abs(fit.response(w) / h - 1) ** 2))
+    assert fit.relative_rms_error == pytest.approx(rel, rel=1e-6, abs=1e-12)
+    u = fit.uncertainty
+    assert list(u.names) == ["static_gain", "natural_frequency", "damping", "delay"]
+    assert u.value[1] == fit.natural_frequency
+    # The vector fit: every declared field, the per-output error recomputed with numpy.
+    w2 = np.linspace(10.0, 1000.0, 800)
+    s2 = 1j * w2
+    h2 = sum(wn**2 / (s2**2 + 2 * 0.01 * wn * s2 + wn**2) for wn in (100.0, 500.0))
+    vf = ident.vector_fit(w2, h2, order=2, fail_if_not_converged=False)
+    err = vf.evaluate(w2)[:, 0] - h2
+    assert vf.relative_rms_error_per_output[0] == pytest.approx(np.sqrt(np.sum(abs(err) ** 2) / np.sum(abs(h2) ** 2)), rel=1e-9)
+    assert vf.rms_error == pytest.approx(np.sqrt(np.mean(abs(err) ** 2)), rel=1e-9)
+    assert vf.convergence in ("not-converged", "poles-settled", "residual-settled")
+    assert vf.converged == (vf.convergence != "not-converged")
+    assert vf.residues.shape == (1, 2) and len(vf.d) == 1 and len(vf.e) == 1
+    assert vf.brief_report()

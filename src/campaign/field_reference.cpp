@@ -57,7 +57,13 @@ std::string field_reference_markdown() {
       "strings `\"nan\"`, `\"inf\"` and `\"-inf\"` (JSON has no such numbers); a value that is absent is `null`.\n"
       "Complex numbers are `[re, im]`.\n";
   std::set<std::string> done;
+  // What a campaign's results hold (CampaignResult: units, batch, iff, superelement), then the ident
+  // results the Python module and the commands return besides.
   document<UnitAnalysis>(out, done);
+  document<BatchAnalysis>(out, done);
+  document<IffStudy>(out, done);
+  document<SuperElementComparison>(out, done);
+  document<ident::LoopMetrics>(out, done);
   return out;
 }
 

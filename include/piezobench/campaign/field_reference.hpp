@@ -7,7 +7,8 @@
 namespace piezobench::campaign {
 
 // The whole document (Markdown): every struct reachable from UnitAnalysis, CampaignResult's batch,
-// IFF study and super element comparison, one table each.
+// IFF study and super element comparison, and ident::LoopMetrics (what `ident.loop_metrics` returns),
+// one table each.
 std::string field_reference_markdown();
 
 }  // namespace piezobench::campaign

@@ -635,7 +635,7 @@ constexpr auto describe(core::Type<IffStudy>) {
       core::field("gains", &S::gains, kNone, "of the damped plants with an identified pole"),
       core::field("damped_poles", &S::damped_poles, kRadPerSecond, "identified on the damped plants").key("damped_poles"),
       core::field("model_poles", &S::model_poles, kRadPerSecond, "the root locus at the same gains").key("model_poles"),
-      core::field("relative_pole_distance", &S::relative_pole_distance, kRatio, "|model - damped| / |damped| per gain"),
+      core::field("relative_pole_distance", &S::relative_pole_distance, kRatio, "|model - damped| / |model| per gain"),
       core::field("max_relative_pole_distance", &S::max_relative_pole_distance, kRatio, "the largest"),
       core::field("pole_distance_tolerance", &S::pole_distance_tolerance, kRatio, "above it: warning"),
       core::field("warning", &S::warning, kNone, "the model misses the damped poles"),

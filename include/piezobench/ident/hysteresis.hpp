@@ -270,4 +270,16 @@ constexpr auto describe(core::Type<CreepFit>) {
       core::field("quality", &S::quality, kNone, "the verdict").key("."));
 }
 
+constexpr auto describe(core::Type<LoopMetrics>) {
+  using S = LoopMetrics;
+  using namespace core::shown;
+  return core::fields<S>("LoopMetrics", "how straight a response is against its command (best line, hysteresis width)",
+      core::field("slope", &S::slope, kNone, "of the best line, output unit per command unit"),
+      core::field("intercept", &S::intercept, kNone, "of the best line, output unit"),
+      core::field("stroke", &S::stroke, kNone, "max - min of the output, output unit"),
+      core::field("width", &S::width, kRatio, "peak-to-peak deviation of the output from the line / stroke"),
+      core::field("rms_deviation", &S::rms_deviation, kNone, "rms of output - line, output unit"),
+      core::field("asymmetry", &S::asymmetry, kRatio, "|x^2 coefficient of the cubic fit| / stroke (0: point-symmetric loop)"));
+}
+
 }  // namespace piezobench::ident
