@@ -6,12 +6,14 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
-#include <utility>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "cli_common.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/ident/features.hpp"
@@ -24,7 +26,6 @@
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/io/units.hpp"
 #include "piezobench/lti/analysis.hpp"
-#include "piezobench/core/units.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -192,7 +193,8 @@ struct FitOptions {
 // `model tune`; a bound given alone keeps the other one open.
 dsp::Frf select_band(const dsp::Frf& frf, FitOptions o) {
   if (o.fmin < 0.0 || (o.fmax > 0.0 && o.fmax <= o.fmin)) {
-    throw UsageError("--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
+    throw UsageError("--fmin/--fmax", "0 <= fmin < fmax",
+                     fmt::format("fmin {}, fmax {}", format_number_exact(o.fmin), format_number_exact(o.fmax)));
   }
   if (o.fmin == 0.0 && o.fmax == 0.0) {
     const dsp::FrequencyBand excited = dsp::excited_band(frf, 0.5);
@@ -210,7 +212,10 @@ dsp::Frf select_band(const dsp::Frf& frf, FitOptions o) {
   }
   dsp::Frf band = dsp::select_band(frf, selection);
   if (band.freq_Hz.size() == 0) {
-    throw InputError(o.file, "freq_Hz", fmt::format("frequencies inside [{:g}, {:g}] Hz", o.fmin, o.fmax), "none");
+    throw InputError(
+        o.file, "freq_Hz",
+        fmt::format("frequencies inside [{}, {}] Hz", format_number_exact(o.fmin), format_number_exact(o.fmax)),
+        "none");
   }
   return band;
 }
@@ -379,7 +384,8 @@ struct IffPlantOptions {
 
 int run_fit_iff_plant(const IffPlantOptions& o) {
   if (o.fmin < 0.0 || (o.fmax > 0.0 && o.fmax <= o.fmin)) {
-    throw UsageError("--fmin/--fmax", "0 <= fmin < fmax", fmt::format("fmin {:g}, fmax {:g}", o.fmin, o.fmax));
+    throw UsageError("--fmin/--fmax", "0 <= fmin < fmax",
+                     fmt::format("fmin {}, fmax {}", format_number_exact(o.fmin), format_number_exact(o.fmax)));
   }
   const io::FrfFile file = read_frf_with_units(o.file, o.units);
   const dsp::Frf& frf = file.frf;

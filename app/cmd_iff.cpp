@@ -10,6 +10,8 @@
 #include "cli_common.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/json.hpp"
@@ -17,7 +19,6 @@
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/rt/damped_plant_study.hpp"
-#include "piezobench/core/units.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -98,7 +99,7 @@ std::optional<Instability> first_unstable_gain(const lti::RootLocus& locus) {
 
 int run_rlocus(const RlocusOptions& o) {
   if (!(std::isfinite(o.delay) && o.delay >= 0.0)) {
-    throw UsageError("--delay", "a delay >= 0 s", std::to_string(o.delay));
+    throw UsageError("--delay", "a delay >= 0 s", format_number_exact(o.delay));
   }
   const LoadedSystem plant = load_plant(o);
   const LoadedSystem controller = load_controller(o);

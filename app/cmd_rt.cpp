@@ -9,6 +9,7 @@
 #include "measure_common.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/dsp/excitation.hpp"
@@ -66,7 +67,9 @@ void open_bench_file(const RtOptions& o, RtBench& b) {
                      "no limit options with a bench file (its [limits] apply)", "limit options");
   }
   if (o.rate_given && std::abs(o.rate - desc.sample_rate) > 1e-9 * desc.sample_rate) {
-    throw InputError(o.bench, "--rate", fmt::format("the bench file's rate {:g} Hz", desc.sample_rate), fmt::format("{:g} Hz", o.rate));
+    throw InputError(o.bench, "--rate",
+                     fmt::format("the bench file's rate {} Hz", format_number_exact(desc.sample_rate)),
+                     fmt::format("{} Hz", format_number_exact(o.rate)));
   }
   b.limits = desc.limits;
   if (desc.backend == "comedi" && !o.realtime) {
@@ -93,8 +96,8 @@ void open_replay(const RtOptions& o, RtBench& b) {
   if (o.replay.empty()) throw UsageError("--replay", "a recorded file (.mat or .csv with de and Vs)", "nothing");
   auto replay = std::make_unique<rt::ReplayBackend>(std::filesystem::path(o.replay));
   if (o.rate_given && std::abs(o.rate - replay->sample_rate()) > 1e-6 * replay->sample_rate()) {
-    throw InputError(o.replay, "--rate", "the record's sample rate " + std::to_string(replay->sample_rate()) + " Hz",
-                     std::to_string(o.rate) + " Hz");
+    throw InputError(o.replay, "--rate", "the record's sample rate " + format_number(replay->sample_rate(), 10) + " Hz",
+                     format_number_exact(o.rate) + " Hz");
   }
   b.source = {{"bench", "replay"}, {"file", o.replay}, {"samples", replay->samples()}};
   b.backend = std::move(replay);
@@ -139,7 +142,7 @@ void add_noise_excitation(const RtOptions& o, double sample_rate, rt::LoopOption
 // A sine of --frequency Hz around --offset V: one period (rounded to whole samples), played cyclically.
 void add_sine_excitation(const RtOptions& o, double sample_rate, rt::LoopOptions& lo) {
   if (!(std::isfinite(o.frequency) && o.frequency > 0.0 && o.frequency < 0.5 * sample_rate)) {
-    throw UsageError("--frequency", "a frequency in (0, rate / 2) Hz", fmt::format("{:g}", o.frequency));
+    throw UsageError("--frequency", "a frequency in (0, rate / 2) Hz", format_number_exact(o.frequency));
   }
   const auto n = static_cast<Eigen::Index>(std::max(2.0, std::round(sample_rate / o.frequency)));
   lo.excitation.resize(n);
@@ -302,7 +305,8 @@ int run_rt(const RtOptions& o) {
   if (o.controller != "iff" && o.controller != "off") {
     throw UsageError("--controller", "iff or off", "'" + o.controller + "'");
   }
-  if (!(std::isfinite(o.rate) && o.rate > 0.0)) throw UsageError("--rate", "a rate > 0 Hz", std::to_string(o.rate));
+  if (!(std::isfinite(o.rate) && o.rate > 0.0))
+    throw UsageError("--rate", "a rate > 0 Hz", format_number_exact(o.rate));
   o.limits.validate();
   const RtBench b = open_bench(o);
   const rt::LoopOptions lo = loop_options(o, b);

@@ -1,5 +1,6 @@
 // piezobench.io: include/piezobench/io/{timeseries,frf_file}.hpp
 #include "common.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/timeseries.hpp"
@@ -142,7 +143,7 @@ data is samples x channels; channel(name) / ts[name] give one channel without a 
         std::string names;
         for (const auto& n : ts.names) names += (names.empty() ? "" : ", ") + n;
         return "TimeSeries([" + names + "], samples=" + std::to_string(ts.samples()) +
-               ", sample_rate=" + std::to_string(ts.sample_rate) + ")";
+               ", sample_rate=" + format_number(ts.sample_rate, 10) + ")";
       });
 }
 

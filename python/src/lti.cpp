@@ -1,6 +1,8 @@
 // piezobench.lti: include/piezobench/lti/*.hpp
-#include "common.hpp"
 #include "piezobench/lti.hpp"
+
+#include "common.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::python {
 namespace {
@@ -68,7 +70,7 @@ py::object time_response(TimeResponse&& r) {
 
 std::string ss_repr(const StateSpace& s) {
   return "StateSpace(states=" + std::to_string(s.states()) + ", inputs=" + std::to_string(s.inputs()) +
-         ", outputs=" + std::to_string(s.outputs()) + ", sample_time=" + std::to_string(s.sample_time) +
+         ", outputs=" + std::to_string(s.outputs()) + ", sample_time=" + format_number(s.sample_time, 10) +
          (s.has_delay() ? ", delayed" : "") + ")";
 }
 
@@ -145,8 +147,8 @@ void bind_siso_forms(py::module_& m) {
       .def_readonly("sample_time", &TransferFunction::sample_time, "s; 0 = continuous")
       .def_readonly("delay", &TransferFunction::delay, "s")
       .def("__repr__", [](const TransferFunction& t) {
-        return "TransferFunction(order=" + std::to_string(t.order()) + ", sample_time=" + std::to_string(t.sample_time) +
-               ", delay=" + std::to_string(t.delay) + ")";
+        return "TransferFunction(order=" + std::to_string(t.order()) +
+               ", sample_time=" + format_number(t.sample_time, 10) + ", delay=" + format_number(t.delay, 10) + ")";
       });
 
   py::class_<Zpk>(m, "Zpk", R"(SISO zeros, poles and gain: gain prod(s - zeros) / prod(s - poles) exp(-s delay)
@@ -162,7 +164,7 @@ void bind_siso_forms(py::module_& m) {
       .def_readonly("delay", &Zpk::delay, "s")
       .def("__repr__", [](const Zpk& z) {
         return "Zpk(zeros=" + std::to_string(z.zeros.size()) + ", poles=" + std::to_string(z.poles.size()) +
-               ", gain=" + std::to_string(z.gain) + ")";
+               ", gain=" + format_number(z.gain) + ")";
       });
 }
 

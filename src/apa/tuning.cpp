@@ -98,14 +98,15 @@ core::FitQuality assess(const TwoDofTuning& t, const FitData& d) {
     const double v = p.get(name);
     const bool gain = name == "ga" || name == "gs";
     if (!std::isfinite(v) || (gain ? v == 0.0 : v <= 0.0)) {
-      q.add_problem(fmt::format("{} = {:.4g} is not physical", name, v), false);
+      q.add_problem(fmt::format("{} = {} is not physical", name, format_number(v, 4)), false);
       finite = false;
     }
   }
   const double largest = std::max({p.k1, p.ke, p.ka});
   for (const auto& [v, name] : {std::pair{p.k1, "k1"}, std::pair{p.ke, "ke"}, std::pair{p.ka, "ka"}}) {
     if (finite && v < 1e-6 * largest) {
-      q.add_problem(fmt::format("{} = {:.4g} N/m is negligible against {:.4g} N/m: no actuator has such stiffnesses", name, v, largest),
+      q.add_problem(fmt::format("{} = {} N/m is negligible against {} N/m: no actuator has such stiffnesses", name,
+                                format_number(v, 4), format_number(largest, 4)),
                     false);
     }
   }
@@ -116,8 +117,9 @@ core::FitQuality assess(const TwoDofTuning& t, const FitData& d) {
     const double lo = d.omega(0), hi = d.omega(d.omega.size() - 1);
     for (const auto& [w, name] : {std::pair{wp, "resonance"}, std::pair{wz, "anti-resonance"}}) {
       if (!(w >= lo && w <= hi)) {
-        q.add_problem(fmt::format("the model's {} {:.4g} Hz is outside the band used, {:.4g} to {:.4g} Hz", name,
-                                  w / kTwoPi, lo / kTwoPi, hi / kTwoPi));
+        q.add_problem(fmt::format("the model's {} {} Hz is outside the band used, {} to {} Hz", name,
+                                  format_number(w / kTwoPi, 4), format_number(lo / kTwoPi, 4),
+                                  format_number(hi / kTwoPi, 4)));
       }
     }
   }
@@ -343,9 +345,11 @@ void mark_undetermined(TwoDofTuning& t, const TuningOptions& o) {
     const double rel = t.uncertainty.empty() ? std::numeric_limits<double>::infinity() : t.uncertainty.relative_standard_error_of(name);
     std::string why;
     if (!(ratio > 1e-3 && ratio < 1e3)) {
-      why = fmt::format("{} = {:.3g} driven to a bound ({:.2g} times the report's procedure's {:.3g})", name, v, ratio, v0);
+      why = fmt::format("{} = {} driven to a bound ({} times the report's procedure's {})", name, format_number(v, 3),
+                        format_number(ratio, 2), format_number(v0, 3));
     } else if (!(rel <= kUndeterminedRelativeError)) {
-      why = fmt::format("{} = {:.3g} undetermined (relative standard error {:.2g} > {:g})", name, v, rel, kUndeterminedRelativeError);
+      why = fmt::format("{} = {} undetermined (relative standard error {} > {})", name, format_number(v, 3),
+                        format_number(rel, 2), format_number(kUndeterminedRelativeError));
     }
     if (why.empty()) continue;
     t.undetermined.push_back(name);
@@ -397,8 +401,8 @@ TwoDofParams report_stiffness_and_damping(const ReportFeatures& f, double m, dou
   const double ktot = m * f.wp * f.wp;
   if (!(ktot > p.k1)) {
     throw NumericalError("2-DoF tuning",
-                         fmt::format("the resonance ({:.4g} Hz) is not above the anti-resonance ({:.4g} Hz) of u -> Vs",
-                                     f.wp / kTwoPi, f.wz / kTwoPi),
+                         fmt::format("the resonance ({} Hz) is not above the anti-resonance ({} Hz) of u -> Vs",
+                                     format_number(f.wp / kTwoPi, 4), format_number(f.wz / kTwoPi, 4)),
                          /*retry_may_help=*/true);
   }
   const double series = rk / (1.0 + rk);  // ke ka/(ke + ka) = series ka when ke = rk ka
@@ -465,8 +469,9 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
   out.status = r.converged() ? TuningStatus::kConverged
                : r.status == core::LmStatus::kMaxIterations ? TuningStatus::kMaxIterations
                                                               : TuningStatus::kNoProgress;
-  out.message = fmt::format("Levenberg-Marquardt: {} after {} steps ({} evaluations), cost {:.4g} -> {:.4g}",
-                            core::to_string(r.status), r.iterations, r.evaluations, r.initial_cost, r.cost);
+  out.message =
+      fmt::format("Levenberg-Marquardt: {} after {} steps ({} evaluations), cost {} -> {}", core::to_string(r.status),
+                  r.iterations, r.evaluations, format_number(r.initial_cost, 4), format_number(r.cost, 4));
 }
 
 }  // namespace

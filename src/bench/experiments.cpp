@@ -10,17 +10,18 @@
 #include <utility>
 
 #include "flatness.hpp"
-#include "random.hpp"
 #include "piezobench/bench/tracking.hpp"
 #include "piezobench/control/discrete_iff.hpp"
 #include "piezobench/control/hysteresis_feedforward.hpp"
 #include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
-#include "piezobench/core/timestamp.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/memory.hpp"
+#include "piezobench/core/timestamp.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/lti/discretize.hpp"
-#include "piezobench/core/units.hpp"
+#include "random.hpp"
 
 namespace piezobench::bench {
 
@@ -112,11 +113,12 @@ void check_range(const Eigen::VectorXd& u, const BenchOptions& b, const std::str
   const double lo = b.amplifier_gain * u.minCoeff();
   const double hi = b.amplifier_gain * u.maxCoeff();
   if (lo < b.va_min - 1e-9 || hi > b.va_max + 1e-9) {
-    throw InputError(kSource, "amplitude",
-                     fmt::format("{} whose stack voltage stays within the actuator's range {:g} V .. {:g} V", what, b.va_min,
-                                 b.va_max),
-                     fmt::format("a stack voltage from {:.4g} V to {:.4g} V (limit {:g} V exceeded)", lo, hi,
-                                 hi > b.va_max + 1e-9 ? b.va_max : b.va_min));
+    throw InputError(
+        kSource, "amplitude",
+        fmt::format("{} whose stack voltage stays within the actuator's range {} V .. {} V", what,
+                    format_number_exact(b.va_min), format_number_exact(b.va_max)),
+        fmt::format("a stack voltage from {} V to {} V (limit {} V exceeded)", format_number(lo, 4),
+                    format_number(hi, 4), format_number_exact(hi > b.va_max + 1e-9 ? b.va_max : b.va_min)));
   }
 }
 
@@ -200,10 +202,12 @@ io::TimeSeries hysteresis(BenchRunner& runner, const UnitTruth& unit, const Expe
   const double amplitude = o.amplitude.value_or(20.0);
   const double offset = 0.5 * (b.va_min + b.va_max);  // 65 V for -20..150 V
   if (offset - amplitude < b.va_min - 1e-12 || offset + amplitude > b.va_max + 1e-12) {
-    throw InputError(kSource, "amplitude",
-                     fmt::format("an amplitude <= {:g} V (offset {:g} V, stack range {:g} V .. {:g} V)",
-                                 std::min(offset - b.va_min, b.va_max - offset), offset, b.va_min, b.va_max),
-                     fmt::format("{:g} V", amplitude));
+    throw InputError(
+        kSource, "amplitude",
+        fmt::format("an amplitude <= {} V (offset {} V, stack range {} V .. {} V)",
+                    format_number(std::min(offset - b.va_min, b.va_max - offset)), format_number_exact(offset),
+                    format_number_exact(b.va_min), format_number_exact(b.va_max)),
+        fmt::format("{} V", format_number_exact(amplitude)));
   }
   dsp::OffsetSineOptions s;
   s.sample_rate = b.sample_rate;
@@ -268,7 +272,7 @@ StackNoise stack_noise(const BenchOptions& b, double duration, double va_rms, st
   no.seed = noise_seed;
   if (no.samples < 2 || no.f_low >= no.f_high) {
     throw InputError(kSource, "duration", "a record long enough for the noise band (at least 2 samples)",
-                     fmt::format("{:g} s", duration));
+                     fmt::format("{} s", format_number_exact(duration)));
   }
   dsp::Excitation ex = dsp::band_limited_noise(no, {-1e300, 1e300, dsp::BoundsPolicy::kReject});
   check_range(ex.u, b, fmt::format("a noise of {:g} V rms at the stacks", va_rms));
@@ -302,9 +306,10 @@ io::TimeSeries frf_sweep(BenchRunner& runner, const UnitTruth& unit, const Exper
   const double va_amplitude = o.amplitude.value_or(1.0);
   if (va_amplitude > std::min(-b.va_min, b.va_max) + 1e-12) {
     throw InputError(kSource, "amplitude",
-                     fmt::format("an amplitude <= {:g} V (a sweep about 0 V within the stack range {:g} V .. {:g} V)",
-                                 std::min(-b.va_min, b.va_max), b.va_min, b.va_max),
-                     fmt::format("{:g} V", va_amplitude));
+                     fmt::format("an amplitude <= {} V (a sweep about 0 V within the stack range {} V .. {} V)",
+                                 format_number(std::min(-b.va_min, b.va_max)), format_number_exact(b.va_min),
+                                 format_number_exact(b.va_max)),
+                     fmt::format("{} V", format_number_exact(va_amplitude)));
   }
   dsp::SweepOptions so;
   so.sample_rate = b.sample_rate;
@@ -364,10 +369,12 @@ constexpr int kTrackingPeriods = 3;
 
 void check_tracking_amplitude(const BenchOptions& b, double amplitude, double offset) {
   if (offset - amplitude < b.va_min - 1e-12 || offset + amplitude > b.va_max + 1e-12) {
-    throw InputError(kSource, "amplitude",
-                     fmt::format("an amplitude <= {:g} V (offset {:g} V, stack range {:g} V .. {:g} V)",
-                                 std::min(offset - b.va_min, b.va_max - offset), offset, b.va_min, b.va_max),
-                     fmt::format("{:g} V", amplitude));
+    throw InputError(
+        kSource, "amplitude",
+        fmt::format("an amplitude <= {} V (offset {} V, stack range {} V .. {} V)",
+                    format_number(std::min(offset - b.va_min, b.va_max - offset)), format_number_exact(offset),
+                    format_number_exact(b.va_min), format_number_exact(b.va_max)),
+        fmt::format("{} V", format_number_exact(amplitude)));
   }
 }
 
@@ -772,11 +779,11 @@ const std::vector<Experiment>& all_experiments() {
 
 void ExperimentOptions::validate() const {
   if (amplitude && !(std::isfinite(*amplitude) && *amplitude > 0.0)) {
-    throw InputError(kSource, "amplitude", "an amplitude > 0 V", fmt::format("{:g}", *amplitude));
+    throw InputError(kSource, "amplitude", "an amplitude > 0 V", format_number_exact(*amplitude));
   }
   if (duration) checked_duration_s(*duration, 1e-3, 1e5, NumberOrigin::file(kSource, "duration"));
   if (gain && !(std::isfinite(*gain) && *gain >= 0.0)) {
-    throw InputError(kSource, "gain", "an IFF gain >= 0", fmt::format("{:g}", *gain));
+    throw InputError(kSource, "gain", "an IFF gain >= 0", format_number_exact(*gain));
   }
   bench.validate();
 }

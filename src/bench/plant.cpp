@@ -7,6 +7,7 @@
 #include <complex>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/lti/discretize.hpp"
 
 namespace piezobench::bench::detail {
@@ -47,10 +48,11 @@ double blocked_capacitance(const apa::TwoDofParams& p, double in_situ) {
 double actuator_blocked_capacitance(const apa::TwoDofParams& p, double in_situ) {
   const double cab = in_situ - p.ga * p.ga / (p.ka + p.ke * p.k1 / (p.ke + p.k1));
   if (!(cab > 0.0)) {
-    throw InputError("unit model", "capacitance_actuator",
-                     fmt::format("an in-situ capacitance above ga^2 / (ka + ke k1 / (ke + k1)) = {:g} F (open-circuit stacks)",
-                                 in_situ - cab),
-                     fmt::format("{:g} F", in_situ));
+    throw InputError(
+        "unit model", "capacitance_actuator",
+        fmt::format("an in-situ capacitance above ga^2 / (ka + ke k1 / (ke + k1)) = {} F (open-circuit stacks)",
+                    format_number(in_situ - cab)),
+        fmt::format("{} F", format_number_exact(in_situ)));
   }
   return cab;
 }
@@ -61,9 +63,11 @@ ContinuousPlant two_dof_plant(const apa::TwoDofParams& p, const Electrics& e) {
   const double alpha = p.gs * cb;
   const double ke_sc = p.ke - p.gs * alpha;
   if (!(ke_sc > 0.0)) {
-    throw InputError("unit model", "gs",
-                     fmt::format("a sensor stack whose short-circuit stiffness ke - gs^2 C_b stays positive (ke = {:g} N/m)", p.ke),
-                     fmt::format("gs = {:g} V/m with C_b = {:g} F", p.gs, cb));
+    throw InputError(
+        "unit model", "gs",
+        fmt::format("a sensor stack whose short-circuit stiffness ke - gs^2 C_b stays positive (ke = {} N/m)",
+                    format_number_exact(p.ke)),
+        fmt::format("gs = {} V/m with C_b = {} F", format_number_exact(p.gs), format_number_exact(cb)));
   }
   const double den = p.ca + p.ce;
   const double wa = e.amplifier_bandwidth;
@@ -253,7 +257,8 @@ ModalPlant discretize_modal(const ContinuousPlant& plant, double ts, double frac
   const double mismatch = (s * lam * s_inv - plant.A).norm() / plant.A.norm();
   if (!(mismatch < 1e-8)) {
     throw NumericalError("modal discretization",
-                         fmt::format("the bench model is not diagonalizable to working precision (relative error {:.2g})", mismatch),
+                         fmt::format("the bench model is not diagonalizable to working precision (relative error {})",
+                                     format_number(mismatch, 2)),
                          true);
   }
   const lti::Matrix bm = s_inv * plant.B;

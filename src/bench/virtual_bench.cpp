@@ -3,18 +3,19 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cassert>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <numbers>
 #include <vector>
 
 #include "nonlinear.hpp"
+#include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/units.hpp"
 #include "plant.hpp"
 #include "random.hpp"
 #include "superelement_plant.hpp"
-#include "piezobench/core/error.hpp"
-#include "piezobench/core/units.hpp"
 
 namespace piezobench::bench {
 
@@ -25,7 +26,7 @@ namespace {
 constexpr const char* kOptionsSource = "bench options";
 
 void require(bool ok, const std::string& source, const std::string& field, const std::string& expected, double found) {
-  if (!ok) throw InputError(source, field, expected, fmt::format("{:g}", found));
+  if (!ok) throw InputError(source, field, expected, format_number_exact(found));
 }
 
 // The 2-DoF bench in the fixed-size form its inner loop uses: six states (Va, x, x', xn, V, Vs at

@@ -16,6 +16,7 @@
 #include "piezobench/campaign/superelement_fit.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/parallel.hpp"
 #include "piezobench/core/statistics.hpp"
 #include "piezobench/core/units.hpp"
@@ -24,8 +25,8 @@
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/mat_struct.hpp"
 #include "piezobench/io/output_dir.hpp"
-#include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/analysis.hpp"
+#include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "piezobench/lti/rlocus.hpp"
 #include "piezobench/metrology/capacitance.hpp"
@@ -203,8 +204,9 @@ std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, co
   for (const auto& f : u.failed) reasons.push_back("analysis failed: " + f);
   const Specs& s = c.specs;
   if (u.flatness && s.flatness_max && *u.flatness > *s.flatness_max) {
-    reasons.push_back(fmt::format("flatness {:.2f} um above the limit {:.2f} um ({})", *u.flatness * 1e6, *s.flatness_max * 1e6,
-                                  metrology::to_string(s.flatness_method)));
+    reasons.push_back(
+        fmt::format("flatness {} um above the limit {} um ({})", format_number_fixed(*u.flatness * 1e6, 2),
+                    format_number_fixed(*s.flatness_max * 1e6, 2), metrology::to_string(s.flatness_method)));
   }
   if (u.capacitance_sensor && u.capacitance_actuator) {
     metrology::CapacitanceSpec spec;
@@ -214,13 +216,15 @@ std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, co
     for (const auto& r : check.reasons) reasons.push_back(r);
   }
   if (u.stroke && s.stroke_min && *u.stroke < *s.stroke_min) {
-    reasons.push_back(fmt::format("stroke {:.1f} um below the minimum {:.1f} um", *u.stroke * 1e6, *s.stroke_min * 1e6));
+    reasons.push_back(fmt::format("stroke {} um below the minimum {} um", format_number_fixed(*u.stroke * 1e6, 1),
+                                  format_number_fixed(*s.stroke_min * 1e6, 1)));
   }
   if (s.stiffness) {
     for (const auto& [name, v] : {std::pair{"k1", u.k1}, std::pair{"k2", u.k2}, std::pair{"from the resonance", u.k_resonance}}) {
       if (v && !s.stiffness->contains(*v)) {
-        reasons.push_back(fmt::format("stiffness {} {:.3f} N/um outside [{:.3f}, {:.3f}] N/um", name, *v * 1e-6, s.stiffness->min * 1e-6,
-                                      s.stiffness->max * 1e-6));
+        reasons.push_back(fmt::format(
+            "stiffness {} {} N/um outside [{}, {}] N/um", name, format_number_fixed(*v * 1e-6, 3),
+            format_number_fixed(s.stiffness->min * 1e-6, 3), format_number_fixed(s.stiffness->max * 1e-6, 3)));
       }
     }
   }
@@ -362,9 +366,11 @@ IffStudy iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units) {
     out.max_relative_pole_distance = std::max(out.max_relative_pole_distance, out.relative_pole_distance.back());
   }
   if (out.max_relative_pole_distance > kPoleDistanceTolerance) {
-    out.warning = fmt::format("the identified damped poles are up to {:.0f} % off the model's root locus (more than {:.0f} %): "
-                              "the IFF plant model (eq. 2.3) does not describe the closed loop at those gains",
-                              100.0 * out.max_relative_pole_distance, 100.0 * kPoleDistanceTolerance);
+    out.warning = fmt::format(
+        "the identified damped poles are up to {} % off the model's root locus (more than {} %): "
+        "the IFF plant model (eq. 2.3) does not describe the closed loop at those gains",
+        format_number_fixed(100.0 * out.max_relative_pole_distance, 0),
+        format_number_fixed(100.0 * kPoleDistanceTolerance, 0));
   }
   return out;
 }

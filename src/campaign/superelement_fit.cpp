@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/statistics.hpp"
 #include "piezobench/core/units.hpp"
 
@@ -99,7 +100,9 @@ SuperElementFit fit_superelement(const fem::SuperElement& se, const fem::SuperEl
     if (f(k) >= r.band_lo_Hz && f(k) <= r.band_hi_Hz) band.push_back(k);
   }
   if (band.size() < 3) {
-    throw InputError(measured.provenance.source, "frf", fmt::format("frequencies in the tuning band {:.3g}-{:.3g} Hz", r.band_lo_Hz, r.band_hi_Hz),
+    throw InputError(measured.provenance.source, "frf",
+                     fmt::format("frequencies in the tuning band {}-{} Hz", format_number(r.band_lo_Hz, 3),
+                                 format_number(r.band_hi_Hz, 3)),
                      fmt::format("{} of them", band.size()));
   }
   Eigen::VectorXd fb(static_cast<Eigen::Index>(band.size()));

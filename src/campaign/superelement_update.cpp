@@ -7,6 +7,7 @@
 #include <set>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/fem/structural_model.hpp"
 
@@ -195,11 +196,16 @@ void check_rank(const Eigen::MatrixXd& J, const SuperElementUpdateOptions& o, Su
   Eigen::Index worst = 0;
   v.maxCoeff(&worst);
   std::string sv;
-  for (Eigen::Index i = 0; i < out.singular_values.size(); ++i) sv += fmt::format("{}{:.3g}", i ? ", " : "", out.singular_values(i));
-  throw InputError(kUpdateSource, "parameters",
-                   fmt::format("parameters the resonance and anti-resonance determine (at most {}: the rank of d ln feature / d ln scale, "
-                               "singular values above {:g} x the largest)", out.rank, o.rank_tolerance),
-                   fmt::format("{} parameters, singular values {}: '{}' is not determined by the data", p, sv, o.parameters[static_cast<std::size_t>(worst)]));
+  for (Eigen::Index i = 0; i < out.singular_values.size(); ++i)
+    sv += (i ? ", " : "") + format_number(out.singular_values(i), 3);
+  throw InputError(
+      kUpdateSource, "parameters",
+      fmt::format(
+          "parameters the resonance and anti-resonance determine (at most {}: the rank of d ln feature / d ln scale, "
+          "singular values above {} x the largest)",
+          out.rank, format_number(o.rank_tolerance)),
+      fmt::format("{} parameters, singular values {}: '{}' is not determined by the data", p, sv,
+                  o.parameters[static_cast<std::size_t>(worst)]));
 }
 
 std::vector<Eigen::Vector2d> target_features(const std::vector<UpdateTarget>& targets) {
@@ -273,7 +279,10 @@ SuperElementUpdate update_superelement(const fem::SuperElement& se, const fem::S
     }
   }
   if (!converged) {
-    throw NumericalError("super element update", fmt::format("no convergence in {} iterations (residual {:.3g} in ln f)", options.max_iterations, r.norm()), false);
+    throw NumericalError("super element update",
+                         fmt::format("no convergence in {} iterations (residual {} in ln f)", options.max_iterations,
+                                     format_number(r.norm(), 3)),
+                         false);
   }
   out.element = scaled(se, parts, theta);
   const BenchFeatures f1 = bench_features(out.element, setup, options.bench);
@@ -288,7 +297,9 @@ SuperElementUpdate update_superelement(const fem::SuperElement& se, const fem::S
     out.parameters.push_back(u);
   }
   if (r.norm() > 1e-3) {
-    out.warnings.push_back(fmt::format("the updated model misses the features by {:.2g} % (least squares: more features than parameters)", 100.0 * r.cwiseAbs().maxCoeff()));
+    out.warnings.push_back(
+        fmt::format("the updated model misses the features by {} % (least squares: more features than parameters)",
+                    format_number(100.0 * r.cwiseAbs().maxCoeff(), 2)));
   }
   uncertainty(y, mean, out);
   return out;

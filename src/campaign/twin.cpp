@@ -8,6 +8,7 @@
 
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/welch.hpp"
@@ -400,17 +401,22 @@ void check_twin(const UnitAnalysis& a, const TwinOptions& o, TwinBuild& out) {
     chk.twin_width = metrology::analyze_hysteresis(column(ts, "Va"), column(ts, "de")).relative_width;
     out.hysteresis.push_back(chk);
     if (chk.unit_width > 0.01 && std::abs(chk.twin_width / chk.unit_width - 1.0) > o.max_width_error) {
-      out.quality.add_problem(fmt::format("hysteresis width at {:.3g} V: twin {:.2f} %, unit {:.2f} %", chk.amplitude, 100.0 * chk.twin_width,
-                                          100.0 * chk.unit_width));
+      out.quality.add_problem(
+          fmt::format("hysteresis width at {} V: twin {} %, unit {} %", format_number(chk.amplitude, 3),
+                      format_number_fixed(100.0 * chk.twin_width, 2), format_number_fixed(100.0 * chk.unit_width, 2)));
     }
   }
   for (const auto& [name, e] : {std::pair{"u -> d_e", out.de}, std::pair{"u -> Vs", out.vs}}) {
-    if (e.points == 0) out.quality.add_problem(fmt::format("{}: no FRF point with coherence >= {:g} in the band", name, o.min_coherence));
-    if (e.max_dB > o.max_frf_error_dB) out.quality.add_problem(fmt::format("{}: FRF error up to {:.2f} dB", name, e.max_dB));
+    if (e.points == 0)
+      out.quality.add_problem(
+          fmt::format("{}: no FRF point with coherence >= {} in the band", name, format_number(o.min_coherence)));
+    if (e.max_dB > o.max_frf_error_dB)
+      out.quality.add_problem(fmt::format("{}: FRF error up to {} dB", name, format_number_fixed(e.max_dB, 2)));
   }
   if (out.iff_optimal_gain_unit && std::abs(out.iff_optimal_gain / *out.iff_optimal_gain_unit - 1.0) > o.max_iff_error) {
-    out.quality.add_problem(fmt::format("IFF optimum: twin g = {:.4g}, unit's fitted plant g = {:.4g}", out.iff_optimal_gain,
-                                        *out.iff_optimal_gain_unit));
+    out.quality.add_problem(fmt::format("IFF optimum: twin g = {}, unit's fitted plant g = {}",
+                                        format_number(out.iff_optimal_gain, 4),
+                                        format_number(*out.iff_optimal_gain_unit, 4)));
   }
   out.quality.advise("check the records the twin was built from (coherence, amplitudes), or build the twin from longer records");
 }

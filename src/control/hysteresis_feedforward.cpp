@@ -4,13 +4,14 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::control {
 
 HysteresisFeedforward::HysteresisFeedforward(const ident::HysteresisModel& model, double sample_rate)
     : model_(model), inverse_((model.validate(), ident::inverse(model.hysteresis))), output_inverse_(ident::inverse(model.output)) {
   if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) {
-    throw InputError("hysteresis feedforward", "sample_rate", "a rate > 0 Hz", std::to_string(sample_rate));
+    throw InputError("hysteresis feedforward", "sample_rate", "a rate > 0 Hz", format_number_exact(sample_rate));
   }
   for (double tau : model_.creep_time_constants) alpha_.push_back(-std::expm1(-1.0 / (sample_rate * tau)));
   creep_.assign(alpha_.size(), 0.0);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/lti/delay.hpp"
@@ -16,7 +17,7 @@ namespace {
 
 void require_positive(double value, const char* field) {
   if (!(std::isfinite(value) && value > 0.0)) {
-    throw InputError("", field, "a finite positive number", std::to_string(value));
+    throw InputError("", field, "a finite positive number", format_number_exact(value));
   }
 }
 
@@ -57,7 +58,8 @@ lti::Index nearest(const lti::CVector& v, lti::Complex target) {
 }  // namespace
 
 void IffControllerParams::validate() const {
-  if (!std::isfinite(gain) || gain == 0.0) throw InputError("", "gain", "a finite non-zero gain", std::to_string(gain));
+  if (!std::isfinite(gain) || gain == 0.0)
+    throw InputError("", "gain", "a finite non-zero gain", format_number_exact(gain));
   require_positive(w_hpf, "w_hpf");
   require_positive(w_lpf, "w_lpf");
   require_positive(w_robust, "w_robust");
@@ -86,8 +88,8 @@ lti::StateSpace iff_open_loop(const lti::StateSpace& plant, const lti::StateSpac
   require_siso(plant, "plant");
   require_siso(controller, "controller");
   if (plant.is_discrete() != controller.is_discrete() || plant.sample_time != controller.sample_time) {
-    throw InputError("", "controller", "the plant's sample time " + std::to_string(plant.sample_time) + " s",
-                     std::to_string(controller.sample_time) + " s");
+    throw InputError("", "controller", "the plant's sample time " + format_number(plant.sample_time, 10) + " s",
+                     format_number(controller.sample_time, 10) + " s");
   }
   const lti::StateSpace g = plant.has_delay() ? lti::pade(plant, options.pade_order) : plant;
   const lti::StateSpace k = controller.has_delay() ? lti::pade(controller, options.pade_order) : controller;
@@ -98,7 +100,7 @@ IffRootLocus iff_root_locus(const lti::StateSpace& plant, const lti::StateSpace&
                             const std::vector<double>& gains, const IffLoopOptions& options) {
   const lti::StateSpace loop = iff_open_loop(plant, controller, options);
   for (const double g : gains) {
-    if (!std::isfinite(g) || g < 0.0) throw InputError("", "gains", "finite gains >= 0", std::to_string(g));
+    if (!std::isfinite(g) || g < 0.0) throw InputError("", "gains", "finite gains >= 0", format_number_exact(g));
   }
   IffRootLocus result;
   const lti::StateSpace plant_states = plant.has_delay() ? lti::pade(plant, options.pade_order) : plant;

@@ -15,6 +15,13 @@ std::string format_number(double value, int significant_digits) {
   return buf;
 }
 
+std::string format_number_fixed(double value, int decimals) {
+  if (!std::isfinite(value)) return format_number(value);
+  char buf[360];  // 1e308 with 17 decimals fits
+  std::snprintf(buf, sizeof buf, "%.*f", std::clamp(decimals, 0, 17), value);
+  return buf;
+}
+
 std::string format_number_exact(double value) {
   if (!std::isfinite(value)) return format_number(value);
   for (int digits = 1; digits < 17; ++digits) {

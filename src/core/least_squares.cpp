@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::core {
 
@@ -45,10 +46,10 @@ void LmOptions::validate() const {
   if (max_iterations < 1) throw InputError(src, "max_iterations", "at least 1", std::to_string(max_iterations));
   for (const auto& [v, name] : {std::pair{cost_tolerance, "cost_tolerance"}, std::pair{step_tolerance, "step_tolerance"},
                                 std::pair{gradient_tolerance, "gradient_tolerance"}}) {
-    if (!(std::isfinite(v) && v >= 0.0)) throw InputError(src, name, "a finite tolerance >= 0", std::to_string(v));
+    if (!(std::isfinite(v) && v >= 0.0)) throw InputError(src, name, "a finite tolerance >= 0", format_number_exact(v));
   }
   for (const auto& [v, name] : {std::pair{initial_lambda, "initial_lambda"}, std::pair{jacobian_step, "jacobian_step"}}) {
-    if (!(std::isfinite(v) && v > 0.0)) throw InputError(src, name, "a finite value > 0", std::to_string(v));
+    if (!(std::isfinite(v) && v > 0.0)) throw InputError(src, name, "a finite value > 0", format_number_exact(v));
   }
 }
 

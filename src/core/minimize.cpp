@@ -5,12 +5,13 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::core {
 
 void GoldenSectionOptions::validate() const {
   if (!(std::isfinite(tolerance) && tolerance >= 0.0)) {
-    throw InputError("golden-section options", "tolerance", "a finite width >= 0", std::to_string(tolerance));
+    throw InputError("golden-section options", "tolerance", "a finite width >= 0", format_number_exact(tolerance));
   }
   if (max_iterations < 0) throw InputError("golden-section options", "max_iterations", ">= 0", std::to_string(max_iterations));
 }
@@ -19,7 +20,8 @@ ScalarMinimum golden_section_minimize(const std::function<double(double)>& f, do
                                       const GoldenSectionOptions& options) {
   options.validate();
   if (!(std::isfinite(a) && std::isfinite(b) && a < b)) {
-    throw InputError("golden-section search", "bracket", "finite a < b", std::to_string(a) + ", " + std::to_string(b));
+    throw InputError("golden-section search", "bracket", "finite a < b",
+                     format_number_exact(a) + ", " + format_number_exact(b));
   }
   ScalarMinimum out;
   auto eval = [&](double x) {

@@ -6,13 +6,14 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench {
 
 void NnlsOptions::validate() const {
   if (max_iterations < 0) throw InputError("nnls options", "max_iterations", "an integer >= 0", std::to_string(max_iterations));
   if (!(std::isfinite(tolerance) && tolerance >= 0.0)) {
-    throw InputError("nnls options", "tolerance", "a finite tolerance >= 0", std::to_string(tolerance));
+    throw InputError("nnls options", "tolerance", "a finite tolerance >= 0", format_number_exact(tolerance));
   }
 }
 

@@ -1,14 +1,14 @@
 #include "piezobench/dsp/frf.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <vector>
-#include <set>
-
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <vector>
+
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 
 namespace piezobench::dsp {
@@ -25,20 +25,13 @@ Index Frf::output_index(const std::string& name) const {
                    "\"" + name + "\"");
 }
 
-namespace {
-std::string format_value(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-}  // namespace
-
 void Frf::validate(const std::string& source) const {
   const std::string src = source.empty() ? provenance.source : source;
   const Index n = freq_Hz.size();
   if (n < 1) throw InputError(src, "freq_Hz", "at least one frequency", "none");
   if (std::isfinite(freq_Hz(0)) && freq_Hz(0) < 0.0) {
-    throw InputError(src, "freq_Hz", "frequencies >= 0 Hz (one-sided FRF)", format_value(freq_Hz(0)) + " Hz at index 0");
+    throw InputError(src, "freq_Hz", "frequencies >= 0 Hz (one-sided FRF)",
+                     format_number(freq_Hz(0), 10) + " Hz at index 0");
   }
   for (Index k = 0; k < n; ++k) {
     if (!std::isfinite(freq_Hz(k))) {
@@ -46,7 +39,7 @@ void Frf::validate(const std::string& source) const {
     }
     if (k > 0 && !(freq_Hz(k) > freq_Hz(k - 1))) {
       throw InputError(src, "freq_Hz", "strictly increasing frequencies",
-                       std::to_string(freq_Hz(k - 1)) + " then " + std::to_string(freq_Hz(k)) + " at index " +
+                       format_number(freq_Hz(k - 1), 10) + " then " + format_number(freq_Hz(k), 10) + " at index " +
                            std::to_string(k));
     }
   }
@@ -71,8 +64,9 @@ void Frf::validate(const std::string& source) const {
     }
     for (Index k = 0; k < n; ++k) {
       if (!std::isfinite(H[i](k).real()) || !std::isfinite(H[i](k).imag())) {
-        throw InputError(src, outputs[i], "finite response values",
-                         "non-finite value at " + std::to_string(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
+        throw InputError(
+            src, outputs[i], "finite response values",
+            "non-finite value at " + format_number(freq_Hz(k), 10) + " Hz (index " + std::to_string(k) + ")");
       }
     }
     if (!coherence.empty()) {
@@ -82,13 +76,15 @@ void Frf::validate(const std::string& source) const {
       }
       for (Index k = 0; k < n; ++k) {
         if (!std::isfinite(coherence[i](k))) {
-          throw InputError(src, outputs[i] + " coherence", "finite values",
-                           "non-finite value at " + std::to_string(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
+          throw InputError(
+              src, outputs[i] + " coherence", "finite values",
+              "non-finite value at " + format_number(freq_Hz(k), 10) + " Hz (index " + std::to_string(k) + ")");
         }
         // Magnitude-squared coherence lies in [0, 1]; the tolerance admits round-off only.
         if (coherence[i](k) < 0.0 || coherence[i](k) > 1.0 + 1e-9) {
           throw InputError(src, outputs[i] + " coherence", "values in [0, 1]",
-                           format_value(coherence[i](k)) + " at " + format_value(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
+                           format_number(coherence[i](k), 10) + " at " + format_number(freq_Hz(k), 10) + " Hz (index " +
+                               std::to_string(k) + ")");
         }
       }
     }
@@ -99,7 +95,8 @@ void Frf::validate(const std::string& source) const {
       for (Index k = 0; k < n; ++k) {
         if (!std::isfinite(std_H[i](k)) || std_H[i](k) < 0.0) {
           throw InputError(src, outputs[i] + " std", "finite values >= 0",
-                           format_value(std_H[i](k)) + " at " + format_value(freq_Hz(k)) + " Hz (index " + std::to_string(k) + ")");
+                           format_number(std_H[i](k), 10) + " at " + format_number(freq_Hz(k), 10) + " Hz (index " +
+                               std::to_string(k) + ")");
         }
       }
     }
@@ -216,8 +213,10 @@ FrequencyBand excited_band(const Frf& frf, double min_coherence) {
   while (lo < n && !excited(lo)) ++lo;
   if (lo == n) {
     throw InputError(frf.provenance.source, "coherence",
-                     fmt::format("a band where the coherence reaches {:g} (the input excites the outputs)", min_coherence),
-                     fmt::format("at most {:.3g}: check the input and output channels, or the excitation", best.maxCoeff()));
+                     fmt::format("a band where the coherence reaches {} (the input excites the outputs)",
+                                 format_number_exact(min_coherence)),
+                     fmt::format("at most {}: check the input and output channels, or the excitation",
+                                 format_number(best.maxCoeff(), 3)));
   }
   Index hi = n - 1;
   while (hi > lo && !excited(hi)) --hi;

@@ -34,7 +34,7 @@ double effective_averages(WindowType window, Index nfft, Index noverlap, Index s
 
 double frf_relative_std(double coherence, double effective_averages) {
   if (!(effective_averages > 0.0)) {
-    throw InputError("frf variance", "effective averages", "a number > 0", std::to_string(effective_averages));
+    throw InputError("frf variance", "effective averages", "a number > 0", format_number_exact(effective_averages));
   }
   const double g2 = std::clamp(coherence, 1e-12, 1.0);
   return std::sqrt((1.0 - g2) / (2.0 * effective_averages * g2));

@@ -1,7 +1,5 @@
 #include "piezobench/dsp/welch.hpp"
 
-#include "piezobench/dsp/frf_variance.hpp"
-
 #include <algorithm>
 #include <atomic>
 #include <cassert>
@@ -12,6 +10,8 @@
 
 #include "fft.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 
 namespace piezobench::dsp {
 
@@ -134,7 +134,7 @@ void WelchOptions::validate(const std::string& source) const {
                      std::to_string(nfft));
   }
   if (!(overlap >= 0.0 && overlap < 1.0)) {
-    throw InputError(source, "overlap", "a fraction in [0, 1)", std::to_string(overlap));
+    throw InputError(source, "overlap", "a fraction in [0, 1)", format_number_exact(overlap));
   }
   if (threads < 0) throw InputError(source, "threads", ">= 0 (0 = all cores)", std::to_string(threads));
 }
@@ -145,10 +145,10 @@ Index WelchOptions::noverlap() const {
 
 Index segment_length_for_record(Index samples, double sample_rate_Hz, double resolution_Hz, const std::string& source) {
   if (!(std::isfinite(sample_rate_Hz) && sample_rate_Hz > 0.0)) {
-    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_Hz));
+    throw InputError(source, "sample rate", "a finite rate > 0 Hz", format_number_exact(sample_rate_Hz));
   }
   if (!(std::isfinite(resolution_Hz) && resolution_Hz > 0.0)) {
-    throw InputError(source, "resolution", "a finite frequency resolution > 0 Hz", std::to_string(resolution_Hz));
+    throw InputError(source, "resolution", "a finite frequency resolution > 0 Hz", format_number_exact(resolution_Hz));
   }
   const auto target = static_cast<Index>(std::lround(sample_rate_Hz / resolution_Hz));
   return std::max<Index>(256, std::min<Index>(target, samples / 4));
@@ -185,7 +185,7 @@ SegmentPlan plan_segments(const Channel& input, const std::vector<Channel>& outp
                           const std::string& source) {
   options.validate(source);
   if (!(std::isfinite(sample_rate_Hz) && sample_rate_Hz > 0.0)) {
-    throw InputError(source, "sample rate", "a finite rate > 0 Hz", std::to_string(sample_rate_Hz));
+    throw InputError(source, "sample rate", "a finite rate > 0 Hz", format_number_exact(sample_rate_Hz));
   }
   SegmentPlan p;
   p.n = static_cast<Index>(input.samples.size());

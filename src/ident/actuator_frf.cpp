@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/ident/low_frequency_high_pass.hpp"
 
@@ -208,8 +209,10 @@ void cross_check(std::vector<std::string>& warnings, const std::string& what, co
   if (!reported || !check || *reported == 0.0) return;
   const double d = std::abs(*check / *reported - 1.0);
   if (d <= tolerance) return;
-  warnings.push_back(fmt::format("{}: {} {:.4g} {} but {} {:.4g} {} ({:.0f} % apart, more than {:.0f} %); the report uses the {}", what,
-                                 reported_from, *reported, unit, check_from, *check, unit, 100.0 * d, 100.0 * tolerance, reported_from));
+  warnings.push_back(fmt::format("{}: {} {} {} but {} {} {} ({} % apart, more than {} %); the report uses the {}", what,
+                                 reported_from, format_number(*reported, 4), unit, check_from, format_number(*check, 4),
+                                 unit, format_number_fixed(100.0 * d, 0), format_number_fixed(100.0 * tolerance, 0),
+                                 reported_from));
 }
 
 // The reported features. Static gain, resonance and its damping: from the mass-spring-damper fit of

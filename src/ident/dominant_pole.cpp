@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 
 namespace piezobench::ident {
@@ -15,7 +16,7 @@ void DominantPoleOptions::validate() const {
   const bool automatic = omega_min == 0.0 && omega_max == 0.0;
   if (!automatic && !(std::isfinite(omega_min) && std::isfinite(omega_max) && omega_min >= 0.0 && omega_max > omega_min)) {
     throw InputError("dominant pole options", "omega_max", "a band 0 <= omega_min < omega_max (rad/s), or both 0",
-                     fmt::format("[{:g}, {:g}]", omega_min, omega_max));
+                     fmt::format("[{}, {}]", format_number_exact(omega_min), format_number_exact(omega_max)));
   }
 }
 
@@ -50,10 +51,11 @@ DominantPole dominant_pole(const Vector& omega, const CVector& h, const Dominant
     }
   }
   if (best < 0.0) {
-    throw NumericalError("dominant pole",
-                         fmt::format("the order-{} vector fit has no complex pole with a natural frequency in [{:.4g}, {:.4g}] Hz",
-                                     options.fit.order, lo / kTwoPi, hi / kTwoPi),
-                         true);
+    throw NumericalError(
+        "dominant pole",
+        fmt::format("the order-{} vector fit has no complex pole with a natural frequency in [{}, {}] Hz",
+                    options.fit.order, format_number(lo / kTwoPi, 4), format_number(hi / kTwoPi, 4)),
+        true);
   }
   d.peak = best;
   d.natural_frequency = std::abs(d.pole);

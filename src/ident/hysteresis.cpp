@@ -8,16 +8,15 @@
 #include <numeric>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/nnls.hpp"
 
 namespace piezobench::ident {
 
 namespace {
 
-std::string num(double v) { return fmt::format("{:g}", v); }
-
 void require_finite(double v, const std::string& source, const std::string& field) {
-  if (!std::isfinite(v)) throw InputError(source, field, "a finite value", num(v));
+  if (!std::isfinite(v)) throw InputError(source, field, "a finite value", format_number_exact(v));
 }
 
 void check_record(std::span<const double> x, std::span<const double> y, const std::string& source, const char* xname,
@@ -95,13 +94,16 @@ void PrandtlIshlinskii::validate(const std::string& source) const {
     require_finite(thresholds[i], s, fmt::format("thresholds[{}]", i));
     require_finite(weights[i], s, fmt::format("weights[{}]", i));
     if (!(thresholds[i] > (i == 0 ? 0.0 : thresholds[i - 1]))) {
-      throw InputError(s, fmt::format("thresholds[{}]", i), "thresholds > 0, strictly increasing", num(thresholds[i]));
+      throw InputError(s, fmt::format("thresholds[{}]", i), "thresholds > 0, strictly increasing",
+                       format_number_exact(thresholds[i]));
     }
   }
-  if (!(linear_weight > 0.0)) throw InputError(s, "linear_weight", "a weight > 0 (an invertible operator)", num(linear_weight));
+  if (!(linear_weight > 0.0))
+    throw InputError(s, "linear_weight", "a weight > 0 (an invertible operator)", format_number_exact(linear_weight));
   const double slope = min_slope();
   if (!(slope > 0.0)) {
-    throw InputError(s, "weights", "partial sums w_0 + ... + w_i > 0 (an invertible operator)", fmt::format("a partial sum {:g}", slope));
+    throw InputError(s, "weights", "partial sums w_0 + ... + w_i > 0 (an invertible operator)",
+                     fmt::format("a partial sum {}", format_number_exact(slope)));
   }
 }
 
@@ -187,14 +189,16 @@ void DeadZoneSuperposition::validate(const std::string& source) const {
   for (std::size_t k = 0; k < x.size(); ++k) {
     require_finite(x[k], s, fmt::format("x[{}]", k));
     require_finite(y[k], s, fmt::format("y[{}]", k));
-    if (k > 0 && !(x[k] > x[k - 1])) throw InputError(s, fmt::format("x[{}]", k), "knots strictly increasing", num(x[k]));
+    if (k > 0 && !(x[k] > x[k - 1]))
+      throw InputError(s, fmt::format("x[{}]", k), "knots strictly increasing", format_number_exact(x[k]));
     if (k > 0 && !(y[k] > y[k - 1])) {
-      throw InputError(s, fmt::format("y[{}]", k), "values strictly increasing (an invertible map)", num(y[k]));
+      throw InputError(s, fmt::format("y[{}]", k), "values strictly increasing (an invertible map)",
+                       format_number_exact(y[k]));
     }
   }
   for (const auto& [name, v] : {std::pair<const char*, double>{"slope_below", slope_below}, {"slope_above", slope_above}}) {
     require_finite(v, s, name);
-    if (!(v > 0.0)) throw InputError(s, name, "a slope > 0 (an invertible map)", num(v));
+    if (!(v > 0.0)) throw InputError(s, name, "a slope > 0 (an invertible map)", format_number_exact(v));
   }
 }
 
@@ -207,21 +211,25 @@ void HysteresisModel::validate(const std::string& source) const {
   const std::string s = source.empty() ? "hysteresis model" : source;
   hysteresis.validate(s);
   output.validate(s + ": output");
-  if (hysteresis.linear_weight != 1.0) throw InputError(s, "linear_weight", "1 (H in effective volts)", num(hysteresis.linear_weight));
+  if (hysteresis.linear_weight != 1.0)
+    throw InputError(s, "linear_weight", "1 (H in effective volts)", format_number_exact(hysteresis.linear_weight));
   if (creep_time_constants.size() != creep_coefficients.size()) {
     throw InputError(s, "creep_coefficients", fmt::format("{} coefficients (one per time constant)", creep_time_constants.size()),
                      std::to_string(creep_coefficients.size()));
   }
   for (std::size_t j = 0; j < creep_time_constants.size(); ++j) {
     const double tau = creep_time_constants[j], c = creep_coefficients[j];
-    if (!(std::isfinite(tau) && tau > 0.0)) throw InputError(s, fmt::format("creep_time_constants[{}]", j), "a time > 0 s", num(tau));
-    if (!(std::isfinite(c) && c >= 0.0)) throw InputError(s, fmt::format("creep_coefficients[{}]", j), "a coefficient >= 0", num(c));
+    if (!(std::isfinite(tau) && tau > 0.0))
+      throw InputError(s, fmt::format("creep_time_constants[{}]", j), "a time > 0 s", format_number_exact(tau));
+    if (!(std::isfinite(c) && c >= 0.0))
+      throw InputError(s, fmt::format("creep_coefficients[{}]", j), "a coefficient >= 0", format_number_exact(c));
   }
   require_finite(gain, s, "gain");
   if (gain == 0.0) throw InputError(s, "gain", "a gain != 0 m/V", "0");
   require_finite(offset, s, "offset");
   require_finite(reference_slope, s, "reference_slope");
-  if (!(reference_slope > 0.0)) throw InputError(s, "reference_slope", "a slope > 0", num(reference_slope));
+  if (!(reference_slope > 0.0))
+    throw InputError(s, "reference_slope", "a slope > 0", format_number_exact(reference_slope));
   require_finite(reference_intercept, s, "reference_intercept");
   require_finite(input_min, s, "input_min");
   require_finite(input_max, s, "input_max");
@@ -246,21 +254,24 @@ void HysteresisFitOptions::validate() const {
   const std::string s = "hysteresis fit options";
   if (operators < 1 || operators > 200) throw InputError(s, "operators", "an integer in 1..200", std::to_string(operators));
   if (!(std::isfinite(threshold_range) && threshold_range >= 0.0)) {
-    throw InputError(s, "threshold_range", "a range >= 0 V (0: half the range of Va)", num(threshold_range));
+    throw InputError(s, "threshold_range", "a range >= 0 V (0: half the range of Va)",
+                     format_number_exact(threshold_range));
   }
   for (std::size_t j = 0; j < creep_time_constants.size(); ++j) {
     const double tau = creep_time_constants[j];
-    if (!(std::isfinite(tau) && tau > 0.0)) throw InputError(s, fmt::format("creep_time_constants[{}]", j), "a time > 0 s", num(tau));
+    if (!(std::isfinite(tau) && tau > 0.0))
+      throw InputError(s, fmt::format("creep_time_constants[{}]", j), "a time > 0 s", format_number_exact(tau));
   }
   if (thresholds.size() > 200) throw InputError(s, "thresholds", "at most 200 thresholds", std::to_string(thresholds.size()));
   for (std::size_t i = 0; i < thresholds.size(); ++i) {
     if (!(std::isfinite(thresholds[i]) && thresholds[i] > (i == 0 ? 0.0 : thresholds[i - 1]))) {
-      throw InputError(s, fmt::format("thresholds[{}]", i), "thresholds > 0, strictly increasing", num(thresholds[i]));
+      throw InputError(s, fmt::format("thresholds[{}]", i), "thresholds > 0, strictly increasing",
+                       format_number_exact(thresholds[i]));
     }
   }
   if (dead_zones < 0 || dead_zones > 50) throw InputError(s, "dead_zones", "an integer in 0..50", std::to_string(dead_zones));
   if (!(std::isfinite(max_relative_residual) && max_relative_residual > 0.0)) {
-    throw InputError(s, "max_relative_residual", "a fraction > 0", num(max_relative_residual));
+    throw InputError(s, "max_relative_residual", "a fraction > 0", format_number_exact(max_relative_residual));
   }
 }
 
@@ -370,8 +381,9 @@ HysteresisFit finish_fit(std::span<const double> va, std::span<const double> de,
   out.rms_residual = std::sqrt(sum / static_cast<double>(de.size()));
   out.relative_residual = out.stroke > 0.0 ? out.rms_residual / out.stroke : 0.0;
   if (!(out.relative_residual <= o.max_relative_residual)) {
-    out.quality.add_problem(fmt::format("d_e: rms residual {:.3g} % of the stroke (limit {:.3g} %)", 100.0 * out.relative_residual,
-                                        100.0 * o.max_relative_residual));
+    out.quality.add_problem(fmt::format("d_e: rms residual {} % of the stroke (limit {} %)",
+                                        format_number(100.0 * out.relative_residual, 3),
+                                        format_number(100.0 * o.max_relative_residual, 3)));
     out.quality.advise("more operators or dead zones, creep states (a drifting record), or a record starting at rest");
   }
   return out;
@@ -385,7 +397,8 @@ HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double>
   const std::string source = "hysteresis fit";
   const std::string method = "Prandtl-Ishlinskii identification";
   check_record(va, de, source, "Va", "de");
-  if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) throw InputError(source, "sample_rate", "a rate > 0 Hz", num(sample_rate));
+  if (!(std::isfinite(sample_rate) && sample_rate > 0.0))
+    throw InputError(source, "sample_rate", "a rate > 0 Hz", format_number_exact(sample_rate));
   const double va_range = range(va);
   if (!(va_range > 0.0)) throw InputError(source, "Va", "a voltage that moves", "a constant");
   const std::vector<double> r = !options.thresholds.empty()
@@ -436,8 +449,9 @@ HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double>
   out.rms_residual = std::sqrt(residual.squaredNorm() / static_cast<double>(rows));
   out.relative_residual = out.stroke > 0.0 ? out.rms_residual / out.stroke : 0.0;
   if (!(out.relative_residual <= options.max_relative_residual)) {
-    out.quality.add_problem(fmt::format("d_e: rms residual {:.3g} % of the stroke (limit {:.3g} %)", 100.0 * out.relative_residual,
-                                        100.0 * options.max_relative_residual));
+    out.quality.add_problem(fmt::format("d_e: rms residual {} % of the stroke (limit {} %)",
+                                        format_number(100.0 * out.relative_residual, 3),
+                                        format_number(100.0 * options.max_relative_residual, 3)));
     out.quality.advise("more operators, creep states (a drifting record), or a record starting at rest; loops asymmetric "
                        "about their centre are beyond a Prandtl-Ishlinskii operator: try the modified one (dead_zones, "
                        "--dead-zones)");
@@ -449,10 +463,11 @@ CreepFit fit_creep(std::span<const double> input, std::span<const double> output
                    std::vector<double> time_constants, double max_relative_residual) {
   const std::string source = "creep fit";
   check_record(input, output, source, "input", "output");
-  if (!(std::isfinite(sample_rate) && sample_rate > 0.0)) throw InputError(source, "sample_rate", "a rate > 0 Hz", num(sample_rate));
+  if (!(std::isfinite(sample_rate) && sample_rate > 0.0))
+    throw InputError(source, "sample_rate", "a rate > 0 Hz", format_number_exact(sample_rate));
   if (!(range(input) > 0.0)) throw InputError(source, "input", "an input that moves (a step)", "a constant");
   if (!(std::isfinite(max_relative_residual) && max_relative_residual > 0.0)) {
-    throw InputError(source, "max_relative_residual", "a fraction > 0", num(max_relative_residual));
+    throw InputError(source, "max_relative_residual", "a fraction > 0", format_number_exact(max_relative_residual));
   }
   const double duration = static_cast<double>(input.size()) / sample_rate;
   if (time_constants.empty()) {
@@ -460,7 +475,8 @@ CreepFit fit_creep(std::span<const double> input, std::span<const double> output
   }
   for (std::size_t j = 0; j < time_constants.size(); ++j) {
     if (!(std::isfinite(time_constants[j]) && time_constants[j] > 0.0)) {
-      throw InputError(source, fmt::format("time_constants[{}]", j), "a time > 0 s", num(time_constants[j]));
+      throw InputError(source, fmt::format("time_constants[{}]", j), "a time > 0 s",
+                       format_number_exact(time_constants[j]));
     }
   }
   const auto m = static_cast<Eigen::Index>(time_constants.size());
@@ -486,8 +502,9 @@ CreepFit fit_creep(std::span<const double> input, std::span<const double> output
   const double stroke = range(output);
   out.relative_residual = stroke > 0.0 ? out.rms_residual / stroke : 0.0;
   if (!(out.relative_residual <= max_relative_residual)) {
-    out.quality.add_problem(fmt::format("output: rms residual {:.3g} % of the range (limit {:.3g} %)", 100.0 * out.relative_residual,
-                                        100.0 * max_relative_residual));
+    out.quality.add_problem(fmt::format("output: rms residual {} % of the range (limit {} %)",
+                                        format_number(100.0 * out.relative_residual, 3),
+                                        format_number(100.0 * max_relative_residual, 3)));
     out.quality.advise("other time constants (a decade apart, within the record), or a record with one clean step");
   }
   return out;

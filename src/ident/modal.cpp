@@ -329,7 +329,7 @@ LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& option
   }
   for (const Mode& m : result.modes) {
     if (m.natural_frequency < w_lo || m.natural_frequency > w_hi) {
-      result.quality.add_problem("mode at " + std::to_string(m.frequency_Hz()) + " Hz outside the band");
+      result.quality.add_problem("mode at " + format_number(m.frequency_Hz()) + " Hz outside the band");
     }
   }
   result.quality.advise("a band around the modes with a high coherence, or more averages");

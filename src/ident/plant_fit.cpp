@@ -5,18 +5,19 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <utility>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
-#include "piezobench/core/least_squares.hpp"
-#include "piezobench/ident/features.hpp"
-#include "piezobench/core/units.hpp"
 #include "piezobench/core/fit_covariance.hpp"
+#include "piezobench/core/format.hpp"
+#include "piezobench/core/least_squares.hpp"
+#include "piezobench/core/units.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
+#include "piezobench/ident/features.hpp"
 
 namespace piezobench::ident {
 
@@ -170,8 +171,8 @@ IffPlantFit from_x(const Eigen::VectorXd& x, double sign, const Layout& l, doubl
 // A fitted frequency (rad/s) must lie inside the band of the points used.
 void check_in_band(core::FitQuality& q, const char* what, double w, const Vector& band) {
   if (w >= band(0) && w <= band(band.size() - 1)) return;
-  q.add_problem(fmt::format("{} {:.4g} Hz outside the band used, {:.4g} to {:.4g} Hz", what, w / kTwoPi,
-                            band(0) / kTwoPi, band(band.size() - 1) / kTwoPi));
+  q.add_problem(fmt::format("{} {} Hz outside the band used, {} to {} Hz", what, format_number(w / kTwoPi, 4),
+                            format_number(band(0) / kTwoPi, 4), format_number(band(band.size() - 1) / kTwoPi, 4)));
 }
 
 void check_lm(core::FitQuality& q, core::LmStatus status) {
@@ -213,7 +214,7 @@ ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit
       v.reason = interval + " contains 0: undetermined";
     }
     if (zero && zero->phase_verdict != PhaseVerdict::kUndetermined) {
-      v.reason += fmt::format("; phase change {:.1f} deg", zero->phase_change_deg);
+      v.reason += fmt::format("; phase change {} deg", format_number_fixed(zero->phase_change_deg, 1));
     }
     return v;
   }
@@ -229,7 +230,8 @@ ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit
     } else {
       v.nonminimum_phase = zero->phase_verdict == PhaseVerdict::kNonMinimumPhase;
       v.from = "phase";
-      v.reason = fmt::format("phase change {:.1f} deg across the anti-resonance: {}", change, kind(*v.nonminimum_phase));
+      v.reason = fmt::format("phase change {} deg across the anti-resonance: {}", format_number_fixed(change, 1),
+                             kind(*v.nonminimum_phase));
       return v;
     }
   } else {
@@ -238,7 +240,8 @@ ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit
   if (plant) {
     v.nonminimum_phase = plant->zero_is_nonminimum_phase();
     v.from = "iff-plant-fit";
-    v.reason = fmt::format("{}; plant fit zero xz = {:.3g} {} 0", phase, plant->xz, plant->xz < 0.0 ? "<" : ">=");
+    v.reason = fmt::format("{}; plant fit zero xz = {} {} 0", phase, format_number(plant->xz, 3),
+                           plant->xz < 0.0 ? "<" : ">=");
   } else if (zero && zero->phase_verdict != PhaseVerdict::kUndetermined) {
     v.nonminimum_phase = zero->phase_verdict == PhaseVerdict::kNonMinimumPhase;
     v.from = "phase";
@@ -246,7 +249,8 @@ ZeroPhaseVerdict zero_phase_verdict(const AntiResonance* zero, const IffPlantFit
   } else if (zero) {
     v.nonminimum_phase = zero->nonminimum_phase_model;
     v.from = "fitted-zero";
-    v.reason = fmt::format("{}, no plant fit; vector fit zero Re = {:.3g} rad/s", phase, zero->root.real());
+    v.reason =
+        fmt::format("{}, no plant fit; vector fit zero Re = {} rad/s", phase, format_number(zero->root.real(), 3));
   } else {
     v.from = "none";
     v.reason = phase + ", no plant fit";
@@ -462,7 +466,8 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   check_in_band(fit.quality, "anti-resonance wz", fit.wz, b.w);
   check_in_band(fit.quality, "resonance wp", fit.wp, b.w);
   check_lm(fit.quality, best.status);
-  if (fit.delay < 0.0) fit.quality.add_problem(fmt::format("delay {:.3g} s < 0 (acausal)", fit.delay), false);
+  if (fit.delay < 0.0)
+    fit.quality.add_problem(fmt::format("delay {} s < 0 (acausal)", format_number(fit.delay, 3)), false);
   fit.quality.advise("a band around the anti-resonance and the resonance where the coherence is high");
   return fit;
 }
@@ -533,7 +538,7 @@ Index second_order_peak(const FitBand& b, const std::string& source) {
   }
   if (peak == 0 || peak == b.w.size() - 1) {
     throw InputError(source, "H", "a resonance peak inside the band",
-                     fmt::format("the largest |H| at the band's edge ({:.4g} Hz)", b.w(peak) / kTwoPi));
+                     fmt::format("the largest |H| at the band's edge ({} Hz)", format_number(b.w(peak) / kTwoPi, 4)));
   }
   return peak;
 }
@@ -616,7 +621,8 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   fit.quality.check_error("second-order fit", fit.relative_rms_error);
   check_in_band(fit.quality, "natural frequency", fit.natural_frequency, b.w);
   check_lm(fit.quality, o.status);
-  if (fit.delay < 0.0) fit.quality.add_problem(fmt::format("delay {:.3g} s < 0 (acausal)", fit.delay), false);
+  if (fit.delay < 0.0)
+    fit.quality.add_problem(fmt::format("delay {} s < 0 (acausal)", format_number(fit.delay, 3)), false);
   fit.quality.advise("a band around the resonance where the coherence is high");
   return fit;
 }

@@ -1074,7 +1074,7 @@ bool spurious_poles(const Vector& omega, VectorFittingResult& result) {
       spurious = true;
     }
     if (p.real() > 0.0) {
-      result.quality.add_problem("unstable pole (Re > 0) at " + std::to_string(w / kTwoPi) + " Hz");
+      result.quality.add_problem("unstable pole (Re > 0) at " + format_number(w / kTwoPi) + " Hz");
       spurious = true;
     }
   }

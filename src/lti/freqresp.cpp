@@ -10,6 +10,7 @@
 
 #include "balance.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/lti/conversions.hpp"
 
 namespace piezobench::lti {
@@ -41,8 +42,9 @@ struct Workspace {
 };
 
 [[noreturn]] void throw_pole(Complex s) {
-  throw NumericalError("freqresp", "the evaluation point (" + std::to_string(s.real()) + ", " +
-                                       std::to_string(s.imag()) + ") is numerically a pole of the system",
+  throw NumericalError("freqresp",
+                       "the evaluation point (" + format_number(s.real(), 10) + ", " + format_number(s.imag(), 10) +
+                           ") is numerically a pole of the system",
                        /*retry_may_help=*/true);
 }
 
@@ -326,7 +328,7 @@ void check_omega(const Vector& omega, const std::string& source) {
   for (Index k = 0; k < omega.size(); ++k) {
     if (!std::isfinite(omega(k))) {
       throw InputError(source, "omega(" + std::to_string(k) + ")", "a finite frequency in rad/s",
-                       std::to_string(omega(k)));
+                       format_number_exact(omega(k)));
     }
   }
 }
@@ -486,10 +488,10 @@ CVector freqresp(const TransferFunction& tf, const Vector& omega) {
 
 Vector logspace(double lo_exponent, double hi_exponent, Index n) {
   if (!std::isfinite(lo_exponent)) {
-    throw InputError("logspace", "lo_exponent", "a finite number", std::to_string(lo_exponent));
+    throw InputError("logspace", "lo_exponent", "a finite number", format_number_exact(lo_exponent));
   }
   if (!std::isfinite(hi_exponent)) {
-    throw InputError("logspace", "hi_exponent", "a finite number", std::to_string(hi_exponent));
+    throw InputError("logspace", "hi_exponent", "a finite number", format_number_exact(hi_exponent));
   }
   if (n < 0) throw InputError("logspace", "n", "a count >= 0", std::to_string(n));
   Vector out(n);

@@ -4,16 +4,19 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::plant {
 namespace {
 
 void require_positive(double value, const char* field) {
-  if (!(std::isfinite(value) && value > 0.0)) throw InputError("", field, "a finite positive number", std::to_string(value));
+  if (!(std::isfinite(value) && value > 0.0))
+    throw InputError("", field, "a finite positive number", format_number_exact(value));
 }
 
 void require_nonnegative(double value, const char* field) {
-  if (!(std::isfinite(value) && value >= 0.0)) throw InputError("", field, "a finite number >= 0", std::to_string(value));
+  if (!(std::isfinite(value) && value >= 0.0))
+    throw InputError("", field, "a finite number >= 0", format_number_exact(value));
 }
 
 // Second-order factor 1 + 2 x s/w + s^2/w^2 in descending powers.
@@ -30,9 +33,10 @@ lti::Vector convolve(const lti::Vector& a, const lti::Vector& b) {
 }  // namespace
 
 void IffPlantParams::validate() const {
-  if (!std::isfinite(g0) || g0 == 0.0) throw InputError("", "g0", "a finite non-zero gain", std::to_string(g0));
+  if (!std::isfinite(g0) || g0 == 0.0) throw InputError("", "g0", "a finite non-zero gain", format_number_exact(g0));
   require_positive(wz, "wz");
-  if (!std::isfinite(xz)) throw InputError("", "xz", "a finite damping ratio (< 0: non-minimum-phase zero)", std::to_string(xz));
+  if (!std::isfinite(xz))
+    throw InputError("", "xz", "a finite damping ratio (< 0: non-minimum-phase zero)", format_number_exact(xz));
   require_positive(wp, "wp");
   require_nonnegative(xp, "xp");
   require_positive(w_hpf, "w_hpf");

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/rt/timing.hpp"
 
 namespace piezobench::rt {
@@ -107,7 +108,7 @@ struct ComediBackend::State {
     if (best < 0) {
       throw InputError(bench.source, "signals." + c.name + ".range",
                        fmt::format("a range the card has on subdevice {} ({})", s.subdevice, available),
-                       fmt::format("[{:g}, {:g}]", s.range_min, s.range_max));
+                       fmt::format("[{}, {}]", format_number_exact(s.range_min), format_number_exact(s.range_max)));
     }
     c.range = static_cast<unsigned>(best);
     const comedi_range* cr = comedi_get_range(dev, c.subdevice, c.channel, c.range);

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/core/timestamp.hpp"
 
 namespace piezobench::rt {
@@ -109,8 +110,9 @@ BackendRunner::BackendRunner(Backend& backend, MeasureOptions options) : backend
   options_.bench.validate();
   const double rate = backend.sample_rate();
   if (std::abs(rate - options_.bench.sample_rate) > 1e-9 * options_.bench.sample_rate) {
-    throw InputError(options_.bench.source, "bench.sample_rate_Hz", fmt::format("the backend's rate {:g} Hz", rate),
-                     fmt::format("{:g} Hz", options_.bench.sample_rate));
+    throw InputError(options_.bench.source, "bench.sample_rate_Hz",
+                     fmt::format("the backend's rate {} Hz", format_number_exact(rate)),
+                     fmt::format("{} Hz", format_number_exact(options_.bench.sample_rate)));
   }
 }
 
@@ -169,20 +171,21 @@ io::TimeSeries BackendRunner::run(LoopOptions lo, const std::vector<bench::Opera
   report_.runs.push_back(rep);
   if (rep.safe_state_cycle >= 0) {
     throw InputError(
-        "measure on " + backend_.name(), "run",
-        "a run without a safety trip",
-        fmt::format("the safe state ({}) at t = {:.4f} s; the output was brought to {:g} V{}", rep.safe_state_reason,
-                    static_cast<double>(rep.safe_state_cycle) / rate, lo.limits.va_safe,
+        "measure on " + backend_.name(), "run", "a run without a safety trip",
+        fmt::format("the safe state ({}) at t = {} s; the output was brought to {} V{}", rep.safe_state_reason,
+                    format_number_fixed(static_cast<double>(rep.safe_state_cycle) / rate, 4),
+                    format_number(lo.limits.va_safe),
                     lo.log_file ? "; the log up to then is in " + lo.log_file->string() : std::string()));
   }
   // A held sample repeats the previous one: beyond the budget the record is not the response.
   const double budget = std::floor(lo.limits.stale_budget * static_cast<double>(rep.cycles));
   if (static_cast<double>(rep.stale_sensor_samples) > budget) {
-    throw InputError("measure on " + backend_.name(), "stale samples",
-                     fmt::format("at most {:g} held samples ({:g} % of the run's {} cycles, limits.stale_budget)", budget,
-                                 100.0 * lo.limits.stale_budget, rep.cycles),
-                     fmt::format("{}{}", rep.stale_sensor_samples,
-                                 lo.log_file ? "; the log is in " + lo.log_file->string() : std::string()));
+    throw InputError(
+        "measure on " + backend_.name(), "stale samples",
+        fmt::format("at most {} held samples ({} % of the run's {} cycles, limits.stale_budget)",
+                    format_number_exact(budget), format_number(100.0 * lo.limits.stale_budget), rep.cycles),
+        fmt::format("{}{}", rep.stale_sensor_samples,
+                    lo.log_file ? "; the log is in " + lo.log_file->string() : std::string()));
   }
   const auto n = static_cast<Eigen::Index>(std::llround(lo.duration * rate));
   if (log.samples() < n) {

@@ -9,6 +9,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/fields.hpp"
+#include "piezobench/core/format.hpp"
 
 namespace piezobench::station {
 
@@ -188,11 +189,12 @@ MeasuredValue judge(const MeasurementKind& kind, std::optional<double> value, co
     }
     if (static_cast<int>(here) > static_cast<int>(m.verdict)) {
       m.verdict = here;
-      m.reason = fmt::format("{} {:.4g} {} {} {} {:.4g} {}{}", kind.description, v, kind.unit,
-                             here == Verdict::kMarginal ? "within the margin of" : (is_min ? "below" : "above"),
-                             is_min ? "the minimum" : "the maximum",
-                             bound, kind.unit,
-                             here == Verdict::kMarginal ? fmt::format(" (margin +-{:.3g} {})", u, kind.unit) : std::string());
+      m.reason =
+          fmt::format("{} {} {} {} {} {} {}{}", kind.description, format_number(v, 4), kind.unit,
+                      here == Verdict::kMarginal ? "within the margin of" : (is_min ? "below" : "above"),
+                      is_min ? "the minimum" : "the maximum", format_number(bound, 4), kind.unit,
+                      here == Verdict::kMarginal ? fmt::format(" (margin +-{} {})", format_number(u, 3), kind.unit)
+                                                 : std::string());
     }
   };
   if (limit.min) check(*limit.min, true);

@@ -44,5 +44,17 @@ TEST(FormatNumberExact, FewestDigitsThatReadBack) {
   EXPECT_EQ(format_number_exact(std::numeric_limits<double>::quiet_NaN()), "nan");
 }
 
+TEST(FormatNumberFixed, DecimalsAfterThePoint) {
+  EXPECT_EQ(format_number_fixed(158.34, 1), "158.3");
+  EXPECT_EQ(format_number_fixed(200.0, 1), "200.0");
+  EXPECT_EQ(format_number_fixed(-174.46, 1), "-174.5");
+  EXPECT_EQ(format_number_fixed(12.5, 0), "12");  // round half to even, as printf
+  EXPECT_EQ(format_number_fixed(1e-12, 2), "0.00");
+  EXPECT_EQ(format_number_fixed(1e300, 0).size(), 301u);
+  EXPECT_EQ(format_number_fixed(0.5, -3), "0");  // clamped to 0 decimals
+  EXPECT_EQ(format_number_fixed(std::numeric_limits<double>::infinity(), 2), "inf");
+  EXPECT_EQ(format_number_fixed(std::numeric_limits<double>::quiet_NaN(), 2), "nan");
+}
+
 }  // namespace
 }  // namespace piezobench

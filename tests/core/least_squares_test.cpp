@@ -96,5 +96,19 @@ TEST(LevenbergMarquardt, StatusNames) {
   EXPECT_THROW((void)lm_status_from_string("done"), InputError);
 }
 
+TEST(LevenbergMarquardt, OptionsErrorShowsATinyToleranceAsWritten) {
+  // std::to_string printed -1e-12 as "-0.000000": the message must show the value the caller gave.
+  LmOptions o;
+  o.cost_tolerance = -1e-12;
+  try {
+    o.validate();
+    FAIL() << "no error for a negative tolerance";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "cost_tolerance");
+    EXPECT_EQ(std::string(e.what()),
+              "Levenberg-Marquardt options: cost_tolerance: expected a finite tolerance >= 0, found -1e-12");
+  }
+}
+
 }  // namespace
 }  // namespace piezobench::core

@@ -43,6 +43,19 @@ TEST(Frf, ValidateAcceptsAConsistentFrfAndNoCoherence) {
   EXPECT_NO_THROW(f.validate());
 }
 
+TEST(Frf, ValidateShowsTinyFrequenciesAsTheyAre) {
+  // std::to_string printed both frequencies as "0.000000", as if they were zero.
+  Frf f = two_outputs();
+  f.freq_Hz << 0.0, 1e-12, 1e-12, 3.0, 4.0;
+  try {
+    f.validate();
+    FAIL() << "no error for a repeated frequency";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "run.mat: freq_Hz: expected strictly increasing frequencies, found 1e-12 then 1e-12 at index 2");
+  }
+}
+
 TEST(Frf, ValidateRejectsEachKindOfInconsistency) {
   auto expect_field = [](const Frf& f, const std::string& field) {
     try {

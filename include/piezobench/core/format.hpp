@@ -15,4 +15,9 @@ std::string format_number(double value, int significant_digits = 6);
 // for the last). "nan", "inf", "-inf" for the non-finite values.
 std::string format_number_exact(double value);
 
+// `value` with `decimals` digits after the point (printf's %.*f): a value set beside a limit in the
+// same unit ("stroke 158.3 um below the minimum 200.0 um"), where aligned decimals read better than
+// significant digits. "nan", "inf", "-inf" for the non-finite values. decimals is clamped to [0, 17].
+std::string format_number_fixed(double value, int decimals);
+
 }  // namespace piezobench
