@@ -9,7 +9,8 @@ The rule (docs/design.md, "Conventions"): a `double` (or `float`, `Eigen::Vector
 `std::vector<double>`) field or parameter of include/piezobench/ names its unit
   - in its name: a unit suffix (`fmin_Hz`, `duration_s`, `stiffness_N_per_m`, `gain_dB`), or
   - in the comment on its line or the comment block just above it (`double wz;  // rad/s`;
-    "dimensionless", "ratio", "relative" count too), or
+    "dimensionless", "ratio", "relative" count too, and so does a unit named by reference: "input
+    unit", "output unit", "data units", "same unit as the values"), or
   - for a parameter, in the comment just above its declaration, on a line naming the parameter
     (`// omega in rad/s`), or
   - it is a dimensionless kind by name (`*_ratio`, `relative_*`, `damping`, `coherence`, `overlap`,
@@ -34,7 +35,10 @@ NAME_UNIT = re.compile(rf"(?:^|_)(?:{UNIT_WORDS})(?:_per_[A-Za-z0-9_]+)?$|_per_(
 # A unit written in a comment.
 COMMENT_UNIT = re.compile(r"(?<![A-Za-z])(?:Hz|kHz|s|ms|us|ns|m|mm|um|nm|V|mV|A|N|kg|Pa|GPa|F|uF|nF|dB|deg|degrees|rad|"
                           r"rad/s|V/V|N/m|V/m|N/V|m/V|m/N|1/s|s\^-1|m/s|m/s\^2|K|W|J|C|ohm|%|ppm|LSB|counts?|"
-                          r"samples?|dimensionless|ratio|fraction|relative|unitless|per unit|a count|SI|Hz\^-1)(?![A-Za-z])")
+                          r"samples?|dimensionless|ratio|fraction|relative|unitless|per unit|a count|SI|Hz\^-1|"
+                          r"Ohm|kOhm|GB|MB|"
+                          # A unit named by reference: generic code whose numbers carry another's unit.
+                          r"(?:input|output|data|command|caller's|values'?) units?|same units? as)(?![A-Za-z])")
 DIMENSIONLESS = re.compile(r"(^|_)(ratio|relative|rel|fraction|damping|zeta|coherence|overlap|factor|weight|weights|z|"
                            r"xz|xp|probability|confidence|quantile|alpha|beta|exponent|order|kurtosis|skew|r2|nrmse|"
                            r"correlation|efficiency|spread|robust_z|tolerance_relative|scale|fill|share|fit|misfit|"

@@ -26,6 +26,7 @@ struct Options {
   double bare = 0.0;
   double a = 0.0, b_m = 0.0;       // (the comment names no unit)
   double trailing_ = 0.0;
+  double y = 0.0;                  // output unit (the caller's)
 };
 
 // The response at omega (rad/s); `gain` in V/V.

@@ -18,7 +18,7 @@ struct PiezoConstants {
   double c_e = 48e9;      // N/m^2, Young's modulus at constant field
   double length = 20e-3;  // m, stack length
   double area = 1e-4;     // m^2, stack cross-section
-  double layers = 160;    // number of layers n in the stack: an integer >= 1
+  double layers = 160;    // count, number of layers n in the stack: an integer >= 1
 
   // InputError (source "piezo constants" unless given) naming the field: every constant positive
   // and finite, layers an integer >= 1.

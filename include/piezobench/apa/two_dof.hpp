@@ -59,6 +59,7 @@ struct TwoDofParams {
   // Value of a named parameter; InputError (field "parameter") for an unknown name.
   [[nodiscard]] double get(const std::string& name) const;
   // Sets a named parameter; InputError naming `source` and the key for an unknown name.
+  // value: SI, the parameter's unit.
   void set(const std::string& name, double value, const std::string& source = "");
 
   // Throws InputError (source "2-DoF parameters" unless given) naming the field: m, k1, ke, ka > 0;

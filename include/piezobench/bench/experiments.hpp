@@ -113,10 +113,12 @@ class BenchRunner {
   // (u'[k] + w[k] (stage - u'[k]): blended in and out), then clamped to the stack range (a real-time
   // loop also slew-limits it: rt::LoopOptions::feedforward, feedforward_weight). w has u's size. out
   // as open_loop's (column u: what was applied). Returns the number of clamped samples.
+  // u_prime: V at the DAC; w: dimensionless.
   virtual std::uint64_t open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
                                               std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) = 0;
   // IFF closed loop u = u' + g K0 Vs (report's controller, control::DiscreteIff), u clamped to the
   // stack range: out is n x 4, columns u, Va, de, Vs. Returns the number of clamped samples.
+  // u_prime: V at the DAC; gain g: V/V.
   virtual std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
                             const Progress& progress) = 0;
   // u = 0 for n samples while the operator carries out `steps` (in order): out is n x 2, columns
@@ -136,11 +138,14 @@ class VirtualRunner final : public BenchRunner {
  public:
   VirtualRunner(const UnitTruth& unit, const BenchOptions& options);
   ~VirtualRunner() override;
+  // u: V at the DAC.
   void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) override;
   // The loop's stages without its timing: the feedforward, then the clamp (the slew limit never
   // acts on the tracking commands at the default 1e5 V/s).
+  // u_prime: V at the DAC; w: dimensionless.
   std::uint64_t open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
                                       std::uint64_t seed, Eigen::MatrixXd& out, const Progress& progress) override;
+  // u_prime: V at the DAC; gain g: V/V.
   std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
                     const Progress& progress) override;
   std::vector<double> hold(Eigen::Index n, const std::vector<OperatorStep>& steps, std::uint64_t seed, Eigen::MatrixXd& out,

@@ -36,7 +36,7 @@
 namespace piezobench::bench {
 
 struct TrackingFigures {
-  double width_open = 0.0, width_ff = 0.0;  // hysteresis width / stroke
+  double width_open = 0.0, width_ff = 0.0;  // ratio, hysteresis width / stroke
   double rms_open = 0.0, rms_ff = 0.0;      // m, rms tracking error
   double stroke_open = 0.0;                 // m
   [[nodiscard]] double width_reduction() const { return width_ff > 0.0 ? width_open / width_ff : 0.0; }

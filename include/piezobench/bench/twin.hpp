@@ -37,7 +37,7 @@ inline constexpr const char* kTwinFormat = "piezobench-twin-1";
 // A one-sided power spectral density (unit^2/Hz) at some frequencies.
 struct NoiseSpectrum {
   std::vector<double> freq_Hz;
-  std::vector<double> psd;
+  std::vector<double> psd;  // unit^2/Hz
 };
 
 struct Twin {

@@ -132,7 +132,7 @@ struct BenchOptions {
   double amplifier_gain = 20.0;             // V/V
   double amplifier_bandwidth_Hz = 5000.0;
   double va_min = -20.0;                    // V, APA300ML stack range
-  double va_max = 150.0;
+  double va_max = 150.0;                    // V
   // Mechanics around the actuator.
   double suspended_mass = 5.7;              // kg, granite and parts on the air bearing
   double added_mass = 6.4;                  // kg, the mass of the static stiffness test (the bench

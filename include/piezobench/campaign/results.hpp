@@ -59,7 +59,7 @@ constexpr auto describe(core::Type<RecordProvenance>) {
 
 // A curve of the report (thinned or log-spaced samples).
 struct Curve {
-  std::vector<double> x, y;
+  std::vector<double> x, y;  // in the units the curve's field names (e.g. x Va [V], y d_e [m])
 };
 
 constexpr auto describe(core::Type<Curve>) {
@@ -77,7 +77,7 @@ struct FlatnessAnalysis {
   std::optional<double> minimum_zone;        // m (at most 100 points)
   long points = 0;
   struct Interface {
-    double id = 0.0;            // value of the interface channel
+    double id = 0.0;            // dimensionless label, value of the interface channel
     double least_squares = 0.0; // m
   };
   std::vector<Interface> per_interface;      // interfaces with 3 non-collinear points or more
@@ -342,7 +342,7 @@ constexpr auto describe(core::Type<ResistorComparison>) {
 
 // One damped plant u' -> d_e of the IFF experiment.
 struct DampedPlant {
-  double gain = 0.0;             // controller gain g
+  double gain = 0.0;             // V/V, controller gain g
   std::string file;              // as given in the campaign
   RecordProvenance provenance;
   dsp::Frf frf;                  // u' -> d_e
@@ -442,7 +442,7 @@ struct UnitAnalysis {
   // The numbers the batch analyses and the acceptance need (SI; nullopt = not available).
   std::optional<double> flatness;            // m, by the spec's method
   std::optional<double> capacitance_sensor;  // F
-  std::optional<double> capacitance_actuator;
+  std::optional<double> capacitance_actuator;  // F
   std::optional<double> stroke;              // m
   std::optional<double> k1, k2, k_resonance; // N/m (k_sc = k1)
   std::optional<double> k_oc;                // N/m, k1 of the test with every stack open
@@ -506,13 +506,13 @@ struct QuantitySpread {
   std::string label;     // for people, e.g. "capacitance of the sensor stack"
   std::string unit;      // of the values, e.g. "uF"
   long units = 0;
-  double min = 0.0, max = 0.0, median = 0.0, relative_spread = 0.0, mad = 0.0;
+  double min = 0.0, max = 0.0, median = 0.0, relative_spread = 0.0, mad = 0.0;  // in `unit` (relative_spread: ratio)
 };
 
 struct BatchOutlier {
   int unit = 0;
   std::string quantity;  // as in QuantitySpread
-  double value = 0.0, median = 0.0, robust_z = 0.0;
+  double value = 0.0, median = 0.0, robust_z = 0.0;  // same unit as the quantity's values (robust_z: dimensionless)
 };
 
 // Unit-to-unit similarity of the FRFs: rms distance in dB from the batch median magnitude.
@@ -596,20 +596,20 @@ struct IffStudy {
   control::IffControllerParams controller;
   std::optional<int> unit;                 // the unit whose plant is used
   std::optional<ident::IffPlantFit> plant;
-  std::vector<double> gains;               // of the damped plants with an identified pole
+  std::vector<double> gains;                                    // V/V, of the damped plants with an identified pole
   std::vector<std::complex<double>> damped_poles, model_poles;  // rad/s
   std::vector<double> relative_pole_distance;
   double max_relative_pole_distance = 0.0;
-  double pole_distance_tolerance = 0.0;    // above it: `warning`
+  double pole_distance_tolerance = 0.0;  // relative, above it: `warning`
   std::optional<std::string> warning;
-  std::optional<double> optimal_gain, max_damping;
+  std::optional<double> optimal_gain, max_damping;  // optimal_gain: V/V (IFF gain g); max_damping: ratio
   std::complex<double> optimal_pole;       // rad/s
   std::string note;                        // why there is no study
   std::optional<std::string> failed;       // a NumericalError of the study
   // The root locus for the plot (report Figure 2.10b), inside 3 wp of the origin, upper half plane.
   struct Branch {
     Curve re_im;               // x Re, y Im [rad/s]
-    std::vector<double> gains; // at each point
+    std::vector<double> gains;  // V/V, at each point
     bool resonance_branch = false;
   };
   std::vector<Branch> branches;

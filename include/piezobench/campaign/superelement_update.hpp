@@ -74,16 +74,16 @@ struct UpdatedParameter {
   std::string name;                       // "shell", "stacks", "stack:A:B"
   double scale = 1.0;                     // factor on the part's stiffness (= on its modulus)
   std::optional<double> modulus_Pa;       // scale x the modulus at scale 1, when known
-  std::optional<double> standard_error;   // of scale (absolute)
+  std::optional<double> standard_error;   // dimensionless, of scale (absolute)
 };
 
 struct SuperElementUpdate {
   std::vector<UpdatedParameter> parameters;
   Eigen::MatrixXd correlation;             // p x p (empty without standard errors)
   Eigen::MatrixXd sensitivity;             // 2 x p, d ln feature / d ln scale at the solution (rows f_r, f_a)
-  Eigen::VectorXd singular_values;         // of the sensitivity at the starting point, descending
+  Eigen::VectorXd singular_values;         // dimensionless, of the sensitivity at the starting point, descending
   int rank = 0;
-  double condition = 0.0;                  // largest / smallest singular value
+  double condition = 0.0;                                           // ratio, largest / smallest singular value
   double target_resonance_Hz = 0.0, target_antiresonance_Hz = 0.0;  // geometric means of the units
   double initial_resonance_Hz = 0.0, initial_antiresonance_Hz = 0.0;
   double resonance_Hz = 0.0, antiresonance_Hz = 0.0;                 // updated model

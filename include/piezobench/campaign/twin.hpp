@@ -47,8 +47,8 @@ struct TwinOptions {
   // Verdict limits (the issue's): FRF within max_frf_error_dB, widths within max_width_error
   // (relative, for loops wider than 1 % of their stroke), IFF optimum within max_iff_error.
   double max_frf_error_dB = 1.0;
-  double max_width_error = 0.10;
-  double max_iff_error = 0.05;
+  double max_width_error = 0.10;  // relative
+  double max_iff_error = 0.05;    // relative
   void validate() const;  // InputError (source "twin options") naming the field
 };
 
@@ -57,7 +57,7 @@ struct TwinNoise {
   bool measured = false;      // false: no quiet segment; the bench's default noise is kept
   std::string source;         // file and segment, e.g. "quiet.mat [0, 10] s"
   double seconds = 0.0;       // length of the segment
-  double measured_rms = 0.0;  // of the segment (quantization included), from its median PSD level
+  double measured_rms = 0.0;  // m for d_e, V for Vs, of the segment (quantization included), from its median PSD level
   double white_rms = 0.0;     // the twin's noise option
   bench::NoiseSpectrum spectrum;  // measured, log-spaced
 };
@@ -65,7 +65,7 @@ struct TwinNoise {
 struct TwinHysteresisCheck {
   double amplitude = 0.0;     // V
   double unit_width = 0.0;    // relative width (metrology::HysteresisResult::relative_width)
-  double twin_width = 0.0;
+  double twin_width = 0.0;    // relative width
 };
 
 struct TwinFrfError {
@@ -81,7 +81,7 @@ struct TwinBuild {
   std::vector<TwinHysteresisCheck> hysteresis;
   TwinNoise de_noise, vs_noise;
   std::optional<double> unit_creep_per_decade, twin_creep_per_decade;  // stiffness record's ident::fit_creep
-  double iff_optimal_gain = 0.0;        // on the twin
+  double iff_optimal_gain = 0.0;                                       // V/V (IFF gain g), on the twin
   double iff_max_damping = 0.0;
   std::optional<double> iff_optimal_gain_unit;  // on the unit's fitted IFF plant (eq. 2.3), as `run`
   core::FitQuality quality;             // poor when a check above fails its limit
@@ -103,9 +103,10 @@ std::pair<double, double> bench_iff_optimum(const bench::UnitTruth& unit, const 
 // The one-sided PSD of a quiet record (linear trend removed; Welch, Hann, 1 s segments at most a
 // quarter of the record) and its median level over [2 Hz, 0.4 fs]: unit^2/Hz.
 struct QuietSpectrum {
-  Eigen::VectorXd freq_Hz, psd;
-  double median_level = 0.0;
+  Eigen::VectorXd freq_Hz, psd;  // psd: unit^2/Hz
+  double median_level = 0.0;     // unit^2/Hz
 };
+// x: the record's unit; sample_rate: Hz.
 QuietSpectrum quiet_spectrum(const Eigen::VectorXd& x, double sample_rate);
 
 }  // namespace piezobench::campaign

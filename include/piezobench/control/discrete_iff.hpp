@@ -28,7 +28,7 @@ struct DiscreteIffOptions {
   // Anti-windup: when the caller reports that the output was limited (applied()), the state of the
   // integral-action section is recomputed as if its output had been gain * applied + (1 - gain) *
   // computed, so with 1 the output tracks what was applied. In [0, 1]; 0 = off.
-  double antiwindup_gain = 1.0;
+  double antiwindup_gain = 1.0;             // ratio
   void validate() const;                    // InputError naming the field
 };
 
@@ -36,16 +36,18 @@ class DiscreteIff {
  public:
   // Throws InputError (params, options, or a non-finite gain).
   explicit DiscreteIff(const IffControllerParams& params = {}, const DiscreteIffOptions& options = {},
-                       double gain = 0.0);
+                       double gain = 0.0);  // gain g: V/V
 
   // One sample: returns g K0 Vs. Allocates nothing.
   // A non-finite input (NaN, inf) is never let into the states: the controller resets (zero
   // states) and returns 0, and nonfinite_inputs() counts it. The same happens if the output itself
   // overflows to a non-finite value. The caller (rt::Loop) reports it and enters its safe state.
+  // vs: V (sensor stack); returns V at the DAC.
   double step(double vs) noexcept;
   // Tells the controller what the loop really applied after its limits for the last output, for
   // the anti-windup. Call after step() when the output was clamped; a call with the value step()
   // returned changes nothing. Non-finite values are ignored.
+  // output: V at the DAC, as step() returns it.
   void applied(double output) noexcept;
   // New gain from the next sample on, without a bump. A non-finite gain is rejected (returns false,
   // gain unchanged).
@@ -68,8 +70,8 @@ class DiscreteIff {
   double a_[kMaxSections][2]{};
   double w_[kMaxSections][2]{};
   int sections_ = 0;
-  double gain_ = 0.0;
-  double last_output_ = 0.0;  // output of the last section (= of the controller) at the last step
+  double gain_ = 0.0;         // V/V
+  double last_output_ = 0.0;  // V, output of the last section (= of the controller) at the last step
   std::uint64_t nonfinite_ = 0;
   IffControllerParams params_;
   DiscreteIffOptions options_;

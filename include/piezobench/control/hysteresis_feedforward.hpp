@@ -26,6 +26,7 @@ namespace piezobench::control {
 class HysteresisFeedforward {
  public:
   // Validates the model (InputError) and the sample rate (> 0 Hz, for the creep states). At rest.
+  // sample_rate: Hz.
   HysteresisFeedforward(const ident::HysteresisModel& model, double sample_rate);
 
   // The stack voltage (V) for the command c (V). A non-finite c gives the last output.
@@ -46,17 +47,19 @@ class HysteresisFeedforward {
   void reset() noexcept;
   [[nodiscard]] const ident::HysteresisModel& model() const noexcept { return model_; }
   // The stack voltage the command c asks for at rest, without history (the start of a run).
+  // c: V at the stacks; returns V at the stacks.
   [[nodiscard]] double at_rest(double c) const;
 
  private:
   ident::HysteresisModel model_;
   ident::PrandtlIshlinskiiOperator inverse_;
   ident::DeadZoneSuperposition output_inverse_;  // S^-1 (identity for the plain PI model)
-  std::vector<double> alpha_, creep_;
-  double last_ = 0.0;
+  std::vector<double> alpha_, creep_;            // alpha_: dimensionless, per sample; creep_: V at the stacks
+  double last_ = 0.0;                            // V at the stacks
 };
 
 // The feedforward applied to a whole command (V at the stacks) from rest: what the stage gives.
+// sample_rate: Hz.
 std::vector<double> apply_feedforward(const ident::HysteresisModel& model, double sample_rate, const std::vector<double>& command);
 
 }  // namespace piezobench::control

@@ -25,6 +25,7 @@ struct NumberOrigin {
 };
 
 // `value` as an integer in [lo, hi]: refused when it is not finite, not a whole number or outside.
+// value: dimensionless, a count or an index.
 std::int64_t checked_integer(double value, std::int64_t lo, std::int64_t hi, const NumberOrigin& origin);
 // An integer (a TOML integer, a parsed option) in [lo, hi].
 std::int64_t checked_integer(std::int64_t value, std::int64_t lo, std::int64_t hi, const NumberOrigin& origin);

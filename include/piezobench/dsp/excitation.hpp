@@ -26,7 +26,7 @@ BoundsPolicy bounds_policy_from_string(const std::string& name);  // InputError 
 // 20 V/V amplifier at the DAC, i.e. -1..7.5 V (DESIGN.md).
 struct VoltageBounds {
   double min = -1.0;
-  double max = 7.5;
+  double max = 7.5;  // V
   BoundsPolicy policy = BoundsPolicy::kScale;
   void validate() const;  // InputError field "bounds": finite, min < max
 };

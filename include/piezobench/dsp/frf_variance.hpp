@@ -34,6 +34,7 @@ namespace piezobench::dsp {
 
 // eps(gamma^2, n_d) above. The coherence is clamped to [1e-12, 1] (a zero coherence gives a large
 // but finite error); n_d must be > 0 (else InputError).
+// effective_averages: a count (n_d).
 [[nodiscard]] double frf_relative_std(double coherence, double effective_averages);
 
 // The smallest relative standard deviation a fit assumes for a line: below it (a coherence of
@@ -57,7 +58,7 @@ inline constexpr double kFitModelRelativeError = 0.05;
 // deviation is Student's t with 2 n_d - 2 degrees of freedom, the estimate's variance having
 // 2 n_d - 2 where eps counts 2 n_d). 2.27 at n_d = 8.6 (a 20 s record in 4 s segments), where 1.96
 // covers 92.5 %; it tends to 1.96 as n_d grows. InputError for n_d <= 1 (no band: one average
-// gives a coherence of 1) or a level outside (0, 1).
+// gives a coherence of 1) or a level outside (0, 1). effective_averages: a count (n_d); level: a fraction.
 [[nodiscard]] double frf_band_factor(double effective_averages, double level = 0.95);
 
 // std_H (per part, H's units) at each line: |H(k)| frf_relative_std(coherence(k), n_d). Sizes must

@@ -113,7 +113,9 @@ FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outpu
                          const WelchOptions& options, const std::string& source = "");
 
 // Single-channel conveniences (same conventions): scipy welch(x) and csd(x, y).
+// x in any unit u: the PSD in u^2/Hz.
 Eigen::VectorXd welch_psd(const Eigen::VectorXd& x, double sample_rate_Hz, const WelchOptions& options);
+// x, y in units u, v: the CSD in u v/Hz.
 Eigen::VectorXcd welch_csd(const Eigen::VectorXd& x, const Eigen::VectorXd& y, double sample_rate_Hz,
                            const WelchOptions& options);
 

@@ -41,6 +41,7 @@ struct Box3 {
   Eigen::Vector3d hi = Eigen::Vector3d::Zero();
   // "x0,y0,z0,x1,y1,z1" (corners in any order); InputError naming `field` otherwise.
   static Box3 parse(const std::string& text, const std::string& field);
+  // tolerance: mm.
   [[nodiscard]] bool contains(const Box3& other, double tolerance) const;
 };
 
@@ -113,12 +114,13 @@ struct StackSpec {
 // surface area, h mesh size), nodes and DOF per element from the element order, peak memory and
 // time of the chain from the measured 2 mm APA95ML run (144k DOF: 1.5 GB, 40-95 s) scaled by DOF^1.2.
 struct MeshEstimate {
-  double volume_mm3 = 0.0, area_mm2 = 0.0;
-  double elements = 0.0, nodes = 0.0, dofs = 0.0;
-  double memory_GB = 0.0;
+  double volume_mm3 = 0.0, area_mm2 = 0.0;         // mm^3, mm^2
+  double elements = 0.0, nodes = 0.0, dofs = 0.0;  // counts
+  double memory_GB = 0.0;                          // GB
   double seconds = 0.0;
   [[nodiscard]] std::string to_string() const;
 };
+// volume_mm3: mm^3; area_mm2: mm^2.
 [[nodiscard]] MeshEstimate estimate_mesh(double volume_mm3, double area_mm2, double mesh_size_mm, int element_order);
 // The default of FromStepOptions::max_memory_GB: half the physical memory, at most 8 GB.
 [[nodiscard]] double default_max_memory_GB();

@@ -41,8 +41,8 @@ struct DisplacementOutput {
 // on its rotational DOF).
 struct PointMass {
   long node = -1;
-  double mass = 0.0;
-  double rotary_inertia = 0.0;
+  double mass = 0.0;            // kg
+  double rotary_inertia = 0.0;  // kg m^2
   // "NODE:KG"; InputError naming `field` otherwise.
   static PointMass parse(const std::string& text, const std::string& field);
 };

@@ -25,7 +25,7 @@ struct DominantPoleOptions {
     return o;
   }();
   double omega_min = 0.0;  // rad/s, band of natural frequencies searched (0 / 0: the data's band)
-  double omega_max = 0.0;
+  double omega_max = 0.0;  // rad/s
   void validate() const;   // InputError (source "dominant pole options"): 0 <= omega_min < omega_max or both 0
 };
 
@@ -40,6 +40,7 @@ struct DominantPole {
 
 // omega, h as for vector_fit (one output). InputError as vector_fit; NumericalError when the fit
 // fails or has no complex pair in the band.
+// omega: rad/s.
 DominantPole dominant_pole(const Vector& omega, const CVector& h, const DominantPoleOptions& options = {});
 
 constexpr auto describe(core::Type<DominantPole>) {

@@ -61,7 +61,7 @@ struct FrfFeatureOptions {
   // Relative half-width of the band examined around an anti-resonance for the phase verdict; it is
   // widened to 5 damping ratios for broad zeros and narrowed to half the distance to the nearest
   // other pole or zero.
-  double phase_band = 0.1;
+  double phase_band = 0.1;  // relative
   // |phase change| above this (deg) gives a verdict; below, kUndetermined.
   double phase_threshold_deg = 90.0;
   // The model is taken to have a high-pass when |DC gain| < this fraction of |H| at the lowest
@@ -92,10 +92,11 @@ FrfFeatures frf_features(const dsp::Frf& frf, const std::string& output, const F
 // form for each corner (variable projection).
 struct HighPassFit {
   double corner = 0.0;              // rad/s
-  double gain = 0.0;                // high-frequency gain g, signed
+  double gain = 0.0;                // output unit per input unit, high-frequency gain g, signed
   double relative_rms_error = 0.0;  // rms |model - data| / rms |data| over the fitted points
   [[nodiscard]] double corner_Hz() const;
 };
+// omega, max_omega: rad/s.
 HighPassFit fit_high_pass(const Vector& omega, const CVector& h, double max_omega = 0.0);
 
 // Second-order low-pass k wn^2 / (s^2 + 2 zeta wn s + wn^2): by nonlinear least squares
@@ -112,15 +113,16 @@ struct SecondOrderFitOptions {
 };
 
 struct SecondOrderFit {
-  double static_gain = 0.0;         // k (model DC gain for vector fitting)
+  double static_gain = 0.0;         // output unit per input unit, k (model DC gain for vector fitting)
   double natural_frequency = 0.0;   // wn, rad/s
   double damping = 0.0;             // zeta (> 1: two real poles)
   CVector poles;                    // rad/s, 2
-  double feedthrough = 0.0;         // d of the vector-fitting model (0 for nls)
+  double feedthrough = 0.0;         // output unit per input unit, d of the vector-fitting model (0 for nls)
   double relative_rms_error = 0.0;
   int iterations = 0;
   [[nodiscard]] double frequency_Hz() const;
 };
+// omega: rad/s.
 SecondOrderFit fit_second_order(const Vector& omega, const CVector& h,
                                 const SecondOrderFitOptions& options = {});
 

@@ -57,11 +57,11 @@ class PrandtlIshlinskiiOperator {
  public:
   PrandtlIshlinskiiOperator() = default;
   explicit PrandtlIshlinskiiOperator(PrandtlIshlinskii h);  // validates; at rest
-  double step(double v) noexcept {
-    double y = h_.linear_weight * v;
+  double step(double v) noexcept {                          // v: input unit; returns the output unit
+    double y = h_.linear_weight * v;                        // output unit
     const std::size_t n = state_.size();
     for (std::size_t i = 0; i < n; ++i) {
-      const double r = h_.thresholds[i];
+      const double r = h_.thresholds[i];  // input unit
       double p = state_[i];
       p = p < v - r ? v - r : p;
       p = p > v + r ? v + r : p;
@@ -76,7 +76,7 @@ class PrandtlIshlinskiiOperator {
 
  private:
   PrandtlIshlinskii h_;
-  std::vector<double> state_;
+  std::vector<double> state_;  // input unit: the play operators' outputs
 };
 
 // H[v] for a whole record, from rest.
@@ -84,6 +84,7 @@ std::vector<double> evaluate(const PrandtlIshlinskii& h, std::span<const double>
 // The play operators' outputs P_{r_i}[v] from rest: v.size() x thresholds.size().
 Eigen::MatrixXd play_outputs(std::span<const double> v, std::span<const double> thresholds);
 // The creep states F_j[v] (see the file comment) from rest: v.size() x time_constants.size().
+// sample_rate: Hz.
 Eigen::MatrixXd creep_states(std::span<const double> v, std::span<const double> time_constants, double sample_rate);
 
 // The static output nonlinearity of Kuhnen's modified PI operator (Kuhnen 2003, section 3): a
@@ -96,8 +97,8 @@ Eigen::MatrixXd creep_states(std::span<const double> v, std::span<const double> 
 struct DeadZoneSuperposition {
   std::vector<double> x;      // knots (input unit), strictly increasing
   std::vector<double> y;      // S(x_k) (output unit), strictly increasing
-  double slope_below = 1.0;   // slope left of x.front(), > 0
-  double slope_above = 1.0;   // slope right of x.back(), > 0
+  double slope_below = 1.0;   // output unit per input unit, slope left of x.front(), > 0
+  double slope_above = 1.0;   // output unit per input unit, slope right of x.back(), > 0
   [[nodiscard]] bool identity() const noexcept { return x.empty(); }
   // InputError (source `source`, default "dead-zone superposition") naming the field.
   void validate(const std::string& source = "") const;
@@ -178,9 +179,9 @@ HysteresisFit fit_hysteresis(std::span<const double> va, std::span<const double>
 // about that coefficient per decade of time between the first and the last time constant).
 struct CreepFit {
   std::vector<double> time_constants;  // s
-  std::vector<double> coefficients;    // c_j
+  std::vector<double> coefficients;    // relative, c_j
   double gain = 0.0;                   // output per input unit (instantaneous)
-  double offset = 0.0;
+  double offset = 0.0;                 // output unit
   double creep_per_decade = 0.0;       // mean c_j (relative)
   double rms_residual = 0.0;           // output unit
   double relative_residual = 0.0;      // rms / (max y - min y)
@@ -188,6 +189,7 @@ struct CreepFit {
 };
 // time_constants empty: 1, 10, 100 s up to half the record's duration (at least one). InputError
 // as fit_hysteresis; NumericalError when the output does not follow the input.
+// sample_rate: Hz.
 CreepFit fit_creep(std::span<const double> input, std::span<const double> output, double sample_rate,
                    std::vector<double> time_constants = {}, double max_relative_residual = 0.05);
 
@@ -196,9 +198,10 @@ CreepFit fit_creep(std::span<const double> input, std::span<const double> output
 // line over the stroke: for a loop symmetric about the line, its full width at the centre) and the
 // rms deviation. `reference` (optional): rms of output - (reference_slope command + reference_intercept).
 struct LoopMetrics {
+  // slope: output unit per command unit; intercept: output unit.
   double slope = 0.0, intercept = 0.0;  // output = slope command + intercept (best line)
-  double stroke = 0.0;                  // max - min of the output
-  double width = 0.0;                   // (max - min of output - line) / stroke
+  double stroke = 0.0;                  // output unit, max - min of the output
+  double width = 0.0;                   // ratio, (max - min of output - line) / stroke
   double rms_deviation = 0.0;           // rms of output - line (output unit)
   // |a2| / stroke, a2 the x^2 coefficient of the least-squares cubic of the output in
   // x = (command - its mid-range) / its half-range: 0 for a loop point-symmetric about its centre

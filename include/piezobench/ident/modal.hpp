@@ -34,13 +34,14 @@ struct Mode {
 struct PeakPickingOptions {
   double min_omega = 0.0;       // rad/s; band searched (0 = from the first point)
   double max_omega = 0.0;       // rad/s; 0 = up to the last point
-  double min_prominence = 2.0;  // peak / the higher of the minima separating it from higher peaks
+  double min_prominence = 2.0;  // ratio, peak / the higher of the minima separating it from higher peaks
   Index max_modes = 0;          // keep the most prominent ones; 0 = all
   void validate() const;        // throws InputError (source "peak picking options")
 };
 
 // Peaks of the sum of |H|^2 over outputs (h: points x outputs), by increasing frequency. Peaks whose
 // half-power points are not both inside the data are skipped.
+// omega: rad/s.
 std::vector<Mode> peak_picking(const Vector& omega, const CMatrix& h, const PeakPickingOptions& options = {});
 
 struct LscfOptions {
@@ -71,6 +72,7 @@ struct LscfResult {
 
 // h: points x outputs (common denominator over outputs). Throws InputError for bad data or too few
 // points for max_order (need at least max_order + 1 points in the band).
+// omega: rad/s.
 LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& options = {});
 
 }  // namespace piezobench::ident

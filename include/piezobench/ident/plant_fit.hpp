@@ -142,7 +142,7 @@ struct DelayedSecondOrderFit {
   // max_iterations reached; impossible: a negative delay.
   core::FitQuality quality;
   [[nodiscard]] lti::Complex pole() const;  // -zeta wn + j wn sqrt(1 - zeta^2) (Im >= 0)
-  [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;
+  [[nodiscard]] lti::CVector response(const lti::Vector& omega) const;  // omega: rad/s
 };
 
 // omega (rad/s, increasing) and h as for fit_iff_plant; options.fmin_Hz/fmax_Hz/min_coherence,
@@ -162,7 +162,7 @@ struct ActuatorPlantOptions {
   double hpf_fmax_Hz = 5.0;      // points below this start the high-pass corner
   double fixed_w_hpf = 0.0;      // rad/s; > 0: the high-pass corner is known (1 / (R C_sensor))
   double min_coherence = 0.5;
-  double effective_averages = 0.0;  // of the FRF (IffPlantFitOptions::effective_averages), for both fits
+  double effective_averages = 0.0;  // a count, of the FRF (IffPlantFitOptions::effective_averages), for both fits
   void validate() const;         // InputError (source "actuator plant options")
 };
 
@@ -176,6 +176,7 @@ struct ActuatorPlants {
 
 // omega (rad/s, increasing), each output's H and coherence (empty = unknown) as for the fits above.
 // Data problems are InputErrors; a fit that fails numerically is left out and listed in `failures`.
+// omega: rad/s; coh_de, coh_vs: dimensionless.
 ActuatorPlants fit_actuator_plants(const lti::Vector& omega, const lti::CVector& h_de, const lti::Vector& coh_de,
                                    const lti::CVector& h_vs, const lti::Vector& coh_vs,
                                    const ActuatorPlantOptions& options = {}, const std::string& source = "");

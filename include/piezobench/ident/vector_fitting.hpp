@@ -79,9 +79,9 @@ struct VectorFittingOptions {
   // longer improves. Setting both significance_floor and residual_tolerance to 0 skips the
   // per-iteration residue identification (fastest). At most max_iterations relocations.
   int max_iterations = 50;
-  double pole_tolerance = 1e-9;
-  double significance_floor = 1e-8;
-  double residual_tolerance = 1e-4;
+  double pole_tolerance = 1e-9;      // relative
+  double significance_floor = 1e-8;  // ratio
+  double residual_tolerance = 1e-4;  // relative
   // When the poles have not settled after max_iterations: true = throw NumericalError
   // (retry_may_help), false = return the last model with converged = false.
   bool fail_if_not_converged = true;
@@ -110,7 +110,7 @@ struct VectorFittingResult {
   // imaginary part, each pair as (p, conj(p)) with Im p > 0 first.
   CVector poles;
   CMatrix residues;  // outputs x N, same column order as poles (conjugate residues for pairs)
-  Vector d;          // outputs; zero unless asymptote includes d
+  Vector d;          // data units, outputs; zero unless asymptote includes d
   Vector e;          // outputs, s; zero unless asymptote is d + s e
   // The proper part (partial fractions + d) as a real state space with one input and `outputs`
   // outputs: A is block diagonal (1x1 for a real pole, [[Re p, Im p], [-Im p, Re p]] for a pair),
@@ -147,6 +147,7 @@ struct VectorFittingResult {
 // when the poles do not settle.
 VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const Matrix& weights,
                                const VectorFittingOptions& options);
+// omega: rad/s.
 VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data,
                                const VectorFittingOptions& options);
 // All outputs of an FRF (frequencies in Hz are converted to rad/s); errors name frf.provenance.source.

@@ -1,6 +1,7 @@
 #pragma once
 // JSON encodings shared by every command: complex numbers as [re, im], vectors as arrays,
 // non-finite numbers as the strings "inf", "-inf" and "nan" (JSON has no such numbers).
+// Units: the caller's (a number is written as given; the key that holds it names its unit).
 #include <Eigen/Dense>
 #include <complex>
 #include <optional>

@@ -37,6 +37,7 @@ struct PoleInfo {
 };
 // Natural frequency and damping of one pole. Discrete poles are mapped to s = log(z) / Ts first
 // (as MATLAB's damp). A pole at s = 0 has natural_frequency 0 and damping -1, as MATLAB's damp.
+// sample_time: s, 0 = continuous.
 PoleInfo pole_info(Complex pole, double sample_time = 0.0);
 // pole_info for every pole of the system, in poles() order.
 std::vector<PoleInfo> damp(const StateSpace& sys);

@@ -13,6 +13,7 @@ namespace piezobench::lti {
 // Roots of the polynomial with coefficients in descending powers (leading zeros dropped):
 // eigenvalues of the balanced companion matrix (trailing zero coefficients give exact roots at 0),
 // sorted as lti::poles. Zero-degree polynomial -> empty vector.
+// coefficients: the caller's units.
 CVector roots(const Vector& coefficients);
 // Monic real polynomial whose roots are `r` (conjugate pairs required; the imaginary round-off of
 // the product is dropped). Descending powers, size r.size() + 1.

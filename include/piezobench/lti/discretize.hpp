@@ -17,6 +17,7 @@ struct DiscretizeOptions {
   // exactly; 0 = no pre-warping. Must lie below the Nyquist frequency pi / Ts.
   double prewarp_frequency = 0.0;
   // Throws InputError naming the field.
+  // sample_time: s.
   void validate(double sample_time) const;
 };
 
@@ -29,7 +30,9 @@ Matrix expm(const Matrix& a);
 //  Tustin: s = (2/Ts) (z - 1)/(z + 1), or with pre-warping at w: s = w / tan(w Ts / 2) (z - 1)/(z + 1).
 // Delays are kept in seconds. Throws InputError for a discrete input or Ts <= 0; NumericalError when
 // Tustin meets a pole at s = 2/Ts.
+// sample_time: s.
 StateSpace c2d(const StateSpace& sys, double sample_time, const DiscretizeOptions& options = {});
+// sample_time: s.
 TransferFunction c2d(const TransferFunction& tf, double sample_time, const DiscretizeOptions& options = {});
 
 struct TimeResponse {
@@ -48,6 +51,7 @@ TimeResponse lsim(const StateSpace& discrete_sys, const Matrix& u, const Vector&
 // ZOH at `sample_time` (exact at the samples for a step); for discrete systems `sample_time` must
 // be 0 or the system's own (InputError otherwise). One column of y per output, input `input`.
 TimeResponse step(const StateSpace& sys, double sample_time, Index samples, Index input = 0);
+// sample_time: s.
 TimeResponse impulse(const StateSpace& sys, double sample_time, Index samples, Index input = 0);
 
 }  // namespace piezobench::lti

@@ -46,7 +46,9 @@ class FrequencyResponseEvaluator {
 FrequencyResponse freqresp(const StateSpace& sys, const Vector& omega);
 // SISO forms: a zpk is evaluated as a product of factors (accurate near lightly damped pairs);
 // a transfer function through its zpk form.
+// omega: rad/s.
 CVector freqresp(const Zpk& zpk, const Vector& omega);
+// omega: rad/s.
 CVector freqresp(const TransferFunction& tf, const Vector& omega);
 
 // n points logarithmically spaced from 10^lo to 10^hi (as MATLAB's logspace, without its special

@@ -17,6 +17,7 @@ StateSpace series(const StateSpace& first, const StateSpace& second);
 // y = a(u) + b(u).
 StateSpace parallel(const StateSpace& a, const StateSpace& b);
 // k * sys (output scaled).
+// k: dimensionless.
 StateSpace scale(const StateSpace& sys, double k);
 // Block-diagonal [a 0; 0 b]: inputs and outputs of a first, then b's.
 StateSpace append(const StateSpace& a, const StateSpace& b);

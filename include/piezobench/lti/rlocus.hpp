@@ -10,7 +10,7 @@
 namespace piezobench::lti {
 
 struct RootLocus {
-  std::vector<double> gains;
+  std::vector<double> gains;  // dimensionless loop gains k
   // poles[i] are the closed-loop poles at gains[i]. Branches are kept in a consistent order: entry
   // b of poles[i] continues entry b of poles[i - 1] (matched by minimum total displacement).
   std::vector<CVector> poles;
@@ -18,10 +18,10 @@ struct RootLocus {
 
 // Closed-loop poles at one gain. Throws InputError for a non-SISO loop or one with delays (use
 // lti::pade first), NumericalError when 1 + k D = 0.
-CVector closed_loop_poles(const StateSpace& open_loop, double gain);
+CVector closed_loop_poles(const StateSpace& open_loop, double gain);  // gain k: dimensionless
 
 // Closed-loop poles at the given gains (any order; kept as given), branches matched.
-RootLocus rlocus(const StateSpace& open_loop, const std::vector<double>& gains);
+RootLocus rlocus(const StateSpace& open_loop, const std::vector<double>& gains);  // gains k: dimensionless
 
 struct RootLocusOptions {
   double gain_min = 0.0;  // first gain of the automatic grid (>= 0)
@@ -38,7 +38,7 @@ struct RootLocusOptions {
   // order n (rejected steps included) and throws NumericalError (retry may help: a larger budget,
   // or fewer points) when they do not suffice.
   int max_order = 200;
-  double max_work = 5e8;
+  double max_work = 5e8;  // a count of operations (n^3 per eigenvalue problem)
   void validate() const;  // InputError naming the field
 };
 
@@ -46,7 +46,7 @@ struct RootLocusOptions {
 RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& options = {});
 
 struct BranchOptimum {
-  double gain = 0.0;     // gain of maximum damping on the branch
+  double gain = 0.0;     // dimensionless, gain of maximum damping on the branch
   double damping = 0.0;  // damping ratio there
   Complex pole;          // the branch's pole there
 };

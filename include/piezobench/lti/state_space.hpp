@@ -30,9 +30,11 @@ struct StateSpace {
   StateSpace() = default;
   // Validates (InputError, see validate()). Conveniences: without states, B and C may be given
   // empty (any shape); with states, an empty D means no feedthrough.
+  // ts: s, 0 = continuous.
   StateSpace(Matrix a, Matrix b, Matrix c, Matrix d, double ts = 0.0);
 
   // A static gain y = D u (no states).
+  // ts: s, 0 = continuous.
   static StateSpace gain(const Matrix& d, double ts = 0.0);
 
   [[nodiscard]] Index states() const { return A.rows(); }

@@ -9,12 +9,13 @@ namespace piezobench::lti {
 // H(s) = num(s) / den(s) * exp(-s delay); coefficients in descending powers of s (z when discrete),
 // as MATLAB's tf: num = {1, 2} is s + 2. Leading zeros of num are allowed and ignored.
 struct TransferFunction {
-  Vector num;
-  Vector den;
+  Vector num;                // the caller's units
+  Vector den;                // the caller's units
   double sample_time = 0.0;  // s; 0 = continuous
   double delay = 0.0;        // s
 
   TransferFunction() = default;
+  // numerator, denominator: the caller's units; ts: s.
   TransferFunction(Vector numerator, Vector denominator, double ts = 0.0, double delay_s = 0.0);  // validates
 
   [[nodiscard]] bool is_discrete() const { return sample_time > 0.0; }
@@ -31,11 +32,12 @@ struct TransferFunction {
 struct Zpk {
   CVector zeros;  // rad/s (continuous) or z-plane (discrete)
   CVector poles;
-  double gain = 1.0;
-  double sample_time = 0.0;
-  double delay = 0.0;
+  double gain = 1.0;         // output unit per input unit
+  double sample_time = 0.0;  // s, 0 = continuous
+  double delay = 0.0;        // s
 
   Zpk() = default;
+  // k: output unit per input unit; ts: s.
   Zpk(CVector z, CVector p, double k, double ts = 0.0, double delay_s = 0.0);  // validates
 
   [[nodiscard]] bool is_discrete() const { return sample_time > 0.0; }

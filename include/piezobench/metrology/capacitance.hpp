@@ -20,8 +20,8 @@ namespace piezobench::metrology {
 // A closed interval [min, max]; either end may be infinite.
 struct Range {
   double min = 0.0;
-  double max = 0.0;
-  [[nodiscard]] bool contains(double v) const { return v >= min && v <= max; }
+  double max = 0.0;                                                             // same unit as min
+  [[nodiscard]] bool contains(double v) const { return v >= min && v <= max; }  // v: same unit as the range
   // InputError (source, field) unless min <= max and neither is NaN.
   void validate(const std::string& source, const std::string& field) const;
 };
@@ -46,13 +46,13 @@ CapacitanceCheck check_capacitance(double sensor_F, double actuator_F, const Cap
                                    const std::string& source = "");
 
 struct OutlierOptions {
-  double threshold = 3.5;                // |modified z| above this ...
+  double threshold = 3.5;                // dimensionless, |modified z| above this ...
   double min_relative_deviation = 0.05;  // ... and |x - median| > this * |median|
   void validate() const;                 // InputError (source "outlier options")
 };
 
 struct OutlierAnalysis {
-  double median = 0.0;
+  double median = 0.0;               // same unit as the values
   double mad = 0.0;                  // median absolute deviation (same unit as the values)
   std::vector<double> robust_z;      // 0.6745 (x - median) / MAD (+-inf when MAD = 0 and x != median)
   std::vector<bool> outlier;
@@ -60,6 +60,7 @@ struct OutlierAnalysis {
 
 // Fewer than 3 values: no verdict (every outlier flag false, robust_z 0). InputError (source,
 // field) for a non-finite value (its index named).
+// values: the caller's unit.
 OutlierAnalysis robust_outliers(const std::vector<double>& values, const OutlierOptions& options = {},
                                 const std::string& source = "", const std::string& field = "values");
 

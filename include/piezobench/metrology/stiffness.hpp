@@ -47,16 +47,16 @@ struct StaticStiffnessOptions {
   double t_on = 0.0;              // s, 0 = detect
   double t_off = 0.0;             // s, 0 = detect
   double min_time_constant = 1e-3;  // s, creep time-constant grid
-  double max_time_constant = 10.0;
+  double max_time_constant = 10.0;  // s
   void validate() const;          // InputError (source "static stiffness options") naming the field
 };
 
 struct StaticStiffnessResult {
   double t_on = 0.0;             // s, events used
-  double t_off = 0.0;
+  double t_off = 0.0;            // s
   double d_before = 0.0;         // m, the three readings
-  double d_loaded = 0.0;
-  double d_after = 0.0;
+  double d_loaded = 0.0;         // m
+  double d_after = 0.0;          // m
   double k1 = 0.0;               // N/m, m_a g / |d_before - d_loaded|
   double k2 = 0.0;               // N/m, m_a g / |d_after - d_loaded|
   double deflection_on = 0.0;    // m, D_on (negative: the mass compresses the APA)

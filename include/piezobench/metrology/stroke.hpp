@@ -32,7 +32,7 @@ struct StrokeOptions {
 struct StrokeResult {
   double stroke = 0.0;       // m, max - min of the smoothed d_e (>= 0)
   double va_min = 0.0;       // V, voltage range covered by the record
-  double va_max = 0.0;
+  double va_max = 0.0;       // V
   double sensitivity = 0.0;  // m/V, slope of the straight line d_e(Va) (negative: the APA shortens)
   double loop_width = 0.0;   // m, largest distance between rising and falling branches
 };

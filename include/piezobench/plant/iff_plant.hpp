@@ -25,6 +25,7 @@ struct IffPlantParams {
 lti::TransferFunction iff_plant(const IffPlantParams& params = {});
 // G(j omega) of the same formula (omega in rad/s), without validation (for fits' inner loops).
 lti::Complex iff_plant_response(const IffPlantParams& params, double omega);
+// omega: rad/s.
 lti::CVector iff_plant_response(const IffPlantParams& params, const lti::Vector& omega);
 
 }  // namespace piezobench::plant

@@ -34,7 +34,7 @@ struct SignalChannel {
   int subdevice = -1;
   int channel = -1;
   double range_min = 0.0;   // V at the converter: the range the converter must cover
-  double range_max = 0.0;
+  double range_max = 0.0;   // V at the converter
   double scale = 1.0;       // see the file comment
   std::string unit;         // "V" (u, Vs, Va) or "m" (d_e)
   std::string kind = "analog";  // "analog" or "counter" (d_e only)

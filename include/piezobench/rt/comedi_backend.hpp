@@ -37,6 +37,7 @@ class ComediBackend final : public Backend {
   // origin and writes the safe output. InputError naming the bench file and signal otherwise.
   void start() override;
   SensorSample read() noexcept override;
+  // u: V at the DAC.
   void write(double u) noexcept override;
   void stop() noexcept override;
   void on_watchdog() noexcept override;

@@ -73,7 +73,7 @@ struct DampedPlantStudyOptions {
 };
 
 struct DampedPlantPoint {
-  double gain = 0.0;
+  double gain = 0.0;                   // V/V (IFF gain g)
   lti::Complex identified_pole;        // rad/s, Im > 0
   double identified_frequency_Hz = 0.0;
   double identified_damping = 0.0;

@@ -30,14 +30,14 @@
 namespace piezobench::rt {
 
 struct LogRecord {
-  double t = 0.0;
-  double u_prime = 0.0;
-  double u = 0.0;
-  double va = 0.0;
-  double va_cmd = 0.0;
-  double de = 0.0;
-  double vs = 0.0;
-  double y = 0.0;
+  double t = 0.0;        // s
+  double u_prime = 0.0;  // V at the DAC
+  double u = 0.0;        // V at the DAC
+  double va = 0.0;       // V
+  double va_cmd = 0.0;   // V
+  double de = 0.0;       // m
+  double vs = 0.0;       // V
+  double y = 0.0;        // V at the DAC (the controller's output)
   double latency_us = 0.0;
   double step_us = 0.0;
   std::uint32_t flags = 0;

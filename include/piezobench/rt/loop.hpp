@@ -65,7 +65,7 @@ struct LoopOptions {
   int priority = 80;          // SCHED_FIFO priority, 1..99
   bool lock_memory = true;    // try mlockall (real-time mode)
   bool controller = true;     // false: open loop (u = u' only)
-  double gain = 0.0;          // IFF gain g
+  double gain = 0.0;          // V/V, IFF gain g
   control::IffControllerParams controller_params;      // K0 (eq. 2.4 by default)
   control::DiscreteIffOptions discrete;                // its sample_rate is replaced by the backend's
   ActuatorLimits limits;
@@ -180,7 +180,7 @@ class Loop {
   struct Cycle;  // the steps of cycle() (loop.cpp)
   Backend& backend_;
   LoopOptions options_;
-  double rate_;
+  double rate_;  // Hz
   std::uint64_t total_cycles_;
   std::uint64_t ramp_in_cycles_, ramp_out_cycles_;
   control::DiscreteIff iff_;
@@ -194,7 +194,7 @@ class Loop {
   std::uint64_t controller_nonfinite_seen_ = 0;
   std::int64_t last_wake_ns_ = 0;
   std::int64_t last_end_ns_ = 0;
-  double va_cmd_min_ = 0.0, va_cmd_max_ = 0.0, max_step_ = 0.0, last_va_cmd_ = 0.0;
+  double va_cmd_min_ = 0.0, va_cmd_max_ = 0.0, max_step_ = 0.0, last_va_cmd_ = 0.0;  // V
   std::int64_t period_ns_ = 0, watchdog_ns_ = 0;
   bool started_ = false, finished_ = false, stopping_ = false;
   io::TimeSeries log_;

@@ -61,10 +61,13 @@ class BackendRunner final : public bench::BenchRunner {
   // bench::BenchRunner. Each throws InputError after the run (its raw log written) when the loop
   // entered its safe state (interrupted, stale input, watchdog, non-finite sensor): a record
   // that is not the experiment's is never returned.
+  // u: V at the DAC.
   void open_loop(const Eigen::VectorXd& u, std::uint64_t seed, Eigen::MatrixXd& out, const bench::Progress& progress) override;
   // The loop's own feedforward stage (LoopOptions::feedforward), before its clamp and slew limit.
+  // u_prime: V at the DAC; w: dimensionless.
   std::uint64_t open_loop_feedforward(const Eigen::VectorXd& u_prime, const Eigen::VectorXd& w, const ident::HysteresisModel& model,
                                       std::uint64_t seed, Eigen::MatrixXd& out, const bench::Progress& progress) override;
+  // u_prime: V at the DAC; gain g: V/V.
   std::uint64_t iff(const Eigen::VectorXd& u_prime, double gain, std::uint64_t seed, Eigen::MatrixXd& out,
                     const bench::Progress& progress) override;
   std::vector<double> hold(Eigen::Index n, const std::vector<bench::OperatorStep>& steps, std::uint64_t seed,
@@ -77,6 +80,7 @@ class BackendRunner final : public bench::BenchRunner {
 
  private:
   io::TimeSeries run(LoopOptions lo, const std::vector<bench::OperatorStep>* steps);
+  // u_prime: V at the DAC.
   void open_run(LoopOptions lo, const Eigen::VectorXd& u_prime, Eigen::MatrixXd& out, const bench::Progress& progress);
   Backend& backend_;
   MeasureOptions options_;

@@ -25,6 +25,7 @@ class ReplayBackend final : public Backend {
   [[nodiscard]] double sample_rate() const override { return sample_rate_; }
   void start() override;
   SensorSample read() noexcept override;
+  // u: V at the DAC.
   void write(double u) noexcept override;
   [[nodiscard]] bool finished() const noexcept override;
   void stop() noexcept override {}
@@ -35,11 +36,11 @@ class ReplayBackend final : public Backend {
   [[nodiscard]] double last_command() const { return last_u_; }
 
  private:
-  std::vector<double> de_, vs_;
-  double sample_rate_ = 0.0;
+  std::vector<double> de_, vs_;  // m, V
+  double sample_rate_ = 0.0;     // Hz
   std::string source_;
   std::size_t next_ = 0;
-  double last_u_ = 0.0;
+  double last_u_ = 0.0;  // V at the DAC
 };
 
 }  // namespace piezobench::rt

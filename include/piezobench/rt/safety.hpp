@@ -54,7 +54,7 @@ struct ActuatorLimits {
   // the APA300ML's stroke; Vs, V: 100 V, well above what the sensor stack gives at 150 V on the
   // actuator stacks (a few V with the 80.6 kOhm resistor, tens without).
   double de_range = 1e-3;
-  double vs_range = 100.0;
+  double vs_range = 100.0;  // V
 
   static constexpr int kMaxStaleCycles = 1000;
   static constexpr double kMaxTime = 60.0;  // s: ramps, watchdog, saturation time
@@ -108,6 +108,7 @@ std::string to_string(Fault fault);  // "none", "non-finite sensor", "sensor out
 class SafetyGuard {
  public:
   // Validates the limits (InputError) and the rate (> 0). The previous output starts at u_safe.
+  // sample_rate: Hz.
   SafetyGuard(const ActuatorLimits& limits, double sample_rate);
 
   // Checks one acquisition: kNonFiniteSensor, kSensorOutOfRange, kStaleSensor (after stale_cycles
@@ -142,8 +143,8 @@ class SafetyGuard {
 
  private:
   ActuatorLimits limits_;
-  double u_min_, u_max_, u_safe_, max_step_;
-  double last_u_;
+  double u_min_, u_max_, u_safe_, max_step_;  // V at the DAC (max_step_: V per sample)
+  double last_u_;                             // V at the DAC
   bool have_sequence_ = false;
   std::uint64_t last_sequence_ = 0;
   int stale_run_ = 0;

@@ -14,7 +14,7 @@ namespace piezobench::rt {
 struct TimingSummary {
   std::uint64_t count = 0;
   double p50 = 0.0, p99 = 0.0, p999 = 0.0, p9999 = 0.0, max = 0.0;  // same unit as the samples
-  double mean = 0.0;
+  double mean = 0.0;                                                // same unit as the samples
 };
 
 class TimingHistogram {
@@ -35,8 +35,8 @@ class TimingHistogram {
   static constexpr int kBins = kBinsPerDecade * kDecades;
   std::array<std::uint64_t, kBins> bins_{};
   std::uint64_t count_ = 0;
-  double max_ = 0.0;
-  double sum_ = 0.0;
+  double max_ = 0.0;  // same unit as the samples
+  double sum_ = 0.0;  // same unit as the samples
 };
 
 // CLOCK_MONOTONIC now, ns.

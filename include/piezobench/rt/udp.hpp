@@ -54,7 +54,7 @@ inline constexpr std::size_t kUdpRequestSize = 32, kUdpReplySize = 56, kUdpTagSi
 struct UdpRequest {
   UdpType type = UdpType::kIo;
   std::uint64_t sequence = 0;
-  double u = 0.0;
+  double u = 0.0;  // V at the DAC
   std::uint32_t flags = 0;
   std::uint32_t session = 0;
 };
@@ -62,7 +62,7 @@ struct UdpReply {
   UdpType type = UdpType::kIoReply;
   std::uint64_t sequence = 0;
   std::uint64_t sample = 0;
-  double de = 0.0, vs = 0.0, va = 0.0;
+  double de = 0.0, vs = 0.0, va = 0.0;  // m, V, V
   std::uint32_t status = 0;
   std::uint32_t session = 0;
 };
@@ -117,6 +117,7 @@ class UdpBackend final : public Backend {
   // A reply of another session, with a sample counter that went back or advanced by more than
   // the requests sent since the previous reply: NaN sensors (the safe state), counted in `errors`.
   SensorSample read() noexcept override;
+  // u: V at the DAC.
   void write(double u) noexcept override;
   // Says bye, waits up to `timeout` for the last replies (counting late ones), closes the socket.
   void stop() noexcept override;
@@ -129,7 +130,7 @@ class UdpBackend final : public Backend {
   void send_request(const UdpRequest& r) noexcept;
   std::optional<UdpReply> receive_reply() noexcept;  // one datagram, unsealed and decoded
   UdpAddress address_;
-  double sample_rate_, timeout_;
+  double sample_rate_, timeout_;  // Hz, s
   UdpBackendOptions options_;
   int fd_ = -1;
   std::uint32_t session_ = 0;

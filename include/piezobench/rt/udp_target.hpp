@@ -32,8 +32,9 @@ namespace piezobench::rt {
 // What a target drives: its rate, a reset to the start (a hello, a reset) and one sample with the
 // DAC at u (V at the DAC) that returns the sensors of the next sample.
 struct UdpTargetIo {
-  double sample_rate = 10e3;
+  double sample_rate = 10e3;  // Hz
   std::function<void()> reset;
+  // u: V at the DAC.
   std::function<bench::BenchSample(double u)> step;
 };
 

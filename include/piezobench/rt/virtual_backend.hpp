@@ -20,6 +20,7 @@ class VirtualBenchBackend final : public Backend {
   [[nodiscard]] double sample_rate() const override;
   void start() override;
   SensorSample read() noexcept override;
+  // u: V at the DAC.
   void write(double u) noexcept override;
   void stop() noexcept override {}
 

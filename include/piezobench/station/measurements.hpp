@@ -39,6 +39,7 @@ const MeasurementKind* find_measurement(const std::string& name);
 
 struct MeasuredValue {
   std::string name, unit;
+  // same unit as `unit` names.
   std::optional<double> value;  // nullopt: the analysis gave none (failed, or not observable)
   Limit limit;
   Verdict verdict = Verdict::kPass;

@@ -38,7 +38,7 @@ struct QualificationRow {
 
 struct MeasurementRow {
   std::string name, unit;
-  std::optional<double> value, min, max;
+  std::optional<double> value, min, max;  // same unit as `unit` names
   std::string verdict, reason;
   bool stop_on_fail = false;
 };
@@ -61,8 +61,8 @@ struct PhaseTryRow {
 // One unit's value of a measurement (RecordStore::history).
 struct HistoryPoint {
   std::string serial, batch;
-  double value = 0.0;
-  std::optional<double> min, max;
+  double value = 0.0;              // same unit as `unit` names
+  std::optional<double> min, max;  // same unit as `unit` names
   std::string verdict;
 };
 

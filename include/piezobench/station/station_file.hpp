@@ -38,7 +38,7 @@ struct PhaseSpec {
   std::string experiment;    // "flatness", "capacitance", "stroke", "hysteresis", "stiffness",
                              // "frf-noise", "iff", "hammer", "tracking" (bench/experiments.hpp)
   campaign::Experiment record = campaign::Experiment::kStroke;  // the campaign key of its record
-  std::optional<double> amplitude_V, duration_s, gain;          // bench::ExperimentOptions
+  std::optional<double> amplitude_V, duration_s, gain;          // gain: V/V (IFF gain g), bench::ExperimentOptions
   bool open_circuit = false;  // stiffness: every stack open (k_oc)
   bool no_resistor = false;   // frf-noise: no resistor across the sensor stack
   ValueSource source = ValueSource::kBench;
