@@ -24,7 +24,9 @@ std::string format_number_fixed(double value, int decimals) {
 
 std::string format_number_exact(double value) {
   if (!std::isfinite(value)) return format_number(value);
-  for (int digits = 1; digits < 17; ++digits) {
+  // From 6 digits up: %g drops the trailing zeros, and fewer digits would only switch round
+  // numbers to the exponent form (150 as "1.5e+02").
+  for (int digits = 6; digits < 17; ++digits) {
     std::string text = format_number(value, digits);
     if (std::strtod(text.c_str(), nullptr) == value) return text;
   }

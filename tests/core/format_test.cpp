@@ -38,6 +38,9 @@ TEST(FormatNumberExact, FewestDigitsThatReadBack) {
   EXPECT_EQ(format_number_exact(0.1), "0.1");
   EXPECT_EQ(format_number_exact(1.0000001), "1.0000001");
   EXPECT_EQ(format_number_exact(-2.5), "-2.5");
+  EXPECT_EQ(format_number_exact(150.0), "150");   // not "1.5e+02"
+  EXPECT_EQ(format_number_exact(-20.0), "-20");
+  EXPECT_EQ(format_number_exact(1e6), "1e+06");
   EXPECT_EQ(format_number_exact(1e13), "1e+13");
   EXPECT_EQ(format_number_exact(0.1 + 0.2), "0.30000000000000004");
   EXPECT_EQ(format_number_exact(std::numeric_limits<double>::infinity()), "inf");

@@ -10,9 +10,10 @@ namespace piezobench {
 // and "-inf" for the non-finite values. significant_digits is clamped to [1, 17].
 std::string format_number(double value, int significant_digits = 6);
 
-// The fewest significant digits (%g style) that read back as exactly `value`: what a user wrote in
-// a file, shown back in an error ("1e-12", "0.1", "1.0000001", where format_number(v) gives "1"
-// for the last). "nan", "inf", "-inf" for the non-finite values.
+// The fewest significant digits (%g style, at least format_number's 6, so 150 stays "150") that read
+// back as exactly `value`: what a user wrote in a file, shown back in an error ("1e-12", "0.1",
+// "1.0000001", where format_number(v) gives "1" for the last). "nan", "inf", "-inf" for the
+// non-finite values.
 std::string format_number_exact(double value);
 
 // `value` with `decimals` digits after the point (printf's %.*f): a value set beside a limit in the
