@@ -100,15 +100,15 @@ int write_and_print(const campaign::CampaignResult& r, const fs::path& out, bool
     for (const auto& [k, v] : extra.items()) doc[k] = v;
     print_json(doc);
   } else {
-    fmt::print("{} units: {} accepted, {} rejected, {} not analysed ({:.1f} s)\n", r.units.size(), r.accepted, r.rejected, r.not_analysed,
-               elapsed);
+    fmt::print("{} units: {} accepted, {}{} rejected, {} not analysed ({:.1f} s)\n", r.units.size(), r.accepted,
+               r.marginal > 0 ? fmt::format("{} marginal, ", r.marginal) : std::string(), r.rejected, r.not_analysed, elapsed);
     for (const auto& u : r.units) {
       if (u.not_analysed) {
         fmt::print("  {:<8} NOT ANALYSED ({})\n           - {}\n", u.name, u.not_analysed->file.empty() ? u.not_analysed->key : u.not_analysed->file,
                    u.not_analysed->reason);
         continue;
       }
-      fmt::print("  {:<8} {}\n", u.name, u.accepted ? "accepted" : "REJECTED");
+      fmt::print("  {:<8} {}\n", u.name, u.accepted ? "accepted" : u.marginal ? "MARGINAL" : "REJECTED");
       for (const auto& reason : u.reasons) fmt::print("           - {}\n", reason);
     }
     if (r.iff.optimal_gain && r.iff.unit) {
@@ -123,7 +123,8 @@ int write_and_print(const campaign::CampaignResult& r, const fs::path& out, bool
     log_line(fmt::format("{} of {} units could not be analysed (exit code {})", r.not_analysed, r.units.size(), kUnitNotAnalysed));
     return kUnitNotAnalysed;
   }
-  return strict && r.rejected > 0 ? kRejected : 0;
+  // --strict: a marginal unit (a limit within its value +- U) is not proved to conform either.
+  return strict && (r.rejected > 0 || r.marginal > 0) ? kRejected : 0;
 }
 
 // Runs the pipeline on a campaign file and writes the outputs; prints the summary.

@@ -293,7 +293,9 @@ long long read_time(const TomlReader& r, const std::string& k, bool end) {
 
 void read_bench(const TomlReader& r, BenchConstants& b) {
   r.only({"amplifier_gain", "suspended_mass_kg", "added_mass_kg", "gravity_m_per_s2", "hpf_resistance_ohm", "probe_accuracy_um",
-          "name", "recorded_from", "recorded_until"});
+          "name", "recorded_from", "recorded_until", "added_mass_uncertainty_kg", "gravity_uncertainty_m_per_s2",
+          "suspended_mass_uncertainty_kg", "encoder_resolution_um", "capacitance_uncertainty_relative",
+          "displacement_scale_uncertainty_relative"});
   if (const auto name = r.string("name")) {
     if (name->empty()) r.fail("name", "the name of the bench (what its records say in settings.bench)", "''");
     b.name = *name;
@@ -313,6 +315,14 @@ void read_bench(const TomlReader& r, BenchConstants& b) {
   const double resistance = r.number("hpf_resistance_ohm", NumberBounds::non_negative()).value_or(0.0);
   if (resistance > 0.0) b.hpf_resistance = resistance;
   b.probe_accuracy = r.number("probe_accuracy_um", NumberBounds::non_negative()).value_or(b.probe_accuracy * 1e6) * 1e-6;
+  metrology::StaticTestUncertainties& u = b.uncertainty;
+  u.added_mass_kg = r.number("added_mass_uncertainty_kg", NumberBounds::non_negative()).value_or(u.added_mass_kg);
+  u.gravity_m_per_s2 = r.number("gravity_uncertainty_m_per_s2", NumberBounds::non_negative()).value_or(u.gravity_m_per_s2);
+  u.suspended_mass_kg = r.number("suspended_mass_uncertainty_kg", NumberBounds::non_negative()).value_or(u.suspended_mass_kg);
+  u.encoder_resolution_m = r.number("encoder_resolution_um", NumberBounds::non_negative()).value_or(u.encoder_resolution_m * 1e6) * 1e-6;
+  u.capacitance_relative = r.number("capacitance_uncertainty_relative", NumberBounds::half_open(0.0, 1.0)).value_or(u.capacitance_relative);
+  u.displacement_scale_relative =
+      r.number("displacement_scale_uncertainty_relative", NumberBounds::half_open(0.0, 1.0)).value_or(u.displacement_scale_relative);
 }
 
 void read_specs(const TomlReader& r, Specs& s) {

@@ -60,6 +60,7 @@ PIEZOBENCH_PART_ENUM(ident::Convergence, "vector fitting convergence", ident::co
 PIEZOBENCH_PART_ENUM(core::LmStatus, "Levenberg-Marquardt status", core::lm_status_from_string)
 PIEZOBENCH_PART_ENUM(core::FitVerdict, "fit verdict", core::fit_verdict_from_string)
 PIEZOBENCH_PART_ENUM(apa::TuningStatus, "tuning status", apa::tuning_status_from_string)
+PIEZOBENCH_PART_ENUM(metrology::Conformity, "conformity verdict", metrology::conformity_from_string)
 #undef PIEZOBENCH_PART_ENUM
 
 template <class T> json encode(const T& v);

@@ -30,7 +30,10 @@
 #include "piezobench/lti/freqresp.hpp"
 #include "piezobench/lti/rlocus.hpp"
 #include "piezobench/metrology/capacitance.hpp"
+#include "piezobench/metrology/conformity.hpp"
+#include "piezobench/metrology/uncertainty_budget.hpp"
 #include "piezobench/report/html_report.hpp"
+#include "shown_units.hpp"
 
 namespace piezobench::campaign {
 
@@ -38,6 +41,7 @@ namespace fs = std::filesystem;
 using Eigen::Index;
 using Eigen::VectorXd;
 using nlohmann::json;
+using namespace shown_units;
 
 namespace {
 
@@ -199,38 +203,113 @@ std::vector<std::string> implausible(const Campaign& c, const UnitAnalysis& u) {
   return out;
 }
 
-std::vector<std::string> acceptance(const Campaign& c, const UnitAnalysis& u, const std::vector<std::string>& outlier_reasons) {
-  std::vector<std::string> reasons;
-  for (const auto& f : u.failed) reasons.push_back("analysis failed: " + f);
+// One acceptance check: the value (SI) +- U of its budget against [min, max] (SI), decided and shown in
+// `unit` (`per_si` of it per SI unit; metrology/conformity.hpp). `fail_text` is the reason of a failed check.
+AcceptanceCheck judged(std::string quantity, const char* unit, double per_si, double value, metrology::UncertaintyBudget budget,
+                       std::optional<double> min, std::optional<double> max, std::string fail_text) {
+  AcceptanceCheck a;
+  const auto shown = [&](std::optional<double> v) { return v ? std::optional<double>(*v * per_si) : std::nullopt; };
+  a.decision = metrology::decide(value * per_si, budget.expanded * per_si, shown(min), shown(max), budget.coverage_factor);
+  if (a.decision.verdict == metrology::Conformity::kFail) {
+    a.reason = std::move(fail_text);
+  } else if (a.decision.verdict == metrology::Conformity::kMarginal) {
+    a.reason = fmt::format("marginal: {} {} +- {} {} (k = 2) has a limit of the specification inside its interval (ISO 14253-1; "
+                           "probability of conformity {} %)",
+                           quantity, format_number(a.decision.value, 4), format_number(a.decision.expanded_uncertainty, 2), unit,
+                           format_number_fixed(100.0 * a.decision.probability_of_conformity, 1));
+  }
+  a.quantity = std::move(quantity);
+  a.unit = unit;
+  a.budget = std::move(budget);
+  return a;
+}
+
+// The added-mass test's k1 (before -> loaded) and k2 (loaded -> after) with their budgets: the
+// deflection between the two readings' windows, the creep fit's residual as the readings' noise.
+std::vector<std::pair<std::string, metrology::UncertaintyBudget>> static_stiffness_budgets(const Campaign& c, const StiffnessAnalysis& s) {
+  const metrology::StaticStiffnessResult& r = s.result;
+  const metrology::StaticStiffnessOptions& o = s.options;
+  const double fs = s.provenance.sample_rate_Hz;
+  const auto samples = [&](const std::array<double, 2>& a, const std::array<double, 2>& b) {
+    return std::max(1.0, std::floor(std::min(a[1] - a[0], b[1] - b[0]) * fs));
+  };
+  std::vector<std::pair<std::string, metrology::UncertaintyBudget>> out;
+  const double d1 = std::abs(r.d_before - r.d_loaded), d2 = std::abs(r.d_after - r.d_loaded);
+  if (d1 > 0.0) out.emplace_back("k1", metrology::stiffness_budget(o.added_mass, o.gravity, d1, r.rms_residual, samples(o.before_s, o.loaded_s), c.bench.uncertainty));
+  if (d2 > 0.0) out.emplace_back("k2", metrology::stiffness_budget(o.added_mass, o.gravity, d2, r.rms_residual, samples(o.after_s, o.loaded_s), c.bench.uncertainty));
+  return out;
+}
+
+// Every acceptance check of the unit with its budget (docs/uncertainty.md, section 7).
+std::vector<AcceptanceCheck> acceptance_checks(const Campaign& c, const UnitAnalysis& u) {
   const Specs& s = c.specs;
-  if (u.flatness && s.flatness_max && *u.flatness > *s.flatness_max) {
-    reasons.push_back(
-        fmt::format("flatness {} um above the limit {} um ({})", format_number_fixed(*u.flatness * 1e6, 2),
-                    format_number_fixed(*s.flatness_max * 1e6, 2), metrology::to_string(s.flatness_method)));
+  const metrology::StaticTestUncertainties& in = c.bench.uncertainty;
+  std::vector<AcceptanceCheck> checks;
+  if (u.flatness && s.flatness_max && u.flatness_analysis) {
+    checks.push_back(judged("flatness", "um", kUm, *u.flatness, metrology::flatness_budget(u.flatness_analysis->probe_accuracy), std::nullopt,
+                            *s.flatness_max,
+                            fmt::format("flatness {} um above the limit {} um ({})", format_number_fixed(*u.flatness * kUm, 2),
+                                        format_number_fixed(*s.flatness_max * kUm, 2), metrology::to_string(s.flatness_method))));
   }
-  if (u.capacitance_sensor && u.capacitance_actuator) {
-    metrology::CapacitanceSpec spec;
-    spec.sensor = s.capacitance_sensor.value_or(metrology::Range{0.0, INFINITY});
-    spec.actuator = s.capacitance_actuator.value_or(metrology::Range{0.0, INFINITY});
-    const auto check = metrology::check_capacitance(*u.capacitance_sensor, *u.capacitance_actuator, spec, c.file.string());
-    for (const auto& r : check.reasons) reasons.push_back(r);
+  if (u.capacitance_analysis) {
+    const CapacitanceAnalysis& ca = *u.capacitance_analysis;
+    const auto capacitance = [&](const char* what, double value, double scatter, const std::optional<metrology::Range>& range) {
+      if (!range) return;
+      checks.push_back(judged(fmt::format("capacitance of the {}", what), "uF", kUf, value,
+                              metrology::capacitance_budget(value, scatter, static_cast<double>(ca.readings), in), range->min,
+                              std::isfinite(range->max) ? std::optional<double>(range->max) : std::nullopt,
+                              fmt::format("capacitance of the {} {} uF outside the specification [{}, {}] uF", what,
+                                          format_number(value * kUf, 3), format_number(range->min * kUf, 3), format_number(range->max * kUf, 3))));
+    };
+    capacitance("sensor stack", ca.sensor, ca.sensor_scatter, s.capacitance_sensor);
+    capacitance("actuator stacks", ca.actuator, ca.actuator_scatter, s.capacitance_actuator);
   }
-  if (u.stroke && s.stroke_min && *u.stroke < *s.stroke_min) {
-    reasons.push_back(fmt::format("stroke {} um below the minimum {} um", format_number_fixed(*u.stroke * 1e6, 1),
-                                  format_number_fixed(*s.stroke_min * 1e6, 1)));
+  if (u.stroke && s.stroke_min && u.stroke_analysis) {
+    const metrology::StrokeResult& r = u.stroke_analysis->result;
+    checks.push_back(judged("stroke", "um", kUm, *u.stroke,
+                            metrology::stroke_budget(*u.stroke, r.noise, static_cast<double>(r.smoothing_samples), in), *s.stroke_min, std::nullopt,
+                            fmt::format("stroke {} um below the minimum {} um", format_number_fixed(*u.stroke * kUm, 1),
+                                        format_number_fixed(*s.stroke_min * kUm, 1))));
   }
   if (s.stiffness) {
-    for (const auto& [name, v] : {std::pair{"k1", u.k1}, std::pair{"k2", u.k2}, std::pair{"from the resonance", u.k_resonance}}) {
-      if (v && !s.stiffness->contains(*v)) {
-        reasons.push_back(fmt::format(
-            "stiffness {} {} N/um outside [{}, {}] N/um", name, format_number_fixed(*v * 1e-6, 3),
-            format_number_fixed(s.stiffness->min * 1e-6, 3), format_number_fixed(s.stiffness->max * 1e-6, 3)));
+    const auto stiffness = [&](const std::string& name, double v, metrology::UncertaintyBudget b) {
+      checks.push_back(judged("stiffness " + name, "N/um", kNPerUm, v, std::move(b), s.stiffness->min, s.stiffness->max,
+                              fmt::format("stiffness {} {} N/um outside [{}, {}] N/um", name, format_number_fixed(v * kNPerUm, 3),
+                                          format_number_fixed(s.stiffness->min * kNPerUm, 3), format_number_fixed(s.stiffness->max * kNPerUm, 3))));
+    };
+    if (u.stiffness_analysis) {
+      for (auto& [name, b] : static_stiffness_budgets(c, *u.stiffness_analysis)) {
+        const std::optional<double>& v = name == "k1" ? u.k1 : u.k2;
+        if (v) stiffness(name, *v, std::move(b));
       }
     }
+    if (u.k_resonance) {
+      const double w = std::sqrt(*u.k_resonance / c.bench.suspended_mass);
+      const double se = u.de_plant ? u.de_plant->uncertainty.standard_error_of("natural_frequency") : 0.0;
+      stiffness("from the resonance", *u.k_resonance,
+                metrology::resonance_stiffness_budget(c.bench.suspended_mass, w, std::isfinite(se) ? se : 0.0, in));
+    }
   }
-  for (const auto& r : outlier_reasons) reasons.push_back(r);
-  for (const auto& r : implausible(c, u)) reasons.push_back(r);
-  return reasons;
+  return checks;
+}
+
+// The unit's verdict: rejected for a failed analysis, check, outlier or implausible value; marginal
+// when none of these but a check is marginal; accepted otherwise. Reasons: the failures, then the
+// marginal checks.
+void accept_or_reject(const Campaign& c, UnitAnalysis& u, const std::vector<std::string>& outlier_reasons) {
+  u.checks = acceptance_checks(c, u);
+  std::vector<std::string> fails, marginal;
+  for (const auto& f : u.failed) fails.push_back("analysis failed: " + f);
+  for (const AcceptanceCheck& a : u.checks) {
+    if (a.decision.verdict == metrology::Conformity::kFail) fails.push_back(a.reason);
+    if (a.decision.verdict == metrology::Conformity::kMarginal) marginal.push_back(a.reason);
+  }
+  for (const auto& r : outlier_reasons) fails.push_back(r);
+  for (const auto& r : implausible(c, u)) fails.push_back(r);
+  u.marginal = fails.empty() && !marginal.empty();
+  u.accepted = fails.empty() && marginal.empty();
+  u.reasons = std::move(fails);
+  u.reasons.insert(u.reasons.end(), marginal.begin(), marginal.end());
 }
 
 // ------------------------------------------------------------------------------------ IFF
@@ -494,9 +573,8 @@ CampaignResult finish_campaign(const Campaign& c, std::vector<UnitAnalysis> unit
       continue;
     }
     const auto it = batch.outlier_reasons.find(u.id);
-    u.reasons = acceptance(c, u, it == batch.outlier_reasons.end() ? std::vector<std::string>{} : it->second);
-    u.accepted = u.reasons.empty();
-    (u.accepted ? r.accepted : r.rejected) += 1;
+    accept_or_reject(c, u, it == batch.outlier_reasons.end() ? std::vector<std::string>{} : it->second);
+    (u.accepted ? r.accepted : u.marginal ? r.marginal : r.rejected) += 1;
   }
   const auto t_iff = std::chrono::steady_clock::now();
   try {

@@ -214,7 +214,7 @@ json results_json(const CampaignResult& r) {
           {"iff", iff(r.iff)},
           {"superelement", r.superelement ? superelement(*r.superelement) : json(nullptr)},
           {"specs", specs},
-          {"summary", {{"units", r.units.size()}, {"accepted", r.accepted}, {"rejected", r.rejected}, {"not_analysed", r.not_analysed}}},
+          {"summary", {{"units", r.units.size()}, {"accepted", r.accepted}, {"marginal", r.marginal}, {"rejected", r.rejected}, {"not_analysed", r.not_analysed}}},
           {"provenance",
            {{"campaign", c.file.string()},
             {"window", dsp::to_string(a.window)},
@@ -226,7 +226,13 @@ json results_json(const CampaignResult& r) {
             {"fit_order", a.fit_order},
             {"bench", {{"amplifier_gain", c.bench.amplifier_gain}, {"suspended_mass_kg", c.bench.suspended_mass},
                        {"added_mass_kg", c.bench.added_mass}, {"gravity_m_per_s2", c.bench.gravity},
-                       {"hpf_resistance_ohm", io::to_json(c.bench.hpf_resistance)}, {"probe_accuracy_um", c.bench.probe_accuracy * kUm}}},
+                       {"hpf_resistance_ohm", io::to_json(c.bench.hpf_resistance)}, {"probe_accuracy_um", c.bench.probe_accuracy * kUm},
+                       {"added_mass_uncertainty_kg", c.bench.uncertainty.added_mass_kg},
+                       {"gravity_uncertainty_m_per_s2", c.bench.uncertainty.gravity_m_per_s2},
+                       {"suspended_mass_uncertainty_kg", c.bench.uncertainty.suspended_mass_kg},
+                       {"encoder_resolution_um", c.bench.uncertainty.encoder_resolution_m * kUm},
+                       {"capacitance_uncertainty_relative", c.bench.uncertainty.capacitance_relative},
+                       {"displacement_scale_uncertainty_relative", c.bench.uncertainty.displacement_scale_relative}}},
             {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
   io::name_non_finite(doc);  // the one encoding of non-finite numbers (docs/formats.md)
   return doc;

@@ -261,8 +261,15 @@ CapacitanceAnalysis capacitance(const Campaign& c, const UnitSpec& spec) {
   CapacitanceAnalysis out;
   if (spec.capacitance) {
     const Record r = load_record(c, spec, *spec.capacitance, Experiment::kCapacitance);
-    out.sensor = r.channel("C_sensor").mean();
-    out.actuator = r.channel("C_actuator").mean();
+    const VectorXd cs = r.channel("C_sensor"), ca = r.channel("C_actuator");
+    out.sensor = cs.mean();
+    out.actuator = ca.mean();
+    out.readings = static_cast<long>(cs.size());
+    const auto scatter = [](const VectorXd& x) {
+      return x.size() > 1 ? std::sqrt((x.array() - x.mean()).square().sum() / static_cast<double>(x.size() - 1)) : 0.0;
+    };
+    out.sensor_scatter = scatter(cs);
+    out.actuator_scatter = scatter(ca);
     out.provenance = provenance(r, {"C_sensor", "C_actuator"});
     for (const auto& [v, role] : {std::pair{out.sensor, "C_sensor"}, std::pair{out.actuator, "C_actuator"}}) {
       if (!(v > 0.0)) {

@@ -16,6 +16,13 @@ std::string to_string(Conformity c) {
   return "fail";
 }
 
+Conformity conformity_from_string(const std::string& name) {
+  for (const Conformity c : {Conformity::kPass, Conformity::kMarginal, Conformity::kFail}) {
+    if (to_string(c) == name) return c;
+  }
+  throw InputError("conformity", "verdict", "pass, marginal or fail", "'" + name + "'");
+}
+
 namespace {
 
 double normal_cdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }

@@ -1,5 +1,7 @@
 #include "piezobench/metrology/stroke.hpp"
 
+#include "piezobench/metrology/uncertainty_budget.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -106,6 +108,8 @@ StrokeResult analyze_stroke(const Eigen::Ref<const VectorXd>& va, const Eigen::R
     throw InputError(source, "Va", "a voltage ramp spanning at least 1 V", fmt::format("{} V", format_number(r.va_max - r.va_min)));
   }
   r.stroke = ds.maxCoeff() - ds.minCoeff();
+  r.noise = noise_from_second_differences(std::vector<double>(de.data(), de.data() + de.size()));
+  r.smoothing_samples = static_cast<long>(w);
   // Straight line d_e = a + b Va (least squares).
   const double vm = va.mean();
   const double dm = de.mean();

@@ -54,14 +54,25 @@ UncertaintyBudget stiffness_budget(double added_mass_kg, double gravity_m_per_s2
   const double u_d = std::sqrt(2.0) * reading_uncertainty(in.encoder_resolution_m, reading_noise_m, samples_per_reading);
   return combine("N/m", {{"added mass", "kg", in.added_mass_kg, k / added_mass_kg, 0.0},
                          {"gravity", "m/s^2", in.gravity_m_per_s2, k / gravity_m_per_s2, 0.0},
-                         {"deflection (two readings: resolution and noise)", "m", u_d, -k / deflection_m, 0.0}});
+                         {"deflection (two readings: resolution and noise)", "m", u_d, -k / deflection_m, 0.0},
+                         {"deflection (the sensor's scale)", "m", in.displacement_scale_relative * deflection_m, -k / deflection_m, 0.0}});
 }
 
-UncertaintyBudget stroke_budget(double noise_m, double averaged_samples, const StaticTestUncertainties& in) {
+UncertaintyBudget resonance_stiffness_budget(double suspended_mass_kg, double resonance_rad_s, double resonance_standard_error_rad_s,
+                                             const StaticTestUncertainties& in) {
+  require_positive("suspended mass", suspended_mass_kg);
+  require_positive("resonance", resonance_rad_s);
+  const double k = suspended_mass_kg * resonance_rad_s * resonance_rad_s;
+  return combine("N/m", {{"suspended mass", "kg", in.suspended_mass_kg, k / suspended_mass_kg, 0.0},
+                         {"resonance (the FRF fit's standard error)", "rad/s", resonance_standard_error_rad_s, 2.0 * k / resonance_rad_s, 0.0}});
+}
+
+UncertaintyBudget stroke_budget(double stroke_m, double noise_m, double averaged_samples, const StaticTestUncertainties& in) {
   if (!(averaged_samples >= 1.0)) throw InputError("uncertainty budget", "samples averaged", "at least 1", format_number(averaged_samples));
   const double u_extreme = reading_uncertainty(in.encoder_resolution_m, noise_m, averaged_samples);
   return combine("m", {{"maximum of d_e (resolution and noise)", "m", u_extreme, 1.0, 0.0},
-                       {"minimum of d_e (resolution and noise)", "m", u_extreme, -1.0, 0.0}});
+                       {"minimum of d_e (resolution and noise)", "m", u_extreme, -1.0, 0.0},
+                       {"the sensor's scale", "m", in.displacement_scale_relative * std::abs(stroke_m), 1.0, 0.0}});
 }
 
 UncertaintyBudget capacitance_budget(double capacitance_F, double scatter_F, double readings, const StaticTestUncertainties& in) {

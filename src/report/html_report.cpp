@@ -150,6 +150,7 @@ struct Unit {
   std::string name;  // the unit's name when results.json gives one, else its id
   std::optional<std::string> not_analysed;  // "file: reason" of a unit that could not be analysed
   bool accepted = false;
+  bool marginal = false;  // no check failed, one is marginal (results.json's `marginal`; absent: false)
   std::vector<std::string> reasons;
   std::vector<Cell> cells;  // one per kColumns entry
 };
@@ -236,6 +237,11 @@ std::vector<Unit> read_units(const json& results) {
       fail(child(at, "accepted"), "true or false", accepted == u.end() ? "nothing" : describe(*accepted));
     }
     unit.accepted = accepted->get<bool>();
+    if (const auto m = u.find("marginal"); m != u.end() && !m->is_null()) {
+      if (!m->is_boolean()) fail(child(at, "marginal"), "true or false", describe(*m));
+      unit.marginal = m->get<bool>();
+      if (unit.marginal && unit.accepted) fail(child(at, "marginal"), "false for an accepted unit", "true");
+    }
     unit.name = optional_string(u, "name", at).value_or(unit.id);
     if (const auto na = u.find("not_analysed"); na != u.end() && !na->is_null()) {
       const std::string nat = child(at, "not_analysed");
@@ -255,7 +261,7 @@ std::vector<Unit> read_units(const json& results) {
       }
     }
     if (!unit.accepted && unit.reasons.empty()) {
-      fail(child(at, "reasons"), "at least one reason for a rejected unit", "none");
+      fail(child(at, "reasons"), "at least one reason for a rejected or marginal unit", "none");
     }
     for (const Column& column : kColumns) unit.cells.push_back(read_cell(u, column, at));
     units.push_back(std::move(unit));
@@ -688,11 +694,10 @@ void acceptance_table(std::string& out, const Document& doc) {
   }
   out += "<th>Reasons</th></tr></thead>\n<tbody>\n";
   for (const Unit& u : doc.units) {
-    out += u.accepted ? "<tr class=\"accepted\">" : u.not_analysed ? "<tr class=\"not-analysed\">" : "<tr class=\"rejected\">";
+    const char* status = u.accepted ? "accepted" : u.not_analysed ? "not analysed" : u.marginal ? "marginal" : "rejected";
+    out += u.not_analysed ? std::string("<tr class=\"not-analysed\">") : "<tr class=\"" + std::string(status) + "\">";
     out += "<th scope=\"row\">" + escape(u.name) + "</th>";
-    out += u.accepted       ? "<td class=\"status\">accepted</td>"
-           : u.not_analysed ? "<td class=\"status\">not analysed</td>"
-                            : "<td class=\"status\">rejected</td>";
+    out += "<td class=\"status\">" + std::string(status) + "</td>";
     for (const Cell& c : u.cells) out += cell_html(c);
     out += "<td class=\"reasons\">";
     if (!u.reasons.empty()) {
@@ -711,12 +716,12 @@ void acceptance_table(std::string& out, const Document& doc) {
 // "Batch comparison" section).
 void batch_summary(std::string& out, const Document& doc) {
   std::size_t accepted = 0;
-  std::vector<const Unit*> rejected, not_analysed;
+  std::vector<const Unit*> rejected, marginal, not_analysed;
   for (const Unit& u : doc.units) {
     if (u.accepted) {
       ++accepted;
     } else {
-      (u.not_analysed ? not_analysed : rejected).push_back(&u);
+      (u.not_analysed ? not_analysed : u.marginal ? marginal : rejected).push_back(&u);
     }
   }
   const auto names = [](const std::vector<const Unit*>& list) {
@@ -727,6 +732,10 @@ void batch_summary(std::string& out, const Document& doc) {
   out += "<section id=\"batch\"><h2>2. Batch summary</h2>\n<dl class=\"summary\">";
   out += "<dt>Units</dt><dd>" + std::to_string(doc.units.size()) + "</dd>";
   out += "<dt>Accepted</dt><dd>" + std::to_string(accepted) + "</dd>";
+  if (!marginal.empty()) {
+    out += "<dt>Marginal</dt><dd>" + std::to_string(marginal.size()) + names(marginal) +
+           " (a limit within the value's 95 % interval: neither conformity nor nonconformity is proved, ISO 14253-1)</dd>";
+  }
   out += "<dt>Rejected</dt><dd>" + std::to_string(rejected.size()) + names(rejected) + "</dd>";
   if (!not_analysed.empty()) {
     out += "<dt>Not analysed</dt><dd>" + std::to_string(not_analysed.size()) + names(not_analysed) + "<ul>";

@@ -10,6 +10,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/fields.hpp"
 #include "piezobench/core/format.hpp"
+#include "piezobench/metrology/conformity.hpp"
 
 namespace piezobench::station {
 
@@ -178,15 +179,13 @@ MeasuredValue judge(const MeasurementKind& kind, std::optional<double> value, co
     return m;
   }
   const double v = *value;
+  // Each limit with its own U = margin |limit| (until the measurement carries its budget), decided by
+  // the campaign's rule (metrology/conformity.hpp, ISO 14253-1).
   const auto check = [&](double bound, bool is_min) {
     const double u = margin_relative * std::abs(bound);
-    const bool outside = is_min ? v < bound : v > bound;
-    Verdict here = Verdict::kPass;
-    if (std::abs(v - bound) <= u) {
-      here = Verdict::kMarginal;
-    } else if (outside) {
-      here = Verdict::kFail;
-    }
+    const auto lower = is_min ? std::optional<double>(bound) : std::nullopt, upper = is_min ? std::nullopt : std::optional<double>(bound);
+    const metrology::Conformity c = metrology::decide(v, u, lower, upper).verdict;
+    const Verdict here = c == metrology::Conformity::kPass ? Verdict::kPass : c == metrology::Conformity::kMarginal ? Verdict::kMarginal : Verdict::kFail;
     if (static_cast<int>(here) > static_cast<int>(m.verdict)) {
       m.verdict = here;
       m.reason =

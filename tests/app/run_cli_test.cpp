@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "app/run_cli.hpp"
@@ -47,6 +48,49 @@ TEST(RunCli, DemoWritesDataCampaignAndReport) {
   EXPECT_EQ(printed["units"].size(), 2u);
   EXPECT_EQ(printed["outputs"].size(), 3u);
   EXPECT_TRUE(contains(strict.err, "report written to")) << strict.err;
+}
+
+// A limit within a unit's value +- U (docs/uncertainty.md, section 7) makes it marginal: neither
+// accepted nor rejected, said in results.json and the summary; `--strict` exits 5 on it too.
+TEST(RunCli, MarginalUnitIsNeitherAcceptedNorRejectedAndStrictFailsOnIt) {
+  const fs::path& d = demo_dir();
+  const json demo = json::parse(read_text(d / "results.json"));
+  const double stroke = demo["units"][0]["stroke_um"].get<double>();  // unit 1, U ~ 0.5 um (0.1 % scale)
+  std::string text = read_text(d / "campaign.toml");
+  const auto at = text.find("stroke_min_um = ");
+  ASSERT_NE(at, std::string::npos);
+  std::ostringstream limit;
+  limit.precision(17);
+  limit << "stroke_min_um = " << stroke - 0.1;
+  text.replace(at, text.find('\n', at) - at, limit.str());
+  // Unit 1 only: the [[units]] tables are last, unit 1's first.
+  const auto second = text.find("[[units]]", text.find("[[units]]") + 1);
+  ASSERT_NE(second, std::string::npos);
+  text.erase(second);
+  std::ofstream(d / "campaign_marginal.toml") << text;
+  TempDir out, out_strict;
+  const std::string campaign = (d / "campaign_marginal.toml").string();
+  const CliRun plain = run_cli("run " + campaign + " --out " + out.path().string());
+  EXPECT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_TRUE(contains(plain.out, "1 units: 0 accepted, 1 marginal, 0 rejected")) << plain.out;
+  EXPECT_TRUE(contains(plain.out, "APA 1    MARGINAL")) << plain.out;
+  const json r = json::parse(read_text(out.path() / "results.json"));
+  EXPECT_EQ(r["summary"]["marginal"], 1);
+  const json& u = r["units"][0];
+  EXPECT_FALSE(u["accepted"].get<bool>());
+  EXPECT_TRUE(u["marginal"].get<bool>());
+  bool found = false;
+  for (const json& c : u["checks"]) {
+    if (c["quantity"] != "stroke") continue;
+    found = true;
+    EXPECT_EQ(c["verdict"], "marginal");
+    EXPECT_GT(c["expanded_uncertainty"].get<double>(), 0.1);  // the limit is inside the interval
+    EXPECT_GT(c["probability_of_conformity"].get<double>(), 0.5);
+    EXPECT_LT(c["probability_of_conformity"].get<double>(), 0.99);
+  }
+  EXPECT_TRUE(found);
+  EXPECT_TRUE(contains(read_text(out.path() / "report.html"), "<td class=\"status\">marginal</td>"));
+  EXPECT_EQ(run_cli("run " + campaign + " --strict --out " + out_strict.path().string()).exit_code, 5);
 }
 
 // The demo campaign split in two parts and merged gives the demo run's results.json, results.mat

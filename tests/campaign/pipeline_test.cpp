@@ -125,6 +125,54 @@ TEST(Pipeline, AcceptanceOutliersAndIff) {
   }
 }
 
+// Each limit is checked with the value's expanded uncertainty (ISO 14253-1): unit 2's stroke
+// (246.5 um, U = 0.49 um mostly from the sensor's 0.1 % scale) is marginal against a limit 0.2 um
+// below or above it, fails 1 um above it; its check states U, the guard band and p_c.
+TEST(Pipeline, ALimitWithinTheUncertaintyIsMarginal) {
+  Batch b;
+  const auto stroke_check = [](const UnitAnalysis& u) {
+    for (const AcceptanceCheck& c : u.checks) {
+      if (c.quantity == "stroke") return c;
+    }
+    throw std::runtime_error("no stroke check");
+  };
+  const auto unit2 = [](const CampaignResult& r) -> const UnitAnalysis& { return r.units[1]; };
+  b.campaign.specs.stroke_min = 246.5e-6 - 0.2e-6;
+  CampaignResult r = run_campaign(b.campaign);
+  EXPECT_EQ(r.accepted, 1);
+  EXPECT_EQ(r.marginal, 1);
+  EXPECT_EQ(r.rejected, 1);
+  EXPECT_FALSE(unit2(r).accepted);
+  EXPECT_TRUE(unit2(r).marginal);
+  const AcceptanceCheck c = stroke_check(unit2(r));
+  EXPECT_EQ(c.decision.verdict, metrology::Conformity::kMarginal);
+  EXPECT_NEAR(c.decision.value, 246.5, 1e-6);
+  EXPECT_NEAR(c.decision.expanded_uncertainty, 2.0 * 0.001 * 246.5, 0.01);  // the scale dominates
+  EXPECT_EQ(c.decision.guard_band, c.decision.expanded_uncertainty);
+  EXPECT_NEAR(c.decision.probability_of_conformity, 0.79, 0.03);  // Phi(0.2 / 0.2465)
+  ASSERT_FALSE(unit2(r).reasons.empty());
+  EXPECT_TRUE(test::contains(unit2(r).reasons[0], "marginal: stroke 246.5 +- 0.49 um")) << unit2(r).reasons[0];
+  b.campaign.specs.stroke_min = 246.5e-6 + 0.2e-6;  // below the limit, but not by more than U
+  r = run_campaign(b.campaign);
+  EXPECT_TRUE(unit2(r).marginal);
+  EXPECT_LT(stroke_check(unit2(r)).decision.probability_of_conformity, 0.5);
+  b.campaign.specs.stroke_min = 246.5e-6 + 1e-6;
+  r = run_campaign(b.campaign);
+  EXPECT_FALSE(unit2(r).marginal);
+  EXPECT_EQ(stroke_check(unit2(r)).decision.verdict, metrology::Conformity::kFail);
+  EXPECT_EQ(r.rejected, 2);
+  // Unit 1's static stiffness check: its budget names the mass, g, the readings and the scale.
+  bool k1 = false;
+  for (const AcceptanceCheck& a : r.units[0].checks) {
+    if (a.quantity != "stiffness k1") continue;
+    k1 = true;
+    EXPECT_EQ(a.decision.verdict, metrology::Conformity::kPass);
+    ASSERT_EQ(a.budget.components.size(), 4u);
+    EXPECT_EQ(a.budget.components[0].name, "added mass");
+  }
+  EXPECT_TRUE(k1);
+}
+
 // Issue 12: a record whose numbers are in um under a label that says metres gave a stroke of
 // 136,000,000 um, accepted. It is rejected as implausible, naming the column and the file.
 TEST(Pipeline, ImplausibleValuesAreRejectedNamingTheColumn) {

@@ -52,7 +52,7 @@ TEST(ResultsJson, BatchAndIffStudy) {
   r.iff.controller.w_hpf = 2.0 * M_PI * 3.0;
   r.iff.note = "no plant";
   const json j = results_json(r);
-  EXPECT_EQ(j["summary"], json({{"units", 2}, {"accepted", 1}, {"rejected", 1}, {"not_analysed", 0}}));
+  EXPECT_EQ(j["summary"], json({{"units", 2}, {"accepted", 1}, {"marginal", 0}, {"rejected", 1}, {"not_analysed", 0}}));
   EXPECT_EQ(j["batch"]["similarity"]["units"][0]["Vs_rms_dB"], "nan");
   EXPECT_NEAR(j["iff"]["controller"]["hpf_Hz"].get<double>(), 3.0, 1e-12);
   EXPECT_TRUE(j["iff"]["unit"].is_null());

@@ -62,6 +62,8 @@ TEST(Conformity, RefusesWhatIsNotADecision) {
   EXPECT_THROW((void)decide(1.0, 0.1, 2.0, 1.0), InputError);
   EXPECT_THROW((void)decide(1.0, 0.1, 0.0, std::nullopt, 0.0), InputError);
   EXPECT_EQ(to_string(Conformity::kMarginal), "marginal");
+  EXPECT_EQ(conformity_from_string("fail"), Conformity::kFail);
+  EXPECT_THROW((void)conformity_from_string("ok"), InputError);
 }
 
 }  // namespace

@@ -58,6 +58,9 @@ TEST(Stroke, NoiseDoesNotWidenTheStroke) {
   // Raw peak-to-peak is ~ 7 sigma too wide; the 20-sample average leaves ~ 1.5 sigma.
   EXPECT_GT(raw - 255e-6, 0.8e-6);
   EXPECT_TRUE(near<double>(out.stroke, 255e-6, {0.0, 0.4e-6}));
+  // The noise per sample is found under the ramp (its second differences), for the stroke's budget.
+  EXPECT_NEAR(out.noise / 0.2e-6, 1.0, 0.03);
+  EXPECT_EQ(out.smoothing_samples, 20);
 }
 
 // Va = 65 + A sin(w t), d_e = s A sin(w t - phi): the loop is an ellipse, crossing the offset at

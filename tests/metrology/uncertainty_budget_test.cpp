@@ -28,14 +28,15 @@ TEST(UncertaintyBudget, StiffnessIsTheProductRule) {
   in.added_mass_kg = 0.0064;  // 0.1 %
   in.gravity_m_per_s2 = 0.0098;  // 0.1 %
   in.encoder_resolution_m = 0.0;
+  in.displacement_scale_relative = 0.001;  // 0.1 %
   // d = 31.36 um (k = 2 N/um), readings of 9,000 samples with 9 nm noise: u(d) = sqrt(2) 9e-9 / sqrt(9000).
   const double d = 6.4 * 9.8 / 2e6;
   const UncertaintyBudget b = stiffness_budget(6.4, 9.8, d, 9e-9, 9000.0, in);
   const double u_d = std::sqrt(2.0) * 9e-9 / std::sqrt(9000.0);
-  const double rel = std::sqrt(1e-6 + 1e-6 + std::pow(u_d / d, 2));
+  const double rel = std::sqrt(1e-6 + 1e-6 + std::pow(u_d / d, 2) + 1e-6);
   EXPECT_NEAR(b.combined, 2e6 * rel, 1e-9 * 2e6 * rel);
   EXPECT_EQ(b.unit, "N/m");
-  ASSERT_EQ(b.components.size(), 3u);
+  ASSERT_EQ(b.components.size(), 4u);
   EXPECT_NEAR(b.components[2].standard_uncertainty, u_d, 1e-22);
 }
 
@@ -48,6 +49,7 @@ TEST(UncertaintyBudget, StiffnessBudgetPredictsTheSpreadOfSimulatedTests) {
   in.added_mass_kg = 0.01;
   in.gravity_m_per_s2 = 0.02;
   in.encoder_resolution_m = 20e-9;
+  in.displacement_scale_relative = 0.0;  // the simulated sensor has an exact scale
   const double m = 6.4, g = 9.8, k_true = 2e6, s = 30e-9;
   const int n = 200;
   const double d = m * g / k_true;
@@ -79,14 +81,25 @@ TEST(UncertaintyBudget, StiffnessBudgetPredictsTheSpreadOfSimulatedTests) {
 TEST(UncertaintyBudget, StrokeCapacitanceAndFlatness) {
   StaticTestUncertainties in;
   in.encoder_resolution_m = 12e-9;  // q^2 / 12 = (3.46 nm)^2
-  const UncertaintyBudget s = stroke_budget(20e-9, 100.0, in);  // noise 2 nm after averaging 100
-  EXPECT_NEAR(s.combined, std::sqrt(2.0 * (12e-9 * 12e-9 / 12.0 + 4e-18)), 1e-20);
+  in.displacement_scale_relative = 1e-4;
+  const UncertaintyBudget s = stroke_budget(250e-6, 20e-9, 100.0, in);  // noise 2 nm after averaging 100; scale 25 nm
+  EXPECT_NEAR(s.combined, std::sqrt(2.0 * (12e-9 * 12e-9 / 12.0 + 4e-18) + 25e-9 * 25e-9), 1e-20);
   in.capacitance_relative = 0.01;
   const UncertaintyBudget c = capacitance_budget(4.4e-6, 0.03e-6, 9.0, in);  // 1 % and 0.01 uF
   EXPECT_NEAR(c.combined, std::hypot(0.044e-6, 0.01e-6), 1e-15);
   EXPECT_NEAR(flatness_budget(0.5e-6).expanded, 2.0 * std::sqrt(2.0) * 0.5e-6, 1e-18);
   EXPECT_THROW((void)capacitance_budget(0.0, 0.0, 1.0, in), InputError);
-  EXPECT_THROW((void)stroke_budget(1e-9, 0.5, in), InputError);
+  EXPECT_THROW((void)stroke_budget(250e-6, 1e-9, 0.5, in), InputError);
+}
+
+TEST(UncertaintyBudget, ResonanceStiffnessDoublesTheResonancesRelativeError) {
+  StaticTestUncertainties in;
+  in.suspended_mass_kg = 0.0;
+  const double w = 2.0 * 3.141592653589793 * 95.0;
+  const UncertaintyBudget b = resonance_stiffness_budget(5.7, w, 0.001 * w, in);  // 0.1 % on w
+  EXPECT_NEAR(b.combined / (5.7 * w * w), 0.002, 1e-15);
+  in.suspended_mass_kg = 0.057;  // 1 % on m
+  EXPECT_NEAR(resonance_stiffness_budget(5.7, w, 0.0, in).combined / (5.7 * w * w), 0.01, 1e-15);
 }
 
 TEST(UncertaintyBudget, NoiseFromSecondDifferencesIgnoresARampAndFindsWhiteNoise) {

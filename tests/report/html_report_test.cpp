@@ -201,6 +201,27 @@ TEST(HtmlReport, NotAnalysedUnitIsNamedWithItsFileAndReason) {
   (void)test::input_error([&] { (void)render_html(doc); }, "results.units[1].accepted");
 }
 
+TEST(HtmlReport, MarginalUnitHasItsStatusAndItsLineInTheSummary) {
+  json doc = sample::document();
+  json& u2 = doc["results"]["units"][1];
+  u2["accepted"] = false;
+  u2["marginal"] = true;
+  u2["reasons"] = {"marginal: stroke 251 +- 4 um (k = 2) has a limit of the specification inside its interval"};
+  const std::string html = render_html(doc);
+  const std::string row = row_of(html, "APA 2");
+  EXPECT_TRUE(contains(row, "<tr class=\"marginal\">")) << row;
+  EXPECT_TRUE(contains(row, "<td class=\"status\">marginal</td>")) << row;
+  EXPECT_TRUE(contains(row, "<li>marginal: stroke 251 +- 4 um"));
+  EXPECT_TRUE(contains(html, "<dt>Marginal</dt><dd>1: APA 2 (a limit within the value's 95 % interval"));
+  EXPECT_TRUE(contains(html, "<dt>Rejected</dt><dd>1: APA 3</dd>"));  // a marginal unit is not counted as rejected
+  EXPECT_EQ(count(html, "<tr class=\"accepted\">"), 5u);
+  u2["accepted"] = true;  // accepted and marginal at once is no verdict
+  (void)test::input_error([&] { (void)render_html(doc); }, "results.units[1].marginal");
+  u2["accepted"] = false;
+  u2["marginal"] = "yes";
+  (void)test::input_error([&] { (void)render_html(doc); }, "results.units[1].marginal");
+}
+
 TEST(HtmlReport, TextBecomesEscapedParagraphs) {
   json doc = sample::document();
   doc["sections"][1]["text"] = "First <paragraph>.\n\nSecond one,\non two lines.\n\n\n\n";

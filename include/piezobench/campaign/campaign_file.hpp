@@ -20,6 +20,7 @@
 #include "piezobench/control/iff.hpp"
 #include "piezobench/dsp/window.hpp"
 #include "piezobench/fem/superelement_setup.hpp"
+#include "piezobench/metrology/uncertainty_budget.hpp"
 #include "piezobench/metrology/capacitance.hpp"
 #include "piezobench/metrology/flatness.hpp"
 
@@ -96,6 +97,10 @@ struct BenchConstants {
   // high-pass is computed from R C_sensor (the report's bench has 80.6 kOhm).
   std::optional<double> hpf_resistance;
   double probe_accuracy = 0.5e-6;   // m (probe_accuracy_um), flatness probe
+  // The inputs' standard uncertainties of the acceptance checks' budgets (docs/uncertainty.md, section
+  // 7): added_mass_uncertainty_kg, gravity_uncertainty_m_per_s2, suspended_mass_uncertainty_kg,
+  // encoder_resolution_um, capacitance_uncertainty_relative, displacement_scale_uncertainty_relative.
+  metrology::StaticTestUncertainties uncertainty;
   // Provenance (docs/campaign.md): the bench the records come from (`name`: a record whose
   // settings.bench names another is refused; "" = not checked) and when they were taken
   // (`recorded_from`, `recorded_until`: TOML dates or date-times; a record whose recorded_at is

@@ -9,9 +9,12 @@
 // measured is reported as such and is no reason to reject):
 //   flatness (spec method) <= flatness_um; capacitance of the sensor and of the actuator stacks
 //   inside their ranges; stroke >= stroke_min_um; k1, k2 and the resonance stiffness inside
-//   stiffness_N_per_um; with reject_outliers, no batch outlier in capacitance or stroke (robust
-//   z-score, metrology/capacitance.hpp); every analysis that was run succeeded. A unit that could
-//   not be analysed is neither accepted nor rejected (CampaignResult::not_analysed).
+//   stiffness_N_per_um; each of these a check of value +- U (GUM budget, k = 2) against its limits
+//   with a verdict pass / marginal / fail (ISO 14253-1, metrology/conformity.hpp; docs/uncertainty.md
+//   section 7); with reject_outliers, no batch outlier in capacitance or stroke (robust z-score,
+//   metrology/capacitance.hpp); every analysis that was run succeeded. Accepted: every check passes;
+//   marginal: none fails, one is marginal; rejected otherwise. A unit that could not be analysed is
+//   neither accepted nor rejected (CampaignResult::not_analysed).
 //
 // Outputs (write_outputs): OUT/results.mat, OUT/report.html and OUT/results.json, staged in a hidden
 // folder inside OUT and renamed into place only when all three are written, results.json last, so

@@ -26,6 +26,8 @@
 #include "piezobench/ident/dominant_pole.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/hysteresis.hpp"
+#include "piezobench/metrology/uncertainty_budget.hpp"
+#include "piezobench/metrology/conformity.hpp"
 #include "piezobench/metrology/capacitance.hpp"
 #include "piezobench/metrology/flatness.hpp"
 #include "piezobench/metrology/stiffness.hpp"
@@ -116,6 +118,9 @@ struct CapacitanceAnalysis {
   double actuator = 0.0;  // F
   std::optional<RecordProvenance> provenance;  // nullopt: typed into the campaign under `key`
   std::string key;                             // "units[i].capacitance_uF" when typed
+  double sensor_scatter = 0.0;    // F, standard deviation of the readings (0: typed)
+  double actuator_scatter = 0.0;  // F
+  long readings = 1;              // readings averaged (a count; 1: typed)
 };
 
 constexpr auto describe(core::Type<CapacitanceAnalysis>) {
@@ -125,7 +130,10 @@ constexpr auto describe(core::Type<CapacitanceAnalysis>) {
       core::field("sensor", &S::sensor, kFaradAsUf, "sensor stack, mean of the readings"),
       core::field("actuator", &S::actuator, kFaradAsUf, "actuator stacks"),
       core::field("provenance", &S::provenance, kNone, "the record (None: typed into the campaign under `key`)"),
-      core::field("key", &S::key, kNone, "\"units[i].capacitance_uF\" when typed"));
+      core::field("key", &S::key, kNone, "\"units[i].capacitance_uF\" when typed"),
+      core::field("sensor_scatter", &S::sensor_scatter, kFaradAsUf, "standard deviation of the sensor's readings").part_only(),
+      core::field("actuator_scatter", &S::actuator_scatter, kFaradAsUf, "standard deviation of the actuator's readings").part_only(),
+      core::field("readings", &S::readings, kNone, "readings averaged (1: typed)").part_only());
 }
 
 struct StrokeAnalysis {
@@ -422,6 +430,27 @@ constexpr auto describe(core::Type<NotAnalysed>) {
       core::field("reason", &S::reason, kNone, "the InputError's message"));
 }
 
+// One acceptance check of a unit (pipeline.hpp): the value with its expanded uncertainty against the
+// specification's limits, decided by metrology::decide (ISO 14253-1: pass, marginal, fail).
+struct AcceptanceCheck {
+  std::string quantity;                    // "stroke", "stiffness k1", "capacitance of the sensor stack", ...
+  std::string unit;                        // of the decision's value, U and limits: "um", "uF", "N/um"
+  metrology::ConformityDecision decision;  // in `unit`
+  metrology::UncertaintyBudget budget;     // SI (its own `unit`)
+  std::string reason;                      // the sentence of a marginal or failed check, "" on pass
+};
+
+constexpr auto describe(core::Type<AcceptanceCheck>) {
+  using S = AcceptanceCheck;
+  using namespace core::shown;
+  return core::fields<S>("AcceptanceCheck", "a value +- U against its limits (ISO 14253-1)",
+      core::field("quantity", &S::quantity, kNone, "what is checked"),
+      core::field("unit", &S::unit, kNone, "of the decision's value, U and limits"),
+      core::field("decision", &S::decision, kNone, "verdict, U, guard band, probability of conformity").key("."),
+      core::field("budget", &S::budget, kNone, "the GUM budget behind U (SI)"),
+      core::field("reason", &S::reason, kNone, "why a check is marginal or fails"));
+}
+
 struct UnitAnalysis {
   int id = 0;
   std::string name;
@@ -453,9 +482,12 @@ struct UnitAnalysis {
   std::vector<std::string> not_measured;     // experiments the campaign does not list
   std::vector<std::string> failed;           // "frf: vector fitting failed: ..." (NumericalError)
   std::vector<std::string> warnings;         // cross-checks that disagree (kHighPassCrossCheckRatio, ...)
-  // The acceptance (pipeline.hpp).
+  // The acceptance (pipeline.hpp): accepted only when every check passes; marginal when none fails
+  // but one is marginal (`run --strict` fails on it too); reasons of both.
   bool accepted = false;
+  bool marginal = false;
   std::vector<std::string> reasons;
+  std::vector<AcceptanceCheck> checks;
 };
 
 constexpr auto describe(core::Type<UnitAnalysis>) {
@@ -495,8 +527,10 @@ constexpr auto describe(core::Type<UnitAnalysis>) {
       core::field("not_measured", &S::not_measured, kNone, "experiments the campaign does not list"),
       core::field("failed", &S::failed, kNone, "one line per analysis that failed"),
       core::field("warnings", &S::warnings, kNone, "cross-checks that disagree"),
-      core::field("accepted", &S::accepted, kNone, "the acceptance"),
-      core::field("reasons", &S::reasons, kNone, "why it is rejected"));
+      core::field("accepted", &S::accepted, kNone, "the acceptance: every check passes"),
+      core::field("marginal", &S::marginal, kNone, "no check fails, one is marginal (a limit within value +- U)"),
+      core::field("reasons", &S::reasons, kNone, "why it is rejected or marginal"),
+      core::field("checks", &S::checks, kNone, "each acceptance check with its uncertainty and verdict"));
 }
 
 // ------------------------------------------------------------------------------------ batch
@@ -748,6 +782,7 @@ struct CampaignResult {
   IffStudy iff;
   std::optional<SuperElementComparison> superelement;  // when the campaign gives one
   int accepted = 0;
+  int marginal = 0;      // analysed, no check failed, one marginal (neither accepted nor rejected)
   int rejected = 0;      // analysed and rejected
   int not_analysed = 0;  // units with UnitAnalysis::not_analysed (neither accepted nor rejected)
 };

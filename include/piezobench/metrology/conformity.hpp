@@ -24,6 +24,7 @@ namespace piezobench::metrology {
 
 enum class Conformity { kPass = 0, kMarginal = 1, kFail = 2 };
 std::string to_string(Conformity c);  // "pass", "marginal", "fail"
+Conformity conformity_from_string(const std::string& name);  // InputError (source "conformity") for anything else
 
 struct ConformityDecision {
   Conformity verdict = Conformity::kPass;

@@ -35,6 +35,8 @@ struct StrokeResult {
   double va_max = 0.0;       // V
   double sensitivity = 0.0;  // m/V, slope of the straight line d_e(Va) (negative: the APA shortens)
   double loop_width = 0.0;   // m, largest distance between rising and falling branches
+  double noise = 0.0;        // m rms per sample of d_e (noise_from_second_differences, uncertainty_budget.hpp)
+  long smoothing_samples = 1;  // samples of the moving average (a count)
 };
 
 // va, de: same length (>= 10 samples), finite; fs > 0 Hz. The voltage must span at least 1 V.
@@ -72,7 +74,9 @@ constexpr auto describe(core::Type<StrokeResult>) {
       core::field("va_min", &S::va_min, kVolt, "lowest Va of the record"),
       core::field("va_max", &S::va_max, kVolt, "highest Va of the record"),
       core::field("sensitivity", &S::sensitivity, kMetrePerVoltAsUmPerV, "slope of d_e against Va (negative: the APA shortens)"),
-      core::field("loop_width", &S::loop_width, kMetreAsUm, "largest distance between the rising and falling branches"));
+      core::field("loop_width", &S::loop_width, kMetreAsUm, "largest distance between the rising and falling branches"),
+      core::field("noise", &S::noise, kMetreAsUm, "noise of d_e per sample (second differences)"),
+      core::field("smoothing_samples", &S::smoothing_samples, kNone, "samples of the moving average"));
 }
 
 constexpr auto describe(core::Type<HysteresisResult>) {

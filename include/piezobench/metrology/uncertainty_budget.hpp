@@ -9,12 +9,14 @@
 // contribution |c_i| u(x_i)), so a report can say which input dominates.
 //
 //  stiffness k = m g / d       (report eq. 2.1), d the deflection between two readings:
-//                              u(m), u(g) declared; u(d)^2 = 2 (q^2 / 12 + s^2 / n), q the encoder's
-//                              resolution, s the reading's noise (the creep fit's rms residual), n
-//                              the samples averaged per reading (white noise assumed).
-//  stroke = max - min of d_e   u^2 = 2 (q^2 / 12 + s^2 / n), each extreme a moving average of n
+//                              u(m), u(g) declared; u(d)^2 = 2 (q^2 / 12 + s^2 / n) + (e d)^2, q the
+//                              encoder's resolution, s the reading's noise (the creep fit's rms
+//                              residual), n the samples averaged per reading (white noise assumed),
+//                              e the displacement sensor's relative scale uncertainty.
+//  stroke = max - min of d_e   u^2 = 2 (q^2 / 12 + s^2 / n) + (e stroke)^2, each extreme a moving average of n
 //                              noisy, quantized samples (the stroke analysis' smoothing), s the
 //                              noise per sample (noise_from_second_differences of the record).
+//  stiffness k = m w^2         (report eq. 2.2): u(m) declared, u(w) the resonance's standard error.
 //  capacitance                 u = the LCR meter's relative standard uncertainty x C (declared)
 //                              combined with the readings' standard error of the mean.
 //  flatness = max - min of the deviations from the plane: u^2 = 2 a^2, a the probe's standard
@@ -77,6 +79,8 @@ struct StaticTestUncertainties {
   double gravity_m_per_s2 = 0.02;          // u(g): 9.8 used for g between 9.78 and 9.83
   double encoder_resolution_m = 2.5e-9;    // q of d_e (the report's encoder: 2.5 nm)
   double capacitance_relative = 0.005;     // u(C) / C of the LCR meter (ratio)
+  double suspended_mass_kg = 0.02;         // u(m) of the suspended mass (resonance stiffness)
+  double displacement_scale_relative = 0.001;  // u of the displacement sensor's scale factor (ratio)
 };
 
 // k = m g / d from the test's deflection d (m, > 0), its readings' noise s (m rms) and the samples
@@ -84,8 +88,12 @@ struct StaticTestUncertainties {
 [[nodiscard]] UncertaintyBudget stiffness_budget(double added_mass_kg, double gravity_m_per_s2, double deflection_m,
                                                  double reading_noise_m, double samples_per_reading,
                                                  const StaticTestUncertainties& inputs);
-// stroke with the noise s (m rms per sample) of d_e and the n samples (a count) its moving average spans.
-[[nodiscard]] UncertaintyBudget stroke_budget(double noise_m, double averaged_samples, const StaticTestUncertainties& inputs);
+// k = m w^2 (report eq. 2.2) from the suspended mass (kg), the resonance w (rad/s) and its standard
+// error (rad/s, from the FRF fit).
+[[nodiscard]] UncertaintyBudget resonance_stiffness_budget(double suspended_mass_kg, double resonance_rad_s,
+                                                           double resonance_standard_error_rad_s, const StaticTestUncertainties& inputs);
+// stroke (m) with the noise s (m rms per sample) of d_e and the n samples (a count) its moving average spans.
+[[nodiscard]] UncertaintyBudget stroke_budget(double stroke_m, double noise_m, double averaged_samples, const StaticTestUncertainties& inputs);
 // The white noise's standard deviation of a record that is smooth at the sample rate (a ramp, a
 // slow sine): rms of the second differences / sqrt(6) (a straight line has none; white noise of
 // sigma gives second differences of variance 6 sigma^2). x and the result in the caller's unit;

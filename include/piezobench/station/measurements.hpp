@@ -4,9 +4,10 @@
 // a fixed unit, checked against the station file's limits with a verdict.
 //
 // Verdicts are ordered pass < marginal < fail, and the verdict of a phase, a unit or a batch is the
-// worst of its parts. Marginal: a limit lies within value +- U, U the measurement's uncertainty.
-// Until the results carry uncertainties, U = margin_relative x |limit| (the station file's
-// `margin_relative`, default 1 %), documented in docs/station.md.
+// worst of its parts. Marginal: a limit lies within value +- U, U the measurement's uncertainty,
+// decided by the campaign's rule (metrology::decide, ISO 14253-1). The station's measurements do not
+// carry their budgets yet: U = margin_relative x |limit| (the station file's `margin_relative`,
+// default 1 %), documented in docs/station.md.
 #include <optional>
 #include <string>
 #include <vector>
