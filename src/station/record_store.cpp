@@ -7,6 +7,7 @@
 #include <chrono>
 #include <ctime>
 #include <fstream>
+#include <thread>
 
 #include "piezobench/core/error.hpp"
 
@@ -207,7 +208,17 @@ RecordStore::RecordStore(const fs::path& file, int busy_timeout_ms) : file_(file
   }
   sqlite3_busy_timeout(db_, busy_timeout_ms);
   try {
-    exec("PRAGMA journal_mode=WAL");
+    // Two stations opening a new database at once: the switch to WAL needs the file alone for a
+    // moment, and SQLite returns SQLITE_BUSY for it without calling the busy handler. Retried until
+    // the busy timeout, as every other statement waits.
+    const auto start = std::chrono::steady_clock::now();
+    for (;;) {
+      const int rc = sqlite3_exec(db_, "PRAGMA journal_mode=WAL", nullptr, nullptr, nullptr);
+      const bool busy = rc == SQLITE_BUSY || rc == SQLITE_LOCKED;
+      if (!busy || std::chrono::steady_clock::now() - start > std::chrono::milliseconds(busy_timeout_ms)) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    exec("PRAGMA journal_mode=WAL");  // a no-op once switched; names the error if it never was
     exec("PRAGMA synchronous=NORMAL");
     exec("PRAGMA foreign_keys=ON");
     Transaction t(db_, file_);
