@@ -108,7 +108,7 @@ StrokeResult analyze_stroke(const Eigen::Ref<const VectorXd>& va, const Eigen::R
     throw InputError(source, "Va", "a voltage ramp spanning at least 1 V", fmt::format("{} V", format_number(r.va_max - r.va_min)));
   }
   r.stroke = ds.maxCoeff() - ds.minCoeff();
-  r.noise = noise_from_second_differences(std::vector<double>(de.data(), de.data() + de.size()));
+  r.noise = noise_from_second_differences({de.data(), static_cast<std::size_t>(de.size())});
   r.smoothing_samples = static_cast<long>(w);
   // Straight line d_e = a + b Va (least squares).
   const double vm = va.mean();

@@ -87,7 +87,7 @@ UncertaintyBudget flatness_budget(double probe_accuracy_m) {
                        {"lowest point (probe accuracy)", "m", probe_accuracy_m, -1.0, 0.0}});
 }
 
-double noise_from_second_differences(const std::vector<double>& x) {
+double noise_from_second_differences(std::span<const double> x) {
   if (x.size() < 3) return 0.0;
   double sum = 0.0;
   for (std::size_t i = 2; i < x.size(); ++i) {

@@ -212,13 +212,17 @@ RecordStore::RecordStore(const fs::path& file, int busy_timeout_ms) : file_(file
     // moment, and SQLite returns SQLITE_BUSY for it without calling the busy handler. Retried until
     // the busy timeout, as every other statement waits.
     const auto start = std::chrono::steady_clock::now();
+    const auto waited_long_enough = [&] { return std::chrono::steady_clock::now() - start > std::chrono::milliseconds(busy_timeout_ms); };
     for (;;) {
-      const int rc = sqlite3_exec(db_, "PRAGMA journal_mode=WAL", nullptr, nullptr, nullptr);
-      const bool busy = rc == SQLITE_BUSY || rc == SQLITE_LOCKED;
-      if (!busy || std::chrono::steady_clock::now() - start > std::chrono::milliseconds(busy_timeout_ms)) break;
+      try {
+        exec("PRAGMA journal_mode=WAL");
+        break;
+      } catch (const InputError&) {
+        const int rc = sqlite3_errcode(db_);
+        if ((rc != SQLITE_BUSY && rc != SQLITE_LOCKED) || waited_long_enough()) throw;
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    exec("PRAGMA journal_mode=WAL");  // a no-op once switched; names the error if it never was
     exec("PRAGMA synchronous=NORMAL");
     exec("PRAGMA foreign_keys=ON");
     Transaction t(db_, file_);

@@ -112,7 +112,7 @@ TEST(UncertaintyBudget, NoiseFromSecondDifferencesIgnoresARampAndFindsWhiteNoise
   }
   EXPECT_NEAR(noise_from_second_differences(ramp), 0.0, 1e-15);
   EXPECT_NEAR(noise_from_second_differences(noisy) / 5e-9, 1.0, 0.02);
-  EXPECT_EQ(noise_from_second_differences({1.0, 2.0}), 0.0);
+  EXPECT_EQ(noise_from_second_differences(std::vector<double>{1.0, 2.0}), 0.0);
 }
 
 }  // namespace

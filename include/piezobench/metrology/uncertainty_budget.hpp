@@ -22,6 +22,7 @@
 //  flatness = max - min of the deviations from the plane: u^2 = 2 a^2, a the probe's standard
 //                              uncertainty per point (declared probe_accuracy).
 // Units: SI (kg, m/s^2, m, F, N/m); the components keep their inputs' units.
+#include <span>
 #include <string>
 #include <vector>
 
@@ -98,7 +99,7 @@ struct StaticTestUncertainties {
 // slow sine): rms of the second differences / sqrt(6) (a straight line has none; white noise of
 // sigma gives second differences of variance 6 sigma^2). x and the result in the caller's unit;
 // 0 for fewer than 3 samples.
-[[nodiscard]] double noise_from_second_differences(const std::vector<double>& x);
+[[nodiscard]] double noise_from_second_differences(std::span<const double> x);
 // capacitance C (F) from `readings` readings with standard deviation `scatter_F` (0 and 1 for a typed value).
 [[nodiscard]] UncertaintyBudget capacitance_budget(double capacitance_F, double scatter_F, double readings,
                                                    const StaticTestUncertainties& inputs);
