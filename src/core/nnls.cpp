@@ -35,6 +35,28 @@ Eigen::VectorXd solve_passive(const Eigen::MatrixXd& a, const Eigen::VectorXd& b
   return z;
 }
 
+// The problem reduced to n rows (see nnls()); `used` false when A is not taller than twice its
+// width, where the reduction would not pay.
+struct Reduced {
+  bool used = false;
+  Eigen::MatrixXd r;  // n x n, upper triangular
+  Eigen::VectorXd c;  // the first n entries of Q^T b
+};
+
+Reduced reduce(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
+  Reduced out;
+  const Eigen::Index m = a.rows(), n = a.cols();
+  if (n == 0 || m <= 2 * n) return out;
+  Eigen::MatrixXd ab(m, n + 1);
+  ab.leftCols(n) = a;
+  ab.col(n) = b;
+  Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(ab);  // in place
+  out.r = ab.topLeftCorner(n, n).triangularView<Eigen::Upper>();
+  out.c = ab.col(n).head(n);
+  out.used = true;
+  return out;
+}
+
 }  // namespace
 
 NnlsResult nnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, const std::vector<bool>& free_variables,
@@ -62,11 +84,18 @@ NnlsResult nnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, const std::v
                          ? options.tolerance
                          : 10.0 * eps * norm1 * static_cast<double>(std::max(a.rows(), n)) * std::max(1.0, b.cwiseAbs().maxCoeff());
   const int max_iter = options.max_iterations > 0 ? options.max_iterations : 3 * static_cast<int>(std::max<Eigen::Index>(n, 1));
-  r.x = solve_passive(a, b, passive);  // the free variables alone
+  // A tall problem is first reduced to its triangular factor: with [A b] = Q [R c; 0 rho],
+  // ||A x - b||^2 = ||R x - c||^2 + rho^2 and A^T (b - A x) = R^T (c - R x), so the active-set steps
+  // below see the same problem with n rows instead of m (each passive solve is a QR of the passive
+  // columns: m n^2 per step on A, n^3 on R; the hysteresis fits have thousands of rows).
+  const Reduced reduced = reduce(a, b);
+  const Eigen::MatrixXd& ar = reduced.used ? reduced.r : a;
+  const Eigen::VectorXd& br = reduced.used ? reduced.c : b;
+  r.x = solve_passive(ar, br, passive);  // the free variables alone
 
   r.converged = false;
   for (r.iterations = 0; r.iterations < max_iter; ++r.iterations) {
-    const Eigen::VectorXd w = a.transpose() * (b - a * r.x);
+    const Eigen::VectorXd w = ar.transpose() * (br - ar * r.x);
     Eigen::Index best = -1;
     double wmax = tol;
     for (Eigen::Index j = 0; j < n; ++j) {
@@ -82,7 +111,7 @@ NnlsResult nnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, const std::v
     passive[static_cast<std::size_t>(best)] = true;
     // Inner loop: step towards the unconstrained solution on the passive set until it is feasible.
     for (int inner = 0; inner <= n; ++inner) {
-      const Eigen::VectorXd z = solve_passive(a, b, passive);
+      const Eigen::VectorXd z = solve_passive(ar, br, passive);
       double alpha = 1.0;
       Eigen::Index blocking = -1;
       for (Eigen::Index j = 0; j < n; ++j) {

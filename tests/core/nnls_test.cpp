@@ -56,6 +56,28 @@ TEST(Nnls, RecoversAFeasibleExactSolution) {
   EXPECT_LT(r.residual_norm, 1e-12);
 }
 
+// A tall problem (40 x 6, solved through its triangular factor) with two equal columns: x is not
+// unique, the residual and A x are.
+TEST(Nnls, TallRankDeficientProblemMatchesScipysResidual) {
+  constexpr int m = 40, n = 6;
+  Eigen::MatrixXd a(m, n);
+  Eigen::VectorXd b(m);
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < n; ++j) a(i, j) = std::sin(0.3 * i * j + 0.5 * j * j + i);
+    a(i, 5) = a(i, 2);
+    b(i) = std::cos(0.4 * i) + 0.3 * i - 0.01 * i * i;
+  }
+  const NnlsResult r = nnls(a, b);
+  // scipy.optimize.nnls(A, b), scipy 1.10.1: x = [0, 0.03085241, 0, 0, 0.12411347, 0].
+  ASSERT_TRUE(r.converged);
+  EXPECT_NEAR(r.residual_norm, 12.013198575957487, 1e-12);
+  const Eigen::VectorXd fit = a * r.x;
+  EXPECT_NEAR(fit(0), 0.13758411506839838, 1e-12);
+  EXPECT_NEAR(fit(1), -0.056818326404451815, 1e-12);
+  EXPECT_NEAR(fit(2), -0.01927084458093238, 1e-12);
+  for (int j = 0; j < n; ++j) EXPECT_GE(r.x(j), 0.0) << j;
+}
+
 TEST(Nnls, RefusesMismatchedSizes) {
   Eigen::MatrixXd a = Eigen::MatrixXd::Ones(3, 2);
   EXPECT_THROW(nnls(a, Eigen::VectorXd::Ones(4)), InputError);

@@ -16,8 +16,9 @@
 //  logarithmic creep
 //    d_e(t) = d0 + sum_k H(t - t_k) [ D_k + c_k log10(1 + (t - t_k) / tau) ],   k = on, off
 //  by linear least squares in (d0, D_on, c_on, D_off, c_off) for each tau of a logarithmic grid
-//  (min_time_constant .. max_time_constant, 41 values, then a parabola through the best three in
-//  log tau), leaving out `settle_s` after each event (the load being applied and the oscillation of
+//  (min_time_constant .. max_time_constant, 41 values searched coarse to fine: every 4th, then those
+//  around the best, or all 41 when the coarse misfits have more than one minimum; then a parabola
+//  through the best three in log tau), leaving out `settle_s` after each event (the load being applied and the oscillation of
 //  the suspended mass). D_k is the deflection at the event without the creep that follows it (the
 //  fitted curve extrapolated back to t_k): k_elastic_on = m_a g / |D_on|, k_elastic_off likewise;
 //  c_k is the creep per decade of time. The creep between the two readings of k1 is what makes
