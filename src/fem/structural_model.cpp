@@ -335,25 +335,46 @@ lti::FrequencyResponse frequency_response(const StructuralModel& model, const Mo
     const double w = kTwoPi * hz;
     return std::copysign(w * w, hz);
   });
-  const Eigen::MatrixXcd t_phi = (model.T * phi).cast<std::complex<double>>();
-  const Eigen::MatrixXcd phi_f = (phi.transpose() * model.F).cast<std::complex<double>>();
-  lti::FrequencyResponse r;
-  r.omega = omega;
-  std::vector<Eigen::MatrixXcd>& H = r.H;
-  H.reserve(static_cast<std::size_t>(omega.size()));
-  Eigen::VectorXcd inv(f);
-  for (Index k = 0; k < omega.size(); ++k) {
+  // H(w) = sum_m (T phi_m)(phi_m^T F) / (lambda_m - w^2 + j w c_m). With the outer products as the
+  // columns of P (outputs * inputs x modes), the responses at every frequency are two real matrix
+  // products, P Re(1/d) and P Im(1/d), instead of a complex product per frequency.
+  const Eigen::MatrixXd t_phi = model.T * phi;
+  const Eigen::MatrixXd phi_f = phi.transpose() * model.F;
+  const Index outputs = t_phi.rows(), inputs = phi_f.cols(), n = omega.size();
+  Eigen::MatrixXd p(outputs * inputs, f);
+  for (Index m = 0; m < f; ++m) {
+    Eigen::Map<Eigen::MatrixXd>(p.col(m).data(), outputs, inputs) = t_phi.col(m) * phi_f.row(m);
+  }
+  Eigen::MatrixXd inv_re(f, n), inv_im(f, n);
+  for (Index k = 0; k < n; ++k) {
     const double w = omega(k);
     if (!std::isfinite(w)) throw InputError("", "omega[" + std::to_string(k) + "]", "a finite frequency", format_number(w, 17));
-    for (Index i = 0; i < f; ++i) inv(i) = 1.0 / std::complex<double>(lambda(i) - w * w, w * c(i));
-    Eigen::MatrixXcd h = t_phi * inv.asDiagonal() * phi_f;
+    for (Index i = 0; i < f; ++i) {
+      // 1 / (a + j b), scaled so that a^2 + b^2 neither overflows nor underflows.
+      const double a = lambda(i) - w * w, b = w * c(i);
+      const double scale = std::max(std::abs(a), std::abs(b));
+      const double as = a / scale, bs = b / scale;
+      const double d = (as * as + bs * bs) * scale;
+      inv_re(i, k) = as / d;
+      inv_im(i, k) = -bs / d;
+    }
+  }
+  const Eigen::MatrixXd h_re = p * inv_re, h_im = p * inv_im;
+  lti::FrequencyResponse r;
+  r.omega = omega;
+  r.H.reserve(static_cast<std::size_t>(n));
+  for (Index k = 0; k < n; ++k) {
+    Eigen::MatrixXcd h(outputs, inputs);
+    for (Index j = 0; j < inputs; ++j) {
+      for (Index i = 0; i < outputs; ++i) h(i, j) = {h_re(i + j * outputs, k), h_im(i + j * outputs, k)};
+    }
     if (!h.allFinite()) {
       throw NumericalError("frequency_response (modal superposition)",
-                           "the dynamic stiffness is singular at " + format_number(w / kTwoPi, 17) +
+                           "the dynamic stiffness is singular at " + format_number(omega(k) / kTwoPi, 17) +
                                " Hz (an undamped resonance, or a free body at 0 Hz)",
                            true);
     }
-    H.push_back(std::move(h));
+    r.H.push_back(std::move(h));
   }
   return r;
 }
