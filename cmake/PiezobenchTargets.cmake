@@ -62,6 +62,14 @@ else()
 endif()
 set(PIEZOBENCH_UNITY_BATCH_SIZE ${_pb_unity_batch_default} CACHE STRING "Source files per unity batch")
 
+# The test programs' own code compiles at -O1 in a Release tree; the modules they test keep -O3.
+# A test file is GoogleTest macros and Eigen expressions instantiated once, where -O3's inlining and
+# vectorization cost compile time and buy nothing: tests/lti's unity batch (11 files) took 58.5 s
+# of CPU at -O3 and 40.4 s at -O1 (-31 %; docs/performance.md, "Build time"). GCC does not change
+# a floating-point result between the two (no -ffast-math, no FMA in the baseline x86-64 ISA).
+# The sanitizer tree (RelWithDebInfo, -O1 -g1) is left as it is.
+set(PIEZOBENCH_TEST_COMPILE_OPTIONS "$<$<CONFIG:Release>:-O1>")
+
 # piezobench_unity_build(<target>)
 function(piezobench_unity_build target)
   if(PIEZOBENCH_UNITY_BUILD)
@@ -165,6 +173,7 @@ function(piezobench_add_test)
     PIEZOBENCH_FIXTURE_DIR="${PROJECT_SOURCE_DIR}/tests/fixtures"
     PIEZOBENCH_SHARED_DATA_DIR="${PIEZOBENCH_SHARED_DATA_DIR}"
     PIEZOBENCH_BINARY="$<TARGET_FILE:piezobench>")
+  target_compile_options(${ARG_NAME} PRIVATE ${PIEZOBENCH_TEST_COMPILE_OPTIONS})
   piezobench_unity_build(${ARG_NAME})
   if(TARGET piezobench_test_pch)
     target_precompile_headers(${ARG_NAME} REUSE_FROM piezobench_test_pch)

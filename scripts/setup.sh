@@ -4,10 +4,12 @@
 #   scripts/setup.sh demo [--sanitize]   install what is missing, build, run the main job
 #   scripts/setup.sh test [--sanitize]   install what is missing, build, run the whole test suite
 #   scripts/setup.sh build [--sanitize]  install what is missing and build
+#   scripts/setup.sh build --fuzz        install what is missing and build the fuzz targets (below)
 #   scripts/setup.sh fuzz                install what is missing, build the readers' libFuzzer
 #                                        targets with clang in build-fuzz/, replay the regression
 #                                        corpus (fatal) and fuzz for PIEZOBENCH_FUZZ_SECONDS
 #                                        (default 88) in all, findings reported (docs/fuzzing.md)
+#   scripts/setup.sh install             install what is missing, nothing else
 #
 # Installing is idempotent: packages already present are left alone, and nothing is installed
 # (not even an `apt-get update`) when everything is there. --sanitize builds in build-sanitize/
@@ -17,16 +19,22 @@ set -euo pipefail
 job="${1:-}"
 shift || true
 sanitize=0
+fuzz_tree=0
 for arg in "$@"; do
   case "$arg" in
     --sanitize) sanitize=1 ;;
-    *) echo "setup.sh: unknown option '$arg' (expected --sanitize)" >&2; exit 2 ;;
+    --fuzz) fuzz_tree=1 ;;
+    *) echo "setup.sh: unknown option '$arg' (expected --sanitize or --fuzz)" >&2; exit 2 ;;
   esac
 done
 case "$job" in
-  demo|test|build|fuzz) ;;
-  *) echo "usage: scripts/setup.sh demo|test|build|fuzz [--sanitize]" >&2; exit 2 ;;
+  demo|test|build|fuzz|install) ;;
+  *) echo "usage: scripts/setup.sh demo|test|build|fuzz|install [--sanitize]" >&2; exit 2 ;;
 esac
+if [ "$fuzz_tree" -eq 1 ] && [ "$job" != build ]; then
+  echo "setup.sh: --fuzz goes with build (scripts/setup.sh fuzz builds and runs the fuzz targets)" >&2; exit 2
+fi
+[ "$job" = fuzz ] && fuzz_tree=1
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
@@ -89,8 +97,9 @@ fi
 # The browser tests' puppeteer-core (tests/js), the same way (the ctest fixture browser.npm_ci runs
 # the same script, a no-op once installed).
 bash "$root/tests/js/install.sh" >/dev/null
+[ "$job" = install ] && exit 0
 
-if [ "$job" = fuzz ]; then
+if [ "$fuzz_tree" -eq 1 ]; then
   # clang-14 is in the packages list above, so a missing compiler is an error, never a skip.
   command -v clang++-14 >/dev/null || { echo "setup.sh: clang++-14 not found (package clang-14)" >&2; exit 1; }
   build_dir="$root/build-fuzz"

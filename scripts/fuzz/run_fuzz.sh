@@ -4,6 +4,8 @@
 #   scripts/fuzz/run_fuzz.sh BUILD_DIR regression       every target over its regression corpus
 #   scripts/fuzz/run_fuzz.sh BUILD_DIR fuzz SECONDS     every target on fresh mutations of its seeds
 #                                                       for SECONDS in all, shared among the targets
+#                                                       (SECONDS / targets each, one target per core
+#                                                       at a time: PIEZOBENCH_FUZZ_JOBS)
 #   scripts/fuzz/run_fuzz.sh BUILD_DIR fuzz SECONDS TARGET   one target (e.g. lti_toml) for SECONDS
 #
 # Limits of every run: 1 GB of RSS (-rss_limit_mb, also the largest single allocation), 20 s per
@@ -55,44 +57,76 @@ seed_dirs() {
   echo "$dir"
 }
 
+# The targets run PIEZOBENCH_FUZZ_JOBS at a time (default: one per core); each writes its own log
+# and its outcome to BUILD_DIR/fuzz-READER.status.
+jobs="${PIEZOBENCH_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}"
+in_background() {
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
+  "$@" &
+}
+
+# regress READER: its regression files, if any; any failure is fatal.
+regress() {
+  local r="$1" files=()
+  [ -d "$root/fuzz/regression/$r" ] && files+=("$root/fuzz/regression/$r"/*)
+  # The .mat reproducers of issue 21 are the io tests' fixtures (scripts/fixtures/make_io_hostile_fixtures.py).
+  case "$r" in mat_timeseries|mat_frf) files+=("$root"/tests/fixtures/io/hostile/*.mat) ;; esac
+  [ ${#files[@]} -gt 0 ] || { echo ok >"$build/fuzz-$r.status"; return 0; }
+  echo "run_fuzz: $r over ${#files[@]} regression file(s)" >&2
+  if "$build/fuzz/fuzz_$r" "${limits[@]}" -artifact_prefix="$artifacts/$r-" "${files[@]}" >"$build/fuzz-$r.log" 2>&1; then
+    echo ok >"$build/fuzz-$r.status"
+  else
+    tail -30 "$build/fuzz-$r.log" >&2
+    echo "run_fuzz: $r FAILED on its regression corpus (log $build/fuzz-$r.log)" >&2
+    echo failed >"$build/fuzz-$r.status"
+  fi
+}
+
+# fuzz_one READER INDEX SECONDS: fresh mutations of its seeds and its corpus.
+fuzz_one() {
+  local r="$1" index="$2" each="$3" seeds corpus
+  seeds="$(seed_dirs "$r")"
+  corpus="$build/fuzz-corpus/$r"   # what the fuzzer finds; kept between local runs
+  mkdir -p "$corpus"
+  echo "run_fuzz: $r for $each s (-seed=$((seed + index)))" >&2
+  if "$build/fuzz/fuzz_$r" "${limits[@]}" -max_len=65536 -max_total_time="$each" -print_final_stats=1 \
+       -seed=$((seed + index)) -artifact_prefix="$artifacts/$r-" "$corpus" "$seeds" >"$build/fuzz-$r.log" 2>&1; then
+    grep -E "^stat::number_of_executed_units" "$build/fuzz-$r.log" | sed "s/^/run_fuzz: $r /" >&2 || true
+    echo ok >"$build/fuzz-$r.status"
+  else
+    tail -40 "$build/fuzz-$r.log" >&2
+    echo "run_fuzz: $r FOUND an input that fails (log $build/fuzz-$r.log, input in $artifacts/)" >&2
+    echo failed >"$build/fuzz-$r.status"
+  fi
+}
+
+# The readers whose status file says failed (every target must have written one).
+failed_readers() {
+  local r
+  for r in "${readers[@]}"; do
+    [ "$(cat "$build/fuzz-$r.status" 2>/dev/null)" = ok ] || echo "$r"
+  done
+}
+
 status=0
+for r in "${readers[@]}"; do rm -f "$build/fuzz-$r.status"; done
 case "$mode" in
   regression)
-    for r in "${readers[@]}"; do
-      files=()
-      [ -d "$root/fuzz/regression/$r" ] && files+=("$root/fuzz/regression/$r"/*)
-      # The .mat reproducers of issue 21 are the io tests' fixtures (scripts/fixtures/make_io_hostile_fixtures.py).
-      case "$r" in mat_timeseries|mat_frf) files+=("$root"/tests/fixtures/io/hostile/*.mat) ;; esac
-      [ ${#files[@]} -gt 0 ] || continue
-      echo "run_fuzz: $r over ${#files[@]} regression file(s)" >&2
-      if ! "$build/fuzz/fuzz_$r" "${limits[@]}" -artifact_prefix="$artifacts/$r-" "${files[@]}" >"$build/fuzz-$r.log" 2>&1; then
-        tail -30 "$build/fuzz-$r.log" >&2
-        echo "run_fuzz: $r FAILED on its regression corpus (log $build/fuzz-$r.log)" >&2
-        status=1
-      fi
-    done
+    for r in "${readers[@]}"; do in_background regress "$r"; done
+    wait
+    [ -z "$(failed_readers)" ] || status=1
     ;;
   fuzz)
     total="${3:?fuzz needs SECONDS}"
     each=$(( total / ${#readers[@]} ))
     [ "$each" -ge 1 ] || each=1
-    found=()
     index=0
     for r in "${readers[@]}"; do
       index=$((index + 1))
-      seeds="$(seed_dirs "$r")"
-      corpus="$build/fuzz-corpus/$r"   # what the fuzzer finds; kept between local runs
-      mkdir -p "$corpus"
-      echo "run_fuzz: $r for $each s (-seed=$((seed + index)))" >&2
-      if ! "$build/fuzz/fuzz_$r" "${limits[@]}" -max_len=65536 -max_total_time="$each" -print_final_stats=1 \
-           -seed=$((seed + index)) -artifact_prefix="$artifacts/$r-" "$corpus" "$seeds" >"$build/fuzz-$r.log" 2>&1; then
-        tail -40 "$build/fuzz-$r.log" >&2
-        echo "run_fuzz: $r FOUND an input that fails (log $build/fuzz-$r.log, input in $artifacts/)" >&2
-        found+=("$r")
-      else
-        grep -E "^stat::number_of_executed_units" "$build/fuzz-$r.log" | sed "s/^/run_fuzz: $r /" >&2 || true
-      fi
+      in_background fuzz_one "$r" "$index" "$each"
     done
+    wait
+    mapfile -t found < <(failed_readers)
     if [ ${#found[@]} -gt 0 ]; then
       echo "run_fuzz: FINDINGS in ${found[*]}: inputs kept in $artifacts/ (reproduce: $build/fuzz/fuzz_READER FILE;" \
            "once fixed, add the file to fuzz/regression/READER/)" >&2
