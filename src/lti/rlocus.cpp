@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -258,8 +259,22 @@ RootLocus rlocus(const StateSpace& open_loop, const std::vector<double>& gains) 
   return rl;
 }
 
-RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& options) {
-  check_loop(open_loop, "rlocus_auto");
+namespace {
+
+// True once the branch `b` has settled: within settle_fraction of an open-loop zero, or gone
+// beyond largest / settle_fraction (towards an asymptote).
+bool branch_settled(const CVector& poles_k, Index b, const LoopScales& sc, double settle_fraction) {
+  const Complex p = poles_k(b);
+  for (Index j = 0; j < sc.zeros.size(); ++j) {
+    if (std::abs(p - sc.zeros(j)) <= settle_fraction * (std::abs(sc.zeros(j)) + sc.smallest)) return true;
+  }
+  return std::abs(p) >= sc.largest / settle_fraction;
+}
+
+// rlocus_auto's grid. With `watch` (the open-loop pole of one branch), the automatic end comes when
+// that branch has settled, whatever the others do (max_damping_on_branch follows one branch; a
+// pole leaving for infinity can take thousands of grid points to pass largest / settle_fraction).
+RootLocus locus_grid(const StateSpace& open_loop, const RootLocusOptions& options, std::optional<Complex> watch) {
   options.validate();
   const Index n = open_loop.states();
   if (n > options.max_order) {
@@ -284,6 +299,11 @@ RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& optio
     return rl;
   }
   const LoopScales sc = loop_scales(open_loop, poles(open_loop));
+  Index watched = -1;
+  if (watch) (current.array() - *watch).abs().minCoeff(&watched);
+  const auto done = [&](const CVector& p) {
+    return watched >= 0 ? branch_settled(p, watched, sc, options.settle_fraction) : settled(p, sc, options.settle_fraction);
+  };
   // 1 + k D vanishes at k = -1/D when D < 0: the locus stops just before it (poles leave for
   // infinity there).
   double hard_limit = std::numeric_limits<double>::infinity();
@@ -298,7 +318,7 @@ RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& optio
   constexpr double kMinRatio = 1.0 + 1e-12;
   while (static_cast<int>(rl.gains.size()) < options.max_points) {
     if (k >= last) break;
-    if (automatic && k > 0.0 && settled(current, sc, options.settle_fraction)) break;
+    if (automatic && k > 0.0 && done(current)) break;
     double next = k == 0.0 ? k_first : k * ratio;
     next = std::min(next, last);
     if (++evaluations > max_evaluations) {
@@ -330,6 +350,13 @@ RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& optio
   return rl;
 }
 
+}  // namespace
+
+RootLocus rlocus_auto(const StateSpace& open_loop, const RootLocusOptions& options) {
+  check_loop(open_loop, "rlocus_auto");
+  return locus_grid(open_loop, options, std::nullopt);
+}
+
 BranchOptimum max_damping_on_branch(const StateSpace& open_loop, Complex start_pole,
                                     const RootLocusOptions& options) {
   check_loop(open_loop, "max_damping_on_branch");
@@ -341,7 +368,7 @@ BranchOptimum max_damping_on_branch(const StateSpace& open_loop, Complex start_p
   }
   RootLocusOptions opts = options;
   opts.gain_min = 0.0;  // the branch is identified by its open-loop pole
-  const RootLocus rl = rlocus_auto(open_loop, opts);
+  const RootLocus rl = locus_grid(open_loop, opts, start_pole);
   const double ts = open_loop.sample_time;
   Index branch = 0;
   (rl.poles.front().array() - start_pole).abs().minCoeff(&branch);

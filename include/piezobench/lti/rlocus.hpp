@@ -51,7 +51,8 @@ struct BranchOptimum {
   Complex pole;          // the branch's pole there
 };
 // Follows the branch that starts (k = 0) at the open-loop pole nearest `start_pole` from gain 0 to
-// gain_max (0 = automatic, as rlocus_auto) and returns the gain that maximizes its damping ratio,
+// gain_max (0 = automatic: rlocus_auto's grid, ending once this branch has settled at a zero or
+// gone towards an asymptote, whatever the other branches do) and returns the gain that maximizes its damping ratio,
 // refined by golden-section search to a relative gain tolerance of 1e-6. options.gain_min is
 // ignored (the grid starts at 0, where the branch is identified).
 BranchOptimum max_damping_on_branch(const StateSpace& open_loop, Complex start_pole,
