@@ -181,6 +181,26 @@ StateSpace iff_loop() {
 
 double damping(Complex p) { return -p.real() / std::abs(p); }
 
+// Independent dense scan: `count` log-spaced gains from lo to hi, poles from Eigen, the branch
+// followed by nearest-neighbour continuation from the open-loop pole (steps are tiny).
+struct DenseOptimum {
+  double damping = -2.0;
+  double gain = 0.0;
+};
+DenseOptimum dense_branch_optimum(const StateSpace& l, Complex p_open, double lo, double hi, int count) {
+  DenseOptimum best;
+  Complex tracked = p_open;
+  for (int i = 0; i < count; ++i) {
+    const double k = lo * std::pow(hi / lo, static_cast<double>(i) / (count - 1));
+    const CVector p = eig_closed_loop(l, k);
+    Index j = 0;
+    (p.array() - tracked).abs().minCoeff(&j);
+    tracked = p(j);
+    if (damping(tracked) > best.damping) best = {damping(tracked), k};
+  }
+  return best;
+}
+
 TEST(RlocusTest, IffLoopMaximumDampingMatchesDenseScan) {
   const StateSpace l = iff_loop();
   const double wp = 2 * kPi * 95.2;
@@ -188,26 +208,10 @@ TEST(RlocusTest, IffLoopMaximumDampingMatchesDenseScan) {
   const Complex p_open(-xp * wp, wp * std::sqrt(1 - xp * xp));
   const BranchOptimum opt = max_damping_on_branch(l, p_open);
 
-  // Independent dense scan: 200,000 log-spaced gains over 9 decades, poles from Eigen, the branch
-  // followed by nearest-neighbour continuation from the open-loop pole (steps are tiny).
-  const int count = 200000;
-  const double lo = 1e-1;
-  const double hi = 1e8;
-  Complex tracked = p_open;
-  double best_damping = -2.0;
-  double best_gain = 0.0;
-  for (int i = 0; i < count; ++i) {
-    const double k = lo * std::pow(hi / lo, static_cast<double>(i) / (count - 1));
-    const CVector p = eig_closed_loop(l, k);
-    Index j = 0;
-    (p.array() - tracked).abs().minCoeff(&j);
-    tracked = p(j);
-    const double z = damping(tracked);
-    if (z > best_damping) {
-      best_damping = z;
-      best_gain = k;
-    }
-  }
+  // 200,000 gains over 9 decades.
+  const DenseOptimum dense = dense_branch_optimum(l, p_open, 1e-1, 1e8, 200000);
+  const double best_damping = dense.damping;
+  const double best_gain = dense.gain;
   std::cout << "IFF loop: max damping " << opt.damping << " at g = " << opt.gain << " (pole " << opt.pole
             << "); dense scan " << best_damping << " at g = " << best_gain << "\n";
   RecordProperty("max_damping", std::to_string(opt.damping));
@@ -238,21 +242,9 @@ TEST(RlocusTest, BranchOptimumEndsWithItsBranchNotTheSlowestOne) {
   budget.max_work = 1500.0 * 12 * 12 * 12;  // 1,500 eigenvalue problems of order 12
   const BranchOptimum opt = max_damping_on_branch(l, p_open, budget);
 
-  const int count = 20000;
-  const double lo = 1e-1, hi = 1e6;
-  Complex tracked = p_open;
-  double best_damping = -2.0, best_gain = 0.0;
-  for (int i = 0; i < count; ++i) {
-    const double k = lo * std::pow(hi / lo, static_cast<double>(i) / (count - 1));
-    const CVector p = eig_closed_loop(l, k);
-    Index j = 0;
-    (p.array() - tracked).abs().minCoeff(&j);
-    tracked = p(j);
-    if (damping(tracked) > best_damping) {
-      best_damping = damping(tracked);
-      best_gain = k;
-    }
-  }
+  const DenseOptimum dense = dense_branch_optimum(l, p_open, 1e-1, 1e6, 20000);
+  const double best_damping = dense.damping;
+  const double best_gain = dense.gain;
   EXPECT_GT(best_damping, 0.3);
   EXPECT_TRUE(near(opt.damping, best_damping, 1e-4)) << opt.damping << " vs " << best_damping;
   EXPECT_TRUE(near(opt.gain, best_gain, 2e-3)) << opt.gain << " vs " << best_gain;
