@@ -162,6 +162,12 @@ double relative_move(const CVector& from, const CVector& to, double smallest) {
   return worst;
 }
 
+// A closed-loop pole at `distance` from the open-loop zero z has reached it: within settle_fraction
+// of the zero's scale |z| + smallest.
+bool reached_zero(double distance, Complex z, const LoopScales& sc, double settle_fraction) {
+  return distance <= settle_fraction * (std::abs(z) + sc.smallest);
+}
+
 // Every open-loop zero has a closed-loop pole within settle_fraction of its scale, and every other
 // pole has gone beyond largest / settle_fraction (on its way to infinity along an asymptote).
 bool settled(const CVector& poles_k, const LoopScales& sc, double settle_fraction) {
@@ -178,7 +184,7 @@ bool settled(const CVector& poles_k, const LoopScales& sc, double settle_fractio
         best = i;
       }
     }
-    if (best < 0 || best_dist > settle_fraction * (std::abs(sc.zeros(j)) + sc.smallest)) return false;
+    if (best < 0 || !reached_zero(best_dist, sc.zeros(j), sc, settle_fraction)) return false;
     used[static_cast<size_t>(best)] = 1;
   }
   const double far = sc.largest / settle_fraction;
@@ -261,12 +267,20 @@ RootLocus rlocus(const StateSpace& open_loop, const std::vector<double>& gains) 
 
 namespace {
 
+// The index of the pole of `poles` nearest to p: the branch that starts at the open-loop pole p
+// (locus_grid watches it, max_damping_on_branch follows it; both find it the same way).
+Index branch_of(const CVector& poles, Complex p) {
+  Index branch = 0;
+  (poles.array() - p).abs().minCoeff(&branch);
+  return branch;
+}
+
 // True once the branch `b` has settled: within settle_fraction of an open-loop zero, or gone
 // beyond largest / settle_fraction (towards an asymptote).
 bool branch_settled(const CVector& poles_k, Index b, const LoopScales& sc, double settle_fraction) {
   const Complex p = poles_k(b);
   for (Index j = 0; j < sc.zeros.size(); ++j) {
-    if (std::abs(p - sc.zeros(j)) <= settle_fraction * (std::abs(sc.zeros(j)) + sc.smallest)) return true;
+    if (reached_zero(std::abs(p - sc.zeros(j)), sc.zeros(j), sc, settle_fraction)) return true;
   }
   return std::abs(p) >= sc.largest / settle_fraction;
 }
@@ -299,8 +313,7 @@ RootLocus locus_grid(const StateSpace& open_loop, const RootLocusOptions& option
     return rl;
   }
   const LoopScales sc = loop_scales(open_loop, poles(open_loop));
-  Index watched = -1;
-  if (watch) (current.array() - *watch).abs().minCoeff(&watched);
+  const Index watched = watch ? branch_of(current, *watch) : -1;
   const auto done = [&](const CVector& p) {
     return watched >= 0 ? branch_settled(p, watched, sc, options.settle_fraction) : settled(p, sc, options.settle_fraction);
   };
@@ -370,8 +383,7 @@ BranchOptimum max_damping_on_branch(const StateSpace& open_loop, Complex start_p
   opts.gain_min = 0.0;  // the branch is identified by its open-loop pole
   const RootLocus rl = locus_grid(open_loop, opts, start_pole);
   const double ts = open_loop.sample_time;
-  Index branch = 0;
-  (rl.poles.front().array() - start_pole).abs().minCoeff(&branch);
+  const Index branch = branch_of(rl.poles.front(), start_pole);
 
   size_t best = 0;
   for (size_t i = 1; i < rl.gains.size(); ++i) {
