@@ -38,7 +38,7 @@ template <class T> py::object py_value(const T& v, py::handle owner) {
   using namespace described_detail;
   if constexpr (std::is_enum_v<T>) {
     return py::str(to_string(v));
-  } else if constexpr (core::kIsOptional<T>) {
+  } else if constexpr (core::kIsOptional<T> || std::is_pointer_v<T>) {  // a derived field's pointer into its owner
     return v ? py_value(*v, owner) : py::none();
   } else if constexpr (std::is_same_v<T, std::vector<double>>) {
     return to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()))));
@@ -71,10 +71,9 @@ template <class S> void bind_described(py::module_& m) {
   constexpr auto& d = core::kFields<S>;
   py::class_<S> c(m, std::string(d.name).c_str(), std::string(d.meaning).c_str());
   core::for_each_field<S>([&](const auto& f) {
-    const auto member = f.member;
     const std::string doc = f.shown.si.empty() ? std::string(f.meaning) : std::string(f.shown.si) + ": " + std::string(f.meaning);
     c.def_property_readonly(
-        std::string(f.name).c_str(), [member](py::object self) { return py_value(self.cast<const S&>().*member, self); }, doc.c_str());
+        std::string(f.name).c_str(), [f](py::object self) { return py_value(f.of(self.cast<const S&>()), self); }, doc.c_str());
   });
   c.def_static("fields", [] { return declared_fields<S>(); }, "The field declaration: [(name, SI unit, shown unit, meaning)].");
   c.def("__getitem__", [](py::object self, const std::string& name) { return self.attr(name.c_str()); }, "A field by name.");

@@ -32,8 +32,9 @@ template <class S> void document(std::string& out, std::set<std::string>& done) 
     using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
     std::string type;
     if constexpr (core::Described<E>) type = std::string(core::kFields<E>.name);
-    out += fmt::format("| `{}` | {} | {} | {} | {} | {}{} |\n", f.name, type, f.shown.si, shown_cell(f.shown), results_cell(f), f.meaning,
-                       f.in(core::kReport) ? " (report table)" : "");
+    out += fmt::format("| `{}` | {} | {} | {} | {} | {}{}{} |\n", f.name, type, f.shown.si, shown_cell(f.shown), results_cell(f), f.meaning,
+                       f.in(core::kReport) ? " (report table)" : "",
+                       std::remove_cvref_t<decltype(f)>::kDerived ? " (derived: read from its analysis, not in part.json)" : "");
   });
   core::for_each_field<S>([&](const auto& f) {
     using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
@@ -52,7 +53,9 @@ std::string field_reference_markdown() {
       "Each result struct declares every field once: its name (the key in part.json and the Python attribute),\n"
       "its SI unit, the unit results.json and the report show it in with the one factor from SI, where it appears,\n"
       "and its meaning. part.json holds every field in SI; results.json the fields it lists, converted, under\n"
-      "`name_UNIT` unless another key is given (a dotted key nests, e.g. `readings_um.before`).\n\n"
+      "`name_UNIT` unless another key is given (a dotted key nests, e.g. `readings_um.before`). A derived field\n"
+      "is a number the struct holds in one of its analyses (the unit's `k1` is its static stiffness analysis'):\n"
+      "declared once, shown like a member, left out of part.json (the analysis it is read from is there).\n\n"
       "**Non-finite numbers** are written one way in results.json, part.json and the report's tables: as the\n"
       "strings `\"nan\"`, `\"inf\"` and `\"-inf\"` (JSON has no such numbers); a value that is absent is `null`.\n"
       "Complex numbers are `[re, im]`.\n";

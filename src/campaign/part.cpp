@@ -108,7 +108,9 @@ template <class T> json encode(const T& v) {
   } else {
     static_assert(core::Described<T>, "part.json writes the structs with a field declaration (core/fields.hpp)");
     json o = json::object();
-    core::for_each_field<T>([&](const auto& f) { o[std::string(f.name)] = encode(f.of(v)); });
+    core::for_each_field<T>([&](const auto& f) {
+      if constexpr (!std::remove_cvref_t<decltype(f)>::kDerived) o[std::string(f.name)] = encode(f.of(v));
+    });
     return o;
   }
 }
@@ -184,7 +186,9 @@ template <class T> void decode(const json& j, T& v, const Where& w) {
     static_assert(core::Described<T>, "part.json reads the structs with a field declaration (core/fields.hpp)");
     if (!j.is_object()) bad(w, "an object", j);
     PartReader r{j, w};
-    core::for_each_field<T>([&](const auto& f) { r(std::string(f.name).c_str(), f.of(v)); });
+    core::for_each_field<T>([&](const auto& f) {
+      if constexpr (!std::remove_cvref_t<decltype(f)>::kDerived) r(std::string(f.name).c_str(), f.of(v));
+    });
   }
 }
 

@@ -47,28 +47,36 @@ namespace {
 
 // ------------------------------------------------------------------------------------ batch
 
+using Number = std::optional<double> (*)(const UnitAnalysis&);
+
 struct Quantity {
   std::string name;   // results key, e.g. "capacitance_sensor_uF"
   std::string label;  // for people (the report, a rejection's reason)
   std::string unit;   // of the reported values
   double scale;       // SI -> reported unit
-  std::optional<double> UnitAnalysis::*member;
+  Number value;       // the unit's number (a derived field of UnitAnalysis's declaration), SI
   bool rejects = false;  // a batch outlier rejects the unit (with reject_outliers)
 };
+
+// A derived number of UnitAnalysis's declaration: its name, unit and factor are the declaration's.
+Quantity quantity(std::string label, Number value, bool rejects = false) {
+  const core::Declared d = core::declared<UnitAnalysis>(value);
+  return {core::results_key(d.name, d.shown), std::move(label), std::string(d.shown.unit), d.shown.per_si, value, rejects};
+}
 
 // In the order of the report: metrology, stiffness, dynamics.
 const std::vector<Quantity>& quantities() {
   static const std::vector<Quantity> q = {
-      {"flatness_um", "flatness", "um", 1e6, &UnitAnalysis::flatness},
-      {"capacitance_sensor_uF", "capacitance of the sensor stack", "uF", 1e6, &UnitAnalysis::capacitance_sensor, true},
-      {"capacitance_actuator_uF", "capacitance of the actuator stacks", "uF", 1e6, &UnitAnalysis::capacitance_actuator, true},
-      {"stroke_um", "stroke", "um", 1e6, &UnitAnalysis::stroke, true},
-      {"k1_N_per_um", "stiffness k1", "N/um", 1e-6, &UnitAnalysis::k1},
-      {"k2_N_per_um", "stiffness k2", "N/um", 1e-6, &UnitAnalysis::k2},
-      {"k_resonance_N_per_um", "stiffness from the resonance", "N/um", 1e-6, &UnitAnalysis::k_resonance},
-      {"resonance_Hz", "resonance", "Hz", 1.0, &UnitAnalysis::resonance_Hz},
-      {"antiresonance_Hz", "anti-resonance", "Hz", 1.0, &UnitAnalysis::antiresonance_Hz},
-      {"static_gain_um_per_V", "static gain u -> d_e", "um/V", 1e6, &UnitAnalysis::static_gain}};
+      quantity("flatness", &flatness_of),
+      quantity("capacitance of the sensor stack", &capacitance_sensor_of, true),
+      quantity("capacitance of the actuator stacks", &capacitance_actuator_of, true),
+      quantity("stroke", &stroke_of, true),
+      quantity("stiffness k1", &k1_of),
+      quantity("stiffness k2", &k2_of),
+      quantity("stiffness from the resonance", &k_resonance_of),
+      quantity("resonance", &resonance_Hz_of),
+      quantity("anti-resonance", &antiresonance_Hz_of),
+      quantity("static gain u -> d_e", &static_gain_of)};
   return q;
 }
 
@@ -102,7 +110,7 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
     std::vector<double> values;
     std::vector<const UnitAnalysis*> who;
     for (const auto& u : units) {
-      if (const auto& v = u.*(q.member)) {
+      if (const std::optional<double> v = q.value(u)) {
         values.push_back(*v * q.scale);
         who.push_back(&u);
       }
@@ -126,7 +134,7 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
   // Unit-to-unit similarity of the FRFs: rms distance in dB from the batch median magnitude.
   std::vector<const UnitAnalysis*> with_frf;
   for (const auto& u : units) {
-    if (u.frf) with_frf.push_back(&u);
+    if (frf_of(u)) with_frf.push_back(&u);
   }
   if (with_frf.size() >= 2) {
     const VectorXd f = Eigen::VectorXd::LinSpaced(120, std::log10(c.analysis.fmin_Hz), std::log10(c.analysis.fmax_Hz)).unaryExpr([](double x) { return std::pow(10.0, x); });
@@ -137,7 +145,7 @@ BatchOutput batch_analysis(const Campaign& c, const std::vector<UnitAnalysis>& u
     double worst = 0.0;
     for (Index o = 0; o < 2; ++o) {
       std::vector<VectorXd> mags;
-      for (const auto* u : with_frf) mags.push_back(magnitude_on(*u->frf, o, f));
+      for (const auto* u : with_frf) mags.push_back(magnitude_on(*frf_of(*u), o, f));
       VectorXd med(f.size());
       for (Index k = 0; k < f.size(); ++k) {
         std::vector<double> v;
@@ -194,12 +202,12 @@ std::vector<std::string> implausible(const Campaign& c, const UnitAnalysis& u) {
                                 *v * scale, unit, lo * scale, hi * scale, unit, where));
     }
   };
-  check(u.stroke, 1e-9, 5e-3, 1e6, "um", "stroke", column(&UnitSpec::stroke, "de"));
-  check(u.k1, 1e3, 1e10, 1e-6, "N/um", "stiffness k1", column(&UnitSpec::stiffness, "de"));
-  check(u.k2, 1e3, 1e10, 1e-6, "N/um", "stiffness k2", column(&UnitSpec::stiffness, "de"));
-  check(u.k_resonance, 1e3, 1e10, 1e-6, "N/um", "stiffness from the resonance", column(&UnitSpec::frf, "de"));
-  check(u.capacitance_sensor, 1e-12, 1e-2, 1e6, "uF", "sensor capacitance", column(&UnitSpec::capacitance, "C_sensor"));
-  check(u.capacitance_actuator, 1e-12, 1e-2, 1e6, "uF", "actuator capacitance", column(&UnitSpec::capacitance, "C_actuator"));
+  check(stroke_of(u), 1e-9, 5e-3, 1e6, "um", "stroke", column(&UnitSpec::stroke, "de"));
+  check(k1_of(u), 1e3, 1e10, 1e-6, "N/um", "stiffness k1", column(&UnitSpec::stiffness, "de"));
+  check(k2_of(u), 1e3, 1e10, 1e-6, "N/um", "stiffness k2", column(&UnitSpec::stiffness, "de"));
+  check(k_resonance_of(u), 1e3, 1e10, 1e-6, "N/um", "stiffness from the resonance", column(&UnitSpec::frf, "de"));
+  check(capacitance_sensor_of(u), 1e-12, 1e-2, 1e6, "uF", "sensor capacitance", column(&UnitSpec::capacitance, "C_sensor"));
+  check(capacitance_actuator_of(u), 1e-12, 1e-2, 1e6, "uF", "actuator capacitance", column(&UnitSpec::capacitance, "C_actuator"));
   return out;
 }
 
@@ -245,10 +253,11 @@ std::vector<AcceptanceCheck> acceptance_checks(const Campaign& c, const UnitAnal
   const Specs& s = c.specs;
   const metrology::StaticTestUncertainties& in = c.bench.uncertainty;
   std::vector<AcceptanceCheck> checks;
-  if (u.flatness && s.flatness_max && u.flatness_analysis) {
-    checks.push_back(judged("flatness", "um", kUm, *u.flatness, metrology::flatness_budget(u.flatness_analysis->probe_accuracy), std::nullopt,
+  if (s.flatness_max && u.flatness_analysis) {
+    const double flatness = u.flatness_analysis->flatness;
+    checks.push_back(judged("flatness", "um", kUm, flatness, metrology::flatness_budget(u.flatness_analysis->probe_accuracy), std::nullopt,
                             *s.flatness_max,
-                            fmt::format("flatness {} um above the limit {} um ({})", format_number_fixed(*u.flatness * kUm, 2),
+                            fmt::format("flatness {} um above the limit {} um ({})", format_number_fixed(flatness * kUm, 2),
                                         format_number_fixed(*s.flatness_max * kUm, 2), metrology::to_string(s.flatness_method))));
   }
   if (u.capacitance_analysis) {
@@ -264,11 +273,11 @@ std::vector<AcceptanceCheck> acceptance_checks(const Campaign& c, const UnitAnal
     capacitance("sensor stack", ca.sensor, ca.sensor_scatter, s.capacitance_sensor);
     capacitance("actuator stacks", ca.actuator, ca.actuator_scatter, s.capacitance_actuator);
   }
-  if (u.stroke && s.stroke_min && u.stroke_analysis) {
+  if (s.stroke_min && u.stroke_analysis) {
     const metrology::StrokeResult& r = u.stroke_analysis->result;
-    checks.push_back(judged("stroke", "um", kUm, *u.stroke,
-                            metrology::stroke_budget(*u.stroke, r.noise, static_cast<double>(r.smoothing_samples), in), *s.stroke_min, std::nullopt,
-                            fmt::format("stroke {} um below the minimum {} um", format_number_fixed(*u.stroke * kUm, 1),
+    checks.push_back(judged("stroke", "um", kUm, r.stroke,
+                            metrology::stroke_budget(r.stroke, r.noise, static_cast<double>(r.smoothing_samples), in), *s.stroke_min, std::nullopt,
+                            fmt::format("stroke {} um below the minimum {} um", format_number_fixed(r.stroke * kUm, 1),
                                         format_number_fixed(*s.stroke_min * kUm, 1))));
   }
   if (s.stiffness) {
@@ -279,14 +288,15 @@ std::vector<AcceptanceCheck> acceptance_checks(const Campaign& c, const UnitAnal
     };
     if (u.stiffness_analysis) {
       for (auto& [name, b] : static_stiffness_budgets(c, *u.stiffness_analysis)) {
-        const std::optional<double>& v = name == "k1" ? u.k1 : u.k2;
+        const std::optional<double> v = name == "k1" ? k1_of(u) : k2_of(u);
         if (v) stiffness(name, *v, std::move(b));
       }
     }
-    if (u.k_resonance) {
-      const double w = std::sqrt(*u.k_resonance / c.bench.suspended_mass);
-      const double se = u.de_plant ? u.de_plant->uncertainty.standard_error_of("natural_frequency") : 0.0;
-      stiffness("from the resonance", *u.k_resonance,
+    if (const std::optional<double> k = k_resonance_of(u)) {
+      const double w = std::sqrt(*k / c.bench.suspended_mass);
+      const ident::DelayedSecondOrderFit* de = de_plant_of(u);
+      const double se = de ? de->uncertainty.standard_error_of("natural_frequency") : 0.0;
+      stiffness("from the resonance", *k,
                 metrology::resonance_stiffness_budget(c.bench.suspended_mass, w, std::isfinite(se) ? se : 0.0, in));
     }
   }
@@ -377,23 +387,23 @@ IffStudy iff_study(const Campaign& c, const std::vector<UnitAnalysis>& units) {
   if (!chosen) {
     for (const auto& u : units) {
       const bool identified = std::any_of(u.damped.begin(), u.damped.end(), [](const DampedPlant& d) { return d.identified.has_value(); });
-      if (!chosen && identified && u.iff_plant) chosen = &u;
+      if (!chosen && identified && iff_plant_of(u)) chosen = &u;
     }
   }
   if (!chosen) {
     for (const auto& u : units) {
-      if (!chosen && u.iff_plant) chosen = &u;
+      if (!chosen && iff_plant_of(u)) chosen = &u;
     }
   }
   IffStudy out;
   out.controller = c.analysis.controller;
-  if (!chosen || !chosen->iff_plant) {
+  if (!chosen || !iff_plant_of(*chosen)) {
     out.note = "no unit with a fitted IFF plant (no FRF u -> Vs)";
     return out;
   }
   out.unit = chosen->id;
-  out.plant = *chosen->iff_plant;
-  const ident::IffPlantFit& p = *chosen->iff_plant;
+  const ident::IffPlantFit& p = *iff_plant_of(*chosen);
+  out.plant = p;
   const lti::StateSpace plant = lti::to_state_space(p.transfer_function());
   const lti::StateSpace controller = lti::to_state_space(control::iff_controller(out.controller));
   control::IffLoopOptions lo;
@@ -485,8 +495,8 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
   out.warnings = se.warnings;
   std::vector<double> ga, gs, measured_res;
   for (const auto& u : units) {
-    if (!u.frf) continue;
-    const SuperElementFit fit = fit_superelement(se, s.setup, *u.frf, fo);
+    if (!frf_of(u)) continue;
+    const SuperElementFit fit = fit_superelement(se, s.setup, *frf_of(u), fo);
     SuperElementUnitFit row;
     row.unit = u.id;
     row.name = u.name;
@@ -497,14 +507,14 @@ SuperElementComparison superelement_comparison(const Campaign& c, const std::vec
     row.band_Hz = {fit.band_lo_Hz, fit.band_hi_Hz};
     row.resonance_Hz = fit.resonance_Hz;
     if (fit.antiresonance_Hz > 0.0) row.antiresonance_Hz = fit.antiresonance_Hz;
-    row.measured_resonance_Hz = u.resonance_Hz;
-    row.measured_antiresonance_Hz = u.antiresonance_Hz;
+    row.measured_resonance_Hz = resonance_Hz_of(u);
+    row.measured_antiresonance_Hz = antiresonance_Hz_of(u);
     row.de_error_dB = fit.de_error_dB;
     row.vs_error_dB = fit.vs_error_dB;
     out.units.push_back(row);
     ga.push_back(std::abs(fit.ga));
     gs.push_back(std::abs(fit.gs));
-    if (u.resonance_Hz) measured_res.push_back(*u.resonance_Hz);
+    if (row.measured_resonance_Hz) measured_res.push_back(*row.measured_resonance_Hz);
     if (!out.figure) out.figure = SuperElementComparison::Response{u.id, u.name, fit.model};
   }
   if (!out.units.empty()) {

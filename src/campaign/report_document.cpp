@@ -174,8 +174,8 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
   }
   if (u.stiffness_analysis) out.stiffness = stiffness_curves(*u.stiffness_analysis);
   if (u.stiffness_open_analysis) out.stiffness_open = stiffness_curves(*u.stiffness_open_analysis);
-  if (u.frf) {
-    const dsp::Frf& frf = *u.frf;
+  if (const dsp::Frf* measured = frf_of(u)) {
+    const dsp::Frf& frf = *measured;
     const VectorXd& f = frf.freq_Hz;
     const std::vector<Index> idx = log_indices(f, std::max(0.5, f(1)), std::min(2.0 * c.analysis.fmax_Hz, f(f.size() - 1)));
     VectorXd w(static_cast<Index>(idx.size()));
@@ -194,13 +194,13 @@ UnitCurves unit_curves(const Campaign& c, const UnitAnalysis& u) {
     }
     out.de = frf_lines(frf, 0, idx, kUmPerV);
     out.vs = frf_lines(frf, 1, idx, 1.0);
-    if (u.iff_plant) {
-      const Eigen::VectorXcd g = u.iff_plant->response(w);
+    if (const ident::IffPlantFit* iff = iff_plant_of(u)) {
+      const Eigen::VectorXcd g = iff->response(w);
       out.iff_fit = model_lines(out.vs->f, std::vector<std::complex<double>>(g.data(), g.data() + g.size()), 1.0);
     }
     // Every line around the anti-resonance (report Figure 2.6: coherence and phase there).
-    if (u.antiresonance_Hz) {
-      const double fz = *u.antiresonance_Hz;
+    if (const std::optional<double> antiresonance = antiresonance_Hz_of(u)) {
+      const double fz = *antiresonance;
       std::vector<Index> near;
       for (Index k = 0; k < f.size(); ++k) {
         if (f(k) >= 0.7 * fz && f(k) <= 1.4 * fz) near.push_back(k);
@@ -867,7 +867,7 @@ std::optional<json> flatness_section(const Campaign& c, const std::vector<UnitCu
 }
 
 // results.json writes stiffness_N_per_um only when one of these is known.
-bool has_stiffness(const UnitAnalysis& u) { return u.k1 || u.k_resonance || u.k_oc; }
+bool has_stiffness(const UnitAnalysis& u) { return k1_of(u) || k_resonance_of(u) || k_oc_of(u); }
 
 // The Prony creep table's columns: the fit's declared ones, then the record's own.
 std::vector<std::string> creep_columns() {
@@ -889,8 +889,8 @@ std::optional<json> stiffness_section(const Campaign& c, const std::vector<UnitC
     }
     const UnitAnalysis& r = *u.result;
     if (has_stiffness(r)) {
-      rows.push_back({u.name(), io::to_json(r.k1, kNPerUm), io::to_json(r.k2, kNPerUm), io::to_json(r.k1, kNPerUm), io::to_json(r.k_oc, kNPerUm),
-                      io::to_json(r.k_resonance, kNPerUm),
+      rows.push_back({u.name(), io::to_json(k1_of(r), kNPerUm), io::to_json(k2_of(r), kNPerUm), io::to_json(k1_of(r), kNPerUm),
+                      io::to_json(k_oc_of(r), kNPerUm), io::to_json(k_resonance_of(r), kNPerUm),
                       r.stiffness_analysis ? json(r.stiffness_analysis->result.creep_on * kUm) : json(nullptr)});
     }
     for (const bool open : {false, true}) {
@@ -1009,8 +1009,8 @@ json batch_section(const CampaignResult& result) {
   const auto capacitance = [](double CapacitanceAnalysis::*which) {
     return [which](const UnitAnalysis& u) { return u.capacitance_analysis ? json((*u.capacitance_analysis).*which * kUf) : json(nullptr); };
   };
-  const auto stiffness = [](std::optional<double> UnitAnalysis::*which) {
-    return [which](const UnitAnalysis& u) { return has_stiffness(u) ? io::to_json(u.*which, kNPerUm) : json(nullptr); };
+  const auto stiffness = [](std::optional<double> (*which)(const UnitAnalysis&)) {
+    return [which](const UnitAnalysis& u) { return has_stiffness(u) ? io::to_json(which(u), kNPerUm) : json(nullptr); };
   };
   json figs = json::array();
   std::vector<std::string> not_measured;
@@ -1033,8 +1033,8 @@ json batch_section(const CampaignResult& result) {
     add(t, "capacitance", figure("batch-capacitance", "Capacitance (Table 1.2)", "", false, json::array({panel("C [uF]", false, t)})));
   }
   {
-    json t = json::array({bars("k1", stiffness(&UnitAnalysis::k1)), bars("k2", stiffness(&UnitAnalysis::k2)),
-                          bars("k_oc", stiffness(&UnitAnalysis::k_oc)), bars("from the resonance", stiffness(&UnitAnalysis::k_resonance))});
+    json t = json::array({bars("k1", stiffness(&k1_of)), bars("k2", stiffness(&k2_of)), bars("k_oc", stiffness(&k_oc_of)),
+                          bars("from the resonance", stiffness(&k_resonance_of))});
     range(t, "stiffness", c.specs.stiffness, kNPerUm);
     add(t, "stiffness", figure("batch-stiffness", "Stiffness (Table 2.1)", "", false, json::array({panel("k [N/um]", false, t)})));
   }

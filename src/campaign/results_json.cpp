@@ -186,7 +186,7 @@ json unit_json(const UnitAnalysis& u) {
   r["stiffness_N_per_um"]["k_sc"] = r["stiffness_N_per_um"]["k1"];
   // A group of numbers none of which was measured is null as a whole (as an analysis not run).
   if (!u.capacitance_analysis) r["capacitance_uF"] = nullptr;
-  if (!u.k1 && !u.k_resonance && !u.k_oc) r["stiffness_N_per_um"] = nullptr;
+  if (!k1_of(u) && !k_resonance_of(u) && !k_oc_of(u)) r["stiffness_N_per_um"] = nullptr;
   if (!u.damped.empty()) r["iff_damped_plants"] = damped_plants(u.damped);
   if (u.flexible_modes) r["flexible_modes"]["welch"] = welch(u.flexible_modes->welch);
   io::name_non_finite(r);

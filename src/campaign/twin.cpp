@@ -369,8 +369,8 @@ bench::Twin tuned_twin(const Campaign& c, const UnitAnalysis& a) {
   t.unit.id = a.id;
   t.unit.model = a.model_2dof->tuning.params;
   t.unit.model.m = c.bench.suspended_mass;
-  t.unit.capacitance_sensor = a.capacitance_sensor.value_or(t.unit.capacitance_sensor);
-  t.unit.capacitance_actuator = a.capacitance_actuator.value_or(t.unit.capacitance_actuator);
+  t.unit.capacitance_sensor = capacitance_sensor_of(a).value_or(t.unit.capacitance_sensor);
+  t.unit.capacitance_actuator = capacitance_actuator_of(a).value_or(t.unit.capacitance_actuator);
   t.unit.creep_coefficient = 0.0;
   t.unit.load_creep_coefficient = 0.0;
   t.options.amplifier_gain = c.bench.amplifier_gain;
@@ -387,7 +387,7 @@ bench::Twin tuned_twin(const Campaign& c, const UnitAnalysis& a) {
   // small (not 0: the refinement takes its magnitude, whose derivative vanishes there).
   const bool nmp = a.frf_analysis && a.frf_analysis->zero_is_nonminimum_phase.value_or(false);
   t.options.ground_resistance = nmp ? bench::BenchOptions{}.ground_resistance : 0.05;
-  t.options.sample_rate = a.frf ? a.frf->provenance.sample_rate : t.options.sample_rate;
+  t.options.sample_rate = frf_of(a) ? frf_of(a)->provenance.sample_rate : t.options.sample_rate;
   if (!(t.options.sample_rate > 0.0)) t.options.sample_rate = bench::BenchOptions{}.sample_rate;
   return t;
 }
@@ -499,13 +499,13 @@ TwinBuild build_twin(const Campaign& campaign, const UnitSpec& unit, const TwinO
   if (!unit.frf) throw InputError(campaign.file.string(), unit.key + ".frf", "an FRF record (the twin's model is tuned to it)", "none");
   say(fmt::format("twin of {}: the campaign's analyses", unit.name));
   const UnitAnalysis a = analyze_unit(campaign, unit);
-  if (!a.model_2dof || !a.frf) {
+  if (!a.model_2dof || !frf_of(a)) {
     throw InputError(campaign.file.string(), unit.key + ".frf", "an FRF the 2-DoF model can be tuned to",
                      a.failed.empty() ? std::string("no tuned model") : a.failed.front());
   }
   TwinBuild out;
   out.twin = tuned_twin(campaign, a);
-  const FrfPoints points = frf_points(*a.frf, options);
+  const FrfPoints points = frf_points(*frf_of(a), options);
   out.de_tuned = frf_error(bench_frf(out.twin.unit, out.twin.options, points.freq_Hz), points, 0);
   out.vs_tuned = frf_error(bench_frf(out.twin.unit, out.twin.options, points.freq_Hz), points, 1);
   say("twin: refining the model on the twin bench's FRF");
@@ -521,8 +521,8 @@ TwinBuild build_twin(const Campaign& campaign, const UnitSpec& unit, const TwinO
   const auto [gain, damping] = bench_iff_optimum(out.twin.unit, out.twin.options, campaign.analysis.controller);
   out.iff_optimal_gain = gain;
   out.iff_max_damping = damping;
-  if (a.iff_plant) {
-    out.iff_optimal_gain_unit = iff_optimum(lti::to_state_space(a.iff_plant->transfer_function()), a.iff_plant->wp,
+  if (const ident::IffPlantFit* plant = iff_plant_of(a)) {
+    out.iff_optimal_gain_unit = iff_optimum(lti::to_state_space(plant->transfer_function()), plant->wp,
                                             campaign.analysis.controller).first;
   }
   for (const auto& [experiment, spec] : {std::pair{"frf", unit.frf}, std::pair{"stiffness", unit.stiffness}, std::pair{"capacitance", unit.capacitance}}) {

@@ -391,12 +391,11 @@ void tune_model(const Campaign& c, UnitAnalysis& u) {
     apa::TuningOptions t;
     t.mass = c.bench.suspended_mass;
     t.bench.amplifier_gain = c.bench.amplifier_gain;
-    if (u.iff_plant) t.bench.hpf_resistance = c.bench.hpf_resistance.value_or(0.0);
+    if (iff_plant_of(u)) t.bench.hpf_resistance = c.bench.hpf_resistance.value_or(0.0);
     t.fmin_Hz = c.analysis.fmin_Hz;
     t.fmax_Hz = c.analysis.fmax_Hz;
     t.min_coherence = 0.5;
-    const apa::TwoDofTuning tuned = apa::tune_two_dof_measured(*u.frf, t, u.de_plant ? &*u.de_plant : nullptr,
-                                                               u.iff_plant ? &*u.iff_plant : nullptr);
+    const apa::TwoDofTuning tuned = apa::tune_two_dof_measured(*frf_of(u), t, de_plant_of(u), iff_plant_of(u));
     u.model_2dof = Model2DofFit{tuned, tuned.bench, t.fmin_Hz, t.fmax_Hz};
   } catch (const NumericalError& e) {
     record_failure(u, "2-DoF tuning", e);
@@ -408,7 +407,7 @@ void tune_model(const Campaign& c, UnitAnalysis& u) {
 void analyze_frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   const AnalysisSettings& a = c.analysis;
   const long nfft = frf_segment_length(a, static_cast<long>(r.ts.samples()), r.ts.sample_rate);
-  u.frf = estimate_record_frf(r, "u", {"de", "Vs"}, a, nfft);
+  dsp::Frf frf = estimate_record_frf(r, "u", {"de", "Vs"}, a, nfft);
   ident::ActuatorFrfOptions o;
   o.fmin_Hz = a.fmin_Hz;
   o.fmax_Hz = a.fmax_Hz;
@@ -416,11 +415,11 @@ void analyze_frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   o.fit_order = a.fit_order;
   o.min_coherence = 0.5;
   o.hpf_resistance_ohm = c.bench.hpf_resistance;
-  o.sensor_capacitance_F = u.capacitance_sensor;
+  o.sensor_capacitance_F = capacitance_sensor_of(u);
   o.suspended_mass_kg = c.bench.suspended_mass;
   o.source = c.file.string();
   o.field = r.spec.key;
-  ident::ActuatorFrfResult result = ident::analyze_actuator_frf(*u.frf, o);
+  ident::ActuatorFrfResult result = ident::analyze_actuator_frf(frf, o);
   for (auto& f : result.failed) u.failed.push_back(std::move(f));
   for (auto& w : result.warnings) u.warnings.push_back(std::move(w));
   FrfAnalysis out;
@@ -428,13 +427,8 @@ void analyze_frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   out.provenance = provenance(r, {"u", "de", "Vs"});
   out.provenance.input = "u";
   out.provenance.outputs = {"de", "Vs"};
-  // The numbers the acceptance and the batch read.
-  u.static_gain = out.static_gain;
-  u.resonance_Hz = out.resonance_Hz;
-  u.antiresonance_Hz = out.antiresonance_Hz;
-  u.de_plant = out.de_plant;
-  u.iff_plant = out.iff_plant;
-  if (result.resonance_rad_s) u.k_resonance = metrology::stiffness_from_resonance(c.bench.suspended_mass, *result.resonance_rad_s, o.source);
+  out.frf = std::move(frf);
+  if (result.resonance_rad_s) out.k_resonance = metrology::stiffness_from_resonance(c.bench.suspended_mass, *result.resonance_rad_s, o.source);
   u.frf_analysis = std::move(out);
   tune_model(c, u);
 }
@@ -468,7 +462,7 @@ std::vector<DampedPlant> analyze_damped_plants(const Campaign& c, const std::vec
   const AnalysisSettings& a = c.analysis;
   std::vector<DampedPlant> out;
   // The loop does not change the delay of d_e: the open-loop u -> d_e fit's is removed first.
-  const double delay = u.de_plant ? std::max(0.0, u.de_plant->delay) : 0.0;
+  const double delay = de_plant_of(u) ? std::max(0.0, de_plant_of(u)->delay) : 0.0;
   for (const Record& r : records) {
     double gain = r.spec.gain;
     if (gain == 0.0) {
@@ -541,18 +535,14 @@ void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& lo
   if (spec.flatness) {
     say("flatness", *spec.flatness);
     u.flatness_analysis = flatness(c, load_record(c, spec, *spec.flatness, Experiment::kFlatness));
-    u.flatness = u.flatness_analysis->flatness;
   }
   if (spec.has(Experiment::kCapacitance)) {
     current = spec.capacitance ? &*spec.capacitance : nullptr;
     u.capacitance_analysis = capacitance(c, spec);
-    u.capacitance_sensor = u.capacitance_analysis->sensor;
-    u.capacitance_actuator = u.capacitance_analysis->actuator;
   }
   if (spec.stroke) {
     say("stroke", *spec.stroke);
     u.stroke_analysis = stroke(c, load_record(c, spec, *spec.stroke, Experiment::kStroke));
-    u.stroke = u.stroke_analysis->result.stroke;
   }
   if (!spec.hysteresis.empty()) {
     std::vector<Record> records;
@@ -584,8 +574,6 @@ void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& lo
     say("static stiffness", *spec.stiffness);
     try {
       u.stiffness_analysis = stiffness(c, load_record(c, spec, *spec.stiffness, Experiment::kStiffness), u, "static stiffness");
-      u.k1 = u.stiffness_analysis->result.k1;
-      u.k2 = u.stiffness_analysis->result.k2;
     } catch (const NumericalError& e) {
       record_failure(u, "static stiffness", e);
     }
@@ -595,7 +583,6 @@ void analyze_measurements(const Campaign& c, const UnitSpec& spec, const Log& lo
     try {
       u.stiffness_open_analysis = stiffness(c, load_record(c, spec, *spec.stiffness_open, Experiment::kStiffnessOpen), u,
                                             "static stiffness, stacks open");
-      u.k_oc = u.stiffness_open_analysis->result.k1;
     } catch (const NumericalError& e) {
       record_failure(u, "static stiffness, stacks open", e);
     }

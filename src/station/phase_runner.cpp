@@ -122,14 +122,15 @@ std::vector<std::string> record_checks(const PhaseSpec& p, const std::map<std::s
 
 std::optional<std::string> coherence_check(const PhaseSpec& p, const campaign::Campaign& c, const campaign::UnitAnalysis& ua) {
   if (p.min_coherence <= 0.0) return std::nullopt;
-  if (!ua.frf || ua.frf->coherence.empty()) return "coherence: the FRF has none";
-  const Eigen::Index de = ua.frf->output_index("de");
+  const dsp::Frf* frf = campaign::frf_of(ua);
+  if (!frf || frf->coherence.empty()) return "coherence: the FRF has none";
+  const Eigen::Index de = frf->output_index("de");
   double sum = 0.0;
   long n = 0;
-  for (Eigen::Index k = 0; k < ua.frf->freq_Hz.size(); ++k) {
-    const double f = ua.frf->freq_Hz(k);
+  for (Eigen::Index k = 0; k < frf->freq_Hz.size(); ++k) {
+    const double f = frf->freq_Hz(k);
     if (f < c.analysis.fmin_Hz || f > c.analysis.fmax_Hz) continue;
-    sum += ua.frf->coherence[static_cast<std::size_t>(de)](k);
+    sum += frf->coherence[static_cast<std::size_t>(de)](k);
     ++n;
   }
   const double mean = n > 0 ? sum / static_cast<double>(n) : 0.0;

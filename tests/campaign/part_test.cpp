@@ -48,23 +48,25 @@ TEST(Part, TypedUnitsRoundTripExactly) {
     const UnitAnalysis back = typed_unit_from_json(json::parse(once.dump()), "test");
     EXPECT_EQ(typed_unit_json(back).dump(), once.dump()) << u.name;
     EXPECT_EQ(unit_json(back).dump(), unit_json(u).dump()) << u.name;
-    ASSERT_EQ(back.frf.has_value(), u.frf.has_value());
-    if (u.frf) {
-      EXPECT_TRUE(back.frf->H[1] == u.frf->H[1]);  // bit for bit
+    ASSERT_EQ(frf_of(back) != nullptr, frf_of(u) != nullptr);
+    if (frf_of(u)) {
+      EXPECT_TRUE(frf_of(back)->H[1] == frf_of(u)->H[1]);  // bit for bit
     }
   }
   // Non-finite numbers, empty optionals and vectors survive.
   UnitAnalysis u;
   u.id = 9;
-  u.k1 = std::numeric_limits<double>::infinity();
-  u.static_gain = std::nan("");
+  u.stiffness_analysis = StiffnessAnalysis{};
+  u.stiffness_analysis->result.k1 = std::numeric_limits<double>::infinity();
+  u.stiffness_analysis->result.k2 = std::nan("");
   u.stroke_analysis = StrokeAnalysis{};
   u.stroke_analysis->result.sensitivity = -std::numeric_limits<double>::infinity();
   const UnitAnalysis back = typed_unit_from_json(json::parse(typed_unit_json(u).dump()), "test");
-  EXPECT_TRUE(std::isinf(*back.k1) && *back.k1 > 0);
-  EXPECT_TRUE(std::isnan(*back.static_gain));
+  EXPECT_TRUE(std::isinf(*k1_of(back)) && *k1_of(back) > 0);
+  EXPECT_TRUE(std::isnan(back.stiffness_analysis->result.k2));
   EXPECT_TRUE(std::isinf(back.stroke_analysis->result.sensitivity) && back.stroke_analysis->result.sensitivity < 0);
   EXPECT_FALSE(back.frf_analysis.has_value());
+  EXPECT_FALSE(static_gain_of(back).has_value());
 }
 
 // run == merge(part 1/2, part 2/2): results.json, results.mat and report.html byte for byte.
@@ -147,8 +149,8 @@ TEST(Part, BadPartsAreRefusedNamingThem) {
     test::expect_input_error([&] { (void)read_part(out.path() / "bad.json"); }, needles);
   };
   json j = doc;
-  j["format_version"] = 1;  // before FRFs carried std_H (issue 30)
-  refused(j, {"bad.json", "format_version", "expected 2", "found 1"});
+  j["format_version"] = 2;  // before the FRF moved into frf_analysis (issue 32)
+  refused(j, {"bad.json", "format_version", "expected 3", "found 2"});
   j = doc;
   j["generator"] = "piezobench 0.0.1";
   refused(j, {"generator", "piezobench 0.0.1"});
@@ -158,8 +160,12 @@ TEST(Part, BadPartsAreRefusedNamingThem) {
   j["units"][0]["frf_analysis"]["welch"]["nfft"] = "many";
   refused(j, {"units[0].frf_analysis.welch.nfft", "an integer", "\"many\""});
   j = doc;
-  j["units"][0].erase("k1");
-  refused(j, {"units[0].k1", "missing"});
+  j["units"][0]["stiffness_analysis"]["result"].erase("k1");
+  refused(j, {"units[0].stiffness_analysis.result.k1", "missing"});
+  j = doc;
+  j["units"][0]["k1"] = "not read";  // a derived field (UnitAnalysis::k1 is its stiffness analysis'): the key is ignored
+  EXPECT_EQ(k1_of(typed_unit_from_json(j["units"][0], "test")), k1_of(typed_unit_from_json(doc["units"][0], "test")));
+  EXPECT_TRUE(k1_of(typed_unit_from_json(doc["units"][0], "test")).has_value());
   j = doc;
   j["units"][0]["model_2dof"]["tuning"]["status"] = "happy";
   refused(j, {"units[0].model_2dof.tuning.status", "tuning status name", "happy"});

@@ -20,10 +20,10 @@ TEST(ResultsJson, UnitsOfTheKeysAndNullsForAbsentAnalyses) {
   u.stroke_analysis->result.stroke = 250e-6;
   u.stroke_analysis->result.sensitivity = -1.5e-6;
   u.stroke_analysis->provenance = {"stroke.mat", "units[0].stroke", {{"Va", "V_stack"}, {"de", "d_enc"}}, 100, 1e3, "", {}};
-  u.stroke = 250e-6;  // the unit's summary numbers (unit_analysis.cpp copies them from the analyses)
-  u.k1 = 1.7e6;
+  u.stiffness_analysis = StiffnessAnalysis{};  // the unit's stiffness_N_per_um and stroke_um are read from the analyses
+  u.stiffness_analysis->result.k1 = 1.7e6;
+  u.stiffness_analysis->result.k2 = 1.9e6;
   u.capacitance_analysis = CapacitanceAnalysis{5.1e-6, 10e-6, std::nullopt, "units[0].capacitance_uF"};
-  u.capacitance_sensor = 5.1e-6;
   u.accepted = false;
   u.reasons = {"stroke too small"};
   const json j = unit_json(u);
@@ -33,7 +33,8 @@ TEST(ResultsJson, UnitsOfTheKeysAndNullsForAbsentAnalyses) {
   EXPECT_EQ(j["stroke"]["provenance"]["channels"]["de"], "d_enc");
   EXPECT_EQ(j["stroke"]["provenance"]["input"], "");  // every declared field is written; only FRF records have an input
   EXPECT_DOUBLE_EQ(j["stiffness_N_per_um"]["k1"].get<double>(), 1.7);
-  EXPECT_TRUE(j["stiffness_N_per_um"]["k2"].is_null());
+  EXPECT_DOUBLE_EQ(j["stiffness_N_per_um"]["k2"].get<double>(), 1.9);
+  EXPECT_TRUE(j["stiffness_N_per_um"]["resonance"].is_null());
   EXPECT_DOUBLE_EQ(j["capacitance_uF"]["sensor"].get<double>(), 5.1);
   EXPECT_EQ(j["capacitance_provenance"], json({{"key", "units[0].capacitance_uF"}}));
   for (const char* k : {"flatness_um", "frf", "hpf_corner_Hz", "model_2dof"}) EXPECT_TRUE(j[k].is_null()) << k;

@@ -67,6 +67,37 @@ TEST(Fields, WhereAFieldAppears) {
   EXPECT_DOUBLE_EQ(shown::kRadPerSecondAsHz.per_si * 2.0 * 3.141592653589793, 1.0);
 }
 
+// A struct that shows a number one of its parts holds: a derived field, read by its getter.
+struct Holder {
+  Probe probe;
+};
+constexpr std::optional<double> gap_of(const Holder& h) { return h.probe.gap; }
+constexpr const Probe* probe_of(const Holder& h) { return &h.probe; }
+
+constexpr auto describe(Type<Holder>) {
+  using S = Holder;
+  return fields<S>("Holder", "holds a probe",
+                   field("probe", &S::probe, shown::kNone, "the part").part_only(),
+                   derived("gap", &gap_of, shown::kMetreAsUm, "the probe's gap").in_report(),
+                   derived("probe_again", &probe_of, shown::kNone, "a pointer into the holder").part_only());
+}
+
+TEST(Fields, ADerivedFieldIsReadByItsGetterAndFoundByIt) {
+  const Holder h{{2.5e-6, std::nullopt, {}, ""}};
+  const auto& gap = std::get<1>(kFields<Holder>.fields);
+  static_assert(std::remove_cvref_t<decltype(gap)>::kDerived && !std::remove_cvref_t<decltype(std::get<0>(kFields<Holder>.fields))>::kDerived);
+  EXPECT_DOUBLE_EQ(*gap.of(h), 2.5e-6);
+  EXPECT_TRUE(gap.in(kReport) && gap.in(kResults));
+  EXPECT_EQ(std::get<2>(kFields<Holder>.fields).of(h), &h.probe);
+  static_assert(std::is_same_v<element_t<const Probe*>, Probe>);
+  const Declared d = declared<Holder>(&gap_of);
+  EXPECT_EQ(d.name, "gap");
+  EXPECT_DOUBLE_EQ(d.shown.per_si, 1e6);
+  EXPECT_EQ(declared<Holder>(&Holder::probe).name, "probe");
+  EXPECT_EQ(declared<Probe>(&Probe::stiffness).meaning, "spring");
+  EXPECT_TRUE(declared<Probe>(&Probe::label).name == "label");
+}
+
 TEST(FieldTypes, TheKindsADocumentTellsApart) {
   static_assert(kIsOptional<std::optional<double>> && !kIsOptional<double>);
   static_assert(kIsVector<std::vector<int>> && !kIsVector<std::array<int, 2>>);

@@ -53,8 +53,8 @@ TEST(Instrument, TypedValuesAndFiles) {
   // The campaign reads the typed values back as LCR readings.
   const campaign::Campaign cp = campaign::parse_campaign("[[units]]\nid = 1\ncapacitance = \"" + c.file.string() + "\"\n", dir.path() / "c.toml");
   const campaign::UnitAnalysis ua = campaign::analyze_unit(cp, cp.units[0]);
-  EXPECT_DOUBLE_EQ(*ua.capacitance_sensor, 4.95e-6);
-  EXPECT_DOUBLE_EQ(*ua.capacitance_actuator, 9.9e-6);
+  EXPECT_DOUBLE_EQ(*capacitance_sensor_of(ua), 4.95e-6);
+  EXPECT_DOUBLE_EQ(*capacitance_actuator_of(ua), 9.9e-6);
   test::write_text(dir.path() / "probe.csv", "x,y,z\n0,0,1e-6\n0.01,0,0\n0,0.01,0\n");
   const Acquired f = inst.acquire(st.phases[1], PhaseValues{std::nullopt, std::nullopt, dir.path() / "probe.csv"}, dir.path() / "f");
   EXPECT_EQ(f.file, dir.path() / "f.csv");

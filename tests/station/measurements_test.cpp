@@ -35,10 +35,13 @@ TEST(Measurements, WorstOfAndNames) {
 
 TEST(Measurements, ValuesComeFromTheUnitAnalysisInTheirUnits) {
   campaign::UnitAnalysis u;
-  u.stroke = 250e-6;
-  u.capacitance_sensor = 4.95e-6;
-  u.k1 = 1.7e6;
-  u.resonance_Hz = 95.0;
+  u.stroke_analysis = campaign::StrokeAnalysis{};
+  u.stroke_analysis->result.stroke = 250e-6;
+  u.capacitance_analysis = campaign::CapacitanceAnalysis{4.95e-6, 10e-6, std::nullopt, ""};
+  u.stiffness_analysis = campaign::StiffnessAnalysis{};
+  u.stiffness_analysis->result.k1 = 1.7e6;
+  u.frf_analysis = campaign::FrfAnalysis{};
+  u.frf_analysis->resonance_Hz = 95.0;
   campaign::HysteresisLoop a, b;
   a.provenance.file = "/d/h4.mat";
   a.result.relative_width = 0.05;
@@ -52,7 +55,7 @@ TEST(Measurements, ValuesComeFromTheUnitAnalysisInTheirUnits) {
   EXPECT_DOUBLE_EQ(*measured_value(u, "resonance_Hz", ""), 95.0);
   EXPECT_DOUBLE_EQ(*measured_value(u, "hysteresis_relative_width", "/d/h80.mat"), 0.12);
   EXPECT_DOUBLE_EQ(*measured_value(u, "hysteresis_width_um", "/d/h80.mat"), 30.0);
-  EXPECT_FALSE(measured_value(u, "k2_N_per_um", "").has_value());
+  EXPECT_FALSE(measured_value(u, "k_oc_N_per_um", "").has_value());
   EXPECT_FALSE(measured_value(u, "hysteresis_relative_width", "/d/other.mat").has_value());
 }
 

@@ -89,10 +89,10 @@ TEST(PhaseRunner, AGoodUnitPassesWithEveryRawFileHashedAndTheCampaignsResults) {
   const campaign::CampaignResult cr = campaign::run_campaign(campaign::read_campaign(campaign_file));
   ASSERT_EQ(cr.units.size(), 1U);
   EXPECT_TRUE(cr.units[0].accepted);
-  EXPECT_DOUBLE_EQ(*tries[1].measurements[0].value, *cr.units[0].stroke * 1e6);
-  EXPECT_DOUBLE_EQ(*tries[0].measurements[0].value, *cr.units[0].capacitance_sensor * 1e6);
+  EXPECT_DOUBLE_EQ(*tries[1].measurements[0].value, *campaign::stroke_of(cr.units[0]) * 1e6);
+  EXPECT_DOUBLE_EQ(*tries[0].measurements[0].value, *campaign::capacitance_sensor_of(cr.units[0]) * 1e6);
   EXPECT_DOUBLE_EQ(*tries[2].measurements[0].value, cr.units[0].hysteresis[0].result.relative_width);
-  EXPECT_DOUBLE_EQ(*r.unit->stroke, *cr.units[0].stroke);
+  EXPECT_DOUBLE_EQ(*campaign::stroke_of(*r.unit), *campaign::stroke_of(cr.units[0]));
   EXPECT_EQ(s.store.qualification(r.qualification_id)->status, "complete");
 }
 

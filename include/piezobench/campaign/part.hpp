@@ -22,7 +22,7 @@
 
 namespace piezobench::campaign {
 
-inline constexpr int kPartFormatVersion = 2;  // 2: FRFs carry std_H (issue 30)
+inline constexpr int kPartFormatVersion = 3;  // 2: FRFs carry std_H (issue 30); 3: the unit's FRF and k_resonance in frf_analysis, no copies of its analyses' numbers (issue 32)
 
 // "fnv1a64:" and 16 hex digits: FNV-1a 64 of the file's bytes. InputError when it cannot be read.
 std::string campaign_hash(const std::filesystem::path& file);

@@ -277,15 +277,23 @@ using ident::VectorFitSummary;
 // The FRFs u -> [d_e, Vs] of a unit's record and what is read from them (ident::analyze_actuator_frf).
 struct FrfAnalysis : ident::ActuatorFrfAnalysis {
   RecordProvenance provenance;
+  dsp::Frf frf;                       // u -> [de, Vs] (outputs named "de", "Vs")
+  std::optional<double> k_resonance;  // N/m, m_sus w_r^2 (metrology::stiffness_from_resonance)
 };
 
-// The record's provenance, then ident::ActuatorFrfAnalysis's own declaration.
+// The record's provenance, FRF and stiffness from the resonance, then ident::ActuatorFrfAnalysis's
+// own declaration.
 constexpr auto describe(core::Type<FrfAnalysis>) {
   using S = FrfAnalysis;
+  using namespace core::shown;
   return std::apply(
       [](const auto&... analysis) {
-        return core::fields<S>("FrfAnalysis", "the FRFs u -> [d_e, Vs] and what is read from them (report 2.3-2.5)",
-                               core::field("provenance", &S::provenance, core::shown::kNone, "the record"), analysis...);
+        return core::fields<S>(
+            "FrfAnalysis", "the FRFs u -> [d_e, Vs] and what is read from them (report 2.3-2.5)",
+            core::field("provenance", &S::provenance, kNone, "the record"),
+            core::field("frf", &S::frf, kNone, "u -> [de, Vs]").part_only(),
+            core::field("k_resonance", &S::k_resonance, kNewtonPerMetreAsNPerUm, "m_sus w_r^2 (results.json: the unit's stiffness_N_per_um.resonance)").part_only(),
+            analysis...);
       },
       core::kFields<ident::ActuatorFrfAnalysis>.fields);
 }
@@ -468,17 +476,6 @@ struct UnitAnalysis {
   std::optional<Model2DofFit> model_2dof;
   std::vector<DampedPlant> damped;         // by gain, with or without an identified pole
   std::optional<FlexibleModes> flexible_modes;
-  // The numbers the batch analyses and the acceptance need (SI; nullopt = not available).
-  std::optional<double> flatness;            // m, by the spec's method
-  std::optional<double> capacitance_sensor;  // F
-  std::optional<double> capacitance_actuator;  // F
-  std::optional<double> stroke;              // m
-  std::optional<double> k1, k2, k_resonance; // N/m (k_sc = k1)
-  std::optional<double> k_oc;                // N/m, k1 of the test with every stack open
-  std::optional<double> resonance_Hz, antiresonance_Hz, static_gain;  // Hz, Hz, m/V
-  std::optional<dsp::Frf> frf;               // u -> [de, Vs] (outputs named "de", "Vs")
-  std::optional<ident::IffPlantFit> iff_plant;      // u -> Vs, eq. 2.3 with delay
-  std::optional<ident::DelayedSecondOrderFit> de_plant;  // u -> d_e, mass-spring-damper with delay
   std::vector<std::string> not_measured;     // experiments the campaign does not list
   std::vector<std::string> failed;           // "frf: vector fitting failed: ..." (NumericalError)
   std::vector<std::string> warnings;         // cross-checks that disagree (kHighPassCrossCheckRatio, ...)
@@ -489,6 +486,52 @@ struct UnitAnalysis {
   std::vector<std::string> reasons;
   std::vector<AcceptanceCheck> checks;
 };
+
+// The numbers the batch analyses and the acceptance read, each from the analysis that holds it
+// (SI; nullopt or nullptr: that analysis was not run or did not give it). UnitAnalysis's
+// declaration lists them as derived fields, so the documents show them as the unit's.
+inline std::optional<double> flatness_of(const UnitAnalysis& u) {  // m, by the spec's method
+  return u.flatness_analysis ? std::optional(u.flatness_analysis->flatness) : std::nullopt;
+}
+inline std::optional<double> capacitance_sensor_of(const UnitAnalysis& u) {  // F
+  return u.capacitance_analysis ? std::optional(u.capacitance_analysis->sensor) : std::nullopt;
+}
+inline std::optional<double> capacitance_actuator_of(const UnitAnalysis& u) {  // F
+  return u.capacitance_analysis ? std::optional(u.capacitance_analysis->actuator) : std::nullopt;
+}
+inline std::optional<double> stroke_of(const UnitAnalysis& u) {  // m
+  return u.stroke_analysis ? std::optional(u.stroke_analysis->result.stroke) : std::nullopt;
+}
+inline std::optional<double> k1_of(const UnitAnalysis& u) {  // N/m (k_sc = k1)
+  return u.stiffness_analysis ? std::optional(u.stiffness_analysis->result.k1) : std::nullopt;
+}
+inline std::optional<double> k2_of(const UnitAnalysis& u) {  // N/m
+  return u.stiffness_analysis ? std::optional(u.stiffness_analysis->result.k2) : std::nullopt;
+}
+inline std::optional<double> k_oc_of(const UnitAnalysis& u) {  // N/m, k1 of the test with every stack open
+  return u.stiffness_open_analysis ? std::optional(u.stiffness_open_analysis->result.k1) : std::nullopt;
+}
+inline std::optional<double> k_resonance_of(const UnitAnalysis& u) {  // N/m, m_sus w_r^2
+  return u.frf_analysis ? u.frf_analysis->k_resonance : std::nullopt;
+}
+inline std::optional<double> resonance_Hz_of(const UnitAnalysis& u) {  // Hz
+  return u.frf_analysis ? u.frf_analysis->resonance_Hz : std::nullopt;
+}
+inline std::optional<double> antiresonance_Hz_of(const UnitAnalysis& u) {  // Hz
+  return u.frf_analysis ? u.frf_analysis->antiresonance_Hz : std::nullopt;
+}
+inline std::optional<double> static_gain_of(const UnitAnalysis& u) {  // m/V
+  return u.frf_analysis ? u.frf_analysis->static_gain : std::nullopt;
+}
+inline const dsp::Frf* frf_of(const UnitAnalysis& u) {  // u -> [de, Vs]
+  return u.frf_analysis ? &u.frf_analysis->frf : nullptr;
+}
+inline const ident::IffPlantFit* iff_plant_of(const UnitAnalysis& u) {  // u -> Vs, eq. 2.3 with delay
+  return u.frf_analysis && u.frf_analysis->iff_plant ? &*u.frf_analysis->iff_plant : nullptr;
+}
+inline const ident::DelayedSecondOrderFit* de_plant_of(const UnitAnalysis& u) {  // u -> d_e, mass-spring-damper with delay
+  return u.frf_analysis && u.frf_analysis->de_plant ? &*u.frf_analysis->de_plant : nullptr;
+}
 
 constexpr auto describe(core::Type<UnitAnalysis>) {
   using S = UnitAnalysis;
@@ -510,20 +553,20 @@ constexpr auto describe(core::Type<UnitAnalysis>) {
       core::field("model_2dof", &S::model_2dof, kNone, "the tuned 2-DoF model (results.json: model_2dof, model_2dof_fit)").part_only(),
       core::field("damped", &S::damped, kNone, "damped plants, by gain (results.json: iff_damped_plants)").part_only(),
       core::field("flexible_modes", &S::flexible_modes, kNone, "flexible modes"),
-      core::field("flatness", &S::flatness, kMetreAsUm, "by the spec's method"),
-      core::field("capacitance_sensor", &S::capacitance_sensor, kFaradAsUf, "sensor stack").key("capacitance_uF.sensor"),
-      core::field("capacitance_actuator", &S::capacitance_actuator, kFaradAsUf, "actuator stacks").key("capacitance_uF.actuator"),
-      core::field("stroke", &S::stroke, kMetreAsUm, "max - min of d_e over the stack range"),
-      core::field("k1", &S::k1, kNewtonPerMetreAsNPerUm, "static stiffness, mass put on (= k_sc)").key("stiffness_N_per_um.k1"),
-      core::field("k2", &S::k2, kNewtonPerMetreAsNPerUm, "static stiffness, mass taken off").key("stiffness_N_per_um.k2"),
-      core::field("k_resonance", &S::k_resonance, kNewtonPerMetreAsNPerUm, "from the resonance, m_sus w^2").key("stiffness_N_per_um.resonance"),
-      core::field("k_oc", &S::k_oc, kNewtonPerMetreAsNPerUm, "static stiffness with every stack open").key("stiffness_N_per_um.k_oc"),
-      core::field("resonance_Hz", &S::resonance_Hz, kHertz, "resonance of u -> d_e").part_only(),
-      core::field("antiresonance_Hz", &S::antiresonance_Hz, kHertz, "anti-resonance of u -> Vs").part_only(),
-      core::field("static_gain", &S::static_gain, kMetrePerVoltAsUmPerV, "static gain u -> d_e").part_only(),
-      core::field("frf", &S::frf, kNone, "u -> [de, Vs]").part_only(),
-      core::field("iff_plant", &S::iff_plant, kNone, "u -> Vs, eq. 2.3 with delay").part_only(),
-      core::field("de_plant", &S::de_plant, kNone, "u -> d_e, mass-spring-damper with delay").part_only(),
+      core::derived("flatness", &flatness_of, kMetreAsUm, "by the spec's method"),
+      core::derived("capacitance_sensor", &capacitance_sensor_of, kFaradAsUf, "sensor stack").key("capacitance_uF.sensor"),
+      core::derived("capacitance_actuator", &capacitance_actuator_of, kFaradAsUf, "actuator stacks").key("capacitance_uF.actuator"),
+      core::derived("stroke", &stroke_of, kMetreAsUm, "max - min of d_e over the stack range"),
+      core::derived("k1", &k1_of, kNewtonPerMetreAsNPerUm, "static stiffness, mass put on (= k_sc)").key("stiffness_N_per_um.k1"),
+      core::derived("k2", &k2_of, kNewtonPerMetreAsNPerUm, "static stiffness, mass taken off").key("stiffness_N_per_um.k2"),
+      core::derived("k_resonance", &k_resonance_of, kNewtonPerMetreAsNPerUm, "from the resonance, m_sus w^2").key("stiffness_N_per_um.resonance"),
+      core::derived("k_oc", &k_oc_of, kNewtonPerMetreAsNPerUm, "static stiffness with every stack open").key("stiffness_N_per_um.k_oc"),
+      core::derived("resonance_Hz", &resonance_Hz_of, kHertz, "resonance of u -> d_e").part_only(),
+      core::derived("antiresonance_Hz", &antiresonance_Hz_of, kHertz, "anti-resonance of u -> Vs").part_only(),
+      core::derived("static_gain", &static_gain_of, kMetrePerVoltAsUmPerV, "static gain u -> d_e").part_only(),
+      core::derived("frf", &frf_of, kNone, "u -> [de, Vs]").part_only(),
+      core::derived("iff_plant", &iff_plant_of, kNone, "u -> Vs, eq. 2.3 with delay").part_only(),
+      core::derived("de_plant", &de_plant_of, kNone, "u -> d_e, mass-spring-damper with delay").part_only(),
       core::field("not_measured", &S::not_measured, kNone, "experiments the campaign does not list"),
       core::field("failed", &S::failed, kNone, "one line per analysis that failed"),
       core::field("warnings", &S::warnings, kNone, "cross-checks that disagree"),

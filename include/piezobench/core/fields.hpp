@@ -14,7 +14,7 @@
 // core::Type<S>) and is constexpr, so the list is a compile-time table of member pointers that
 // for_each_field visits generically.
 //
-// Contract of an entry:
+// Contract of an entry (a member `field`, or a `derived` value read from one of the struct's parts):
 //  - name: the member's name; the key in part.json (SI values) and the Python attribute.
 //  - shown: the member's SI unit and the unit documents show it in, with the ONE factor between
 //    them (shown = SI value * per_si). results.json's key is `name_UNIT` (UNIT with "/" spelled
@@ -78,28 +78,71 @@ enum Appears : unsigned { kPartOnly = 0U, kResults = 1U, kReport = 2U };
 // The tag `describe` is found by.
 template <class S> struct Type {};
 
-template <class S, class M> struct Field {
-  using Struct = S;
-  using Member = M;
+// What every entry declares besides how its value is read (Self: the entry's type, for the modifiers).
+template <class Self> struct Entry {
   std::string_view name;
-  M S::*member;
   Shown shown;
   std::string_view meaning;
   unsigned appears = kResults;
   std::string_view results_key = {};  // "" = name_UNIT
 
-  [[nodiscard]] constexpr const M& of(const S& s) const { return s.*member; }
-  [[nodiscard]] constexpr M& of(S& s) const { return s.*member; }
   [[nodiscard]] constexpr bool in(Appears where) const { return (appears & where) != 0U; }
   // Modifiers (constexpr copies): another results.json key, left out of results.json, in the report table.
-  [[nodiscard]] constexpr Field key(std::string_view k) const { Field f = *this; f.results_key = k; return f; }
-  [[nodiscard]] constexpr Field part_only() const { Field f = *this; f.appears = kPartOnly; return f; }
-  [[nodiscard]] constexpr Field in_report() const { Field f = *this; f.appears |= kReport; return f; }
+  [[nodiscard]] constexpr Self key(std::string_view k) const { Self f = self(); f.results_key = k; return f; }
+  [[nodiscard]] constexpr Self part_only() const { Self f = self(); f.appears = kPartOnly; return f; }
+  [[nodiscard]] constexpr Self in_report() const { Self f = self(); f.appears |= kReport; return f; }
+
+ private:
+  [[nodiscard]] constexpr const Self& self() const { return static_cast<const Self&>(*this); }
 };
+
+// A member of the struct.
+template <class S, class M> struct Field : Entry<Field<S, M>> {
+  using Struct = S;
+  using Member = M;
+  static constexpr bool kDerived = false;
+  M S::*member = nullptr;
+
+  [[nodiscard]] constexpr const M& of(const S& s) const { return s.*member; }
+  [[nodiscard]] constexpr M& of(S& s) const { return s.*member; }
+};
+
+// A derived field: a value the struct holds in one of its parts, declared like a member with a
+// getter instead of a member pointer (UnitAnalysis's k1 is its stiffness analysis' k1, read by
+// `k1_of`), so that each number lives in one place. The getter returns the value (a number or an
+// optional) or a pointer into the struct (nullptr: absent). results.json, the report, docs/fields.md
+// and Python (a read-only property) show it like a member; part.json leaves it out (the part it is
+// read from is there) and its reader ignores the key.
+template <class S, class V> struct Derived : Entry<Derived<S, V>> {
+  using Struct = S;
+  using Member = V;
+  static constexpr bool kDerived = true;
+  V (*get)(const S&) = nullptr;
+
+  [[nodiscard]] constexpr V of(const S& s) const { return get(s); }
+};
+
+namespace fields_detail {
+template <class F> constexpr F named(F f, std::string_view name, Shown shown, std::string_view meaning) {
+  f.name = name;
+  f.shown = shown;
+  f.meaning = meaning;
+  return f;
+}
+}  // namespace fields_detail
 
 template <class S, class M>
 constexpr Field<S, M> field(std::string_view name, M S::*member, Shown shown, std::string_view meaning) {
-  return Field<S, M>{name, member, shown, meaning};
+  Field<S, M> f;
+  f.member = member;
+  return fields_detail::named(f, name, shown, meaning);
+}
+
+template <class S, class V>
+constexpr Derived<S, V> derived(std::string_view name, V (*get)(const S&), Shown shown, std::string_view meaning) {
+  Derived<S, V> f;
+  f.get = get;
+  return fields_detail::named(f, name, shown, meaning);
 }
 
 // A struct's declaration: its name and meaning, and its fields in order.
@@ -131,9 +174,32 @@ template <class T> struct Element { using type = T; };
 template <class T> struct Element<std::optional<T>> : Element<T> {};
 template <class T, class A> struct Element<std::vector<T, A>> : Element<T> {};
 template <class T, std::size_t N> struct Element<std::array<T, N>> : Element<T> {};
+template <class T> struct Element<T*> : Element<std::remove_const_t<T>> {};
 template <class T> using element_t = typename Element<T>::type;
 
 template <class S> constexpr std::size_t field_count() { return std::tuple_size_v<decltype(kFields<S>.fields)>; }
+
+// What a declaration says of one entry, found by its member pointer or derived getter (a `which` the
+// declaration does not list gives an empty name).
+struct Declared {
+  std::string_view name;
+  Shown shown;
+  std::string_view meaning;
+};
+template <class S, class W> Declared declared(W which) {
+  Declared out;
+  for_each_field<S>([&](const auto& f) {
+    using F = std::remove_cvref_t<decltype(f)>;
+    if constexpr (F::kDerived) {
+      if constexpr (std::is_same_v<decltype(f.get), W>) {
+        if (f.get == which) out = {f.name, f.shown, f.meaning};
+      }
+    } else if constexpr (std::is_same_v<decltype(f.member), W>) {
+      if (f.member == which) out = {f.name, f.shown, f.meaning};
+    }
+  });
+  return out;
+}
 
 // "um/V" -> "um_per_V", "m/s^2" -> "m_per_s2", "N s/m" -> "N_s_per_m".
 std::string unit_key_suffix(std::string_view unit);

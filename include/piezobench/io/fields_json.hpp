@@ -6,7 +6,7 @@
 // as "readings_um.before" nests; the key "." merges a nested struct into its parent), each number
 // converted once from SI to the shown unit. The one encoding of values: non-finite numbers as the
 // strings "nan", "inf", "-inf" (to_json below), complex numbers as [re, im], an absent optional as
-// null, enums by their module's to_string, a list of (text, value) pairs as an object.
+// null (a derived field's nullptr too), enums by their module's to_string, a list of (text, value) pairs as an object.
 #include <Eigen/Core>
 #include <array>
 #include <complex>
@@ -48,7 +48,7 @@ template <class T> nlohmann::json shown_json(const T& v, double per_si = 1.0) {
     return to_json(v * per_si);
   } else if constexpr (std::is_same_v<T, core::ParameterUncertainty>) {
     return to_json(v);
-  } else if constexpr (core::kIsOptional<T>) {
+  } else if constexpr (core::kIsOptional<T> || std::is_pointer_v<T>) {
     return v ? shown_json(*v, per_si) : nlohmann::json(nullptr);
   } else if constexpr (core::kIsPairList<T>) {
     nlohmann::json o = nlohmann::json::object();
