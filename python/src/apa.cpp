@@ -1,5 +1,6 @@
 // piezobench.apa: include/piezobench/apa/{two_dof,tuning,piezo}.hpp
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/apa/piezo.hpp"
 #include "piezobench/apa/tuning.hpp"
 #include "piezobench/apa/two_dof.hpp"
@@ -91,40 +92,6 @@ const std::string& model_doc() {
   return s;
 }
 
-}  // namespace
-
-py::dict two_dof_bench_dict(const TwoDofBench& b) { return two_dof_bench_options().to_dict(b); }
-
-py::object tuning_result(const TwoDofTuning& r) {
-  py::dict feat;
-  feat["resonance"] = r.features.resonance;
-  feat["resonance_damping"] = r.features.resonance_damping;
-  feat["antiresonance"] = r.features.antiresonance;
-  feat["antiresonance_damping"] = r.features.antiresonance_damping;
-  feat["static_gain_de"] = r.features.static_gain_de;
-  feat["static_gain_vs"] = r.features.static_gain_vs;
-  py::dict d;
-  d["params"] = params_options().to_dict(r.params);
-  d["initial"] = params_options().to_dict(r.initial);
-  d["features"] = result("TuningFeatures", feat);
-  d["fit_error_de"] = r.fit_error_de;
-  d["fit_error_vs"] = r.fit_error_vs;
-  d["initial_fit_error_de"] = r.initial_fit_error_de;
-  d["initial_fit_error_vs"] = r.initial_fit_error_vs;
-  d["points"] = r.points;
-  d["iterations"] = r.iterations;
-  d["status"] = to_string(r.status);
-  d["message"] = r.message;
-  d["bench"] = two_dof_bench_dict(r.bench);
-  d["quality"] = py::cast(r.quality);
-  d["uncertainty"] = r.uncertainty.empty() ? py::none() : py::cast(r.uncertainty);  // ident.ParameterUncertainty
-  d["undetermined"] = py::cast(r.undetermined);
-  d["brief_report"] = r.brief_report();
-  return result("TwoDofTuning", d);
-}
-
-namespace {
-
 // two_dof_actuator, two_dof_bench and two_dof_response (apa/two_dof.hpp).
 void bind_two_dof_models(py::module_& m) {
   using py::arg;
@@ -195,22 +162,27 @@ void bind_characterization(py::module_& m) {
           .c_str());
 }
 
-// tune_two_dof and tune_two_dof_measured (apa/tuning.hpp).
+// tune_two_dof and tune_two_dof_measured (apa/tuning.hpp); apa.TwoDofTuning (and the parameters,
+// features and bench it holds) from its declaration.
 void bind_tuning(py::module_& m) {
   using py::arg;
+  bind_described<TwoDofTuning>(m);
+  bound_class<TwoDofTuning>().def_property_readonly("brief_report", &TwoDofTuning::brief_report,
+                                                     "One line with the status, the iterations and the errors.");
   m.def(
       "tune_two_dof",
       [](py::object frf, const py::kwargs& kw) {
         const std::string src = "apa.tune_two_dof";
         const auto& f = frf_arg(frf, src, "frf");
         auto o = tuning_options().from_kwargs(kwargs_dict(kw), src);
-        return tuning_result(without_gil([&] { return tune_two_dof(f, o); }));
+        return without_gil([&] { return tune_two_dof(f, o); });
       },
       arg("frf"),
       ("Tunes the 2-DoF model to a measured FRF u -> [d_e, Vs] (report section 3): the report's procedure,\n"
-       "then Levenberg-Marquardt on the relative complex error. Returns a Result: params and initial\n"
-       "(dicts of the 9 parameters, SI), features (rad/s), fit errors (rms relative), points, iterations,\n"
-       "status, message, bench (the measurement chain removed), quality (ident.FitQuality).\n\n"
+       "then Levenberg-Marquardt on the relative complex error. Returns an apa.TwoDofTuning: params and\n"
+       "initial (apa.TwoDofParams, the 9 parameters in SI; p[\"k1\"], dict(p)), features (rad/s), fit errors\n"
+       "(rms relative), points, iterations, status, message, bench (apa.TwoDofBench, the measurement chain\n"
+       "removed), quality (ident.FitQuality), uncertainty, undetermined, brief_report.\n\n"
        "Keywords (TuningOptions):\n" + tuning_options().doc())
           .c_str());
   m.def(
@@ -233,13 +205,13 @@ void bind_tuning(py::module_& m) {
           }
           vs = &vs_plant.cast<const ident::IffPlantFit&>();
         }
-        return tuning_result(without_gil([&] { return tune_two_dof_measured(f, o, de, vs); }));
+        return without_gil([&] { return tune_two_dof_measured(f, o, de, vs); });
       },
       arg("frf"), arg("de_plant") = py::none(), arg("vs_plant") = py::none(),
       ("The campaign's tuning on measured FRFs (`piezobench run` and `model tune`): the measurement chain\n"
        "found by the plant fits (ident.fit_actuator_plants: de_plant gives the delay, vs_plant the high-pass\n"
        "corner and Vs's extra lag) removed, then apa.tune_two_dof. A plant that is None leaves the `bench`\n"
-       "keyword's part as given. Returns the same Result as tune_two_dof (bench = the chain removed).\n\n"
+       "keyword's part as given. Returns an apa.TwoDofTuning as tune_two_dof does (bench = the chain removed).\n\n"
        "Keywords (TuningOptions):\n" + tuning_options().doc())
           .c_str());
 }

@@ -86,26 +86,16 @@ void bind_batch_and_iff(py::module_& m) {
   bind_described<SuperElementComparison>(m);
 }
 
-// campaign.CampaignResult, what campaign.run returns.
+// campaign.CampaignResult, what campaign.run returns: the fields of its declaration (results.hpp), the
+// files written and results.json as Results.
 void bind_campaign_result(py::module_& m) {
   py::class_<CampaignRun> c(m, "CampaignResult", R"(The results of campaign.run (campaign/results.hpp): units (campaign.UnitAnalysis),
 batch (campaign.BatchAnalysis), iff (campaign.IffStudy), superelement (campaign.SuperElementComparison
-or None), accepted and rejected (counts), written (the files, when out_dir was given). results is the
-results.json document as Results (every analysis, the report's units: _um, _uF, _Hz, ...); to_dict()
-is that document as plain dicts.)");
-  c.def_property_readonly("units", [](const CampaignRun& r) -> const std::vector<UnitAnalysis>& { return r.result.units; },
-                          py::return_value_policy::reference_internal, "list of campaign.UnitAnalysis")
-      .def_property_readonly("batch", [](const CampaignRun& r) -> const BatchAnalysis& { return r.result.batch; },
-                             py::return_value_policy::reference_internal, "campaign.BatchAnalysis")
-      .def_property_readonly("iff", [](const CampaignRun& r) -> const IffStudy& { return r.result.iff; },
-                             py::return_value_policy::reference_internal, "campaign.IffStudy")
-      .def_property_readonly("superelement", [](py::object self) { return py_value(self.cast<const CampaignRun&>().result.superelement, self); },
-                             "campaign.SuperElementComparison (None when the campaign gives no super element)")
-      .def_property_readonly("accepted", [](const CampaignRun& r) { return r.result.accepted; }, "units accepted")
-      .def_property_readonly("rejected", [](const CampaignRun& r) { return r.result.rejected; }, "units rejected")
-      .def_property_readonly("not_analysed", [](const CampaignRun& r) { return r.result.not_analysed; },
-                             "units whose data could not be analysed (neither accepted nor rejected)")
-      .def_readonly("written", &CampaignRun::written, "files written (empty without out_dir)")
+or None), accepted, marginal, rejected and not_analysed (counts), written (the files, when out_dir was
+given). results is the results.json document as Results (every analysis, the report's units: _um, _uF, _Hz, ...); to_dict()
+is that document as plain dicts. fields() lists the declaration.)");
+  def_fields<CampaignResult>(c, [](const CampaignRun& r) -> const CampaignResult& { return r.result; });
+  c.def_readonly("written", &CampaignRun::written, "files written (empty without out_dir)")
       .def_property_readonly("results", [](const CampaignRun& r) {
         return from_json(results_json(r.result), "CampaignResults", true);
       }, "results.json as Results (r.results.units[0].frf.resonance_Hz)")
@@ -128,8 +118,14 @@ void bind_result_classes(py::module_& m) {
   bind_unit_analysis(m);
   bind_batch_and_iff(m);
   bind_campaign_result(m);
-  m.def("declarations", [] { return declarations_of<UnitAnalysis, BatchAnalysis, IffStudy, SuperElementComparison>(); }, "{declared struct: (its Python class, [field names])} for every declared struct a CampaignResult holds\n"
-     "(its units, batch, iff and superelement; docs/fields.md).");
+  m.def("declarations", [] {
+    py::dict d = declarations_of<UnitAnalysis, BatchAnalysis, IffStudy, SuperElementComparison>();
+    const py::type run = py::type::of<CampaignRun>();  // campaign.CampaignResult: CampaignResult's fields, and `written`
+    d["CampaignResult"] = py::make_tuple(run, run.attr("keys")());
+    return d;
+  },
+        "{declared struct: (its Python class, [field names])} for CampaignResult and every declared struct it holds\n"
+        "(its units, batch, iff and superelement; docs/fields.md).");
 }
 
 }  // namespace

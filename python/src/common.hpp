@@ -35,11 +35,6 @@ struct FrequencyResponse;
 }
 namespace piezobench::dsp {
 struct Frf;
-struct FrfProvenance;
-}
-namespace piezobench::apa {
-struct TwoDofTuning;
-struct TwoDofBench;
 }
 
 namespace piezobench::python {
@@ -338,12 +333,6 @@ class Options;
 const Options<lti::RootLocusOptions>& root_locus_options();
 // Result(gains, poles): poles[i] are the closed-loop poles at gains[i] (lti.cpp).
 py::object root_locus_result(const lti::RootLocus& r);
-// Result of apa.tune_two_dof (apa.cpp), also campaign.Model2DofFit.tuning.
-py::object tuning_result(const apa::TwoDofTuning& t);
-// How an FRF was estimated (Frf.provenance, campaign.FrfAnalysis.welch) as a dict (dsp.cpp).
-py::dict provenance_dict(const dsp::FrfProvenance& p);
-// apa.TwoDofBench keywords as a dict (apa.cpp).
-py::dict two_dof_bench_dict(const apa::TwoDofBench& b);
 // An argument that must be a dsp.Frf.
 const dsp::Frf& frf_arg(py::handle obj, const std::string& source, const std::string& field);
 

@@ -3,22 +3,24 @@
 // bind_described<S>(m) makes S a read-only class with one property per declared field (the field's
 // name, docstring "SI unit: meaning"), and does the same for every declared struct its fields hold,
 // so that every member of a result is reachable from Python with no list to keep in step.
+// def_fields<S>(cls, part) adds S's fields to a class that holds an S (campaign.CampaignResult holds
+// the CampaignResult of a run) or that binds some fields in its own layout (dsp.Frf's H as one array).
 //
 // Values: numbers in SI as the struct holds them; lists of numbers as numpy arrays; enums by their
-// names; a declared struct as its class (a view that keeps its owner alive), or as the dict / Result
-// its module's bindings already give (dsp.Frf's provenance, apa's tuning and bench); lists and
-// optionals of those likewise (None when absent). fields(S) lists the declaration for the tests.
+// names; a declared struct as its class (a view that keeps its owner alive); lists and optionals of
+// those likewise (None when absent). Every class has fields() (the declaration, for the tests),
+// keys() and [name] (so dict(r) and f(**r) work, as with the dicts they replace), to_dict() and a repr.
 #include <complex>
+#include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
 #include "common.hpp"
-#include "piezobench/apa/tuning.hpp"
 #include "piezobench/core/field_types.hpp"
 #include "piezobench/core/fields.hpp"
-#include "piezobench/dsp/frf.hpp"
 
 namespace piezobench::python {
 
@@ -28,11 +30,6 @@ template <class T, class A> struct IsDescribedList<std::vector<T, A>> : std::boo
 }  // namespace described_detail
 
 template <class S> void bind_described(py::module_& m);
-
-// The module's own converters of these declared structs (kept: the bindings of apa and dsp use them).
-inline py::object py_value(const dsp::FrfProvenance& p, py::handle) { return provenance_dict(p); }
-inline py::object py_value(const apa::TwoDofTuning& t, py::handle) { return tuning_result(t); }
-inline py::object py_value(const apa::TwoDofBench& b, py::handle) { return two_dof_bench_dict(b); }
 
 template <class T> py::object py_value(const T& v, py::handle owner) {
   using namespace described_detail;
@@ -66,22 +63,45 @@ template <class S> py::list declared_fields() {
   return out;
 }
 
-template <class S> void bind_described(py::module_& m) {
-  if (py::detail::get_type_info(typeid(S)) != nullptr) return;  // bound already (here or by its module)
-  constexpr auto& d = core::kFields<S>;
-  py::class_<S> c(m, std::string(d.name).c_str(), std::string(d.meaning).c_str());
+// Adds to `cls` (a py::class_ of T) one read-only property per field of S's declaration, read from
+// `part(const T&)` (a const S&), except the fields named in `own` (bound by the caller in another
+// layout), and fields() / keys() / [name] over the whole declaration.
+template <class S, class Class, class Part>
+void def_fields(Class& cls, Part part, std::initializer_list<std::string_view> own = {}) {
+  using T = typename Class::type;
   core::for_each_field<S>([&](const auto& f) {
+    for (const std::string_view o : own) {
+      if (o == f.name) return;
+    }
     const std::string doc = f.shown.si.empty() ? std::string(f.meaning) : std::string(f.shown.si) + ": " + std::string(f.meaning);
-    c.def_property_readonly(
-        std::string(f.name).c_str(), [f](py::object self) { return py_value(f.of(self.cast<const S&>()), self); }, doc.c_str());
+    cls.def_property_readonly(
+        std::string(f.name).c_str(), [f, part](py::object self) { return py_value(f.of(part(self.cast<const T&>())), self); },
+        doc.c_str());
   });
-  c.def_static("fields", [] { return declared_fields<S>(); }, "The field declaration: [(name, SI unit, shown unit, meaning)].");
-  c.def("__getitem__", [](py::object self, const std::string& name) { return self.attr(name.c_str()); }, "A field by name.");
-  typed(c);
+  cls.def_static("fields", [] { return declared_fields<S>(); }, "The field declaration: [(name, SI unit, shown unit, meaning)].");
+  cls.def_static("keys", [] {
+    py::list names;
+    core::for_each_field<S>([&](const auto& f) { names.append(std::string(f.name)); });
+    return names;
+  }, "The declared field names (with [name]: dict(r) and f(**r) work).");
+  cls.def("__getitem__", [](py::object self, const std::string& name) { return self.attr(name.c_str()); }, "A field by name.");
+}
+
+// Binds, in m, every declared struct S's fields hold that is not bound yet.
+template <class S> void bind_held(py::module_& m) {
   core::for_each_field<S>([&](const auto& f) {
     using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
     if constexpr (core::Described<E>) bind_described<E>(m);
   });
+}
+
+template <class S> void bind_described(py::module_& m) {
+  if (py::detail::get_type_info(typeid(S)) != nullptr) return;  // bound already (here or by its module)
+  constexpr auto& d = core::kFields<S>;
+  py::class_<S> c(m, std::string(d.name).c_str(), std::string(d.meaning).c_str());
+  def_fields<S>(c, [](const S& s) -> const S& { return s; });
+  typed(c);
+  bind_held<S>(m);
 }
 
 // {declared name: (Python class, [field names])} for S and every declared struct its fields hold;

@@ -225,20 +225,6 @@ void def_excitation(py::module_& m, const char* name, const Options<O>& table, E
 
 }  // namespace
 
-py::dict provenance_dict(const dsp::FrfProvenance& p) {
-  py::dict d;
-  d["source"] = p.source;
-  d["estimator"] = p.estimator;
-  d["window"] = p.window;
-  d["nfft"] = p.nfft;
-  d["overlap"] = p.overlap;
-  d["detrend"] = p.detrend;
-  d["averages"] = p.averages;
-  d["sample_rate"] = p.sample_rate;
-  d["effective_averages"] = p.effective_averages;
-  return d;
-}
-
 const Frf& frf_arg(py::handle obj, const std::string& source, const std::string& field) {
   if (!py::isinstance<Frf>(obj)) throw InputError(source, field, "a dsp.Frf (dsp.frf(...).frf, io.read_frf, dsp.Frf(...))", short_repr(obj));
   return obj.cast<const Frf&>();
@@ -249,15 +235,17 @@ namespace {
 // The keywords of every Welch estimate, for their docstrings.
 std::string welch_keywords() { return "\nKeywords (WelchOptions):\n" + welch_options().doc(); }
 
-// dsp.Frf (dsp/frf.hpp).
+// dsp.Frf (dsp/frf.hpp): its fields from the declaration but H, coherence and std_H, which Python
+// holds stacked as one array (1-D for one output, else (outputs, points)).
 void bind_frf_class(py::module_& m) {
   using py::arg;
-  py::class_<Frf>(m, "Frf", R"(A frequency response: one input, named outputs, a common grid (dsp/frf.hpp).
+  bind_described<FrfProvenance>(m);
+  py::class_<Frf> c(m, "Frf", R"(A frequency response: one input, named outputs, a common grid (dsp/frf.hpp).
 
 H[i][k] = output i / input at freq_Hz[k]; coherence where known; std_H the standard deviation of the
 random error of H's real and imaginary parts (std |H|, and std phase = std_H / |H| rad; Bendat & Piersol,
-dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
-      .def(py::init([](py::object freq_Hz, py::object H, py::object outputs, const std::string& input,
+dsp/frf_variance.hpp) where known; provenance (dsp.FrfProvenance) says how it was estimated.)");
+  c.def(py::init([](py::object freq_Hz, py::object H, py::object outputs, const std::string& input,
                        py::object coherence, py::object std_H) {
              const std::string src = "dsp.Frf";
              Frf f;
@@ -289,13 +277,7 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
            arg("std_H") = py::none(),
            "freq_Hz (Hz, increasing); H: 1-D for one output or (outputs, points); outputs: names; coherence "
            "and std_H like H (None = unknown).")
-      .def_property_readonly("freq_Hz", [](py::object self) { return view(self.cast<const Frf&>().freq_Hz, self); }, "Hz")
-      .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_Hz)); }, "rad/s")
-      .def_readonly("input", &Frf::input)
-      .def_readonly("outputs", &Frf::outputs)
-      .def_static("fields", [] { return declared_fields<Frf>(); },
-                  "The field declaration (dsp/frf.hpp): [(name, SI unit, shown unit, meaning)]; H, coherence and std_H "
-                  "are stacked here as arrays.")
+      .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_Hz)); }, "rad/s, 2 pi freq_Hz")
       .def_property_readonly("H", [](const Frf& f) { return stack(f.H, f.H.size() == 1); },
                              "1-D complex array for one output, else (outputs, points)")
       .def_property_readonly("coherence", [](const Frf& f) -> py::object {
@@ -310,7 +292,6 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
         if (!(f.provenance.effective_averages > 1.0)) return py::none();
         return py::float_(frf_band_factor(f.provenance.effective_averages));
       }, "k of the 95 % band H +- k std_H from the estimate's n_d (Student's t, dsp/frf_variance.hpp; None when n_d is unknown)")
-      .def_property_readonly("provenance", [](const Frf& f) { return provenance_dict(f.provenance); })
       .def("response", [](const Frf& f, const std::string& name) { return to_numpy(f.H[static_cast<std::size_t>(f.output_index(name))]); },
            arg("output"), "H of the named output (InputError listing the names when unknown).")
       .def("__repr__", [](const Frf& f) {
@@ -318,6 +299,7 @@ dsp/frf_variance.hpp) where known; provenance says how it was estimated.)")
         for (const auto& o : f.outputs) outs += (outs.empty() ? "" : ", ") + o;
         return "Frf(input=" + f.input + ", outputs=[" + outs + "], points=" + std::to_string(f.freq_Hz.size()) + ")";
       });
+  def_fields<Frf>(c, [](const Frf& f) -> const Frf& { return f; }, {"H", "coherence", "std_H"});
 }
 
 // window, and the spectra of dsp/welch.hpp: welch, csd and frf.

@@ -162,77 +162,9 @@ PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle
 
 py::object vf_result(VectorFittingResult r) { return py::cast(std::move(r)); }
 
-py::dict modal(const ModalFeature& f) {
-  py::dict d;
-  d["root"] = f.root;
-  d["natural_frequency"] = f.natural_frequency;
-  d["frequency_Hz"] = f.frequency_Hz();
-  d["damping"] = f.damping;
-  return d;
-}
-
-py::object features_result(const FrfFeatures& f) {
-  py::list res, anti;
-  for (const auto& r : f.resonances) res.append(result("Resonance", modal(r)));
-  for (const auto& a : f.antiresonances) {
-    py::dict d = modal(a);
-    d["nonminimum_phase_model"] = a.nonminimum_phase_model;
-    d["phase_verdict"] = to_string(a.phase_verdict);
-    d["phase_change_deg"] = a.phase_change_deg;
-    d["phase_points"] = a.phase_points;
-    anti.append(result("AntiResonance", d));
-  }
-  py::dict d;
-  d["static_gain"] = f.static_gain;
-  d["static_gain_source"] = to_string(f.static_gain_source);
-  d["plateau_frequency"] = f.plateau_frequency;
-  d["resonances"] = res;
-  d["antiresonances"] = anti;
-  d["fit"] = vf_result(f.fit);
-  return result("FrfFeatures", d);
-}
-
-py::object mode_result(const Mode& md) {
-  py::dict d;
-  d["pole"] = md.pole;
-  d["natural_frequency"] = md.natural_frequency;
-  d["frequency_Hz"] = md.frequency_Hz();
-  d["damping"] = md.damping;
-  d["stable_orders"] = md.stable_orders;
-  return result("Mode", d);
-}
-
 // omega and the response(s): h is (points,) or (points, outputs).
 std::pair<Vector, CMatrix> data_args(py::handle omega, py::handle h, const std::string& source) {
   return {to_vector(omega, source, "omega"), to_complex_matrix(h, source, "h")};
-}
-
-// The modes and the stabilization diagram (as arrays) of an LSCF run.
-py::object lscf_result(const LscfResult& r) {
-  py::list modes;
-  for (const auto& md : r.modes) modes.append(mode_result(md));
-  const auto n = static_cast<Index>(r.diagram.size());
-  Eigen::VectorXd order(n), wn(n), zeta(n), stable(n);
-  Eigen::VectorXcd pole(n);
-  for (Index i = 0; i < n; ++i) {
-    const auto& p = r.diagram[static_cast<std::size_t>(i)];
-    order(i) = static_cast<double>(p.order);
-    pole(i) = p.pole;
-    wn(i) = p.natural_frequency;
-    zeta(i) = p.damping;
-    stable(i) = p.stable ? 1.0 : 0.0;
-  }
-  py::dict diag;
-  diag["order"] = to_numpy(std::move(order));
-  diag["pole"] = to_numpy(std::move(pole));
-  diag["natural_frequency"] = to_numpy(std::move(wn));
-  diag["damping"] = to_numpy(std::move(zeta));
-  diag["stable"] = to_numpy(std::move(stable));
-  py::dict d;
-  d["modes"] = modes;
-  d["diagram"] = result("StabilizationDiagram", diag);
-  d["quality"] = py::cast(r.quality);
-  return result("LscfResult", d);
 }
 
 // ident.FitQuality and ident.ParameterUncertainty, the verdict and the standard errors every fit
@@ -310,6 +242,22 @@ void bind_vector_fitting_result(py::module_& m) {
       .def("brief_report", &VectorFittingResult::brief_report, "One line: order, iterations, converged, rms.");
 }
 
+// The results of frf_features, fit_high_pass, fit_second_order, peak_picking, lscf and
+// fit_actuator_plants (ident/features.hpp, modal.hpp, plant_fit.hpp) from their declarations, with
+// the frequencies in Hz that their structs compute.
+void bind_feature_classes(py::module_& m) {
+  bind_described<FrfFeatures>(m);
+  bound_class<ModalFeature>().def_property_readonly("frequency_Hz", &ModalFeature::frequency_Hz, "Hz, natural_frequency / 2 pi");
+  bound_class<AntiResonance>().def_property_readonly("frequency_Hz", &AntiResonance::frequency_Hz, "Hz, natural_frequency / 2 pi");
+  bind_described<HighPassFit>(m);
+  bound_class<HighPassFit>().def_property_readonly("corner_Hz", &HighPassFit::corner_Hz, "Hz, corner / 2 pi");
+  bind_described<SecondOrderFit>(m);
+  bound_class<SecondOrderFit>().def_property_readonly("frequency_Hz", &SecondOrderFit::frequency_Hz, "Hz, natural_frequency / 2 pi");
+  bind_described<LscfResult>(m);
+  bound_class<Mode>().def_property_readonly("frequency_Hz", &Mode::frequency_Hz, "Hz, natural_frequency / 2 pi");
+  bind_described<ActuatorPlants>(m);
+}
+
 // fit_iff_plant, fit_delayed_second_order and fit_actuator_plants.
 void bind_plant_fits(py::module_& m) {
   using py::arg;
@@ -354,20 +302,14 @@ void bind_plant_fits(py::module_& m) {
         const auto coh = [&](std::size_t i) { return i < f.coherence.size() ? f.coherence[i] : Vector(); };
         const std::string source = f.provenance.source.empty() ? src : f.provenance.source;
         if (o.effective_averages == 0.0) o.effective_averages = f.provenance.effective_averages;
-        auto p = without_gil([&] {
+        return without_gil([&] {
           return fit_actuator_plants(kTwoPi * f.freq_Hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
         });
-        py::dict d;
-        d["de"] = p.de ? py::cast(*p.de) : py::none();
-        d["vs"] = p.vs ? py::cast(*p.vs) : py::none();
-        d["de_options"] = plant_fit_options().to_dict(p.de_options);
-        d["vs_options"] = plant_fit_options().to_dict(p.vs_options);
-        d["failures"] = py::cast(p.failures);
-        return result("ActuatorPlants", d);
       },
       arg("frf"), arg("de_output") = "de", arg("vs_output") = "Vs",
       ("Both plants of an actuator's FRF u -> [d_e, Vs] fitted as `piezobench run` and `model tune` do:\n"
-       "Result(de (ident.DelayedSecondOrderFit or None), vs (ident.IffPlantFit or None), de_options, vs_options,\n"
+       "ident.ActuatorPlants(de (ident.DelayedSecondOrderFit or None), vs (ident.IffPlantFit or None), de_options,\n"
+       "vs_options (ident.IffPlantFitOptions), "
        "failures (a fit that failed numerically)). Pass de and vs to apa.tune_two_dof_measured.\n\n"
        "Keywords (ActuatorPlantOptions):\n" + actuator_plant_options().doc())
           .c_str());
@@ -404,17 +346,18 @@ void bind_vector_fitting(py::module_& m) {
         if (py::isinstance<dsp::Frf>(omega_or_frf)) {
           const auto& f = frf_arg(omega_or_frf, src, "frf");
           auto name = string_arg(h_or_output, src, "output");
-          return features_result(without_gil([&] { return frf_features(f, name, o); }));
+          return without_gil([&] { return frf_features(f, name, o); });
         }
         auto w = to_vector(omega_or_frf, src, "omega");
         auto h = to_complex_vector(h_or_output, src, "h");
-        return features_result(without_gil([&] { return frf_features(w, h, o); }));
+        return without_gil([&] { return frf_features(w, h, o); });
       },
       arg("omega"), arg("h"),
       ("Static gain, resonances and anti-resonances (rad/s, damping) of one response, with the\n"
        "non-minimum-phase verdicts (fitted zero and measured phase; report section 2.3). Call with\n"
-       "(omega, h) or (frf, output_name). Returns a Result: static_gain, static_gain_source,\n"
-       "plateau_frequency, resonances, antiresonances (phase_verdict, nonminimum_phase_model), fit.\n\n"
+       "(omega, h) or (frf, output_name). Returns an ident.FrfFeatures: static_gain, static_gain_source,\n"
+       "plateau_frequency, resonances (ident.ModalFeature), antiresonances (ident.AntiResonance: phase_verdict,\n"
+       "nonminimum_phase_model, ...), fit.\n\n"
        "Keywords:\n" + feature_options().doc())
           .c_str());
 }
@@ -427,17 +370,11 @@ void bind_low_order_fits(py::module_& m) {
       [](py::object omega, py::object h, double max_omega) {
         auto w = to_vector(omega, "ident.fit_high_pass", "omega");
         auto hv = to_complex_vector(h, "ident.fit_high_pass", "h");
-        auto r = fit_high_pass(w, hv, max_omega);
-        py::dict d;
-        d["corner"] = r.corner;
-        d["corner_Hz"] = r.corner_Hz();
-        d["gain"] = r.gain;
-        d["relative_rms_error"] = r.relative_rms_error;
-        return result("HighPassFit", d);
+        return fit_high_pass(w, hv, max_omega);
       },
       arg("omega"), arg("h"), arg("max_omega") = 0.0,
       "First-order high-pass g s / (s + corner) fitted to the points with omega <= max_omega (rad/s; 0 = all):\n"
-      "Result(corner (rad/s), corner_Hz, gain, relative_rms_error).");
+      "ident.HighPassFit(corner (rad/s), corner_Hz, gain, relative_rms_error).");
   m.def(
       "fit_second_order",
       [](py::object omega, py::object h, const py::kwargs& kw) {
@@ -445,20 +382,10 @@ void bind_low_order_fits(py::module_& m) {
         auto o = second_order_options().from_kwargs(kwargs_dict(kw), src);
         auto w = to_vector(omega, src, "omega");
         auto hv = to_complex_vector(h, src, "h");
-        auto r = without_gil([&] { return fit_second_order(w, hv, o); });
-        py::dict d;
-        d["static_gain"] = r.static_gain;
-        d["natural_frequency"] = r.natural_frequency;
-        d["frequency_Hz"] = r.frequency_Hz();
-        d["damping"] = r.damping;
-        d["poles"] = to_numpy(std::move(r.poles));
-        d["feedthrough"] = r.feedthrough;
-        d["relative_rms_error"] = r.relative_rms_error;
-        d["iterations"] = r.iterations;
-        return result("SecondOrderFit", d);
+        return without_gil([&] { return fit_second_order(w, hv, o); });
       },
       arg("omega"), arg("h"),
-      ("k wn^2 / (s^2 + 2 zeta wn s + wn^2) fitted to h at j omega (rad/s): Result(static_gain,\n"
+      ("k wn^2 / (s^2 + 2 zeta wn s + wn^2) fitted to h at j omega (rad/s): ident.SecondOrderFit(static_gain,\n"
        "natural_frequency (rad/s), frequency_Hz, damping, poles, feedthrough, relative_rms_error, iterations).\n\n"
        "Keywords:\n" + second_order_options().doc())
           .c_str());
@@ -473,14 +400,11 @@ void bind_modal(py::module_& m) {
         const std::string src = "ident.peak_picking";
         auto o = peak_options().from_kwargs(kwargs_dict(kw), src);
         auto [w, hm] = data_args(omega, h, src);
-        auto modes = peak_picking(w, hm, o);
-        py::list out;
-        for (const auto& md : modes) out.append(mode_result(md));
-        return out;
+        return peak_picking(w, hm, o);
       },
       arg("omega"), arg("h"),
       ("Modes from the peaks of sum |H|^2 (h: (points,) or (points, outputs)), damping from the half-power\n"
-       "bandwidth: a list of Result(pole, natural_frequency (rad/s), frequency_Hz, damping).\n\nKeywords:\n" +
+       "bandwidth: a list of ident.Mode(pole, natural_frequency (rad/s), frequency_Hz, damping, stable_orders).\n\nKeywords:\n" +
        peak_options().doc())
           .c_str());
   m.def(
@@ -489,12 +413,13 @@ void bind_modal(py::module_& m) {
         const std::string src = "ident.lscf";
         auto o = lscf_options().from_kwargs(kwargs_dict(kw), src);
         auto [w, hm] = data_args(omega, h, src);
-        return lscf_result(without_gil([&] { return lscf(w, hm, o); }));
+        return without_gil([&] { return lscf(w, hm, o); });
       },
       arg("omega"), arg("h"),
       ("Least-squares complex-frequency estimator (PolyMAX-like, single reference) over a range of\n"
-       "orders with a stabilization diagram: Result(modes, diagram (order, pole, natural_frequency,\n"
-       "damping, stable as arrays), quality (ident.FitQuality)).\n\nKeywords:\n" + lscf_options().doc())
+       "orders with a stabilization diagram: ident.LscfResult(modes (ident.Mode), diagram (a list of\n"
+       "ident.StabilizationPole: order, pole, natural_frequency, damping, stable), quality (ident.FitQuality)).\n\n"
+       "Keywords:\n" + lscf_options().doc())
           .c_str());
 }
 
@@ -504,12 +429,14 @@ void bind_ident(py::module_& m) {
   bind_fit_quality(m);
   bind_vector_fitting_result(m);
   bind_plant_fit_classes(m);
+  bind_feature_classes(m);
   bind_plant_fits(m);
   bind_vector_fitting(m);
   bind_low_order_fits(m);
   bind_modal(m);
   m.def("declarations", [] {
-    return declarations_of<IffPlantFit, DelayedSecondOrderFit, VectorFittingResult, HysteresisFit, CreepFit, LoopMetrics>();
+    return declarations_of<IffPlantFit, DelayedSecondOrderFit, VectorFittingResult, FrfFeatures, HighPassFit, SecondOrderFit,
+                           LscfResult, ActuatorPlants, HysteresisFit, CreepFit, LoopMetrics>();
   }, "{declared struct: (its Python class, [field names])} for every declared result ident returns (ident/*.hpp).");
 }
 

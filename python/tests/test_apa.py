@@ -36,6 +36,13 @@ def test_tuning_recovers_the_parameters_from_exact_frfs():
     for name in ("k1", "ka", "ke", "ga", "gs"):
         assert r.params[name] == pytest.approx(true[name], rel=1e-3), name
     assert r.fit_error_de < 1e-4
+    # The tuning is apa.TwoDofTuning, from its declaration (apa/tuning.hpp): every declared field an
+    # attribute; the parameters a class that reads like the dict it replaced.
+    assert isinstance(r, apa.TwoDofTuning) and isinstance(r.params, apa.TwoDofParams)
+    assert [f[0] for f in apa.TwoDofTuning.fields()] == list(apa.TwoDofTuning.keys())
+    assert all(hasattr(r, name) for name in apa.TwoDofTuning.keys())
+    assert dict(r.params)["k1"] == r.params.k1 == r.params["k1"]
+    assert r.features.resonance > 0 and r.brief_report.startswith("2-DoF tuning: converged")
 
 
 def test_piezo_sensitivities_table_4_1():

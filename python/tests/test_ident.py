@@ -61,6 +61,7 @@ def test_high_pass_and_second_order_fits():
     s = 1j * w
     hp = ident.fit_high_pass(w, 3.0 * s / (s + 2.5))
     assert hp.corner == pytest.approx(2.5, rel=1e-6) and hp.gain == pytest.approx(3.0, rel=1e-6)
+    assert hp.corner_Hz == pytest.approx(2.5 / (2 * np.pi), rel=1e-6) and isinstance(hp, ident.HighPassFit)
     wn, z, k = 2 * np.pi * 95.2, 0.02, -1.7e-5
     w2 = 2 * np.pi * np.linspace(10, 400, 600)
     s2 = 1j * w2
@@ -70,6 +71,7 @@ def test_high_pass_and_second_order_fits():
         assert f.natural_frequency == pytest.approx(wn, rel=1e-6)
         assert f.damping == pytest.approx(z, rel=1e-5)
         assert f.static_gain == pytest.approx(k, rel=1e-5)
+        assert f.frequency_Hz == pytest.approx(95.2, rel=1e-6) and f.poles.shape == (2,)
 
 
 def test_peak_picking_and_lscf_find_both_modes():
@@ -82,7 +84,9 @@ def test_peak_picking_and_lscf_find_both_modes():
     freqs = sorted(m.natural_frequency for m in r.modes)
     assert freqs == pytest.approx([100.0, 300.0], rel=1e-4)
     assert sorted(m.damping for m in r.modes) == pytest.approx([0.01, 0.02], rel=1e-2)
-    assert r.diagram.order.size == r.diagram.pole.size > 0
+    # The stabilization diagram: every physical pole of every order, each an ident.StabilizationPole.
+    assert len(r.diagram) > 0 and all(p.order >= 2 and p.pole.imag > 0 for p in r.diagram)
+    assert any(p.stable for p in r.diagram) and r.quality.verdict == "good"
 
 
 # ---- the plant fits of the report (ident/plant_fit.hpp) on scipy-generated responses -----------
@@ -178,7 +182,9 @@ def test_each_declared_ident_result_is_a_class_with_every_declared_field():
     classes live in ident (not in the module that first held them)."""
     decl = ident.declarations()
     assert {"IffPlantFit", "DelayedSecondOrderFit", "VectorFittingResult", "HysteresisFit", "HysteresisModel",
-            "PrandtlIshlinskii", "DeadZoneSuperposition", "CreepFit", "LoopMetrics"} <= set(decl)
+            "PrandtlIshlinskii", "DeadZoneSuperposition", "CreepFit", "LoopMetrics", "FrfFeatures", "ModalFeature",
+            "AntiResonance", "HighPassFit", "SecondOrderFit", "LscfResult", "Mode", "StabilizationPole",
+            "ActuatorPlants", "IffPlantFitOptions"} <= set(decl)
     for name, (cls, fields) in decl.items():
         assert getattr(ident, name) is cls, name
         assert [f[0] for f in cls.fields()] == fields, name

@@ -16,6 +16,7 @@
 #include "piezobench/campaign/superelement_fit.hpp"
 #include "piezobench/control/iff.hpp"
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/parallel.hpp"
 #include "piezobench/core/statistics.hpp"
@@ -195,19 +196,21 @@ std::vector<std::string> implausible(const Campaign& c, const UnitAnalysis& u) {
     return fmt::format("column '{}' of '{}'", it != f.channels.end() ? it->second : role, f.given);
   };
   std::vector<std::string> out;
-  const auto check = [&](const std::optional<double>& v, double lo, double hi, double scale, const char* unit, const std::string& what,
+  // A unit's figure (a derived field of UnitAnalysis) outside [lo, hi] (SI), told in its declared unit.
+  const auto check = [&](std::optional<double> (*figure)(const UnitAnalysis&), double lo, double hi, const std::string& what,
                          const std::string& where) {
-    if (v && !(*v >= lo && *v <= hi)) {
-      out.push_back(fmt::format("implausible: {} {:.4g} {} cannot be a measurement (plausible {:g} to {:g} {}): check the units of {}", what,
-                                *v * scale, unit, lo * scale, hi * scale, unit, where));
-    }
+    const std::optional<double> v = figure(u);
+    if (!v || (*v >= lo && *v <= hi)) return;
+    const core::Shown shown = core::declared<UnitAnalysis>(figure).shown;
+    out.push_back(fmt::format("implausible: {} {:.4g} {} cannot be a measurement (plausible {:g} to {:g} {}): check the units of {}", what,
+                              *v * shown.per_si, shown.unit, lo * shown.per_si, hi * shown.per_si, shown.unit, where));
   };
-  check(stroke_of(u), 1e-9, 5e-3, 1e6, "um", "stroke", column(&UnitSpec::stroke, "de"));
-  check(k1_of(u), 1e3, 1e10, 1e-6, "N/um", "stiffness k1", column(&UnitSpec::stiffness, "de"));
-  check(k2_of(u), 1e3, 1e10, 1e-6, "N/um", "stiffness k2", column(&UnitSpec::stiffness, "de"));
-  check(k_resonance_of(u), 1e3, 1e10, 1e-6, "N/um", "stiffness from the resonance", column(&UnitSpec::frf, "de"));
-  check(capacitance_sensor_of(u), 1e-12, 1e-2, 1e6, "uF", "sensor capacitance", column(&UnitSpec::capacitance, "C_sensor"));
-  check(capacitance_actuator_of(u), 1e-12, 1e-2, 1e6, "uF", "actuator capacitance", column(&UnitSpec::capacitance, "C_actuator"));
+  check(&stroke_of, 1e-9, 5e-3, "stroke", column(&UnitSpec::stroke, "de"));
+  check(&k1_of, 1e3, 1e10, "stiffness k1", column(&UnitSpec::stiffness, "de"));
+  check(&k2_of, 1e3, 1e10, "stiffness k2", column(&UnitSpec::stiffness, "de"));
+  check(&k_resonance_of, 1e3, 1e10, "stiffness from the resonance", column(&UnitSpec::frf, "de"));
+  check(&capacitance_sensor_of, 1e-12, 1e-2, "sensor capacitance", column(&UnitSpec::capacitance, "C_sensor"));
+  check(&capacitance_actuator_of, 1e-12, 1e-2, "actuator capacitance", column(&UnitSpec::capacitance, "C_actuator"));
   return out;
 }
 

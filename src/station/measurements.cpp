@@ -57,10 +57,10 @@ Entry entry(std::string name, Experiment experiment, std::string description, co
 }
 
 // A number of UnitAnalysis's declaration (core/fields.hpp; a derived field, read from its analysis):
-// the measurement's name and unit are the declaration's results key and shown unit.
-Entry unit_entry(Experiment e, std::string description, Si (*value)(const UnitAnalysis&)) {
+// the measurement's name, unit and description are the declaration's results key, shown unit and meaning.
+Entry unit_entry(Experiment e, Si (*value)(const UnitAnalysis&)) {
   const core::Declared d = core::declared<UnitAnalysis>(value);
-  return entry(core::results_key(d.name, d.shown), e, std::move(description), d.shown,
+  return entry(core::results_key(d.name, d.shown), e, std::string(d.meaning), d.shown,
                [value](const UnitAnalysis& u, const std::string&) { return value(u); });
 }
 
@@ -89,10 +89,10 @@ Si damped_pick(const UnitAnalysis& u, const std::string& file, double ident::Dom
 const std::vector<Entry>& catalog() {
   using campaign::FrfAnalysis;
   static const std::vector<Entry> entries = {
-      unit_entry(Experiment::kFlatness, "flatness of the interfaces by the campaign's method", &campaign::flatness_of),
-      unit_entry(Experiment::kCapacitance, "capacitance of the sensor stack", &campaign::capacitance_sensor_of),
-      unit_entry(Experiment::kCapacitance, "capacitance of the actuator stacks", &campaign::capacitance_actuator_of),
-      unit_entry(Experiment::kStroke, "stroke, max - min of d_e over the stack range", &campaign::stroke_of),
+      unit_entry(Experiment::kFlatness, &campaign::flatness_of),
+      unit_entry(Experiment::kCapacitance, &campaign::capacitance_sensor_of),
+      unit_entry(Experiment::kCapacitance, &campaign::capacitance_actuator_of),
+      unit_entry(Experiment::kStroke, &campaign::stroke_of),
       entry("sensitivity_um_per_V", Experiment::kStroke, "slope of d_e against Va", shown_of(&metrology::StrokeResult::sensitivity),
             [](const UnitAnalysis& u, const std::string&) { return u.stroke_analysis ? Si(u.stroke_analysis->result.sensitivity) : std::nullopt; }),
       entry("hysteresis_relative_width", Experiment::kHysteresis, "loop width at the offset / loop stroke",
@@ -100,15 +100,15 @@ const std::vector<Entry>& catalog() {
             [](const UnitAnalysis& u, const std::string& f) { return hysteresis_pick(u, f, &metrology::HysteresisResult::relative_width); }),
       entry("hysteresis_width_um", Experiment::kHysteresis, "loop width at the offset", shown_of(&metrology::HysteresisResult::width),
             [](const UnitAnalysis& u, const std::string& f) { return hysteresis_pick(u, f, &metrology::HysteresisResult::width); }),
-      unit_entry(Experiment::kStiffness, "static stiffness, mass put on", &campaign::k1_of),
-      unit_entry(Experiment::kStiffness, "static stiffness, mass taken off", &campaign::k2_of),
-      unit_entry(Experiment::kStiffnessOpen, "static stiffness with every stack open", &campaign::k_oc_of),
-      unit_entry(Experiment::kFrf, "resonance of u -> d_e", &campaign::resonance_Hz_of),
-      unit_entry(Experiment::kFrf, "anti-resonance of u -> Vs", &campaign::antiresonance_Hz_of),
+      unit_entry(Experiment::kStiffness, &campaign::k1_of),
+      unit_entry(Experiment::kStiffness, &campaign::k2_of),
+      unit_entry(Experiment::kStiffnessOpen, &campaign::k_oc_of),
+      unit_entry(Experiment::kFrf, &campaign::resonance_Hz_of),
+      unit_entry(Experiment::kFrf, &campaign::antiresonance_Hz_of),
       entry("resonance_damping", Experiment::kFrf, "damping ratio of the resonance", shown_of(&FrfAnalysis::resonance_damping),
             [](const UnitAnalysis& u, const std::string&) { return u.frf_analysis ? u.frf_analysis->resonance_damping : std::nullopt; }),
-      unit_entry(Experiment::kFrf, "stiffness from the resonance, m_sus w^2", &campaign::k_resonance_of),
-      unit_entry(Experiment::kFrf, "static gain u -> d_e", &campaign::static_gain_of),
+      unit_entry(Experiment::kFrf, &campaign::k_resonance_of),
+      unit_entry(Experiment::kFrf, &campaign::static_gain_of),
       entry("hpf_corner_Hz", Experiment::kFrf, "high-pass corner of the force sensor", shown_of(&campaign::HighPassCorner::corner_Hz),
             [](const UnitAnalysis& u, const std::string&) { return u.frf_analysis ? u.frf_analysis->hpf.corner_Hz : std::nullopt; }),
       entry("hpf_corner_without_resistor_Hz", Experiment::kFrfNoResistor, "fitted corner without the resistor",

@@ -553,13 +553,13 @@ constexpr auto describe(core::Type<UnitAnalysis>) {
       core::field("model_2dof", &S::model_2dof, kNone, "the tuned 2-DoF model (results.json: model_2dof, model_2dof_fit)").part_only(),
       core::field("damped", &S::damped, kNone, "damped plants, by gain (results.json: iff_damped_plants)").part_only(),
       core::field("flexible_modes", &S::flexible_modes, kNone, "flexible modes"),
-      core::derived("flatness", &flatness_of, kMetreAsUm, "by the spec's method"),
-      core::derived("capacitance_sensor", &capacitance_sensor_of, kFaradAsUf, "sensor stack").key("capacitance_uF.sensor"),
-      core::derived("capacitance_actuator", &capacitance_actuator_of, kFaradAsUf, "actuator stacks").key("capacitance_uF.actuator"),
-      core::derived("stroke", &stroke_of, kMetreAsUm, "max - min of d_e over the stack range"),
+      core::derived("flatness", &flatness_of, kMetreAsUm, "flatness of the interfaces by the spec's method"),
+      core::derived("capacitance_sensor", &capacitance_sensor_of, kFaradAsUf, "capacitance of the sensor stack").key("capacitance_uF.sensor"),
+      core::derived("capacitance_actuator", &capacitance_actuator_of, kFaradAsUf, "capacitance of the actuator stacks").key("capacitance_uF.actuator"),
+      core::derived("stroke", &stroke_of, kMetreAsUm, "stroke, max - min of d_e over the stack range"),
       core::derived("k1", &k1_of, kNewtonPerMetreAsNPerUm, "static stiffness, mass put on (= k_sc)").key("stiffness_N_per_um.k1"),
       core::derived("k2", &k2_of, kNewtonPerMetreAsNPerUm, "static stiffness, mass taken off").key("stiffness_N_per_um.k2"),
-      core::derived("k_resonance", &k_resonance_of, kNewtonPerMetreAsNPerUm, "from the resonance, m_sus w^2").key("stiffness_N_per_um.resonance"),
+      core::derived("k_resonance", &k_resonance_of, kNewtonPerMetreAsNPerUm, "stiffness from the resonance, m_sus w^2").key("stiffness_N_per_um.resonance"),
       core::derived("k_oc", &k_oc_of, kNewtonPerMetreAsNPerUm, "static stiffness with every stack open").key("stiffness_N_per_um.k_oc"),
       core::derived("resonance_Hz", &resonance_Hz_of, kHertz, "resonance of u -> d_e").part_only(),
       core::derived("antiresonance_Hz", &antiresonance_Hz_of, kHertz, "anti-resonance of u -> Vs").part_only(),
@@ -829,5 +829,22 @@ struct CampaignResult {
   int rejected = 0;      // analysed and rejected
   int not_analysed = 0;  // units with UnitAnalysis::not_analysed (neither accepted nor rejected)
 };
+
+// What campaign.run returns in Python (the campaign as read is its input, not declared). results.json
+// writes the same parts its own way (results_json.cpp: "units", "batch", "iff", "superelement",
+// "summary"), so the declaration keeps them out of results_object.
+constexpr auto describe(core::Type<CampaignResult>) {
+  using S = CampaignResult;
+  using namespace core::shown;
+  return core::fields<S>("CampaignResult", "the results of a campaign: every unit, the batch, the IFF study",
+      core::field("units", &S::units, kNone, "every unit's analysis, in the campaign's order").part_only(),
+      core::field("batch", &S::batch, kNone, "the batch's spreads, outliers and FRF similarity").part_only(),
+      core::field("iff", &S::iff, kNone, "the IFF study").part_only(),
+      core::field("superelement", &S::superelement, kNone, "the super element on the bench (when the campaign gives one)").part_only(),
+      core::field("accepted", &S::accepted, kNone, "units accepted").part_only(),
+      core::field("marginal", &S::marginal, kNone, "units with a marginal check and no failed one").part_only(),
+      core::field("rejected", &S::rejected, kNone, "units analysed and rejected").part_only(),
+      core::field("not_analysed", &S::not_analysed, kNone, "units whose data could not be analysed").part_only());
+}
 
 }  // namespace piezobench::campaign

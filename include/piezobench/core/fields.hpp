@@ -158,6 +158,14 @@ constexpr FieldList<S, Fs...> fields(std::string_view name, std::string_view mea
   return FieldList<S, Fs...>{name, meaning, std::tuple<Fs...>{f...}};
 }
 
+// A derived struct's declaration: its base's fields (base: the base's kFields), then its own.
+template <class S, class B, class... Bs, class... Fs>
+constexpr FieldList<S, Bs..., Fs...> extended_fields(std::string_view name, std::string_view meaning, const FieldList<B, Bs...>& base,
+                                                     Fs... f) {
+  static_assert(std::is_base_of_v<B, S>, "a declaration extends the declaration of a base of its struct");
+  return FieldList<S, Bs..., Fs...>{name, meaning, std::tuple_cat(base.fields, std::tuple<Fs...>{f...})};
+}
+
 // True for a struct with a declaration.
 template <class S> concept Described = requires { describe(Type<S>{}); };
 

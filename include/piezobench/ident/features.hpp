@@ -126,4 +126,58 @@ struct SecondOrderFit {
 SecondOrderFit fit_second_order(const Vector& omega, const CVector& h,
                                 const SecondOrderFitOptions& options = {});
 
+constexpr auto describe(core::Type<ModalFeature>) {
+  using S = ModalFeature;
+  using namespace core::shown;
+  return core::fields<S>("ModalFeature", "a lightly damped pole pair (resonance) of the fitted model",
+      core::field("root", &S::root, kRadPerSecond, "the member of the pair with Im > 0"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecondAsHz, "|root|"),
+      core::field("damping", &S::damping, kRatio, "|Re root| / |root| (positive also for a mirrored zero)"));
+}
+
+constexpr auto describe(core::Type<AntiResonance>) {
+  using S = AntiResonance;
+  using namespace core::shown;
+  return core::extended_fields<S>("AntiResonance", "a lightly damped zero pair of the fitted model, with its two phase verdicts",
+      core::kFields<ModalFeature>,
+      core::field("nonminimum_phase_model", &S::nonminimum_phase_model, kNone, "the fitted zero has Re > 0"),
+      core::field("phase_verdict", &S::phase_verdict, kNone, "from the data's phase across the zero"),
+      core::field("phase_change_deg", &S::phase_change_deg, kDegree, "unwrapped phase change of the data across the zero"),
+      core::field("phase_points", &S::phase_points, kNone, "data points in the band examined"));
+}
+
+constexpr auto describe(core::Type<FrfFeatures>) {
+  using S = FrfFeatures;
+  using namespace core::shown;
+  return core::fields<S>("FrfFeatures", "static gain, resonances and anti-resonances of one response",
+      core::field("static_gain", &S::static_gain, kNone, "output units / input units, signed (negative: phase 180 deg)"),
+      core::field("static_gain_source", &S::static_gain_source, kNone, "the model's DC gain or the data's plateau"),
+      core::field("plateau_frequency", &S::plateau_frequency, kRadPerSecondAsHz, "where the plateau was read (data-plateau only)"),
+      core::field("resonances", &S::resonances, kNone, "by increasing frequency, inside the data band"),
+      core::field("antiresonances", &S::antiresonances, kNone, "by increasing frequency"),
+      core::field("fit", &S::fit, kNone, "the model the features come from"));
+}
+
+constexpr auto describe(core::Type<HighPassFit>) {
+  using S = HighPassFit;
+  using namespace core::shown;
+  return core::fields<S>("HighPassFit", "first-order high-pass g s / (s + corner) fitted to the low-frequency points",
+      core::field("corner", &S::corner, kRadPerSecondAsHz, "corner frequency"),
+      core::field("gain", &S::gain, kNone, "high-frequency gain g, output unit per input unit, signed"),
+      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms |model - data| / rms |data| over the fitted points"));
+}
+
+constexpr auto describe(core::Type<SecondOrderFit>) {
+  using S = SecondOrderFit;
+  using namespace core::shown;
+  return core::fields<S>("SecondOrderFit", "k wn^2 / (s^2 + 2 zeta wn s + wn^2) fitted to an FRF",
+      core::field("static_gain", &S::static_gain, kNone, "k, output unit per input unit (model DC gain for vector fitting)"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecondAsHz, "wn"),
+      core::field("damping", &S::damping, kRatio, "zeta (> 1: two real poles)"),
+      core::field("poles", &S::poles, kRadPerSecond, "the two poles"),
+      core::field("feedthrough", &S::feedthrough, kNone, "d of the vector-fitting model, output unit per input unit (0 for nls)"),
+      core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms |model - data| / rms |data|"),
+      core::field("iterations", &S::iterations, kNone, "Levenberg-Marquardt steps"));
+}
+
 }  // namespace piezobench::ident

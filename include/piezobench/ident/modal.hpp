@@ -75,4 +75,34 @@ struct LscfResult {
 // omega: rad/s.
 LscfResult lscf(const Vector& omega, const CMatrix& h, const LscfOptions& options = {});
 
+constexpr auto describe(core::Type<Mode>) {
+  using S = Mode;
+  using namespace core::shown;
+  return core::fields<S>("Mode", "a mode found by peak picking or LSCF",
+      core::field("pole", &S::pole, kRadPerSecond, "Im > 0 (peak picking: -zeta wn + j wn sqrt(1 - zeta^2))"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecondAsHz, "wn"),
+      core::field("damping", &S::damping, kRatio, "zeta"),
+      core::field("stable_orders", &S::stable_orders, kNone, "LSCF: length of the chain of stable poles; peak picking: 0"));
+}
+
+constexpr auto describe(core::Type<StabilizationPole>) {
+  using S = StabilizationPole;
+  using namespace core::shown;
+  return core::fields<S>("StabilizationPole", "a physical pole of one order of the LSCF's stabilization diagram",
+      core::field("order", &S::order, kNone, "denominator order"),
+      core::field("pole", &S::pole, kRadPerSecond, "Im > 0"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecondAsHz, "|pole|"),
+      core::field("damping", &S::damping, kRatio, "zeta"),
+      core::field("stable", &S::stable, kNone, "matched a pole of the previous order within both tolerances"));
+}
+
+constexpr auto describe(core::Type<LscfResult>) {
+  using S = LscfResult;
+  using namespace core::shown;
+  return core::fields<S>("LscfResult", "the modes and the stabilization diagram of an LSCF run",
+      core::field("modes", &S::modes, kNone, "by increasing frequency"),
+      core::field("diagram", &S::diagram, kNone, "every physical pole of every order"),
+      core::field("quality", &S::quality, kNone, "the verdict (poor: no stable mode, or a mode outside the band)").key("."));
+}
+
 }  // namespace piezobench::ident

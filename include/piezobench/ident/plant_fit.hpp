@@ -219,4 +219,29 @@ constexpr auto describe(core::Type<IffPlantFit>) {
       core::field("uncertainty", &S::uncertainty, kNone, "standard errors of g0, wz, xz, wp, xp, w_hpf, delay"));
 }
 
+constexpr auto describe(core::Type<IffPlantFitOptions>) {
+  using S = IffPlantFitOptions;
+  using namespace core::shown;
+  return core::fields<S>("IffPlantFitOptions", "the options of a plant fit (as used)",
+      core::field("fmin_Hz", &S::fmin_Hz, kHertz, "band used (0 = from the lowest positive frequency)"),
+      core::field("fmax_Hz", &S::fmax_Hz, kHertz, "0 = up to the highest"),
+      core::field("hpf_fmax_Hz", &S::hpf_fmax_Hz, kHertz, "points below this start the high-pass corner"),
+      core::field("min_coherence", &S::min_coherence, kRatio, "points with a known coherence below this are left out"),
+      core::field("fit_delay", &S::fit_delay, kNone, "false: delay fixed at 0"),
+      core::field("fixed_w_hpf", &S::fixed_w_hpf, kRadPerSecond, "> 0: the high-pass corner is set to this, not fitted"),
+      core::field("max_iterations", &S::max_iterations, kNone, "Levenberg-Marquardt steps"),
+      core::field("effective_averages", &S::effective_averages, kRatio, "Welch's n_d of the FRF (0: unknown)"));
+}
+
+constexpr auto describe(core::Type<ActuatorPlants>) {
+  using S = ActuatorPlants;
+  using namespace core::shown;
+  return core::fields<S>("ActuatorPlants", "both plants of an actuator's FRF, fitted as `run` and `model tune` do",
+      core::field("de", &S::de, kNone, "u -> d_e (absent when the fit failed)"),
+      core::field("vs", &S::vs, kNone, "u -> Vs (absent when the fit failed)"),
+      core::field("de_options", &S::de_options, kNone, "the d_e fit's options as used"),
+      core::field("vs_options", &S::vs_options, kNone, "the Vs fit's options as used"),
+      core::field("failures", &S::failures, kNone, "a fit that failed numerically, with its reason"));
+}
+
 }  // namespace piezobench::ident
