@@ -6,6 +6,7 @@
 #include <cmath>
 #include <complex>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/lti/discretize.hpp"

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::core {

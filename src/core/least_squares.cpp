@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 

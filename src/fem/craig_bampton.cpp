@@ -13,6 +13,7 @@
 #include <memory>
 #include <set>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"

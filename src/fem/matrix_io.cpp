@@ -5,6 +5,7 @@
 #include <fstream>
 #include <set>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/file.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/text.hpp"

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/core/minimize.hpp"

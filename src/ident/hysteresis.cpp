@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/nnls.hpp"

@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/dsp/frf.hpp"

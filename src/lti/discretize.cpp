@@ -9,6 +9,7 @@
 #include <string>
 
 #include "check.hpp"
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/lti/conversions.hpp"

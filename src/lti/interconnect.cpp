@@ -3,6 +3,7 @@
 #include <string>
 
 #include "check.hpp"
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 

@@ -7,6 +7,7 @@
 
 #include "balance.hpp"
 #include "check.hpp"
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::lti::detail {

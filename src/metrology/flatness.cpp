@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "check.hpp"
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 
 namespace piezobench::metrology {

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/lti/freqresp.hpp"

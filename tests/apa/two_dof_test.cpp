@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/freqresp.hpp"

@@ -16,6 +16,8 @@
 #include "run_cli.hpp"
 #include "test_util.hpp"
 
+#include "piezobench/core/eigen_solvers.hpp"
+
 namespace piezobench {
 namespace {
 

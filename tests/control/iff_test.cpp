@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <numbers>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/analysis.hpp"
 #include "piezobench/lti/conversions.hpp"

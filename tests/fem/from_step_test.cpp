@@ -16,6 +16,7 @@
 
 #include "from_step_files.hpp"
 #include "from_step_process.hpp"
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/fem/superelement.hpp"

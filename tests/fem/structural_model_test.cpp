@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/freqresp.hpp"
 #include "piezobench/core/units.hpp"

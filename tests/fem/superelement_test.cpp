@@ -10,6 +10,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "test_util.hpp"
 #include "fem_test_data.hpp"

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <random>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "test_util.hpp"

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/core/units.hpp"

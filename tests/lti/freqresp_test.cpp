@@ -9,6 +9,7 @@
 #include <numbers>
 #include <random>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/lti/conversions.hpp"
 #include "piezobench/core/units.hpp"

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <numbers>
 
+#include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/lti/delay.hpp"

@@ -8,6 +8,8 @@
 
 #include "test_util.hpp"
 
+#include "piezobench/core/eigen_solvers.hpp"
+
 namespace piezobench::metrology {
 namespace {
 
