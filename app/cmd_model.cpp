@@ -196,6 +196,7 @@ int run_tune(const TuneCommand& c) {
                 {"stack_stiffness_ratio", o.stack_stiffness_ratio},
                 {"stack_damping_ratio", o.stack_damping_ratio},
                 {"uncertainty", io::to_json(t.uncertainty)},
+                {"uncertainty_with_misfit", io::to_json(t.uncertainty_with_misfit)},
                 {"undetermined", t.undetermined},
                 {"points", t.points},
                 {"iterations", t.iterations},

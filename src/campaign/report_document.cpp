@@ -653,8 +653,9 @@ json model_section(const std::vector<UnitCurves>& units) {
                            {"unit", "k1", "c1", "ke", "ce", "ka", "ca", "ga", "gs", "undetermined", "condition number",
                             "correlations > 0.95"},
                            se_rows,
-                           "Linearized at the solution, from the FRF's variance (docs/uncertainty.md); ke, ce follow ka, ca "
-                           "(ratios 2 imposed). A parameter above 5 % (a 95 % interval wider than +-10 %) is undetermined."));
+                           "The random error, linearized at the solution from the FRF's variance (docs/uncertainty.md); ke, "
+                           "ce follow ka, ca (ratios 2 imposed). A parameter whose standard error widened by the model's "
+                           "local misfit exceeds 5 % (a 95 % interval wider than +-10 %) is undetermined."));
   }
   return {{"id", "model"}, {"title", "Two degrees-of-freedom model (report 3)"},
           {"tables", tables},

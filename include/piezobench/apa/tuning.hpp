@@ -16,12 +16,14 @@
 //   against log frequency); zeta_p from the peak height over the low-frequency gain (the quality
 //   factor 1/(2 zeta)), zeta_z from the depth of the dip.
 // Step 2, refinement: Levenberg-Marquardt (numeric Jacobian) on the logarithms of the parameters
-//   (m fixed, signs of ga and gs kept from step 1) minimizing the relative complex error
-//   sum_o 1/N_o sum_k |H_model,o(j w_k) / H_o(j w_k) - 1|^2 over both outputs (magnitude and phase
-//   at once, each output weighted equally, independent of the units); with the FRF's variance known
-//   (coherence and provenance.effective_averages), each point is also divided by
-//   sqrt(eps^2 + 0.05^2), eps its relative standard deviation (dsp/frf_variance.hpp), normalized per
-//   output.
+//   (m fixed, signs of ga and gs kept from step 1) minimizing the complex error relative to a
+//   reference model G0, sum_o sum_k v_k^2 |H_model,o(j w_k) - H_o(j w_k)|^2 / |G0,o(j w_k)|^2 over both
+//   outputs (magnitude and phase at once, independent of the units), in two passes: G0 the report's
+//   procedure's model, then the first pass's. v_k = 1, or with the FRF's variance known (its std_H,
+//   else the coherence and provenance.effective_averages) 1/sqrt(eps_k^2 + 0.05^2), eps_k = std_k/|G0_k|
+//   the point's relative standard deviation (dsp/frf_variance.hpp); v normalized per output (each
+//   output weighted equally). The data are never in a denominator: 1/H of a noisy point near the
+//   anti-resonance is biased towards 0, which biased the dampings (issue 30).
 //   With 1 % relative complex noise on FRFs of a 2-DoF actuator from 1 Hz to 2 kHz, the stiffnesses
 //   and gains come back within 2 % and the dampings ca, ce within 10 % (tests/apa/tuning_test.cpp).
 //
@@ -111,12 +113,19 @@ struct TwoDofTuning {
   // (ke = 8e19 N/m with k1 = 1e-8 N/m is no actuator).
   core::FitQuality quality;
   // Standard errors of the 9 parameters (m fixed: 0; ke, ce tied: the ratio times ka's, ca's),
-  // linearized at the solution (core/fit_covariance.hpp), from the FRF's variance when known;
-  // empty when not refined.
+  // linearized at the solution (core/fit_covariance.hpp). With the FRF's variance known: the random
+  // error alone (the sandwich form, no misfit widening), what value +- 1.96 se covers 95 % of the time
+  // around the model's best fit to the noise-free response; else from the residuals' scatter.
+  // Empty when not refined.
   core::ParameterUncertainty uncertainty;
-  // Parameters the data do not determine: relative standard error above kUndeterminedRelativeError
-  // or driven 1000 times away from step 1's value (a bound of the log-parameters). Each is a problem
-  // of `quality`, so the verdict is not "good".
+  // The same widened by the local misfit (core/fit_covariance.hpp's f_j): large where the model misses
+  // the data by more than their noise where the parameter is decided (a structure the 2-DoF model
+  // lacks biases it). Equal to `uncertainty` without the FRF's variance.
+  core::ParameterUncertainty uncertainty_with_misfit;
+  // Parameters the data do not determine: relative standard error with the misfit
+  // (uncertainty_with_misfit) above kUndeterminedRelativeError or driven 1000 times away from step
+  // 1's value (a bound of the log-parameters). Each is a problem of `quality`, so the verdict is not
+  // "good".
   std::vector<std::string> undetermined;
 
   // One line with the status, the iterations and the errors.
@@ -168,7 +177,9 @@ constexpr auto describe(core::Type<TwoDofTuning>) {
       core::field("status", &S::status, kNone, "how the refinement ended"),
       core::field("message", &S::message, kNone, "what stopped the refinement"),
       core::field("quality", &S::quality, kNone, "the verdict").key("."),
-      core::field("uncertainty", &S::uncertainty, kNone, "standard errors of the 9 parameters"),
+      core::field("uncertainty", &S::uncertainty, kNone, "standard errors of the 9 parameters (random error)"),
+      core::field("uncertainty_with_misfit", &S::uncertainty_with_misfit, kNone,
+                  "the same widened by the model's local misfit (decides undetermined)"),
       core::field("undetermined", &S::undetermined, kNone, "parameters the data do not determine"));
 }
 
