@@ -509,22 +509,27 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
   core::LmOptions lm;
   lm.max_iterations = o.max_iterations;
   // Two passes: the weights relative to the report's procedure's model, then to the first pass's.
-  Vector x = layout.pack(p);
+  const Vector start = layout.pack(p);
+  Vector x = start;
   core::LmResult r;
   int iterations = 0;
   Weights wt;
+  const core::ResidualFunction residual = [&](const Vector& v) { return residuals(layout.unpack(v), d, wt); };
   for (int pass = 0; pass < 2; ++pass) {
     const TwoDofParams reference = layout.unpack(x);
     if (pass > 0 && !(x.allFinite() && usable(reference))) break;
     wt = weights(d, reference);
-    const core::ResidualFunction residual = [&](const Vector& v) { return residuals(layout.unpack(v), d, wt); };
     r = core::levenberg_marquardt(residual, x, lm);
     iterations += r.iterations;
     x = r.x;
   }
-  const core::ResidualFunction residual = [&](const Vector& v) { return residuals(layout.unpack(v), d, wt); };
+  // A parameter the data do not show (c1) can run to exp(-745) = 0, "not physical": it is reported
+  // at kBoundRatio^2 from the report's procedure's value instead (undetermined, at a bound; the fit
+  // does not see the difference).
+  const double reach = 2.0 * std::log(kBoundRatio);
+  r.x = r.x.array().max(start.array() - reach).min(start.array() + reach).matrix();
   out.params = layout.unpack(r.x);
-  const std::vector<Index> keep = unbounded(r.x, layout.pack(p));
+  const std::vector<Index> keep = unbounded(r.x, start);
   if (r.x.allFinite() && usable(out.params) && !keep.empty()) {
     const Eigen::MatrixXd jacobian = core::central_difference_jacobian(residual, r.x)(Eigen::all, keep);
     const Vector res = residual(r.x), sd = residual_std(wt);
