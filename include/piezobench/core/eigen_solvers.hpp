@@ -12,5 +12,5 @@
 #include <Eigen/Dense>
 
 #define PIEZOBENCH_EIGEN_INSTANCE(...) extern template __VA_ARGS__;
-#include "piezobench/core/eigen_solvers.inc"
+#include "eigen_solvers.inc"  // beside this header: found whatever the include path
 #undef PIEZOBENCH_EIGEN_INSTANCE
