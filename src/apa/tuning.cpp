@@ -160,8 +160,8 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
   // the coherence and n_d.
   const bool has_std = frf.std_H.size() == frf.H.size() && frf.std_H[static_cast<std::size_t>(ide)].size() > 0;
   const bool variance = has_std || (has_coh(ide) && has_coh(ivs) && frf.provenance.effective_averages > 0.0);
-  const auto relative_std = [&](Index o, Index k) {
-    const auto io = static_cast<std::size_t>(o);
+  const auto relative_std = [&](Index output, Index k) {
+    const auto io = static_cast<std::size_t>(output);
     const double eps = has_std ? frf.std_H[io](k) / std::abs(frf.H[io](k))
                                : dsp::frf_relative_std(frf.coherence[io](k), frf.provenance.effective_averages);
     return std::max(eps, dsp::kMinFitRelativeStd);
