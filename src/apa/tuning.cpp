@@ -300,6 +300,14 @@ bool usable(const TwoDofParams& p) {
   return p.k1 > 0.0 && p.ke > 0.0 && p.ka > 0.0 && p.ca + p.ce > 0.0 && p.ga != 0.0 && p.gs != 0.0;
 }
 
+// The model's u -> d_e and u -> Vs of the actuator alone (a bench of unit amplifier gain), what the
+// tuning compares with the data at every step.
+lti::CMatrix actuator_response(const TwoDofParams& p, const Vector& omega) {
+  TwoDofBench bare;
+  bare.amplifier_gain = 1.0;
+  return two_dof_response(p, bare, omega);
+}
+
 // Per-point weights of the complex errors H_model - H_data of each output, relative to a reference
 // model's response G0 (the previous pass's): v_k / |G0_k| with v_k = 1 (unknown variance) or
 // 1/sqrt((std_k/|G0_k|)^2 + kFitModelRelativeError^2), std_k = eps_k |H_k| the point's standard
@@ -314,9 +322,7 @@ struct Weights {
 };
 Weights weights(const FitData& d, const TwoDofParams& reference) {
   const Index n = d.omega.size();
-  TwoDofBench bare;
-  bare.amplifier_gain = 1.0;
-  const lti::CMatrix g0 = two_dof_response(reference, bare, d.omega);
+  const lti::CMatrix g0 = actuator_response(reference, d.omega);
   const bool variance = d.eps_de.size() == n;
   Weights out;
   const auto one = [&](Index o, const CVector& h, const Vector& eps, Vector& w, Vector& sd) {
@@ -355,9 +361,7 @@ Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
   const Index n = d.omega.size();
   Vector r(4 * n);
   if (!usable(p)) return Vector::Constant(4 * n, std::numeric_limits<double>::quiet_NaN());
-  TwoDofBench bare;
-  bare.amplifier_gain = 1.0;
-  const lti::CMatrix h = two_dof_response(p, bare, d.omega);
+  const lti::CMatrix h = actuator_response(p, d.omega);
   for (Index k = 0; k < n; ++k) {
     const Complex ede = (h(k, kOutputDe) - d.de(k)) * wt.de(k);
     const Complex evs = (h(k, kOutputVs) - d.vs(k)) * wt.vs(k);
@@ -373,9 +377,7 @@ Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
 std::pair<double, double> fit_errors(const TwoDofParams& p, const FitData& d) {
   const Index n = d.omega.size();
   if (!usable(p)) return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
-  TwoDofBench bare;
-  bare.amplifier_gain = 1.0;
-  const lti::CMatrix h = two_dof_response(p, bare, d.omega);
+  const lti::CMatrix h = actuator_response(p, d.omega);
   double de = 0.0, vs = 0.0;
   for (Index k = 0; k < n; ++k) {
     de += std::norm(h(k, kOutputDe) / d.de(k) - 1.0);
@@ -475,9 +477,7 @@ void fit_gains(const FitData& d, TwoDofParams& p) {
   const Index n = d.omega.size();
   p.ga = 1.0;
   p.gs = 1.0;
-  TwoDofBench bare;
-  bare.amplifier_gain = 1.0;
-  const lti::CMatrix h = two_dof_response(p, bare, d.omega);
+  const lti::CMatrix h = actuator_response(p, d.omega);
   double num = 0.0, den = 0.0;
   for (Index k = 0; k < n; ++k) {
     const Complex a = h(k, kOutputDe) / d.de(k);
