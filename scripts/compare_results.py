@@ -10,7 +10,9 @@ purpose regenerates it with the Release build and says in its commit which value
     cp /tmp/demo-seed1/results.json tests/fixtures/campaign/demo_seed1_results.json
 Every value of the reference must be in NEW under the
 same key, or under its new name when RENAMES lists one; numbers agree to a relative tolerance
-(|a - b| <= rtol max(|a|, |b|) + 1e-300), strings, booleans and nulls exactly. Keys only NEW has
+(|a - b| <= rtol max(|a|, |b|) + 1e-300), except the entries of a correlation matrix, whose scale
+is 1 whatever their value (|a - b| <= rtol max(|a|, |b|, 1): a correlation of 7e-12 is 0 to every
+digit that means something, and its last bits differ between CPUs), strings, booleans and nulls exactly. Keys only NEW has
 (analyses added later) are listed, not refused. Keys that hold a machine path or the version are
 not compared (IGNORED). Exit 0 when the documents agree, 1 with the differences otherwise,
 2 on a bad command line or an unreadable file.
@@ -62,7 +64,11 @@ def renamed(path):
     return path
 
 
-def same(a, b, rtol):
+# Entries of a correlation matrix (scale 1, see above).
+CORRELATION = re.compile(r"\.correlation\[\d+\]\[\d+\]$")
+
+
+def same(a, b, rtol, scale=0.0):
     if isinstance(a, bool) or isinstance(b, bool) or a is None or b is None or isinstance(a, str) or isinstance(b, str):
         return a == b
     if isinstance(a, list) or isinstance(b, list):
@@ -70,7 +76,7 @@ def same(a, b, rtol):
     a, b = float(a), float(b)
     if math.isnan(a) or math.isnan(b):
         return math.isnan(a) and math.isnan(b)
-    return abs(a - b) <= rtol * max(abs(a), abs(b)) + 1e-300
+    return abs(a - b) <= rtol * max(abs(a), abs(b), scale) + 1e-300
 
 
 def main():
@@ -98,7 +104,7 @@ def main():
             problems.append(f"missing: {path}" + (f" (renamed {target})" if target != path else "") + f" = {value!r}")
             continue
         compared += 1
-        if not same(value, new_leaves[target], args.rtol):
+        if not same(value, new_leaves[target], args.rtol, 1.0 if CORRELATION.search(path) else 0.0):
             problems.append(f"differs: {path}: reference {value!r}, new {new_leaves[target]!r}")
     ref_targets = {renamed(p) for p, _ in leaves(ref)}
     added = sorted({re.sub(r"\[\d+\]", "[]", p) for p in new_leaves if p not in ref_targets})

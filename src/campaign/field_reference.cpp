@@ -1,48 +1,16 @@
 #include "piezobench/campaign/field_reference.hpp"
 
-#include <fmt/format.h>
-
 #include <set>
-#include <type_traits>
 
 #include "piezobench/campaign/results.hpp"
-#include "piezobench/core/fields.hpp"
+#include "piezobench/ident/actuator_frf.hpp"
+#include "piezobench/ident/features.hpp"
+#include "piezobench/ident/low_frequency_high_pass.hpp"
+#include "piezobench/ident/modal.hpp"
+#include "piezobench/ident/plant_fit.hpp"
+#include "field_table.hpp"
 
 namespace piezobench::campaign {
-
-namespace {
-
-std::string shown_cell(const core::Shown& s) {
-  if (s.unit.empty() || s.unit == s.si) return std::string(s.unit);
-  return fmt::format("{} (SI x {:g})", s.unit, s.per_si);
-}
-
-template <class F> std::string results_cell(const F& f) {
-  if (!f.in(core::kResults)) return "(part.json only)";
-  const std::string key = core::results_key(f);
-  return key == "." ? "(merged into its parent)" : "`" + key + "`";
-}
-
-// One table for S, then one for each described struct its fields hold (each struct once).
-template <class S> void document(std::string& out, std::set<std::string>& done) {
-  constexpr auto& d = core::kFields<S>;
-  if (!done.insert(std::string(d.name)).second) return;
-  out += fmt::format("\n## {}\n\n{}.\n\n| field | type | SI | shown | results.json | meaning |\n|---|---|---|---|---|---|\n", d.name, d.meaning);
-  core::for_each_field<S>([&](const auto& f) {
-    using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
-    std::string type;
-    if constexpr (core::Described<E>) type = std::string(core::kFields<E>.name);
-    out += fmt::format("| `{}` | {} | {} | {} | {} | {}{}{} |\n", f.name, type, f.shown.si, shown_cell(f.shown), results_cell(f), f.meaning,
-                       f.in(core::kReport) ? " (report table)" : "",
-                       std::remove_cvref_t<decltype(f)>::kDerived ? " (derived: read from its analysis, not in part.json)" : "");
-  });
-  core::for_each_field<S>([&](const auto& f) {
-    using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
-    if constexpr (core::Described<E>) document<E>(out, done);
-  });
-}
-
-}  // namespace
 
 std::string field_reference_markdown() {
   std::string out =
@@ -61,12 +29,21 @@ std::string field_reference_markdown() {
       "Complex numbers are `[re, im]`.\n";
   std::set<std::string> done;
   // What a campaign's results hold (CampaignResult: units, batch, iff, superelement), then the ident
-  // results the Python module and the commands return besides.
-  document<UnitAnalysis>(out, done);
-  document<BatchAnalysis>(out, done);
-  document<IffStudy>(out, done);
-  document<SuperElementComparison>(out, done);
-  document<ident::LoopMetrics>(out, done);
+  // results the Python module (piezobench.ident) and the commands return besides: the FRF's analysis
+  // and plant fits, its features, the high-pass and second-order fits, peak picking and LSCF.
+  field_table<UnitAnalysis>(out, done);
+  field_table<BatchAnalysis>(out, done);
+  field_table<IffStudy>(out, done);
+  field_table<SuperElementComparison>(out, done);
+  field_table<ident::LoopMetrics>(out, done);
+  field_table<ident::ActuatorFrfAnalysis>(out, done);
+  field_table<ident::ActuatorPlants>(out, done);
+  field_table<ident::FrfFeatures>(out, done);
+  field_table<ident::HighPassFit>(out, done);
+  field_table<ident::SecondOrderFit>(out, done);
+  field_table<ident::LowFrequencyHighPass>(out, done);
+  field_table<ident::Mode>(out, done);
+  field_table<ident::LscfResult>(out, done);
   return out;
 }
 

@@ -21,6 +21,7 @@
 #include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/version.hpp"
+#include "report_table.hpp"
 #include "shown_units.hpp"
 
 namespace piezobench::campaign {
@@ -356,19 +357,6 @@ std::string amplitude_label(double a) { return fmt::format("{:.3g} V", a); }
 json plain(const std::optional<double>& v, double scale = 1.0) { return v ? json(*v * scale) : json(nullptr); }
 // A finite number times `scale`, else null (percentages of numbers written through io::to_json).
 json finite_scaled(double v, double scale) { return std::isfinite(v) ? json(v * scale) : json(nullptr); }
-
-// A report table's columns and cells for a result struct: the fields its declaration puts in the
-// report (core/fields.hpp), headed by name and shown unit, in that unit.
-template <class S> void report_columns(std::vector<std::string>& columns) {
-  core::for_each_field<S>([&](const auto& f) {
-    if (f.in(core::kReport)) columns.push_back(core::report_heading(f));
-  });
-}
-template <class S> void report_cells(json& row, const S& s) {
-  core::for_each_field<S>([&](const auto& f) {
-    if (f.in(core::kReport)) row.push_back(io::shown_json(f.of(s), f.shown.per_si));
-  });
-}
 
 // ---- the sections
 

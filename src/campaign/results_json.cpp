@@ -163,7 +163,6 @@ json unit_json(const UnitAnalysis& u) {
   json r = io::results_object(u);
   r["capacitance_provenance"] = nullptr;
   r["hpf"] = nullptr;
-  r["hpf_corner_Hz"] = nullptr;
   r["model_2dof"] = nullptr;
   if (u.capacitance_analysis) {
     const auto& c = *u.capacitance_analysis;
@@ -178,7 +177,6 @@ json unit_json(const UnitAnalysis& u) {
   if (u.frf_analysis) {
     r["frf"] = frf(*u.frf_analysis);
     r["hpf"] = io::results_object(u.frf_analysis->hpf);
-    r["hpf_corner_Hz"] = io::shown_json(u.frf_analysis->hpf.corner_Hz);
   }
   if (u.model_2dof) model_2dof(*u.model_2dof, r);
   if (u.resistor) r["hpf_resistor"] = resistor(*u.resistor);
@@ -206,7 +204,8 @@ json results_json(const CampaignResult& r) {
                 {"stroke_min_um", sp.stroke_min ? json(*sp.stroke_min * kUm) : json(nullptr)},
                 {"stiffness_N_per_um", range(sp.stiffness, kNPerUm)},
                 {"reject_outliers", sp.reject_outliers}};
-  json doc = {{"title", c.title},
+  json doc = io::results_object(r);  // the declared view: the summary's counts
+  doc.update(json{{"title", c.title},
           {"campaign", c.file.string()},
           {"generator", std::string("piezobench ") + kVersion},
           {"units", units},
@@ -214,7 +213,6 @@ json results_json(const CampaignResult& r) {
           {"iff", iff(r.iff)},
           {"superelement", r.superelement ? superelement(*r.superelement) : json(nullptr)},
           {"specs", specs},
-          {"summary", {{"units", r.units.size()}, {"accepted", r.accepted}, {"marginal", r.marginal}, {"rejected", r.rejected}, {"not_analysed", r.not_analysed}}},
           {"provenance",
            {{"campaign", c.file.string()},
             {"window", dsp::to_string(a.window)},
@@ -233,7 +231,7 @@ json results_json(const CampaignResult& r) {
                        {"encoder_resolution_um", c.bench.uncertainty.encoder_resolution_m * kUm},
                        {"capacitance_uncertainty_relative", c.bench.uncertainty.capacitance_relative},
                        {"displacement_scale_uncertainty_relative", c.bench.uncertainty.displacement_scale_relative}}},
-            {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}};
+            {"note", "per-analysis files, channels, window, nfft and averages are in each unit's provenance/welch entries"}}}});
   io::name_non_finite(doc);  // the one encoding of non-finite numbers (docs/formats.md)
   return doc;
 }

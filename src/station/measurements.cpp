@@ -87,14 +87,12 @@ Si damped_pick(const UnitAnalysis& u, const std::string& file, double ident::Dom
 }
 
 const std::vector<Entry>& catalog() {
-  using campaign::FrfAnalysis;
   static const std::vector<Entry> entries = {
       unit_entry(Experiment::kFlatness, &campaign::flatness_of),
       unit_entry(Experiment::kCapacitance, &campaign::capacitance_sensor_of),
       unit_entry(Experiment::kCapacitance, &campaign::capacitance_actuator_of),
       unit_entry(Experiment::kStroke, &campaign::stroke_of),
-      entry("sensitivity_um_per_V", Experiment::kStroke, "slope of d_e against Va", shown_of(&metrology::StrokeResult::sensitivity),
-            [](const UnitAnalysis& u, const std::string&) { return u.stroke_analysis ? Si(u.stroke_analysis->result.sensitivity) : std::nullopt; }),
+      unit_entry(Experiment::kStroke, &campaign::sensitivity_of),
       entry("hysteresis_relative_width", Experiment::kHysteresis, "loop width at the offset / loop stroke",
             shown_of(&metrology::HysteresisResult::relative_width),
             [](const UnitAnalysis& u, const std::string& f) { return hysteresis_pick(u, f, &metrology::HysteresisResult::relative_width); }),
@@ -105,32 +103,18 @@ const std::vector<Entry>& catalog() {
       unit_entry(Experiment::kStiffnessOpen, &campaign::k_oc_of),
       unit_entry(Experiment::kFrf, &campaign::resonance_Hz_of),
       unit_entry(Experiment::kFrf, &campaign::antiresonance_Hz_of),
-      entry("resonance_damping", Experiment::kFrf, "damping ratio of the resonance", shown_of(&FrfAnalysis::resonance_damping),
-            [](const UnitAnalysis& u, const std::string&) { return u.frf_analysis ? u.frf_analysis->resonance_damping : std::nullopt; }),
+      unit_entry(Experiment::kFrf, &campaign::resonance_damping_of),
       unit_entry(Experiment::kFrf, &campaign::k_resonance_of),
       unit_entry(Experiment::kFrf, &campaign::static_gain_of),
-      entry("hpf_corner_Hz", Experiment::kFrf, "high-pass corner of the force sensor", shown_of(&campaign::HighPassCorner::corner_Hz),
-            [](const UnitAnalysis& u, const std::string&) { return u.frf_analysis ? u.frf_analysis->hpf.corner_Hz : std::nullopt; }),
-      entry("hpf_corner_without_resistor_Hz", Experiment::kFrfNoResistor, "fitted corner without the resistor",
-            shown_of(&campaign::LowFrequencyVs::fitted_corner_Hz),
-            [](const UnitAnalysis& u, const std::string&) { return u.resistor ? u.resistor->without_resistor.fitted_corner_Hz : std::nullopt; }),
+      unit_entry(Experiment::kFrf, &campaign::hpf_corner_Hz_of),
+      unit_entry(Experiment::kFrfNoResistor, &campaign::hpf_corner_without_resistor_Hz_of),
       entry("damped_damping", Experiment::kIff, "damping ratio of the identified damped pole", shown_of(&ident::DominantPole::damping),
             [](const UnitAnalysis& u, const std::string& f) { return damped_pick(u, f, &ident::DominantPole::damping); }),
       entry("damped_frequency_Hz", Experiment::kIff, "frequency of the identified damped pole", shown_of(&ident::DominantPole::natural_frequency),
             [](const UnitAnalysis& u, const std::string& f) { return damped_pick(u, f, &ident::DominantPole::natural_frequency); }),
-      entry("first_mode_Hz", Experiment::kHammer, "first flexible mode (LSCF, else peak picking)",
-            shown_of(&campaign::FlexibleModes::Mode::frequency_Hz),
-            [](const UnitAnalysis& u, const std::string&) -> Si {
-              if (!u.flexible_modes) return std::nullopt;
-              const auto& m = u.flexible_modes->lscf.empty() ? u.flexible_modes->peak_picking : u.flexible_modes->lscf;
-              return m.empty() ? std::nullopt : Si(m.front().frequency_Hz);
-            }),
-      entry("tracking_width_ff", Experiment::kTracking, "hysteresis width of the 1 Hz sine with the feedforward",
-            shown_of(&bench::TrackingFigures::width_ff),
-            [](const UnitAnalysis& u, const std::string&) { return u.tracking ? Si(u.tracking->sine.width_ff) : std::nullopt; }),
-      // A ratio of two declared figures (bench::TrackingFigures::rms_reduction), not a field.
-      entry("tracking_rms_reduction", Experiment::kTracking, "rms tracking error without / with the feedforward (sine)", core::shown::kRatio,
-            [](const UnitAnalysis& u, const std::string&) { return u.tracking ? Si(u.tracking->sine.rms_reduction()) : std::nullopt; }),
+      unit_entry(Experiment::kHammer, &campaign::first_mode_Hz_of),
+      unit_entry(Experiment::kTracking, &campaign::tracking_width_ff_of),
+      unit_entry(Experiment::kTracking, &campaign::tracking_rms_reduction_of),
   };
   return entries;
 }

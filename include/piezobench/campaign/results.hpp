@@ -523,6 +523,29 @@ inline std::optional<double> antiresonance_Hz_of(const UnitAnalysis& u) {  // Hz
 inline std::optional<double> static_gain_of(const UnitAnalysis& u) {  // m/V
   return u.frf_analysis ? u.frf_analysis->static_gain : std::nullopt;
 }
+inline std::optional<double> sensitivity_of(const UnitAnalysis& u) {  // m/V
+  return u.stroke_analysis ? std::optional(u.stroke_analysis->result.sensitivity) : std::nullopt;
+}
+inline std::optional<double> resonance_damping_of(const UnitAnalysis& u) {  // 1
+  return u.frf_analysis ? u.frf_analysis->resonance_damping : std::nullopt;
+}
+inline std::optional<double> hpf_corner_Hz_of(const UnitAnalysis& u) {  // Hz
+  return u.frf_analysis ? u.frf_analysis->hpf.corner_Hz : std::nullopt;
+}
+inline std::optional<double> hpf_corner_without_resistor_Hz_of(const UnitAnalysis& u) {  // Hz
+  return u.resistor ? u.resistor->without_resistor.fitted_corner_Hz : std::nullopt;
+}
+inline std::optional<double> first_mode_Hz_of(const UnitAnalysis& u) {  // Hz, LSCF's first mode, else peak picking's
+  if (!u.flexible_modes) return std::nullopt;
+  const auto& modes = u.flexible_modes->lscf.empty() ? u.flexible_modes->peak_picking : u.flexible_modes->lscf;
+  return modes.empty() ? std::nullopt : std::optional(modes.front().frequency_Hz);
+}
+inline std::optional<double> tracking_width_ff_of(const UnitAnalysis& u) {  // 1
+  return u.tracking ? std::optional(u.tracking->sine.width_ff) : std::nullopt;
+}
+inline std::optional<double> tracking_rms_reduction_of(const UnitAnalysis& u) {  // 1
+  return u.tracking ? std::optional(u.tracking->sine.rms_reduction()) : std::nullopt;
+}
 inline const dsp::Frf* frf_of(const UnitAnalysis& u) {  // u -> [de, Vs]
   return u.frf_analysis ? &u.frf_analysis->frf : nullptr;
 }
@@ -564,6 +587,13 @@ constexpr auto describe(core::Type<UnitAnalysis>) {
       core::derived("resonance_Hz", &resonance_Hz_of, kHertz, "resonance of u -> d_e").part_only(),
       core::derived("antiresonance_Hz", &antiresonance_Hz_of, kHertz, "anti-resonance of u -> Vs").part_only(),
       core::derived("static_gain", &static_gain_of, kMetrePerVoltAsUmPerV, "static gain u -> d_e").part_only(),
+      core::derived("sensitivity", &sensitivity_of, kMetrePerVoltAsUmPerV, "slope of d_e against Va").part_only(),
+      core::derived("resonance_damping", &resonance_damping_of, kRatio, "damping ratio of the resonance").part_only(),
+      core::derived("hpf_corner_Hz", &hpf_corner_Hz_of, kHertz, "high-pass corner of the force sensor"),
+      core::derived("hpf_corner_without_resistor_Hz", &hpf_corner_without_resistor_Hz_of, kHertz, "fitted corner without the resistor").part_only(),
+      core::derived("first_mode_Hz", &first_mode_Hz_of, kHertz, "first flexible mode (LSCF, else peak picking)").part_only(),
+      core::derived("tracking_width_ff", &tracking_width_ff_of, kRatio, "hysteresis width of the 1 Hz sine with the feedforward").part_only(),
+      core::derived("tracking_rms_reduction", &tracking_rms_reduction_of, kRatio, "rms tracking error without / with the feedforward (sine)").part_only(),
       core::derived("frf", &frf_of, kNone, "u -> [de, Vs]").part_only(),
       core::derived("iff_plant", &iff_plant_of, kNone, "u -> Vs, eq. 2.3 with delay").part_only(),
       core::derived("de_plant", &de_plant_of, kNone, "u -> d_e, mass-spring-damper with delay").part_only(),
@@ -830,9 +860,11 @@ struct CampaignResult {
   int not_analysed = 0;  // units with UnitAnalysis::not_analysed (neither accepted nor rejected)
 };
 
+inline int unit_count_of(const CampaignResult& r) { return static_cast<int>(r.units.size()); }
+
 // What campaign.run returns in Python (the campaign as read is its input, not declared). results.json
-// writes the same parts its own way (results_json.cpp: "units", "batch", "iff", "superelement",
-// "summary"), so the declaration keeps them out of results_object.
+// holds the counts under "summary" from this declaration; it writes the parts its own way
+// (results_json.cpp: "units", "batch", "iff", "superelement"), so they are kept out of results_object.
 constexpr auto describe(core::Type<CampaignResult>) {
   using S = CampaignResult;
   using namespace core::shown;
@@ -841,10 +873,11 @@ constexpr auto describe(core::Type<CampaignResult>) {
       core::field("batch", &S::batch, kNone, "the batch's spreads, outliers and FRF similarity").part_only(),
       core::field("iff", &S::iff, kNone, "the IFF study").part_only(),
       core::field("superelement", &S::superelement, kNone, "the super element on the bench (when the campaign gives one)").part_only(),
-      core::field("accepted", &S::accepted, kNone, "units accepted").part_only(),
-      core::field("marginal", &S::marginal, kNone, "units with a marginal check and no failed one").part_only(),
-      core::field("rejected", &S::rejected, kNone, "units analysed and rejected").part_only(),
-      core::field("not_analysed", &S::not_analysed, kNone, "units whose data could not be analysed").part_only());
+      core::derived("unit_count", &unit_count_of, kNone, "units of the campaign").key("summary.units"),
+      core::field("accepted", &S::accepted, kNone, "units accepted").key("summary.accepted"),
+      core::field("marginal", &S::marginal, kNone, "units with a marginal check and no failed one").key("summary.marginal"),
+      core::field("rejected", &S::rejected, kNone, "units analysed and rejected").key("summary.rejected"),
+      core::field("not_analysed", &S::not_analysed, kNone, "units whose data could not be analysed").key("summary.not_analysed"));
 }
 
 }  // namespace piezobench::campaign
