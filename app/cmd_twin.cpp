@@ -14,6 +14,7 @@
 #include "piezobench/campaign/twin.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/io/fields_json.hpp"
 
 namespace piezobench::app {
 namespace {
@@ -51,41 +52,14 @@ campaign::Campaign records_campaign(const TwinArgs& a) {
   return campaign::parse_campaign(text, std::filesystem::current_path() / "twin (command line)", true);
 }
 
-nlohmann::json frf_error_json(const campaign::TwinFrfError& e) {
-  return {{"points", e.points}, {"max_dB", e.max_dB}, {"median_dB", e.median_dB}};
-}
-
-nlohmann::json noise_json(const campaign::TwinNoise& n) {
-  return {{"channel", n.channel}, {"measured", n.measured}, {"source", n.source}, {"seconds", n.seconds},
-          {"measured_rms", n.measured_rms}, {"white_rms", n.white_rms}};
-}
-
+// The build's declared fields (campaign/twin.hpp: FRF errors, hysteresis checks, noise, creep, IFF,
+// quality, notes and what it shows of the twin's chain), then what the declaration leaves to this
+// command: the file written and the twin's model, in SI as in the file's [model].
 nlohmann::json build_json(const campaign::TwinBuild& b, const std::string& file) {
   const apa::TwoDofParams& p = b.twin.unit.model;
-  nlohmann::json hyst = nlohmann::json::array();
-  for (const auto& h : b.hysteresis) hyst.push_back({{"amplitude_V", h.amplitude}, {"unit_width", h.unit_width}, {"twin_width", h.twin_width}});
-  nlohmann::json doc = {
-      {"file", file},
-      {"unit", b.twin.unit.id},
-      {"name", b.twin.name},
-      {"model", {{"k1", p.k1}, {"c1", p.c1}, {"ke", p.ke}, {"ce", p.ce}, {"ka", p.ka}, {"ca", p.ca}, {"ga", p.ga}, {"gs", p.gs}}},
-      {"chain",
-       {{"delay_s", b.twin.options.delay}, {"hpf_resistance_ohm", b.twin.options.hpf_resistance},
-        {"ground_resistance_ohm", b.twin.options.ground_resistance}}},
-      {"frf_error", {{"de", frf_error_json(b.de)}, {"Vs", frf_error_json(b.vs)}}},
-      {"frf_error_tuned", {{"de", frf_error_json(b.de_tuned)}, {"Vs", frf_error_json(b.vs_tuned)}}},
-      {"hysteresis", hyst},
-      {"hysteresis_thresholds_V", b.twin.unit.hysteresis_thresholds},
-      {"hysteresis_weights", b.twin.unit.hysteresis_weights},
-      {"creep", {{"voltage_per_decade", b.twin.unit.creep_coefficient}, {"load_per_decade", b.twin.unit.load_creep_coefficient},
-                 {"unit_creep_per_decade", b.unit_creep_per_decade ? nlohmann::json(*b.unit_creep_per_decade) : nlohmann::json(nullptr)},
-                 {"twin_creep_per_decade", b.twin_creep_per_decade ? nlohmann::json(*b.twin_creep_per_decade) : nlohmann::json(nullptr)}}},
-      {"noise", {noise_json(b.de_noise), noise_json(b.vs_noise)}},
-      {"iff", {{"optimal_gain", b.iff_optimal_gain}, {"max_damping", b.iff_max_damping},
-               {"optimal_gain_unit_plant", b.iff_optimal_gain_unit ? nlohmann::json(*b.iff_optimal_gain_unit) : nlohmann::json(nullptr)}}},
-      {"notes", b.notes},
-      {"seconds", b.seconds}};
-  doc.update(quality_json(b.quality));
+  nlohmann::json doc = io::results_object(b);
+  doc["file"] = file;
+  doc["model"] = {{"k1", p.k1}, {"c1", p.c1}, {"ke", p.ke}, {"ce", p.ce}, {"ka", p.ka}, {"ca", p.ca}, {"ga", p.ga}, {"gs", p.gs}};
   return doc;
 }
 

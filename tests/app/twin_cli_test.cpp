@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <set>
+#include <string>
 
 #include "run_cli.hpp"
 #include "test_util.hpp"
@@ -27,6 +29,16 @@ TEST(TwinCli, FromRecordsThenSimulateAndMeasureOnIt) {
   ASSERT_TRUE(t.exit_code == 0 || t.exit_code == 6) << t.err;  // 6: a check above its limit (a 20 s FRF)
   const auto j = nlohmann::json::parse(t.out);
   EXPECT_EQ(j["unit"], 4);
+  // The document's keys, as scripts read them: TwinBuild's declared fields (campaign/twin.hpp), the
+  // file and the model.
+  std::set<std::string> keys;
+  for (const auto& [k, v] : j.items()) keys.insert(k);
+  EXPECT_EQ(keys, (std::set<std::string>{"file", "model", "unit", "name", "chain", "frf_error", "frf_error_tuned", "hysteresis",
+                                         "hysteresis_thresholds_V", "hysteresis_weights", "creep", "noise", "iff", "notes", "seconds",
+                                         "quality", "quality_problems", "quality_advice", "quality_impossible"}));
+  EXPECT_EQ(j["model"].size(), 8u);
+  EXPECT_EQ(j["creep"].size(), 4u);
+  EXPECT_EQ(j["noise"][0].size(), 6u);  // channel, measured, source, seconds, measured_rms, white_rms (not the spectrum)
   EXPECT_LT(j["frf_error"]["de"]["median_dB"].get<double>(), 0.5);
   EXPECT_LT(j["frf_error"]["Vs"]["median_dB"].get<double>(), 0.5);
   EXPECT_EQ(j["hysteresis"].size(), 2u);

@@ -8,15 +8,20 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <fstream>
 #include <memory>
+#include <set>
+#include <string>
 
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/bench/twin.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/twin.hpp"
 #include "piezobench/dsp/welch.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/metrology/stroke.hpp"
 #include "test_util.hpp"
@@ -222,6 +227,72 @@ TEST(Twin, IffOptimumWithinFivePercentOfTheUnits) {
   EXPECT_LT(std::abs(b.iff_optimal_gain / truth - 1.0), 0.05) << "twin " << b.iff_optimal_gain << ", unit " << truth;
   EXPECT_GT(damping, 0.1);
   EXPECT_EQ(b.quality.verdict, core::FitVerdict::kGood) << b.quality.summary();
+}
+
+// The dotted results key of a declaration ("frf_error.de") as a JSON pointer ("/frf_error/de").
+nlohmann::json::json_pointer pointer_of(std::string key) {
+  for (char& c : key) {
+    if (c == '.') c = '/';
+  }
+  return nlohmann::json::json_pointer("/" + key);
+}
+
+// The keys results_object writes for S: the declared ones in results.json, nothing else.
+template <class S> std::set<std::string> declared_keys() {
+  std::set<std::string> keys;
+  core::for_each_field<S>([&](const auto& f) {
+    if (f.in(core::kResults)) keys.insert(core::results_key(f));
+  });
+  return keys;
+}
+
+std::set<std::string> keys_of(const nlohmann::json& object) {
+  std::set<std::string> keys;
+  for (const auto& [k, v] : object.items()) keys.insert(k);
+  return keys;
+}
+
+TEST(Twin, BuildJsonKeysComeFromTheDeclarations) {
+  const TwinBuild& b = build();
+  const nlohmann::json j = io::results_object(b);  // what `twin --json` prints besides "file" and "model"
+  std::set<std::string> top;
+  core::for_each_field<TwinBuild>([&](const auto& f) {
+    if (!f.in(core::kResults)) return;
+    const std::string key = core::results_key(f);
+    if (key == ".") {
+      for (const std::string& k : declared_keys<core::FitQuality>()) top.insert(k);
+    } else {
+      EXPECT_TRUE(j.contains(pointer_of(key))) << key;
+      top.insert(key.substr(0, key.find('.')));
+    }
+  });
+  EXPECT_EQ(keys_of(j), top);
+  EXPECT_EQ(top, (std::set<std::string>{"unit", "name", "chain", "frf_error", "frf_error_tuned", "hysteresis", "hysteresis_thresholds_V",
+                                        "hysteresis_weights", "creep", "noise", "iff", "notes", "seconds", "quality", "quality_problems",
+                                        "quality_advice", "quality_impossible"}));
+  // Every declared TwinFrfError field under each of the four errors, and nothing else.
+  const std::set<std::string> frf_keys = declared_keys<TwinFrfError>();
+  EXPECT_EQ(frf_keys, (std::set<std::string>{"points", "max_dB", "median_dB"}));
+  for (const char* e : {"/frf_error/de", "/frf_error/Vs", "/frf_error_tuned/de", "/frf_error_tuned/Vs"}) {
+    EXPECT_EQ(keys_of(j.at(nlohmann::json::json_pointer(e))), frf_keys) << e;
+  }
+  EXPECT_EQ(j["frf_error"]["Vs"]["points"].get<long>(), b.vs.points);
+  EXPECT_EQ(j["frf_error_tuned"]["de"]["max_dB"].get<double>(), b.de_tuned.max_dB);
+  // noise: the two channels in a list, each with TwinNoise's declared keys (its spectrum is part.json's).
+  ASSERT_EQ(j["noise"].size(), 2U);
+  EXPECT_EQ(keys_of(j["noise"][0]), declared_keys<TwinNoise>());
+  EXPECT_EQ(keys_of(j["noise"][1]), (std::set<std::string>{"channel", "measured", "source", "seconds", "measured_rms", "white_rms"}));
+  EXPECT_EQ(j["noise"][1]["channel"], "Vs");
+  EXPECT_EQ(j["noise"][1]["white_rms"].get<double>(), b.vs_noise.white_rms);
+  ASSERT_EQ(j["hysteresis"].size(), b.hysteresis.size());
+  EXPECT_EQ(keys_of(j["hysteresis"][0]), (std::set<std::string>{"amplitude_V", "unit_width", "twin_width"}));
+  EXPECT_EQ(j["hysteresis"][0]["amplitude_V"].get<double>(), b.hysteresis[0].amplitude);
+  // The units shown are SI (factor 1): the values are the build's, bit for bit.
+  EXPECT_EQ(j["iff"]["optimal_gain"].get<double>(), b.iff_optimal_gain);
+  EXPECT_EQ(j["chain"]["delay_s"].get<double>(), b.twin.options.delay);
+  EXPECT_EQ(j["creep"]["load_per_decade"].get<double>(), b.twin.unit.load_creep_coefficient);
+  EXPECT_EQ(j["unit"], 9);
+  EXPECT_EQ(j["name"], "APA 9");
 }
 
 TEST(Twin, FileRoundTripAndTheRecordsItMakes) {

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "piezobench/bench/virtual_bench.hpp"
+#include "piezobench/core/fields.hpp"
 
 namespace piezobench::bench {
 
@@ -39,6 +40,14 @@ struct NoiseSpectrum {
   std::vector<double> freq_Hz;
   std::vector<double> psd;  // unit^2/Hz
 };
+
+constexpr auto describe(core::Type<NoiseSpectrum>) {
+  using S = NoiseSpectrum;
+  using namespace core::shown;
+  return core::fields<S>("NoiseSpectrum", "a one-sided power spectral density of a channel at some frequencies",
+      core::field("freq_Hz", &S::freq_Hz, kHertz, "the frequencies"),
+      core::field("psd", &S::psd, kNone, "one-sided PSD in the channel's SI unit squared per Hz (m^2/Hz for d_e, V^2/Hz for Vs)"));
+}
 
 struct Twin {
   std::string name;                   // the unit's name ("APA 9")
