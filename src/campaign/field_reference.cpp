@@ -3,6 +3,7 @@
 #include <set>
 
 #include "piezobench/campaign/results.hpp"
+#include "piezobench/campaign/twin.hpp"
 #include "piezobench/ident/actuator_frf.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/low_frequency_high_pass.hpp"
@@ -36,6 +37,7 @@ std::string field_reference_markdown() {
   field_table<IffStudy>(out, done);
   field_table<SuperElementComparison>(out, done);
   field_table<ident::LoopMetrics>(out, done);
+  field_table<TwinBuild>(out, done);  // `piezobench twin --json`
   field_table<ident::ActuatorFrfAnalysis>(out, done);
   field_table<ident::ActuatorPlants>(out, done);
   field_table<ident::FrfFeatures>(out, done);

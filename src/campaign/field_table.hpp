@@ -7,6 +7,7 @@
 
 #include <set>
 #include <string>
+#include <string_view>
 #include <type_traits>
 
 #include "piezobench/core/fields.hpp"
@@ -15,8 +16,18 @@ namespace piezobench::campaign {
 
 namespace field_table_detail {
 inline std::string shown_cell(const core::Shown& s) {
-  if (s.unit.empty() || s.unit == s.si) return std::string(s.unit);
+  if (s.unit.empty() || s.per_si == 1.0) return std::string(s.unit);
   return fmt::format("{} (SI x {:g})", s.unit, s.per_si);
+}
+
+// A table cell's text: "|" (as in "|H|") escaped, so that it does not end the cell.
+inline std::string cell(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
 }
 
 template <class F> std::string results_cell(const F& f) {
@@ -37,7 +48,7 @@ template <class S> void field_table(std::string& out, std::set<std::string>& don
     using E = core::element_t<typename std::remove_cvref_t<decltype(f)>::Member>;
     std::string type;
     if constexpr (core::Described<E>) type = std::string(core::kFields<E>.name);
-    out += fmt::format("| `{}` | {} | {} | {} | {} | {}{}{} |\n", f.name, type, f.shown.si, field_table_detail::shown_cell(f.shown), field_table_detail::results_cell(f), f.meaning,
+    out += fmt::format("| `{}` | {} | {} | {} | {} | {}{}{} |\n", f.name, type, f.shown.si, field_table_detail::shown_cell(f.shown), field_table_detail::results_cell(f), field_table_detail::cell(f.meaning),
                        f.in(core::kReport) ? " (report table)" : "",
                        std::remove_cvref_t<decltype(f)>::kDerived ? " (derived: read from its analysis, not in part.json)" : "");
   });

@@ -26,6 +26,9 @@ TEST(FieldReference, EveryStructOnceWithUnitsKeysAndMeanings) {
   EXPECT_NE(doc.find("| `shell_stiffness` |  | N/m | N/um (SI x 1e-06) | `shell_stiffness_N_per_um` | m_sus w_z^2 (report table) |"),
             std::string::npos);
   EXPECT_NE(doc.find("\"nan\""), std::string::npos);  // the one encoding of non-finite numbers
+  // A "|" in a meaning is escaped (it would end the cell); a shown unit with factor 1 has no "SI x 1".
+  EXPECT_NE(doc.find("| \\|pole\\| |"), std::string::npos);
+  EXPECT_EQ(doc.find("(SI x 1)"), std::string::npos);
 }
 
 }  // namespace
