@@ -377,6 +377,7 @@ struct IffPlantOptions {
   double fmax = 0.0;
   double hpf_fmax = 5.0;
   double min_coherence = 0.5;
+  bool no_window_resolution = false;
   std::string out;
   bool json = false;
   std::string units;  // --units
@@ -401,6 +402,7 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
   fo.hpf_fmax_Hz = o.hpf_fmax;
   fo.min_coherence = o.min_coherence;
   fo.effective_averages = frf.provenance.effective_averages;
+  if (!o.no_window_resolution) fo.resolution = dsp::resolution_kernel(frf.provenance);
   if (!o.json) log_line(fmt::format("fitting the IFF plant (eq. 2.3 with delay) to u -> {} of {}, {:.4g} to {:.4g} Hz", o.output, o.file, fo.fmin_Hz, fo.fmax_Hz));
   const lti::Vector coh = i < frf.coherence.size() ? frf.coherence[i] : lti::Vector();
   const ident::IffPlantFit p = ident::fit_iff_plant(kTwoPi * frf.freq_Hz, frf.H[i], coh, fo, o.file);
@@ -534,6 +536,9 @@ void add_frf_commands(CLI::App& app, Action& action) {
   iff_plant->add_option("--min-coherence", ip->min_coherence, "leave out frequencies with a lower coherence")
       ->capture_default_str()
       ->check(number_in(0.0, 0.999));
+  iff_plant->add_flag("--no-window-resolution", ip->no_window_resolution,
+                      "compare the model with the FRF directly, not through its Welch window's resolution kernel (which is used when "
+                      "the file gives the window, nfft and sample rate)");
   iff_plant->add_option("--out", ip->out, "write the plant as an LTI TOML file (transfer function with delay)")
       ->check(output_extension({".toml"}));
   iff_plant->add_flag("--json", ip->json, "print one JSON document on stdout");

@@ -131,13 +131,27 @@ struct TuneCommand {
   bool min_coherence_given = false;
   bool delay_given = false;
   bool free_ratios = false;
+  bool no_window_resolution = false;
   bool json = false;
   std::string units;  // --units
 };
 
+// The plant fits' options of `model tune` (the tuning's band, coherence threshold and window
+// resolution; the Vs fit goes down to the lowest frequency for the high-pass corner).
+ident::ActuatorPlantOptions tune_plant_options(const apa::TuningOptions& o, const dsp::Frf& frf) {
+  ident::ActuatorPlantOptions po;
+  po.fmin_Hz = o.fmin_Hz;
+  po.fmax_Hz = o.fmax_Hz;
+  po.min_coherence = o.min_coherence;
+  po.effective_averages = frf.provenance.effective_averages;
+  if (o.window_resolution) po.resolution = dsp::resolution_kernel(frf.provenance);
+  return po;
+}
+
 int run_tune(const TuneCommand& c) {
   apa::TuningOptions o = c.options;
   o.refine = !c.no_refine;
+  o.window_resolution = !c.no_window_resolution;
   o.validate();
   const io::FrfFile file = read_frf_with_units(c.frf_file, c.units);
   const dsp::Frf& frf = file.frf;
@@ -161,11 +175,7 @@ int run_tune(const TuneCommand& c) {
     log_line(fmt::format("tuning the 2-DoF model on {} ({} frequencies, band {:.4g} to {:.4g} Hz{})", c.frf_file, frf.freq_Hz.size(),
                          o.fmin_Hz, o.fmax_Hz, has_coherence ? " where the coherence is at least 0.5" : ""));
   }
-  ident::ActuatorPlantOptions po;  // the Vs fit goes down to the lowest frequency for the high-pass corner
-  po.fmin_Hz = o.fmin_Hz;
-  po.fmax_Hz = o.fmax_Hz;
-  po.min_coherence = o.min_coherence;
-  po.effective_averages = frf.provenance.effective_averages;
+  ident::ActuatorPlantOptions po = tune_plant_options(o, frf);
   if (c.free_ratios) o.stack_stiffness_ratio = o.stack_damping_ratio = 0.0;
   if (o.bench.hpf_resistance > 0.0 && o.bench.hpf_capacitance > 0.0) po.fixed_w_hpf = o.bench.hpf_corner();
   const lti::Vector omega = kTwoPi * frf.freq_Hz;
@@ -311,6 +321,9 @@ void add_model_commands(CLI::App& app, Action& action) {
   tune->add_flag("--free-ratios", u->free_ratios, "free ke and ce (both ratios 0): parameters the data do not determine are reported undetermined");
   tune->add_option("--de-output", u->options.de_output, "name of the displacement output")->capture_default_str();
   tune->add_option("--vs-output", u->options.vs_output, "name of the force-sensor output")->capture_default_str();
+  tune->add_flag("--no-window-resolution", u->no_window_resolution,
+                 "compare the models with the FRF directly, not through its Welch window's resolution kernel (which is used when "
+                 "the file gives the window, nfft and sample rate)");
   tune->add_flag("--no-refine", u->no_refine, "stop after the report's procedure (no least-squares refinement)");
   tune->add_flag("--json", u->json, "print one JSON document on stdout");
   add_units_option(tune, u->units);

@@ -69,6 +69,8 @@ const Options<TuningOptions>& tuning_options() {
         .add("stack_stiffness_ratio", &TuningOptions::stack_stiffness_ratio, "ke / ka imposed in the refinement; 0 = free")
         .add("stack_damping_ratio", &TuningOptions::stack_damping_ratio, "ce / ca imposed in the refinement; 0 = free")
         .add("refine", &TuningOptions::refine, "False: stop after the report's procedure")
+        .add("window_resolution", &TuningOptions::window_resolution,
+             "the model seen through the FRF's Welch resolution kernel (from its provenance); False: the model itself")
         .add("max_iterations", &TuningOptions::max_iterations, "Levenberg-Marquardt steps")
         .add("de_output", &TuningOptions::de_output, "name of the u -> d_e output in the FRF")
         .add("vs_output", &TuningOptions::vs_output, "name of the u -> Vs output in the FRF");

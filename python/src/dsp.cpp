@@ -246,7 +246,7 @@ H[i][k] = output i / input at freq_Hz[k]; coherence where known; std_H the stand
 random error of H's real and imaginary parts (std |H|, and std phase = std_H / |H| rad; Bendat & Piersol,
 dsp/frf_variance.hpp) where known; provenance (dsp.FrfProvenance) says how it was estimated.)");
   c.def(py::init([](py::object freq_Hz, py::object H, py::object outputs, const std::string& input,
-                       py::object coherence, py::object std_H) {
+                       py::object coherence, py::object std_H, py::object provenance) {
              const std::string src = "dsp.Frf";
              Frf f;
              f.freq_Hz = to_vector(freq_Hz, src, "freq_Hz");
@@ -270,13 +270,35 @@ dsp/frf_variance.hpp) where known; provenance (dsp.FrfProvenance) says how it wa
                if (c.cols() == 1 && c.rows() == f.freq_Hz.size()) c.transposeInPlace();
                for (Index i = 0; i < c.rows(); ++i) f.std_H.push_back(c.row(i).transpose());
              }
+             if (!provenance.is_none()) {
+               // Another Frf's provenance (or a mapping of its keys): how these lines were estimated, which the
+               // fits read (n_d, and the Welch settings of the resolution kernel, dsp/resolution_kernel.hpp).
+               const py::dict d = py::module_::import("builtins").attr("dict")(provenance);
+               FrfProvenance& p = f.provenance;
+               for (const auto& item : d) {
+                 const std::string key = py::str(item.first);
+                 const py::handle v = item.second;
+                 if (v.is_none()) continue;
+                 if (key == "source") p.source = string_arg(v, src, "provenance.source");
+                 else if (key == "estimator") p.estimator = string_arg(v, src, "provenance.estimator");
+                 else if (key == "window") p.window = string_arg(v, src, "provenance.window");
+                 else if (key == "detrend") p.detrend = string_arg(v, src, "provenance.detrend");
+                 else if (key == "nfft") p.nfft = static_cast<Index>(integer_arg(v, src, "provenance.nfft"));
+                 else if (key == "averages") p.averages = static_cast<Index>(integer_arg(v, src, "provenance.averages"));
+                 else if (key == "overlap") p.overlap = number_arg(v, src, "provenance.overlap");
+                 else if (key == "sample_rate") p.sample_rate = number_arg(v, src, "provenance.sample_rate");
+                 else if (key == "effective_averages") p.effective_averages = number_arg(v, src, "provenance.effective_averages");
+                 else throw InputError(src, "provenance", "keys of dsp.FrfProvenance", "'" + key + "'");
+               }
+             }
              f.validate(src);
              return f;
            }),
            arg("freq_Hz"), arg("H"), arg("outputs") = py::none(), arg("input") = "u", arg("coherence") = py::none(),
-           arg("std_H") = py::none(),
+           arg("std_H") = py::none(), arg("provenance") = py::none(),
            "freq_Hz (Hz, increasing); H: 1-D for one output or (outputs, points); outputs: names; coherence "
-           "and std_H like H (None = unknown).")
+           "and std_H like H (None = unknown); provenance: another Frf's (or a dict of dsp.FrfProvenance's keys), "
+           "how the lines were estimated (the fits take n_d and the Welch resolution kernel from it).")
       .def_property_readonly("omega", [](const Frf& f) { return to_numpy(Eigen::VectorXd(kTwoPi * f.freq_Hz)); }, "rad/s, 2 pi freq_Hz")
       .def_property_readonly("H", [](const Frf& f) { return stack(f.H, f.H.size() == 1); },
                              "1-D complex array for one output, else (outputs, points)")

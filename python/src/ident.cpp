@@ -142,7 +142,20 @@ struct PlantData {
   CVector h;
   Vector coherence;
   double effective_averages = 0.0;  // of an Frf's provenance
+  dsp::ResolutionKernel resolution;  // of an Frf's provenance (dsp::resolution_kernel); inactive for arrays
 };
+
+// The keyword window_resolution (default True) of the plant fits, taken out of kw: True, the model is
+// seen through the Frf's Welch resolution kernel (from its provenance), False: the model itself.
+bool take_window_resolution(py::dict& kw, const std::string& source) {
+  if (!kw.contains("window_resolution")) return true;
+  const bool on = bool_arg(kw["window_resolution"], source, "window_resolution");
+  PyDict_DelItemString(kw.ptr(), "window_resolution");
+  return on;
+}
+constexpr const char* kWindowResolutionDoc =
+    "    window_resolution: bool = True  (the model seen through the Frf's Welch resolution kernel, from its provenance; "
+    "False: the model itself; arrays have none)\n";
 PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle coherence, const std::string& source) {
   PlantData d;
   if (py::isinstance<dsp::Frf>(omega_or_frf)) {
@@ -152,6 +165,7 @@ PlantData plant_data(py::handle omega_or_frf, py::handle h_or_output, py::handle
     d.h = f.H[i];
     if (i < f.coherence.size()) d.coherence = f.coherence[i];
     d.effective_averages = f.provenance.effective_averages;
+    d.resolution = dsp::resolution_kernel(f.provenance);
     return d;
   }
   d.omega = to_vector(omega_or_frf, source, "omega");
@@ -265,43 +279,52 @@ void bind_plant_fits(py::module_& m) {
       "fit_iff_plant",
       [](py::object omega_or_frf, py::object h_or_output, py::object coherence, const py::kwargs& kw) {
         const std::string src = "ident.fit_iff_plant";
-        auto o = plant_fit_options().from_kwargs(kwargs_dict(kw), src);
+        py::dict k = kwargs_dict(kw);
+        const bool window_resolution = take_window_resolution(k, src);
+        auto o = plant_fit_options().from_kwargs(k, src);
         auto d = plant_data(omega_or_frf, h_or_output, coherence, src);
         if (o.effective_averages == 0.0) o.effective_averages = d.effective_averages;
+        if (window_resolution) o.resolution = d.resolution;
         return without_gil([&] { return fit_iff_plant(d.omega, d.h, d.coherence, o, src); });
       },
       arg("omega"), arg("h"), arg("coherence") = py::none(),
       ("The IFF plant of eq. 2.3 (report section 2.6) with its delay fitted to u -> Vs by Levenberg-Marquardt on\n"
        "the relative complex error: (omega (rad/s), h (V/V), coherence=None) or (frf, output_name). Returns an\n"
        "ident.IffPlantFit (g0, wz, xz, wp, xp, w_hpf, delay, errors, quality).\n\nKeywords (IffPlantFitOptions):\n" +
-       plant_fit_options().doc())
+       plant_fit_options().doc() + kWindowResolutionDoc)
           .c_str());
   m.def(
       "fit_delayed_second_order",
       [](py::object omega_or_frf, py::object h_or_output, py::object coherence, const py::kwargs& kw) {
         const std::string src = "ident.fit_delayed_second_order";
-        auto o = plant_fit_options().from_kwargs(kwargs_dict(kw), src);
+        py::dict k = kwargs_dict(kw);
+        const bool window_resolution = take_window_resolution(k, src);
+        auto o = plant_fit_options().from_kwargs(k, src);
         auto d = plant_data(omega_or_frf, h_or_output, coherence, src);
         if (o.effective_averages == 0.0) o.effective_averages = d.effective_averages;
+        if (window_resolution) o.resolution = d.resolution;
         return without_gil([&] { return fit_delayed_second_order(d.omega, d.h, d.coherence, o, src); });
       },
       arg("omega"), arg("h"), arg("coherence") = py::none(),
       ("k wn^2 / (s^2 + 2 zeta wn s + wn^2) exp(-s delay) fitted to u -> d_e (or a damped plant u' -> d_e):\n"
        "(omega (rad/s), h, coherence=None) or (frf, output_name). Returns an ident.DelayedSecondOrderFit.\n"
        "Keywords: fmin_Hz, fmax_Hz, min_coherence, fit_delay, max_iterations of IffPlantFitOptions:\n" +
-       plant_fit_options().doc())
+       plant_fit_options().doc() + kWindowResolutionDoc)
           .c_str());
   m.def(
       "fit_actuator_plants",
       [](py::object frf, const std::string& de_output, const std::string& vs_output, const py::kwargs& kw) {
         const std::string src = "ident.fit_actuator_plants";
-        auto o = actuator_plant_options().from_kwargs(kwargs_dict(kw), src);
+        py::dict k = kwargs_dict(kw);
+        const bool window_resolution = take_window_resolution(k, src);
+        auto o = actuator_plant_options().from_kwargs(k, src);
         const auto& f = frf_arg(frf, src, "frf");
         const auto ide = static_cast<std::size_t>(f.output_index(de_output));
         const auto ivs = static_cast<std::size_t>(f.output_index(vs_output));
         const auto coh = [&](std::size_t i) { return i < f.coherence.size() ? f.coherence[i] : Vector(); };
         const std::string source = f.provenance.source.empty() ? src : f.provenance.source;
         if (o.effective_averages == 0.0) o.effective_averages = f.provenance.effective_averages;
+        if (window_resolution) o.resolution = dsp::resolution_kernel(f.provenance);
         return without_gil([&] {
           return fit_actuator_plants(kTwoPi * f.freq_Hz, f.H[ide], coh(ide), f.H[ivs], coh(ivs), o, source);
         });
@@ -311,7 +334,7 @@ void bind_plant_fits(py::module_& m) {
        "ident.ActuatorPlants(de (ident.DelayedSecondOrderFit or None), vs (ident.IffPlantFit or None), de_options,\n"
        "vs_options (ident.IffPlantFitOptions), "
        "failures (a fit that failed numerically)). Pass de and vs to apa.tune_two_dof_measured.\n\n"
-       "Keywords (ActuatorPlantOptions):\n" + actuator_plant_options().doc())
+       "Keywords (ActuatorPlantOptions):\n" + actuator_plant_options().doc() + kWindowResolutionDoc)
           .c_str());
 }
 

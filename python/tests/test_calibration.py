@@ -99,7 +99,7 @@ def test_tuned_parameters_intervals_against_the_noise_free_record(records):
     z = {n: [] for n in ["k1", "c1", "ka", "ca", "ga", "gs"]}  # ke, ce = 2 ka, 2 ca
     for frf, ideal, band, _ in records:
         est, _ = calibrate.fitted(frf, 20.0, 500.0)
-        ref = calibrate.tuned_reference(frf, ideal.H[:, band], band, 20.0, 500.0)
+        ref = calibrate.tuned_reference(frf, ideal.H[:, band], band, 20.0, 500.0, welch_estimate=True)
         for n in z:
             value, se = est["tuned_" + n]
             z[n].append((value - ref["tuned_" + n]) / se)

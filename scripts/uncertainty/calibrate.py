@@ -7,20 +7,23 @@ For each noise seed, unit `--unit` of the batch drawn from that seed runs the fr
     (Bendat & Piersol with Welch's n_d, dsp/frf_variance.hpp);
   - the plant fits (ident.fit_actuator_plants, weighted by that variance) with their standard errors;
   - the 2-DoF tuning (apa.tune_two_dof_measured, ratios 2) with its standard errors.
-Two references (the bench knows both; for the tuned parameters see tuned_reference):
-  - truth: the bench's own linear model u -> [d_e, Vs] (bench.linear_model) as the sampled bench
-    sees it (the hold's images included: sampled_response), its resonance,
-    anti-resonance and damping ratios (bench.truth) and the unit's 2-DoF parameters;
-  - ideal: the same analysis of the same seed's record without noise or quantization (IDEAL below):
-    what the estimates scatter around. The random error (the FRF band, the standard errors) is
-    calibrated against it; truth - ideal is the bias (the window's resolution at the resonance, the
-    hold, a model's structure), which no random-error interval covers.
-
-The tuned 2-DoF parameters' truth is their pseudo-true value: the same estimator (plant fits and
-tuning, with the noisy record's weights) on the bench's exact sampled response, the 2-DoF model's best
-fit to a bench it does not contain exactly (its sensor stack is electromechanically coupled); their
-ideal is the same estimator on the noise-free record; the bench's own 2-DoF parameters ("physical")
-give the structural bias.
+Three references (the bench knows them all):
+  - truth: for the FRF band, the bench's own linear model u -> [d_e, Vs] (bench.linear_model) as the
+    sampled bench sees it (the hold's images included: sampled_response). For every fitted quantity
+    (resonance, anti-resonance, damping ratios, tuned 2-DoF parameters) its pseudo-true value: the
+    estimator (plant fits and tuning, with the noisy record's weights) on that exact response, each
+    model's best fit to a bench it does not contain exactly (H. White, Econometrica 1982), and
+    WITHOUT the Welch resolution kernel (dsp/resolution_kernel.hpp): the fits see their models
+    through the window's kernel because a Welch estimate converges to H smoothed by it; the exact
+    response is not smoothed (it is the H the kernel is applied to);
+  - ideal: the same analysis of the same seed's record without noise or quantization (IDEAL below),
+    kernel included (a Welch estimate, smoothed like the noisy one): what the estimates scatter
+    around. The random error (the FRF band, the standard errors) is calibrated against it; truth -
+    ideal is what the estimator gets wrong beyond the noise (the window's resolution where the kernel
+    does not model it, the leakage common to the noisy and the noise-free record);
+  - physical: the bench's own resonance, anti-resonance and damping ratios (bench.truth) and 2-DoF
+    parameters: truth - physical is the models' structural bias (eq. 2.3's zero is not the bench's
+    lowest zero pair; the 2-DoF model lacks the sensor stack's electromechanical coupling).
 
 Coverage measured (docs/uncertainty.md, section 6):
   - band: fraction of (seed, output, line) with coherence > 0.5 in 1-2000 Hz whose reference |H|
@@ -110,9 +113,10 @@ def band_counts(frf, reference):
     return out
 
 
-def fitted(frf, fmin, fmax):
-    """{name: (value, standard error)} of the plant fits and the 2-DoF tuning on one FRF."""
-    plants = ident.fit_actuator_plants(frf, "de", "Vs", fmin_Hz=fmin, fmax_Hz=fmax)
+def fitted(frf, fmin, fmax, effective_averages=0.0):
+    """{name: (value, standard error)} of the plant fits and the 2-DoF tuning on one FRF (n_d from its
+    provenance unless given)."""
+    plants = ident.fit_actuator_plants(frf, "de", "Vs", fmin_Hz=fmin, fmax_Hz=fmax, effective_averages=effective_averages)
     v = {}
     if plants.de is not None:
         u = plants.de.uncertainty
@@ -141,25 +145,35 @@ def tuned(frf, plants, fmin, fmax):
     return {"tuned_" + n: (t.params[n], t.uncertainty.standard_error_of(n)) for n in TUNED}, list(t.undetermined)
 
 
-def tuned_reference(frf, h, band, fmin, fmax):
+def tuned_reference(frf, h, band, fmin, fmax, welch_estimate):
     """The tuned parameters of the same estimator (the plant fits and the tuning, with the weights of
     the noisy record `frf`: its coherence, std_H and n_d) on the noise-free response h at the lines
     `band`: the noise-free record (what the estimates scatter around) or the bench's exact sampled
     response (the pseudo-true parameters: the 2-DoF model's best fit to the bench, which it does not
     contain exactly). The weights matter: the model misses the bench by more than the noise, so each
     weighting has its own best fit (c1 changed threefold between the noisy record's weights and the
-    noise-free record's own)."""
-    ref = dsp.Frf(frf.freq_Hz[band], h, outputs=["de", "Vs"], coherence=frf.coherence[:, band], std_H=frf.std_H[:, band])
-    plants = ident.fit_actuator_plants(ref, "de", "Vs", fmin_Hz=fmin, fmax_Hz=fmax,
-                                       effective_averages=frf.provenance["effective_averages"])
-    return {k: value for k, (value, _) in tuned(ref, plants, fmin, fmax)[0].items()}
+    noise-free record's own).
+    welch_estimate: True, h is a Welch estimate (the noise-free record), seen by the fits through the
+    window's resolution kernel as the noisy record is (its provenance passed on); False, h is the exact
+    response, which has no window smoothing, fitted without the kernel (no provenance: the fits'
+    models as they are)."""
+    return {k: v for k, v in reference_fits(frf, h, band, fmin, fmax, welch_estimate).items() if k.startswith("tuned_")}
+
+
+def reference_fits(frf, h, band, fmin, fmax, welch_estimate):
+    """{name: value} of the plant fits and the tuning (the estimator, with the noisy record's weights)
+    on the noise-free response h at the lines `band` (tuned_reference). On the bench's exact response
+    (welch_estimate False) these are the pseudo-true values: each model's best fit to the bench."""
+    ref = dsp.Frf(frf.freq_Hz[band], h, outputs=["de", "Vs"], coherence=frf.coherence[:, band], std_H=frf.std_H[:, band],
+                  provenance=frf.provenance if welch_estimate else None)
+    values, _ = fitted(ref, fmin, fmax, effective_averages=frf.provenance["effective_averages"])
+    return {k: value for k, (value, _) in values.items()}
 
 
 def one_seed(seed, unit=1, duration=20.0, fmin=20.0, fmax=500.0, kw=None):
-    """Coverage counts and interval checks of one noise seed, against two references: the bench's
-    own parameters ("truth": its linear model, its resonance, anti-resonance and 2-DoF parameters)
-    and the same analysis of the ideal record ("ideal": what the estimate scatters around; it differs
-    from the truth by the bias errors: the window's resolution bias, the models' structure)."""
+    """Coverage counts and interval checks of one noise seed against the three references of the
+    module's docstring: truth (the exact sampled response; the fits' pseudo-true values), ideal (the
+    noise-free record) and physical (the bench's own parameters)."""
     kw = kw or {}
     frf = welch(bench.simulate("frf-noise", unit, seed, duration=duration, **kw))
     ideal = welch(bench.simulate("frf-noise", unit, seed, duration=duration, **{**kw, **IDEAL}))
@@ -172,15 +186,19 @@ def one_seed(seed, unit=1, duration=20.0, fmin=20.0, fmax=500.0, kw=None):
     ref, _ = fitted(ideal, fmin, fmax)
     ref = {k: value for k, value in ref.items() if not k.startswith("tuned_")}
     t = bench.truth(unit, seed, **kw)
-    truth = {"resonance_Hz": t.resonance_Hz, "resonance_damping": t.resonance_damping,
-             "antiresonance_Hz": t.antiresonance_Hz, "antiresonance_damping": t.antiresonance_damping}
-    # The tuned parameters: the truth is the pseudo-true value (the same estimator on the bench's exact
-    # sampled response), the ideal the same estimator on the noise-free record; the bench's own 2-DoF
-    # parameters ("physical") differ by the model's structure (the sensor stack's electromechanical
-    # coupling, bench/plant.cpp), reported as a bias.
-    ref.update({k: (v, None) for k, v in tuned_reference(frf, ideal.H[:, band], band, fmin, fmax).items()})
-    truth.update(tuned_reference(frf, h_true[:, band], band, fmin, fmax))
-    physical = {"tuned_" + n: t.model_2dof[n] for n in TUNED} if t.model_2dof is not None else {}
+    # The truth of every fitted quantity is its pseudo-true value: the estimator (without the window's
+    # resolution kernel, which models the Welch smoothing the exact response does not have) on the
+    # bench's exact sampled response, each model's best fit to the bench. The ideal is the same
+    # estimator on the noise-free record (the tuned parameters with the noisy record's weights). The
+    # bench's own parameters ("physical": its resonance, anti-resonance, damping ratios and 2-DoF
+    # parameters) differ by the models' structure (eq. 2.3's zero is not the bench's lowest zero pair;
+    # the 2-DoF model lacks the sensor stack's electromechanical coupling, bench/plant.cpp), reported as a bias.
+    ref.update({k: (v, None) for k, v in tuned_reference(frf, ideal.H[:, band], band, fmin, fmax, welch_estimate=True).items()})
+    truth = reference_fits(frf, h_true[:, band], band, fmin, fmax, welch_estimate=False)
+    physical = {"resonance_Hz": t.resonance_Hz, "resonance_damping": t.resonance_damping,
+                "antiresonance_Hz": t.antiresonance_Hz, "antiresonance_damping": t.antiresonance_damping}
+    if t.model_2dof is not None:
+        physical.update({"tuned_" + n: t.model_2dof[n] for n in TUNED})
     out["intervals"]["physical"] = {}
     for key, (value, se) in est.items():
         if not (se is not None and math.isfinite(se)):
@@ -245,9 +263,9 @@ def main():
     print(file=sys.stderr)
     s = summarize(results)
     print(f"{s['seeds']} seeds, unit {a.unit}, bench {kw or 'default'}")
-    what = {"truth": " (the bench's own model and parameters; the tuned ones: the 2-DoF model's best fit to the bench's exact response)",
+    what = {"truth": " (the band: the bench's exact sampled response; the fits: each model's best fit to it, without the window's kernel)",
             "ideal": " (the same analysis of the noise- and quantization-free record)",
-            "physical": " (the bench's own 2-DoF parameters: the tuning's structural bias)"}
+            "physical": " (the bench's own resonance, anti-resonance, dampings and 2-DoF parameters: the models' structural bias)"}
     for ref in ("truth", "ideal", "physical"):
         print(f"-- against the {ref}" + what[ref])
         if ref in s["band"]:

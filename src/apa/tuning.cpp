@@ -15,6 +15,7 @@
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
+#include "piezobench/dsp/resolution_kernel.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 
@@ -87,6 +88,8 @@ struct FitData {
   // Relative standard deviation of each point (dsp/frf_variance.hpp, floored at 1e-4) when the FRF's
   // variance is known (coherence of both outputs and n_d); empty otherwise.
   Vector eps_de, eps_vs;
+  // The Welch estimate's resolution kernel the model is seen through (inactive: the model itself).
+  dsp::ResolutionKernel kernel;
 };
 
 // The quality verdict of a tuning (tuning.hpp).
@@ -151,6 +154,7 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
                      std::to_string(used.size()));
   }
   FitData d;
+  if (o.window_resolution) d.kernel = dsp::resolution_kernel(frf.provenance);
   const auto n = static_cast<Index>(used.size());
   d.omega.resize(n);
   d.de.resize(n);
@@ -301,11 +305,13 @@ bool usable(const TwoDofParams& p) {
 }
 
 // The model's u -> d_e and u -> Vs of the actuator alone (a bench of unit amplifier gain), what the
-// tuning compares with the data at every step.
-lti::CMatrix actuator_response(const TwoDofParams& p, const Vector& omega) {
+// tuning compares with the data at every step: through the Welch estimate's resolution kernel when
+// it is active, sum_j c_j H(omega + j 2 pi df) (dsp/resolution_kernel.hpp; the chain divided out of
+// the data is smooth over a line and left outside the kernel).
+lti::CMatrix actuator_response(const TwoDofParams& p, const Vector& omega, const dsp::ResolutionKernel& kernel) {
   TwoDofBench bare;
   bare.amplifier_gain = 1.0;
-  return two_dof_response(p, bare, omega);
+  return dsp::smoothed_response(kernel, omega, [&](const Vector& w) { return two_dof_response(p, bare, w); });
 }
 
 // Per-point weights of the complex errors H_model - H_data of each output, relative to a reference
@@ -322,7 +328,7 @@ struct Weights {
 };
 Weights weights(const FitData& d, const TwoDofParams& reference) {
   const Index n = d.omega.size();
-  const lti::CMatrix g0 = actuator_response(reference, d.omega);
+  const lti::CMatrix g0 = actuator_response(reference, d.omega, d.kernel);
   const bool variance = d.eps_de.size() == n;
   Weights out;
   const auto one = [&](Index o, const CVector& h, const Vector& eps, Vector& w, Vector& sd) {
@@ -361,7 +367,7 @@ Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
   const Index n = d.omega.size();
   Vector r(4 * n);
   if (!usable(p)) return Vector::Constant(4 * n, std::numeric_limits<double>::quiet_NaN());
-  const lti::CMatrix h = actuator_response(p, d.omega);
+  const lti::CMatrix h = actuator_response(p, d.omega, d.kernel);
   for (Index k = 0; k < n; ++k) {
     const Complex ede = (h(k, kOutputDe) - d.de(k)) * wt.de(k);
     const Complex evs = (h(k, kOutputVs) - d.vs(k)) * wt.vs(k);
@@ -377,7 +383,7 @@ Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
 std::pair<double, double> fit_errors(const TwoDofParams& p, const FitData& d) {
   const Index n = d.omega.size();
   if (!usable(p)) return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
-  const lti::CMatrix h = actuator_response(p, d.omega);
+  const lti::CMatrix h = actuator_response(p, d.omega, d.kernel);
   double de = 0.0, vs = 0.0;
   for (Index k = 0; k < n; ++k) {
     de += std::norm(h(k, kOutputDe) / d.de(k) - 1.0);
@@ -477,7 +483,7 @@ void fit_gains(const FitData& d, TwoDofParams& p) {
   const Index n = d.omega.size();
   p.ga = 1.0;
   p.gs = 1.0;
-  const lti::CMatrix h = actuator_response(p, d.omega);
+  const lti::CMatrix h = actuator_response(p, d.omega, d.kernel);
   double num = 0.0, den = 0.0;
   for (Index k = 0; k < n; ++k) {
     const Complex a = h(k, kOutputDe) / d.de(k);

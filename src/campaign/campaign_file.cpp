@@ -365,7 +365,7 @@ void read_controller(const TomlReader& c, control::IffControllerParams& p) {
 
 void read_analysis(const TomlReader& r, AnalysisSettings& a) {
   r.only({"window", "nfft", "overlap", "fmin_Hz", "fmax_Hz", "hpf_fmax_Hz", "damped_fmin_Hz", "damped_fmax_Hz",
-          "hammer_fmin_Hz", "hammer_fmax_Hz", "fit_order", "iff_unit", "iff_controller", "threads"});
+          "hammer_fmin_Hz", "hammer_fmax_Hz", "fit_order", "window_resolution", "iff_unit", "iff_controller", "threads"});
   if (const auto w = r.string("window")) {
     try {
       a.window = dsp::window_type_from_string(*w);
@@ -390,6 +390,7 @@ void read_analysis(const TomlReader& r, AnalysisSettings& a) {
   band("hammer_fmin_Hz", a.hammer_fmin_Hz, "hammer_fmax_Hz", a.hammer_fmax_Hz);
   check_band(r, "hammer_fmin_Hz", a.hammer_fmin_Hz, "hammer_fmax_Hz", a.hammer_fmax_Hz);
   if (const auto n = r.integer("fit_order", 2, 40)) a.fit_order = *n;
+  if (const auto b = r.boolean("window_resolution")) a.window_resolution = *b;
   // A unit id (ids are 0 .. 1000000) or 0 = the first unit with IFF data.
   if (const auto n = r.integer("iff_unit", 0, 1000000)) a.iff_unit = static_cast<int>(*n);
   if (const auto c = r.table("iff_controller")) read_controller(*c, a.controller);

@@ -395,6 +395,7 @@ void tune_model(const Campaign& c, UnitAnalysis& u) {
     t.fmin_Hz = c.analysis.fmin_Hz;
     t.fmax_Hz = c.analysis.fmax_Hz;
     t.min_coherence = 0.5;
+    t.window_resolution = c.analysis.window_resolution;
     const apa::TwoDofTuning tuned = apa::tune_two_dof_measured(*frf_of(u), t, de_plant_of(u), iff_plant_of(u));
     u.model_2dof = Model2DofFit{tuned, tuned.bench, t.fmin_Hz, t.fmax_Hz};
   } catch (const NumericalError& e) {
@@ -417,6 +418,7 @@ void analyze_frf(const Campaign& c, const Record& r, UnitAnalysis& u) {
   o.hpf_resistance_ohm = c.bench.hpf_resistance;
   o.sensor_capacitance_F = capacitance_sensor_of(u);
   o.suspended_mass_kg = c.bench.suspended_mass;
+  o.window_resolution = a.window_resolution;
   o.source = c.file.string();
   o.field = r.spec.key;
   ident::ActuatorFrfResult result = ident::analyze_actuator_frf(frf, o);

@@ -101,6 +101,7 @@ void fit_plants(const dsp::Frf& frf, Index de, Index vs, const ActuatorFrfOption
   po.fixed_w_hpf = w_rc;
   po.min_coherence = o.min_coherence;
   po.effective_averages = frf.provenance.effective_averages;
+  if (o.window_resolution) po.resolution = dsp::resolution_kernel(frf.provenance);
   const auto coherence = [&](Index i) { return frf.coherence.empty() ? Eigen::VectorXd() : frf.coherence[static_cast<std::size_t>(i)]; };
   ActuatorPlants plants = fit_actuator_plants(kTwoPi * frf.freq_Hz, frf.H[static_cast<std::size_t>(de)], coherence(de),
                                               frf.H[static_cast<std::size_t>(vs)], coherence(vs), po, fit_source(o));

@@ -131,6 +131,11 @@ core::FitCovariance covariance_at(const core::ResidualFunction& residual, const 
 
 Complex model(const IffPlantFit& p, double w) { return plant::iff_plant_response(p, w); }
 
+// The model as the data see it: through the Welch estimate's resolution kernel when it is active.
+Complex model(const IffPlantFit& p, double w, const dsp::ResolutionKernel& kernel) {
+  return dsp::smoothed_response(kernel, w, [&](double x) { return model(p, x); });
+}
+
 // Scaled parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, log w_hpf, delay / 100 us.
 constexpr double kXzScale = 0.01;
 constexpr double kDelayScale = 1e-4;
@@ -385,12 +390,13 @@ struct IffResidual {
   double sign;
   Layout layout;
   double fixed_w_hpf;
+  const dsp::ResolutionKernel& kernel;
 
   Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
     const IffPlantFit p = from_x(x, sign, layout, fixed_w_hpf);
     Eigen::VectorXd r(2 * b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) {
-      const Complex e = (model(p, b.w(k)) / b.d(k) - 1.0) * weight(k);
+      const Complex e = (model(p, b.w(k), kernel) / b.d(k) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
@@ -446,14 +452,15 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   if (start.g0 == 0.0) start.g0 = 1.0;
   const double sign = start.g0 > 0.0 ? 1.0 : -1.0;
   const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
-  const IffResidual residual{b, pw.weight, sign, Layout{options.fixed_w_hpf == 0.0, options.fit_delay}, options.fixed_w_hpf};
+  const IffResidual residual{b, pw.weight, sign, Layout{options.fixed_w_hpf == 0.0, options.fit_delay}, options.fixed_w_hpf,
+                             options.resolution};
   double initial_cost = 0.0;
   const core::LmResult best = best_iff_solution(residual, start, options.max_iterations, initial_cost, source);
 
   const double n = static_cast<double>(b.w.size());
   IffPlantFit fit = from_x(best.x, sign, residual.layout, options.fixed_w_hpf);
   double plain = 0.0;
-  for (Index k = 0; k < b.w.size(); ++k) plain += std::norm(model(fit, b.w(k)) / b.d(k) - 1.0);
+  for (Index k = 0; k < b.w.size(); ++k) plain += std::norm(model(fit, b.w(k), options.resolution) / b.d(k) - 1.0);
   fit.relative_rms_error = std::sqrt(plain / n);
   fit.weighted_relative_rms_error = std::sqrt(2.0 * best.cost / n);
   fit.initial_relative_rms_error = std::sqrt(initial_cost / n);
@@ -478,6 +485,11 @@ Complex second_order(const DelayedSecondOrderFit& p, double w) {
   const Complex s(0.0, w);
   const double wn = p.natural_frequency;
   return p.static_gain * wn * wn / (s * s + 2.0 * p.damping * wn * s + wn * wn) * std::exp(-s * p.delay);
+}
+
+// The second order as the data see it (through the resolution kernel when it is active).
+Complex second_order(const DelayedSecondOrderFit& p, double w, const dsp::ResolutionKernel& kernel) {
+  return dsp::smoothed_response(kernel, w, [&](double x) { return second_order(p, x); });
 }
 
 // Starting values: the natural frequency at the peak, the damping from its half-power points, the
@@ -550,6 +562,7 @@ struct SecondOrderResidual {
   const Vector& weight;
   double sign;
   bool fit_delay;
+  const dsp::ResolutionKernel& kernel;
 
   [[nodiscard]] DelayedSecondOrderFit unpack(const Eigen::VectorXd& x) const {
     DelayedSecondOrderFit p;
@@ -564,7 +577,7 @@ struct SecondOrderResidual {
     const DelayedSecondOrderFit p = unpack(x);
     Eigen::VectorXd r(2 * b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) {
-      const Complex e = (second_order(p, b.w(k)) / b.d(k) - 1.0) * weight(k);
+      const Complex e = (second_order(p, b.w(k), kernel) / b.d(k) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
@@ -601,7 +614,7 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   if (b.w.size() < 8) throw InputError(source, "H", "at least 8 usable points in the band", std::to_string(b.w.size()));
   const DelayedSecondOrderFit start = second_order_start(b, second_order_peak(b, source), options.fit_delay);
   const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
-  const SecondOrderResidual residual{b, pw.weight, start.static_gain >= 0.0 ? 1.0 : -1.0, options.fit_delay};
+  const SecondOrderResidual residual{b, pw.weight, start.static_gain >= 0.0 ? 1.0 : -1.0, options.fit_delay, options.resolution};
   const Eigen::VectorXd x0 = second_order_x0(start, options.fit_delay);
   if (!residual(x0).allFinite()) {
     throw NumericalError("second-order fit (" + source + ")", "the starting point gives a non-finite error", true);
@@ -612,7 +625,7 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   }
   DelayedSecondOrderFit fit = residual.unpack(o.x);
   double plain = 0.0;
-  for (Index k = 0; k < b.w.size(); ++k) plain += std::norm(second_order(fit, b.w(k)) / b.d(k) - 1.0);
+  for (Index k = 0; k < b.w.size(); ++k) plain += std::norm(second_order(fit, b.w(k), options.resolution) / b.d(k) - 1.0);
   fit.relative_rms_error = std::sqrt(plain / static_cast<double>(b.w.size()));
   fit.points = b.w.size();
   fit.iterations = o.iterations;
@@ -651,6 +664,7 @@ ActuatorPlants fit_actuator_plants(const Vector& omega, const CVector& h_de, con
   out.de_options.min_coherence = options.min_coherence;
   out.de_options.effective_averages = options.effective_averages;
   out.vs_options.effective_averages = options.effective_averages;
+  out.de_options.resolution = out.vs_options.resolution = options.resolution;
   out.vs_options.fmin_Hz = options.iff_fmin_Hz;
   out.vs_options.fmax_Hz = options.fmax_Hz;
   out.vs_options.hpf_fmax_Hz = options.hpf_fmax_Hz;

@@ -67,6 +67,10 @@ struct TuningOptions {
   // 2-DoF FRF gave ce = 1.8e-6 and ca = 91.7 N s/m for a truth of 130 and 65, issue 30).
   double stack_damping_ratio = 2.0;
   bool refine = true;        // false: stop after the report's procedure
+  // The model is compared with the data through the FRF's Welch resolution kernel (dsp::
+  // resolution_kernel of its provenance: window, nfft, sample rate; dsp/resolution_kernel.hpp), what
+  // a Welch estimate converges to; without a provenance that gives it, or false: the model's own response.
+  bool window_resolution = true;
   int max_iterations = 200;  // Levenberg-Marquardt steps
   std::string de_output = "de";  // names of the outputs in the FRF
   std::string vs_output = "Vs";

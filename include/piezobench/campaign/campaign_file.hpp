@@ -126,6 +126,9 @@ struct AnalysisSettings {
   double hammer_fmin_Hz = 100.0; // band searched for flexible modes
   double hammer_fmax_Hz = 1000.0;
   long fit_order = 6;            // vector-fitting order of the FRF features
+  // The plant fits and the 2-DoF tuning compare their models with the FRF through the Welch window's
+  // resolution kernel (dsp/resolution_kernel.hpp); false: the models' own responses.
+  bool window_resolution = true;
   int iff_unit = 0;              // unit whose IFF data make the batch's `iff` result (0 = first with IFF data)
   control::IffControllerParams controller;  // eq. 2.4 (iff_controller = {gain, hpf_Hz, lpf_Hz, robust_Hz})
   int threads = 0;               // units analysed in parallel; 0 = all cores

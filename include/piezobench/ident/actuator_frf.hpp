@@ -186,6 +186,9 @@ struct ActuatorFrfOptions {
   std::optional<double> hpf_resistance_ohm;
   std::optional<double> sensor_capacitance_F;
   double suspended_mass_kg = 0.0;  // m_sus of shell_stiffness
+  // The plant fits see their models through the FRF's Welch resolution kernel when its provenance
+  // gives it (dsp::resolution_kernel; IffPlantFitOptions::resolution); false: the models' own responses.
+  bool window_resolution = true;
   // Errors: InputError(source, field, ...); the fits' messages name "source: field".
   std::string source, field;
 };

@@ -31,6 +31,7 @@
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/fit_quality.hpp"
 #include "piezobench/core/least_squares.hpp"
+#include "piezobench/dsp/resolution_kernel.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
@@ -53,13 +54,19 @@ struct IffPlantFitOptions {
   // standard errors come from that variance (sandwich form, widened when the misfit exceeds it);
   // 0: from the residuals' scatter.
   double effective_averages = 0.0;
+  // The Welch estimate's resolution kernel of the FRF (dsp::resolution_kernel of its provenance;
+  // dsp/resolution_kernel.hpp): active, the model is compared with the data through it,
+  // sum_j c_j G(omega + j 2 pi df), which is what a Welch estimate converges to (the hann window's
+  // smoothing biased the resonance damping +3 % on the virtual bench). Inactive (the default; an FRF
+  // computed from a model, a file that does not say how it was estimated, or turned off): G itself.
+  dsp::ResolutionKernel resolution;
   void validate() const;      // InputError (source "iff plant fit options")
 };
 
 // The fitted plant is a plant::IffPlantParams (g0 V/V signed, wz, wp, w_hpf rad/s, xz < 0 for a
 // non-minimum-phase zero pair, xp, delay s) with how well it fits.
 struct IffPlantFit : plant::IffPlantParams {
-  double relative_rms_error = 0.0;           // rms |G/H - 1| over the points used
+  double relative_rms_error = 0.0;           // rms |G/H - 1| over the points used (G through options.resolution)
   double weighted_relative_rms_error = 0.0;  // the same with the fit's per-decade weights
   double initial_relative_rms_error = 0.0;   // weighted, at the better of the two starts
   long points = 0;
@@ -132,7 +139,7 @@ struct DelayedSecondOrderFit {
   double natural_frequency = 0.0;  // wn, rad/s
   double damping = 0.0;            // zeta
   double delay = 0.0;              // s
-  double relative_rms_error = 0.0; // rms |H_model / H - 1| over the points used
+  double relative_rms_error = 0.0; // rms |H_model / H - 1| over the points used (through options.resolution)
   long points = 0;
   // Standard errors of static_gain, natural_frequency, damping, delay (as IffPlantFit::uncertainty).
   core::ParameterUncertainty uncertainty;
@@ -163,6 +170,7 @@ struct ActuatorPlantOptions {
   double fixed_w_hpf = 0.0;      // rad/s; > 0: the high-pass corner is known (1 / (R C_sensor))
   double min_coherence = 0.5;
   double effective_averages = 0.0;  // a count, of the FRF (IffPlantFitOptions::effective_averages), for both fits
+  dsp::ResolutionKernel resolution;  // of the FRF (IffPlantFitOptions::resolution), for both fits
   void validate() const;         // InputError (source "actuator plant options")
 };
 

@@ -1,0 +1,81 @@
+#pragma once
+// The resolution of a Welch FRF estimate: what its lines converge to, as a kernel a model's response
+// is passed through before it is compared with the estimate.
+//
+// A Welch estimate with the window w of nfft samples does not converge to H(f) but to H smoothed by
+// the window's spectral kernel |W(nu)|^2 (for an input whose spectrum is flat across the kernel,
+// H1 -> integral H(nu) |W(f - nu)|^2 dnu / integral |W|^2): a resonance or an anti-resonance a few
+// lines wide comes out wider and shallower (the resonance damping of the virtual bench +3 %, its
+// anti-resonance damping +1-2 %, docs/uncertainty.md section 6). On the estimate's own line grid,
+// df = fs / nfft, the kernel is sampled at the window's DFT bins:
+//
+//   H_est(f) ~ sum_j c_j H(f + j df),   c_j = |W_j|^2 / sum_i |W_i|^2,   W_j = sum_n w(n) e^(-2 pi i j n / nfft)
+//
+// (sum_i |W_i|^2 = nfft sum_n w(n)^2, Parseval). For a cosine-sum window (hann, hamming, flat-top)
+// the bins are exactly the cosine coefficients: periodic hann 0.5 - 0.5 cos gives W_0 = nfft/2,
+// W_+-1 = -nfft/4, c = (1/6, 2/3, 1/6); periodic hamming (0.23^2, 0.54^2, 0.23^2) / 0.3974; the
+// rectangular window c = (1): no smoothing on its own grid. The sampled kernel has the same second
+// moment as the continuous one, sum_j c_j j^2 = (nfft / 2 pi)^2 sum |w'|^2 / sum w^2 in lines^2
+// (1/3 for hann), so it reproduces the continuous smoothing to second order in df (a response whose
+// curvature is H'' gets H'' df^2 / 6 from hann, which is how the resonance's damping moves).
+// Bins with c_j below kResolutionKernelFloor are left out (a symmetric window's DFT has
+// O(1/nfft^2) tails) and the rest renormalized to a sum of 1.
+#include <Eigen/Dense>
+#include <complex>
+#include <numbers>
+#include <type_traits>
+#include <vector>
+
+#include "piezobench/dsp/frf.hpp"
+#include "piezobench/dsp/window.hpp"
+
+namespace piezobench::dsp {
+
+// The kernel on an FRF's line grid: weights[j] for the offset (j - half_width()) lines, line_spacing_Hz
+// apart. Inactive (no weights, or the single weight of a rectangular window): the identity.
+struct ResolutionKernel {
+  double line_spacing_Hz = 0.0;  // Hz, df = sample rate / nfft; 0: none
+  std::vector<double> weights;   // dimensionless, odd count, symmetric, sum 1
+  [[nodiscard]] bool active() const { return line_spacing_Hz > 0.0 && weights.size() > 1; }
+  [[nodiscard]] long half_width() const { return static_cast<long>(weights.size() / 2); }
+};
+
+inline constexpr double kResolutionKernelFloor = 1e-9;  // relative weight below which a bin is dropped
+inline constexpr long kResolutionKernelMaxHalfWidth = 8;  // lines on each side at most (flat-top: 4)
+
+// The kernel of `window` of nfft samples at sample_rate_Hz (line spacing sample_rate_Hz / nfft).
+// InputError (source "resolution kernel") for nfft < 2 or a sample rate that is not finite and > 0.
+[[nodiscard]] ResolutionKernel resolution_kernel(WindowType window, Eigen::Index nfft, double sample_rate_Hz);
+
+// The kernel of a Welch FRF from its provenance (window, nfft, sample_rate); inactive when the
+// provenance does not give all three (an FRF computed from a model, or read from a file that does
+// not say how it was estimated, or names a window window_type_from_string does not know).
+[[nodiscard]] ResolutionKernel resolution_kernel(const FrfProvenance& provenance);
+
+namespace detail {
+// omega + delta, omega and delta in rad/s.
+inline double shifted(double omega, double delta) { return omega + delta; }
+// omega + delta for every frequency, omega and delta in rad/s.
+inline Eigen::VectorXd shifted(const Eigen::VectorXd& omega, double delta) { return (omega.array() + delta).matrix(); }
+}  // namespace detail
+
+// sum_j c_j response(omega + j 2 pi df) at omega (rad/s; one frequency or a vector of them): what a
+// Welch estimate of `response` converges to; response(omega) itself when the kernel is inactive.
+// `response` takes what omega is and returns a complex value or an Eigen matrix of them (outputs,
+// frequencies).
+template <class Omega, class Response>
+auto smoothed_response(const ResolutionKernel& kernel, const Omega& omega, const Response& response) {
+  using Value = std::decay_t<decltype(response(omega))>;
+  if (!kernel.active()) return Value(response(omega));
+  const double step = 2.0 * std::numbers::pi * kernel.line_spacing_Hz;  // rad/s per line
+  const long half = kernel.half_width();
+  Value sum = Value(response(omega)) * kernel.weights[static_cast<std::size_t>(half)];
+  for (long j = 1; j <= half; ++j) {
+    const double c = kernel.weights[static_cast<std::size_t>(half + j)];
+    const double delta = static_cast<double>(j) * step;
+    sum += (Value(response(detail::shifted(omega, delta))) + Value(response(detail::shifted(omega, -delta)))) * c;
+  }
+  return sum;
+}
+
+}  // namespace piezobench::dsp

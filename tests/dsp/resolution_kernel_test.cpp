@@ -1,0 +1,149 @@
+#include "piezobench/dsp/resolution_kernel.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <numbers>
+#include <random>
+
+#include "piezobench/core/error.hpp"
+#include "piezobench/dsp/welch.hpp"
+
+namespace piezobench::dsp {
+namespace {
+
+using Complex = std::complex<double>;
+
+TEST(ResolutionKernel, CosineWindowsGiveTheirSquaredCoefficients) {
+  // Periodic hann 0.5 - 0.5 cos(2 pi n / N): W_0 = N/2, W_+-1 = -N/4, so |W|^2 is 4 : 1 : 1 -> (1/6, 2/3, 1/6).
+  const ResolutionKernel hann = resolution_kernel(WindowType::kHannPeriodic, 40000, 10000.0);
+  ASSERT_EQ(hann.weights.size(), 3u);
+  EXPECT_NEAR(hann.weights[0], 1.0 / 6.0, 1e-12);
+  EXPECT_NEAR(hann.weights[1], 2.0 / 3.0, 1e-12);
+  EXPECT_NEAR(hann.weights[2], 1.0 / 6.0, 1e-12);
+  EXPECT_DOUBLE_EQ(hann.line_spacing_Hz, 0.25);
+  EXPECT_TRUE(hann.active());
+  // Periodic hamming 0.54 - 0.46 cos: W_0 = 0.54 N, W_+-1 = -0.23 N.
+  const ResolutionKernel hamming = resolution_kernel(WindowType::kHammingPeriodic, 1024, 1024.0);
+  const double total = 0.54 * 0.54 + 2.0 * 0.23 * 0.23;
+  ASSERT_EQ(hamming.weights.size(), 3u);
+  EXPECT_NEAR(hamming.weights[1], 0.54 * 0.54 / total, 1e-12);
+  EXPECT_NEAR(hamming.weights[0], 0.23 * 0.23 / total, 1e-12);
+  EXPECT_DOUBLE_EQ(hamming.line_spacing_Hz, 1.0);
+  // Periodic flat-top sum (-1)^k a_k cos: W_0 = a_0 N, W_+-k = +-a_k N / 2: four bins on each side.
+  const double a[] = {0.21557895, 0.41663158, 0.277263158, 0.083578947, 0.006947368};
+  double ft = a[0] * a[0];
+  for (int k = 1; k < 5; ++k) ft += 2.0 * a[k] * a[k] / 4.0;
+  const ResolutionKernel flattop = resolution_kernel(WindowType::kFlatTopPeriodic, 2048, 100.0);
+  ASSERT_EQ(flattop.weights.size(), 9u);
+  EXPECT_NEAR(flattop.weights[4], a[0] * a[0] / ft, 1e-12);
+  for (int k = 1; k < 5; ++k) EXPECT_NEAR(flattop.weights[static_cast<std::size_t>(4 + k)], a[k] * a[k] / 4.0 / ft, 1e-12);
+  // Rectangular: a single bin, no smoothing on its own grid.
+  const ResolutionKernel rect = resolution_kernel(WindowType::kRectangular, 1000, 1000.0);
+  EXPECT_EQ(rect.weights.size(), 1u);
+  EXPECT_FALSE(rect.active());
+}
+
+TEST(ResolutionKernel, SecondMomentIsTheContinuousKernels) {
+  // The continuous |W(nu)|^2's second moment in lines^2 is (N / 2 pi)^2 sum |w'|^2 / sum w^2 (Parseval on
+  // the derivative): 1/3 for hann. The sampled kernel has the same, for the symmetric window too (to O(1/N)).
+  for (const WindowType type : {WindowType::kHannPeriodic, WindowType::kHannSymmetric, WindowType::kHammingPeriodic}) {
+    const Eigen::Index n = 4096;
+    const ResolutionKernel k = resolution_kernel(type, n, 1.0);
+    double moment = 0.0, sum = 0.0;
+    for (long j = -k.half_width(); j <= k.half_width(); ++j) {
+      moment += k.weights[static_cast<std::size_t>(j + k.half_width())] * static_cast<double>(j * j);
+      sum += k.weights[static_cast<std::size_t>(j + k.half_width())];
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-14);
+    // Continuous window of the same cosine coefficients: hann (0.5, 0.5): (1/2 * 0.25) / 0.375 / 1 = 1/3.
+    const double c1 = type == WindowType::kHammingPeriodic ? 0.46 : 0.5, c0 = type == WindowType::kHammingPeriodic ? 0.54 : 0.5;
+    const double continuous = (c1 * c1 / 2.0) / (c0 * c0 + c1 * c1 / 2.0);
+    EXPECT_NEAR(moment, continuous, type == WindowType::kHannSymmetric ? 2e-3 : 1e-12) << to_string(type);
+  }
+}
+
+TEST(ResolutionKernel, SmoothsAQuadraticByItsSecondMoment) {
+  // H(f) = c0 + c1 f + c2 f^2: hann's (1/6, 2/3, 1/6) gives H + c2 df^2 / 3 (a line is unchanged).
+  const ResolutionKernel k = resolution_kernel(WindowType::kHannPeriodic, 400, 100.0);  // df = 0.25 Hz
+  const Complex c0(1.0, -2.0), c1(0.3, 0.1), c2(-0.05, 0.02);
+  const auto h = [&](double omega) {
+    const double f = omega / (2.0 * std::numbers::pi);
+    return c0 + c1 * f + c2 * f * f;
+  };
+  const double f = 37.0, w = 2.0 * std::numbers::pi * f;
+  const Complex s = smoothed_response(k, w, h);
+  const Complex expected = h(w) + c2 * 0.25 * 0.25 / 3.0;
+  EXPECT_NEAR(std::abs(s - expected), 0.0, 1e-12);
+  // Inactive kernel: the response itself.
+  EXPECT_EQ(smoothed_response(ResolutionKernel{}, w, h), h(w));
+  // A vector of outputs goes through as a whole.
+  const auto two = [&](double omega) { return Eigen::Vector2cd(h(omega), 2.0 * h(omega)); };
+  const Eigen::Vector2cd v = smoothed_response(k, w, two);
+  EXPECT_NEAR(std::abs(v(1) - 2.0 * expected), 0.0, 1e-12);
+}
+
+TEST(ResolutionKernel, WelchEstimateOfAResonanceConvergesToTheSmoothedResponse) {
+  // A resonance of 10 Hz, zeta 0.05 (half-power width 1 Hz, four 0.25 Hz lines, as the virtual bench's
+  // resonance is 16 of its lines) driven by white noise, noise-free output, estimated with hann at 50 %:
+  // at the peak the estimate is ~7 % below H (H'' df^2 / 6 to second order) and within its random error
+  // (0.4-1 % at the peak for 800 segments, seeds 4-6; 2.5 % for seed 3) of the smoothed response. The
+  // continuous kernel's expectation differs from the three sampled bins by 0.2 % there (numpy, not here).
+  const double fs = 64.0, fn = 10.0, zeta = 0.05;
+  const Eigen::Index nfft = 256, n = 256 * 400;
+  // Exact discrete resonance (impulse invariant two-pole filter) on white noise.
+  const double wn = 2.0 * std::numbers::pi * fn / fs, r = std::exp(-zeta * wn), wd = wn * std::sqrt(1.0 - zeta * zeta);
+  const double a1 = -2.0 * r * std::cos(wd), a2 = r * r;
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::VectorXd u(n), y(n);
+  double y1 = 0.0, y2 = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    u(i) = g(rng);
+    const double yi = u(i) - a1 * y1 - a2 * y2;
+    y(i) = yi;
+    y2 = y1;
+    y1 = yi;
+  }
+  const auto h = [&](double omega) {
+    const Complex z = std::polar(1.0, -omega / fs);  // z^-1
+    return 1.0 / (1.0 + a1 * z + a2 * z * z);
+  };
+  WelchOptions o;
+  o.nfft = nfft;
+  o.overlap = 0.5;
+  o.threads = 1;
+  const Frf frf = estimate_frf(channel("u", u), {channel("y", y)}, fs, o).frf;
+  const ResolutionKernel k = resolution_kernel(frf.provenance);
+  ASSERT_TRUE(k.active());
+  double raw = 0.0, smooth = 0.0;
+  for (Eigen::Index i = 0; i < frf.freq_Hz.size(); ++i) {
+    if (std::abs(frf.freq_Hz(i) - fn) > 0.6) continue;
+    const double w = 2.0 * std::numbers::pi * frf.freq_Hz(i);
+    raw = std::max(raw, std::abs(frf.H[0](i) / h(w) - 1.0));
+    smooth = std::max(smooth, std::abs(frf.H[0](i) / smoothed_response(k, w, h) - 1.0));
+  }
+  EXPECT_GT(raw, 0.05);
+  EXPECT_LT(smooth, raw / 4.0);
+  std::printf("peak error against H %.4f, against the smoothed H %.4f\n", raw, smooth);
+}
+
+TEST(ResolutionKernel, ProvenanceGivesTheKernelOrNone) {
+  FrfProvenance p;
+  EXPECT_FALSE(resolution_kernel(p).active());
+  p.window = "hann";
+  p.nfft = 40000;
+  p.sample_rate = 10000.0;
+  const ResolutionKernel k = resolution_kernel(p);
+  EXPECT_TRUE(k.active());
+  EXPECT_DOUBLE_EQ(k.line_spacing_Hz, 0.25);
+  p.window = "kaiser";  // not one of ours: its kernel is unknown
+  EXPECT_FALSE(resolution_kernel(p).active());
+  EXPECT_THROW((void)resolution_kernel(WindowType::kHannPeriodic, 1, 10.0), InputError);
+  EXPECT_THROW((void)resolution_kernel(WindowType::kHannPeriodic, 64, 0.0), InputError);
+}
+
+}  // namespace
+}  // namespace piezobench::dsp
