@@ -20,6 +20,7 @@
 #include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/ident/vector_fitting.hpp"
 #include "piezobench/io/atomic_file.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/io/lti_toml.hpp"
@@ -67,19 +68,19 @@ nlohmann::json frf_json(const dsp::Frf& frf) {
     if (i < frf.std_H.size() && frf.std_H[i].size() > 0) o["std"] = io::to_json(frf.std_H[i]);
     outputs[frf.outputs[i]] = std::move(o);
   }
+  // Welch's settings from dsp::FrfProvenance's declaration (estimator, nfft, overlap, detrend,
+  // averages; the window below as an object); the fields its declaration keeps out of results.json
+  // (source, sample rate, effective averages) and the FRF itself, whose outputs this document keys by name.
   const auto& p = frf.provenance;
-  return {{"source", p.source},
-          {"input", frf.input},
-          {"freq_Hz", io::to_json(frf.freq_Hz)},
-          {"window", {{"name", p.window}, {"length", p.nfft}, {"periodic", p.window.find("periodic") != std::string::npos}}},
-          {"nfft", p.nfft},
-          {"overlap", p.overlap},
-          {"detrend", p.detrend},
-          {"estimator", p.estimator},
-          {"averages", p.averages},
-          {"effective_averages", io::to_json(p.effective_averages)},
-          {"sample_rate_Hz", p.sample_rate},
-          {"outputs", std::move(outputs)}};
+  nlohmann::json doc = io::results_object(p);
+  doc["window"] = {{"name", p.window}, {"length", p.nfft}, {"periodic", p.window.find("periodic") != std::string::npos}};
+  doc["source"] = p.source;
+  doc["input"] = frf.input;
+  doc["freq_Hz"] = io::to_json(frf.freq_Hz);
+  doc["effective_averages"] = io::to_json(p.effective_averages);
+  doc["sample_rate_Hz"] = p.sample_rate;
+  doc["outputs"] = std::move(outputs);
+  return doc;
 }
 
 int run_frf(const FrfOptions& o) {

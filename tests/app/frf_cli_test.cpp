@@ -7,10 +7,13 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
+#include "piezobench/dsp/frf.hpp"
 #include "run_cli.hpp"
 #include "test_util.hpp"
 
@@ -42,6 +45,34 @@ TEST(FrfCli, MatFileMadeByScipyGivesScipysH1AndCoherence) {
           << name << " bin " << k;
     }
   }
+}
+
+// `frf --json`: Welch's settings are dsp::FrfProvenance's results fields under their declared keys
+// (the window as an object with its name and length); the rest is what the command names itself.
+TEST(FrfCli, JsonKeysOfTheProvenanceComeFromItsDeclaration) {
+  const std::string mat = test::fixture_path("io/scipy_two_outputs.mat").string();
+  const test::CliRun r = run_cli("frf " + mat + " --input u_dac --output d_enc --nfft 512 --overlap 0.5 --detrend none --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::set<std::string> declared;
+  core::for_each_field<dsp::FrfProvenance>([&](const auto& f) {
+    if (f.in(core::kResults)) declared.insert(core::results_key(f));
+  });
+  EXPECT_EQ(declared, (std::set<std::string>{"estimator", "window", "nfft", "overlap", "detrend", "averages"}));
+  std::set<std::string> keys;
+  for (const auto& [k, v] : j.items()) keys.insert(k);
+  std::set<std::string> own = {"source", "input", "freq_Hz", "effective_averages", "sample_rate_Hz", "outputs", "H_units", "warnings"};
+  std::set<std::string> expected = declared;
+  expected.insert(own.begin(), own.end());
+  EXPECT_EQ(keys, expected);
+  EXPECT_EQ(j["estimator"], "H1");
+  EXPECT_EQ(j["nfft"], 512);
+  EXPECT_EQ(j["overlap"], 0.5);
+  EXPECT_EQ(j["detrend"], "none");
+  EXPECT_EQ(j["averages"], 15);  // (4096 - 512) / 256 + 1
+  EXPECT_EQ(j["window"]["name"], "hann-periodic");
+  EXPECT_EQ(j["window"]["length"], 512);
+  EXPECT_EQ(j["window"]["periodic"], true);
 }
 
 TEST(FrfCli, WritesTheFrfThatFitReadsBack) {
