@@ -17,6 +17,7 @@
 #include "piezobench/core/checked_number.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/rt/comedi_backend.hpp"
@@ -55,22 +56,13 @@ nlohmann::json settings_json(const io::TimeSeries& ts) {
 
 }  // namespace
 
-nlohmann::json timing_json(const rt::TimingSummary& s) {
-  return {{"p50", s.p50}, {"p99", s.p99}, {"p999", s.p999}, {"max", s.max}, {"mean", s.mean}, {"count", s.count}};
-}
-
-nlohmann::json loop_timing_json(const rt::LoopReport& r) {
-  const auto known = [](auto value) { return value >= 0 ? nlohmann::json(value) : nlohmann::json(nullptr); };
-  return {{"overruns", r.overruns},
-          {"overrun_causes", {{"late_wakeup", r.overruns_late_wakeup}, {"long_step", r.overruns_long_step}}},
-          {"host",
-           {{"overruns_late_wakeup", r.overruns_late_wakeup},
-            {"skipped_deadlines", r.skipped_deadlines},
-            {"wait_ms", known(r.host_wait_ms)},
-            {"preemptions", known(r.host_preemptions)}}},
-          {"code", {{"overruns_long_step", r.overruns_long_step}, {"step_time_us", timing_json(r.step_time_us)}}},
-          {"skipped_deadlines", r.skipped_deadlines},
-          {"step_time_us", timing_json(r.step_time_us)}};
+nlohmann::json loop_report_json(const rt::LoopReport& r) {
+  nlohmann::json doc = io::results_object(r);
+  doc["host"]["overruns_late_wakeup"] = r.overruns_late_wakeup;
+  doc["host"]["skipped_deadlines"] = r.skipped_deadlines;
+  doc["code"] = {{"overruns_long_step", r.overruns_long_step}, {"step_time_us", doc["step_time_us"]}};
+  if (!r.realtime) doc["period_jitter_us"] = doc["wake_latency_us"] = nullptr;
+  return doc;
 }
 
 const std::atomic<bool>* stop_on_sigint() {
@@ -252,21 +244,29 @@ void add_hardware_json(const MeasureRequest& r, const Measurement& m, nlohmann::
   doc["backend"] = m.backend->name();
   doc["bench_file"] = r.bench->source;
   doc["cycles"] = rep.cycles();
-  doc["io"] = {{"exchanges", io.exchanges}, {"replies", io.replies}, {"lost", io.lost},       {"late", io.late},
-               {"stale_inputs", io.timeouts}, {"errors", io.errors}, {"rejected", io.rejected},
-               {"round_trip_us", timing_json(io.round_trip_us)}};
+  doc["io"] = io::results_object(io);
+  // Each run: the part of its loop report (rt::LoopReport's declared keys) the measurement shows;
+  // the whole report is `rt --json`'s.
+  static constexpr const char* kRunKeys[] = {"overruns",
+                                             "overrun_causes",
+                                             "host",
+                                             "code",
+                                             "skipped_deadlines",
+                                             "step_time_us",
+                                             "cycles",
+                                             "feedforward",
+                                             "clamped_samples",
+                                             "slew_limited_samples",
+                                             "stale_sensor_samples",
+                                             "safe_state_reason",
+                                             "sched_fifo",
+                                             "memory_locked",
+                                             "warnings"};
   nlohmann::json runs = nlohmann::json::array();
   for (const rt::LoopReport& lr : rep.runs) {
-    nlohmann::json run = loop_timing_json(lr);
-    run.update({{"cycles", lr.cycles},
-                {"feedforward", lr.feedforward},
-                {"clamped_samples", lr.clamped_samples},
-                {"slew_limited_samples", lr.slew_limited_samples},
-                {"stale_sensor_samples", lr.stale_sensor_samples},
-                {"safe_state_reason", lr.safe_state_reason},
-                {"sched_fifo", lr.sched_fifo},
-                {"memory_locked", lr.memory_locked},
-                {"warnings", lr.warnings}});
+    const nlohmann::json report = loop_report_json(lr);
+    nlohmann::json run = nlohmann::json::object();
+    for (const char* key : kRunKeys) run[key] = report.at(key);
     runs.push_back(std::move(run));
   }
   doc["runs"] = runs;

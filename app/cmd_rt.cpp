@@ -13,6 +13,7 @@
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/usage_error.hpp"
 #include "piezobench/dsp/excitation.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/hysteresis_toml.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/rt/bench_file.hpp"
@@ -202,59 +203,20 @@ nlohmann::json signal_summary(const rt::LoopOptions& lo, const io::TimeSeries& l
           {"y_rms_V", rms(log.channel("y"))}};
 }
 
-nlohmann::json limits_json(const rt::ActuatorLimits& limits) {
-  return {{"actuator", limits.actuator},
-          {"va_min_V", limits.va_min},
-          {"va_max_V", limits.va_max},
-          {"amplifier_gain", limits.amplifier_gain},
-          {"slew_rate_V_per_s", limits.slew_rate},
-          {"ramp_s", limits.ramp_in},
-          {"watchdog_s", limits.watchdog_timeout},
-          {"saturation_time_s", limits.saturation_time},
-          {"stale_cycles", limits.stale_cycles}};
-}
-
-// The --json document of a run.
+// The --json document of a run: the loop's report (loop_report_json: rt::LoopReport's declared
+// fields, its I/O rt::IoStats', its timing summaries rt::TimingSummary's), the limits
+// (rt::ActuatorLimits' declared fields), and what only the command knows: the bench's source, the
+// options, the log file and the signals computed from the log.
 nlohmann::json rt_json(const RtOptions& o, const RtBench& b, const rt::LoopReport& r, const nlohmann::json& signals) {
-  nlohmann::json doc = loop_timing_json(r);
+  nlohmann::json doc = loop_report_json(r);
+  doc["io"].erase("rejected");  // this document has always left it out (measure's has it)
   doc.update({{"source", b.source},
               {"controller", o.controller},
               {"gain", o.gain},
-              {"rate_Hz", r.sample_rate},
               {"duration_s", o.duration},
-              {"realtime", r.realtime},
-              {"sched_fifo", r.sched_fifo},
-              {"memory_locked", r.memory_locked},
-              {"cycles", r.cycles},
-              {"wind_down_cycles", r.wind_down_cycles},
-              {"period_jitter_us", r.realtime ? timing_json(r.period_jitter_us) : nlohmann::json(nullptr)},
-              {"wake_latency_us", r.realtime ? timing_json(r.wake_latency_us) : nlohmann::json(nullptr)},
-              {"clamped_samples", r.clamped_samples},
-              {"slew_limited_samples", r.slew_limited_samples},
-              {"safe_state_events", r.safe_state_events},
-              {"safe_state_reason", r.safe_state_reason},
-              {"safe_state_cycle", r.safe_state_cycle},
-              {"watchdog_trips", r.watchdog_trips},
-              {"nonfinite_sensor_samples", r.nonfinite_sensor_samples},
-              {"stale_sensor_samples", r.stale_sensor_samples},
-              {"feedforward", r.feedforward},
-              {"va_cmd_min_V", r.va_cmd_min},
-              {"va_cmd_max_V", r.va_cmd_max},
-              {"io",
-               {{"exchanges", r.io.exchanges},
-                {"replies", r.io.replies},
-                {"lost", r.io.lost},
-                {"late", r.io.late},
-                {"stale_inputs", r.io.timeouts},
-                {"errors", r.io.errors},
-                {"round_trip_us", timing_json(r.io.round_trip_us)}}},
-              {"max_va_cmd_step_V", r.max_va_cmd_step},
-              {"limits", limits_json(b.limits)},
+              {"limits", io::results_object(b.limits)},
               {"log", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
-              {"logged_samples", r.logged_samples},
-              {"dropped_log_samples", r.dropped_log_samples},
-              {"signals", signals},
-              {"warnings", r.warnings}});
+              {"signals", signals}});
   return doc;
 }
 

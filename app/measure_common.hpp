@@ -47,12 +47,12 @@ inline constexpr const char* kHysteresisLawHelp =
 // Runs the experiment, writes the record, prints the summary (or the JSON document).
 int run_measurement(const MeasureRequest& request);
 
-// The timing report of one loop run as JSON, the same in `rt --json` and in each run of
-// `measure --json`: overruns and their causes, what the shared host took (late wake-ups, skipped
-// deadlines, wait for a core, preemptions) apart from what the code took (long steps, step time).
-nlohmann::json loop_timing_json(const rt::LoopReport& report);
-// p50, p99, p999, max, mean and count of a timing summary.
-nlohmann::json timing_json(const rt::TimingSummary& summary);
+// One loop run as JSON, the same in `rt --json` and in each run of `measure --json` (which shows
+// a part of it): rt::LoopReport's declared fields (io::results_object), plus the timing figures
+// grouped again by where they come from: what the shared host took ("host": late wake-ups,
+// skipped deadlines, wait for a core, preemptions) apart from what the code took ("code": long
+// steps, step time). The pacing percentiles are null in lockstep (no clock to be late on).
+nlohmann::json loop_report_json(const rt::LoopReport& report);
 
 // The backend a bench file names (virtual: the batch unit of its [virtual] table, or its twin). InputError when
 // the device cannot be used. reset_target: a UDP target found in its latched safe state is reset

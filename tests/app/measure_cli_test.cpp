@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <chrono>
 #include <string>
 #include <thread>
@@ -14,8 +15,11 @@
 #include <variant>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/io/timeseries.hpp"
+#include "piezobench/rt/backend.hpp"
+#include "piezobench/rt/loop.hpp"
 #include "run_cli.hpp"
 
 namespace piezobench {
@@ -182,6 +186,32 @@ TEST(MeasureCli, TwoProcessesOverLoopbackMatchTheInProcessBench) {
   EXPECT_EQ(run["overrun_causes"]["late_wakeup"].get<std::uint64_t>() + run["overrun_causes"]["long_step"].get<std::uint64_t>(),
             run["overruns"].get<std::uint64_t>());
   EXPECT_EQ(run["code"]["step_time_us"], run["step_time_us"]);
+  // The JSON's keys for the declared structs come from their declarations: "io" is rt::IoStats'
+  // (rejected included, unlike rt's), each run a part of rt::LoopReport's with rt's values.
+  const auto keys_of = [](const nlohmann::json& object) {
+    std::set<std::string> keys;
+    for (const auto& item : object.items()) keys.insert(item.key());
+    return keys;
+  };
+  std::set<std::string> io_keys, report_keys = {"host", "code"}, timing_keys;
+  core::for_each_field<rt::IoStats>([&](const auto& f) {
+    if (f.in(core::kResults)) io_keys.insert(core::results_key(f));
+  });
+  core::for_each_field<rt::LoopReport>([&](const auto& f) {
+    const std::string key = core::results_key(f);
+    if (f.in(core::kResults)) report_keys.insert(key.substr(0, key.find('.')));
+  });
+  core::for_each_field<rt::TimingSummary>([&](const auto& f) {
+    if (f.in(core::kResults)) timing_keys.insert(core::results_key(f));
+  });
+  EXPECT_EQ(keys_of(mj["io"]), io_keys);
+  EXPECT_TRUE(io_keys.count("stale_inputs") == 1 && io_keys.count("rejected") == 1);
+  EXPECT_EQ(keys_of(mj["io"]["round_trip_us"]), timing_keys);
+  EXPECT_EQ(keys_of(run), (std::set<std::string>{"overruns", "overrun_causes", "host", "code", "skipped_deadlines", "step_time_us", "cycles",
+                                                 "feedforward", "clamped_samples", "slew_limited_samples", "stale_sensor_samples",
+                                                 "safe_state_reason", "sched_fifo", "memory_locked", "warnings"}));
+  for (const std::string& key : keys_of(run)) EXPECT_EQ(report_keys.count(key), 1U) << key << " is not a LoopReport key";
+  EXPECT_EQ(keys_of(run["step_time_us"]), timing_keys);
   ASSERT_EQ(run_cli("simulate frf-noise --unit 1 --seed 1 --duration 4 --out " + sim_mat).exit_code, 0);
   const std::string served = server.finish();
   EXPECT_EQ(nlohmann::json::parse(served)["sessions"], 2) << served;

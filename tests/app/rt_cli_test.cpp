@@ -3,8 +3,13 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <string>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/io/timeseries.hpp"
+#include "piezobench/rt/loop.hpp"
+#include "piezobench/rt/safety.hpp"
 #include "run_cli.hpp"
 #include "test_util.hpp"
 
@@ -12,6 +17,54 @@ namespace piezobench {
 namespace {
 
 using test::run_cli;
+
+template <class S> std::set<std::string> declared_keys() {
+  std::set<std::string> keys;
+  core::for_each_field<S>([&](const auto& f) {
+    if (f.in(core::kResults)) keys.insert(core::results_key(f));
+  });
+  return keys;
+}
+
+std::set<std::string> keys_of(const nlohmann::json& object) {
+  std::set<std::string> keys;
+  for (const auto& [k, v] : object.items()) keys.insert(k);
+  return keys;
+}
+
+// `rt --json` is rt::LoopReport's declared keys (a dotted key under its first part), "host" and
+// "code" (the timing figures grouped by origin), and the command's own: the bench's source, the
+// options, the log and the logged signals. The limits, the I/O and the timing summaries are
+// rt::ActuatorLimits', rt::IoStats' (without "rejected") and rt::TimingSummary's declared keys.
+TEST(RtCli, JsonKeysComeFromTheDeclarations) {
+  const test::CliRun r = run_cli("rt --bench virtual --gain 1e8 --excitation noise --amplitude 5 --duration 0.1 --realtime false --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  std::set<std::string> top = {"code", "source", "controller", "gain", "duration_s", "limits", "log", "signals"};
+  for (const std::string& key : declared_keys<rt::LoopReport>()) top.insert(key.substr(0, key.find('.')));
+  EXPECT_EQ(keys_of(j), top);
+  EXPECT_TRUE(top.count("rate_Hz") == 1 && top.count("overrun_causes") == 1 && top.count("va_cmd_max_V") == 1);
+  EXPECT_EQ(keys_of(j["overrun_causes"]), (std::set<std::string>{"late_wakeup", "long_step"}));
+  EXPECT_EQ(keys_of(j["host"]), (std::set<std::string>{"wait_ms", "preemptions", "overruns_late_wakeup", "skipped_deadlines"}));
+  EXPECT_TRUE(j["host"]["wait_ms"].is_null());  // lockstep: unknown
+  EXPECT_EQ(keys_of(j["limits"]), declared_keys<rt::ActuatorLimits>());
+  EXPECT_EQ(keys_of(j["limits"]), (std::set<std::string>{"actuator", "va_min_V", "va_max_V", "amplifier_gain", "slew_rate_V_per_s",
+                                                          "ramp_s", "watchdog_s", "saturation_time_s", "stale_cycles"}));
+  EXPECT_EQ(j["limits"]["va_max_V"], 150.0);
+  EXPECT_EQ(j["limits"]["amplifier_gain"], 20.0);
+  std::set<std::string> io = declared_keys<rt::IoStats>();
+  io.erase("rejected");
+  EXPECT_EQ(keys_of(j["io"]), io);
+  const std::set<std::string> timing = declared_keys<rt::TimingSummary>();
+  EXPECT_EQ(timing, (std::set<std::string>{"p50", "p99", "p999", "max", "mean", "count"}));
+  EXPECT_EQ(keys_of(j["step_time_us"]), timing);
+  EXPECT_EQ(j["code"]["step_time_us"], j["step_time_us"]);
+  EXPECT_EQ(keys_of(j["io"]["round_trip_us"]), timing);
+  EXPECT_TRUE(j["period_jitter_us"].is_null());  // lockstep: no pacing
+  EXPECT_EQ(j["cycles"], 1000);                  // 0.1 s at 10 kHz
+  EXPECT_EQ(j["step_time_us"]["count"], 1000);
+  EXPECT_EQ(j["rate_Hz"], 10000.0);
+}
 
 // The command, shortened to 0.3 s: real time, IFF at the report's optimal gain on the
 // virtual bench. Every cycle logged, timing reported, the damped loop stays at rest (no

@@ -13,6 +13,7 @@
 #include <limits>
 #include <string>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/rt/timing.hpp"
 
 namespace piezobench::rt {
@@ -53,6 +54,20 @@ struct IoStats {
   std::uint64_t rejected = 0;    // datagrams refused (udp: another session's, a tag that does not verify)
   TimingSummary round_trip_us;   // request -> reply (udp) or instruction list (comedi) time
 };
+
+constexpr auto describe(core::Type<IoStats>) {
+  using S = IoStats;
+  using core::shown::kNone;
+  return core::fields<S>("IoStats", "a backend's I/O health over a run",
+      core::field("exchanges", &S::exchanges, kNone, "I/O transactions started (datagrams sent, instruction lists run)"),
+      core::field("replies", &S::replies, kNone, "answered in time"),
+      core::field("lost", &S::lost, kNone, "never answered (counted when the backend stops)"),
+      core::field("late", &S::late, kNone, "answered after the cycle had given up on them (stale input)"),
+      core::field("timeouts", &S::timeouts, kNone, "reads that returned no fresh sample in time").key("stale_inputs"),
+      core::field("errors", &S::errors, kNone, "device errors (each one also trips the safe state)"),
+      core::field("rejected", &S::rejected, kNone, "datagrams refused (udp: another session's, a tag that does not verify)"),
+      core::field("round_trip_us", &S::round_trip_us, kNone, "request -> reply (udp) or instruction list (comedi) time, us"));
+}
 
 class Backend {
  public:

@@ -44,6 +44,7 @@
 #include <Eigen/Core>
 
 #include "piezobench/control/discrete_iff.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/control/hysteresis_feedforward.hpp"
 #include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/io/timeseries.hpp"
@@ -141,6 +142,60 @@ struct LoopReport {
   double max_va_cmd_step = 0.0;               // V, largest |change| of it between two cycles
   std::vector<std::string> warnings;
 };
+
+// The host's share, null when unknown (-1: not Linux, lockstep mode).
+inline std::optional<double> known_host_wait_ms(const LoopReport& r) {
+  return r.host_wait_ms >= 0 ? std::optional<double>(r.host_wait_ms) : std::nullopt;
+}
+inline std::optional<std::int64_t> known_host_preemptions(const LoopReport& r) {
+  return r.host_preemptions >= 0 ? std::optional<std::int64_t>(r.host_preemptions) : std::nullopt;
+}
+
+// `rt --json`'s keys (the command adds the duplicates under "host" and "code" and its options).
+constexpr auto describe(core::Type<LoopReport>) {
+  using S = LoopReport;
+  using namespace core::shown;
+  return core::fields<S>("LoopReport", "what a run of the real-time loop did",
+      core::field("backend", &S::backend, kNone, "\"virtual\", \"replay\", \"udp\", ...").part_only(),
+      core::field("sample_rate", &S::sample_rate, kHertz, "the loop's rate").key("rate_Hz"),
+      core::field("realtime", &S::realtime, kNone, "paced by the clock (false: lockstep)"),
+      core::field("sched_fifo", &S::sched_fifo, kNone, "SCHED_FIFO obtained"),
+      core::field("memory_locked", &S::memory_locked, kNone, "mlockall obtained"),
+      core::field("cycles", &S::cycles, kNone, "cycles run"),
+      core::field("overruns", &S::overruns, kNone, "cycles that ended after the next deadline"),
+      core::field("overruns_late_wakeup", &S::overruns_late_wakeup, kNone, "overruns charged to the wake-up's lateness (the host)")
+          .key("overrun_causes.late_wakeup"),
+      core::field("overruns_long_step", &S::overruns_long_step, kNone, "overruns charged to the step's execution time (the code)")
+          .key("overrun_causes.long_step"),
+      core::field("host_wait_ms", &S::host_wait_ms, kMillisecond, "time runnable but waiting for a core, -1 unknown").part_only(),
+      core::field("host_preemptions", &S::host_preemptions, kNone, "involuntary context switches, -1 unknown").part_only(),
+      core::derived("host_wait", &known_host_wait_ms, kMillisecond, "time runnable but waiting for a core (null: unknown)")
+          .key("host.wait_ms"),
+      core::derived("host_preemptions_known", &known_host_preemptions, kNone, "involuntary context switches (null: unknown)")
+          .key("host.preemptions"),
+      core::field("skipped_deadlines", &S::skipped_deadlines, kNone, "deadlines skipped after an overrun"),
+      core::field("wind_down_cycles", &S::wind_down_cycles, kNone, "extra cycles that brought the output to the safe value"),
+      core::field("period_jitter_us", &S::period_jitter_us, kNone, "|actual period - T| between consecutive wake-ups, us"),
+      core::field("wake_latency_us", &S::wake_latency_us, kNone, "wake-up time - deadline, us"),
+      core::field("step_time_us", &S::step_time_us, kNone, "execution time of a cycle: read .. log push, us"),
+      core::field("feedforward", &S::feedforward, kNone, "the inverse hysteresis feedforward was on"),
+      core::field("clamped_samples", &S::clamped_samples, kNone, "outputs clamped to the actuator's range"),
+      core::field("slew_limited_samples", &S::slew_limited_samples, kNone, "outputs held to the slew rate"),
+      core::field("safe_state_events", &S::safe_state_events, kNone, "entries into the safe state"),
+      core::field("safe_state_reason", &S::safe_state_reason, kNone, "to_string(Fault), \"none\""),
+      core::field("safe_state_cycle", &S::safe_state_cycle, kNone, "first cycle in the safe state, -1 = never"),
+      core::field("nonfinite_sensor_samples", &S::nonfinite_sensor_samples, kNone, "sensor readings that were not finite"),
+      core::field("stale_sensor_samples", &S::stale_sensor_samples, kNone, "reads without a fresh sample"),
+      core::field("watchdog_trips", &S::watchdog_trips, kNone, "safe states tripped by the watchdog"),
+      core::field("interrupted", &S::interrupted, kNone, "the run was ended by LoopOptions::stop").part_only(),
+      core::field("io", &S::io, kNone, "the backend's I/O health"),
+      core::field("logged_samples", &S::logged_samples, kNone, "samples written to the log"),
+      core::field("dropped_log_samples", &S::dropped_log_samples, kNone, "samples the logger could not keep"),
+      core::field("va_cmd_min", &S::va_cmd_min, kVolt, "lowest commanded stack voltage"),
+      core::field("va_cmd_max", &S::va_cmd_max, kVolt, "highest commanded stack voltage"),
+      core::field("max_va_cmd_step", &S::max_va_cmd_step, kVolt, "largest |change| of it between two cycles"),
+      core::field("warnings", &S::warnings, kNone, "what the run noticed"));
+}
 
 // The loop with the pacing left to the caller: start(), then cycle() until it returns false, then
 // finish(). run_loop() does this with the pacing, the threads and the real-time setup; tests call

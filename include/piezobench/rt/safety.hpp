@@ -24,6 +24,7 @@
 #include <optional>
 #include <string>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/rt/backend.hpp"
 
 namespace piezobench::rt {
@@ -71,6 +72,28 @@ struct ActuatorLimits {
   // Largest change of the DAC command per sample at `sample_rate` Hz.
   [[nodiscard]] double max_step(double sample_rate) const { return slew_rate / amplifier_gain / sample_rate; }
 };
+
+inline constexpr core::Shown kVoltPerSecond{"V/s", "V/s", 1.0};
+
+constexpr auto describe(core::Type<ActuatorLimits>) {
+  using S = ActuatorLimits;
+  using namespace core::shown;
+  return core::fields<S>("ActuatorLimits", "the limits the real-time loop keeps the actuator's output in",
+      core::field("actuator", &S::actuator, kNone, "actuator the limits are for"),
+      core::field("va_min", &S::va_min, kVolt, "lowest stack voltage"),
+      core::field("va_max", &S::va_max, kVolt, "highest stack voltage"),
+      core::field("amplifier_gain", &S::amplifier_gain, kVoltPerVolt, "DAC voltage -> stack voltage").key("amplifier_gain"),
+      core::field("va_safe", &S::va_safe, kVolt, "stack voltage of the safe state and of the ramps' ends").part_only(),
+      core::field("slew_rate", &S::slew_rate, kVoltPerSecond, "largest rate of change of the stack voltage"),
+      core::field("ramp_in", &S::ramp_in, kSecond, "controller gain and output envelope from 0 to 1 at the start").key("ramp_s"),
+      core::field("ramp_out", &S::ramp_out, kSecond, "and back to 0 at the end of the run").part_only(),
+      core::field("watchdog_timeout", &S::watchdog_timeout, kSecond, "without a completed cycle before the safe state").key("watchdog_s"),
+      core::field("saturation_time", &S::saturation_time, kSecond, "of (net) saturated output before the safe state"),
+      core::field("stale_cycles", &S::stale_cycles, kNone, "consecutive stale reads tolerated"),
+      core::field("stale_budget", &S::stale_budget, kRatio, "held samples a run may contain, fraction of its cycles").part_only(),
+      core::field("de_range", &S::de_range, kMetre, "|d_e| beyond is a sensor fault").part_only(),
+      core::field("vs_range", &S::vs_range, kVolt, "|Vs| beyond is a sensor fault").part_only());
+}
 
 // What a datasheet says an actuator takes; the limits of a bench file must stay inside it.
 struct ActuatorDatasheet {

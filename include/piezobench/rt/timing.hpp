@@ -9,6 +9,8 @@
 #include <array>
 #include <cstdint>
 
+#include "piezobench/core/fields.hpp"
+
 namespace piezobench::rt {
 
 struct TimingSummary {
@@ -16,6 +18,25 @@ struct TimingSummary {
   double p50 = 0.0, p99 = 0.0, p999 = 0.0, p9999 = 0.0, max = 0.0;  // same unit as the samples
   double mean = 0.0;                                                // same unit as the samples
 };
+
+// The loop's durations are microseconds (TimingHistogram::summary_us), not SI seconds: the unit they
+// are kept and shown in.
+inline constexpr core::Shown kMicrosecond{"us", "us", 1.0};
+inline constexpr core::Shown kMillisecond{"ms", "ms", 1.0};
+
+// A summary's keys are the bare percentile names: the unit is in its parent's key ("step_time_us").
+constexpr auto describe(core::Type<TimingSummary>) {
+  using S = TimingSummary;
+  using core::shown::kNone;
+  return core::fields<S>("TimingSummary", "percentiles of a loop duration (TimingHistogram, microseconds)",
+      core::field("p50", &S::p50, kMicrosecond, "median").key("p50"),
+      core::field("p99", &S::p99, kMicrosecond, "99th percentile").key("p99"),
+      core::field("p999", &S::p999, kMicrosecond, "99.9th percentile").key("p999"),
+      core::field("p9999", &S::p9999, kMicrosecond, "99.99th percentile").part_only(),
+      core::field("max", &S::max, kMicrosecond, "largest sample (exact)").key("max"),
+      core::field("mean", &S::mean, kMicrosecond, "mean of the samples").key("mean"),
+      core::field("count", &S::count, kNone, "samples"));
+}
 
 class TimingHistogram {
  public:
