@@ -44,8 +44,8 @@
 #include <Eigen/Core>
 
 #include "piezobench/control/discrete_iff.hpp"
-#include "piezobench/core/fields.hpp"
 #include "piezobench/control/hysteresis_feedforward.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/rt/backend.hpp"
