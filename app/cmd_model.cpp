@@ -19,6 +19,7 @@
 #include "piezobench/ident/plant_fit.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/usage_error.hpp"
+#include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/frf_file.hpp"
 #include "piezobench/io/json.hpp"
 #include "piezobench/lti/freqresp.hpp"
@@ -73,7 +74,8 @@ int run_two_dof(const TwoDofCommand& o) {
   const lti::CVector h_vs = fr.channel(apa::kOutputVs, 0);
 
   if (o.json) {
-    print_json({{"model", "2dof"},
+    nlohmann::json doc = io::results_object(c);  // poles, zeros, static gains, resonances (declared)
+    doc.update(nlohmann::json{{"model", "2dof"},
                 {"params", params_json(p)},
                 {"params_source", o.params_file.empty() ? std::string("report Table 3.1") : o.params_file},
                 {"bench",
@@ -84,19 +86,11 @@ int run_two_dof(const TwoDofCommand& o) {
                   {"hpf_corner_Hz", o.bench.hpf_corner() / kTwoPi},
                   {"delay_s", o.bench.delay}}},
                 {"input", "u (V at the DAC, amplifier included)"},
-                {"poles", complex_list(c.poles)},
-                {"zeros_Vs", complex_list(c.zeros_vs)},
-                {"static_gain_de_um_per_V", io::to_json(c.static_gain_de * 1e6)},
-                {"static_gain_Vs_V_per_V", io::to_json(c.static_gain_vs)},
-                {"static_gain_Vs_before_hpf_V_per_V", io::to_json(c.static_gain_vs_actuator)},
-                {"resonance_Hz", io::to_json(c.resonance / kTwoPi)},
-                {"resonance_damping", io::to_json(c.resonance_damping)},
-                {"antiresonance_Hz", io::to_json(c.antiresonance / kTwoPi)},
-                {"antiresonance_damping", io::to_json(c.antiresonance_damping)},
                 {"units", {{"poles", "rad/s"}, {"zeros_Vs", "rad/s"}, {"H_de", "m/V"}, {"H_Vs", "V/V"}}},
                 {"freq_Hz", io::to_json(f)},
                 {"H_de", complex_list(h_de)},
                 {"H_Vs", complex_list(h_vs)}});
+    print_json(doc);
     return 0;
   }
   fmt::print("2-DoF APA model (report section 3), parameters from {}\n",
@@ -256,10 +250,8 @@ int run_piezo(const PiezoCommand& c) {
   const apa::PiezoSensitivities s = apa::piezo_sensitivities(c.constants);
   const apa::PiezoConstants& k = c.constants;
   if (c.json) {
-    print_json({{"ga_N_per_V", io::to_json(s.ga)},
-                {"gs_V_per_m", io::to_json(s.gs)},
-                {"ka_N_per_m", io::to_json(s.ka)},
-                {"formulas", "ka = cE A / L, ga = d33 n ka, gs = d33 / (eps_T sD n) (report eq. 4.1)"},
+    nlohmann::json doc = io::results_object(s);  // ka_N_per_m, ga_N_per_V, gs_V_per_m (declared)
+    doc.update(nlohmann::json{{"formulas", "ka = cE A / L, ga = d33 n ka, gs = d33 / (eps_T sD n) (report eq. 4.1)"},
                 {"constants",
                  {{"d33_m_per_V", k.d33},
                   {"eps_t_F_per_m", k.eps_t},
@@ -268,6 +260,7 @@ int run_piezo(const PiezoCommand& c) {
                   {"length_m", k.length},
                   {"area_m2", k.area},
                   {"layers", k.layers}}}});
+    print_json(doc);
     return 0;
   }
   fmt::print("stack sensitivities from piezo constants (report eq. 4.1)\n");

@@ -126,22 +126,13 @@ void bind_two_dof_models(py::module_& m) {
 
 // characterize, default_params and piezo_sensitivities.
 void bind_characterization(py::module_& m) {
+  bind_described<TwoDofCharacteristics>(m);
+  bind_described<PiezoSensitivities>(m);
   m.def(
       "characterize",
       [](const py::kwargs& kw) {
         auto [p, b] = model_kwargs(kw, "apa.characterize");
-        auto c = characterize(p, b);
-        py::dict d;
-        d["poles"] = to_numpy(std::move(c.poles));
-        d["zeros_vs"] = to_numpy(std::move(c.zeros_vs));
-        d["static_gain_de"] = c.static_gain_de;
-        d["static_gain_vs"] = c.static_gain_vs;
-        d["static_gain_vs_actuator"] = c.static_gain_vs_actuator;
-        d["resonance"] = c.resonance;
-        d["resonance_damping"] = c.resonance_damping;
-        d["antiresonance"] = c.antiresonance;
-        d["antiresonance_damping"] = c.antiresonance_damping;
-        return result("TwoDofCharacteristics", d);
+        return characterize(p, b);
       },
       ("Poles, zeros of u -> Vs (rad/s), static gains (m/V, V/V), resonance and anti-resonance (rad/s)\n"
        "with damping: what `piezobench model 2dof` reports." + model_doc()).c_str());
@@ -151,12 +142,7 @@ void bind_characterization(py::module_& m) {
   m.def(
       "piezo_sensitivities",
       [](const py::kwargs& kw) {
-        auto s = piezo_sensitivities(piezo_options().from_kwargs(kwargs_dict(kw), "apa.piezo_sensitivities"));
-        py::dict d;
-        d["ka"] = s.ka;
-        d["ga"] = s.ga;
-        d["gs"] = s.gs;
-        return result("PiezoSensitivities", d);
+        return piezo_sensitivities(piezo_options().from_kwargs(kwargs_dict(kw), "apa.piezo_sensitivities"));
       },
       ("Eq. 4.1: ka = cE A / L (N/m), ga = d33 n ka (N/V), gs = d33 / (eps_T sD n) (V/m).\n"
        "Defaults: Table 4.1 (ga = 26.11 N/V, gs = 5.06e6 V/m, ka = 2.4e8 N/m).\n\nKeywords (PiezoConstants):\n" +

@@ -2,6 +2,8 @@
 
 #include <set>
 
+#include "piezobench/apa/piezo.hpp"
+#include "piezobench/apa/two_dof.hpp"
 #include "piezobench/campaign/results.hpp"
 #include "piezobench/campaign/twin.hpp"
 #include "piezobench/ident/actuator_frf.hpp"
@@ -38,6 +40,8 @@ std::string field_reference_markdown() {
   field_table<SuperElementComparison>(out, done);
   field_table<ident::LoopMetrics>(out, done);
   field_table<TwinBuild>(out, done);  // `piezobench twin --json`
+  field_table<apa::TwoDofCharacteristics>(out, done);  // `model 2dof --json`, apa.characterize
+  field_table<apa::PiezoSensitivities>(out, done);     // `piezo --json`, apa.piezo_sensitivities
   field_table<ident::ActuatorFrfAnalysis>(out, done);
   field_table<ident::ActuatorPlants>(out, done);
   field_table<ident::FrfFeatures>(out, done);

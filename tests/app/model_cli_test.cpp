@@ -13,6 +13,9 @@
 
 #include "run_cli.hpp"
 #include "test_util.hpp"
+#include "piezobench/apa/piezo.hpp"
+#include "piezobench/apa/two_dof.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/core/units.hpp"
 
 namespace piezobench {
@@ -292,6 +295,40 @@ TEST(ModelCli, PiezoTable41) {
     EXPECT_TRUE(test::no_result(b));
   }
   EXPECT_NE(run_cli("piezo --layers 160.5").err.find("layers"), std::string::npos);
+}
+
+// The commands' numbers are their structs' declared fields (issue 32): every field of
+// apa::TwoDofCharacteristics and apa::PiezoSensitivities is in the JSON under its results key, in its
+// shown unit, equal to the library's value.
+TEST(ModelCli, JsonKeysComeFromTheDeclarations) {
+  const Outcome r = run_cli("model 2dof --json --points 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const apa::TwoDofCharacteristics c = apa::characterize(apa::TwoDofParams{}, apa::TwoDofBench{});
+  int numbers = 0;
+  core::for_each_field<apa::TwoDofCharacteristics>([&](const auto& f) {
+    const std::string key = core::results_key(f);
+    ASSERT_TRUE(j.contains(key)) << key;
+    if constexpr (std::is_same_v<std::remove_cvref_t<decltype(f.of(c))>, double>) {
+      EXPECT_NEAR(j[key].get<double>(), f.of(c) * f.shown.per_si, 1e-12 * std::abs(f.of(c) * f.shown.per_si)) << key;
+      ++numbers;
+    } else {
+      EXPECT_EQ(j[key].size(), static_cast<std::size_t>(f.of(c).size())) << key;
+    }
+  });
+  EXPECT_EQ(numbers, 7);
+  EXPECT_TRUE(near(j["resonance_Hz"].get<double>(), 95.37, 1e-3));  // report Table 3.1's model
+
+  const Outcome p = run_cli("piezo --json");
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  const auto jp = nlohmann::json::parse(p.out);
+  const apa::PiezoSensitivities s = apa::piezo_sensitivities(apa::PiezoConstants{});
+  core::for_each_field<apa::PiezoSensitivities>([&](const auto& f) {
+    const std::string key = core::results_key(f);
+    ASSERT_TRUE(jp.contains(key)) << key;
+    EXPECT_DOUBLE_EQ(jp[key].get<double>(), f.of(s)) << key;
+  });
+  EXPECT_TRUE(jp.contains("ka_N_per_m") && jp.contains("ga_N_per_V") && jp.contains("gs_V_per_m"));
 }
 
 }  // namespace

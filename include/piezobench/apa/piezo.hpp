@@ -9,6 +9,8 @@
 // Defaults are Table 4.1 (THP5H-like soft PZT): ga = 26.11 N/V, gs = 5.06e6 V/m, ka = 2.4e8 N/m.
 #include <string>
 
+#include "piezobench/core/fields.hpp"
+
 namespace piezobench::apa {
 
 struct PiezoConstants {
@@ -30,6 +32,15 @@ struct PiezoSensitivities {
   double ga = 0.0;  // N/V
   double gs = 0.0;  // V/m
 };
+
+// Shown in SI (`model piezo --json`'s keys ka_N_per_m, ga_N_per_V, gs_V_per_m).
+constexpr auto describe(core::Type<PiezoSensitivities>) {
+  using S = PiezoSensitivities;
+  return core::fields<S>("PiezoSensitivities", "eq. 4.1's sensitivities of a stack from its material constants",
+      core::field("ka", &S::ka, core::Shown{"N/m", "N/m", 1.0}, "cE A / L: stack stiffness at constant field"),
+      core::field("ga", &S::ga, core::shown::kNewtonPerVolt, "d33 n ka: blocked force per volt (eq. 4.1b)"),
+      core::field("gs", &S::gs, core::Shown{"V/m", "V/m", 1.0}, "d33 / (eps_T sD n): open-circuit volts per metre of extension (eq. 4.1a)"));
+}
 
 // Eq. 4.1 (validates the constants).
 PiezoSensitivities piezo_sensitivities(const PiezoConstants& c);

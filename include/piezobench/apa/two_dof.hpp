@@ -129,6 +129,23 @@ struct TwoDofCharacteristics {
 };
 TwoDofCharacteristics characterize(const TwoDofParams& p, const TwoDofBench& bench);
 
+// `model 2dof --json`'s keys (poles and zeros in rad/s, the rest in their shown units).
+constexpr auto describe(core::Type<TwoDofCharacteristics>) {
+  using S = TwoDofCharacteristics;
+  using namespace core::shown;
+  return core::fields<S>("TwoDofCharacteristics", "poles, zeros, static gains and resonances of a 2-DoF model on the bench",
+      core::field("poles", &S::poles, kRadPerSecond, "poles of the model on the bench").key("poles"),
+      core::field("zeros_vs", &S::zeros_vs, kRadPerSecond, "transmission zeros of u -> Vs").key("zeros_Vs"),
+      core::field("static_gain_de", &S::static_gain_de, kMetrePerVoltAsUmPerV, "u -> d_e at s = 0"),
+      core::field("static_gain_vs", &S::static_gain_vs, kVoltPerVolt, "u -> Vs at s = 0 (0 with the high-pass)").key("static_gain_Vs_V_per_V"),
+      core::field("static_gain_vs_actuator", &S::static_gain_vs_actuator, kVoltPerVolt, "u -> Vs at s = 0 without the high-pass")
+          .key("static_gain_Vs_before_hpf_V_per_V"),
+      core::field("resonance", &S::resonance, kRadPerSecondAsHz, "natural frequency of the least damped pole pair"),
+      core::field("resonance_damping", &S::resonance_damping, kRatio, "its damping ratio"),
+      core::field("antiresonance", &S::antiresonance, kRadPerSecondAsHz, "natural frequency of the least damped zero pair of u -> Vs"),
+      core::field("antiresonance_damping", &S::antiresonance_damping, kRatio, "its damping ratio"));
+}
+
 constexpr auto describe(core::Type<TwoDofParams>) {
   using S = TwoDofParams;
   using namespace core::shown;
