@@ -11,6 +11,7 @@
 #include "piezobench/rt/loop.hpp"
 #include "piezobench/rt/safety.hpp"
 #include "run_cli.hpp"
+#include "declared_keys.hpp"
 #include "test_util.hpp"
 
 namespace piezobench {
@@ -18,19 +19,8 @@ namespace {
 
 using test::run_cli;
 
-template <class S> std::set<std::string> declared_keys() {
-  std::set<std::string> keys;
-  core::for_each_field<S>([&](const auto& f) {
-    if (f.in(core::kResults)) keys.insert(core::results_key(f));
-  });
-  return keys;
-}
-
-std::set<std::string> keys_of(const nlohmann::json& object) {
-  std::set<std::string> keys;
-  for (const auto& [k, v] : object.items()) keys.insert(k);
-  return keys;
-}
+using test::declared_keys;
+using test::keys_of;
 
 // `rt --json` is rt::LoopReport's declared keys (a dotted key under its first part), "host" and
 // "code" (the timing figures grouped by origin), and the command's own: the bench's source, the

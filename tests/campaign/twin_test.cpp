@@ -24,6 +24,7 @@
 #include "piezobench/io/fields_json.hpp"
 #include "piezobench/io/timeseries.hpp"
 #include "piezobench/metrology/stroke.hpp"
+#include "declared_keys.hpp"
 #include "test_util.hpp"
 
 namespace piezobench::campaign {
@@ -237,20 +238,8 @@ nlohmann::json::json_pointer pointer_of(std::string key) {
   return nlohmann::json::json_pointer("/" + key);
 }
 
-// The keys results_object writes for S: the declared ones in results.json, nothing else.
-template <class S> std::set<std::string> declared_keys() {
-  std::set<std::string> keys;
-  core::for_each_field<S>([&](const auto& f) {
-    if (f.in(core::kResults)) keys.insert(core::results_key(f));
-  });
-  return keys;
-}
-
-std::set<std::string> keys_of(const nlohmann::json& object) {
-  std::set<std::string> keys;
-  for (const auto& [k, v] : object.items()) keys.insert(k);
-  return keys;
-}
+using test::declared_keys;
+using test::keys_of;
 
 TEST(Twin, BuildJsonKeysComeFromTheDeclarations) {
   const TwinBuild& b = build();
