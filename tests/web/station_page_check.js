@@ -34,6 +34,8 @@ const WIDTH = 1280, HEIGHT = 1100;
 const TIMEOUT_MS = Number(process.env.PIEZOBENCH_PAGE_TIMEOUT_MS || 100000);
 const LATENCY_LIMIT_MS = 200;
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+// A latency in the summary: none when no sample arrived (the failures then say why).
+const ms = (x) => (typeof x === 'number' ? x.toFixed(0) : 'none');
 const t0 = Date.now();
 const trace = (what) => { if (process.env.PIEZOBENCH_PAGE_CHECK_VERBOSE) console.error(`${Date.now() - t0} ms: ${what}`); };
 
@@ -320,7 +322,7 @@ async function main() {
     else if (end.code !== 0) failures.push(`qualify exited with ${end.code} (${end.signal})`);
     summary = `station_page_check: ${live.phases.length} phases finished in order (${seenRunning} seen running), ${answered.length} prompts answered in the page, ` +
       `${live.samples} screen samples in ${live.messages} messages, FRF averages ${Array.from(frfAverages).sort((a, b) => a - b).join(',')}; ` +
-      `latency sample -> page p50 ${live.p50.toFixed(0)} ms, p99 ${live.p99.toFixed(0)} ms, max ${live.max.toFixed(0)} ms over ${live.latencies} samples; ` +
+      `latency sample -> page p50 ${ms(live.p50)} ms, p99 ${ms(live.p99)} ms, max ${ms(live.max)} ms over ${live.latencies} samples; ` +
       `verdict table (${live.table.length} measurements, unit ${live.verdict}) equal to the terminal's and the database's; ` +
       `hostile requests refused cleanly while it ran (1,000 concurrent: ${hostileResult.served} served, ${hostileResult.busy} refused 503); ` +
       `no console error; Ctrl-C with a stream open: exit in ${shutdownMs} ms; screenshots in ${out}`;
