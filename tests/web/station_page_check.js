@@ -37,7 +37,13 @@ const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 // A latency in the summary: none when no sample arrived (the failures then say why).
 const ms = (x) => (typeof x === 'number' ? x.toFixed(0) : 'none');
 const t0 = Date.now();
-const trace = (what) => { if (process.env.PIEZOBENCH_PAGE_CHECK_VERBOSE) console.error(`${Date.now() - t0} ms: ${what}`); };
+// What happened when: printed as it happens with PIEZOBENCH_PAGE_CHECK_VERBOSE, and with the failures.
+const traced = [];
+const trace = (what) => {
+  const line = `${Date.now() - t0} ms: ${what}`;
+  traced.push(line);
+  if (process.env.PIEZOBENCH_PAGE_CHECK_VERBOSE) console.error(line);
+};
 
 // qualify's table on stdout: "      NAME   VALUE UNIT [MIN, MAX] VERDICT" under "  PHASE  try N ...".
 function terminalTable(text) {
@@ -101,6 +107,20 @@ async function hostileBurst(port) {
   const served = statuses.filter((x) => x === 200).length, busy = statuses.filter((x) => x === 503).length;
   if (served + busy !== 1000 || served < 1) failures.push(`1,000 concurrent connections: ${served} served, ${busy} refused 503, ${1000 - served - busy} other`);
   return { failures, served, busy };
+}
+
+// Takes `count` of the station's event streams with raw sockets (each answered 200 and kept open);
+// resolves to a function that closes them.
+async function holdStreams(port, count) {
+  const net = require('node:net');
+  const sockets = await Promise.all(Array.from({ length: count }, () => new Promise((resolve) => {
+    const socket = net.connect(port, '127.0.0.1', () => socket.write(`GET /api/events HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\n\r\n`));
+    let head = '';
+    socket.on('data', (d) => { if (head.length < 64) { head += d.toString('latin1'); if (/^HTTP\/1\.1 \d{3}/.test(head)) resolve(socket); } });
+    socket.on('error', () => resolve(socket));
+    socket.setTimeout(5000, () => resolve(socket));
+  })));
+  return () => { for (const socket of sockets) socket.destroy(); };
 }
 
 // Types the capacitances in the page's fields as an operator would: first a bad sensor value
@@ -194,7 +214,23 @@ async function main() {
       return true;
     };
 
+    // Every stream the station serves taken (max_streams, 16): the page's stream is refused (503) and
+    // the browser closes it for good; the page must ask again by itself once one is free.
+    const port = Number(url.base.match(/:(\d+)\//)[1]);
+    const releaseStreams = await holdStreams(port, 16);
     await page.goto(url.base + '#token=' + url.token, { waitUntil: 'load' });
+    let refusedOnce = false;
+    for (let i = 0; i < 100 && !refusedOnce; ++i) { await sleep(50); refusedOnce = await evaluate('!!window.pbLive && window.pbLive.reconnects > 0'); }
+    releaseStreams();
+    if (!refusedOnce) failures.push('with every stream taken, the page saw no refusal of its own (pbLive.reconnects = 0)');
+    let reconnectedMs = null;
+    const released = Date.now();
+    for (let i = 0; i < 100 && reconnectedMs === null; ++i) {
+      if (await evaluate("document.getElementById('pb-status').dataset.state === 'connected'")) reconnectedMs = Date.now() - released;
+      else await sleep(100);
+    }
+    if (reconnectedMs === null) failures.push('the page did not connect within 10 s of a stream becoming free');
+    trace(`stream refused, then connected ${reconnectedMs} ms after the streams were freed`);
     let loaded = false;
     for (let i = 0; i < 100 && !loaded; ++i) {
       loaded = await evaluate("document.readyState === 'complete' && !!window.pbLive");
@@ -203,7 +239,6 @@ async function main() {
     if (!loaded) throw new Error('the page did not load within 5 s');
     trace('loaded');
     // Follow the qualification: answer each prompt with the mouse, watch the live data.
-    const port = Number(url.base.match(/:(\d+)\//)[1]);
     let hostile = null, typed = null;
     const answered = [];
     const samplesAt = [];
@@ -214,10 +249,14 @@ async function main() {
       const s = await evaluate(`(() => { const l = window.pbLive || {}; const st = l.state || {};
         const box = document.getElementById('prompt');
         return { state: document.getElementById('pb-status').dataset.state, status: st.status, prompt: st.prompt ? st.prompt.id : null,
+          stream: l.source ? l.source.readyState : null, reconnects: l.reconnects,
           fields: st.prompt && st.prompt.fields ? st.prompt.fields.length : 0,
           shown: box && !box.hidden ? box.dataset.id : null, samples: l.samplesReceived || 0, frf: l.frf ? l.frf.averages : null,
           frfPhase: l.frf ? l.frf.phase : null, drawn: document.querySelectorAll('#plot-signals .scatterlayer .trace').length }; })()`);
       samplesAt.push({ t: Date.now(), n: s.samples });
+      if (samplesAt.length % 50 === 1) {
+        trace(`page: ${s.state}, run ${s.status}, prompt ${s.prompt} (shown ${s.shown}), stream readyState ${s.stream} after ${s.reconnects} refusals, ${s.samples} samples`);
+      }
       if (s.frf !== null) frfAverages.add(s.frf);
       if (s.shown && s.prompt !== null && String(s.prompt) === s.shown && !answered.includes(s.prompt)) {
         if (hostile) await hostile;  // the page's own requests must not meet the burst's 503s
@@ -307,6 +346,8 @@ async function main() {
     // The refused value's answer is a 422 by design: Chromium logs it as a failed load, once.
     const refused = consoleErrors.findIndex((e) => /status of 422/.test(e) && /\/api\/answer/.test(e));
     if (refused >= 0) consoleErrors.splice(refused, 1);
+    // So is the stream's 503 while every stream was taken (Chromium words it as a failed load or an aborted EventSource).
+    for (let i = consoleErrors.length - 1; i >= 0; --i) if (/503/.test(consoleErrors[i]) && /api\/events|EventSource/.test(consoleErrors[i])) consoleErrors.splice(i, 1);
     failures.push(...consoleErrors);
 
     // Ctrl-C with the page's event stream open: qualify ends within 1 s.
@@ -325,20 +366,21 @@ async function main() {
       `latency sample -> page p50 ${ms(live.p50)} ms, p99 ${ms(live.p99)} ms, max ${ms(live.max)} ms over ${live.latencies} samples; ` +
       `verdict table (${live.table.length} measurements, unit ${live.verdict}) equal to the terminal's and the database's; ` +
       `hostile requests refused cleanly while it ran (1,000 concurrent: ${hostileResult.served} served, ${hostileResult.busy} refused 503); ` +
-      `no console error; Ctrl-C with a stream open: exit in ${shutdownMs} ms; screenshots in ${out}`;
+      `a refused stream asked again (connected ${reconnectedMs} ms after a stream was free); no console error; Ctrl-C with a stream open: exit in ${shutdownMs} ms; screenshots in ${out}`;
   } finally {
     clearTimeout(timer);
     if (chromium) await chromium.close();
     qualify.kill('SIGKILL');
   }
   if (failures.length > 0) {
-    console.error('station_page_check: FAILED\n  ' + failures.join('\n  ') + '\n--- qualify stderr (end):\n' + stderr.slice(-2000));
+    console.error('station_page_check: FAILED\n  ' + failures.join('\n  ') + '\n--- trace:\n' + traced.join('\n') +
+      '\n--- qualify stderr (end):\n' + stderr.slice(-2000));
     process.exit(1);
   }
   console.log(summary);
 }
 
 main().then(() => process.exit(0)).catch((e) => {
-  console.error('station_page_check: ' + e.stack);
+  console.error('station_page_check: ' + e.stack + '\n--- trace:\n' + traced.join('\n'));
   process.exit(1);
 });

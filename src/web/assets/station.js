@@ -6,6 +6,7 @@
 (() => {
   const WINDOW_S = 30;            // seconds of signals shown
   const LATENCY_KEEP = 2000;      // latencies kept for window.pbLive
+  const RECONNECT_MS = 2000;      // a refused stream (503: the station is busy) is asked again after this
   const $ = (id) => document.getElementById(id);
   const status = $('pb-status');
 
@@ -63,7 +64,7 @@
   // ---- live state --------------------------------------------------------------------------------
   const live = {
     state: null, clockOffsetMs: 0, samples: [], frf: null, messages: 0, samplesReceived: 0,
-    latencies: [], phasesSeen: {}, answered: [],
+    latencies: [], phasesSeen: {}, answered: [], reconnects: 0,
   };
   window.pbLive = live;  // for tests and the curious: counters, latencies (ms), the last state
 
@@ -165,7 +166,9 @@
     try {
       await api('/api/answer', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
       live.answered.push({ id, choice });
-      $('prompt').hidden = true;
+      // The station may already have opened the next prompt, its state arriving on the stream before
+      // this answer's response: hide the box only while it still shows the prompt just answered.
+      if ($('prompt').dataset.id === String(id)) $('prompt').hidden = true;
     } catch (e) {
       $('prompt-error').textContent = `Not answered: ${e.message}`;
     }
@@ -271,11 +274,20 @@
     scheduleRedraw();
   }
 
+  // A dropped stream is reconnected by the browser itself; a refused one (an answer other than 200:
+  // a 503 while the station serves its maximum of connections or pages) closes it for good, so the
+  // page asks again itself: it must never go silent while the station runs.
   function connect() {
     const source = new EventSource(withToken('/api/events'));
     source.onopen = () => { $('conn').textContent = 'live'; };
     source.onmessage = onMessage;
-    source.onerror = () => { $('conn').textContent = 'reconnecting…'; };
+    source.onerror = () => {
+      $('conn').textContent = 'reconnecting…';
+      if (source.readyState === EventSource.CLOSED) {
+        live.reconnects++;
+        setTimeout(() => { if (live.source === source) connect(); }, RECONNECT_MS);
+      }
+    };
     live.source = source;
   }
 
