@@ -5,6 +5,7 @@
 #include <limits>
 #include <tuple>
 
+#include "piezobench/core/complex_division.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/lti/analysis.hpp"
@@ -180,10 +181,10 @@ lti::CMatrix two_dof_response(const TwoDofParams& p, const TwoDofBench& bench, c
     const lti::Complex top = mass * s * s + z1;  // the mass on the shell
     const lti::Complex den = top * (ze + za) + ze * za;
     lti::Complex f = p.ga * bench.amplifier_gain;
-    if (bench.delay > 0.0) f *= std::exp(-s * bench.delay);
-    H(k, kOutputDe) = f * ze / den;
-    H(k, kOutputVs) = -p.gs * f * top / den;
-    if (wc > 0.0) H(k, kOutputVs) *= s / (s + wc);
+    if (bench.delay > 0.0) f *= core::delay_phasor(omega(k), bench.delay);
+    H(k, kOutputDe) = core::divide(f * ze, den);  // core::divide: the library's bits, inline
+    H(k, kOutputVs) = core::divide(-p.gs * f * top, den);
+    if (wc > 0.0) H(k, kOutputVs) *= core::divide(s, s + wc);
   }
   return H;
 }

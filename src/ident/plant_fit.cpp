@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "piezobench/core/complex_division.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/format.hpp"
@@ -396,7 +397,7 @@ struct IffResidual {
     const IffPlantFit p = from_x(x, sign, layout, fixed_w_hpf);
     Eigen::VectorXd r(2 * b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) {
-      const Complex e = (model(p, b.w(k), kernel) / b.d(k) - 1.0) * weight(k);
+      const Complex e = (core::divide(model(p, b.w(k), kernel), b.d(k)) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
@@ -484,7 +485,7 @@ namespace {
 Complex second_order(const DelayedSecondOrderFit& p, double w) {
   const Complex s(0.0, w);
   const double wn = p.natural_frequency;
-  return p.static_gain * wn * wn / (s * s + 2.0 * p.damping * wn * s + wn * wn) * std::exp(-s * p.delay);
+  return core::divide(Complex(p.static_gain * wn * wn), s * s + 2.0 * p.damping * wn * s + wn * wn) * core::delay_phasor(w, p.delay);
 }
 
 // The second order as the data see it (through the resolution kernel when it is active).
@@ -577,7 +578,7 @@ struct SecondOrderResidual {
     const DelayedSecondOrderFit p = unpack(x);
     Eigen::VectorXd r(2 * b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) {
-      const Complex e = (second_order(p, b.w(k), kernel) / b.d(k) - 1.0) * weight(k);
+      const Complex e = (core::divide(second_order(p, b.w(k), kernel), b.d(k)) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }

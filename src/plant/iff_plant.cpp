@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "piezobench/core/complex_division.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 
@@ -56,7 +57,8 @@ lti::Complex iff_plant_response(const IffPlantParams& p, double omega) {
   const lti::Complex s(0.0, omega);
   const lti::Complex num = 1.0 + 2.0 * p.xz * s / p.wz + s * s / (p.wz * p.wz);
   const lti::Complex den = 1.0 + 2.0 * p.xp * s / p.wp + s * s / (p.wp * p.wp);
-  return p.g0 * num / den * s / (p.w_hpf + s) * std::exp(-s * p.delay);
+  // p.g0 * num / den * s / (p.w_hpf + s) * std::exp(-s * p.delay), the same bits without the library calls.
+  return core::divide(core::divide(p.g0 * num, den) * s, p.w_hpf + s) * core::delay_phasor(omega, p.delay);
 }
 
 lti::CVector iff_plant_response(const IffPlantParams& params, const lti::Vector& omega) {
