@@ -90,6 +90,7 @@ struct FitData {
   Vector eps_de, eps_vs;
   // The Welch estimate's resolution kernel the model is seen through (inactive: the model itself).
   dsp::ResolutionKernel kernel;
+  dsp::KernelGrid grid;  // omega through the kernel: each line's model response evaluated once
 };
 
 // The quality verdict of a tuning (tuning.hpp).
@@ -194,6 +195,7 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
       }
     }
   }
+  d.grid = dsp::KernelGrid(d.kernel, d.omega);
   return d;
 }
 
@@ -308,10 +310,10 @@ bool usable(const TwoDofParams& p) {
 // tuning compares with the data at every step: through the Welch estimate's resolution kernel when
 // it is active, sum_j c_j H(omega + j 2 pi df) (dsp/resolution_kernel.hpp; the chain divided out of
 // the data is smooth over a line and left outside the kernel).
-lti::CMatrix actuator_response(const TwoDofParams& p, const Vector& omega, const dsp::ResolutionKernel& kernel) {
+lti::CMatrix actuator_response(const TwoDofParams& p, const FitData& d) {
   TwoDofBench bare;
   bare.amplifier_gain = 1.0;
-  return dsp::smoothed_response(kernel, omega, [&](const Vector& w) { return two_dof_response(p, bare, w); });
+  return d.grid.smooth(two_dof_response(p, bare, d.grid.nodes()));
 }
 
 // Per-point weights of the complex errors H_model - H_data of each output, relative to a reference
@@ -328,7 +330,7 @@ struct Weights {
 };
 Weights weights(const FitData& d, const TwoDofParams& reference) {
   const Index n = d.omega.size();
-  const lti::CMatrix g0 = actuator_response(reference, d.omega, d.kernel);
+  const lti::CMatrix g0 = actuator_response(reference, d);
   const bool variance = d.eps_de.size() == n;
   Weights out;
   const auto one = [&](Index o, const CVector& h, const Vector& eps, Vector& w, Vector& sd) {
@@ -367,7 +369,7 @@ Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
   const Index n = d.omega.size();
   Vector r(4 * n);
   if (!usable(p)) return Vector::Constant(4 * n, std::numeric_limits<double>::quiet_NaN());
-  const lti::CMatrix h = actuator_response(p, d.omega, d.kernel);
+  const lti::CMatrix h = actuator_response(p, d);
   for (Index k = 0; k < n; ++k) {
     const Complex ede = (h(k, kOutputDe) - d.de(k)) * wt.de(k);
     const Complex evs = (h(k, kOutputVs) - d.vs(k)) * wt.vs(k);
@@ -383,7 +385,7 @@ Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
 std::pair<double, double> fit_errors(const TwoDofParams& p, const FitData& d) {
   const Index n = d.omega.size();
   if (!usable(p)) return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
-  const lti::CMatrix h = actuator_response(p, d.omega, d.kernel);
+  const lti::CMatrix h = actuator_response(p, d);
   double de = 0.0, vs = 0.0;
   for (Index k = 0; k < n; ++k) {
     de += std::norm(h(k, kOutputDe) / d.de(k) - 1.0);
@@ -483,7 +485,7 @@ void fit_gains(const FitData& d, TwoDofParams& p) {
   const Index n = d.omega.size();
   p.ga = 1.0;
   p.gs = 1.0;
-  const lti::CMatrix h = actuator_response(p, d.omega, d.kernel);
+  const lti::CMatrix h = actuator_response(p, d);
   double num = 0.0, den = 0.0;
   for (Index k = 0; k < n; ++k) {
     const Complex a = h(k, kOutputDe) / d.de(k);

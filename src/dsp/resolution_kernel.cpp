@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 
 #include "piezobench/core/error.hpp"
@@ -55,6 +57,53 @@ ResolutionKernel resolution_kernel(const FrfProvenance& provenance) {
     return {};  // a window this library does not know (a foreign file's): its kernel is unknown
   }
   return resolution_kernel(window, provenance.nfft, provenance.sample_rate);
+}
+
+KernelGrid::KernelGrid(const ResolutionKernel& kernel, const Eigen::VectorXd& omega) : points_(omega.size()), nodes_(omega) {
+  if (!kernel.active()) return;
+  weights_ = kernel.weights;
+  const long half = kernel.half_width();
+  const auto width = static_cast<Eigen::Index>(2 * half + 1);
+  const double step = 2.0 * std::numbers::pi * kernel.line_spacing_Hz;  // rad/s per line, as smoothed_response
+  const double tol = 1e-6 * step;
+  const bool ascending = std::is_sorted(omega.data(), omega.data() + omega.size());
+  std::vector<double> extra;                  // shifted frequencies not in omega
+  std::map<long long, Eigen::Index> by_line;  // their line offset from omega(0) -> node
+  const auto node_of = [&](double t) -> Eigen::Index {
+    if (ascending && omega.size() > 0) {
+      const double* first = omega.data();
+      const double* last = first + omega.size();
+      const double* it = std::lower_bound(first, last, t);
+      for (const double* c : {it, it == first ? it : it - 1}) {
+        if (c != last && std::abs(*c - t) <= tol) return static_cast<Eigen::Index>(c - first);
+      }
+    }
+    const double lines = omega.size() > 0 ? (t - omega(0)) / step : 0.0;
+    const bool keyed = std::abs(lines) < 1e15;
+    const long long key = keyed ? std::llround(lines) : 0;
+    if (keyed) {
+      if (const auto found = by_line.find(key); found != by_line.end()) {
+        const double there = extra[static_cast<std::size_t>(found->second - omega.size())];
+        if (std::abs(there - t) <= tol) return found->second;
+      }
+    }
+    const auto node = omega.size() + static_cast<Eigen::Index>(extra.size());
+    extra.push_back(t);
+    if (keyed) by_line.emplace(key, node);
+    return node;
+  };
+  index_.resize(static_cast<std::size_t>(omega.size() * width));
+  for (Eigen::Index k = 0; k < omega.size(); ++k) {
+    Eigen::Index* at = index_.data() + k * width + half;
+    at[0] = k;
+    for (long j = 1; j <= half; ++j) {
+      const double delta = static_cast<double>(j) * step;
+      at[j] = node_of(detail::shifted(omega(k), delta));
+      at[-j] = node_of(detail::shifted(omega(k), -delta));
+    }
+  }
+  nodes_.conservativeResize(omega.size() + static_cast<Eigen::Index>(extra.size()));
+  for (std::size_t i = 0; i < extra.size(); ++i) nodes_(omega.size() + static_cast<Eigen::Index>(i)) = extra[i];
 }
 
 }  // namespace piezobench::dsp

@@ -391,13 +391,14 @@ struct IffResidual {
   double sign;
   Layout layout;
   double fixed_w_hpf;
-  const dsp::ResolutionKernel& kernel;
+  dsp::KernelGrid grid;  // b.w through the FRF's resolution kernel: the model at each line once
 
   Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
     const IffPlantFit p = from_x(x, sign, layout, fixed_w_hpf);
+    const CVector g = grid.smooth(plant::iff_plant_response(p, grid.nodes()));
     Eigen::VectorXd r(2 * b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) {
-      const Complex e = (core::divide(model(p, b.w(k), kernel), b.d(k)) - 1.0) * weight(k);
+      const Complex e = (core::divide(g(k), b.d(k)) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
@@ -454,7 +455,7 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   const double sign = start.g0 > 0.0 ? 1.0 : -1.0;
   const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
   const IffResidual residual{b, pw.weight, sign, Layout{options.fixed_w_hpf == 0.0, options.fit_delay}, options.fixed_w_hpf,
-                             options.resolution};
+                             dsp::KernelGrid(options.resolution, b.w)};
   double initial_cost = 0.0;
   const core::LmResult best = best_iff_solution(residual, start, options.max_iterations, initial_cost, source);
 
@@ -563,7 +564,7 @@ struct SecondOrderResidual {
   const Vector& weight;
   double sign;
   bool fit_delay;
-  const dsp::ResolutionKernel& kernel;
+  dsp::KernelGrid grid;  // b.w through the FRF's resolution kernel: the model at each line once
 
   [[nodiscard]] DelayedSecondOrderFit unpack(const Eigen::VectorXd& x) const {
     DelayedSecondOrderFit p;
@@ -576,9 +577,10 @@ struct SecondOrderResidual {
 
   Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
     const DelayedSecondOrderFit p = unpack(x);
+    const CVector g = grid.smooth(p.response(grid.nodes()));
     Eigen::VectorXd r(2 * b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) {
-      const Complex e = (core::divide(second_order(p, b.w(k), kernel), b.d(k)) - 1.0) * weight(k);
+      const Complex e = (core::divide(g(k), b.d(k)) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
@@ -615,7 +617,8 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   if (b.w.size() < 8) throw InputError(source, "H", "at least 8 usable points in the band", std::to_string(b.w.size()));
   const DelayedSecondOrderFit start = second_order_start(b, second_order_peak(b, source), options.fit_delay);
   const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
-  const SecondOrderResidual residual{b, pw.weight, start.static_gain >= 0.0 ? 1.0 : -1.0, options.fit_delay, options.resolution};
+  const SecondOrderResidual residual{b, pw.weight, start.static_gain >= 0.0 ? 1.0 : -1.0, options.fit_delay,
+                                       dsp::KernelGrid(options.resolution, b.w)};
   const Eigen::VectorXd x0 = second_order_x0(start, options.fit_delay);
   if (!residual(x0).allFinite()) {
     throw NumericalError("second-order fit (" + source + ")", "the starting point gives a non-finite error", true);

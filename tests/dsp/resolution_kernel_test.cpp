@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/dsp/welch.hpp"
@@ -83,6 +84,46 @@ TEST(ResolutionKernel, SmoothsAQuadraticByItsSecondMoment) {
   const auto two = [&](double omega) { return Eigen::Vector2cd(h(omega), 2.0 * h(omega)); };
   const Eigen::Vector2cd v = smoothed_response(k, w, two);
   EXPECT_NEAR(std::abs(v(1) - 2.0 * expected), 0.0, 1e-12);
+}
+
+TEST(KernelGrid, EvaluatesEachLineOnceAndGivesTheSmoothedResponse) {
+  // A 5 Hz resonance on hann's grid of 0.25 Hz lines 2..200, lines 50..52 and 120 missing (low
+  // coherence): the nodes are the 195 lines plus the 5 shifted lines not among them (1, 201, 50
+  // and 52 next to the gap of three, 120), not 3 x 195.
+  const ResolutionKernel k = resolution_kernel(WindowType::kHannPeriodic, 400, 100.0);
+  const double dw = 2.0 * std::numbers::pi * 0.25;
+  std::vector<double> lines;
+  for (int i = 2; i <= 200; ++i) {
+    if ((i < 50 || i > 52) && i != 120) lines.push_back(i * dw);
+  }
+  const Eigen::VectorXd omega = Eigen::Map<const Eigen::VectorXd>(lines.data(), static_cast<Eigen::Index>(lines.size()));
+  const double wn = 2.0 * std::numbers::pi * 5.0;
+  const auto h = [&](double w) { return wn * wn / Complex(wn * wn - w * w, 2.0 * 0.05 * wn * w); };
+  const KernelGrid grid(k, omega);
+  ASSERT_EQ(grid.nodes().size(), omega.size() + 5);
+  EXPECT_EQ(grid.nodes().head(omega.size()), omega);
+  Eigen::MatrixX2cd at_nodes(grid.nodes().size(), 2);
+  for (Eigen::Index i = 0; i < grid.nodes().size(); ++i) at_nodes.row(i) << h(grid.nodes()(i)), -3.0 * h(grid.nodes()(i));
+  const Eigen::MatrixX2cd smooth = grid.smooth(at_nodes);
+  ASSERT_EQ(smooth.rows(), omega.size());
+  for (Eigen::Index i = 0; i < omega.size(); ++i) {
+    const Complex want = smoothed_response(k, omega(i), h);
+    EXPECT_NEAR(std::abs(smooth(i, 0) / want - 1.0), 0.0, 1e-13) << i;  // the lines differ from omega + df by round-off
+    EXPECT_NEAR(std::abs(smooth(i, 1) / want + 3.0), 0.0, 1e-13) << i;
+  }
+  // Frequencies off the grid (and out of order) share nothing: exactly smoothed_response.
+  Eigen::VectorXd odd(3);
+  odd << 30.1, 10.0, 20.7;
+  const KernelGrid apart(k, odd);
+  EXPECT_EQ(apart.nodes().size(), 9);
+  Eigen::VectorXcd values(apart.nodes().size());
+  for (Eigen::Index i = 0; i < values.size(); ++i) values(i) = h(apart.nodes()(i));
+  const Eigen::VectorXcd s = apart.smooth(values);
+  for (Eigen::Index i = 0; i < odd.size(); ++i) EXPECT_EQ(s(i), smoothed_response(k, odd(i), h));
+  // An inactive kernel: the nodes are omega and smooth() the values.
+  const KernelGrid none(ResolutionKernel{}, odd);
+  EXPECT_EQ(none.nodes(), odd);
+  EXPECT_EQ(none.smooth(Eigen::Vector3cd(1.0, 2.0, 3.0)), Eigen::Vector3cd(1.0, 2.0, 3.0));
 }
 
 TEST(ResolutionKernel, WelchEstimateOfAResonanceConvergesToTheSmoothedResponse) {

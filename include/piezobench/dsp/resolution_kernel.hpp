@@ -78,4 +78,48 @@ auto smoothed_response(const ResolutionKernel& kernel, const Omega& omega, const
   return sum;
 }
 
+// smoothed_response at a fixed set of frequencies, each distinct frequency evaluated once. On a
+// Welch estimate's uniform grid omega_k + j 2 pi df is (to round-off) the line omega_(k+j), so a
+// fit that passes its model through the kernel at every iteration evaluates it at about n + 2 half
+// frequencies instead of n (2 half + 1): the plant fits and the 2-DoF tuning evaluated their models
+// three times over with hann's kernel (docs/performance.md, "The demo"). A shifted frequency within
+// 1e-6 lines of one of omega (or of an earlier shifted one) is taken as that frequency; the response
+// there differs from smoothed_response's by the model's change over that round-off.
+class KernelGrid {
+ public:
+  KernelGrid() = default;  // inactive: nodes() empty, smooth() the identity
+  // The grid of `kernel` at omega (rad/s, any order; only an ascending omega is searched for lines).
+  KernelGrid(const ResolutionKernel& kernel, const Eigen::VectorXd& omega);
+
+  // Where to evaluate the response (rad/s): omega itself first, then the shifted frequencies that
+  // are not in omega.
+  [[nodiscard]] const Eigen::VectorXd& nodes() const { return nodes_; }
+
+  // sum_j c_j R(omega_k + j df) for every k, R's values at nodes() in `at_nodes` (one row per node,
+  // any number of columns); the sum in smoothed_response's order.
+  template <class Derived>
+  [[nodiscard]] Eigen::Matrix<typename Derived::Scalar, Eigen::Dynamic, Derived::ColsAtCompileTime> smooth(
+      const Eigen::MatrixBase<Derived>& at_nodes) const {
+    using Out = Eigen::Matrix<typename Derived::Scalar, Eigen::Dynamic, Derived::ColsAtCompileTime>;
+    if (weights_.size() <= 1) return Out(at_nodes.topRows(points_));
+    Out sum(points_, at_nodes.cols());
+    const auto width = static_cast<Eigen::Index>(weights_.size());
+    const Eigen::Index half = width / 2;
+    for (Eigen::Index k = 0; k < points_; ++k) {
+      const Eigen::Index* at = index_.data() + k * width + half;  // at[j]: the node of omega_k + j df
+      sum.row(k) = at_nodes.row(at[0]) * weights_[static_cast<std::size_t>(half)];
+      for (Eigen::Index j = 1; j <= half; ++j) {
+        sum.row(k) += (at_nodes.row(at[j]) + at_nodes.row(at[-j])) * weights_[static_cast<std::size_t>(half + j)];
+      }
+    }
+    return sum;
+  }
+
+ private:
+  Eigen::Index points_ = 0;
+  Eigen::VectorXd nodes_;
+  std::vector<double> weights_;        // the kernel's, or empty when it is inactive
+  std::vector<Eigen::Index> index_;    // (k, j + half) -> node, row-major
+};
+
 }  // namespace piezobench::dsp
