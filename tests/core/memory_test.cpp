@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <vector>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace piezobench::core {
 namespace {
@@ -26,6 +31,23 @@ TEST(Memory, AdvisingHugePagesKeepsTheData) {
     big.back() = 7.0;
     EXPECT_EQ(big.back(), 7.0);
   }
+}
+
+// After keep_freed_memory, a 16 MB block comes from the heap (glibc maps blocks above 128 KiB on
+// their own by default: mallinfo2's hblks counts them) and a freed one is not returned.
+TEST(Memory, KeepFreedMemoryServesRecordSizedBlocksFromTheHeap) {
+#if defined(__GLIBC__)
+  ASSERT_TRUE(keep_freed_memory());
+  const std::size_t mapped_before = mallinfo2().hblks;
+  void* block = std::malloc(std::size_t{16} << 20);
+  ASSERT_NE(block, nullptr);
+  EXPECT_EQ(mallinfo2().hblks, mapped_before);
+  const std::size_t heap = mallinfo2().arena;
+  std::free(block);
+  EXPECT_EQ(mallinfo2().arena, heap);  // the heap's top kept, not trimmed
+#else
+  EXPECT_FALSE(keep_freed_memory());
+#endif
 }
 
 }  // namespace

@@ -10,4 +10,14 @@ namespace piezobench::core {
 // allocation and before the first write. A hint: it never fails and does nothing elsewhere.
 void advise_huge_pages(void* data, std::size_t bytes) noexcept;
 
+// Makes the C library's malloc (glibc) keep freed memory for the process's next allocations instead
+// of handing it back to the kernel: blocks up to 256 MiB come from the heap rather than from a fresh
+// mmap each, and the heap keeps up to 512 MiB of free space at its top. A program that allocates and
+// frees record-sized buffers over and over (the demo: simulated records, fits' tall matrices) then
+// faults each page in once instead of at every allocation (the demo: 139,000 minor page faults ->
+// 26,000, 0.46 -> 0.21 s of system time; docs/performance.md, "The demo"), for a peak about 20 MB
+// higher. A policy of the whole process: the piezobench program sets it at start-up (app/
+// process_memory.cpp), the library never does. Returns false where it is not supported.
+bool keep_freed_memory() noexcept;
+
 }  // namespace piezobench::core
