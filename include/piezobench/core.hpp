@@ -3,8 +3,10 @@
 // Levenberg-Marquardt, the one golden-section search, fit-quality verdicts and sign-constrained
 // linear least squares, the median, a runner of independent jobs on a few threads, text helpers
 // whole-file input/output shared by the readers, shared libraries loaded on first use, and files
-// linked into the binary (incbin.hpp); Eigen's dense solvers compiled once (eigen_solvers.hpp).
+// linked into the binary (incbin.hpp); complex division and delay phasors with the library's bits
+// (complex_division.hpp); Eigen's dense solvers compiled once (eigen_solvers.hpp).
 #include "piezobench/core/checked_number.hpp"
+#include "piezobench/core/complex_division.hpp"
 #include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/file.hpp"

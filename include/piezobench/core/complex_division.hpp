@@ -15,6 +15,9 @@
 // std::exp(std::complex<double>(-0.0, y)) (a delay's e^(-s tau) at s = j omega) is cexp, which for
 // a zero real part returns exactly (cos y, sin y) after a rounding-mode switch; delay_phasor computes
 // those two values directly.
+//
+// Units: the caller's (the quotient's unit is x's over y's; delay_phasor takes omega in rad/s and
+// delay in s, or any pair whose product is in rad).
 #include <cmath>
 #include <complex>
 
@@ -49,7 +52,7 @@ inline std::complex<double> divide(std::complex<double> x, std::complex<double> 
   return {(a + (d * (b / c))) / denom, (b - (d * (a / c))) / denom};
 }
 
-// e^(-j omega delay) = std::exp(-std::complex<double>(0, omega) * delay), the same bits.
+// e^(-j omega delay) (omega in rad/s, delay in s) = std::exp(-std::complex<double>(0, omega) * delay), the same bits.
 inline std::complex<double> delay_phasor(double omega, double delay) {
   const double y = -omega * delay;
   return {std::cos(y), std::sin(y)};

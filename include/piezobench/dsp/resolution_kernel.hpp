@@ -117,7 +117,7 @@ class KernelGrid {
 
  private:
   Eigen::Index points_ = 0;
-  Eigen::VectorXd nodes_;
+  Eigen::VectorXd nodes_;              // rad/s
   std::vector<double> weights_;        // the kernel's, or empty when it is inactive
   std::vector<Eigen::Index> index_;    // (k, j + half) -> node, row-major
 };
