@@ -331,8 +331,6 @@ py::array response_array(const lti::FrequencyResponse& r, bool squeeze_siso);
 template <class T>
 class Options;
 const Options<lti::RootLocusOptions>& root_locus_options();
-// Result(gains, poles): poles[i] are the closed-loop poles at gains[i] (lti.cpp).
-py::object root_locus_result(const lti::RootLocus& r);
 // An argument that must be a dsp.Frf.
 const dsp::Frf& frf_arg(py::handle obj, const std::string& source, const std::string& field);
 

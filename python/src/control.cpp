@@ -65,6 +65,11 @@ const Options<DiscreteIffOptions>& discrete_options() {
 
 void bind_control(py::module_& m) {
   using py::arg;
+  bind_described<IffRootLocus>(m);  // its lti.RootLocus and lti.BranchOptimum are lti's classes
+  // The controller a result holds (campaign.IffStudy.controller), from its declaration (control/iff.hpp).
+  bind_described<IffControllerParams>(m);
+  m.def("declarations", [] { return declarations_of<IffRootLocus, IffControllerParams>(); },
+        "{declared struct: (its Python class, [field names])} for every declared result control returns (control/iff.hpp).");
 
   m.def(
       "iff_plant",
@@ -106,22 +111,12 @@ void bind_control(py::module_& m) {
           auto a = vector_arg(gains, src, "gains");
           gv.assign(a.data(), a.data() + a.size());
         }
-        auto r = without_gil([&] { return iff_root_locus(g, k, gv, o); });
-        py::dict opt;
-        opt["gain"] = r.optimum.gain;
-        opt["damping"] = r.optimum.damping;
-        opt["pole"] = r.optimum.pole;
-        py::dict d;
-        d["locus"] = root_locus_result(r.locus);
-        d["resonance_pole"] = r.resonance_pole;
-        d["optimum"] = result("BranchOptimum", opt);
-        d["resonance_branch"] = r.resonance_branch;
-        return result("IffRootLocus", d);
+        return without_gil([&] { return iff_root_locus(g, k, gv, o); });
       },
       arg("plant"), arg("controller"), arg("gains") = py::none(),
       ("Root locus of the IFF loop 1 - g K0 G = 0 (report Figure 2.9) at `gains` (None = automatic) and the\n"
-       "gain of maximum damping on the resonance branch: Result(locus, resonance_pole, optimum,\n"
-       "resonance_branch).\n\nKeywords:\n" + loop_options().doc())
+       "gain of maximum damping on the resonance branch: a control.IffRootLocus(locus (an lti.RootLocus),\n"
+       "resonance_pole, optimum (an lti.BranchOptimum), resonance_branch).\n\nKeywords:\n" + loop_options().doc())
           .c_str());
 
   py::class_<DiscreteIff>(m, "DiscreteIff", R"(The report's IFF controller as it runs on the real-time target
@@ -160,8 +155,6 @@ anti-windup. y[k] = g K0(z) Vs[k]; a non-finite input resets the states and give
       .def("reset", &DiscreteIff::reset, "Zero states; the gain is kept.")
       .def_property_readonly("nonfinite_inputs", &DiscreteIff::nonfinite_inputs)
       .def("model", &DiscreteIff::model, "The discrete controller at gain 1 as an lti.StateSpace (input Vs, output y).");
-  // The controller a result holds (campaign.IffStudy.controller), from its declaration (control/iff.hpp).
-  bind_described<IffControllerParams>(m);
 }
 
 }  // namespace piezobench::python

@@ -6,11 +6,13 @@
 // def_fields<S>(cls, part) adds S's fields to a class that holds an S (campaign.CampaignResult holds
 // the CampaignResult of a run) or that binds some fields in its own layout (dsp.Frf's H as one array).
 //
-// Values: numbers in SI as the struct holds them; lists of numbers as numpy arrays; enums by their
+// Values: numbers in SI as the struct holds them; lists of numbers as numpy arrays (a list of Eigen
+// vectors as one 2-D array, a row each; paths as str); enums by their
 // names; a declared struct as its class (a view that keeps its owner alive); lists and optionals of
 // those likewise (None when absent). Every class has fields() (the declaration, for the tests),
 // keys() and [name] (so dict(r) and f(**r) work, as with the dicts they replace), to_dict() and a repr.
 #include <complex>
+#include <filesystem>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -27,6 +29,29 @@ namespace piezobench::python {
 namespace described_detail {
 template <class T> struct IsDescribedList : std::false_type {};
 template <class T, class A> struct IsDescribedList<std::vector<T, A>> : std::bool_constant<core::Described<T>> {};
+// A list of Eigen vectors of one length (lti::RootLocus's poles per gain): one 2-D array, a row each.
+template <class T> struct IsVectorList : std::false_type {};
+template <class T> constexpr bool is_column() {
+  if constexpr (core::kIsEigen<T>) {
+    return T::ColsAtCompileTime == 1;
+  } else {
+    return false;
+  }
+}
+template <class T, class A> struct IsVectorList<std::vector<T, A>> : std::bool_constant<is_column<T>()> {};
+
+template <class V> py::object stacked_rows(const std::vector<V>& v) {
+  using Scalar = typename V::Scalar;
+  const Eigen::Index n = v.empty() ? 0 : v.front().size();
+  Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> out(static_cast<Eigen::Index>(v.size()), n);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v[i].size() != n) {
+      throw NumericalError("python", "rows of unequal length (" + std::to_string(v[i].size()) + " and " + std::to_string(n) + ")", false);
+    }
+    out.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+  }
+  return to_numpy(std::move(out));
+}
 }  // namespace described_detail
 
 template <class S> void bind_described(py::module_& m);
@@ -43,7 +68,11 @@ template <class T> py::object py_value(const T& v, py::handle owner) {
     return to_numpy(Eigen::VectorXcd(Eigen::Map<const Eigen::VectorXcd>(v.data(), static_cast<Eigen::Index>(v.size()))));
   } else if constexpr (core::kIsEigen<T>) {
     return to_numpy(v);  // a copy, as the other numeric arrays
-  } else if constexpr (IsDescribedList<T>::value) {
+  } else if constexpr (IsVectorList<T>::value) {
+    return stacked_rows(v);
+  } else if constexpr (std::is_same_v<T, std::filesystem::path>) {
+    return py::str(v.string());
+  } else if constexpr (IsDescribedList<T>::value || std::is_same_v<T, std::vector<std::filesystem::path>>) {
     py::list l;
     for (const auto& x : v) l.append(py_value(x, owner));
     return l;

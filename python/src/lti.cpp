@@ -2,6 +2,7 @@
 #include "piezobench/lti.hpp"
 
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/core/format.hpp"
 
 namespace piezobench::python {
@@ -60,14 +61,6 @@ py::array response_array(const FrequencyResponse& r, bool squeeze_siso) {
 
 namespace {
 
-py::object time_response(TimeResponse&& r) {
-  py::dict d;
-  d["t"] = to_numpy(std::move(r.t));
-  d["y"] = to_numpy(std::move(r.y));
-  d["x"] = to_numpy(std::move(r.x));
-  return result("TimeResponse", d);
-}
-
 std::string ss_repr(const StateSpace& s) {
   return "StateSpace(states=" + std::to_string(s.states()) + ", inputs=" + std::to_string(s.inputs()) +
          ", outputs=" + std::to_string(s.outputs()) + ", sample_time=" + format_number(s.sample_time, 10) +
@@ -75,16 +68,6 @@ std::string ss_repr(const StateSpace& s) {
 }
 
 }  // namespace
-
-py::object root_locus_result(const RootLocus& r) {
-  py::dict d;
-  const Index n = r.poles.empty() ? 0 : r.poles[0].size();
-  Eigen::MatrixXcd p(static_cast<Index>(r.poles.size()), n);
-  for (std::size_t i = 0; i < r.poles.size(); ++i) p.row(static_cast<Index>(i)) = r.poles[i].transpose();
-  d["gains"] = to_numpy(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(r.gains.data(), static_cast<Index>(r.gains.size()))));
-  d["poles"] = to_numpy(std::move(p));
-  return result("RootLocus", d);
-}
 
 StateSpace state_space_arg(py::handle obj, const std::string& source, const std::string& field) {
   if (py::isinstance<StateSpace>(obj)) return obj.cast<StateSpace>();
@@ -226,22 +209,9 @@ through a Hessenberg reduction (O(n^2) per frequency), zpk forms as products of 
   m.def(
       "damp",
       [](py::object sys) {
-        auto s = state_space_arg(sys, "lti.damp", "sys");
-        auto info = lti::damp(s);
-        Eigen::VectorXcd p(static_cast<Index>(info.size()));
-        Eigen::VectorXd wn(p.size()), zeta(p.size());
-        for (Index i = 0; i < p.size(); ++i) {
-          p(i) = info[i].pole;
-          wn(i) = info[i].natural_frequency;
-          zeta(i) = info[i].damping;
-        }
-        py::dict d;
-        d["poles"] = to_numpy(std::move(p));
-        d["natural_frequency"] = to_numpy(std::move(wn));
-        d["damping"] = to_numpy(std::move(zeta));
-        return result("Damping", d);
+        return lti::damp_columns(state_space_arg(sys, "lti.damp", "sys"));
       },
-      arg("sys"), "Poles with natural frequency (rad/s) and damping ratio (as MATLAB's damp).");
+      arg("sys"), "Poles with natural frequency (rad/s) and damping ratio (as MATLAB's damp): an lti.Damping.");
 }
 
 // c2d, lsim, step, impulse, expm and pade.
@@ -265,25 +235,25 @@ void bind_time_domain(py::module_& m) {
         auto sys = state_space_arg(sys_arg, "lti.lsim", "sys");
         auto um = to_matrix(u, "lti.lsim", "u", true);
         Eigen::VectorXd x = x0.is_none() ? Eigen::VectorXd() : to_vector(x0, "lti.lsim", "x0");
-        return time_response(without_gil([&] { return lti::lsim(sys, um, x); }));
+        return without_gil([&] { return lti::lsim(sys, um, x); });
       },
       arg("sys"), arg("u"), arg("x0") = py::none(),
       "Response of a discrete system to u (samples x inputs; 1-D for one input) from x0 (None = 0).\n"
-      "Returns a Result with t (s), y (samples x outputs), x (samples x states).");
+      "Returns an lti.TimeResponse: t (s), y (samples x outputs), x (samples x states).");
   m.def(
       "step",
       [](py::object sys, double ts, Index samples, Index input) {
-        return time_response(lti::step(state_space_arg(sys, "lti.step", "sys"), ts, samples, input));
+        return lti::step(state_space_arg(sys, "lti.step", "sys"), ts, samples, input);
       },
       arg("sys"), arg("sample_time"), arg("samples"), arg("input") = 0,
-      "Unit-step response (continuous systems discretized by ZOH at sample_time): Result(t, y, x).");
+      "Unit-step response (continuous systems discretized by ZOH at sample_time): lti.TimeResponse(t, y, x).");
   m.def(
       "impulse",
       [](py::object sys, double ts, Index samples, Index input) {
-        return time_response(lti::impulse(state_space_arg(sys, "lti.impulse", "sys"), ts, samples, input));
+        return lti::impulse(state_space_arg(sys, "lti.impulse", "sys"), ts, samples, input);
       },
       arg("sys"), arg("sample_time"), arg("samples"), arg("input") = 0,
-      "Unit-impulse response (area-1 pulse over the first sample for continuous systems): Result(t, y, x).");
+      "Unit-impulse response (area-1 pulse over the first sample for continuous systems): lti.TimeResponse(t, y, x).");
   m.def("expm", [](py::object a) { return to_numpy(lti::expm(to_matrix(a, "lti.expm", "a"))); }, arg("a"),
         "Matrix exponential (scaling and squaring, [13/13] Pade; Higham 2005).");
   m.def("pade", [](double delay, int order) { return lti::pade(delay, order); }, arg("delay"), arg("order"),
@@ -324,13 +294,13 @@ void bind_root_locus(py::module_& m) {
       [](py::object sys, py::object gains, const py::kwargs& kw) {
         auto s = state_space_arg(sys, "lti.rlocus", "open_loop");
         auto o = rlocus_options().from_kwargs(kwargs_dict(kw), "lti.rlocus");
-        if (gains.is_none()) return root_locus_result(without_gil([&] { return lti::rlocus_auto(s, o); }));
+        if (gains.is_none()) return without_gil([&] { return lti::rlocus_auto(s, o); });
         auto g = vector_arg(gains, "lti.rlocus", "gains");
         std::vector<double> gv(g.data(), g.data() + g.size());
-        return root_locus_result(without_gil([&] { return lti::rlocus(s, gv); }));
+        return without_gil([&] { return lti::rlocus(s, gv); });
       },
       arg("open_loop"), arg("gains") = py::none(),
-      ("Root locus of the SISO loop L under u = -k y: Result(gains, poles) with poles[i] the closed-loop\n"
+      ("Root locus of the SISO loop L under u = -k y: an lti.RootLocus(gains, poles) with poles[i] the closed-loop\n"
        "poles at gains[i] (branches kept in a consistent column order). gains None = automatic grid.\n\n"
        "Keywords (automatic grid):\n" + rlocus_options().doc())
           .c_str());
@@ -339,22 +309,22 @@ void bind_root_locus(py::module_& m) {
       [](py::object sys, Complex start, const py::kwargs& kw) {
         auto s = state_space_arg(sys, "lti.max_damping_on_branch", "open_loop");
         auto o = rlocus_options().from_kwargs(kwargs_dict(kw), "lti.max_damping_on_branch");
-        auto b = without_gil([&] { return lti::max_damping_on_branch(s, start, o); });
-        py::dict d;
-        d["gain"] = b.gain;
-        d["damping"] = b.damping;
-        d["pole"] = b.pole;
-        return result("BranchOptimum", d);
+        return without_gil([&] { return lti::max_damping_on_branch(s, start, o); });
       },
       arg("open_loop"), arg("start_pole"),
       ("The gain of maximum damping on the branch starting at the open-loop pole nearest start_pole\n"
-       "(golden section to 1e-6): Result(gain, damping, pole).\n\nKeywords:\n" + rlocus_options().doc())
+       "(golden section to 1e-6): an lti.BranchOptimum(gain, damping, pole).\n\nKeywords:\n" + rlocus_options().doc())
           .c_str());
 }
 
 }  // namespace
 
 void bind_lti(py::module_& m) {
+  // The declared results (lti/*.hpp's describe), bound before the functions that return them.
+  bind_described<TimeResponse>(m);
+  bind_described<RootLocus>(m);
+  bind_described<Damping>(m);
+  bind_described<BranchOptimum>(m);
   bind_state_space(m);
   bind_siso_forms(m);
   bind_conversions(m);
@@ -362,6 +332,8 @@ void bind_lti(py::module_& m) {
   bind_time_domain(m);
   bind_interconnections(m);
   bind_root_locus(m);
+  m.def("declarations", [] { return declarations_of<TimeResponse, RootLocus, Damping, BranchOptimum>(); },
+        "{declared struct: (its Python class, [field names])} for every declared result lti returns (lti/*.hpp).");
 }
 
 }  // namespace piezobench::python

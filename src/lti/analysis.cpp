@@ -119,4 +119,17 @@ std::vector<PoleInfo> damp(const StateSpace& sys) {
   return out;
 }
 
+Damping damp_columns(const StateSpace& sys) {
+  const std::vector<PoleInfo> info = damp(sys);
+  const auto n = static_cast<Index>(info.size());
+  Damping out{CVector(n), Vector(n), Vector(n)};
+  for (Index i = 0; i < n; ++i) {
+    const PoleInfo& p = info[static_cast<std::size_t>(i)];
+    out.poles(i) = p.pole;
+    out.natural_frequency(i) = p.natural_frequency;
+    out.damping(i) = p.damping;
+  }
+  return out;
+}
+
 }  // namespace piezobench::lti

@@ -68,6 +68,16 @@ struct IffRootLocus {
   lti::Index resonance_branch = 0;
 };
 
+constexpr auto describe(core::Type<IffRootLocus>) {
+  using S = IffRootLocus;
+  using namespace core::shown;
+  return core::fields<S>("IffRootLocus", "root locus of the IFF loop 1 - g K0 G = 0 and the damping optimum on its resonance branch",
+      core::field("locus", &S::locus, kNone, "closed-loop poles at each gain g"),
+      core::field("resonance_pole", &S::resonance_pole, kRadPerSecond, "open-loop pole the optimized branch starts from"),
+      core::field("optimum", &S::optimum, kNone, "gain of maximum damping on that branch"),
+      core::field("resonance_branch", &S::resonance_branch, kNone, "column of the optimized branch in locus.poles"));
+}
+
 // Root locus at the given gains (automatic grid when `gains` is empty) and the optimum on the
 // resonance branch. Throws InputError for non-SISO plant/controller or a plant with no complex pole.
 IffRootLocus iff_root_locus(const lti::StateSpace& plant, const lti::StateSpace& controller,

@@ -2,6 +2,7 @@
 // Poles, transmission zeros, static gain, natural frequency and damping.
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 
@@ -41,5 +42,22 @@ struct PoleInfo {
 PoleInfo pole_info(Complex pole, double sample_time = 0.0);
 // pole_info for every pole of the system, in poles() order.
 std::vector<PoleInfo> damp(const StateSpace& sys);
+
+// damp() as three columns (MATLAB's [wn, zeta, p] = damp(sys)), in poles() order.
+struct Damping {
+  CVector poles;             // rad/s or z-plane, as poles()
+  Vector natural_frequency;  // rad/s
+  Vector damping;            // damping ratio
+};
+Damping damp_columns(const StateSpace& sys);
+
+constexpr auto describe(core::Type<Damping>) {
+  using S = Damping;
+  using namespace core::shown;
+  return core::fields<S>("Damping", "every pole of a system with its natural frequency and damping ratio (MATLAB's damp)",
+      core::field("poles", &S::poles, kRadPerSecond, "the poles as poles() gives them (z-plane when discrete)"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecond, "|s| of each pole's continuous equivalent"),
+      core::field("damping", &S::damping, kRatio, "-Re(s) / |s| of each (-1 for s = 0)"));
+}
 
 }  // namespace piezobench::lti

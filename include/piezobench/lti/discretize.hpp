@@ -2,6 +2,7 @@
 // Discretization (c2d) and time responses.
 #include <string>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/lti/state_space.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 
@@ -40,6 +41,15 @@ struct TimeResponse {
   Matrix y;  // samples x outputs
   Matrix x;  // samples x states
 };
+
+constexpr auto describe(core::Type<TimeResponse>) {
+  using S = TimeResponse;
+  using namespace core::shown;
+  return core::fields<S>("TimeResponse", "the samples of a discrete system's response (lsim, step, impulse)",
+      core::field("t", &S::t, kSecond, "time of each sample, k Ts"),
+      core::field("y", &S::y, kNone, "outputs, samples x outputs (the system's output units)"),
+      core::field("x", &S::x, kNone, "states, samples x states"));
+}
 
 // Response of a discrete system to the input samples u (samples x inputs) from state x0 (empty =
 // zero). Delays must be whole multiples of the sample time (InputError otherwise) and shift the

@@ -5,6 +5,7 @@
 // closed-loop poles are the roots of 1 + k L(s) = 0, i.e. eig(A - k B (1 + k D)^-1 C).
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
 #include "piezobench/lti/state_space.hpp"
 
 namespace piezobench::lti {
@@ -15,6 +16,15 @@ struct RootLocus {
   // b of poles[i] continues entry b of poles[i - 1] (matched by minimum total displacement).
   std::vector<CVector> poles;
 };
+
+constexpr auto describe(core::Type<RootLocus>) {
+  using S = RootLocus;
+  using namespace core::shown;
+  return core::fields<S>("RootLocus", "closed-loop poles of a SISO loop under u = -k y at a list of gains",
+      core::field("gains", &S::gains, kRatio, "loop gains k"),
+      core::field("poles", &S::poles, kRadPerSecond,
+                  "closed-loop poles (z-plane when discrete), a row per gain, a column per branch (Python: gains x branches)"));
+}
 
 // Closed-loop poles at one gain. Throws InputError for a non-SISO loop or one with delays (use
 // lti::pade first), NumericalError when 1 + k D = 0.
@@ -50,6 +60,15 @@ struct BranchOptimum {
   double damping = 0.0;  // damping ratio there
   Complex pole;          // the branch's pole there
 };
+
+constexpr auto describe(core::Type<BranchOptimum>) {
+  using S = BranchOptimum;
+  using namespace core::shown;
+  return core::fields<S>("BranchOptimum", "the gain of maximum damping on one root-locus branch",
+      core::field("gain", &S::gain, kRatio, "loop gain k of maximum damping on the branch"),
+      core::field("damping", &S::damping, kRatio, "damping ratio of the branch's pole there"),
+      core::field("pole", &S::pole, kRadPerSecond, "the branch's pole there (z-plane when discrete)"));
+}
 // Follows the branch that starts (k = 0) at the open-loop pole nearest `start_pole` from gain 0 to
 // gain_max (0 = automatic: rlocus_auto's grid, ending once this branch has settled at a zero or
 // gone towards an asymptote, whatever the other branches do) and returns the gain that maximizes its damping ratio,
