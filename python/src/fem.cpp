@@ -1,5 +1,6 @@
 // piezobench.fem: include/piezobench/fem/{superelement,structural_model,matrix_io,craig_bampton}.hpp
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/fem/craig_bampton.hpp"
 #include "piezobench/fem/matrix_io.hpp"
 #include "piezobench/fem/structural_model.hpp"
@@ -230,14 +231,10 @@ void bind_analyses(py::module_& m) {
   m.def(
       "modes",
       [](py::object K, py::object M) {
-        auto r = fem::modes(to_matrix(K, "fem.modes", "K"), to_matrix(M, "fem.modes", "M"));
-        py::dict d;
-        d["frequencies_Hz"] = to_numpy(std::move(r.frequencies_Hz));
-        d["shapes"] = to_numpy(std::move(r.shapes));
-        return result("Modes", d);
+        return fem::modes(to_matrix(K, "fem.modes", "K"), to_matrix(M, "fem.modes", "M"));
       },
       arg("K"), arg("M"),
-      "Undamped modes K phi = w^2 M phi: Result(frequencies_Hz (signed, ascending), shapes (mass-normalized columns)).");
+      "Undamped modes K phi = w^2 M phi: a fem.Modes(frequencies_Hz (signed, ascending), shapes (mass-normalized columns)).");
   m.def(
       "assemble",
       [](const SuperElement& se, const std::vector<long>& fixed_nodes, const std::vector<std::string>& masses,
@@ -260,18 +257,9 @@ void bind_analyses(py::module_& m) {
   m.def(
       "check_rigid_body_modes",
       [](const SuperElement& se, double threshold) {
-        auto r = check_rigid_body_modes(se, threshold);
-        py::dict d;
-        d["performed"] = r.performed;
-        d["free_free"] = r.free_free;
-        d["spoiled"] = r.spoiled;
-        d["lowest_modes_Hz"] = to_numpy(std::move(r.lowest_modes_Hz));
-        d["rigid_fraction"] = to_numpy(std::move(r.rigid_fraction));
-        d["first_flexible_Hz"] = r.first_flexible_Hz;
-        d["message"] = r.message;
-        return result("RigidBodyCheck", d);
+        return check_rigid_body_modes(se, threshold);
       },
-      arg("se"), arg("relative_threshold") = 1e-3, "Are the six free-free rigid-body modes at ~0 Hz?");
+      arg("se"), arg("relative_threshold") = 1e-3, "Are the six free-free rigid-body modes at ~0 Hz? A fem.RigidBodyCheck.");
 }
 
 // craig_bampton (fem/craig_bampton.hpp).
@@ -290,20 +278,11 @@ void bind_reduction(py::module_& m) {
                                                                  : std::to_string(integer_arg(item, src, field));
           points.push_back(InterfacePoint::parse(text, field));
         }
-        auto r = without_gil([&] { return craig_bampton(model, points, o); });
-        py::dict d;
-        d["reduced"] = py::cast(std::move(r.reduced));
-        d["fixed_interface_Hz"] = to_numpy(std::move(r.fixed_interface_Hz));
-        d["interior_dofs"] = r.interior_dofs;
-        d["interface_dofs"] = r.interface_dofs;
-        d["factor_nonzeros"] = r.factor_nonzeros;
-        d["eigensolver_iterations"] = r.eigensolver_iterations;
-        d["seconds"] = r.seconds;
-        return result("CraigBamptonResult", d);
+        return without_gil([&] { return craig_bampton(model, points, o); });
       },
       arg("model"), arg("interface"),
       ("Craig-Bampton reduction of a fem.SparseModel to a super element: interface points are nodes\n"
-       "(int or \"NODE\") or \"REF:ROT\" rigid bodies. Result(reduced (SuperElement), fixed_interface_Hz, ...).\n\n"
+       "(int or \"NODE\") or \"REF:ROT\" rigid bodies. A fem.CraigBamptonResult(reduced (SuperElement), fixed_interface_Hz, ...).\n\n"
        "Keywords (CraigBamptonOptions):\n" + cb_options().doc())
           .c_str());
 }
@@ -312,6 +291,12 @@ void bind_reduction(py::module_& m) {
 
 void bind_fem(py::module_& m) {
   bind_super_element(m);
+  // The declared results (fem/*.hpp's describe); CraigBamptonResult.reduced is a fem.SuperElement.
+  bind_described<Modes>(m);
+  bind_described<RigidBodyCheck>(m);
+  bind_described<CraigBamptonResult>(m);
+  m.def("declarations", [] { return declarations_of<Modes, RigidBodyCheck, CraigBamptonResult>(); },
+        "{declared struct: (its Python class, [field names])} for every declared result fem returns (fem/*.hpp).");
   bind_sparse_and_structural_models(m);
   bind_readers(m);
   bind_analyses(m);

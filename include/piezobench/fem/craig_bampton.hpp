@@ -55,6 +55,20 @@ struct CraigBamptonResult {
   double seconds = 0.0;                    // wall time of the reduction
 };
 
+constexpr auto describe(core::Type<CraigBamptonResult>) {
+  using S = CraigBamptonResult;
+  using namespace core::shown;
+  return core::fields<S>("CraigBamptonResult", "a Craig-Bampton reduction of a large model to a super element",
+      core::field("reduced", &S::reduced, kNone, "the super element: interface DOF (per point), then N modal DOF"),
+      core::field("fixed_interface_Hz", &S::fixed_interface_Hz, kHertz, "the N fixed-interface modes, ascending"),
+      core::field("interior_dofs", &S::interior_dofs, kNone, "DOF condensed into the modes"),
+      core::field("interface_dofs", &S::interface_dofs, kNone, "DOF kept at the interface points"),
+      core::field("factor_nonzeros", &S::factor_nonzeros, kNone, "nonzeros of the Cholesky factor of K_ii"),
+      core::field("eigensolver_iterations", &S::eigensolver_iterations, kNone, "Lanczos restarts (Spectra)"),
+      core::field("eigensolver_operations", &S::eigensolver_operations, kNone, "solves with the factor"),
+      core::field("seconds", &S::seconds, kSecond, "wall time of the reduction"));
+}
+
 // Throws InputError for interface points that are not in the model (or lack DOF) and for a
 // request of more modes than interior DOF; NumericalError when K_ii is not positive definite (an
 // unconstrained interior: retain more DOF) or the eigensolver does not converge (retry_may_help).

@@ -102,6 +102,14 @@ struct Modes {
   Eigen::VectorXd frequencies_Hz;
   Eigen::MatrixXd shapes;
 };
+
+constexpr auto describe(core::Type<Modes>) {
+  using S = Modes;
+  using namespace core::shown;
+  return core::fields<S>("Modes", "undamped modes of K phi = w^2 M phi",
+      core::field("frequencies_Hz", &S::frequencies_Hz, kHertz, "ascending, signed: sign(w^2) sqrt|w^2| / 2 pi (negative: a negative eigenvalue)"),
+      core::field("shapes", &S::shapes, kNone, "mode shapes, mass-normalized columns (DOF x modes)"));
+}
 [[nodiscard]] Modes modes(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M);
 [[nodiscard]] inline Modes modes(const StructuralModel& model) { return modes(model.K, model.M); }
 

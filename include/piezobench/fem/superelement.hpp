@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
+
 namespace piezobench::fem {
 
 // The frequency [Hz] of an eigenvalue lambda = w^2 of K phi = w^2 M phi, signed:
@@ -144,6 +146,19 @@ struct RigidBodyCheck {
   double first_flexible_Hz = 0.0;    // 7th free-free mode
   std::string message;               // the warning text when spoiled (else a short note)
 };
+
+constexpr auto describe(core::Type<RigidBodyCheck>) {
+  using S = RigidBodyCheck;
+  using namespace core::shown;
+  return core::fields<S>("RigidBodyCheck", "are a super element's six free-free rigid-body modes at ~0 Hz",
+      core::field("performed", &S::performed, kNone, "false: no coordinates for some nodes, or too large"),
+      core::field("free_free", &S::free_free, kNone, "the 6 lowest modes are rigid-body motions (>= 90 % of M-norm)"),
+      core::field("spoiled", &S::spoiled, kNone, "free_free and their frequencies are not ~0"),
+      core::field("lowest_modes_Hz", &S::lowest_modes_Hz, kHertz, "6 lowest free-free modes, sign(lambda) sqrt|lambda| / 2 pi"),
+      core::field("rigid_fraction", &S::rigid_fraction, kRatio, "share of each of them in the rigid-body subspace (M-norm)"),
+      core::field("first_flexible_Hz", &S::first_flexible_Hz, kHertz, "7th free-free mode"),
+      core::field("message", &S::message, kNone, "the warning text when spoiled (else a short note)"));
+}
 // Spoiled when max |f_1..6| > relative_threshold * f_7. Rigid-body shapes are built from the node
 // coordinates (translations, and rotations about the centroid; modal coordinates zero, which is
 // exact for Craig-Bampton super elements).
