@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.hpp"
+#include "described.hpp"
 #include "piezobench/bench/experiments.hpp"
 #include "piezobench/bench/truth.hpp"
 #include "piezobench/bench/virtual_bench.hpp"
@@ -61,28 +62,6 @@ BenchOptions bench_kwargs(const py::kwargs& kw, const std::string& source) {
   return bench_options().from_kwargs(kwargs_dict(kw), source);
 }
 
-py::object unit_result(const UnitTruth& u) {
-  py::dict model;
-  for (const auto& n : apa::TwoDofParams::names()) model[py::str(n)] = u.model.get(n);
-  py::dict d;
-  d["id"] = u.id;
-  d["model"] = model;
-  d["capacitance_sensor"] = u.capacitance_sensor;
-  d["capacitance_actuator"] = u.capacitance_actuator;
-  d["stroke_factor"] = u.stroke_factor;
-  d["flatness_tilt"] = u.flatness_tilt;
-  d["flatness_warp"] = u.flatness_warp;
-  d["hysteresis_scale"] = u.hysteresis_scale;
-  d["creep_coefficient"] = u.creep_coefficient;
-  d["load_creep_coefficient"] = u.load_creep_coefficient;
-  d["mode_y_Hz"] = u.mode_y_Hz;
-  d["mode_x_Hz"] = u.mode_x_Hz;
-  d["mode_damping"] = u.mode_damping;
-  d["defective"] = u.defective;
-  d["defect"] = u.defect;
-  return result("UnitTruth", d);
-}
-
 const std::string& bench_doc() {
   static const std::string s = "\nKeywords (BenchOptions):\n" + bench_options().doc();
   return s;
@@ -93,8 +72,13 @@ const std::string& bench_doc() {
 void bind_bench(py::module_& m) {
   using py::arg;
 
-  m.def("unit", [](int id, std::uint64_t seed) { return unit_result(batch_unit(id, seed)); }, arg("id"), arg("seed") = 1,
-        "Unit `id` (1..7) of the report's batch drawn from `seed` (unit 3 defective): its true properties (SI).");
+  // The declared results (bench/virtual_bench.hpp); UnitTruth.model is an apa.TwoDofParams.
+  bind_described<UnitTruth>(m);
+  bind_described<BenchRun>(m);
+  m.def("declarations", [] { return declarations_of<UnitTruth, BenchRun>(); },
+        "{declared struct: (its Python class, [field names])} for every declared result bench returns (bench/*.hpp).");
+  m.def("unit", [](int id, std::uint64_t seed) { return batch_unit(id, seed); }, arg("id"), arg("seed") = 1,
+        "Unit `id` (1..7) of the report's batch drawn from `seed` (unit 3 defective): its true properties (SI), a bench.UnitTruth.");
   m.def(
       "truth",
       [](int id, std::uint64_t seed, const py::kwargs& kw) {
@@ -152,24 +136,9 @@ hysteresis, creep, the NMP zero, DAC/amplifier/encoder/ADC, noise and delay, sam
           "run",
           [](VirtualBench& b, py::object u) {
             auto a = vector_arg(u, "bench.VirtualBench.run", "u", false);
-            std::vector<BenchSample> out(static_cast<std::size_t>(a.size()));
-            {
-              py::gil_scoped_release release;
-              b.run(span(a), out);
-            }
-            Eigen::VectorXd de(a.size()), vs(a.size()), va(a.size());
-            for (py::ssize_t k = 0; k < a.size(); ++k) {
-              de(k) = out[static_cast<std::size_t>(k)].de;
-              vs(k) = out[static_cast<std::size_t>(k)].vs;
-              va(k) = out[static_cast<std::size_t>(k)].va;
-            }
-            py::dict d;
-            d["de"] = to_numpy(std::move(de));
-            d["vs"] = to_numpy(std::move(vs));
-            d["va"] = to_numpy(std::move(va));
-            return result("BenchRun", d);
+            return without_gil([&] { return b.run(span(a)); });
           },
-          arg("u"), "Runs the DAC commands u (1-D, V) in order: Result(de (m), vs (V), va (V)) arrays.")
+          arg("u"), "Runs the DAC commands u (1-D, V) in order: a bench.BenchRun of arrays de (m), vs (V), va (V).")
       .def("set_added_mass", &VirtualBench::set_added_mass, arg("kg"))
       .def("set_load_fraction", &VirtualBench::set_load_fraction, arg("fraction"))
       .def("reset", &VirtualBench::reset, arg("seed"), "Back to rest, noise reseeded.")

@@ -133,6 +133,7 @@ void bind_result_classes(py::module_& m) {
 void bind_campaign(py::module_& m) {
   using py::arg;
   bind_result_classes(m);
+  bind_described<DemoFiles>(m);  // write_demo's result (campaign/demo.hpp)
 
   m.def(
       "run",
@@ -171,20 +172,13 @@ void bind_campaign(py::module_& m) {
         o.iff_unit = iff_unit;
         o.tracking_unit = tracking_unit;
         o.threads = threads;
-        auto f = without_gil([&] { return write_demo_campaign(dir, o); });
-        py::dict d;
-        d["campaign"] = f.campaign.string();
-        d["truth"] = f.truth.string();
-        py::list data;
-        for (const auto& p : f.data) data.append(p.string());
-        d["data"] = data;
-        return result("DemoFiles", d);
+        return without_gil([&] { return write_demo_campaign(dir, o); });
       },
       arg("dir"), arg("seed") = DemoOptions{}.seed, arg("fast") = DemoOptions{}.fast, arg("units") = DemoOptions{}.units,
       arg("hysteresis_amplitudes") = DemoOptions{}.hysteresis_amplitudes, arg("iff_gains") = DemoOptions{}.iff_gains,
       arg("iff_unit") = DemoOptions{}.iff_unit, arg("tracking_unit") = DemoOptions{}.tracking_unit, arg("threads") = DemoOptions{}.threads,
       "Simulates the report's campaign on the virtual bench into DIR (data files, campaign.toml,\n"
-      "data/truth.json): Result(campaign, truth, data). fast = shorter records for tests; tracking_unit: the unit\n"
+      "data/truth.json): a campaign.DemoFiles(campaign, truth, superelement, data), paths as str. fast = shorter records for tests; tracking_unit: the unit\n"
       "with a tracking record (0: none).");
 }
 

@@ -186,20 +186,32 @@ py::array stack(const std::vector<Eigen::VectorXd>& v, bool single) {
   return out;
 }
 
-py::object excitation(Excitation&& e) {
-  py::dict d;
-  const double fs = e.sample_rate;
-  const Index n = e.u.size();
-  d["u"] = to_numpy(std::move(e.u));
-  d["t"] = to_numpy(Eigen::VectorXd(Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1)) / fs));
-  d["sample_rate"] = fs;
-  d["kind"] = e.kind;
-  d["scaled"] = e.scaled;
-  d["scale"] = e.scale;
-  d["clipped"] = e.clipped;
-  d["lines_Hz"] = to_numpy(std::move(e.lines_Hz));
-  d["seed"] = e.seed;
-  return result("Excitation", d);
+// dsp.frf's result: the estimate, and whether y was one 1-D output (then H, coherence, std_H, Syy and
+// Suy are 1-D, else (outputs, points)).
+struct FrfEstimateResult {
+  FrfEstimate estimate;
+  bool single = false;
+};
+
+// dsp.FrfEstimate from FrfEstimate's declaration (dsp/welch.hpp), its per-output arrays stacked as above.
+void bind_frf_estimate_class(py::module_& m) {
+  constexpr auto& decl = core::kFields<FrfEstimate>;
+  py::class_<FrfEstimateResult> c(m, std::string(decl.name).c_str(), std::string(decl.meaning).c_str());
+  def_fields<FrfEstimate>(c, [](const FrfEstimateResult& r) -> const FrfEstimate& { return r.estimate; },
+                          {"H", "coherence", "std_H", "Syy", "Suy"});
+  const auto stacked = [&c](auto getter) {
+    const core::Declared d = core::declared<FrfEstimate>(getter);
+    const std::string doc = std::string(d.meaning) + "; 1-D for one 1-D output, else (outputs, points)";
+    c.def_property_readonly(std::string(d.name).c_str(), [getter](const FrfEstimateResult& r) { return stack(*getter(r.estimate), r.single); },
+                            doc.c_str());
+  };
+  stacked(&estimate_H);
+  stacked(&estimate_coherence);
+  stacked(&estimate_std_H);
+  stacked(&estimate_Syy);
+  stacked(&estimate_Suy);
+  typed(c);
+  bind_held<FrfEstimate>(m);
 }
 
 template <class O>
@@ -215,10 +227,10 @@ void def_excitation(py::module_& m, const char* name, const Options<O>& table, E
           if (!py::isinstance<py::dict>(bounds)) throw InputError(source, "bounds", "a dict (min, max, policy)", short_repr(bounds));
           b = bounds_options().from_kwargs(py::reinterpret_borrow<py::dict>(bounds), source);
         }
-        return excitation(without_gil([&] { return f(o, b); }));
+        return without_gil([&] { return f(o, b); });
       },
       py::arg("bounds") = py::none(),
-      (doc + "\nReturns a Result: u (V), t (s), sample_rate (Hz), kind, scaled, scale, clipped, lines_Hz, seed.\n\n"
+      (doc + "\nReturns a dsp.Excitation: u (V), t (s), sample_rate (Hz), kind, scaled, scale, clipped, lines_Hz, seed.\n\n"
              "bounds: dict of\n" + bounds_options().doc("    ") + "\nKeywords:\n" + table.doc())
           .c_str());
 }
@@ -367,24 +379,12 @@ void bind_spectra(py::module_& m) {
         auto o = welch_options().from_kwargs(kwargs_dict(kw), "dsp.frf");
         auto a = vector_arg(u, "dsp.frf", "u", false);
         auto ys = outputs_arg(y, "dsp.frf", names);
-        auto e = estimate(a, ys, fs, o, input, "dsp.frf");
-        py::dict d;
-        const bool single = ys.single;
-        d["freq_Hz"] = to_numpy(e.spectra.freq_Hz);
-        d["H"] = stack(e.frf.H, single);
-        d["coherence"] = stack(e.frf.coherence, single);
-        d["std_H"] = stack(e.frf.std_H, single);
-        d["Suu"] = to_numpy(std::move(e.spectra.Suu));
-        d["Syy"] = stack(e.spectra.Syy, single);
-        d["Suy"] = stack(e.spectra.Suy, single);
-        d["averages"] = e.spectra.averages;
-        d["frf"] = py::cast(std::move(e.frf));
-        return result("FrfEstimate", d);
+        return FrfEstimateResult{estimate(a, ys, fs, o, input, "dsp.frf"), ys.single};
       },
       arg("u"), arg("y"), arg("fs"), arg("outputs") = py::none(), arg("input") = "u",
       ("H1 (or H2) and coherence of every output in one pass over the data (the samples are read in\n"
        "place, without copies, and the GIL is released). u: input (1-D), y: one output (1-D), a list,\n"
-       "or (outputs, samples); fs: Hz; outputs: names. Returns a Result: freq_Hz, H, coherence,\n"
+       "or (outputs, samples); fs: Hz; outputs: names. Returns a dsp.FrfEstimate: freq_Hz, H, coherence,\n"
        "Suu, Syy, Suy (1-D for one output, else (outputs, points)), averages, and frf (a dsp.Frf)." + keywords)
           .c_str());
 }
@@ -444,6 +444,14 @@ void bind_excitations(py::module_& m) {
 
 void bind_dsp(py::module_& m) {
   bind_frf_class(m);
+  bind_frf_estimate_class(m);
+  bind_described<Excitation>(m);
+  m.def("declarations", [] {
+    py::dict d = declarations_of<Frf, Excitation>();
+    const py::type estimate = py::type::of<FrfEstimateResult>();  // dsp.FrfEstimate: FrfEstimate's fields
+    d["FrfEstimate"] = py::make_tuple(estimate, estimate.attr("keys")());
+    return d;
+  }, "{declared struct: (its Python class, [field names])} for every declared result dsp returns (dsp/*.hpp).");
   bind_spectra(m);
   bind_frf_estimators(m);
   bind_excitations(m);

@@ -440,6 +440,20 @@ void VirtualBench::run(std::span<const double> u, std::span<BenchSample> out) no
   s.d = local;
 }
 
+BenchRun VirtualBench::run(std::span<const double> u) {
+  std::vector<BenchSample> out(u.size());
+  run(u, out);
+  const auto n = static_cast<Eigen::Index>(u.size());
+  BenchRun r{Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const BenchSample& b = out[static_cast<std::size_t>(k)];
+    r.de(k) = b.de;
+    r.vs(k) = b.vs;
+    r.va(k) = b.va;
+  }
+  return r;
+}
+
 void VirtualBench::set_added_mass(double kg) noexcept {
   State& s = *state_;
   if (!(std::isfinite(kg) && kg >= 0.0)) return;

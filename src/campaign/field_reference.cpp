@@ -4,13 +4,24 @@
 
 #include "piezobench/apa/piezo.hpp"
 #include "piezobench/apa/two_dof.hpp"
+#include "piezobench/bench/virtual_bench.hpp"
+#include "piezobench/campaign/demo.hpp"
 #include "piezobench/campaign/results.hpp"
 #include "piezobench/campaign/twin.hpp"
+#include "piezobench/control/iff.hpp"
+#include "piezobench/dsp/excitation.hpp"
+#include "piezobench/dsp/welch.hpp"
+#include "piezobench/fem/craig_bampton.hpp"
+#include "piezobench/fem/structural_model.hpp"
+#include "piezobench/fem/superelement.hpp"
 #include "piezobench/ident/actuator_frf.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/low_frequency_high_pass.hpp"
 #include "piezobench/ident/modal.hpp"
 #include "piezobench/ident/plant_fit.hpp"
+#include "piezobench/lti/analysis.hpp"
+#include "piezobench/lti/discretize.hpp"
+#include "piezobench/lti/rlocus.hpp"
 #include "field_table.hpp"
 
 namespace piezobench::campaign {
@@ -50,6 +61,20 @@ std::string field_reference_markdown() {
   field_table<ident::LowFrequencyHighPass>(out, done);
   field_table<ident::Mode>(out, done);
   field_table<ident::LscfResult>(out, done);
+  // The results the other Python modules return (piezobench.lti, fem, dsp, control, bench, campaign).
+  field_table<lti::TimeResponse>(out, done);       // lti.lsim, step, impulse
+  field_table<lti::RootLocus>(out, done);          // lti.rlocus
+  field_table<lti::Damping>(out, done);            // lti.damp
+  field_table<lti::BranchOptimum>(out, done);      // lti.max_damping_on_branch
+  field_table<control::IffRootLocus>(out, done);   // control.iff_root_locus
+  field_table<fem::Modes>(out, done);              // fem.modes
+  field_table<fem::RigidBodyCheck>(out, done);     // fem.check_rigid_body_modes
+  field_table<fem::CraigBamptonResult>(out, done); // fem.craig_bampton
+  field_table<dsp::Excitation>(out, done);         // dsp.band_limited_noise, multisine, ...
+  field_table<dsp::FrfEstimate>(out, done);        // dsp.frf
+  field_table<bench::UnitTruth>(out, done);        // bench.unit
+  field_table<bench::BenchRun>(out, done);         // bench.VirtualBench.run
+  field_table<DemoFiles>(out, done);               // campaign.write_demo
   return out;
 }
 

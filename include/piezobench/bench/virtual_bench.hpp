@@ -62,6 +62,7 @@
 #include <vector>
 
 #include "piezobench/apa/two_dof.hpp"
+#include "piezobench/core/fields.hpp"
 #include "piezobench/lti/state_space.hpp"
 
 namespace piezobench::bench {
@@ -103,6 +104,31 @@ struct UnitTruth {
   // [0, 1), play operators as said above.
   void validate() const;
 };
+
+constexpr auto describe(core::Type<UnitTruth>) {
+  using S = UnitTruth;
+  using namespace core::shown;
+  constexpr core::Shown kRadian{"rad", "rad", 1.0};
+  return core::fields<S>("UnitTruth", "the true properties of one unit of the virtual batch (SI)",
+      core::field("id", &S::id, kNone, "unit number (1..7 in the report's batch)"),
+      core::field("model", &S::model, kNone, "2-DoF parameters of this unit (m is replaced on the bench by the bench's masses)"),
+      core::field("capacitance_sensor", &S::capacitance_sensor, kFaradAsUf, "sensor stack in situ (LCR at 1 kHz, small signal)"),
+      core::field("capacitance_actuator", &S::capacitance_actuator, kFaradAsUf, "the two actuator stacks in parallel (LCR)"),
+      core::field("stroke_factor", &S::stroke_factor, kRatio, "free stroke relative to a good unit (already in model.ga)"),
+      core::field("flatness_tilt", &S::flatness_tilt, kRadian, "tilt of interface 2 relative to interface 1"),
+      core::field("flatness_tilt_direction", &S::flatness_tilt_direction, kRadian, "direction of that tilt in the probe plane (x-y)"),
+      core::field("flatness_warp", &S::flatness_warp, kMetreAsUm, "saddle-shaped warp amplitude of the interfaces"),
+      core::field("hysteresis_scale", &S::hysteresis_scale, kRatio, "relative width (and large-signal gain) of the hysteresis"),
+      core::field("hysteresis_thresholds", &S::hysteresis_thresholds, kVolt, "play operators' thresholds (empty: the default operators)"),
+      core::field("hysteresis_weights", &S::hysteresis_weights, kVoltPerVolt, "play operators' weights (empty: the default operators)"),
+      core::field("creep_coefficient", &S::creep_coefficient, kRatio, "voltage creep per decade of time, relative to the step"),
+      core::field("load_creep_coefficient", &S::load_creep_coefficient, kRatio, "creep of the stacks' strain under a load, per decade of time"),
+      core::field("mode_y_Hz", &S::mode_y_Hz, kHertz, "fixed-free bending mode in y (hammer test)"),
+      core::field("mode_x_Hz", &S::mode_x_Hz, kHertz, "fixed-free bending mode in x (hammer test)"),
+      core::field("mode_damping", &S::mode_damping, kRatio, "damping ratio of those modes"),
+      core::field("defective", &S::defective, kNone, "the unit is defective"),
+      core::field("defect", &S::defect, kNone, "what is wrong with it (\"\" for a good unit)"));
+}
 
 // Unit `id` of the report's batch (1..7) drawn around the report's values from `seed`: stiffness
 // and capacitance within about +-2 %, flatness from a random tilt and warp (Table 1.1-like), unit 3
@@ -198,6 +224,22 @@ struct BenchSample {
   double va = 0.0;  // V, amplifier output at the actuator stacks (after its clamp)
 };
 
+// The samples of a run, one array per channel (VirtualBench::run(u)).
+struct BenchRun {
+  Eigen::VectorXd de;  // m
+  Eigen::VectorXd vs;  // V
+  Eigen::VectorXd va;  // V
+};
+
+constexpr auto describe(core::Type<BenchRun>) {
+  using S = BenchRun;
+  using namespace core::shown;
+  return core::fields<S>("BenchRun", "the measurements of a run of DAC commands on the virtual bench, one per command",
+      core::field("de", &S::de, kMetre, "encoder (quantized, noisy, delayed)"),
+      core::field("vs", &S::vs, kVolt, "force-sensor stack through the high-pass and the ADC"),
+      core::field("va", &S::va, kVolt, "amplifier output at the actuator stacks (after its clamp)"));
+}
+
 class VirtualBench {
  public:
   // Validates the options and the unit (InputError; a super-element file that cannot be read or
@@ -216,6 +258,8 @@ class VirtualBench {
   // The same as out[k] = step(u[k]) for k = 0 .. min(sizes) - 1, in order, but faster: the bench's
   // state stays in registers between samples. For experiments that know their command in advance.
   void run(std::span<const double> u, std::span<BenchSample> out) noexcept;
+  // run(u, out) for every command of u, the samples as one array per channel.
+  BenchRun run(std::span<const double> u);
 
   // Puts a mass on the suspended mass (kg, >= 0; 0 takes it off), effective from the next step:
   // its inertia and (times the load fraction) its weight. 0 and options().added_mass are

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "piezobench/campaign/unit_analysis.hpp"
+#include "piezobench/core/fields.hpp"
 
 namespace piezobench::campaign {
 
@@ -44,6 +45,16 @@ struct DemoFiles {
   std::filesystem::path superelement;  // DIR/superelement/apa300ml.toml (with its K, M and DOF list)
   std::vector<std::filesystem::path> data;
 };
+
+constexpr auto describe(core::Type<DemoFiles>) {
+  using S = DemoFiles;
+  using namespace core::shown;
+  return core::fields<S>("DemoFiles", "the files write_demo_campaign wrote (paths; Python: str)",
+      core::field("campaign", &S::campaign, kNone, "DIR/campaign.toml"),
+      core::field("truth", &S::truth, kNone, "DIR/data/truth.json"),
+      core::field("superelement", &S::superelement, kNone, "DIR/superelement/apa300ml.toml (with its K, M and DOF list)"),
+      core::field("data", &S::data, kNone, "the data files, one per record"));
+}
 
 // Simulates and writes everything under `dir` (created). InputError when a file cannot be written.
 DemoFiles write_demo_campaign(const std::filesystem::path& dir, const DemoOptions& options = {});

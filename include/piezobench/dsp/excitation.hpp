@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "piezobench/core/fields.hpp"
+
 namespace piezobench::dsp {
 
 enum class BoundsPolicy { kScale, kClip, kReject };
@@ -41,6 +43,27 @@ struct Excitation {
   Eigen::VectorXd lines_Hz;      // multisine: the excited lines; noise: the first and last line
   std::uint64_t seed = 0;        // random signals: the seed used
 };
+
+// s, the time of each sample of e.u: k / sample_rate.
+inline Eigen::VectorXd excitation_times(const Excitation& e) {
+  const Eigen::Index n = e.u.size();
+  return Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1)) / e.sample_rate;
+}
+
+constexpr auto describe(core::Type<Excitation>) {
+  using S = Excitation;
+  using namespace core::shown;
+  return core::fields<S>("Excitation", "an excitation signal with how it was made and fitted to the voltage bounds",
+      core::field("u", &S::u, kVolt, "the samples"),
+      core::derived("t", &excitation_times, kSecond, "time of each sample, k / sample_rate"),
+      core::field("sample_rate", &S::sample_rate, kHertz, "sample rate of u"),
+      core::field("kind", &S::kind, kNone, "\"noise\", \"multisine-schroeder\", \"sweep-log\", ..."),
+      core::field("scaled", &S::scaled, kNone, "u was scaled by `scale` < 1 to fit the bounds"),
+      core::field("scale", &S::scale, kRatio, "that factor (1: not scaled)"),
+      core::field("clipped", &S::clipped, kNone, "samples clamped to the bounds (clip policy)"),
+      core::field("lines_Hz", &S::lines_Hz, kHertz, "multisine: the excited lines; noise: the first and last line"),
+      core::field("seed", &S::seed, kNone, "random signals: the seed used"));
+}
 
 // Gaussian noise made in the frequency domain: the DFT lines inside [f_low, f_high] (DC excluded:
 // it is the offset; the Nyquist line allowed) are drawn as a white Gaussian sequence's DFT has

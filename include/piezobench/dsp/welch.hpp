@@ -109,6 +109,32 @@ struct FrfEstimate {
   Frf frf;               // options.estimator; provenance filled in (source, window, nfft, ...)
   CrossSpectra spectra;  // the raw densities it was computed from
 };
+
+// FrfEstimate's figures as its declaration shows them (read from its frf and spectra).
+inline const Eigen::VectorXd* estimate_freq_Hz(const FrfEstimate& e) { return &e.spectra.freq_Hz; }
+inline const std::vector<Eigen::VectorXcd>* estimate_H(const FrfEstimate& e) { return &e.frf.H; }
+inline const std::vector<Eigen::VectorXd>* estimate_coherence(const FrfEstimate& e) { return &e.frf.coherence; }
+inline const std::vector<Eigen::VectorXd>* estimate_std_H(const FrfEstimate& e) { return &e.frf.std_H; }
+inline const Eigen::VectorXd* estimate_Suu(const FrfEstimate& e) { return &e.spectra.Suu; }
+inline const std::vector<Eigen::VectorXd>* estimate_Syy(const FrfEstimate& e) { return &e.spectra.Syy; }
+inline const std::vector<Eigen::VectorXcd>* estimate_Suy(const FrfEstimate& e) { return &e.spectra.Suy; }
+inline Eigen::Index estimate_averages(const FrfEstimate& e) { return e.spectra.averages; }
+
+// The spectra's window, detrend and segment settings are in frf.provenance.
+constexpr auto describe(core::Type<FrfEstimate>) {
+  using S = FrfEstimate;
+  using namespace core::shown;
+  return core::fields<S>("FrfEstimate", "H1 (or H2), coherence and the Welch densities of every output, from one pass over the data",
+      core::derived("freq_Hz", &estimate_freq_Hz, kHertz, "k fs / nfft, k = 0 .. nfft / 2"),
+      core::derived("H", &estimate_H, kNone, "H[i](k): output i / input (frf.H)"),
+      core::derived("coherence", &estimate_coherence, kRatio, "same layout as H (frf.coherence)"),
+      core::derived("std_H", &estimate_std_H, kNone, "standard deviation of H's random error, H's units (frf.std_H)"),
+      core::derived("Suu", &estimate_Suu, kNone, "input PSD, [u]^2/Hz"),
+      core::derived("Syy", &estimate_Syy, kNone, "Syy[i]: PSD of output i, [y_i]^2/Hz"),
+      core::derived("Suy", &estimate_Suy, kNone, "Suy[i]: CSD conj(U) Y_i, [u][y_i]/Hz (scipy csd(u, y_i))"),
+      core::derived("averages", &estimate_averages, kNone, "segments averaged"),
+      core::field("frf", &S::frf, kNone, "the FRF with its provenance (window, nfft, overlap, ...)"));
+}
 FrfEstimate estimate_frf(const Channel& input, const std::vector<Channel>& outputs, double sample_rate_Hz,
                          const WelchOptions& options, const std::string& source = "");
 
