@@ -29,3 +29,25 @@ def welch_frf():
     H = np.vstack([data[:, 1] + 1j * data[:, 2], data[:, 4] + 1j * data[:, 5]])
     coh = np.vstack([data[:, 3], data[:, 6]])
     return pb.dsp.Frf(data[:, 0], H, outputs=["de", "Vs"], coherence=coh), truth
+
+
+@pytest.fixture
+def declared():
+    """check(obj, module, name): obj is the class `module.declarations()` gives for the declared struct
+    `name` (issue 32: made from the C++ declaration, not a dict): its fields() are the declaration, every
+    declared field is an attribute and obj[name], and to_dict() holds them all. Returns obj."""
+    def check(obj, module, name):
+        cls, fields = module.declarations()[name]
+        assert type(obj) is cls and cls.__name__ == name
+        assert [f[0] for f in cls.fields()] == fields == list(obj.keys())
+        assert all(len(f) == 4 and f[3] for f in cls.fields()), "every field has a meaning"
+        for f in fields:
+            value, item = getattr(obj, f), obj[f]
+            if isinstance(value, np.ndarray):
+                np.testing.assert_array_equal(item, value)
+            elif not hasattr(value, "keys"):  # a nested class is a new view each time
+                assert item == value
+        assert set(obj.to_dict()) == set(fields)
+        assert repr(obj).startswith(name + "(")
+        return obj
+    return check

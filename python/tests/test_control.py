@@ -39,6 +39,21 @@ def test_iff_root_locus_optimum_is_the_most_damped_point():
     assert r.locus.poles.shape[0] == r.locus.gains.size
 
 
+def test_iff_root_locus_is_the_declared_class(declared):
+    g, k = control.iff_plant(), control.iff_controller()
+    r = declared(control.iff_root_locus(g, k, [0.0, 1e3]), control, "IffRootLocus")
+    assert r.keys() == ["locus", "resonance_pole", "optimum", "resonance_branch"]
+    assert isinstance(r.locus, lti.RootLocus) and isinstance(r.optimum, lti.BranchOptimum)
+    assert isinstance(r.resonance_pole, complex) and isinstance(r.resonance_branch, int)
+    # At gain 0 the locus holds the open-loop poles: the resonance branch starts at the resonance pole.
+    np.testing.assert_array_equal(r.locus.gains, [0.0, 1e3])
+    ol = control.iff_open_loop(g, k)
+    np.testing.assert_allclose(np.sort_complex(r.locus.poles[1]), np.sort_complex(lti.closed_loop_poles(ol, 1e3)), rtol=1e-9)
+    assert r.locus.poles[0, r.resonance_branch] == pytest.approx(r.resonance_pole, rel=1e-9)
+    assert abs(r.resonance_pole.imag) / (2 * np.pi) == pytest.approx(95.0, rel=0.1)
+    assert r.to_dict()["optimum"]["gain"] == r.optimum.gain
+
+
 def test_discrete_iff_equals_scipy_bilinear_of_the_controller():
     fs = 10e3
     c = control.DiscreteIff(gain=1.0, sample_rate=fs, prewarp=0.0)

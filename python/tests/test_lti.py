@@ -43,6 +43,35 @@ def test_poles_zeros_dc_gain_damp():
     np.testing.assert_allclose(d.damping, [0.05, 0.05], rtol=1e-12)
 
 
+def test_lti_results_are_the_declared_classes(declared):
+    """lti.damp, lsim/step/impulse, rlocus and max_damping_on_branch return the classes of their C++
+    declarations (issue 32) with the attributes the dicts had, arrays as numpy arrays."""
+    assert set(lti.declarations()) == {"TimeResponse", "RootLocus", "Damping", "BranchOptimum"}
+    # damp of wn^2 / (s^2 + 2 zeta wn s + wn^2): poles -zeta wn +- j wn sqrt(1 - zeta^2).
+    wn, zeta = 30.0, 0.05
+    d = declared(lti.damp(lti.TransferFunction([1.0], [1.0, 2 * zeta * wn, wn**2])), lti, "Damping")
+    assert d.keys() == ["poles", "natural_frequency", "damping"]
+    assert d.poles.dtype == complex and d.natural_frequency.dtype == float and d.damping.shape == (2,)
+    np.testing.assert_allclose(np.sort_complex(d.poles), np.sort_complex(np.roots([1.0, 2 * zeta * wn, wn**2])), rtol=1e-12)
+    # step of a first-order lag 1 / (tau s + 1) at the samples: 1 - exp(-t / tau) (ZOH is exact for a step).
+    tau, ts = 0.01, 1e-3
+    st = declared(lti.step(lti.TransferFunction([1.0], [tau, 1.0]), ts, 50), lti, "TimeResponse")
+    assert st.keys() == ["t", "y", "x"] and st.y.shape == (50, 1) and st.x.shape == (50, 1)
+    np.testing.assert_allclose(st.y[:, 0], 1.0 - np.exp(-st.t / tau), atol=1e-12)
+    np.testing.assert_allclose(st.t, np.arange(50) * ts, rtol=1e-15)
+    # rlocus of 1 / (s (s + 2)): s^2 + 2 s + k = 0.
+    rl = declared(lti.rlocus(lti.TransferFunction([1.0], [1.0, 2.0, 0.0]), [0.0, 4.0]), lti, "RootLocus")
+    assert rl.keys() == ["gains", "poles"] and rl.gains.dtype == float and rl.poles.dtype == complex
+    np.testing.assert_array_equal(rl.gains, [0.0, 4.0])
+    np.testing.assert_allclose(np.sort_complex(rl.poles[1]), np.sort_complex(np.roots([1.0, 2.0, 4.0])), rtol=1e-12)
+    # 1/((s+1)(s^2 + 0.2 s + 100)): the optimum's pole is a closed-loop pole at its gain, damping -Re/|p|.
+    res = lti.TransferFunction([1.0], np.polymul([1.0, 1.0], [1.0, 0.2, 100.0]))
+    b = declared(lti.max_damping_on_branch(res, complex(-0.1, 10.0)), lti, "BranchOptimum")
+    assert b.keys() == ["gain", "damping", "pole"] and isinstance(b.pole, complex) and isinstance(b.gain, float)
+    assert b.damping == pytest.approx(-b.pole.real / abs(b.pole), rel=1e-9)
+    assert np.min(np.abs(lti.closed_loop_poles(res, b.gain) - b.pole)) < 1e-9 * abs(b.pole)
+
+
 def test_c2d_equals_scipy():
     ts = 1e-3
     sys = lti.ss(lti.TransferFunction(NUM, DEN))
