@@ -119,13 +119,13 @@ void bind_result_classes(py::module_& m) {
   bind_batch_and_iff(m);
   bind_campaign_result(m);
   m.def("declarations", [] {
-    py::dict d = declarations_of<UnitAnalysis, BatchAnalysis, IffStudy, SuperElementComparison>();
+    py::dict d = declarations_of<UnitAnalysis, BatchAnalysis, IffStudy, SuperElementComparison, DemoFiles>();
     const py::type run = py::type::of<CampaignRun>();  // campaign.CampaignResult: CampaignResult's fields, and `written`
     d["CampaignResult"] = py::make_tuple(run, run.attr("keys")());
     return d;
   },
         "{declared struct: (its Python class, [field names])} for CampaignResult and every declared struct it holds\n"
-        "(its units, batch, iff and superelement; docs/fields.md).");
+        "(its units, batch, iff and superelement; docs/fields.md), and DemoFiles (write_demo's).");
 }
 
 }  // namespace

@@ -45,8 +45,10 @@ def declared():
             value, item = getattr(obj, f), obj[f]
             if isinstance(value, np.ndarray):
                 np.testing.assert_array_equal(item, value)
-            elif not hasattr(value, "keys"):  # a nested class is a new view each time
+            elif isinstance(value, (int, float, complex, str, list, type(None))):
                 assert item == value
+            else:  # a nested class: a new view (or copy) each time
+                assert type(item) is type(value)
         assert set(obj.to_dict()) == set(fields)
         assert repr(obj).startswith(name + "(")
         return obj

@@ -39,6 +39,26 @@ def test_virtual_bench_run_equals_step_by_step():
     assert bench.unit(3, 1).defective
 
 
+def test_bench_results_are_the_declared_classes(declared):
+    assert set(bench.declarations()) >= {"UnitTruth", "BenchRun", "TwoDofParams"}
+    r = declared(bench.VirtualBench(unit=1, seed=3, noise=False).run(np.full(50, 0.5)), bench, "BenchRun")
+    assert r.keys() == ["de", "vs", "va"] and all(getattr(r, k).shape == (50,) for k in r.keys())
+    b = bench.VirtualBench(unit=1, seed=3, noise=False)
+    np.testing.assert_array_equal(np.array([b.step(0.5) for _ in range(50)]), np.column_stack([r.de, r.vs, r.va]))
+    u = declared(bench.unit(3, 1), bench, "UnitTruth")
+    for k in ("id", "model", "capacitance_sensor", "capacitance_actuator", "stroke_factor", "flatness_tilt", "flatness_warp",
+              "hysteresis_scale", "creep_coefficient", "load_creep_coefficient", "mode_y_Hz", "mode_x_Hz", "mode_damping",
+              "defective", "defect"):
+        assert k in u.keys()
+    assert u.id == 3 and u.defective and u.defect and isinstance(u.capacitance_sensor, float)
+    # The model is the apa.TwoDofParams class (was a dict): read by name as before, the stroke factor in ga.
+    good = bench.unit(1, 1)
+    assert dict(u.model)["ka"] == u.model["ka"] == u.model.ka
+    assert u.stroke_factor < 0.8 < good.stroke_factor
+    assert u.capacitance_sensor < 0.7 * good.capacitance_sensor  # "about half the stack capacitance" (virtual_bench.hpp)
+    assert good.capacitance_sensor == pytest.approx(4.95e-6, rel=0.05)
+
+
 def test_bad_experiment_and_option():
     with pytest.raises(pb.InputError) as e:
         bench.simulate("frf-nois")

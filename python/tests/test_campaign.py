@@ -27,6 +27,16 @@ def demo(tmp_path_factory):
     return tmp, files, campaign.run(files.campaign, out_dir=str(tmp / "out"))
 
 
+def test_write_demo_returns_the_declared_demo_files(demo, declared):
+    tmp, files, _ = demo
+    cls, fields = campaign.declarations()["DemoFiles"]
+    assert fields == ["campaign", "truth", "superelement", "data"]
+    declared(files, campaign, "DemoFiles")
+    assert files.campaign == str(tmp / "campaign.toml") and files.truth == str(tmp / "data" / "truth.json")
+    assert all(isinstance(p, str) and os.path.exists(p) for p in [files.campaign, files.truth, files.superelement] + files.data)
+    assert files.data and all(p.startswith(str(tmp)) for p in files.data)
+
+
 def test_demo_campaign_results_agree_with_the_truth(demo):
     tmp, files, r = demo
     truth = json.loads(open(files.truth).read())["units"][0]

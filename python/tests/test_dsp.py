@@ -127,6 +127,39 @@ def test_excitations():
     assert set(np.round(np.unique(st.u), 12)) == {0.0, 1.0, 2.0}
 
 
+def test_dsp_results_are_the_declared_classes(declared):
+    """The excitations and dsp.frf return the classes of their declarations, arrays as before."""
+    assert {"Frf", "FrfProvenance", "Excitation", "FrfEstimate"} <= set(dsp.declarations())
+    ms = declared(dsp.multisine(sample_rate=1000.0, period_samples=1000, periods=2, lines_Hz=[10.0, 20.0, 50.0], rms=0.5,
+                                offset=3.0), dsp, "Excitation")
+    assert ms.keys() == ["u", "t", "sample_rate", "kind", "scaled", "scale", "clipped", "lines_Hz", "seed"]
+    np.testing.assert_array_equal(ms.t, np.arange(2000) / 1000.0)
+    np.testing.assert_array_equal(ms.lines_Hz, [10.0, 20.0, 50.0])
+    assert ms.sample_rate == 1000.0 and ms.kind.startswith("multisine") and isinstance(ms.clipped, int)
+    assert not ms.scaled and ms.scale == 1.0
+    noise = declared(dsp.band_limited_noise(samples=4096, f_low=10.0, f_high=500.0, rms=0.1, seed=7), dsp, "Excitation")
+    assert noise.seed == 7 and isinstance(noise.seed, int)
+    # dsp.frf: one 1-D output gives 1-D arrays, two give (outputs, points); values as scipy's Welch.
+    rng = np.random.default_rng(1)
+    fs, nfft = 1000.0, 256
+    u = rng.standard_normal(8192)
+    y = ss.lfilter([0.5, 0.2], [1.0], u)
+    kw = dict(nfft=nfft, overlap=0.5, window="hann-periodic", detrend="none")
+    one = declared(dsp.frf(u, y, fs, **kw), dsp, "FrfEstimate")
+    assert set(one.keys()) == {"freq_Hz", "H", "coherence", "std_H", "Suu", "Syy", "Suy", "averages", "frf"}
+    assert one.H.shape == (nfft // 2 + 1,) and one.H.dtype == complex and one.Syy.shape == one.coherence.shape == one.H.shape
+    f, pxy = ss.csd(u, y, fs, window="hann", nperseg=nfft, noverlap=nfft // 2, detrend=False)
+    np.testing.assert_allclose(one.freq_Hz, f, rtol=1e-12)
+    np.testing.assert_allclose(one.Suy, pxy, rtol=1e-9, atol=1e-15)
+    _, puu = ss.welch(u, fs, window="hann", nperseg=nfft, noverlap=nfft // 2, detrend=False)
+    np.testing.assert_allclose(one.Suu, puu, rtol=1e-9)
+    np.testing.assert_allclose(one.H, pxy / puu, rtol=1e-9)
+    assert isinstance(one.frf, dsp.Frf) and one.averages == one.frf.provenance.averages
+    two = dsp.frf(u, np.vstack([y, 2 * y]), fs, outputs=["a", "b"], **kw)
+    assert two.H.shape == (2, nfft // 2 + 1) and two.Syy.shape == two.Suy.shape == two.std_H.shape == two.H.shape
+    np.testing.assert_allclose(two.H[1], 2 * one.H, rtol=1e-12)
+
+
 def test_bad_arguments_raise_input_error_naming_the_field():
     u, y, _, fs = _record(n=4096)
     with pytest.raises(pb.InputError) as e:

@@ -67,3 +67,36 @@ def test_craig_bampton_condenses_statically_and_keeps_the_low_modes():
     # The lowest modes of the reduced model converge to the full model's.
     full = np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True)[:3]) / (2 * np.pi)
     np.testing.assert_allclose(fem.modes(red.K, red.M).frequencies_Hz[:3], full, rtol=1e-3)
+
+
+def test_fem_results_are_the_declared_classes(declared, tmp_path):
+    """fem.modes, check_rigid_body_modes and craig_bampton return the classes of their declarations."""
+    assert set(fem.declarations()) == {"Modes", "RigidBodyCheck", "CraigBamptonResult"}
+    K, M = _chain(6)
+    K[0, 0] += 1e6
+    m = declared(fem.modes(K, M), fem, "Modes")
+    assert m.keys() == ["frequencies_Hz", "shapes"] and m.shapes.shape == (6, 6) and m.frequencies_Hz.dtype == float
+    np.testing.assert_allclose(m.frequencies_Hz, np.sqrt(scipy.linalg.eigh(K, M, eigvals_only=True)) / (2 * np.pi), rtol=1e-10)
+    # A free-free chain along x has one rigid-body mode, not six: the check says so.
+    K2, M2 = _chain(4)
+    scipy.io.mmwrite(tmp_path / "k.mtx", sp.coo_matrix(K2), symmetry="symmetric")
+    scipy.io.mmwrite(tmp_path / "m.mtx", sp.coo_matrix(M2), symmetry="symmetric")
+    (tmp_path / "dofs.txt").write_text("".join(f"{i} UX {0.01 * i} 0 0\n" for i in range(1, 5)))
+    se = fem.read_super_element(str(tmp_path / "k.mtx"), str(tmp_path / "m.mtx"), str(tmp_path / "dofs.txt"),
+                                check_rigid_body_modes=False)
+    c = declared(fem.check_rigid_body_modes(se), fem, "RigidBodyCheck")
+    assert c.keys() == ["performed", "free_free", "spoiled", "lowest_modes_Hz", "rigid_fraction", "first_flexible_Hz", "message"]
+    assert isinstance(c.performed, bool) and isinstance(c.message, str) and isinstance(c.lowest_modes_Hz, np.ndarray)
+    assert not c.spoiled
+    n = 12
+    K3, M3 = _chain(n)
+    K3[0, 0] += 1e6
+    model = fem.SparseModel(sp.csc_matrix(K3), sp.csc_matrix(M3), [(i + 1, "x") for i in range(n)])
+    r = declared(fem.craig_bampton(model, [1, n], modes=4), fem, "CraigBamptonResult")
+    assert r.keys() == ["reduced", "fixed_interface_Hz", "interior_dofs", "interface_dofs", "factor_nonzeros",
+                        "eigensolver_iterations", "eigensolver_operations", "seconds"]
+    assert isinstance(r.reduced, fem.SuperElement) and r.reduced.size == 2 + 4
+    assert r.interior_dofs == n - 2 and r.interface_dofs == 2 and r.factor_nonzeros > 0 and r.seconds >= 0.0
+    i = list(range(1, n - 1))
+    ref = np.sqrt(scipy.linalg.eigh(K3[np.ix_(i, i)], M3[np.ix_(i, i)], eigvals_only=True)[:4]) / (2 * np.pi)
+    np.testing.assert_allclose(r.fixed_interface_Hz, ref, rtol=1e-8)
