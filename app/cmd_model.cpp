@@ -180,33 +180,21 @@ int run_tune(const TuneCommand& c) {
   const apa::TwoDofTuning t = apa::tune_two_dof_measured(frf, o, plants.de && !given_delay ? &*plants.de : nullptr,
                                                          plants.vs && po.fixed_w_hpf == 0.0 ? &*plants.vs : nullptr);
   if (c.json) {
-    nlohmann::json doc = {{"source", c.frf_file},
-                {"model_2dof", t.quality.impossible ? nlohmann::json(nullptr) : params_json(t.params)},
-                {"fit_error", {{"de", io::to_json(t.fit_error_de)}, {"Vs", io::to_json(t.fit_error_vs)}}},
-                {"fit_error_definition", "rms over the frequencies used of |H_model / H_data - 1| per output"},
-                {"initial", t.quality.impossible ? nlohmann::json(nullptr) : params_json(t.initial)},
-                {"initial_fit_error", {{"de", io::to_json(t.initial_fit_error_de)}, {"Vs", io::to_json(t.initial_fit_error_vs)}}},
-                {"features",
-                 {{"resonance_Hz", io::to_json(t.features.resonance / kTwoPi)},
-                  {"resonance_damping", io::to_json(t.features.resonance_damping)},
-                  {"antiresonance_Hz", io::to_json(t.features.antiresonance / kTwoPi)},
-                  {"antiresonance_damping", io::to_json(t.features.antiresonance_damping)},
-                  {"static_gain_de_um_per_V", io::to_json(t.features.static_gain_de * 1e6)},
-                  {"static_gain_Vs_V_per_V", io::to_json(t.features.static_gain_vs)}}},
-                {"amplifier_gain", o.bench.amplifier_gain},
-                {"band_Hz", {o.fmin_Hz, o.fmax_Hz}},
-                {"min_coherence", o.min_coherence},
-                {"chain", {{"delay_s", t.bench.delay}, {"hpf_corner_Hz", t.bench.hpf_corner() / kTwoPi}}},
-                {"stack_stiffness_ratio", o.stack_stiffness_ratio},
-                {"stack_damping_ratio", o.stack_damping_ratio},
-                {"uncertainty", io::to_json(t.uncertainty)},
-                {"uncertainty_with_misfit", io::to_json(t.uncertainty_with_misfit)},
-                {"undetermined", t.undetermined},
-                {"points", t.points},
-                {"iterations", t.iterations},
-                {"status", apa::to_string(t.status)},
-                {"message", t.message}};
-    doc.update(quality_json(t.quality));
+    // The tuning's declared view (results.json's model_2dof_fit: features, fit errors, initial,
+    // bench, uncertainty, status, the verdict ...), the parameters in SI under model_2dof (as
+    // results.json's), and only the command's own: the file, the band, the ratios and the chain.
+    nlohmann::json doc = io::results_object(t);
+    doc.erase("params");
+    doc["source"] = c.frf_file;
+    doc["model_2dof"] = t.quality.impossible ? nlohmann::json(nullptr) : params_json(t.params);
+    if (t.quality.impossible) doc["initial"] = nullptr;
+    doc["fit_error_definition"] = "rms over the frequencies used of |H_model / H_data - 1| per output";
+    doc["amplifier_gain"] = o.bench.amplifier_gain;
+    doc["band_Hz"] = {o.fmin_Hz, o.fmax_Hz};
+    doc["min_coherence"] = o.min_coherence;
+    doc["chain"] = {{"delay_s", t.bench.delay}, {"hpf_corner_Hz", t.bench.hpf_corner() / kTwoPi}};
+    doc["stack_stiffness_ratio"] = o.stack_stiffness_ratio;
+    doc["stack_damping_ratio"] = o.stack_damping_ratio;
     doc["warnings"] = file.warnings;
     print_json(doc);
     return report_quality(t.quality);
