@@ -242,6 +242,20 @@ struct ZeroReport {
   std::string evidence;                   // ident::zero_phase_verdict's reason, or "fitted zero"
 };
 
+double zero_frequency(const ZeroReport& z) { return std::abs(z.zero); }  // rad/s
+
+constexpr auto describe(core::Type<ZeroReport>) {
+  using S = ZeroReport;
+  using namespace core::shown;
+  return core::fields<S>("ZeroReport", "a zero of `fit`'s model of one output, with its phase evidence",
+      core::field("zero", &S::zero, kRadPerSecond, "[re, im]").key("zero"),
+      core::derived("frequency", &zero_frequency, kRadPerSecondAsHz, "|zero|"),
+      core::field("lightly_damped", &S::lightly_damped, kNone, "|damping| < 0.2"),
+      core::field("nonminimum_phase", &S::nonminimum_phase, kNone,
+                  "for a lightly damped pair in the band: the data's phase, else the model's (null: undecided)"),
+      core::field("evidence", &S::evidence, kNone, "ident::zero_phase_verdict's reason, or \"fitted zero\""));
+}
+
 std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const dsp::Frf& band, Eigen::Index i,
                                      const ident::VectorFittingOptions& vf) {
   std::vector<ZeroReport> out;
@@ -285,39 +299,26 @@ std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const 
   return out;
 }
 
+// VectorFittingResult's declared view (results.json's: poles_rad_per_s, d, e, rms_error,
+// relative_rms_error(_per_output), the verdict, iterations, convergence, frequency_scale_rad_per_s),
+// the residues one list per output (the declared view flattens the matrix), and the command's own:
+// the file, outputs, band, order and each output's declared zeros.
 nlohmann::json fit_json(const ident::VectorFittingResult& r, const dsp::Frf& band, const std::vector<std::vector<ZeroReport>>& zeros) {
+  nlohmann::json doc = io::results_object(r);
   nlohmann::json residues = nlohmann::json::array();
   for (Eigen::Index i = 0; i < r.residues.rows(); ++i) residues.push_back(io::to_json(Eigen::VectorXcd(r.residues.row(i).transpose())));
+  doc["residues"] = residues;
   nlohmann::json per_output = nlohmann::json::object();
   for (std::size_t i = 0; i < band.outputs.size(); ++i) {
-    nlohmann::json z = nlohmann::json::array();
-    for (const auto& rep : zeros[i]) {
-      z.push_back({{"zero", io::to_json(rep.zero)},
-                   {"frequency_Hz", std::abs(rep.zero) / kTwoPi},
-                   {"lightly_damped", rep.lightly_damped},
-                   {"nonminimum_phase", rep.nonminimum_phase ? nlohmann::json(*rep.nonminimum_phase) : nlohmann::json(nullptr)},
-                   {"evidence", rep.evidence}});
-    }
     per_output[band.outputs[i]] = {{"relative_rms_error", io::to_json(r.relative_rms_error_per_output(static_cast<Eigen::Index>(i)))},
-                                   {"zeros", z}};
+                                   {"zeros", io::shown_json(zeros[i])}};
   }
-  nlohmann::json doc = {{"source", band.provenance.source},
-                        {"outputs", band.outputs},
-                        {"fmin_Hz", band.freq_Hz(0)},
-                        {"fmax_Hz", band.freq_Hz(band.freq_Hz.size() - 1)},
-                        {"order", r.poles.size()},
-                        {"poles", io::to_json(r.poles)},
-                        {"residues", residues},
-                        {"d", io::to_json(r.d)},
-                        {"e", io::to_json(r.e)},
-                        {"rms_error", io::to_json(r.rms_error)},
-                        {"relative_rms_error", io::to_json(r.relative_rms_error)},
-                        {"per_output", per_output},
-                        {"iterations", r.iterations},
-                        {"converged", r.converged},
-                        {"convergence", ident::to_string(r.convergence)},
-                        {"frequency_scale_rad_per_s", r.frequency_scale}};
-  doc.update(quality_json(r.quality));
+  doc["source"] = band.provenance.source;
+  doc["outputs"] = band.outputs;
+  doc["fmin_Hz"] = band.freq_Hz(0);
+  doc["fmax_Hz"] = band.freq_Hz(band.freq_Hz.size() - 1);
+  doc["order"] = r.poles.size();
+  doc["per_output"] = per_output;
   return doc;
 }
 
@@ -422,12 +423,19 @@ int run_fit_iff_plant(const IffPlantOptions& o) {
                         {"status", core::to_string(p.status)},
                         {"formula", "G(s) = g0 (1 + 2 xz s/wz + s^2/wz^2) / (1 + 2 xp s/wp + s^2/wp^2) s / (w_hpf + s) exp(-s delay)"}};
   if (!p.quality.impossible) {
-    doc["plant"] = {{"g0", io::to_json(p.g0)},
-                    {"g0_unit", g0_unit.empty() ? nlohmann::json() : nlohmann::json(g0_unit)},
-                    {"wz_Hz", io::to_json(p.wz * hz)},
-                    {"xz", io::to_json(p.xz)},
-                    {"wp_Hz", io::to_json(p.wp * hz)},  {"xp", io::to_json(p.xp)},          {"w_hpf_Hz", io::to_json(p.w_hpf * hz)},
-                    {"delay_s", io::to_json(p.delay)}, {"zero_is_nonminimum_phase", p.zero_is_nonminimum_phase()}};
+    // IffPlantFit's declared parameters (wz_Hz, xz, wp_Hz, xp, w_hpf_Hz, delay_s; the fit's
+    // statistics are the document's own keys above); g0 in H's unit as the file states it (the
+    // declaration's V/V is the campaign's u -> Vs in V), with that unit.
+    nlohmann::json plant = io::results_object(p);
+    for (const char* k : {"g0_V_per_V", "relative_rms_error", "weighted_relative_rms_error", "initial_relative_rms_error", "points",
+                          "iterations", "converged", "status", "quality", "quality_advice", "quality_impossible", "quality_problems",
+                          "uncertainty"}) {
+      plant.erase(k);
+    }
+    plant["g0"] = io::to_json(p.g0);
+    plant["g0_unit"] = g0_unit.empty() ? nlohmann::json() : nlohmann::json(g0_unit);
+    plant["zero_is_nonminimum_phase"] = p.zero_is_nonminimum_phase();
+    doc["plant"] = plant;
     doc["uncertainty"] = io::to_json(p.uncertainty);
     const ident::ZeroPhaseVerdict v = ident::zero_phase_verdict(nullptr, &p);
     doc["zero_verdict"] = {{"nonminimum_phase", v.nonminimum_phase ? nlohmann::json(*v.nonminimum_phase) : nlohmann::json(nullptr)},

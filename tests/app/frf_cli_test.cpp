@@ -89,8 +89,8 @@ TEST(FrfCli, WritesTheFrfThatFitReadsBack) {
   const test::CliRun f = run_cli("fit " + csv + " --order 2 --fmin 20 --fmax 400 --out " + model + " --json");
   ASSERT_EQ(f.exit_code, 0) << f.err;
   const auto j = nlohmann::json::parse(f.out);
-  ASSERT_EQ(j["poles"].size(), 2U);
-  const auto p = pair(j["poles"][1]);
+  ASSERT_EQ(j["poles_rad_per_s"].size(), 2U);
+  const auto p = pair(j["poles_rad_per_s"][1]);
   EXPECT_NEAR(std::abs(p) / (2 * std::numbers::pi), 95.0, 2.0);
   EXPECT_GT(-p.real() / std::abs(p), 0.02);
   EXPECT_LT(-p.real() / std::abs(p), 0.05);
@@ -120,10 +120,10 @@ TEST(FitCli, RecoversKnownPolesFromAnExactFrf) {
   const test::CliRun r = run_cli("fit " + file + " --order 6 --asymptote none --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  ASSERT_EQ(j["poles"].size(), 6U);
+  ASSERT_EQ(j["poles_rad_per_s"].size(), 6U);
   for (const auto& expected : poles) {
     double best = 1e300;
-    for (const auto& q : j["poles"]) best = std::min(best, std::abs(pair(q) - expected) / std::abs(expected));
+    for (const auto& q : j["poles_rad_per_s"]) best = std::min(best, std::abs(pair(q) - expected) / std::abs(expected));
     EXPECT_LT(best, 1e-6) << expected;
   }
 }
@@ -202,8 +202,8 @@ TEST(FitCli, BothOutputsOfAScipyWelchFrfGiveTheResonance) {
   const test::CliRun r = run_cli("fit " + f + " --order 2 --fmin 20 --fmax 400 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  ASSERT_EQ(j["poles"].size(), 2U);
-  const auto p = pair(j["poles"][1]);
+  ASSERT_EQ(j["poles_rad_per_s"].size(), 2U);
+  const auto p = pair(j["poles_rad_per_s"][1]);
   EXPECT_NEAR(std::abs(p) / (2 * std::numbers::pi) / truth["resonance_Hz"].get<double>(), 1.0, 0.01);
   EXPECT_EQ(j["quality"], "good");
   for (const char* name : {"de", "Vs"}) EXPECT_LT(j["per_output"][name]["relative_rms_error"].get<double>(), 0.2) << name;
