@@ -224,16 +224,12 @@ void print_measurement(const MeasureRequest& r, const std::string& out, const be
   }
 }
 
+// bench::TrackingSummary's declared view (rms and stroke in um, as results.json's tracking), with
+// each waveform's rms_reduction (a method of TrackingFigures, added as results.json adds it).
 nlohmann::json tracking_json(const bench::TrackingSummary& tracking) {
-  nlohmann::json t = nlohmann::json::object();
-  for (const auto& [name, f] : {std::pair<const char*, const bench::TrackingFigures&>{"sine", tracking.sine},
-                                {"triangle", tracking.triangle}}) {
-    t[name] = {{"width_open", f.width_open}, {"width_ff", f.width_ff}, {"rms_open_m", f.rms_open}, {"rms_ff_m", f.rms_ff},
-               {"stroke_open_m", f.stroke_open}, {"rms_reduction", f.rms_reduction()}};
-  }
-  t["identified"] = tracking.identified;
-  t["fit_relative_residual"] = tracking.fit_relative_residual;
-  t["clamped_samples"] = tracking.clamped_samples;
+  nlohmann::json t = io::results_object(tracking);
+  t["sine"]["rms_reduction"] = io::to_json(tracking.sine.rms_reduction());
+  t["triangle"]["rms_reduction"] = io::to_json(tracking.triangle.rms_reduction());
   return t;
 }
 

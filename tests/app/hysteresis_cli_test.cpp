@@ -35,6 +35,10 @@ TEST(HysteresisCli, FitWritesAModelThatTrackingAndRtUse) {
   EXPECT_LT(t["sine"]["width_ff"].get<double>(), 0.03);
   EXPECT_GT(t["sine"]["width_open"].get<double>(), 0.15);
   EXPECT_GE(t["sine"]["rms_reduction"].get<double>(), 5.0);
+  // TrackingSummary's declared view: rms and stroke in um (results.json's units), the reduction their ratio.
+  EXPECT_NEAR(t["sine"]["rms_open_um"].get<double>() / t["sine"]["rms_ff_um"].get<double>(), t["sine"]["rms_reduction"].get<double>(), 1e-9);
+  EXPECT_GT(t["sine"]["stroke_open_um"].get<double>(), 10.0);  // tens of um at 80 V (metres would be < 1e-3)
+  EXPECT_FALSE(t["sine"].contains("rms_open_m"));
 
   const test::CliRun rt = run_cli("rt --bench virtual --hysteresis-law bouc-wen --controller off --gain 0 --excitation sine "
                                   "--offset 3.25 --amplitude 4 --duration 1.5 --realtime false --feedforward " +

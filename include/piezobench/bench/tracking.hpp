@@ -85,4 +85,15 @@ constexpr auto describe(core::Type<TrackingFigures>) {
       core::field("stroke_open", &S::stroke_open, kMetreAsUm, "stroke without"));
 }
 
+constexpr auto describe(core::Type<TrackingSummary>) {
+  using S = TrackingSummary;
+  using namespace core::shown;
+  return core::fields<S>("TrackingSummary", "the figures of a tracking record (`measure tracking`, `simulate tracking`)",
+      core::field("sine", &S::sine, kNone, "the 1 Hz sine"),
+      core::field("triangle", &S::triangle, kNone, "the 1 Hz triangle"),
+      core::field("identified", &S::identified, kNone, "the feedforward's model came from the open run"),
+      core::field("fit_relative_residual", &S::fit_relative_residual, kRatio, "the identified model's residual / stroke (identified only)"),
+      core::field("clamped_samples", &S::clamped_samples, kNone, "compensated samples clamped to [va_min, va_max]"));
+}
+
 }  // namespace piezobench::bench
