@@ -241,30 +241,10 @@ void add_hardware_json(const MeasureRequest& r, const Measurement& m, nlohmann::
   doc["bench_file"] = r.bench->source;
   doc["cycles"] = rep.cycles();
   doc["io"] = io::results_object(io);
-  // Each run: the part of its loop report (rt::LoopReport's declared keys) the measurement shows;
-  // the whole report is `rt --json`'s.
-  static constexpr const char* kRunKeys[] = {"overruns",
-                                             "overrun_causes",
-                                             "host",
-                                             "code",
-                                             "skipped_deadlines",
-                                             "step_time_us",
-                                             "cycles",
-                                             "feedforward",
-                                             "clamped_samples",
-                                             "slew_limited_samples",
-                                             "stale_sensor_samples",
-                                             "safe_state_reason",
-                                             "sched_fifo",
-                                             "memory_locked",
-                                             "warnings"};
+  // Each run: its loop report as `rt --json` writes it (loop_report_json: rt::LoopReport's declared
+  // view, its own I/O included).
   nlohmann::json runs = nlohmann::json::array();
-  for (const rt::LoopReport& lr : rep.runs) {
-    const nlohmann::json report = loop_report_json(lr);
-    nlohmann::json run = nlohmann::json::object();
-    for (const char* key : kRunKeys) run[key] = report.at(key);
-    runs.push_back(std::move(run));
-  }
+  for (const rt::LoopReport& lr : rep.runs) runs.push_back(loop_report_json(lr));
   doc["runs"] = runs;
   nlohmann::json steps = nlohmann::json::array();
   for (const rt::OperatorConfirmation& c : rep.operator_steps) {

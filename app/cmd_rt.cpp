@@ -204,12 +204,11 @@ nlohmann::json signal_summary(const rt::LoopOptions& lo, const io::TimeSeries& l
 }
 
 // The --json document of a run: the loop's report (loop_report_json: rt::LoopReport's declared
-// fields, its I/O rt::IoStats', its timing summaries rt::TimingSummary's), the limits
+// fields, its I/O rt::IoStats' as measure's, rejected included, its timing summaries rt::TimingSummary's), the limits
 // (rt::ActuatorLimits' declared fields), and what only the command knows: the bench's source, the
 // options, the log file and the signals computed from the log.
 nlohmann::json rt_json(const RtOptions& o, const RtBench& b, const rt::LoopReport& r, const nlohmann::json& signals) {
   nlohmann::json doc = loop_report_json(r);
-  doc["io"].erase("rejected");  // this document has always left it out (measure's has it)
   doc.update({{"source", b.source},
               {"controller", o.controller},
               {"gain", o.gain},
