@@ -11,9 +11,9 @@
 #include <regex>
 
 #include "cli_common.hpp"
+#include "field_reference.hpp"
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/demo.hpp"
-#include "piezobench/campaign/field_reference.hpp"
 #include "piezobench/campaign/part.hpp"
 #include "piezobench/campaign/pipeline.hpp"
 #include "piezobench/campaign/results_json.hpp"
@@ -307,7 +307,7 @@ void add_run_commands(CLI::App& app, Action& action) {
   fields->add_option("--out", *fields_out, "Write it to this file instead of stdout");
   fields->callback([fields_out, &action] {
     action = [fields_out] {
-      const std::string doc = campaign::field_reference_markdown();
+      const std::string doc = field_reference_markdown();
       if (fields_out->empty()) {
         fmt::print("{}", doc);
       } else {

@@ -4,6 +4,7 @@
 #include "piezobench/campaign/campaign_file.hpp"
 #include "piezobench/campaign/demo.hpp"
 #include "piezobench/campaign/field_reference.hpp"
+#include "piezobench/campaign/field_table.hpp"
 #include "piezobench/campaign/pipeline.hpp"
 #include "piezobench/campaign/report_document.hpp"
 #include "piezobench/campaign/results.hpp"

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "field_table.hpp"
+#include "piezobench/campaign/field_table.hpp"
 #include "part_codec.hpp"
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/fields.hpp"

@@ -1,8 +1,10 @@
 #pragma once
-// docs/fields.md's tables (campaign-private): one markdown table per declared result struct, derived
-// from its declaration (core/fields.hpp): each field's name, type, SI unit, shown unit with its
-// factor, results.json key, meaning and where it appears. field_reference.cpp writes the document
-// with them; a test adds a test-only declared struct and finds its field's row (tests/campaign).
+// docs/fields.md's tables: one markdown table per declared result struct, derived from its
+// declaration (core/fields.hpp): each field's name, type, SI unit, shown unit with its factor,
+// results.json key, meaning and where it appears. campaign::field_reference_markdown writes the
+// document with them, and the program (app/field_reference.cpp, which sees every module) adds the
+// tables of the modules campaign does not depend on (rt); a test adds a test-only declared struct
+// and finds its field's row (tests/campaign).
 #include <fmt/format.h>
 
 #include <set>
