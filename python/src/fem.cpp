@@ -246,7 +246,7 @@ void bind_analyses(py::module_& m) {
         for (std::size_t i = 0; i < outputs.size(); ++i) {
           o.outputs.push_back(DisplacementOutput::parse(outputs[i], "outputs[" + std::to_string(i) + "]"));
         }
-        o.damping = Damping::parse(damping, "damping");
+        o.damping = fem::Damping::parse(damping, "damping");
         return assemble(se, o);
       },
       arg("se"), arg("fixed_nodes") = std::vector<long>{}, arg("masses") = std::vector<std::string>{},
