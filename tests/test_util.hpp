@@ -40,6 +40,20 @@
 
 namespace piezobench::test {
 
+// A sanitizer build (ASan, MSan, TSan; GCC says __SANITIZE_ADDRESS__, clang __has_feature): it
+// replaces malloc and reserves terabytes of address space.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitizerBuild = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer) || __has_feature(thread_sanitizer)
+inline constexpr bool kSanitizerBuild = true;
+#else
+inline constexpr bool kSanitizerBuild = false;
+#endif
+#else
+inline constexpr bool kSanitizerBuild = false;
+#endif
+
 // Double round-off accumulated through O(n) operations on well-conditioned data.
 inline constexpr double kRoundoff = 1e-12;
 // What a backward-stable algorithm achieves on the lightly damped (0.1 %) systems of the tests:

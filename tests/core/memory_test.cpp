@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <vector>
 
+#include "test_util.hpp"
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -36,13 +38,7 @@ TEST(Memory, AdvisingHugePagesKeepsTheData) {
 // After keep_freed_memory, a 16 MB block comes from the heap (glibc maps blocks above 128 KiB on
 // their own by default: mallinfo2's hblks counts them) and a freed one is not returned.
 TEST(Memory, KeepFreedMemoryServesRecordSizedBlocksFromTheHeap) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "AddressSanitizer replaces malloc: glibc's mallopt and mallinfo2 do not describe its heap";
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-  GTEST_SKIP() << "AddressSanitizer replaces malloc: glibc's mallopt and mallinfo2 do not describe its heap";
-#endif
-#endif
+  if (test::kSanitizerBuild) GTEST_SKIP() << "the sanitizer replaces malloc: glibc's mallopt and mallinfo2 do not describe its heap";
 #if defined(__GLIBC__)
   ASSERT_TRUE(keep_freed_memory());
   const std::size_t mapped_before = mallinfo2().hblks;

@@ -38,17 +38,7 @@ class AddressSpaceLimit {
 };
 
 // Sanitizer builds reserve terabytes of address space: no limit there.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kLimitAddressSpace = false;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer) || __has_feature(thread_sanitizer)
-constexpr bool kLimitAddressSpace = false;
-#else
-constexpr bool kLimitAddressSpace = true;
-#endif
-#else
-constexpr bool kLimitAddressSpace = true;
-#endif
+constexpr bool kLimitAddressSpace = !test::kSanitizerBuild;
 
 template <typename F>
 void expect_refused(F&& f, const std::vector<std::string>& needles) {
