@@ -273,14 +273,14 @@ dsp/frf_variance.hpp) where known; provenance (dsp.FrfProvenance) says how it wa
                for (auto n : outputs) f.outputs.push_back(string_arg(n, src, "outputs"));
              }
              if (!coherence.is_none()) {
-               auto c = to_matrix(coherence, src, "coherence", true);
-               if (c.cols() == 1 && c.rows() == f.freq_Hz.size()) c.transposeInPlace();
-               for (Index i = 0; i < c.rows(); ++i) f.coherence.push_back(c.row(i).transpose());
+               auto gamma2 = to_matrix(coherence, src, "coherence", true);
+               if (gamma2.cols() == 1 && gamma2.rows() == f.freq_Hz.size()) gamma2.transposeInPlace();
+               for (Index i = 0; i < gamma2.rows(); ++i) f.coherence.push_back(gamma2.row(i).transpose());
              }
              if (!std_H.is_none()) {
-               auto c = to_matrix(std_H, src, "std_H", true);
-               if (c.cols() == 1 && c.rows() == f.freq_Hz.size()) c.transposeInPlace();
-               for (Index i = 0; i < c.rows(); ++i) f.std_H.push_back(c.row(i).transpose());
+               auto sd = to_matrix(std_H, src, "std_H", true);
+               if (sd.cols() == 1 && sd.rows() == f.freq_Hz.size()) sd.transposeInPlace();
+               for (Index i = 0; i < sd.rows(); ++i) f.std_H.push_back(sd.row(i).transpose());
              }
              if (!provenance.is_none()) {
                // Another Frf's provenance (or a mapping of its keys): how these lines were estimated, which the

@@ -522,20 +522,25 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
   core::LmResult r;
   int iterations = 0;
   Weights wt;
-  const core::ResidualFunction residual = [&](const Vector& v) { return residuals(layout.unpack(v), d, wt); };
+  // The solver's parameters stay within kBoundRatio^2 of the report's procedure's values: beyond, the
+  // residuals see the bound. A parameter the data do not show (c1) would otherwise run towards
+  // exp(-inf), and with ||x|| in the millions the step tolerance, relative to ||x||, would stop the
+  // solver while the others still move by per cents (ce, ca then depended on round-off).
+  const double reach = 2.0 * std::log(kBoundRatio);
+  const auto bounded = [&](const Vector& v) -> Vector { return v.array().max(start.array() - reach).min(start.array() + reach).matrix(); };
+  const core::ResidualFunction residual = [&](const Vector& v) { return residuals(layout.unpack(bounded(v)), d, wt); };
   for (int pass = 0; pass < 2; ++pass) {
     const TwoDofParams reference = layout.unpack(x);
     if (pass > 0 && !(x.allFinite() && usable(reference))) break;
     wt = weights(d, reference);
     r = core::levenberg_marquardt(residual, x, lm);
     iterations += r.iterations;
-    x = r.x;
+    x = bounded(r.x);
   }
   // A parameter the data do not show (c1) can run to exp(-745) = 0, "not physical": it is reported
   // at kBoundRatio^2 from the report's procedure's value instead (undetermined, at a bound; the fit
   // does not see the difference).
-  const double reach = 2.0 * std::log(kBoundRatio);
-  r.x = r.x.array().max(start.array() - reach).min(start.array() + reach).matrix();
+  r.x = bounded(r.x);
   out.params = layout.unpack(r.x);
   const std::vector<Index> keep = unbounded(r.x, start);
   if (r.x.allFinite() && usable(out.params) && !keep.empty()) {

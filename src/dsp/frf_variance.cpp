@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
+#include <utility>
 #include <string>
 
 #include "piezobench/core/error.hpp"
@@ -57,6 +60,84 @@ Eigen::VectorXd frf_standard_deviation(const Eigen::VectorXcd& H, const Eigen::V
   Eigen::VectorXd s(H.size());
   for (Index k = 0; k < H.size(); ++k) s(k) = std::abs(H(k)) * frf_relative_std(coherence(k), effective_averages);
   return s;
+}
+
+Eigen::VectorXd FrfNoiseEstimate::relative_std_at(const Eigen::VectorXcd& model) const {
+  Eigen::VectorXd eps(model.size());
+  const double a = additive_std * additive_std, b = relative_std * relative_std;
+  for (Index k = 0; k < model.size(); ++k) {
+    const double g2 = std::norm(model(k));
+    eps(k) = g2 > 0.0 ? std::sqrt(a / g2 + b) : std::numeric_limits<double>::infinity();
+  }
+  return eps;
+}
+
+namespace {
+
+// The negative log-likelihood (up to a constant) of the per-part variances m_k = a + b x_k for the
+// samples v_k (|H_k - G_k|^2 / 2, exponential with mean m_k); inf where a variance is not positive.
+double noise_cost(const Eigen::VectorXd& v, const Eigen::VectorXd& x, double a, double b) {
+  double cost = 0.0;
+  for (Index k = 0; k < v.size(); ++k) {
+    const double m = a + b * x(k);
+    if (m == 0.0 && v(k) == 0.0) continue;  // a line the model meets exactly, with no variance
+    if (!(m > 0.0)) return std::numeric_limits<double>::infinity();
+    cost += v(k) / m + std::log(m);
+  }
+  return cost;
+}
+
+// Both components positive, by iteratively reweighted least squares from the additive-only fit;
+// nullopt when an iterate leaves the positive quadrant (the optimum is then on its boundary).
+std::optional<std::pair<double, double>> both_components(const Eigen::VectorXd& v, const Eigen::VectorXd& x, double a0) {
+  double a = a0, b = 0.0;
+  for (int it = 0; it < 100; ++it) {
+    // Weighted least squares of v on [1, x] with weights 1 / m^2.
+    double s0 = 0, s1 = 0, s2 = 0, t0 = 0, t1 = 0;
+    for (Index k = 0; k < v.size(); ++k) {
+      const double m = a + b * x(k), w = 1.0 / (m * m);
+      s0 += w, s1 += w * x(k), s2 += w * x(k) * x(k), t0 += w * v(k), t1 += w * x(k) * v(k);
+    }
+    const double det = s0 * s2 - s1 * s1;
+    if (!(det > 0.0)) return std::nullopt;
+    const double a1 = (s2 * t0 - s1 * t1) / det, b1 = (s0 * t1 - s1 * t0) / det;
+    if (!(a1 > 0.0 && b1 > 0.0)) return std::nullopt;
+    const bool done = std::abs(a1 - a) <= 1e-10 * a1 && std::abs(b1 - b) <= 1e-10 * b1;
+    a = a1, b = b1;
+    if (done) break;
+  }
+  return std::make_pair(a, b);
+}
+
+}  // namespace
+
+FrfNoiseEstimate estimate_frf_noise(const Eigen::VectorXcd& H, const Eigen::VectorXcd& model) {
+  if (H.size() != model.size()) {
+    throw InputError("frf noise", "model", std::to_string(H.size()) + " values (one per line)", std::to_string(model.size()));
+  }
+  if (H.size() < 3) throw InputError("frf noise", "H", "at least 3 lines", std::to_string(H.size()));
+  Eigen::VectorXd v(H.size()), x(H.size());
+  for (Index k = 0; k < H.size(); ++k) {
+    v(k) = 0.5 * std::norm(H(k) - model(k));
+    x(k) = std::norm(model(k));
+  }
+  if (!v.allFinite() || !x.allFinite()) throw NumericalError("frf noise", "a non-finite residual or model value", false);
+  FrfNoiseEstimate e;
+  const double additive = v.mean();
+  if (!(additive > 0.0)) return e;  // an exact fit: no noise to see
+  // The candidates: additive only (its ML value is the mean), proportional only (the mean of v / x),
+  // both; the most likely wins.
+  double best_a = additive, best_b = 0.0, best = noise_cost(v, x, additive, 0.0);
+  if ((x.array() > 0.0).all()) {
+    const double b = (v.array() / x.array()).mean();
+    if (const double c = noise_cost(v, x, 0.0, b); c < best) best = c, best_a = 0.0, best_b = b;
+  }
+  if (const auto ab = both_components(v, x, additive)) {
+    if (const double c = noise_cost(v, x, ab->first, ab->second); c < best) best = c, best_a = ab->first, best_b = ab->second;
+  }
+  e.additive_std = std::sqrt(best_a);
+  e.relative_std = std::sqrt(best_b);
+  return e;
 }
 
 std::vector<Eigen::VectorXd> std_from_coherence(Frf& frf) {

@@ -98,23 +98,23 @@ void select_band(const Vector& omega, const CVector& h, const Vector& coherence,
 
 // Weights of the relative residual G/H_k - 1 of both fits. Every decade counts alike: on a uniform
 // grid the weight is 1/sqrt(omega), otherwise the mass line above the resonance, which holds most
-// of the points, would decide the fit. With the FRF's variance known (coherence and n_d), each point
-// is further divided by sqrt(eps_k^2 + kFitModelRelativeError^2), eps_k its relative standard
-// deviation (dsp/frf_variance.hpp): a line where the coherence drops (the anti-resonance) counts
-// little. residual_std is then the standard deviation of each weighted residual part's random error
-// (weight_k eps_k), for the sandwich covariance; else empty.
+// of the points, would decide the fit. With the FRF's relative standard deviation eps_k known (from
+// the coherence and n_d, dsp/frf_variance.hpp, or estimated from a first fit's residuals), each point
+// is further divided by sqrt(eps_k^2 + kFitModelRelativeError^2): a line where the noise is large
+// (the anti-resonance) counts little. residual_std is then the standard deviation of each weighted
+// residual part's random error (weight_k eps_k), for the sandwich covariance; else empty.
 struct PointWeights {
   Vector weight, residual_std;
 };
-PointWeights point_weights(const Vector& w, const Vector& c, double effective_averages) {
+PointWeights point_weights(const Vector& w, const Vector& eps_known) {
   PointWeights p;
   p.weight.resize(w.size());
   for (Index k = 0; k < w.size(); ++k) p.weight(k) = 1.0 / std::sqrt(w(k));
-  const bool known = c.size() == w.size() && effective_averages > 0.0;
+  const bool known = eps_known.size() == w.size() && w.size() > 0;
   if (known) {
     p.residual_std.resize(2 * w.size());
     for (Index k = 0; k < w.size(); ++k) {
-      const double eps = std::max(dsp::frf_relative_std(c(k), effective_averages), dsp::kMinFitRelativeStd);
+      const double eps = std::max(eps_known(k), dsp::kMinFitRelativeStd);
       p.weight(k) /= std::hypot(eps, dsp::kFitModelRelativeError);
       p.residual_std(2 * k) = p.residual_std(2 * k + 1) = p.weight(k) * eps;
     }
@@ -123,6 +123,14 @@ PointWeights point_weights(const Vector& w, const Vector& c, double effective_av
   p.weight /= norm;
   if (known) p.residual_std /= norm;
   return p;
+}
+
+// eps_k from the coherence and Welch's n_d; empty when either is unknown.
+Vector coherence_relative_std(const Vector& c, double effective_averages) {
+  if (c.size() == 0 || !(effective_averages > 0.0)) return {};
+  Vector eps(c.size());
+  for (Index k = 0; k < c.size(); ++k) eps(k) = dsp::frf_relative_std(c(k), effective_averages);
+  return eps;
 }
 
 // The covariance of the solver's parameters at its solution x (core/fit_covariance.hpp).
@@ -431,7 +439,7 @@ core::LmResult best_iff_solution(const IffResidual& residual, const IffPlantFit&
 
 // Standard errors of the plant's parameters, linearized at the solution.
 core::ParameterUncertainty iff_uncertainty(const IffResidual& residual, const core::LmResult& best, const IffPlantFit& fit,
-                                           const Vector& residual_std) {
+                                           const Vector& residual_std, bool from_frf_variance) {
   const core::FitCovariance cov = covariance_at(residual, best.x, residual_std);
   // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
   const Layout& layout = residual.layout;
@@ -440,7 +448,7 @@ core::ParameterUncertainty iff_uncertainty(const IffResidual& residual, const co
   value << fit.g0, fit.wz, fit.xz, fit.wp, fit.xp, fit.w_hpf, fit.delay;
   deriv << fit.g0, fit.wz, kXzScale, fit.wp, fit.xp, layout.hpf ? fit.w_hpf : 0.0, layout.delay ? kDelayScale : 0.0;
   return core::parameter_uncertainty({"g0", "wz", "xz", "wp", "xp", "w_hpf", "delay"}, value, deriv, {0, 1, 2, 3, 4, hpf, delay}, cov,
-                                     residual_std.size() > 0);
+                                     from_frf_variance);
 }
 
 }  // namespace
@@ -453,11 +461,28 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   IffPlantFit start = iff_start(b, options, source);
   if (start.g0 == 0.0) start.g0 = 1.0;
   const double sign = start.g0 > 0.0 ? 1.0 : -1.0;
-  const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
-  const IffResidual residual{b, pw.weight, sign, Layout{options.fixed_w_hpf == 0.0, options.fit_delay}, options.fixed_w_hpf,
-                             dsp::KernelGrid(options.resolution, b.w)};
+  const Vector eps = coherence_relative_std(b.c, options.effective_averages);
+  PointWeights pw = point_weights(b.w, eps);
+  const Layout layout{options.fixed_w_hpf == 0.0, options.fit_delay};
+  const dsp::KernelGrid grid(options.resolution, b.w);
+  const auto residual_with = [&](const PointWeights& weights) {
+    return IffResidual{b, weights.weight, sign, layout, options.fixed_w_hpf, grid};
+  };
   double initial_cost = 0.0;
-  const core::LmResult best = best_iff_solution(residual, start, options.max_iterations, initial_cost, source);
+  core::LmResult best = best_iff_solution(residual_with(pw), start, options.max_iterations, initial_cost, source);
+  if (eps.size() == 0) {
+    // No variance recorded: the noise this fit's residuals show (additive and proportional) weights
+    // a second fit, whose residuals give the noise of its standard errors (two-step feasible
+    // generalized least squares). Without it the lines of the dip, where the sensor's noise is
+    // largest relative to H, would decide xz with a standard error taken from the average line.
+    for (int round = 0; round < 2; ++round) {
+      const IffPlantFit f = from_x(best.x, sign, layout, options.fixed_w_hpf);
+      const CVector g = grid.smooth(plant::iff_plant_response(f, grid.nodes()));
+      pw = point_weights(b.w, dsp::estimate_frf_noise(b.d, g).relative_std_at(g));
+      if (round == 0) best = best_iff_solution(residual_with(pw), start, options.max_iterations, initial_cost, source);
+    }
+  }
+  const IffResidual residual = residual_with(pw);
 
   const double n = static_cast<double>(b.w.size());
   IffPlantFit fit = from_x(best.x, sign, residual.layout, options.fixed_w_hpf);
@@ -470,7 +495,7 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   fit.iterations = best.iterations;
   fit.converged = best.converged();
   fit.status = best.status;
-  fit.uncertainty = iff_uncertainty(residual, best, fit, pw.residual_std);
+  fit.uncertainty = iff_uncertainty(residual, best, fit, pw.residual_std, eps.size() > 0);
   fit.quality.check_error("u -> Vs (IFF plant, eq. 2.3)", fit.relative_rms_error);
   check_in_band(fit.quality, "anti-resonance wz", fit.wz, b.w);
   check_in_band(fit.quality, "resonance wp", fit.wp, b.w);
@@ -599,13 +624,14 @@ Eigen::VectorXd second_order_x0(const DelayedSecondOrderFit& start, bool fit_del
 
 // Standard errors of static_gain, natural_frequency, damping and delay, linearized at the solution.
 core::ParameterUncertainty second_order_uncertainty(const SecondOrderResidual& residual, const core::LmResult& o,
-                                                    const DelayedSecondOrderFit& fit, const Vector& residual_std) {
+                                                    const DelayedSecondOrderFit& fit, const Vector& residual_std,
+                                                    bool from_frf_variance) {
   const core::FitCovariance cov = covariance_at(residual, o.x, residual_std);
   Eigen::VectorXd value(4), deriv(4);
   value << fit.static_gain, fit.natural_frequency, fit.damping, fit.delay;
   deriv << fit.static_gain, fit.natural_frequency, fit.damping, residual.fit_delay ? kDelayScale : 0.0;
   return core::parameter_uncertainty({"static_gain", "natural_frequency", "damping", "delay"}, value, deriv,
-                                     {0, 1, 2, residual.fit_delay ? 3 : -1}, cov, residual_std.size() > 0);
+                                     {0, 1, 2, residual.fit_delay ? 3 : -1}, cov, from_frf_variance);
 }
 
 }  // namespace
@@ -616,17 +642,33 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   const FitBand b = fit_band(omega, h, coherence, options, source);
   if (b.w.size() < 8) throw InputError(source, "H", "at least 8 usable points in the band", std::to_string(b.w.size()));
   const DelayedSecondOrderFit start = second_order_start(b, second_order_peak(b, source), options.fit_delay);
-  const PointWeights pw = point_weights(b.w, b.c, options.effective_averages);
-  const SecondOrderResidual residual{b, pw.weight, start.static_gain >= 0.0 ? 1.0 : -1.0, options.fit_delay,
-                                       dsp::KernelGrid(options.resolution, b.w)};
+  const Vector eps = coherence_relative_std(b.c, options.effective_averages);
+  PointWeights pw = point_weights(b.w, eps);
+  const dsp::KernelGrid grid(options.resolution, b.w);
+  const double sign = start.static_gain >= 0.0 ? 1.0 : -1.0;
   const Eigen::VectorXd x0 = second_order_x0(start, options.fit_delay);
-  if (!residual(x0).allFinite()) {
+  if (!SecondOrderResidual{b, pw.weight, sign, options.fit_delay, grid}(x0).allFinite()) {
     throw NumericalError("second-order fit (" + source + ")", "the starting point gives a non-finite error", true);
   }
-  const core::LmResult o = least_squares(residual, x0, options.max_iterations);
-  if (!std::isfinite(o.cost)) {
-    throw NumericalError("second-order fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
+  const auto solve = [&](const PointWeights& weights) {
+    const core::LmResult o = least_squares(SecondOrderResidual{b, weights.weight, sign, options.fit_delay, grid}, x0, options.max_iterations);
+    if (!std::isfinite(o.cost)) {
+      throw NumericalError("second-order fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
+    }
+    return o;
+  };
+  core::LmResult o = solve(pw);
+  if (eps.size() == 0) {
+    // No variance recorded: the noise of this fit's residuals weights a second fit and gives the
+    // standard errors (as fit_iff_plant does).
+    for (int round = 0; round < 2; ++round) {
+      const DelayedSecondOrderFit f = SecondOrderResidual{b, pw.weight, sign, options.fit_delay, grid}.unpack(o.x);
+      const CVector g = grid.smooth(f.response(grid.nodes()));
+      pw = point_weights(b.w, dsp::estimate_frf_noise(b.d, g).relative_std_at(g));
+      if (round == 0) o = solve(pw);
+    }
   }
+  const SecondOrderResidual residual{b, pw.weight, sign, options.fit_delay, grid};
   DelayedSecondOrderFit fit = residual.unpack(o.x);
   double plain = 0.0;
   for (Index k = 0; k < b.w.size(); ++k) plain += std::norm(second_order(fit, b.w(k), options.resolution) / b.d(k) - 1.0);
@@ -634,7 +676,7 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   fit.points = b.w.size();
   fit.iterations = o.iterations;
   fit.status = o.status;
-  fit.uncertainty = second_order_uncertainty(residual, o, fit, pw.residual_std);
+  fit.uncertainty = second_order_uncertainty(residual, o, fit, pw.residual_std, eps.size() > 0);
   fit.quality.check_error("second-order fit", fit.relative_rms_error);
   check_in_band(fit.quality, "natural frequency", fit.natural_frequency, b.w);
   check_lm(fit.quality, o.status);

@@ -48,6 +48,26 @@ inline constexpr double kMinFitRelativeStd = 1e-4;
 // pure 1/eps weighting lets the model's misfit where eps is smallest decide the fit).
 inline constexpr double kFitModelRelativeError = 0.05;
 
+// The noise of an FRF whose variance nothing records (no coherence, or no Welch provenance), estimated
+// from the residuals of a model fitted to it: each part of H_k - G_k has the variance
+//
+//   s_k^2 = additive_std^2 + relative_std^2 |G_k|^2
+//
+// (the sensor's noise, which does not shrink in a dip, plus an error proportional to the response).
+// The two are the maximum-likelihood values for |H_k - G_k|^2 / 2 exponentially distributed with mean
+// s_k^2 (a gamma GLM with identity link, by iteratively reweighted least squares; a component that
+// would be negative is 0). The model's misfit counts as noise: the fits that use it then weight the
+// lines by what they can tell, and their standard errors see the dip's noise instead of the average.
+struct FrfNoiseEstimate {
+  double additive_std = 0.0;  // per part, H's units
+  double relative_std = 0.0;  // per part, a fraction of |G|
+  // s_k / |G_k|: the relative standard deviation per part at each line (inf where G_k = 0).
+  [[nodiscard]] Eigen::VectorXd relative_std_at(const Eigen::VectorXcd& model) const;
+};
+// InputError when the sizes differ or there are fewer than 3 lines; NumericalError for a non-finite
+// residual.
+[[nodiscard]] FrfNoiseEstimate estimate_frf_noise(const Eigen::VectorXcd& H, const Eigen::VectorXcd& model);
+
 // The coverage factor k of the 95 % (or `level`) band H +- k std_H with n_d effective averages:
 //
 //   k = sqrt(n_d / (n_d - 1)) t_{(1 + level) / 2}(2 n_d - 2)
