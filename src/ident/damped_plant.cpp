@@ -7,6 +7,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/dsp/resolution_kernel.hpp"
 
 namespace piezobench::ident {
 
@@ -24,7 +25,8 @@ DampedPlantAnalysis analyze_damped_plant(const dsp::Frf& frf, const DampedPlantO
   const Eigen::VectorXd omega = kTwoPi * part.freq_Hz;  // rad/s, as the fitters take it
   Eigen::VectorXcd h = part.H[0];
   for (Eigen::Index k = 0; k < omega.size(); ++k) h(k) *= std::exp(std::complex<double>(0.0, omega(k) * o.delay_s));
-  const Eigen::VectorXd coherence = part.coherence.empty() ? Eigen::VectorXd::Ones(omega.size()) : part.coherence[0];
+  // The coherence when the file has one (none: the fit estimates the noise from its residuals).
+  const Eigen::VectorXd coherence = part.coherence.empty() ? Eigen::VectorXd() : part.coherence[0];
   DampedPlantAnalysis out;
   out.delay_removed_s = o.delay_s;
   out.fmin_Hz = o.fmin_Hz;
@@ -43,6 +45,10 @@ DampedPlantAnalysis analyze_damped_plant(const dsp::Frf& frf, const DampedPlantO
   try {
     IffPlantFitOptions so;
     so.fit_delay = false;
+    // As the campaign's other plant fits: points weighted by the FRF's variance (coherence and n_d),
+    // the model seen through the Welch estimate's resolution kernel when the provenance gives it.
+    so.effective_averages = part.coherence.empty() ? 0.0 : frf.provenance.effective_averages;
+    so.resolution = dsp::resolution_kernel(frf.provenance);
     out.second_order = fit_delayed_second_order(omega, h, coherence, so, source);
   } catch (const NumericalError& e) {
     out.second_order_error = e.what();
