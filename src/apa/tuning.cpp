@@ -363,6 +363,21 @@ Vector residual_std(const Weights& w) {
   return s;
 }
 
+// c_k of core::fit_covariance for residuals(): the Welch estimate's error correlates between
+// neighbouring lines (dsp::adjacent_line_pairs), within each output's block of n complex residuals,
+// not between the last d_e line and the first Vs line. The chain divided out of the data rotates the
+// error by its phase step between two lines, below 1e-3 rad (the delay: 2 pi df tau; the high-pass,
+// far below the band), taken as 0.
+Eigen::VectorXcd adjacent_correlation(const FitData& d) {
+  const Vector pairs = dsp::adjacent_line_pairs(d.kernel, d.omega);
+  const Index n = d.omega.size();
+  if (pairs.size() == 0) return {};
+  Eigen::VectorXcd c = Eigen::VectorXcd::Zero(2 * n - 1);
+  c.head(n - 1) = pairs.cast<Complex>();
+  c.tail(n - 1) = pairs.cast<Complex>();
+  return c;
+}
+
 // Weighted complex errors (H_model - H_data) w_k, [Re, Im] of d_e then of Vs (weights()); NaN when the
 // parameters are out of range.
 Vector residuals(const TwoDofParams& p, const FitData& d, const Weights& wt) {
@@ -547,13 +562,14 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
     const Eigen::MatrixXd jacobian = core::central_difference_jacobian(residual, r.x)(Eigen::all, keep);
     const Vector res = residual(r.x), sd = residual_std(wt);
     const bool from_variance = sd.size() > 0;
-    const core::FitCovariance with_misfit = core::fit_covariance(jacobian, res, sd);
+    const Eigen::VectorXcd adjacent = from_variance ? adjacent_correlation(d) : Eigen::VectorXcd();
+    const core::FitCovariance with_misfit = core::fit_covariance(jacobian, res, sd, adjacent);
     // With the FRF's variance the interval is the random error alone: the covariance of zero residuals
     // has no misfit widening (f_j = 1, core/fit_covariance.hpp). The 2-DoF model's misfit on a real
     // bench is a bias, the same for every record, not a scatter: widened by it, the intervals of
     // k1, ka, ga, gs were 2-5 times the scatter over 200 noise seeds (docs/uncertainty.md, section 6).
     // The misfit still decides which parameters are undetermined (uncertainty_with_misfit).
-    core::FitCovariance random = from_variance ? core::fit_covariance(jacobian, Vector::Zero(res.size()), sd) : with_misfit;
+    core::FitCovariance random = from_variance ? core::fit_covariance(jacobian, Vector::Zero(res.size()), sd, adjacent) : with_misfit;
     random.chi2_per_dof = with_misfit.chi2_per_dof;
     out.uncertainty = tuning_uncertainty(out.params, layout, keep, random, from_variance);
     out.uncertainty_with_misfit = tuning_uncertainty(out.params, layout, keep, with_misfit, from_variance);

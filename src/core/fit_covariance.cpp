@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <limits>
 
@@ -14,12 +15,38 @@ using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-FitCovariance fit_covariance(const MatrixXd& J, const VectorXd& r, const VectorXd& residual_std) {
+namespace {
+
+// J^T Sigma J for the (scaled) Jacobian Js and Sigma = diag(s^2) plus the adjacent lines' blocks
+// (fit_covariance's header).
+MatrixXd noise_middle(const MatrixXd& Js, const VectorXd& s, const Eigen::VectorXcd& c) {
+  const MatrixXd U = s.asDiagonal() * Js;  // row i: s_i dr_i/dx
+  MatrixXd B = U.transpose() * U;
+  for (Index k = 0; k < c.size(); ++k) {
+    if (c(k) == std::complex<double>(0.0)) continue;
+    const auto a0 = U.row(2 * k), b0 = U.row(2 * k + 1), a1 = U.row(2 * k + 2), b1 = U.row(2 * k + 3);
+    // E[a0 a1] = E[b0 b1] = Re c, E[b0 a1] = Im c, E[a0 b1] = -Im c (in units of s s).
+    const MatrixXd same = a0.transpose() * a1 + b0.transpose() * b1;
+    const MatrixXd cross = b0.transpose() * a1 - a0.transpose() * b1;
+    const MatrixXd term = c(k).real() * same + c(k).imag() * cross;
+    B += term + term.transpose();
+  }
+  return B;
+}
+
+}  // namespace
+
+FitCovariance fit_covariance(const MatrixXd& J, const VectorXd& r, const VectorXd& residual_std,
+                             const Eigen::VectorXcd& adjacent_correlation) {
   const Index m = J.rows(), p = J.cols();
   if (m <= p || p < 1) throw InputError("fit covariance", "Jacobian", "more residuals than parameters (>= 1)", std::to_string(m) + " x " + std::to_string(p));
   if (r.size() != m) throw InputError("fit covariance", "residuals", std::to_string(m) + " values", std::to_string(r.size()));
   if (residual_std.size() != 0 && residual_std.size() != m) {
     throw InputError("fit covariance", "residual_std", std::to_string(m) + " values or none", std::to_string(residual_std.size()));
+  }
+  if (adjacent_correlation.size() != 0 && (residual_std.size() != m || m % 2 != 0 || adjacent_correlation.size() != m / 2 - 1)) {
+    throw InputError("fit covariance", "adjacent_correlation", std::to_string(m / 2 - 1) + " values (complex residuals, residual_std given) or none",
+                     std::to_string(adjacent_correlation.size()));
   }
   FitCovariance out;
   const double inf = std::numeric_limits<double>::infinity();
@@ -56,7 +83,7 @@ FitCovariance fit_covariance(const MatrixXd& J, const VectorXd& r, const VectorX
     VectorXd widen(p);
     const double hc1 = static_cast<double>(m) / dof;  // the residuals' lost degrees of freedom
     for (Index j = 0; j < p; ++j) widen(j) = noise(j) > 0.0 ? std::sqrt(std::max(1.0, hc1 * misfit(j) / noise(j))) : 1.0;
-    const MatrixXd B = Js.transpose() * residual_std.array().square().matrix().asDiagonal() * Js;
+    const MatrixXd B = noise_middle(Js, residual_std, adjacent_correlation);
     Cs = widen.asDiagonal() * (A * B * A) * widen.asDiagonal();
   } else {
     Cs = A * out.chi2_per_dof;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <numbers>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -33,6 +35,43 @@ double effective_averages(WindowType window, Index nfft, Index noverlap, Index s
     sum += (1.0 - static_cast<double>(j) / k) * rho * rho;
   }
   return k / (1.0 + 2.0 * sum);
+}
+
+double adjacent_line_correlation(WindowType window, Index nfft, Index noverlap, Index segments) {
+  (void)effective_averages(window, nfft, noverlap, segments);  // the same validation
+  const Eigen::VectorXd w = make_window(window, nfft);
+  const Index shift = nfft - noverlap;
+  const double step = 2.0 * std::numbers::pi / static_cast<double>(nfft);
+  double num = 0.0, den = 0.0;
+  for (Index j = 1 - segments; j < segments; ++j) {
+    const Index lag = std::abs(j) * shift;
+    if (lag >= nfft) continue;  // no shared samples
+    // A_j(d) = sum_n w(n) w(n + j D) e^(i d step n); |A_j| = |A_-j| up to a phase, so |j| will do.
+    std::complex<double> a1 = 0.0;
+    double a0 = 0.0;
+    for (Index n = 0; n + lag < nfft; ++n) {
+      const double ww = w(n) * w(n + lag);
+      a0 += ww;
+      a1 += ww * std::polar(1.0, step * static_cast<double>(n));
+    }
+    const double count = static_cast<double>(segments - std::abs(j));
+    num += count * std::norm(a1);
+    den += count * a0 * a0;
+  }
+  return den > 0.0 ? num / den : 0.0;
+}
+
+double adjacent_line_correlation(const FrfProvenance& p) {
+  if (p.window.empty() || p.nfft < 2 || p.averages < 1) return 0.0;
+  WindowType window{};
+  try {
+    window = window_type_from_string(p.window);
+  } catch (const InputError&) {
+    return 0.0;  // a window piezobench does not know
+  }
+  const auto noverlap = static_cast<Index>(std::floor(p.overlap * static_cast<double>(p.nfft)));
+  if (noverlap < 0 || noverlap >= p.nfft) return 0.0;
+  return adjacent_line_correlation(window, p.nfft, noverlap, p.averages);
 }
 
 double frf_relative_std(double coherence, double effective_averages) {

@@ -1,5 +1,7 @@
 #include "piezobench/dsp/resolution_kernel.hpp"
 
+#include "piezobench/dsp/frf_variance.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -56,7 +58,20 @@ ResolutionKernel resolution_kernel(const FrfProvenance& provenance) {
   } catch (const InputError&) {
     return {};  // a window this library does not know (a foreign file's): its kernel is unknown
   }
-  return resolution_kernel(window, provenance.nfft, provenance.sample_rate);
+  ResolutionKernel kernel = resolution_kernel(window, provenance.nfft, provenance.sample_rate);
+  kernel.adjacent_line_correlation = adjacent_line_correlation(provenance);
+  return kernel;
+}
+
+Eigen::VectorXd adjacent_line_pairs(const ResolutionKernel& kernel, const Eigen::VectorXd& omega) {
+  const double rho = kernel.adjacent_line_correlation;
+  if (!(rho > 0.0 && kernel.line_spacing_Hz > 0.0) || omega.size() < 2) return {};
+  const double step = 2.0 * std::numbers::pi * kernel.line_spacing_Hz;
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(omega.size() - 1);
+  for (Eigen::Index k = 0; k + 1 < omega.size(); ++k) {
+    if (std::abs(omega(k + 1) - omega(k) - step) <= 1e-6 * step) c(k) = rho;
+  }
+  return c;
 }
 
 KernelGrid::KernelGrid(const ResolutionKernel& kernel, const Eigen::VectorXd& omega) : points_(omega.size()), nodes_(omega) {

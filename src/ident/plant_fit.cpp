@@ -134,8 +134,25 @@ Vector coherence_relative_std(const Vector& c, double effective_averages) {
 }
 
 // The covariance of the solver's parameters at its solution x (core/fit_covariance.hpp).
-core::FitCovariance covariance_at(const core::ResidualFunction& residual, const Eigen::VectorXd& x, const Vector& residual_std) {
-  return core::fit_covariance(core::central_difference_jacobian(residual, x), residual(x), residual_std);
+core::FitCovariance covariance_at(const core::ResidualFunction& residual, const Eigen::VectorXd& x, const Vector& residual_std,
+                                  const Eigen::VectorXcd& adjacent = {}) {
+  return core::fit_covariance(core::central_difference_jacobian(residual, x), residual(x), residual_std, adjacent);
+}
+
+// c_k of core::fit_covariance for the relative residuals G/H_k - 1 ~ -e_k / H_k of a Welch estimate:
+// its error e is circular with the real correlation rho_1 between neighbouring lines
+// (dsp::adjacent_line_pairs); dividing by H rotates it: c_k = rho_1 e^(i (phi_k+1 - phi_k)), phi the
+// model's phase at the solution. None without the residuals' noise or the correlation.
+Eigen::VectorXcd adjacent_correlation(const dsp::ResolutionKernel& kernel, const Vector& w, const CVector& model, const Vector& residual_std) {
+  const Vector pairs = dsp::adjacent_line_pairs(kernel, w);
+  if (pairs.size() == 0 || residual_std.size() == 0) return {};
+  Eigen::VectorXcd c = Eigen::VectorXcd::Zero(pairs.size());
+  for (Index k = 0; k < pairs.size(); ++k) {
+    if (pairs(k) > 0.0 && model(k) != Complex(0.0) && model(k + 1) != Complex(0.0)) {
+      c(k) = pairs(k) * std::polar(1.0, std::arg(model(k + 1)) - std::arg(model(k)));
+    }
+  }
+  return c;
 }
 
 Complex model(const IffPlantFit& p, double w) { return plant::iff_plant_response(p, w); }
@@ -439,8 +456,11 @@ core::LmResult best_iff_solution(const IffResidual& residual, const IffPlantFit&
 
 // Standard errors of the plant's parameters, linearized at the solution.
 core::ParameterUncertainty iff_uncertainty(const IffResidual& residual, const core::LmResult& best, const IffPlantFit& fit,
-                                           const Vector& residual_std, bool from_frf_variance) {
-  const core::FitCovariance cov = covariance_at(residual, best.x, residual_std);
+                                           const Vector& residual_std, bool from_frf_variance, const dsp::ResolutionKernel& kernel) {
+  const IffPlantFit at = from_x(best.x, residual.sign, residual.layout, residual.fixed_w_hpf);
+  const CVector model = residual.grid.smooth(plant::iff_plant_response(at, residual.grid.nodes()));
+  const core::FitCovariance cov =
+      covariance_at(residual, best.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std));
   // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
   const Layout& layout = residual.layout;
   const int hpf = layout.hpf ? 5 : -1, delay = layout.delay ? (layout.hpf ? 6 : 5) : -1;
@@ -495,7 +515,7 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   fit.iterations = best.iterations;
   fit.converged = best.converged();
   fit.status = best.status;
-  fit.uncertainty = iff_uncertainty(residual, best, fit, pw.residual_std, eps.size() > 0);
+  fit.uncertainty = iff_uncertainty(residual, best, fit, pw.residual_std, eps.size() > 0, options.resolution);
   fit.quality.check_error("u -> Vs (IFF plant, eq. 2.3)", fit.relative_rms_error);
   check_in_band(fit.quality, "anti-resonance wz", fit.wz, b.w);
   check_in_band(fit.quality, "resonance wp", fit.wp, b.w);
@@ -625,8 +645,10 @@ Eigen::VectorXd second_order_x0(const DelayedSecondOrderFit& start, bool fit_del
 // Standard errors of static_gain, natural_frequency, damping and delay, linearized at the solution.
 core::ParameterUncertainty second_order_uncertainty(const SecondOrderResidual& residual, const core::LmResult& o,
                                                     const DelayedSecondOrderFit& fit, const Vector& residual_std,
-                                                    bool from_frf_variance) {
-  const core::FitCovariance cov = covariance_at(residual, o.x, residual_std);
+                                                    bool from_frf_variance, const dsp::ResolutionKernel& kernel) {
+  const CVector model = residual.grid.smooth(residual.unpack(o.x).response(residual.grid.nodes()));
+  const core::FitCovariance cov =
+      covariance_at(residual, o.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std));
   Eigen::VectorXd value(4), deriv(4);
   value << fit.static_gain, fit.natural_frequency, fit.damping, fit.delay;
   deriv << fit.static_gain, fit.natural_frequency, fit.damping, residual.fit_delay ? kDelayScale : 0.0;
@@ -676,7 +698,7 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   fit.points = b.w.size();
   fit.iterations = o.iterations;
   fit.status = o.status;
-  fit.uncertainty = second_order_uncertainty(residual, o, fit, pw.residual_std, eps.size() > 0);
+  fit.uncertainty = second_order_uncertainty(residual, o, fit, pw.residual_std, eps.size() > 0, options.resolution);
   fit.quality.check_error("second-order fit", fit.relative_rms_error);
   check_in_band(fit.quality, "natural frequency", fit.natural_frequency, b.w);
   check_lm(fit.quality, o.status);

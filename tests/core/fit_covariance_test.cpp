@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <limits>
 
 #include "piezobench/core/eigen_solvers.hpp"
@@ -74,6 +75,55 @@ TEST(FitCovariance, MisfitWidensOnlyTheParametersItInfluences) {
   EXPECT_NEAR(c.standard_error(1), 0.1 / std::sqrt(10.0) * std::sqrt(20.0 / 18.0 * 9.0), 1e-12);
   // The global chi2 per degree of freedom is still reported: 10 * 9 / 18.
   EXPECT_NEAR(c.chi2_per_dof, 5.0, 1e-12);
+}
+
+// Complex residuals whose errors correlate with the next one's (a Welch FRF's neighbouring lines):
+// the covariance is (J^T J)^-1 J^T Sigma J (J^T J)^-1 with Sigma written out densely here from its
+// definition (E[u_k u_k+1^*] = c_k 2 s s, circular), the local chi2 at 1 (zero residuals). A smooth
+// parameter (a constant offset of the real parts) gets the variance of a mean of positively
+// correlated errors: larger than with independent ones; a wrongly sized c is refused.
+TEST(FitCovariance, AdjacentCorrelationEntersTheSandwichAsItsDenseForm) {
+  const int n = 6, m = 2 * n;  // 6 complex residuals
+  MatrixXd J(m, 3);
+  for (int k = 0; k < n; ++k) {
+    J.row(2 * k) << 1.0, 0.3 * k, 0.0;
+    J.row(2 * k + 1) << 0.0, 0.1 * k * k, 1.0 - 0.2 * k;
+  }
+  VectorXd s(m);
+  for (int i = 0; i < m; ++i) s(i) = 0.5 + 0.1 * (i / 2);
+  Eigen::VectorXcd c(n - 1);
+  c << std::complex<double>(0.4, 0.1), std::complex<double>(0.0, 0.0), std::complex<double>(0.3, -0.2),
+      std::complex<double>(0.44, 0.0), std::complex<double>(-0.1, 0.3);
+  MatrixXd sigma = s.cwiseAbs2().asDiagonal();
+  for (int k = 0; k + 1 < n; ++k) {
+    const double ss = s(2 * k) * s(2 * k + 2);
+    // rows Re u_k, Im u_k; columns Re u_k+1, Im u_k+1: [[Re c, -Im c], [Im c, Re c]]
+    sigma(2 * k, 2 * k + 2) = c(k).real() * ss;
+    sigma(2 * k, 2 * k + 3) = -c(k).imag() * ss;
+    sigma(2 * k + 1, 2 * k + 2) = c(k).imag() * ss;
+    sigma(2 * k + 1, 2 * k + 3) = c(k).real() * ss;
+  }
+  sigma.triangularView<Eigen::StrictlyLower>() = sigma.transpose().triangularView<Eigen::StrictlyLower>();
+  const MatrixXd A = (J.transpose() * J).inverse();
+  const MatrixXd expected = A * J.transpose() * sigma * J * A;
+  const FitCovariance f = fit_covariance(J, VectorXd::Zero(m), s, c);
+  EXPECT_LT((f.covariance - expected).norm(), 1e-12 * expected.norm());
+  // The dense form's circularity: Sigma's 2x2 block for u_k, u_k+1 has E[Re Re] = E[Im Im].
+  const FitCovariance independent = fit_covariance(J, VectorXd::Zero(m), s);
+  const MatrixXd expected_independent = A * J.transpose() * s.cwiseAbs2().asDiagonal() * J * A;
+  EXPECT_LT((independent.covariance - expected_independent).norm(), 1e-12 * expected_independent.norm());
+  // A mean of n equally correlated neighbours (real c = rho): variance s^2 (n + 2 (n - 1) rho) / n^2.
+  MatrixXd mean(m, 1);
+  for (int k = 0; k < n; ++k) mean(2 * k, 0) = 1.0, mean(2 * k + 1, 0) = 0.0;
+  MatrixXd mean2(m, 2);
+  mean2.col(0) = mean.col(0);
+  for (int k = 0; k < n; ++k) mean2(2 * k, 1) = 0.0, mean2(2 * k + 1, 1) = 1.0;
+  const double rho = 0.45;
+  const FitCovariance g = fit_covariance(mean2, VectorXd::Zero(m), VectorXd::Ones(m), Eigen::VectorXcd::Constant(n - 1, rho));
+  EXPECT_NEAR(g.covariance(0, 0), (n + 2.0 * (n - 1) * rho) / (n * n), 1e-14);
+  EXPECT_NEAR(g.covariance(1, 1), (n + 2.0 * (n - 1) * rho) / (n * n), 1e-14);
+  EXPECT_THROW((void)fit_covariance(J, VectorXd::Zero(m), s, Eigen::VectorXcd::Zero(n)), InputError);
+  EXPECT_THROW((void)fit_covariance(J, VectorXd::Zero(m), VectorXd(), c), InputError);
 }
 
 TEST(FitCovariance, NearlyCollinearColumnsAreFlaggedAndDependentOnesSingular) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/dsp/welch.hpp"
 
 namespace piezobench::dsp {
@@ -45,6 +46,29 @@ TEST(ResolutionKernel, CosineWindowsGiveTheirSquaredCoefficients) {
   const ResolutionKernel rect = resolution_kernel(WindowType::kRectangular, 1000, 1000.0);
   EXPECT_EQ(rect.weights.size(), 1u);
   EXPECT_FALSE(rect.active());
+}
+
+// The kernel from a provenance carries the adjacent lines' error correlation; adjacent_line_pairs gives
+// it for consecutive points one line apart and 0 across a gap; nothing without it.
+TEST(ResolutionKernel, AdjacentLinePairsFollowTheGrid) {
+  FrfProvenance p;
+  p.window = "hann-periodic";
+  p.nfft = 4000;
+  p.overlap = 0.5;
+  p.averages = 9;
+  p.sample_rate = 1000.0;  // 0.25 Hz lines
+  const ResolutionKernel k = resolution_kernel(p);
+  EXPECT_DOUBLE_EQ(k.adjacent_line_correlation, adjacent_line_correlation(WindowType::kHannPeriodic, 4000, 2000, 9));
+  const double w0 = 2.0 * std::numbers::pi * 0.25;
+  Eigen::VectorXd omega(5);
+  omega << 40 * w0, 41 * w0, 42 * w0, 45 * w0, 46 * w0;
+  const Eigen::VectorXd pairs = adjacent_line_pairs(k, omega);
+  ASSERT_EQ(pairs.size(), 4);
+  EXPECT_DOUBLE_EQ(pairs(0), k.adjacent_line_correlation);
+  EXPECT_DOUBLE_EQ(pairs(1), k.adjacent_line_correlation);
+  EXPECT_EQ(pairs(2), 0.0);
+  EXPECT_DOUBLE_EQ(pairs(3), k.adjacent_line_correlation);
+  EXPECT_EQ(adjacent_line_pairs(resolution_kernel(WindowType::kHannPeriodic, 4000, 1000.0), omega).size(), 0);
 }
 
 TEST(ResolutionKernel, SecondMomentIsTheContinuousKernels) {

@@ -47,8 +47,16 @@ struct FitCovariance {
 
 // J: m x p (m > p, else InputError); r: the m residuals at the solution; residual_std: m values > 0, or
 // empty (unknown). A rank-deficient J gives singular = true and infinite standard errors.
+//
+// Correlated noise: residuals that are the (Re, Im) parts of complex residuals u_k = r_2k + i r_2k+1
+// (interleaved) whose errors correlate with the next one's, E[u_k u_k+1^*] = c_k 2 s_2k s_2k+2 (a
+// Welch FRF's adjacent lines, dsp/frf_variance.hpp), give `adjacent_correlation` (c_k, size m / 2 - 1,
+// 0 where u_k and u_k+1 are not neighbours; a circular error: E[u_k u_k+1] = 0). The sandwich's
+// middle is then J^T Sigma J with Sigma's off-diagonal blocks s_2k s_2k+2 [[Re c, -Im c], [Im c, Re c]]
+// (rows Re u_k, Im u_k; columns Re u_k+1, Im u_k+1); the local chi2 f_j keeps its diagonal noise.
 [[nodiscard]] FitCovariance fit_covariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
-                                           const Eigen::VectorXd& residual_std = {});
+                                           const Eigen::VectorXd& residual_std = {},
+                                           const Eigen::VectorXcd& adjacent_correlation = {});
 
 // A fit's parameters in their natural units with their standard errors: what results.json, --json,
 // Python and the report print. Built from the FitCovariance of the solver's (scaled) parameters x

@@ -36,6 +36,10 @@ namespace piezobench::dsp {
 struct ResolutionKernel {
   double line_spacing_Hz = 0.0;  // Hz, df = sample rate / nfft; 0: none
   std::vector<double> weights;   // dimensionless, odd count, symmetric, sum 1
+  // The correlation of the estimate's random error at adjacent lines (dsp/frf_variance.hpp,
+  // adjacent_line_correlation), which the fits' covariances use; 0 when the provenance does not say
+  // how the segments overlapped (or for resolution_kernel(window, nfft, rate)).
+  double adjacent_line_correlation = 0.0;
   [[nodiscard]] bool active() const { return line_spacing_Hz > 0.0 && weights.size() > 1; }
   [[nodiscard]] long half_width() const { return static_cast<long>(weights.size() / 2); }
 };
@@ -51,6 +55,11 @@ inline constexpr long kResolutionKernelMaxHalfWidth = 8;  // lines on each side 
 // provenance does not give all three (an FRF computed from a model, or read from a file that does
 // not say how it was estimated, or names a window window_type_from_string does not know).
 [[nodiscard]] ResolutionKernel resolution_kernel(const FrfProvenance& provenance);
+
+// For each pair of consecutive points of omega (rad/s): the kernel's adjacent_line_correlation when
+// they are neighbouring lines of the estimate's grid (2 pi line_spacing_Hz apart), else 0 (a band
+// with lines left out). Size omega.size() - 1; empty when the kernel carries no correlation.
+[[nodiscard]] Eigen::VectorXd adjacent_line_pairs(const ResolutionKernel& kernel, const Eigen::VectorXd& omega);
 
 namespace detail {
 // omega + delta, omega and delta in rad/s.
