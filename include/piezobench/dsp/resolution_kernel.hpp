@@ -21,6 +21,7 @@
 // Bins with c_j below kResolutionKernelFloor are left out (a symmetric window's DFT has
 // O(1/nfft^2) tails) and the rest renormalized to a sum of 1.
 #include <Eigen/Dense>
+#include <algorithm>
 #include <complex>
 #include <numbers>
 #include <type_traits>
@@ -122,6 +123,20 @@ class KernelGrid {
       }
     }
     return sum;
+  }
+
+  // The coherence a noise-free Welch estimate of the response R shows at each point because of the
+  // window's leakage alone: |sum_j c_j R_j|^2 / sum_j c_j |R_j|^2 (the cross-spectrum averages R over
+  // the kernel, the output's auto-spectrum |R|^2), 1 where the kernel is inactive. Near a sharp
+  // resonance it drops below 1 although nothing is random: dividing a measured coherence by it leaves
+  // the part that the noise explains. R's values at nodes().
+  [[nodiscard]] Eigen::VectorXd leakage_coherence(const Eigen::VectorXcd& at_nodes) const {
+    if (weights_.size() <= 1) return Eigen::VectorXd::Ones(points_);
+    const Eigen::VectorXcd mean = smooth(at_nodes);
+    const Eigen::VectorXd power = smooth(Eigen::VectorXd(at_nodes.cwiseAbs2()));
+    Eigen::VectorXd c(points_);
+    for (Eigen::Index k = 0; k < points_; ++k) c(k) = power(k) > 0.0 ? std::min(1.0, std::norm(mean(k)) / power(k)) : 1.0;
+    return c;
   }
 
  private:
