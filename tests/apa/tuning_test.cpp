@@ -325,21 +325,29 @@ TEST(Tuning, BadInput) {
   }
 }
 
+// The scipy fixture's FRF, its plant fits and the campaign's tuning options (20-500 Hz, coherence 0.5).
+struct ScipyFixture {
+  dsp::Frf frf = io::read_frf(test::fixture_path("ident/two_dof_welch_frf.csv"));
+  ident::ActuatorPlants plants = ident::fit_actuator_plants(2.0 * std::numbers::pi * frf.freq_Hz, frf.H[0], frf.coherence[0],
+                                                            frf.H[1], frf.coherence[1]);
+  TuningOptions options = [] {
+    TuningOptions o;
+    o.fmin_Hz = 20.0;
+    o.fmax_Hz = 500.0;
+    o.min_coherence = 0.5;
+    return o;
+  }();
+};
+
 // The campaign's procedure on a lab's Welch FRF (scripts/fixtures/make_two_dof_frf_fixtures.py: the
 // 2-DoF model of Table 3.1 simulated by scipy with the bench's high-pass and delay): the chain
 // found by the plant fits is removed and the stiffnesses and gains come back within 3 %; without
 // removing it, the verdict says the tuning is not to be trusted as is.
 TEST(Tuning, MeasuredProcedureOnAScipyWelchFrf) {
-  const dsp::Frf frf = io::read_frf(test::fixture_path("ident/two_dof_welch_frf.csv"));
+  const ScipyFixture f;
   const auto truth = nlohmann::json::parse(test::read_text(test::fixture_path("ident/two_dof_welch_truth.json")));
-  const lti::Vector w = 2.0 * std::numbers::pi * frf.freq_Hz;
-  const ident::ActuatorPlants plants = ident::fit_actuator_plants(w, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1]);
-  ASSERT_TRUE(plants.de && plants.vs);
-  TuningOptions o;
-  o.fmin_Hz = 20.0;
-  o.fmax_Hz = 500.0;
-  o.min_coherence = 0.5;
-  const TwoDofTuning t = tune_two_dof_measured(frf, o, &*plants.de, &*plants.vs);
+  ASSERT_TRUE(f.plants.de && f.plants.vs);
+  const TwoDofTuning t = tune_two_dof_measured(f.frf, f.options, &*f.plants.de, &*f.plants.vs);
   for (const char* key : {"k1", "ke", "ka", "ga", "gs"}) {
     EXPECT_TRUE(test::near(t.params.get(key), truth[key].get<double>(), 0.03)) << key;
   }
@@ -363,18 +371,12 @@ TEST(Tuning, MeasuredProcedureOnAScipyWelchFrf) {
 // parameters now stay within their bounds during the fit: the same data 1e-12 apart give the same
 // tuning to 1e-6.
 TEST(Tuning, RefinementDoesNotDependOnRoundOff) {
-  const dsp::Frf frf = io::read_frf(test::fixture_path("ident/two_dof_welch_frf.csv"));
-  const lti::Vector w = 2.0 * std::numbers::pi * frf.freq_Hz;
-  const ident::ActuatorPlants plants = ident::fit_actuator_plants(w, frf.H[0], frf.coherence[0], frf.H[1], frf.coherence[1]);
-  ASSERT_TRUE(plants.de && plants.vs);
-  TuningOptions o;
-  o.fmin_Hz = 20.0;
-  o.fmax_Hz = 500.0;
-  o.min_coherence = 0.5;
-  const TwoDofTuning a = tune_two_dof_measured(frf, o, &*plants.de, &*plants.vs);
-  ident::DelayedSecondOrderFit de = *plants.de;
+  const ScipyFixture f;
+  ASSERT_TRUE(f.plants.de && f.plants.vs);
+  const TwoDofTuning a = tune_two_dof_measured(f.frf, f.options, &*f.plants.de, &*f.plants.vs);
+  ident::DelayedSecondOrderFit de = *f.plants.de;
   de.delay *= 1.0 + 1e-12;
-  const TwoDofTuning b = tune_two_dof_measured(frf, o, &de, &*plants.vs);
+  const TwoDofTuning b = tune_two_dof_measured(f.frf, f.options, &de, &*f.plants.vs);
   for (const auto& key : TwoDofParams::names()) {
     if (key == "c1") continue;  // undetermined, at its bound in both
     EXPECT_TRUE(test::near(a.params.get(key), b.params.get(key), 1e-6)) << key;

@@ -150,37 +150,52 @@ TEST(KernelGrid, EvaluatesEachLineOnceAndGivesTheSmoothedResponse) {
   EXPECT_EQ(none.smooth(Eigen::Vector3cd(1.0, 2.0, 3.0)), Eigen::Vector3cd(1.0, 2.0, 3.0));
 }
 
+// A resonance of fn Hz and damping zeta (the exact discrete impulse-invariant two-pole filter) driven
+// by `segments` 256-sample segments of white noise at 64 Hz, its output noise-free, estimated with
+// hann at 50 %; with the filter's exact response h(omega).
+struct ResonanceRecord {
+  double fs = 64.0, a1 = 0.0, a2 = 0.0;
+  Frf frf;
+  [[nodiscard]] Complex h(double omega) const {
+    const Complex z = std::polar(1.0, -omega / fs);  // z^-1
+    return 1.0 / (1.0 + a1 * z + a2 * z * z);
+  }
+};
+ResonanceRecord resonance_record(double fn, double zeta, Eigen::Index segments, unsigned seed) {
+  ResonanceRecord out;
+  const Eigen::Index nfft = 256, n = nfft * segments;
+  const double wn = 2.0 * std::numbers::pi * fn / out.fs, r = std::exp(-zeta * wn), wd = wn * std::sqrt(1.0 - zeta * zeta);
+  out.a1 = -2.0 * r * std::cos(wd);
+  out.a2 = r * r;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::VectorXd u(n), y(n);
+  double y1 = 0.0, y2 = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    u(i) = g(rng);
+    const double yi = u(i) - out.a1 * y1 - out.a2 * y2;
+    y(i) = yi;
+    y2 = y1;
+    y1 = yi;
+  }
+  WelchOptions o;
+  o.nfft = nfft;
+  o.overlap = 0.5;
+  o.threads = 1;
+  out.frf = estimate_frf(channel("u", u), {channel("y", y)}, out.fs, o).frf;
+  return out;
+}
+
 TEST(ResolutionKernel, WelchEstimateOfAResonanceConvergesToTheSmoothedResponse) {
   // A resonance of 10 Hz, zeta 0.05 (half-power width 1 Hz, four 0.25 Hz lines, as the virtual bench's
   // resonance is 16 of its lines) driven by white noise, noise-free output, estimated with hann at 50 %:
   // at the peak the estimate is ~7 % below H (H'' df^2 / 6 to second order) and within its random error
   // (0.4-1 % at the peak for 800 segments, seeds 4-6; 2.5 % for seed 3) of the smoothed response. The
   // continuous kernel's expectation differs from the three sampled bins by 0.2 % there (numpy, not here).
-  const double fs = 64.0, fn = 10.0, zeta = 0.05;
-  const Eigen::Index nfft = 256, n = 256 * 400;
-  // Exact discrete resonance (impulse invariant two-pole filter) on white noise.
-  const double wn = 2.0 * std::numbers::pi * fn / fs, r = std::exp(-zeta * wn), wd = wn * std::sqrt(1.0 - zeta * zeta);
-  const double a1 = -2.0 * r * std::cos(wd), a2 = r * r;
-  std::mt19937_64 rng(4);
-  std::normal_distribution<double> g(0.0, 1.0);
-  Eigen::VectorXd u(n), y(n);
-  double y1 = 0.0, y2 = 0.0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    u(i) = g(rng);
-    const double yi = u(i) - a1 * y1 - a2 * y2;
-    y(i) = yi;
-    y2 = y1;
-    y1 = yi;
-  }
-  const auto h = [&](double omega) {
-    const Complex z = std::polar(1.0, -omega / fs);  // z^-1
-    return 1.0 / (1.0 + a1 * z + a2 * z * z);
-  };
-  WelchOptions o;
-  o.nfft = nfft;
-  o.overlap = 0.5;
-  o.threads = 1;
-  const Frf frf = estimate_frf(channel("u", u), {channel("y", y)}, fs, o).frf;
+  const double fn = 10.0;
+  const ResonanceRecord rec = resonance_record(fn, 0.05, 400, 4);
+  const Frf& frf = rec.frf;
+  const auto h = [&](double omega) { return rec.h(omega); };
   const ResolutionKernel k = resolution_kernel(frf.provenance);
   ASSERT_TRUE(k.active());
   double raw = 0.0, smooth = 0.0;
@@ -201,30 +216,10 @@ TEST(ResolutionKernel, WelchEstimateOfAResonanceConvergesToTheSmoothedResponse) 
 // no noise: within 0.6 Hz of the peak the measured 1 - gamma^2 and the predicted one agree within a
 // third (their largest values: printed); a flat response has coherence 1; an inactive kernel gives 1.
 TEST(ResolutionKernel, LeakageCoherencePredictsTheNoiseFreeEstimatesCoherence) {
-  const double fs = 64.0, fn = 10.0, zeta = 0.05;
-  const Eigen::Index nfft = 256, n = 256 * 200;
-  const double wn = 2.0 * std::numbers::pi * fn / fs, r = std::exp(-zeta * wn), wd = wn * std::sqrt(1.0 - zeta * zeta);
-  const double a1 = -2.0 * r * std::cos(wd), a2 = r * r;
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> g(0.0, 1.0);
-  Eigen::VectorXd u(n), y(n);
-  double y1 = 0.0, y2 = 0.0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    u(i) = g(rng);
-    const double yi = u(i) - a1 * y1 - a2 * y2;
-    y(i) = yi;
-    y2 = y1;
-    y1 = yi;
-  }
-  const auto h = [&](double omega) {
-    const Complex z = std::polar(1.0, -omega / fs);
-    return 1.0 / (1.0 + a1 * z + a2 * z * z);
-  };
-  WelchOptions o;
-  o.nfft = nfft;
-  o.overlap = 0.5;
-  o.threads = 1;
-  const Frf frf = estimate_frf(channel("u", u), {channel("y", y)}, fs, o).frf;
+  const double fn = 10.0;
+  const ResonanceRecord rec = resonance_record(fn, 0.05, 200, 5);
+  const Frf& frf = rec.frf;
+  const auto h = [&](double omega) { return rec.h(omega); };
   const ResolutionKernel k = resolution_kernel(frf.provenance);
   std::vector<Eigen::Index> near;
   for (Eigen::Index i = 0; i < frf.freq_Hz.size(); ++i) {
