@@ -76,9 +76,11 @@ StateSpace diagonal(const std::vector<StateSpace>& blocks, double ts) {
   for (Index i = 0; i < k; ++i) {
     const StateSpace& blk = blocks[static_cast<size_t>(i)];
     const Index ni = blk.states();
-    out.A.block(pos, pos, ni, ni) = blk.A;
-    out.B.block(pos, i, ni, 1) = blk.B;
-    out.C.block(i, pos, 1, ni) = blk.C;
+    if (ni > 0) {  // a block of a matrix with no states would be an offset from a null pointer
+      out.A.block(pos, pos, ni, ni) = blk.A;
+      out.B.block(pos, i, ni, 1) = blk.B;
+      out.C.block(i, pos, 1, ni) = blk.C;
+    }
     out.D(i, i) = blk.D(0, 0);
     pos += ni;
   }

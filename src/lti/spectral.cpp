@@ -79,10 +79,12 @@ Quad reduce(Quad s, double tol) {
     Quad r;
     r.a = at.topLeftCorner(k, k);
     r.b = bt.topRows(k);
+    // Eigen's comma initializer takes a block of the destination for each piece: into an empty matrix
+    // (no states left, or no inputs) that is an offset from a null pointer, so an empty one is only sized.
     r.c.resize(rho + sigma, k);
-    r.c << at.bottomLeftCorner(rho, k), ct.leftCols(k);
+    if (r.c.size() > 0) r.c << at.bottomLeftCorner(rho, k), ct.leftCols(k);
     r.d.resize(rho + sigma, m);
-    r.d << bt.bottomRows(rho), d2;
+    if (r.d.size() > 0) r.d << bt.bottomRows(rho), d2;
     s = std::move(r);
   }
 }
