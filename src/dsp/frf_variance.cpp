@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <numbers>
 #include <limits>
+#include <numbers>
 #include <optional>
-#include <utility>
 #include <string>
+#include <utility>
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
@@ -61,17 +61,32 @@ double adjacent_line_correlation(WindowType window, Index nfft, Index noverlap, 
   return den > 0.0 ? num / den : 0.0;
 }
 
-double adjacent_line_correlation(const FrfProvenance& p) {
-  if (p.window.empty() || p.nfft < 2 || p.averages < 1) return 0.0;
+namespace {
+
+// The Welch layout an FRF's provenance records; nullopt when the window, nfft, overlap or averages
+// are missing, or the window is one piezobench does not know (no variance rather than a wrong one).
+struct WelchLayout {
   WindowType window{};
+  Index noverlap = 0;
+};
+std::optional<WelchLayout> welch_layout(const FrfProvenance& p) {
+  if (p.window.empty() || p.nfft < 2 || p.averages < 1) return std::nullopt;
+  WelchLayout l;
   try {
-    window = window_type_from_string(p.window);
+    l.window = window_type_from_string(p.window);
   } catch (const InputError&) {
-    return 0.0;  // a window piezobench does not know
+    return std::nullopt;
   }
-  const auto noverlap = static_cast<Index>(std::floor(p.overlap * static_cast<double>(p.nfft)));
-  if (noverlap < 0 || noverlap >= p.nfft) return 0.0;
-  return adjacent_line_correlation(window, p.nfft, noverlap, p.averages);
+  l.noverlap = static_cast<Index>(std::floor(p.overlap * static_cast<double>(p.nfft)));
+  if (l.noverlap < 0 || l.noverlap >= p.nfft) return std::nullopt;
+  return l;
+}
+
+}  // namespace
+
+double adjacent_line_correlation(const FrfProvenance& p) {
+  const auto l = welch_layout(p);
+  return l ? adjacent_line_correlation(l->window, p.nfft, l->noverlap, p.averages) : 0.0;
 }
 
 double frf_relative_std(double coherence, double effective_averages) {
@@ -181,16 +196,9 @@ FrfNoiseEstimate estimate_frf_noise(const Eigen::VectorXcd& H, const Eigen::Vect
 
 std::vector<Eigen::VectorXd> std_from_coherence(Frf& frf) {
   const FrfProvenance& p = frf.provenance;
-  if (frf.coherence.size() != frf.H.size() || frf.H.empty() || p.nfft < 2 || p.averages < 1 || p.window.empty()) return {};
-  WindowType window{};
-  try {
-    window = window_type_from_string(p.window);
-  } catch (const InputError&) {
-    return {};  // a window piezobench does not know: no variance rather than a wrong one
-  }
-  const auto noverlap = static_cast<Index>(std::floor(p.overlap * static_cast<double>(p.nfft)));
-  if (noverlap < 0 || noverlap >= p.nfft) return {};
-  const double n_d = effective_averages(window, p.nfft, noverlap, p.averages);
+  const auto l = welch_layout(p);
+  if (frf.coherence.size() != frf.H.size() || frf.H.empty() || !l) return {};
+  const double n_d = effective_averages(l->window, p.nfft, l->noverlap, p.averages);
   if (frf.provenance.effective_averages <= 0.0) frf.provenance.effective_averages = n_d;
   std::vector<Eigen::VectorXd> std_H;
   for (std::size_t i = 0; i < frf.H.size(); ++i) std_H.push_back(frf_standard_deviation(frf.H[i], frf.coherence[i], n_d));

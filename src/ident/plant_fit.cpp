@@ -473,9 +473,9 @@ core::LmResult best_iff_solution(const IffResidual& residual, const IffPlantFit&
 
 // Standard errors of the plant's parameters, linearized at the solution.
 core::ParameterUncertainty iff_uncertainty(const IffResidual& residual, const core::LmResult& best, const IffPlantFit& fit,
-                                           const Vector& residual_std, bool from_frf_variance, const dsp::ResolutionKernel& kernel) {
-  const IffPlantFit at = from_x(best.x, residual.sign, residual.layout, residual.fixed_w_hpf);
-  const CVector model = residual.grid.smooth(plant::iff_plant_response(at, residual.grid.nodes()));
+                                           const Vector& residual_std, bool from_frf_variance, const dsp::ResolutionKernel& kernel,
+                                           const CVector& model_at_nodes) {
+  const CVector model = residual.grid.smooth(model_at_nodes);
   const core::FitCovariance cov =
       covariance_at(residual, best.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std));
   // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
@@ -532,9 +532,9 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   fit.iterations = best.iterations;
   fit.converged = best.converged();
   fit.status = best.status;
-  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid,
-                                                 plant::iff_plant_response(fit, grid.nodes()));
-  fit.uncertainty = iff_uncertainty(residual, best, fit, noise, eps.size() > 0, options.resolution);
+  const CVector at_nodes = plant::iff_plant_response(fit, grid.nodes());  // the solution's model, for both
+  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid, at_nodes);
+  fit.uncertainty = iff_uncertainty(residual, best, fit, noise, eps.size() > 0, options.resolution, at_nodes);
   fit.quality.check_error("u -> Vs (IFF plant, eq. 2.3)", fit.relative_rms_error);
   check_in_band(fit.quality, "anti-resonance wz", fit.wz, b.w);
   check_in_band(fit.quality, "resonance wp", fit.wp, b.w);
@@ -664,8 +664,9 @@ Eigen::VectorXd second_order_x0(const DelayedSecondOrderFit& start, bool fit_del
 // Standard errors of static_gain, natural_frequency, damping and delay, linearized at the solution.
 core::ParameterUncertainty second_order_uncertainty(const SecondOrderResidual& residual, const core::LmResult& o,
                                                     const DelayedSecondOrderFit& fit, const Vector& residual_std,
-                                                    bool from_frf_variance, const dsp::ResolutionKernel& kernel) {
-  const CVector model = residual.grid.smooth(residual.unpack(o.x).response(residual.grid.nodes()));
+                                                    bool from_frf_variance, const dsp::ResolutionKernel& kernel,
+                                                    const CVector& model_at_nodes) {
+  const CVector model = residual.grid.smooth(model_at_nodes);
   const core::FitCovariance cov =
       covariance_at(residual, o.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std));
   Eigen::VectorXd value(4), deriv(4);
@@ -717,8 +718,9 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   fit.points = b.w.size();
   fit.iterations = o.iterations;
   fit.status = o.status;
-  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid, fit.response(grid.nodes()));
-  fit.uncertainty = second_order_uncertainty(residual, o, fit, noise, eps.size() > 0, options.resolution);
+  const CVector at_nodes = fit.response(grid.nodes());  // the solution's model, for both
+  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid, at_nodes);
+  fit.uncertainty = second_order_uncertainty(residual, o, fit, noise, eps.size() > 0, options.resolution, at_nodes);
   fit.quality.check_error("second-order fit", fit.relative_rms_error);
   check_in_band(fit.quality, "natural frequency", fit.natural_frequency, b.w);
   check_lm(fit.quality, o.status);
