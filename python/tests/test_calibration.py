@@ -91,12 +91,12 @@ def test_antiresonance_intervals_against_the_noise_free_record(records):
 def test_tuned_parameters_intervals_against_the_noise_free_record(records):
     # z = (value - ideal) / se of the 2-DoF tuning's parameters (ratios 2), the ideal being the same
     # estimator with the same weights on the noise-free record (calibrate.tuned_reference). Mean z^2
-    # is 1 for a right standard error; over these 8 seeds it is 0.26-2.14 per parameter (0.97 pooled
-    # with the window's resolution kernel in the fits, 0.93 without:
-    # ka, ga and gs lower, their std_H near the resonance also counting the Welch estimate's leakage,
-    # which both records share; docs/uncertainty.md, section 6). The pooled bounds fail standard
-    # errors 2 times too large or too small; no parameter is biased by the noise (the former relative
-    # error's c1: z +2.5 on average, mean z^2 ~ 6.6).
+    # is 1 for a right standard error; over these 8 seeds it is 0.31-1.61 per parameter, 0.90 pooled
+    # (over 200 seeds each parameter's z has a standard deviation of 0.89-1.02; with the window's
+    # leakage counted as noise, before dsp::random_frf_std, 0.56-0.61 for ka, ga, gs:
+    # docs/uncertainty.md, section 6). The pooled bounds fail standard errors 2 times too large or too
+    # small; no parameter is biased by the noise (the former relative error's c1: z +2.5 on average,
+    # mean z^2 ~ 6.6).
     z = {n: [] for n in ["k1", "c1", "ka", "ca", "ga", "gs"]}  # ke, ce = 2 ka, 2 ca
     for frf, ideal, band, _ in records:
         est, _ = calibrate.fitted(frf, 20.0, 500.0)

@@ -91,6 +91,7 @@ struct FitData {
   // The Welch estimate's resolution kernel the model is seen through (inactive: the model itself).
   dsp::ResolutionKernel kernel;
   dsp::KernelGrid grid;  // omega through the kernel: each line's model response evaluated once
+  double effective_averages = 0.0;  // n_d of the Welch estimate (0: unknown)
 };
 
 // The quality verdict of a tuning (tuning.hpp).
@@ -196,6 +197,7 @@ FitData prepare(const dsp::Frf& frf, const TuningOptions& o, const std::string& 
     }
   }
   d.grid = dsp::KernelGrid(d.kernel, d.omega);
+  d.effective_averages = frf.provenance.effective_averages;
   return d;
 }
 
@@ -359,6 +361,26 @@ Vector residual_std(const Weights& w) {
   for (Index k = 0; k < n; ++k) {
     s(2 * k) = s(2 * k + 1) = w.std_de(k);
     s(2 * n + 2 * k) = s(2 * n + 2 * k + 1) = w.std_vs(k);
+  }
+  return s;
+}
+
+// residual_std() from the FRF's random error alone (dsp::random_frf_std at the model p: the window's
+// leakage at the resonance and the dip left out), for the intervals; the measured one without n_d.
+Vector random_residual_std(const FitData& d, const TwoDofParams& p, const Weights& wt) {
+  Vector s = residual_std(wt);
+  const Index n = d.omega.size();
+  if (s.size() == 0 || !(d.effective_averages > 0.0)) return s;
+  TwoDofBench bare;
+  bare.amplifier_gain = 1.0;
+  const lti::CMatrix at_nodes = two_dof_response(p, bare, d.grid.nodes());
+  const lti::CMatrix at_lines = d.grid.smooth(at_nodes);
+  for (const Index o : {kOutputDe, kOutputVs}) {
+    const CVector& h = o == kOutputDe ? d.de : d.vs;
+    const Vector std_h = (o == kOutputDe ? d.eps_de : d.eps_vs).cwiseProduct(h.cwiseAbs());
+    const Vector random = dsp::random_frf_std(h, std_h, at_lines.col(o), d.grid.leakage_coherence(at_nodes.col(o)), d.effective_averages).std;
+    const Vector& w = o == kOutputDe ? wt.de : wt.vs;
+    for (Index k = 0; k < n; ++k) s(2 * n * o + 2 * k) = s(2 * n * o + 2 * k + 1) = w(k) * random(k);
   }
   return s;
 }
@@ -565,11 +587,14 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
     const Eigen::VectorXcd adjacent = from_variance ? adjacent_correlation(d) : Eigen::VectorXcd();
     const core::FitCovariance with_misfit = core::fit_covariance(jacobian, res, sd, adjacent);
     // With the FRF's variance the interval is the random error alone: the covariance of zero residuals
-    // has no misfit widening (f_j = 1, core/fit_covariance.hpp). The 2-DoF model's misfit on a real
-    // bench is a bias, the same for every record, not a scatter: widened by it, the intervals of
-    // k1, ka, ga, gs were 2-5 times the scatter over 200 noise seeds (docs/uncertainty.md, section 6).
-    // The misfit still decides which parameters are undetermined (uncertainty_with_misfit).
-    core::FitCovariance random = from_variance ? core::fit_covariance(jacobian, Vector::Zero(res.size()), sd, adjacent) : with_misfit;
+    // has no misfit widening (f_j = 1, core/fit_covariance.hpp), with the FRF's random error without
+    // the window's leakage (random_residual_std). The 2-DoF model's misfit on a real bench is a bias,
+    // the same for every record, not a scatter: widened by it, the intervals of k1, ka, ga, gs were 2-5
+    // times the scatter over 200 noise seeds; with the leakage counted as noise, those of ka, ga, gs
+    // were 1.6 times (docs/uncertainty.md, section 6). The misfit, against the measured variance,
+    // still decides which parameters are undetermined (uncertainty_with_misfit).
+    core::FitCovariance random =
+        from_variance ? core::fit_covariance(jacobian, Vector::Zero(res.size()), random_residual_std(d, out.params, wt), adjacent) : with_misfit;
     random.chi2_per_dof = with_misfit.chi2_per_dof;
     out.uncertainty = tuning_uncertainty(out.params, layout, keep, random, from_variance);
     out.uncertainty_with_misfit = tuning_uncertainty(out.params, layout, keep, with_misfit, from_variance);

@@ -175,6 +175,14 @@ FrfNoiseEstimate estimate_frf_noise(const Eigen::VectorXcd& H, const Eigen::Vect
     v(k) = 0.5 * std::norm(H(k) - model(k));
     x(k) = std::norm(model(k));
   }
+  return fit_frf_noise(v, x);
+}
+
+FrfNoiseEstimate fit_frf_noise(const Eigen::VectorXd& v, const Eigen::VectorXd& x) {
+  if (v.size() != x.size()) {
+    throw InputError("frf noise", "model", std::to_string(v.size()) + " values (one per line)", std::to_string(x.size()));
+  }
+  if (v.size() < 3) throw InputError("frf noise", "variance", "at least 3 lines", std::to_string(v.size()));
   if (!v.allFinite() || !x.allFinite()) throw NumericalError("frf noise", "a non-finite residual or model value", false);
   FrfNoiseEstimate e;
   const double additive = v.mean();
@@ -192,6 +200,63 @@ FrfNoiseEstimate estimate_frf_noise(const Eigen::VectorXcd& H, const Eigen::Vect
   e.additive_std = std::sqrt(best_a);
   e.relative_std = std::sqrt(best_b);
   return e;
+}
+
+RandomFrfStd random_frf_std(const Eigen::VectorXcd& H, const Eigen::VectorXd& std_H, const Eigen::VectorXcd& model,
+                            const Eigen::VectorXd& leakage, double effective_averages) {
+  const Index n = H.size();
+  for (const auto& [size, name] : {std::pair{std_H.size(), "std_H"}, std::pair{model.size(), "model"}, std::pair{leakage.size(), "leakage"}}) {
+    if (size != n) throw InputError("frf noise", name, std::to_string(n) + " values (one per line)", std::to_string(size));
+  }
+  if (!(effective_averages > 0.0)) {
+    throw InputError("frf noise", "effective averages", "a number > 0", format_number_exact(effective_averages));
+  }
+  RandomFrfStd out;
+  out.std = std_H;
+  constexpr double kLeakageShare = 0.1;  // of the measured coherence loss
+  constexpr Index kMinClean = 8, kGroups = 8;
+  std::vector<Index> clean;
+  std::vector<bool> is_clean(static_cast<std::size_t>(n), false);
+  for (Index k = 0; k < n; ++k) {
+    const double abs_h = std::abs(H(k));
+    if (!(abs_h > 0.0 && std_H(k) > 0.0 && leakage(k) > 0.0)) continue;
+    const double eps = std_H(k) / abs_h;
+    const double q = 2.0 * effective_averages * eps * eps;  // (1 - gamma^2) / gamma^2
+    if (1.0 / leakage(k) - 1.0 <= kLeakageShare * q) {
+      clean.push_back(k);
+      is_clean[static_cast<std::size_t>(k)] = true;
+    }
+  }
+  out.clean_lines = static_cast<Index>(clean.size());
+  if (out.clean_lines < kMinClean) return out;
+  Eigen::VectorXd v(out.clean_lines), x(out.clean_lines);
+  for (Index i = 0; i < out.clean_lines; ++i) {
+    const Index k = clean[static_cast<std::size_t>(i)];
+    v(i) = std_H(k) * std_H(k);
+    x(i) = std::norm(model(k));
+  }
+  out.noise = fit_frf_noise(v, x);
+  const double a = out.noise.additive_std * out.noise.additive_std, b = out.noise.relative_std * out.noise.relative_std;
+  // The model describes the clean lines when their variance over it averages to 1 (within a factor 2)
+  // in every group of consecutive clean lines.
+  bool adequate = a + b > 0.0;
+  for (Index g = 0; g < kGroups && adequate; ++g) {
+    const Index lo = g * out.clean_lines / kGroups, hi = (g + 1) * out.clean_lines / kGroups;
+    double ratio = 0.0;
+    for (Index i = lo; i < hi; ++i) ratio += v(i) / (a + b * x(i));
+    ratio /= static_cast<double>(hi - lo);
+    adequate = ratio >= 0.5 && ratio <= 2.0;
+  }
+  out.smooth_model = adequate;
+  for (Index k = 0; k < n; ++k) {
+    const double m = std::sqrt(a + b * std::norm(model(k)));
+    if (adequate) {
+      out.std(k) = m;
+    } else if (!is_clean[static_cast<std::size_t>(k)] && m > 0.0) {
+      out.std(k) = std::min(std_H(k), m);
+    }
+  }
+  return out;
 }
 
 std::vector<Eigen::VectorXd> std_from_coherence(Frf& frf) {

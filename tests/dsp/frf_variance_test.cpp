@@ -182,6 +182,63 @@ TEST(FrfVariance, NoiseEstimateRecoversAdditiveAndProportionalParts) {
   EXPECT_THROW((void)estimate_frf_noise(bad, g), NumericalError);
 }
 
+// The random part of a Welch estimate's std_k: 4,000 lines of a resonance (Q = 50) whose std_k^2 is the
+// noise sqrt(a^2 + (r |G|)^2) squared times a chi-square of 2 n_d degrees of freedom over 2 n_d (what a
+// coherence from n_d = 8.6 averages gives), plus the window's leakage |H|^2 (1/leakage - 1) / (2 n_d)
+// over the peak: the noise model comes back within 5 %, at the peak std is the model (the leakage, there
+// 28 times the noise, left out), and at a clean line too (the line's own chi-square scatter smoothed
+// away). A noise 10 times larger over the upper half (coloured: the model does not fit it) keeps the
+// measured std at clean lines and caps it by the model at the leaky ones; without 8 clean lines, std_H
+// as it is.
+TEST(FrfVariance, RandomStdLeavesTheLeakageOutAndSmoothsTheNoise) {
+  const Index n = 4000, peak = 2000;
+  const double nd = 8.6, a = 1e-4, r = 2e-3;
+  Eigen::VectorXcd g(n);
+  Eigen::VectorXd leakage(n), chi(n);
+  std::mt19937 rng(5);
+  std::chi_squared_distribution<double> chi2(2.0 * nd);
+  for (Index k = 0; k < n; ++k) {
+    const double x = static_cast<double>(k - peak) / 400.0;  // frequency over the resonance's, minus 1
+    g(k) = 1.0 / std::complex<double>(1.0 - (1.0 + x) * (1.0 + x), 0.02 * (1.0 + x));
+    leakage(k) = 1.0 - 0.05 * std::exp(-std::pow(static_cast<double>(k - peak) / 6.0, 2));
+    chi(k) = chi2(rng) / (2.0 * nd);
+  }
+  const auto measured = [&](const Eigen::VectorXd& noise_var) {
+    Eigen::VectorXd s(n);
+    for (Index k = 0; k < n; ++k) s(k) = std::sqrt(noise_var(k) * chi(k) + std::norm(g(k)) * (1.0 / leakage(k) - 1.0) / (2.0 * nd));
+    return s;
+  };
+  Eigen::VectorXd var(n);
+  for (Index k = 0; k < n; ++k) var(k) = a * a + r * r * std::norm(g(k));
+  const Eigen::VectorXd std_h = measured(var);
+  RandomFrfStd out = random_frf_std(g, std_h, g, leakage, nd);
+  ASSERT_TRUE(out.smooth_model);
+  EXPECT_GT(out.clean_lines, 3900);
+  EXPECT_NEAR(out.noise.additive_std, a, 0.05 * a);
+  EXPECT_NEAR(out.noise.relative_std, r, 0.05 * r);
+  EXPECT_GT(std_h(peak), 25.0 * std::sqrt(var(peak)));
+  EXPECT_NEAR(out.std(peak), std::sqrt(var(peak)), 0.05 * std::sqrt(var(peak)));
+  EXPECT_NEAR(out.std(100), std::sqrt(var(100)), 0.05 * std::sqrt(var(100)));
+
+  Eigen::VectorXd coloured = var;
+  coloured.tail(n / 2) *= 100.0;
+  const Eigen::VectorXd std_c = measured(coloured);
+  out = random_frf_std(g, std_c, g, leakage, nd);
+  EXPECT_FALSE(out.smooth_model);
+  EXPECT_EQ(out.std(100), std_c(100));
+  EXPECT_EQ(out.std(3900), std_c(3900));
+  const double capped = std::hypot(out.noise.additive_std, out.noise.relative_std * std::abs(g(peak)));
+  EXPECT_LT(capped, 0.25 * std_c(peak));
+  EXPECT_DOUBLE_EQ(out.std(peak), capped);
+
+  out = random_frf_std(g, std_h, g, Eigen::VectorXd::Constant(n, 0.5), nd);
+  EXPECT_FALSE(out.smooth_model);
+  EXPECT_EQ(out.clean_lines, 0);
+  EXPECT_EQ(out.std, std_h);
+  EXPECT_THROW((void)random_frf_std(g, std_h.head(10), g, leakage, nd), InputError);
+  EXPECT_THROW((void)random_frf_std(g, std_h, g, leakage, 0.0), InputError);
+}
+
 // The correlation of a Welch estimate's errors at neighbouring lines: without overlap only the
 // window's own leakage, |sum w^2 e^(2 pi i n / N)|^2 / (sum w^2)^2 (periodic hann: (2/3)^2 = 4/9;
 // rectangular: 0, its bins are orthogonal); hann at 50 % with 9 segments: 0.457 (scipy's csd/welch,

@@ -83,6 +83,36 @@ struct FrfNoiseEstimate {
 // InputError when the sizes differ or there are fewer than 3 lines; NumericalError for a non-finite
 // residual.
 [[nodiscard]] FrfNoiseEstimate estimate_frf_noise(const Eigen::VectorXcd& H, const Eigen::VectorXcd& model);
+// The same maximum-likelihood fit from per-part variance samples v_k (|H_k - G_k|^2 / 2, or a Welch
+// estimate's std_k^2: the same likelihood equations for any gamma shape) and the model's power
+// |G_k|^2: `variance` and `model_power` in the same units as |H|^2. InputError / NumericalError as above.
+[[nodiscard]] FrfNoiseEstimate fit_frf_noise(const Eigen::VectorXd& variance, const Eigen::VectorXd& model_power);
+
+// The random error of a Welch estimate per line (per part, H's units): what makes the fitted
+// parameters scatter from one record to the next, for their standard errors.
+//
+// B&P's std_k from the measured coherence also counts the window's leakage at a sharp resonance or
+// dip (dsp::KernelGrid::leakage_coherence): power the estimate spreads over neighbouring lines, the
+// same for every record of the same excitation, not a noise. Near the APA's resonance it is 10^3-10^5
+// times the noise's share of 1 - gamma^2, and the 2-DoF tuning's intervals of ka, ga, gs were 1.6
+// times their scatter (docs/uncertainty.md, section 6). Here the noise is the additive and
+// proportional model of fit_frf_noise, fitted to std_k^2 on the lines where the leakage is below a
+// tenth of the measured coherence loss (1/leakage - 1 <= 0.1 (1 - gamma^2)/gamma^2, gamma^2 from
+// std_k / |H_k| and n_d) and evaluated at every line: smooth, it also leaves out the scatter of each
+// line's own estimate (8 averages: +-35 %), which the weights computed from the same coherence would
+// turn into standard errors 5-10 % too small.
+// When fewer than 8 lines are clean, or the model misses the clean lines' variance (mean ratio outside
+// [0.5, 2] in one of 8 consecutive groups: a coloured noise this model does not describe), the
+// measured std_k is kept where the leakage is small and capped by the model elsewhere
+// (smooth_model false). std_H, H, model and leakage: one value per line; n_d > 0.
+struct RandomFrfStd {
+  Eigen::VectorXd std;         // per part, H's units
+  FrfNoiseEstimate noise;      // the model fitted on the clean lines
+  Eigen::Index clean_lines = 0;
+  bool smooth_model = false;   // std is the model at every line
+};
+[[nodiscard]] RandomFrfStd random_frf_std(const Eigen::VectorXcd& H, const Eigen::VectorXd& std_H, const Eigen::VectorXcd& model,
+                                          const Eigen::VectorXd& leakage, double effective_averages);
 
 // The coverage factor k of the 95 % (or `level`) band H +- k std_H with n_d effective averages:
 //
