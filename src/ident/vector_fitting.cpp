@@ -283,10 +283,12 @@ void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights
 // The pole relocation spends most of its time in the QR of tall matrices (2 rows per frequency,
 // 2N + 2 columns). Eigen's HouseholderQR treats a matrix of fewer than 48 columns as one panel and
 // applies each reflector separately (a matrix-vector product and a rank-1 update per reflector).
-// The kernel below applies the reflectors in panels of kPanel (compact WY form, Q = I - V T V^T):
-// two passes over the trailing columns per panel instead of two per reflector, two trailing
-// columns per pass (each load of V serves both), with the sums over rows in W-wide vectors (GCC/
-// Clang vector extensions; the compiler does not vectorize floating-point sums by itself). It is
+// The kernel below applies the reflectors in panels of P = 4 (compact WY form, Q = I - V T V^T):
+// two passes over the trailing columns per panel instead of two per reflector, G trailing columns
+// per pass (each load of V serves all G: G = 4 with AVX-512's 32 vector registers, 2 otherwise;
+// panels of 8 measured slower: their reflector-by-reflector part grows), with the sums over rows
+// in W-wide vectors (GCC/Clang vector extensions; the compiler does not vectorize floating-point
+// sums by itself). It is
 // compiled three times, for W = 2 (SSE2 on x86-64, NEON on ARM), W = 4 (AVX2 with FMA) and W = 8
 // (AVX-512), and the widest the processor has is chosen once at run time (the build itself stays
 // generic x86-64). It is the same Householder QR (beta = -sign(x) ||x||, as Eigen's), so R agrees
@@ -299,9 +301,6 @@ template <int W>
 struct Lanes {
   typedef double Vec __attribute__((vector_size(8 * W), aligned(8), may_alias));
 };
-
-constexpr int kPanel = 4;
-
 
 // sum_i x[i] y[i]
 template <int W>
@@ -320,156 +319,198 @@ PB_KERNEL double dot(const double* x, const double* y, Index n) {
   return sum;
 }
 
-// One panel's block reflector applied to G consecutive trailing columns c[0..G): c -= V (T^T (V^T
-// c)). vcol[q] are V's columns (rows k0 + q + 1 .. bulk - 1 stored below the unit diagonal, rows
-// from `bulk` down stored whole); unused ones (q >= nb) repeat the last with a zero row of T.
-template <int W, int G>
-PB_KERNEL void apply_panel(const double* const* vcol, const double (*t)[kPanel], int nb, Index k0,
-                           Index bulk, Index rows, double* const* c) {
+// Where a panel's reflectors live: reflector q (q < nb) is 1 at row k0 + q, vcol[q][i] in rows
+// k0 + q + 1 .. bulk - 1 (V's lower triangle) and in the dense rows `dense` .. rows - 1; rows
+// bulk .. dense - 1 are zero in every reflector (the zero part of the triangle carried on top of
+// a TSQR block) and are skipped. Unused columns (q >= nb) repeat the last with a zero row of T.
+template <int P>
+struct Panel {
+  const double* vcol[P];
+  double t[P][P];  // T of Q = I - V T V^T (upper triangular)
+  int nb;
+  Index k0, bulk, dense, rows;
+};
+
+// The block reflector applied to G consecutive trailing columns c[0..G): c -= V (T^T (V^T c)).
+template <int W, int P, int G>
+PB_KERNEL void apply_panel(const Panel<P>& pn, double* const* c) {
   using V = typename Lanes<W>::Vec;
-  const Index blen = rows - bulk;
-  double w[G][kPanel] = {};
+  // Local copies: the stores into c (may_alias vectors) could otherwise alias pn and force reloads.
+  const double* vcol[P];
+  for (int q = 0; q < P; ++q) vcol[q] = pn.vcol[q];
+  const Index dense = pn.dense, dlen = pn.rows - dense;
+  double w[G][P] = {};
   for (int g = 0; g < G; ++g) {
-    for (int q = 0; q < nb; ++q) {
-      double d = c[g][k0 + q];
-      for (Index i = k0 + q + 1; i < bulk; ++i) d += vcol[q][i] * c[g][i];
+    for (int q = 0; q < pn.nb; ++q) {
+      double d = c[g][pn.k0 + q];
+      for (Index i = pn.k0 + q + 1; i < pn.bulk; ++i) d += vcol[q][i] * c[g][i];
       w[g][q] = d;
     }
   }
   {
-    V acc[G][kPanel];
+    V acc[G][P];
     for (int g = 0; g < G; ++g) {
-      for (int q = 0; q < kPanel; ++q) acc[g][q] = V{};
+      for (int q = 0; q < P; ++q) acc[g][q] = V{};
     }
     Index i = 0;
-    for (; i + W <= blen; i += W) {
-      V v[kPanel];
-      for (int q = 0; q < kPanel; ++q) v[q] = *reinterpret_cast<const V*>(vcol[q] + bulk + i);
+    for (; i + W <= dlen; i += W) {
+      V v[P];
+      for (int q = 0; q < P; ++q) v[q] = *reinterpret_cast<const V*>(vcol[q] + dense + i);
       for (int g = 0; g < G; ++g) {
-        const V x = *reinterpret_cast<const V*>(c[g] + bulk + i);
-        for (int q = 0; q < kPanel; ++q) acc[g][q] += v[q] * x;
+        const V x = *reinterpret_cast<const V*>(c[g] + dense + i);
+        for (int q = 0; q < P; ++q) acc[g][q] += v[q] * x;
       }
     }
     for (int g = 0; g < G; ++g) {
-      double sum[kPanel];
-      for (int q = 0; q < kPanel; ++q) {
+      double sum[P];
+      for (int q = 0; q < P; ++q) {
         sum[q] = 0.0;
         for (int l = 0; l < W; ++l) sum[q] += acc[g][q][l];
       }
-      for (Index r = i; r < blen; ++r) {
-        for (int q = 0; q < kPanel; ++q) sum[q] += vcol[q][bulk + r] * c[g][bulk + r];
+      for (Index r = i; r < dlen; ++r) {
+        for (int q = 0; q < P; ++q) sum[q] += vcol[q][dense + r] * c[g][dense + r];
       }
-      for (int q = 0; q < nb; ++q) w[g][q] += sum[q];
+      for (int q = 0; q < pn.nb; ++q) w[g][q] += sum[q];
     }
   }
-  double tw[G][kPanel] = {};
+  double tw[G][P] = {};
   for (int g = 0; g < G; ++g) {
-    for (int q = 0; q < nb; ++q) {
-      for (int p = 0; p <= q; ++p) tw[g][q] += t[p][q] * w[g][p];
+    for (int q = 0; q < pn.nb; ++q) {
+      for (int p = 0; p <= q; ++p) tw[g][q] += pn.t[p][q] * w[g][p];
     }
-    for (int q = 0; q < nb; ++q) {
-      c[g][k0 + q] -= tw[g][q];
-      for (Index i = k0 + q + 1; i < bulk; ++i) c[g][i] -= vcol[q][i] * tw[g][q];
+    for (int q = 0; q < pn.nb; ++q) {
+      c[g][pn.k0 + q] -= tw[g][q];
+      for (Index i = pn.k0 + q + 1; i < pn.bulk; ++i) c[g][i] -= vcol[q][i] * tw[g][q];
     }
   }
   Index i = 0;
-  for (; i + W <= blen; i += W) {
-    V v[kPanel];
-    for (int q = 0; q < kPanel; ++q) v[q] = *reinterpret_cast<const V*>(vcol[q] + bulk + i);
+  for (; i + W <= dlen; i += W) {
+    V v[P];
+    for (int q = 0; q < P; ++q) v[q] = *reinterpret_cast<const V*>(vcol[q] + dense + i);
     for (int g = 0; g < G; ++g) {
       V u = v[0] * tw[g][0];
-      for (int q = 1; q < kPanel; ++q) u += v[q] * tw[g][q];
-      *reinterpret_cast<V*>(c[g] + bulk + i) -= u;
+      for (int q = 1; q < P; ++q) u += v[q] * tw[g][q];
+      *reinterpret_cast<V*>(c[g] + dense + i) -= u;
     }
   }
-  for (; i < blen; ++i) {
+  for (; i < dlen; ++i) {
     for (int g = 0; g < G; ++g) {
       double u = 0.0;
-      for (int q = 0; q < kPanel; ++q) u += tw[g][q] * vcol[q][bulk + i];
-      c[g][bulk + i] -= u;
+      for (int q = 0; q < P; ++q) u += tw[g][q] * vcol[q][dense + i];
+      c[g][dense + i] -= u;
     }
   }
 }
 
-// In place on the column-major rows x cols matrix `a` (leading dimension ld): on return its upper
-// triangle (trapezoid if rows < cols) holds R; the entries below it are left undefined.
-template <int W>
-PB_KERNEL void triangularize_lanes(double* a, Index rows, Index cols, Index ld) {
-  const Index kmax = std::min(rows, cols);
-  for (Index k0 = 0; k0 < kmax; k0 += kPanel) {
-    const int nb = static_cast<int>(std::min<Index>(kPanel, kmax - k0));
-    // Panel: reflector by reflector on its own columns. Reflector k is I - tau v v^T with v = 1 at
-    // row k and v[i] = a(i, k) below it.
-    double tau[kPanel] = {};
-    for (int q = 0; q < nb; ++q) {
-      const Index k = k0 + q;
-      double* col = a + k * ld;
-      double* v = col + k + 1;
-      const Index len = rows - k - 1;
-      const double sigma = dot<W>(v, v, len);
-      if (sigma == 0.0) continue;  // already triangular in this column: tau = 0
-      const double x = col[k];
-      const double norm = std::sqrt(x * x + sigma);
-      const double beta = x >= 0.0 ? -norm : norm;
-      const double inv = 1.0 / (x - beta);
-      tau[q] = (beta - x) / beta;
-      col[k] = beta;
-      for (Index i = 0; i < len; ++i) v[i] *= inv;
-      for (Index j = k + 1; j < k0 + nb; ++j) {
-        double* c = a + j * ld;
-        const double d = tau[q] * (c[k] + dot<W>(v, c + k + 1, len));
-        c[k] -= d;
-        for (Index i = 0; i < len; ++i) c[k + 1 + i] -= d * v[i];
-      }
+// The panel's reflectors, one by one on the panel's own columns (reflector k is I - tau v v^T
+// with v = 1 at row k and v[i] = a(i, k) below it, zero in the rows above `top`); returns the taus.
+template <int W, int P>
+PB_KERNEL void factor_panel(double* a, Index rows, Index ld, Index top, Index k0, int nb, double* tau) {
+  for (int q = 0; q < nb; ++q) {
+    const Index k = k0 + q;
+    double* col = a + k * ld;
+    const Index first = std::max(k + 1, top);  // rows k + 1 .. top - 1 are zero in column k
+    double* v = col + first;
+    const Index len = rows - first;
+    tau[q] = 0.0;
+    const double sigma = dot<W>(v, v, len);
+    if (sigma == 0.0) continue;  // already triangular in this column: tau = 0
+    const double x = col[k];
+    const double norm = std::sqrt(x * x + sigma);
+    const double beta = x >= 0.0 ? -norm : norm;
+    const double inv = 1.0 / (x - beta);
+    tau[q] = (beta - x) / beta;
+    col[k] = beta;
+    for (Index i = 0; i < len; ++i) v[i] *= inv;
+    for (Index j = k + 1; j < k0 + nb; ++j) {
+      double* c = a + j * ld;
+      const double d = tau[q] * (c[k] + dot<W>(v, c + first, len));
+      c[k] -= d;
+      for (Index i = 0; i < len; ++i) c[first + i] -= d * v[i];
     }
-    if (k0 + nb >= cols) continue;
-    // Columns of V (unused ones repeat the last, with a zero coefficient below). Rows from `bulk`
-    // down are stored entries of every column; the rows above form V's unit lower triangle.
-    const double* vcol[kPanel];
-    for (int q = 0; q < kPanel; ++q) vcol[q] = a + (k0 + std::min(q, nb - 1)) * ld;
-    const Index bulk = k0 + nb;
-    const Index blen = rows - bulk;
-    // T (upper triangular): T(q,q) = tau_q, T(0:q,q) = -tau_q T(0:q,0:q) V(:,0:q)^T V(:,q).
-    double t[kPanel][kPanel] = {};
-    for (int q = 0; q < nb; ++q) {
-      t[q][q] = tau[q];
-      double vv[kPanel] = {};
-      for (int p = 0; p < q; ++p) {
-        double d = vcol[p][k0 + q];
-        for (Index i = k0 + q + 1; i < bulk; ++i) d += vcol[p][i] * vcol[q][i];
-        vv[p] = d + dot<W>(vcol[p] + bulk, vcol[q] + bulk, blen);
-      }
-      for (int p = 0; p < q; ++p) {
-        double sum = 0.0;
-        for (int r = p; r < q; ++r) sum += t[p][r] * vv[r];
-        t[p][q] = -tau[q] * sum;
-      }
+  }
+}
+
+// T (upper triangular): T(q,q) = tau_q, T(0:q,q) = -tau_q T(0:q,0:q) V(:,0:q)^T V(:,q).
+template <int W, int P>
+PB_KERNEL void panel_t(Panel<P>& pn, const double* tau) {
+  const Index dlen = pn.rows - pn.dense;
+  for (int p = 0; p < P; ++p) {
+    for (int q = 0; q < P; ++q) pn.t[p][q] = 0.0;
+  }
+  for (int q = 0; q < pn.nb; ++q) {
+    pn.t[q][q] = tau[q];
+    double vv[P] = {};
+    for (int p = 0; p < q; ++p) {
+      double d = pn.vcol[p][pn.k0 + q];
+      for (Index i = pn.k0 + q + 1; i < pn.bulk; ++i) d += pn.vcol[p][i] * pn.vcol[q][i];
+      vv[p] = d + dot<W>(pn.vcol[p] + pn.dense, pn.vcol[q] + pn.dense, dlen);
     }
-    // Trailing columns, two at a time.
-    Index j = bulk;
-    for (; j + 2 <= cols; j += 2) {
-      double* const c[2] = {a + j * ld, a + (j + 1) * ld};
-      apply_panel<W, 2>(vcol, t, nb, k0, bulk, rows, c);
+    for (int p = 0; p < q; ++p) {
+      double sum = 0.0;
+      for (int r = p; r < q; ++r) sum += pn.t[p][r] * vv[r];
+      pn.t[p][q] = -tau[q] * sum;
+    }
+  }
+}
+
+// In place on the column-major rows x cols matrix `a` (leading dimension ld): the first
+// min(rows, steps) Householder reflectors, each applied to all the columns after its own. With
+// steps >= cols, the upper triangle (trapezoid if rows < cols) holds R on return. Rows 0 .. top - 1
+// must be upper triangular (zero below the diagonal: the triangle carried on top of a TSQR block);
+// their zeros are skipped. Below the diagonal, rows top .. rows - 1 hold the reflectors on return;
+// the zeros of rows < top stay.
+template <int W, int P, int G>
+PB_KERNEL void triangularize_lanes(double* a, Index rows, Index cols, Index ld, Index top, Index steps) {
+  const Index kmax = std::min({rows, cols, steps});
+  for (Index k0 = 0; k0 < kmax; k0 += P) {
+    Panel<P> pn;
+    pn.nb = static_cast<int>(std::min<Index>(P, kmax - k0));
+    pn.k0 = k0;
+    pn.bulk = k0 + pn.nb;
+    pn.dense = std::max(pn.bulk, top);
+    pn.rows = rows;
+    double tau[P];
+    factor_panel<W, P>(a, rows, ld, top, k0, pn.nb, tau);
+    if (pn.bulk >= cols) continue;
+    for (int q = 0; q < P; ++q) pn.vcol[q] = a + (k0 + std::min(q, pn.nb - 1)) * ld;
+    panel_t<W, P>(pn, tau);
+    // Trailing columns, G at a time.
+    Index j = pn.bulk;
+    for (; j + G <= cols; j += G) {
+      double* c[G];
+      for (int g = 0; g < G; ++g) c[g] = a + (j + g) * ld;
+      apply_panel<W, P, G>(pn, c);
+    }
+    if constexpr (G > 2) {
+      for (; j + 2 <= cols; j += 2) {
+        double* const c[2] = {a + j * ld, a + (j + 1) * ld};
+        apply_panel<W, P, 2>(pn, c);
+      }
     }
     if (j < cols) {
       double* const c[1] = {a + j * ld};
-      apply_panel<W, 1>(vcol, t, nb, k0, bulk, rows, c);
+      apply_panel<W, P, 1>(pn, c);
     }
   }
 }
 
-void triangularize_generic(double* a, Index rows, Index cols, Index ld) { triangularize_lanes<2>(a, rows, cols, ld); }
+void triangularize_generic(double* a, Index rows, Index cols, Index ld, Index top, Index steps) {
+  triangularize_lanes<2, 4, 2>(a, rows, cols, ld, top, steps);
+}
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-[[gnu::target("avx2,fma")]] void triangularize_avx2(double* a, Index rows, Index cols, Index ld) {
-  triangularize_lanes<4>(a, rows, cols, ld);
+[[gnu::target("avx2,fma")]] void triangularize_avx2(double* a, Index rows, Index cols, Index ld, Index top,
+                                                    Index steps) {
+  triangularize_lanes<4, 4, 2>(a, rows, cols, ld, top, steps);
 }
-[[gnu::target("avx512f,avx2,fma")]] void triangularize_avx512(double* a, Index rows, Index cols, Index ld) {
-  triangularize_lanes<8>(a, rows, cols, ld);
+[[gnu::target("avx512f,avx2,fma")]] void triangularize_avx512(double* a, Index rows, Index cols, Index ld,
+                                                             Index top, Index steps) {
+  triangularize_lanes<8, 4, 4>(a, rows, cols, ld, top, steps);
 }
 #endif
 
-using TriangularizeFn = void (*)(double*, Index, Index, Index);
+using TriangularizeFn = void (*)(double*, Index, Index, Index, Index, Index);
 
 // The widest variant this processor runs, chosen once.
 TriangularizeFn pick_triangularize() {
@@ -481,9 +522,9 @@ TriangularizeFn pick_triangularize() {
   return triangularize_generic;
 }
 
-void triangularize(double* a, Index rows, Index cols, Index ld) {
+void triangularize(double* a, Index rows, Index cols, Index ld, Index top, Index steps) {
   static const TriangularizeFn fn = pick_triangularize();
-  fn(a, rows, cols, ld);
+  fn(a, rows, cols, ld, top, steps);
 }
 
 // The triangular factor R of a tall matrix whose rows are supplied in blocks (a sequential TSQR):
@@ -491,13 +532,20 @@ void triangularize(double* a, Index rows, Index cols, Index ld) {
 // Householder QR of the whole matrix, with a working set that stays in the cache (a 4000 x 43
 // matrix does not fit in a 1 MB L2 cache; blocks of 1024 rows do) and without the large buffer.
 // Columns holding right-hand sides b end up holding Q^T b.
+//
+// With steps < cols only the first `steps` columns are reduced (Q^T of their QR is applied to the
+// others); the rows each block leaves below the triangle, zero in the reduced columns, are then
+// the caller's (residual()) to reduce further, as those of a QR of the whole matrix would be.
 class TriangularFactor {
  public:
-  // Starts a factorization of `cols` columns, rows added in blocks of at most max_block_rows.
-  void reset(Index cols, Index max_block_rows) {
+  // Starts a factorization of `cols` columns (the first `steps` reduced; all by default), rows
+  // added in blocks of at most max_block_rows.
+  void reset(Index cols, Index max_block_rows, Index steps = -1) {
     cols_ = cols;
+    steps_ = steps < 0 ? cols : steps;
     top_ = 0;
-    work_.resize(cols + max_block_rows, cols);
+    residual_rows_ = 0;
+    work_.resize(steps_ + max_block_rows, cols);
   }
   // The next `rows` rows, to fill before add_block().
   Eigen::Block<Matrix> block(Index rows) {
@@ -505,10 +553,16 @@ class TriangularFactor {
     return work_.block(top_, 0, rows, cols_);
   }
   void add_block() {
-    triangularize(work_.data(), top_ + rows_, cols_, work_.outerStride());
-    top_ = std::min(top_ + rows_, cols_);
+    const Index rows = top_ + rows_;
+    triangularize(work_.data(), rows, cols_, work_.outerStride(), top_, steps_);
+    top_ = std::min(rows, steps_);
+    residual_rows_ = rows - top_;
+    // triangularize() skips the zeros below the carried triangle: they must be zeros.
     work_.topRows(top_).triangularView<Eigen::StrictlyLower>().setZero();
   }
+  // After add_block(), with steps < cols: the rows below the triangle in the columns after the
+  // reduced ones (valid until the next block()).
+  Eigen::Block<Matrix> residual() { return work_.block(top_, steps_, residual_rows_, cols_ - steps_); }
   // R, cols x cols (upper triangular; rows beyond the number of rows supplied are zero).
   Eigen::Block<Matrix> r() {
     if (top_ < cols_) work_.middleRows(top_, cols_ - top_).setZero();
@@ -519,8 +573,10 @@ class TriangularFactor {
  private:
   Matrix work_;
   Index cols_ = 0;
+  Index steps_ = 0;
   Index top_ = 0;
   Index rows_ = 0;
+  Index residual_rows_ = 0;
 };
 
 // Frequencies per row block of the least-squares problems (two real rows each).
@@ -643,54 +699,21 @@ class Fitter {
  private:
   // Builds each output's least-squares problem [A B b] (A: the partial fractions and asymptotic
   // terms of the output, B: those of sigma times the data; b: the right-hand side of the fixed
-  // normalization), reduces it to its triangular factor (TriangularFactor) and keeps only the
+  // normalization), reduces it to its triangular factor (reduce_sigma_blocks) and keeps only the
   // sigma block R22 and the matching part of Q^T b (Gustavsen's fast VF); the sigma blocks of all
   // outputs are then stacked and solved. With the relaxed normalization b is zero on every data
   // row: the column is left out, and the normalization row (zero on A) joins the stacked problem
   // directly, which is the same least-squares problem.
   bool solve_sigma(const CVector& poles, bool relaxed, CVector& relocated) {
-    const Index left = n_ + offs_;
     const Index nsig = relaxed ? n_ + 1 : n_;
-    const Index cols = left + nsig + (relaxed ? 0 : 1);
-    const Index block_points = std::min(kBlockPoints, ns_);
     const Index stacked_rows = nc_ * nsig + (relaxed ? 1 : 0);
     stacked_.resize(stacked_rows, nsig);
     stacked_rhs_.setZero(stacked_rows);
 
-    for (Index i = 0; i < nc_; ++i) {
-      const auto w = weights_.col(weights_.cols() == 1 ? 0 : i);
-      tall_.reset(cols, 2 * block_points);
-      for (Index k0 = 0; k0 < ns_; k0 += block_points) {
-        const Index cnt = std::min(block_points, ns_ - k0);
-        auto rows = tall_.block(2 * cnt);
-        for (Index j = 0; j < left; ++j) {
-          for (Index k = 0; k < cnt; ++k) {
-            const Complex v = w(k0 + k) * basis_(k0 + k, j);
-            rows(k, j) = v.real();
-            rows(cnt + k, j) = v.imag();
-          }
-        }
-        for (Index k = 0; k < cnt; ++k) wd_(k) = -w(k0 + k) * data_(k0 + k, i);
-        for (Index j = 0; j < nsig; ++j) {
-          for (Index k = 0; k < cnt; ++k) {
-            // basis * wd in real arithmetic (no NaN check per product, see fill_basis)
-            const Complex x = basis_(k0 + k, j), y = wd_(k);
-            rows(k, left + j) = x.real() * y.real() - x.imag() * y.imag();
-            rows(cnt + k, left + j) = x.real() * y.imag() + x.imag() * y.real();
-          }
-        }
-        if (!relaxed) {
-          // Fixed normalization: sigma's constant is 1, so its term moves to the right-hand side.
-          for (Index k = 0; k < cnt; ++k) {
-            rows(k, cols - 1) = -wd_(k).real();
-            rows(cnt + k, cols - 1) = -wd_(k).imag();
-          }
-        }
-        tall_.add_block();
-      }
-      const auto r = tall_.r();
-      stacked_.middleRows(i * nsig, nsig) = r.block(left, left, nsig, nsig);
-      if (!relaxed) stacked_rhs_.segment(i * nsig, nsig) = r.col(cols - 1).segment(left, nsig);
+    if (weights_.cols() == 1) {
+      reduce_sigma_blocks(weights_.col(0), 0, nc_, relaxed);
+    } else {
+      for (Index i = 0; i < nc_; ++i) reduce_sigma_blocks(weights_.col(i), i, 1, relaxed);
     }
     if (relaxed) {
       // Relaxed normalization (Gustavsen 2006, eq. 8): Re sum_k sigma(s_k) = Ns, scaled by the
@@ -739,6 +762,73 @@ class Fitter {
     return relocated.size() == n_;
   }
 
+  // The sigma blocks of the outputs first .. first + count - 1, which share the row weights w, into
+  // stacked_ (and stacked_rhs_). The left block [A] (partial fractions and asymptotic terms) is the
+  // same for all of them: its QR is done once (TriangularFactor with steps = its columns) and its
+  // Q^T applied to every output's [B b]; each output's remaining rows are then reduced on their own
+  // (own_[i]). R22 is that of the QR of the output's [A B b] up to the signs of its rows, which do
+  // not change the stacked least-squares solution; per output this saves the QR of A.
+  void reduce_sigma_blocks(const Eigen::Ref<const Vector>& w, Index first, Index count, bool relaxed) {
+    const Index left = n_ + offs_;
+    const Index nsig = relaxed ? n_ + 1 : n_;
+    const Index own_cols = nsig + (relaxed ? 0 : 1);  // B, and b with the fixed normalization
+    const Index block_points = std::min(kBlockPoints, ns_);
+    // One output: the QR of its whole [A B b] (the same reflectors, without the copies).
+    const bool shared = count > 1;
+    tall_.reset(left + count * own_cols, 2 * block_points, shared ? left : -1);
+    if (static_cast<Index>(own_.size()) < count) own_.resize(static_cast<size_t>(count));
+    for (Index i = 0; i < count; ++i) own_[static_cast<size_t>(i)].reset(own_cols, 2 * block_points);
+    for (Index k0 = 0; k0 < ns_; k0 += block_points) {
+      const Index cnt = std::min(block_points, ns_ - k0);
+      auto rows = tall_.block(2 * cnt);
+      for (Index j = 0; j < left; ++j) {
+        for (Index k = 0; k < cnt; ++k) {
+          const Complex v = w(k0 + k) * basis_(k0 + k, j);
+          rows(k, j) = v.real();
+          rows(cnt + k, j) = v.imag();
+        }
+      }
+      for (Index i = 0; i < count; ++i) {
+        for (Index k = 0; k < cnt; ++k) wd_(k) = -w(k0 + k) * data_(k0 + k, first + i);
+        const Index c0 = left + i * own_cols;
+        for (Index j = 0; j < nsig; ++j) {
+          for (Index k = 0; k < cnt; ++k) {
+            // basis * wd in real arithmetic (no NaN check per product, see fill_basis)
+            const Complex x = basis_(k0 + k, j), y = wd_(k);
+            rows(k, c0 + j) = x.real() * y.real() - x.imag() * y.imag();
+            rows(cnt + k, c0 + j) = x.real() * y.imag() + x.imag() * y.real();
+          }
+        }
+        if (!relaxed) {
+          // Fixed normalization: sigma's constant is 1, so its term moves to the right-hand side.
+          for (Index k = 0; k < cnt; ++k) {
+            rows(k, c0 + nsig) = -wd_(k).real();
+            rows(cnt + k, c0 + nsig) = -wd_(k).imag();
+          }
+        }
+      }
+      tall_.add_block();
+      const auto residual = tall_.residual();
+      if (!shared || residual.rows() == 0) continue;
+      for (Index i = 0; i < count; ++i) {
+        TriangularFactor& own = own_[static_cast<size_t>(i)];
+        own.block(residual.rows()) = residual.middleCols(i * own_cols, own_cols);
+        own.add_block();
+      }
+    }
+    if (!shared) {
+      const auto r = tall_.r();
+      stacked_.middleRows(first * nsig, nsig) = r.block(left, left, nsig, nsig);
+      if (!relaxed) stacked_rhs_.segment(first * nsig, nsig) = r.col(left + nsig).segment(left, nsig);
+      return;
+    }
+    for (Index i = 0; i < count; ++i) {
+      const auto r = own_[static_cast<size_t>(i)].r();
+      stacked_.middleRows((first + i) * nsig, nsig) = r.topLeftCorner(nsig, nsig);
+      if (!relaxed) stacked_rhs_.segment((first + i) * nsig, nsig) = r.col(nsig).head(nsig);
+    }
+  }
+
   const CMatrix& data_;
   const Matrix& weights_;
   const VectorFittingOptions& opts_;
@@ -747,6 +837,7 @@ class Fitter {
   CMatrix basis_;
   CVector wd_;  // -w H of one output over one row block
   TriangularFactor tall_;
+  std::vector<TriangularFactor> own_;  // per output: the rows of [B b] left by the QR of A
   Matrix stacked_;
   Vector stacked_rhs_;
   double data_max_ = 1.0;
