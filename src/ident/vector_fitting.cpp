@@ -960,27 +960,43 @@ void VectorFittingOptions::validate() const {
   }
 }
 
-CVector VectorFittingResult::evaluate_at(Complex s) const {
-  CVector out(outputs());
-  for (Index i = 0; i < outputs(); ++i) out(i) = d(i) + s * e(i);
-  for (Index n = 0; n < poles.size(); ++n) {
-    // r / z as r conj(z) / |z|^2 (no overflow concern at frequencies where the model is used), the
-    // product in real arithmetic (GCC's complex product checks each result for NaN).
-    const Complex z = s - poles(n);
-    const double n2 = z.real() * z.real() + z.imag() * z.imag();
-    const double zr = z.real() / n2, zi = -z.imag() / n2;
-    for (Index i = 0; i < outputs(); ++i) {
-      const Complex r = residues(i, n);
-      out(i) += Complex(r.real() * zr - r.imag() * zi, r.real() * zi + r.imag() * zr);
+namespace {
+
+// The model d + s e + sum_n r_n / (s - p_n) of every output at the points s (one row per point),
+// frequencies innermost (their loops vectorize). r / z as r conj(z) / |z|^2 (no overflow concern at
+// frequencies where the model is used), the product in real arithmetic (GCC's complex product
+// checks each result for NaN).
+CMatrix model_at(const VectorFittingResult& m, const CVector& s) {
+  const Index ns = s.size();
+  CMatrix out(ns, m.outputs());
+  for (Index i = 0; i < m.outputs(); ++i) {
+    Complex* o = out.col(i).data();
+    for (Index k = 0; k < ns; ++k) o[k] = m.d(i) + s(k) * m.e(i);
+  }
+  for (Index n = 0; n < m.poles.size(); ++n) {
+    const double pr = m.poles(n).real(), pi = m.poles(n).imag();
+    for (Index i = 0; i < m.outputs(); ++i) {
+      const double rr = m.residues(i, n).real(), ri = m.residues(i, n).imag();
+      Complex* o = out.col(i).data();
+      for (Index k = 0; k < ns; ++k) {
+        const double zr0 = s(k).real() - pr, zi0 = s(k).imag() - pi;
+        const double n2 = zr0 * zr0 + zi0 * zi0;
+        const double zr = zr0 / n2, zi = -zi0 / n2;
+        o[k] += Complex(rr * zr - ri * zi, rr * zi + ri * zr);
+      }
     }
   }
   return out;
 }
 
+}  // namespace
+
+CVector VectorFittingResult::evaluate_at(Complex s) const {
+  return model_at(*this, CVector::Constant(1, s)).row(0).transpose();
+}
+
 CMatrix VectorFittingResult::evaluate(const Vector& omega) const {
-  CMatrix out(omega.size(), outputs());
-  for (Index k = 0; k < omega.size(); ++k) out.row(k) = evaluate_at(Complex(0.0, omega(k))).transpose();
-  return out;
+  return model_at(*this, omega.cast<Complex>() * kJ);
 }
 
 std::string VectorFittingResult::brief_report() const {
