@@ -1,0 +1,53 @@
+#pragma once
+// Standard errors of a vector fit (issue 30): its poles, their natural frequencies and damping
+// ratios, and the zeros of each output, from the covariance of the fitted rational model
+//
+//   f_i(s) = sum_n r_in / (s - p_n) + d_i + s e_i
+//
+// linearized at the solution in all its real parameters: each complex pair's Re p and Im p (a real
+// pole's p), each output's residues (Re r and Im r of a pair, r of a real pole), d_i and e_i when
+// fitted. The relocation and the residue identification of vector fitting end at a least-squares
+// solution of the weighted error w_k (f_i(j omega_k) - H_ik), so the covariance is
+// core::fit_covariance's of that error: with the FRF's standard deviation std_ik the sandwich form
+// and the local misfit widening; without it, the residuals' own scatter (chi2 per degree of
+// freedom). Zeros by the implicit function theorem: f_i(z) = 0 gives dz = -(df_i / dtheta) dtheta /
+// f_i'(z).
+#include <Eigen/Dense>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "piezobench/core/fit_covariance.hpp"
+#include "piezobench/ident/vector_fitting.hpp"
+
+namespace piezobench::ident {
+
+// One pole or zero with its standard errors (rad/s for the frequencies, the damping dimensionless).
+struct RootUncertainty {
+  Complex root;                   // rad/s
+  double natural_frequency = 0.0; // |root|, rad/s
+  double natural_frequency_se = 0.0;  // rad/s
+  double damping = 0.0;           // -Re root / |root| (negative: a right-half-plane root)
+  double damping_se = 0.0;        // dimensionless
+  double real_se = 0.0, imag_se = 0.0;  // of Re root and Im root, rad/s
+};
+
+struct VectorFitUncertainty {
+  core::FitCovariance covariance;  // of the model's real parameters, in the order of `names`
+  std::vector<std::string> names;  // "p3.re", "p3.im" (pair), "p0" (real pole), "r1.3.re", "d1", "e1"
+  std::vector<RootUncertainty> poles;  // one per fit.poles entry, same order (a pair's two share errors)
+  bool from_data_variance = false;     // std_H given: the sandwich form; else the residuals' scatter
+};
+
+// omega: rad/s, the fit's points; data: points x outputs, as fitted; fit: vector_fit's result on
+// them; weights: the fit's row weights (points x 1 or points x outputs; empty: unit); std_H: the
+// data's standard deviation per part (points x outputs, data units; empty: unknown). InputError
+// (source "vector fit uncertainty") for mismatched sizes or fewer residuals than parameters.
+[[nodiscard]] VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& data, const VectorFittingResult& fit,
+                                                          const Matrix& weights = {}, const Matrix& std_H = {});
+
+// The zeros `zeros` (rad/s) of output `output` of the fit, with their standard errors from u.
+[[nodiscard]] std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u,
+                                                            Index output, const CVector& zeros);
+
+}  // namespace piezobench::ident

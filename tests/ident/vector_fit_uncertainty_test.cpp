@@ -1,0 +1,152 @@
+#include "piezobench/ident/vector_fit_uncertainty.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
+
+namespace piezobench::ident {
+namespace {
+
+// Two modes of a collocated response, a ω^2 / (s^2 + 2 ζ ω s + ω^2) at 95 Hz (ζ 0.02, a 1) and 400 Hz
+// (ζ 0.03, a 0.5), plus d = 0.05: an anti-resonance between them, at 152.4 Hz.
+struct TwoModes {
+  CVector poles = CVector(4);
+  CVector residues = CVector(4);
+  double d = 0.05;
+  TwoModes() {
+    const double f[2] = {95.0, 400.0}, z[2] = {0.02, 0.03}, a[2] = {1.0, 0.5};
+    for (int i = 0; i < 2; ++i) {
+      const double w = kTwoPi * f[i];
+      const Complex p(-z[i] * w, w * std::sqrt(1.0 - z[i] * z[i]));
+      poles(2 * i) = p;
+      poles(2 * i + 1) = std::conj(p);
+      residues(2 * i) = a[i] * w * w / (p - std::conj(p));
+      residues(2 * i + 1) = std::conj(residues(2 * i));
+    }
+  }
+  Complex at(Complex s) const {
+    Complex h = d;
+    for (Index n = 0; n < 4; ++n) h += residues(n) / (s - poles(n));
+    return h;
+  }
+  Complex slope(Complex s) const {
+    Complex g = 0.0;
+    for (Index n = 0; n < 4; ++n) g -= residues(n) / ((s - poles(n)) * (s - poles(n)));
+    return g;
+  }
+  // The zero between the modes, by Newton from a point on the way.
+  Complex zero(Complex start) const {
+    Complex s = start;
+    for (int i = 0; i < 50; ++i) s -= at(s) / slope(s);
+    return s;
+  }
+};
+
+// The zero of a fitted output near `start`, by Newton on the fit.
+Complex fitted_zero(const VectorFittingResult& fit, Complex start) {
+  Complex s = start;
+  for (int i = 0; i < 50; ++i) {
+    Complex slope = fit.e(0);
+    for (Index n = 0; n < fit.poles.size(); ++n) slope -= fit.residues(0, n) / ((s - fit.poles(n)) * (s - fit.poles(n)));
+    s -= fit.evaluate_at(s)(0) / slope;
+  }
+  return s;
+}
+
+// Monte Carlo on the exact model with complex Gaussian noise of known standard deviation (0.003 per
+// part on |H| from 0.05 to 25): over 300 seeds, z = (estimate - truth) / se of the 95 Hz mode's
+// frequency and damping, the 400 Hz mode's damping and the anti-resonance's frequency and damping
+// has a mean within +-0.2 and a standard deviation within 0.85-1.15, and the 95 % interval covers the
+// truth in 91-98.5 % of the seeds; the same from the residuals' own scatter (no std_H). Measured:
+// mean -0.08..+0.05, standard deviation 0.90-1.01, coverage 94.0-97.0 %; standard errors 20 % too
+// large would fail (standard deviation 0.75-0.84).
+TEST(VectorFitUncertainty, IntervalsOfPolesAndZerosCoverTheTruth) {
+  const TwoModes truth;
+  const Index m = 800;
+  Vector omega(m);
+  for (Index k = 0; k < m; ++k) omega(k) = kTwoPi * 20.0 * std::pow(50.0, static_cast<double>(k) / static_cast<double>(m - 1));
+  const double sigma = 0.003;
+  const Complex zero = truth.zero(Complex(-5.0, kTwoPi * 170.0));
+  ASSERT_NEAR(zero.imag() / kTwoPi, 152.4, 0.1);
+  VectorFittingOptions o;
+  o.order = 4;
+  o.asymptote = Asymptote::kConstant;
+  o.fail_if_not_converged = false;
+  std::vector<std::vector<double>> z(2, std::vector<double>());  // per variant: flattened [seed][quantity]
+  constexpr int kQuantities = 5;
+  const int seeds = 300;
+  for (int variant = 0; variant < 2; ++variant) {
+    std::mt19937 rng(11);
+    std::normal_distribution<double> n01;
+    for (int seed = 0; seed < seeds; ++seed) {
+      CMatrix h(m, 1);
+      for (Index k = 0; k < m; ++k) h(k, 0) = truth.at(Complex(0.0, omega(k))) + Complex(sigma * n01(rng), sigma * n01(rng));
+      const VectorFittingResult fit = vector_fit(omega, h, o);
+      ASSERT_EQ(fit.poles.size(), 4);
+      const Matrix std_h = variant == 0 ? Matrix::Constant(m, 1, sigma) : Matrix();
+      const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, Matrix(), std_h);
+      EXPECT_EQ(u.from_data_variance, variant == 0);
+      ASSERT_EQ(u.poles.size(), 4u);
+      const CVector zeros = (CVector(1) << fitted_zero(fit, zero)).finished();
+      const RootUncertainty zu = zero_uncertainty(fit, u, 0, zeros).front();
+      const auto mode = [&](Index k) { return truth.poles(k); };
+      const double values[kQuantities][3] = {
+          {u.poles[0].natural_frequency, u.poles[0].natural_frequency_se, std::abs(mode(0))},
+          {u.poles[0].damping, u.poles[0].damping_se, -mode(0).real() / std::abs(mode(0))},
+          {u.poles[2].damping, u.poles[2].damping_se, -mode(2).real() / std::abs(mode(2))},
+          {zu.natural_frequency, zu.natural_frequency_se, std::abs(zero)},
+          {zu.damping, zu.damping_se, -zero.real() / std::abs(zero)}};
+      for (const auto& v : values) z[static_cast<std::size_t>(variant)].push_back((v[0] - v[2]) / v[1]);
+      // The pair's lower member carries the same errors.
+      EXPECT_DOUBLE_EQ(u.poles[1].natural_frequency_se, u.poles[0].natural_frequency_se);
+      EXPECT_DOUBLE_EQ(u.poles[1].damping_se, u.poles[0].damping_se);
+    }
+  }
+  for (int variant = 0; variant < 2; ++variant) {
+    for (int q = 0; q < kQuantities; ++q) {
+      double mean = 0.0, sq = 0.0, covered = 0.0;
+      for (int seed = 0; seed < seeds; ++seed) {
+        const double v = z[static_cast<std::size_t>(variant)][static_cast<std::size_t>(seed * kQuantities + q)];
+        mean += v;
+        sq += v * v;
+        covered += std::abs(v) <= 1.959964 ? 1.0 : 0.0;
+      }
+      mean /= seeds;
+      const double sd = std::sqrt(sq / seeds - mean * mean);
+      covered /= seeds;
+      SCOPED_TRACE("variant " + std::to_string(variant) + " quantity " + std::to_string(q));
+      EXPECT_LT(std::abs(mean), 0.2);
+      EXPECT_GT(sd, 0.85);
+      EXPECT_LT(sd, 1.15);
+      EXPECT_GE(covered, 0.91);
+      EXPECT_LE(covered, 0.985);
+    }
+  }
+}
+
+TEST(VectorFitUncertainty, BadSizesAreInputErrors) {
+  const TwoModes truth;
+  const Index m = 100;
+  Vector omega(m);
+  CMatrix h(m, 1);
+  for (Index k = 0; k < m; ++k) {
+    omega(k) = kTwoPi * (20.0 + 5.0 * static_cast<double>(k));
+    h(k, 0) = truth.at(Complex(0.0, omega(k)));
+  }
+  VectorFittingOptions o;
+  o.order = 4;
+  const VectorFittingResult fit = vector_fit(omega, h, o);
+  EXPECT_THROW((void)vector_fit_uncertainty(omega.head(50), h, fit), InputError);
+  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, Matrix::Ones(m, 2)), InputError);
+  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, Matrix(), Matrix::Ones(m - 1, 1)), InputError);
+  const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit);
+  EXPECT_THROW((void)zero_uncertainty(fit, u, 1, CVector::Zero(1)), InputError);
+}
+
+}  // namespace
+}  // namespace piezobench::ident
