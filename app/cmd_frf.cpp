@@ -18,6 +18,7 @@
 #include "piezobench/dsp/welch.hpp"
 #include "piezobench/ident/features.hpp"
 #include "piezobench/ident/plant_fit.hpp"
+#include "piezobench/ident/vector_fit_uncertainty.hpp"
 #include "piezobench/ident/vector_fitting.hpp"
 #include "piezobench/io/atomic_file.hpp"
 #include "piezobench/io/fields_json.hpp"
@@ -237,6 +238,8 @@ std::vector<lti::Complex> output_zeros(const ident::VectorFittingResult& r, Eige
 
 struct ZeroReport {
   lti::Complex zero;
+  double frequency_se = 0.0;  // rad/s, standard error of |zero| (ident::zero_uncertainty)
+  double damping_se = 0.0;    // standard error of the damping ratio
   bool lightly_damped = false;            // |damping| < 0.2
   std::optional<bool> nonminimum_phase;   // for a lightly damped pair in the band: the data's phase, else the model's
   std::string evidence;                   // ident::zero_phase_verdict's reason, or "fitted zero"
@@ -250,6 +253,8 @@ constexpr auto describe(core::Type<ZeroReport>) {
   return core::fields<S>("ZeroReport", "a zero of `fit`'s model of one output, with its phase evidence",
       core::field("zero", &S::zero, kRadPerSecond, "[re, im]").key("zero"),
       core::derived("frequency", &zero_frequency, kRadPerSecondAsHz, "|zero|"),
+      core::field("frequency_se", &S::frequency_se, kRadPerSecondAsHz, "standard error of |zero|"),
+      core::field("damping_se", &S::damping_se, kRatio, "standard error of the damping ratio -Re zero / |zero|"),
       core::field("lightly_damped", &S::lightly_damped, kNone, "|damping| < 0.2"),
       core::field("nonminimum_phase", &S::nonminimum_phase, kNone,
                   "for a lightly damped pair in the band: the data's phase, else the model's (null: undecided)"),
@@ -257,7 +262,7 @@ constexpr auto describe(core::Type<ZeroReport>) {
 }
 
 std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const dsp::Frf& band, Eigen::Index i,
-                                     const ident::VectorFittingOptions& vf) {
+                                     const ident::VectorFittingOptions& vf, const ident::VectorFitUncertainty& u) {
   std::vector<ZeroReport> out;
   // The phase of the data across each lightly damped zero pair (ident::frf_features).
   std::vector<ident::AntiResonance> anti;
@@ -272,9 +277,15 @@ std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const 
     // no phase evidence: the fitted zero decides
   }
   const double f_lo = band.freq_Hz.minCoeff(), f_hi = band.freq_Hz.maxCoeff();
-  for (const lti::Complex z : output_zeros(r, i)) {
+  const std::vector<lti::Complex> found = output_zeros(r, i);
+  const std::vector<ident::RootUncertainty> se =
+      ident::zero_uncertainty(r, u, i, Eigen::Map<const lti::CVector>(found.data(), static_cast<Eigen::Index>(found.size())));
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    const lti::Complex z = found[k];
     ZeroReport rep;
     rep.zero = z;
+    rep.frequency_se = se[k].natural_frequency_se;
+    rep.damping_se = se[k].damping_se;
     const double damping = std::abs(z) > 0.0 ? -z.real() / std::abs(z) : 0.0;
     rep.lightly_damped = z.imag() > 0.0 && std::abs(damping) < 0.2;
     const double fz = std::abs(z) / kTwoPi;
@@ -303,8 +314,12 @@ std::vector<ZeroReport> zero_reports(const ident::VectorFittingResult& r, const 
 // relative_rms_error(_per_output), the verdict, iterations, convergence, frequency_scale_rad_per_s),
 // the residues one list per output (the declared view flattens the matrix), and the command's own:
 // the file, outputs, band, order and each output's declared zeros.
-nlohmann::json fit_json(const ident::VectorFittingResult& r, const dsp::Frf& band, const std::vector<std::vector<ZeroReport>>& zeros) {
+nlohmann::json fit_json(const ident::VectorFittingResult& r, const ident::VectorFitUncertainty& u, const dsp::Frf& band,
+                        const std::vector<std::vector<ZeroReport>>& zeros) {
   nlohmann::json doc = io::results_object(r);
+  doc["pole_uncertainty"] = io::shown_json(u.poles);
+  doc["uncertainty_from_data_variance"] = u.from_data_variance;
+  doc["condition_number"] = io::to_json(u.covariance.condition_number);
   nlohmann::json residues = nlohmann::json::array();
   for (Eigen::Index i = 0; i < r.residues.rows(); ++i) residues.push_back(io::to_json(Eigen::VectorXcd(r.residues.row(i).transpose())));
   doc["residues"] = residues;
@@ -322,6 +337,25 @@ nlohmann::json fit_json(const ident::VectorFittingResult& r, const dsp::Frf& ban
   return doc;
 }
 
+// The fit's standard errors: from the FRF's std_H when every output carries one, else from the
+// residuals' scatter (ident/vector_fit_uncertainty.hpp).
+ident::VectorFitUncertainty fit_uncertainty(const ident::VectorFittingResult& r, const dsp::Frf& band, const ident::VectorFittingOptions& vf) {
+  const auto n = band.freq_Hz.size();
+  const auto outputs = static_cast<Eigen::Index>(band.H.size());
+  lti::CMatrix data(n, outputs);
+  Eigen::MatrixXd std_h(n, outputs);
+  bool variance = band.std_H.size() == band.H.size();
+  for (Eigen::Index i = 0; i < outputs; ++i) {
+    data.col(i) = band.H[static_cast<std::size_t>(i)];
+    if (variance && band.std_H[static_cast<std::size_t>(i)].size() == n) {
+      std_h.col(i) = band.std_H[static_cast<std::size_t>(i)];
+    } else {
+      variance = false;
+    }
+  }
+  return ident::vector_fit_uncertainty(kTwoPi * band.freq_Hz, data, r, vf, {}, variance ? std_h : Eigen::MatrixXd());
+}
+
 int run_fit(const FitOptions& o) {
   ident::VectorFittingOptions vf;
   vf.order = o.order;
@@ -333,9 +367,10 @@ int run_fit(const FitOptions& o) {
   const dsp::Frf band = select_band(file.frf, o);
   if (!o.json) log_line(fmt::format("fitting {} poles to {} points of {}", o.order, band.freq_Hz.size(), fmt::join(band.outputs, ", ")));
   const ident::VectorFittingResult r = ident::vector_fit(band, vf);
+  const ident::VectorFitUncertainty u = fit_uncertainty(r, band, vf);
   std::vector<std::vector<ZeroReport>> zeros;
-  for (std::size_t i = 0; i < band.outputs.size(); ++i) zeros.push_back(zero_reports(r, band, static_cast<Eigen::Index>(i), vf));
-  nlohmann::json document = fit_json(r, band, zeros);
+  for (std::size_t i = 0; i < band.outputs.size(); ++i) zeros.push_back(zero_reports(r, band, static_cast<Eigen::Index>(i), vf, u));
+  nlohmann::json document = fit_json(r, u, band, zeros);
   document["warnings"] = file.warnings;
   nlohmann::json units = nlohmann::json::object();
   for (std::size_t i = 0; i < file.frf.outputs.size(); ++i) units[file.frf.outputs[i]] = file.units[i];
@@ -346,19 +381,22 @@ int run_fit(const FitOptions& o) {
     return report_quality(r.quality);
   }
   fmt::print("{}\n", r.brief_report());
-  fmt::print("{:>26}  {:>10}  {:>9}\n", "pole [rad/s]", "f [Hz]", "damping");
-  for (const auto p : r.poles) {
+  fmt::print("{:>26}  {:>10}  {:>9}  {:>9}  {:>9}   (standard errors {})\n", "pole [rad/s]", "f [Hz]", "se [Hz]", "damping", "se",
+             u.from_data_variance ? "from the FRF's std_H" : "from the residuals' scatter");
+  for (Eigen::Index k = 0; k < r.poles.size(); ++k) {
+    const auto p = r.poles(k);
     if (p.imag() < 0.0) continue;
-    fmt::print("{:>12.6g} {:+12.6g}j  {:>10.5g}  {:>9.5f}\n", p.real(), p.imag(), std::abs(p) / kTwoPi,
-               std::abs(p) > 0 ? -p.real() / std::abs(p) : 0.0);
+    const ident::RootUncertainty& pu = u.poles[static_cast<std::size_t>(k)];
+    fmt::print("{:>12.6g} {:+12.6g}j  {:>10.5g}  {:>9.2g}  {:>9.5f}  {:>9.2g}\n", p.real(), p.imag(), pu.natural_frequency / kTwoPi,
+               pu.natural_frequency_se / kTwoPi, pu.damping, pu.damping_se);
   }
   for (std::size_t i = 0; i < band.outputs.size(); ++i) {
     fmt::print("{}: relative rms error {:.3g}; zeros of the fitted model [rad/s], frequency, damping ratio:{}\n", band.outputs[i],
                r.relative_rms_error_per_output(static_cast<Eigen::Index>(i)), zeros[i].empty() ? " none" : "");
     for (const auto& rep : zeros[i]) {
       const lti::Complex z = rep.zero;
-      fmt::print("  {:>12.6g} {:+12.6g}j  {:>10.5g} Hz  damping {:+.5f}", z.real(), z.imag(), std::abs(z) / kTwoPi,
-                 std::abs(z) > 0 ? -z.real() / std::abs(z) : 0.0);
+      fmt::print("  {:>12.6g} {:+12.6g}j  {:>10.5g} Hz (se {:.2g})  damping {:+.5f} (se {:.2g})", z.real(), z.imag(), std::abs(z) / kTwoPi,
+                 rep.frequency_se / kTwoPi, std::abs(z) > 0 ? -z.real() / std::abs(z) : 0.0, rep.damping_se);
       if (rep.nonminimum_phase) {
         fmt::print("  lightly damped, {} ({})", *rep.nonminimum_phase ? "NON-minimum phase" : "minimum phase", rep.evidence);
       } else if (rep.lightly_damped) {

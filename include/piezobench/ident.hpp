@@ -15,4 +15,5 @@
 #include "piezobench/ident/low_frequency_high_pass.hpp"
 #include "piezobench/ident/modal.hpp"
 #include "piezobench/ident/plant_fit.hpp"
+#include "piezobench/ident/vector_fit_uncertainty.hpp"
 #include "piezobench/ident/vector_fitting.hpp"

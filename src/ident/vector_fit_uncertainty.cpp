@@ -5,6 +5,7 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/dsp/frf_variance.hpp"
 
 namespace piezobench::ident {
 
@@ -118,15 +119,17 @@ Eigen::Matrix2d block(const Matrix& c, Index i, Index j) {
 }  // namespace
 
 VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& data, const VectorFittingResult& fit,
-                                            const Matrix& weights, const Matrix& std_H) {
+                                            const VectorFittingOptions& options, const Matrix& user_weights, const Matrix& std_H) {
   const Index m = omega.size(), nc = data.cols();
   if (data.rows() != m || fit.outputs() != nc) {
     throw InputError(kSource, "data", std::to_string(m) + " points x " + std::to_string(fit.outputs()) + " outputs",
                      std::to_string(data.rows()) + " x " + std::to_string(nc));
   }
-  if (weights.size() != 0 && (weights.rows() != m || (weights.cols() != 1 && weights.cols() != nc))) {
-    throw InputError(kSource, "weights", std::to_string(m) + " x 1 or x " + std::to_string(nc), std::to_string(weights.rows()) + " x " + std::to_string(weights.cols()));
+  if (user_weights.size() != 0 && (user_weights.rows() != m || (user_weights.cols() != 1 && user_weights.cols() != nc))) {
+    throw InputError(kSource, "weights", std::to_string(m) + " x 1 or x " + std::to_string(nc),
+                     std::to_string(user_weights.rows()) + " x " + std::to_string(user_weights.cols()));
   }
+  const Matrix weights = vector_fitting_weights(data, user_weights, options);
   if (std_H.size() != 0 && (std_H.rows() != m || std_H.cols() != nc)) {
     throw InputError(kSource, "std_H", std::to_string(m) + " x " + std::to_string(nc), std::to_string(std_H.rows()) + " x " + std::to_string(std_H.cols()));
   }
@@ -135,18 +138,28 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
   const auto p = static_cast<Index>(params.size());
   // Rows: output by output, each point's real then imaginary part of w (f - H).
   Matrix J(2 * m * nc, p);
-  Vector r(2 * m * nc), s;
+  Vector r(2 * m * nc), s(2 * m * nc);
   out.from_data_variance = std_H.size() != 0;
-  if (out.from_data_variance) s.resize(2 * m * nc);
   const CMatrix model = fit.evaluate(omega);
+  // Without the data's variance, each output's noise from the fit's residuals, additive plus
+  // proportional (dsp::estimate_frf_noise, as the plant fits do): equal weights would take the dip's
+  // few noisy lines as precise as the peak's, and a zero's damping error would be many times too small.
+  Matrix noise = std_H;
+  if (!out.from_data_variance) {
+    noise.resize(m, nc);
+    for (Index i = 0; i < nc; ++i) {
+      const dsp::FrfNoiseEstimate e = dsp::estimate_frf_noise(data.col(i), model.col(i));
+      for (Index k = 0; k < m; ++k) noise(k, i) = std::hypot(e.additive_std, e.relative_std * std::abs(model(k, i)));
+    }
+  }
   for (Index i = 0; i < nc; ++i) {
     for (Index k = 0; k < m; ++k) {
-      const double w = weights.size() == 0 ? 1.0 : weights(k, weights.cols() == 1 ? 0 : i);
+      const double w = weights(k, weights.cols() == 1 ? 0 : i);
       const Index row = 2 * (i * m + k);
       const Complex e = w * (model(k, i) - data(k, i));
       r(row) = e.real();
       r(row + 1) = e.imag();
-      if (out.from_data_variance) s(row) = s(row + 1) = w * std_H(k, i);
+      s(row) = s(row + 1) = w * noise(k, i);
       const Complex sk(0.0, omega(k));
       for (Index j = 0; j < p; ++j) {
         const Complex d = w * derivative(fit, params[static_cast<std::size_t>(j)], i, sk);

@@ -210,12 +210,6 @@ Matrix base_weights(const CMatrix& data, const Matrix& user, Weighting weighting
   return w;
 }
 
-// The row weights: the explicit ones or those of the weighting, times the point weights.
-Matrix make_weights(const CMatrix& data, const Matrix& user, const VectorFittingOptions& o) {
-  Matrix w = base_weights(data, user, o.weighting);
-  if (o.point_weights.size() > 0) w.array().colwise() *= o.point_weights.array();
-  return w;
-}
 
 void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights,
                  const VectorFittingOptions& o) {
@@ -846,6 +840,12 @@ class Fitter {
 
 }  // namespace
 
+Matrix vector_fitting_weights(const CMatrix& data, const Matrix& user, const VectorFittingOptions& o) {
+  Matrix w = base_weights(data, user, o.weighting);
+  if (o.point_weights.size() > 0) w.array().colwise() *= o.point_weights.array();
+  return w;
+}
+
 std::string to_string(Asymptote a) {
   switch (a) {
     case Asymptote::kNone: return "none";
@@ -1214,7 +1214,7 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
                                const VectorFittingOptions& options) {
   options.validate();
   check_input(omega, data, user_weights, options);
-  const Matrix weights = make_weights(data, user_weights, options);
+  const Matrix weights = vector_fitting_weights(data, user_weights, options);
   const double scale = options.frequency_scale > 0.0 ? options.frequency_scale : omega(omega.size() - 1);
   CVector poles = canonical_poles(snapped_starting_poles(omega, options) / scale);
 

@@ -217,10 +217,22 @@ TEST(FitCli, BothOutputsOfAScipyWelchFrfGiveTheResonance) {
     found = true;
     EXPECT_NEAR(z["frequency_Hz"].get<double>() / truth["antiresonance_Hz"].get<double>(), 1.0, 0.01);
     EXPECT_TRUE(z["nonminimum_phase"].is_boolean());
+    // Its standard errors (docs/uncertainty.md, section 5; no std_H in this file: the noise comes from
+    // the residuals): 41.08 +- 0.55 Hz, and a damping of -0.022 +- 0.012 whose 95 % interval holds 0,
+    // the truth's side being undecided by these data (equal weights gave +-0.0086, a confident wrong sign).
+    const double se = z["frequency_se_Hz"].get<double>(), damping_se = z["damping_se"].get<double>();
+    EXPECT_GT(se, 0.0);
+    EXPECT_LT(std::abs(z["frequency_Hz"].get<double>() - truth["antiresonance_Hz"].get<double>()), 3.0 * se);
+    const double damping = -z["zero"][0].get<double>() / (2.0 * std::numbers::pi * z["frequency_Hz"].get<double>());
+    EXPECT_LT(damping - 1.96 * damping_se, 0.0);
+    EXPECT_GT(damping + 1.96 * damping_se, 0.0);
   }
+  EXPECT_EQ(j6["uncertainty_from_data_variance"], false);
+  EXPECT_EQ(j6["pole_uncertainty"].size(), j6["poles_rad_per_s"].size());
   EXPECT_TRUE(found) << six.out;
   const test::CliRun text = run_cli("fit " + f + " --order 6 --fmin 20 --fmax 400");
   EXPECT_NE(text.out.find("minimum phase"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("standard errors from the residuals"), std::string::npos) << text.out;
 }
 
 // A fit over a band the input did not excite is poor: warning, "quality": "poor", exit 6.

@@ -89,7 +89,7 @@ TEST(VectorFitUncertainty, IntervalsOfPolesAndZerosCoverTheTruth) {
       const VectorFittingResult fit = vector_fit(omega, h, o);
       ASSERT_EQ(fit.poles.size(), 4);
       const Matrix std_h = variant == 0 ? Matrix::Constant(m, 1, sigma) : Matrix();
-      const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, Matrix(), std_h);
+      const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, o, Matrix(), std_h);
       EXPECT_EQ(u.from_data_variance, variant == 0);
       ASSERT_EQ(u.poles.size(), 4u);
       const CVector zeros = (CVector(1) << fitted_zero(fit, zero)).finished();
@@ -141,10 +141,10 @@ TEST(VectorFitUncertainty, BadSizesAreInputErrors) {
   VectorFittingOptions o;
   o.order = 4;
   const VectorFittingResult fit = vector_fit(omega, h, o);
-  EXPECT_THROW((void)vector_fit_uncertainty(omega.head(50), h, fit), InputError);
-  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, Matrix::Ones(m, 2)), InputError);
-  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, Matrix(), Matrix::Ones(m - 1, 1)), InputError);
-  const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit);
+  EXPECT_THROW((void)vector_fit_uncertainty(omega.head(50), h, fit, o), InputError);
+  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix::Ones(m, 2)), InputError);
+  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix(), Matrix::Ones(m - 1, 1)), InputError);
+  const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, o);
   EXPECT_THROW((void)zero_uncertainty(fit, u, 1, CVector::Zero(1)), InputError);
 }
 

@@ -8,9 +8,9 @@
 // pole's p), each output's residues (Re r and Im r of a pair, r of a real pole), d_i and e_i when
 // fitted. The relocation and the residue identification of vector fitting end at a least-squares
 // solution of the weighted error w_k (f_i(j omega_k) - H_ik), so the covariance is
-// core::fit_covariance's of that error: with the FRF's standard deviation std_ik the sandwich form
-// and the local misfit widening; without it, the residuals' own scatter (chi2 per degree of
-// freedom). Zeros by the implicit function theorem: f_i(z) = 0 gives dz = -(df_i / dtheta) dtheta /
+// core::fit_covariance's of that error (the sandwich form and the local misfit widening) with the
+// FRF's standard deviation std_ik, or without it each output's noise estimated from the fit's
+// residuals, additive plus proportional (dsp::estimate_frf_noise, as the plant fits do). Zeros by the implicit function theorem: f_i(z) = 0 gives dz = -(df_i / dtheta) dtheta /
 // f_i'(z).
 #include <Eigen/Dense>
 #include <complex>
@@ -32,19 +32,34 @@ struct RootUncertainty {
   double real_se = 0.0, imag_se = 0.0;  // of Re root and Im root, rad/s
 };
 
+constexpr auto describe(core::Type<RootUncertainty>) {
+  using S = RootUncertainty;
+  using namespace core::shown;
+  return core::fields<S>("RootUncertainty", "a pole or zero of a vector fit with its standard errors",
+      core::field("root", &S::root, kRadPerSecond, "[re, im]"),
+      core::field("natural_frequency", &S::natural_frequency, kRadPerSecondAsHz, "|root|"),
+      core::field("natural_frequency_se", &S::natural_frequency_se, kRadPerSecondAsHz, "standard error of |root|"),
+      core::field("damping", &S::damping, kRatio, "-Re root / |root|"),
+      core::field("damping_se", &S::damping_se, kRatio, "standard error of the damping"),
+      core::field("real_se", &S::real_se, kRadPerSecond, "standard error of Re root"),
+      core::field("imag_se", &S::imag_se, kRadPerSecond, "standard error of Im root"));
+}
+
 struct VectorFitUncertainty {
   core::FitCovariance covariance;  // of the model's real parameters, in the order of `names`
   std::vector<std::string> names;  // "p3.re", "p3.im" (pair), "p0" (real pole), "r1.3.re", "d1", "e1"
   std::vector<RootUncertainty> poles;  // one per fit.poles entry, same order (a pair's two share errors)
-  bool from_data_variance = false;     // std_H given: the sandwich form; else the residuals' scatter
+  bool from_data_variance = false;     // std_H given; else the noise estimated from the residuals
 };
 
 // omega: rad/s, the fit's points; data: points x outputs, as fitted; fit: vector_fit's result on
-// them; weights: the fit's row weights (points x 1 or points x outputs; empty: unit); std_H: the
-// data's standard deviation per part (points x outputs, data units; empty: unknown). InputError
-// (source "vector fit uncertainty") for mismatched sizes or fewer residuals than parameters.
+// them with `options` and `weights` (the fit's own row weights follow: vector_fitting_weights);
+// std_H: the data's standard deviation per part (points x outputs, data units; empty: unknown).
+// InputError (source "vector fit uncertainty") for mismatched sizes or fewer residuals than
+// parameters.
 [[nodiscard]] VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& data, const VectorFittingResult& fit,
-                                                          const Matrix& weights = {}, const Matrix& std_H = {});
+                                                          const VectorFittingOptions& options, const Matrix& weights = {},
+                                                          const Matrix& std_H = {});
 
 // The zeros `zeros` (rad/s) of output `output` of the fit, with their standard errors from u.
 [[nodiscard]] std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u,

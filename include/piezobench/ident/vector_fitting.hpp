@@ -139,6 +139,10 @@ struct VectorFittingResult {
   [[nodiscard]] std::string brief_report() const;
 };
 
+// The row weights vector_fit uses: `weights` if given, else those of options.weighting (points x 1
+// or points x outputs), times options.point_weights.
+[[nodiscard]] Matrix vector_fitting_weights(const CMatrix& data, const Matrix& weights, const VectorFittingOptions& options);
+
 // omega: rad/s, strictly increasing, >= 0, finite. data: points x outputs (data(k, i) = f_i(j
 // omega_k)), finite, not all zero. weights: empty (options.weighting is used), points x 1 (common
 // to all outputs) or points x outputs, finite and > 0; options.point_weights multiply them.
