@@ -9,6 +9,8 @@
 
 namespace piezobench::ident {
 
+// The helpers in their own namespace: a unity batch compiles this file with vector_fitting.cpp.
+namespace fit_uncertainty {
 namespace {
 
 constexpr const char* kSource = "vector fit uncertainty";
@@ -117,24 +119,25 @@ Eigen::Matrix2d block(const Matrix& c, Index i, Index j) {
 }
 
 }  // namespace
+}  // namespace fit_uncertainty
 
 VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& data, const VectorFittingResult& fit,
                                             const VectorFittingOptions& options, const Matrix& user_weights, const Matrix& std_H) {
   const Index m = omega.size(), nc = data.cols();
   if (data.rows() != m || fit.outputs() != nc) {
-    throw InputError(kSource, "data", std::to_string(m) + " points x " + std::to_string(fit.outputs()) + " outputs",
+    throw InputError(fit_uncertainty::kSource, "data", std::to_string(m) + " points x " + std::to_string(fit.outputs()) + " outputs",
                      std::to_string(data.rows()) + " x " + std::to_string(nc));
   }
   if (user_weights.size() != 0 && (user_weights.rows() != m || (user_weights.cols() != 1 && user_weights.cols() != nc))) {
-    throw InputError(kSource, "weights", std::to_string(m) + " x 1 or x " + std::to_string(nc),
+    throw InputError(fit_uncertainty::kSource, "weights", std::to_string(m) + " x 1 or x " + std::to_string(nc),
                      std::to_string(user_weights.rows()) + " x " + std::to_string(user_weights.cols()));
   }
   const Matrix weights = vector_fitting_weights(data, user_weights, options);
   if (std_H.size() != 0 && (std_H.rows() != m || std_H.cols() != nc)) {
-    throw InputError(kSource, "std_H", std::to_string(m) + " x " + std::to_string(nc), std::to_string(std_H.rows()) + " x " + std::to_string(std_H.cols()));
+    throw InputError(fit_uncertainty::kSource, "std_H", std::to_string(m) + " x " + std::to_string(nc), std::to_string(std_H.rows()) + " x " + std::to_string(std_H.cols()));
   }
   VectorFitUncertainty out;
-  const std::vector<Parameter> params = layout(fit, out.names);
+  const std::vector<fit_uncertainty::Parameter> params = fit_uncertainty::layout(fit, out.names);
   const auto p = static_cast<Index>(params.size());
   // Rows: output by output, each point's real then imaginary part of w (f - H).
   Matrix J(2 * m * nc, p);
@@ -162,13 +165,13 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
       s(row) = s(row + 1) = w * noise(k, i);
       const Complex sk(0.0, omega(k));
       for (Index j = 0; j < p; ++j) {
-        const Complex d = w * derivative(fit, params[static_cast<std::size_t>(j)], i, sk);
+        const Complex d = w * fit_uncertainty::derivative(fit, params[static_cast<std::size_t>(j)], i, sk);
         J(row, j) = d.real();
         J(row + 1, j) = d.imag();
       }
     }
   }
-  if (J.rows() <= p) throw InputError(kSource, "data", "more real residuals than the model's " + std::to_string(p) + " parameters", std::to_string(J.rows()));
+  if (J.rows() <= p) throw InputError(fit_uncertainty::kSource, "data", "more real residuals than the model's " + std::to_string(p) + " parameters", std::to_string(J.rows()));
   out.covariance = core::fit_covariance(J, r, s);
   const Matrix& c = out.covariance.covariance;
   for (Index k = 0; k < fit.poles.size(); ++k) {
@@ -180,10 +183,10 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
     if (pole.imag() == 0.0) {
       ck(0, 0) = c(at, at);
     } else {
-      ck = block(c, at, at + 1);
+      ck = fit_uncertainty::block(c, at, at + 1);
       if (pole.imag() < 0.0) ck(0, 1) = ck(1, 0) = -ck(0, 1);  // Im of the conjugate
     }
-    out.poles.push_back(root_uncertainty(pole, ck));
+    out.poles.push_back(fit_uncertainty::root_uncertainty(pole, ck));
   }
   return out;
 }
@@ -191,11 +194,11 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
 std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output,
                                               const CVector& zeros) {
   if (output < 0 || output >= fit.outputs()) {
-    throw InputError(kSource, "output", "0 to " + std::to_string(fit.outputs() - 1), std::to_string(output));
+    throw InputError(fit_uncertainty::kSource, "output", "0 to " + std::to_string(fit.outputs() - 1), std::to_string(output));
   }
   std::vector<std::string> names;
-  const std::vector<Parameter> params = layout(fit, names);
-  if (names != u.names) throw InputError(kSource, "uncertainty", "the covariance of this fit", "another fit's");
+  const std::vector<fit_uncertainty::Parameter> params = fit_uncertainty::layout(fit, names);
+  if (names != u.names) throw InputError(fit_uncertainty::kSource, "uncertainty", "the covariance of this fit", "another fit's");
   std::vector<RootUncertainty> out;
   for (Index z = 0; z < zeros.size(); ++z) {
     const Complex s = zeros(z);
@@ -204,13 +207,13 @@ std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, co
     for (Index n = 0; n < fit.poles.size(); ++n) slope -= fit.residues(output, n) / ((s - fit.poles(n)) * (s - fit.poles(n)));
     Eigen::Matrix<double, 2, Eigen::Dynamic> g(2, static_cast<Index>(params.size()));
     for (Index j = 0; j < g.cols(); ++j) {
-      const Complex dz = -derivative(fit, params[static_cast<std::size_t>(j)], output, s) / slope;
+      const Complex dz = -fit_uncertainty::derivative(fit, params[static_cast<std::size_t>(j)], output, s) / slope;
       g(0, j) = dz.real();
       g(1, j) = dz.imag();
     }
     const Eigen::Matrix2d c = u.covariance.singular ? Eigen::Matrix2d::Constant(std::numeric_limits<double>::infinity())
                                                     : Eigen::Matrix2d(core::propagate_covariance(g, u.covariance.covariance));
-    out.push_back(root_uncertainty(s, c));
+    out.push_back(fit_uncertainty::root_uncertainty(s, c));
   }
   return out;
 }
