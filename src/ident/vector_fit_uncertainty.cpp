@@ -177,6 +177,9 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
   for (Index k = 0; k < fit.poles.size(); ++k) {
     const Complex pole = fit.poles(k);
     const Index upper = pole.imag() < 0.0 ? k - 1 : k;  // a pair's lower member follows its upper one
+    if (upper < 0 || (upper != k && fit.poles(upper) != std::conj(pole))) {
+      throw InputError(fit_uncertainty::kSource, "poles", "pairs in vector_fit's order (Im > 0 first)", "a lower member without its upper one before it");
+    }
     Index at = 0;
     while (params[static_cast<std::size_t>(at)].pole != upper) ++at;
     Eigen::Matrix2d ck = Eigen::Matrix2d::Zero();

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "piezobench/core/error.hpp"
@@ -146,6 +147,11 @@ TEST(VectorFitUncertainty, BadSizesAreInputErrors) {
   EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix(), Matrix::Ones(m - 1, 1)), InputError);
   const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, o);
   EXPECT_THROW((void)zero_uncertainty(fit, u, 1, CVector::Zero(1)), InputError);
+  VectorFittingResult reordered = fit;  // a pair's lower member first: not vector_fit's order
+  const Index last = reordered.poles.size() - 1;
+  ASSERT_LT(reordered.poles(last).imag(), 0.0);
+  std::swap(reordered.poles(last - 1), reordered.poles(last));
+  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, reordered, o), InputError);
 }
 
 }  // namespace
