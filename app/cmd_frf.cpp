@@ -337,25 +337,6 @@ nlohmann::json fit_json(const ident::VectorFittingResult& r, const ident::Vector
   return doc;
 }
 
-// The fit's standard errors: from the FRF's std_H when every output carries one, else from the
-// residuals' scatter (ident/vector_fit_uncertainty.hpp).
-ident::VectorFitUncertainty fit_uncertainty(const ident::VectorFittingResult& r, const dsp::Frf& band, const ident::VectorFittingOptions& vf) {
-  const auto n = band.freq_Hz.size();
-  const auto outputs = static_cast<Eigen::Index>(band.H.size());
-  lti::CMatrix data(n, outputs);
-  Eigen::MatrixXd std_h(n, outputs);
-  bool variance = band.std_H.size() == band.H.size();
-  for (Eigen::Index i = 0; i < outputs; ++i) {
-    data.col(i) = band.H[static_cast<std::size_t>(i)];
-    if (variance && band.std_H[static_cast<std::size_t>(i)].size() == n) {
-      std_h.col(i) = band.std_H[static_cast<std::size_t>(i)];
-    } else {
-      variance = false;
-    }
-  }
-  return ident::vector_fit_uncertainty(kTwoPi * band.freq_Hz, data, r, vf, {}, variance ? std_h : Eigen::MatrixXd());
-}
-
 int run_fit(const FitOptions& o) {
   ident::VectorFittingOptions vf;
   vf.order = o.order;
@@ -367,7 +348,7 @@ int run_fit(const FitOptions& o) {
   const dsp::Frf band = select_band(file.frf, o);
   if (!o.json) log_line(fmt::format("fitting {} poles to {} points of {}", o.order, band.freq_Hz.size(), fmt::join(band.outputs, ", ")));
   const ident::VectorFittingResult r = ident::vector_fit(band, vf);
-  const ident::VectorFitUncertainty u = fit_uncertainty(r, band, vf);
+  const ident::VectorFitUncertainty u = ident::vector_fit_uncertainty(band, r, vf);
   std::vector<std::vector<ZeroReport>> zeros;
   for (std::size_t i = 0; i < band.outputs.size(); ++i) zeros.push_back(zero_reports(r, band, static_cast<Eigen::Index>(i), vf, u));
   nlohmann::json document = fit_json(r, u, band, zeros);
@@ -382,7 +363,7 @@ int run_fit(const FitOptions& o) {
   }
   fmt::print("{}\n", r.brief_report());
   fmt::print("{:>26}  {:>10}  {:>9}  {:>9}  {:>9}   (standard errors {})\n", "pole [rad/s]", "f [Hz]", "se [Hz]", "damping", "se",
-             u.from_data_variance ? "from the FRF's std_H" : "from the residuals' scatter");
+             u.from_data_variance ? "from the FRF's std_H" : "from the residuals' noise");
   for (Eigen::Index k = 0; k < r.poles.size(); ++k) {
     const auto p = r.poles(k);
     if (p.imag() < 0.0) continue;

@@ -5,6 +5,8 @@
 #include <string>
 
 #include "piezobench/core/error.hpp"
+#include "piezobench/core/units.hpp"
+#include "piezobench/dsp/frf.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
 
 namespace piezobench::ident {
@@ -192,6 +194,20 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
     out.poles.push_back(fit_uncertainty::root_uncertainty(pole, ck));
   }
   return out;
+}
+
+VectorFitUncertainty vector_fit_uncertainty(const dsp::Frf& frf, const VectorFittingResult& fit, const VectorFittingOptions& options) {
+  const Index n = frf.freq_Hz.size(), outputs = static_cast<Index>(frf.H.size());
+  CMatrix data(n, outputs);
+  Matrix std_h(n, outputs);
+  bool variance = frf.std_H.size() == frf.H.size();
+  for (Index i = 0; i < outputs; ++i) {
+    const auto io = static_cast<std::size_t>(i);
+    data.col(i) = frf.H[io];
+    variance = variance && frf.std_H[io].size() == n;
+    if (variance) std_h.col(i) = frf.std_H[io];
+  }
+  return vector_fit_uncertainty(kTwoPi * frf.freq_Hz, data, fit, options, {}, variance ? std_h : Matrix());
 }
 
 std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output,

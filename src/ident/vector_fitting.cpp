@@ -210,7 +210,6 @@ Matrix base_weights(const CMatrix& data, const Matrix& user, Weighting weighting
   return w;
 }
 
-
 void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights,
                  const VectorFittingOptions& o) {
   const Index ns = omega.size();
@@ -282,10 +281,9 @@ void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights
 // per pass (each load of V serves all G: G = 4 with AVX-512's 32 vector registers, 2 otherwise;
 // panels of 8 measured slower: their reflector-by-reflector part grows), with the sums over rows
 // in W-wide vectors (GCC/Clang vector extensions; the compiler does not vectorize floating-point
-// sums by itself). It is
-// compiled three times, for W = 2 (SSE2 on x86-64, NEON on ARM), W = 4 (AVX2 with FMA) and W = 8
-// (AVX-512), and the widest the processor has is chosen once at run time (the build itself stays
-// generic x86-64). It is the same Householder QR (beta = -sign(x) ||x||, as Eigen's), so R agrees
+// sums by itself). It is compiled three times, for W = 2 (SSE2 on x86-64, NEON on ARM), W = 4
+// (AVX2 with FMA) and W = 8 (AVX-512), and the widest the processor has is chosen once at run time
+// (the build itself stays generic x86-64). It is the same Householder QR (beta = -sign(x) ||x||, as Eigen's), so R agrees
 // with Eigen's to round-off; the variants differ from one another by round-off only (FMA).
 // docs/performance.md ("ident") has the figures.
 

@@ -61,6 +61,11 @@ struct VectorFitUncertainty {
                                                           const VectorFittingOptions& options, const Matrix& weights = {},
                                                           const Matrix& std_H = {});
 
+// All outputs of an FRF, as vector_fit(frf, options) fitted them: its std_H when every output
+// carries one, else the noise estimated from the residuals. Errors as above.
+[[nodiscard]] VectorFitUncertainty vector_fit_uncertainty(const dsp::Frf& frf, const VectorFittingResult& fit,
+                                                          const VectorFittingOptions& options);
+
 // The zeros `zeros` (rad/s) of output `output` of the fit, with their standard errors from u.
 [[nodiscard]] std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u,
                                                             Index output, const CVector& zeros);
