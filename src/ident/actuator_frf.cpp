@@ -10,6 +10,7 @@
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/ident/low_frequency_high_pass.hpp"
+#include "piezobench/ident/vector_fit_uncertainty.hpp"
 
 namespace piezobench::ident {
 
@@ -45,12 +46,34 @@ const T* nearest(const std::vector<T>& features, double target_rad_s) {
   return best;
 }
 
-FrfFeatures vector_fit_features(const dsp::Frf& band, const ActuatorFrfOptions& o) {
+FrfFeatureOptions vector_fit_options(const ActuatorFrfOptions& o) {
   FrfFeatureOptions fo;
   fo.fit.order = o.fit_order;
   fo.fit.fail_if_not_converged = false;
-  return frf_features(kTwoPi * band.freq_Hz, band.H[0], fo);
+  return fo;
 }
+
+FrfFeatures vector_fit_features(const dsp::Frf& band, const ActuatorFrfOptions& o) {
+  return frf_features(kTwoPi * band.freq_Hz, band.H[0], vector_fit_options(o));
+}
+
+// The covariance of the features' vector fit of a one-output band (its std_H when it has one); nullopt
+// when it is singular (a pole with a vanishing residue, as a noise-free FRF fitted with more poles
+// than it has gives: its place is undetermined, and so, linearized, is every parameter; the standard
+// errors are then left out, not written as 0 or inf), and with a warning when it cannot be had.
+std::optional<VectorFitUncertainty> features_uncertainty(const dsp::Frf& band, const FrfFeatures& f, const ActuatorFrfOptions& o,
+                                                         const std::string& what, ActuatorFrfResult& r) {
+  try {
+    VectorFitUncertainty u = vector_fit_uncertainty(band, f.fit, vector_fit_options(o).fit);
+    if (!u.covariance.singular) return u;
+  } catch (const Error& e) {
+    r.warnings.push_back("vector fit of " + what + ": no standard errors: " + e.what());
+  }
+  return std::nullopt;
+}
+
+// x when finite, else nullopt (an undetermined standard error is not written).
+std::optional<double> finite(double x) { return std::isfinite(x) ? std::optional<double>(x) : std::nullopt; }
 
 // u -> d_e by vector fitting: the static gain, and the resonance nearest the peak of |H|.
 std::optional<ModalFeature> de_features(const dsp::Frf& de, const ActuatorFrfOptions& o, ActuatorFrfResult& r) {
@@ -61,7 +84,20 @@ std::optional<ModalFeature> de_features(const dsp::Frf& de, const ActuatorFrfOpt
     a.static_gain = f.static_gain;
     a.static_gain_source = to_string(f.static_gain_source);
     a.fit_de = VectorFitSummary{o.fit_order, f.fit.relative_rms_error, f.fit.converged};
-    if (const ModalFeature* m = nearest(f.resonances, kTwoPi * de.freq_Hz(peak_line(de)))) return *m;
+    const ModalFeature* m = nearest(f.resonances, kTwoPi * de.freq_Hz(peak_line(de)));
+    if (const std::optional<VectorFitUncertainty> u = features_uncertainty(de, f, o, "u -> d_e", r)) {
+      if (f.static_gain_source == StaticGainSource::kModelDcGain) {
+        a.static_gain_vector_fit_standard_error = finite(std::sqrt(response_covariance(f.fit, *u, 0, Complex(0.0, 0.0))(0, 0)));
+      }
+      // The pole the resonance is (frf_features copies it: root = the pole with Im > 0).
+      for (Index k = 0; m && k < f.fit.poles.size(); ++k) {
+        if (f.fit.poles(k) != m->root) continue;
+        const RootUncertainty& pu = u->poles[static_cast<std::size_t>(k)];
+        a.resonance_vector_fit_standard_error_Hz = finite(pu.natural_frequency_se / kTwoPi);
+        a.resonance_vector_fit_damping_standard_error = finite(pu.damping_se);
+      }
+    }
+    if (m) return *m;
   } catch (const NumericalError& e) {
     r.failed.push_back(std::string("frf u -> d_e features: ") + e.what());
   }
@@ -81,6 +117,13 @@ std::optional<AntiResonance> vs_features(const dsp::Frf& vs, const ActuatorFrfOp
     }
     const AntiResonance* z = dip >= 0 ? nearest(f.antiresonances, kTwoPi * vs.freq_Hz(dip)) : nullptr;
     if (z) r.analysis.nmp.zero = NmpEvidence::Zero{z->phase_verdict, z->phase_change_deg, z->root, z->nonminimum_phase_model};
+    if (z) {
+      if (const std::optional<VectorFitUncertainty> u = features_uncertainty(vs, f, o, "u -> Vs", r)) {
+        const RootUncertainty zu = zero_uncertainty(f.fit, *u, 0, CVector::Constant(1, z->root)).front();
+        r.analysis.antiresonance_vector_fit_standard_error_Hz = finite(zu.natural_frequency_se / kTwoPi);
+        r.analysis.antiresonance_vector_fit_damping_standard_error = finite(zu.damping_se);
+      }
+    }
     r.analysis.static_gain_vs = f.static_gain;
     r.analysis.fit_vs = VectorFitSummary{o.fit_order, f.fit.relative_rms_error, f.fit.converged};
     if (z) return *z;

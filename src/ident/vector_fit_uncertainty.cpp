@@ -210,14 +210,36 @@ VectorFitUncertainty vector_fit_uncertainty(const dsp::Frf& frf, const VectorFit
   return vector_fit_uncertainty(kTwoPi * frf.freq_Hz, data, fit, options, {}, variance ? std_h : Matrix());
 }
 
-std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output,
-                                              const CVector& zeros) {
+namespace fit_uncertainty {
+namespace {
+// The parameters of `fit` after checking that `output` is one of its outputs and u is its covariance.
+std::vector<Parameter> checked_layout(const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output) {
   if (output < 0 || output >= fit.outputs()) {
-    throw InputError(fit_uncertainty::kSource, "output", "0 to " + std::to_string(fit.outputs() - 1), std::to_string(output));
+    throw InputError(kSource, "output", "0 to " + std::to_string(fit.outputs() - 1), std::to_string(output));
   }
   std::vector<std::string> names;
-  const std::vector<fit_uncertainty::Parameter> params = fit_uncertainty::layout(fit, names);
-  if (names != u.names) throw InputError(fit_uncertainty::kSource, "uncertainty", "the covariance of this fit", "another fit's");
+  std::vector<Parameter> params = layout(fit, names);
+  if (names != u.names) throw InputError(kSource, "uncertainty", "the covariance of this fit", "another fit's");
+  return params;
+}
+}  // namespace
+}  // namespace fit_uncertainty
+
+Eigen::Matrix2d response_covariance(const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output, Complex s) {
+  const std::vector<fit_uncertainty::Parameter> params = fit_uncertainty::checked_layout(fit, u, output);
+  if (u.covariance.singular) return Eigen::Matrix2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Matrix<double, 2, Eigen::Dynamic> g(2, static_cast<Index>(params.size()));
+  for (Index j = 0; j < g.cols(); ++j) {
+    const Complex d = fit_uncertainty::derivative(fit, params[static_cast<std::size_t>(j)], output, s);
+    g(0, j) = d.real();
+    g(1, j) = d.imag();
+  }
+  return core::propagate_covariance(g, u.covariance.covariance);
+}
+
+std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output,
+                                              const CVector& zeros) {
+  const std::vector<fit_uncertainty::Parameter> params = fit_uncertainty::checked_layout(fit, u, output);
   std::vector<RootUncertainty> out;
   for (Index z = 0; z < zeros.size(); ++z) {
     const Complex s = zeros(z);

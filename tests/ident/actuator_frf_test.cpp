@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <complex>
+#include <random>
 #include <string>
 
 #include "piezobench/core/error.hpp"
@@ -106,6 +107,38 @@ TEST(ActuatorFrf, FeaturesOfAnalyticPlants) {
   EXPECT_EQ(a.nmp.zero->phase_verdict, PhaseVerdict::kNonMinimumPhase);
   EXPECT_TRUE(near(*a.nmp.iff_plant_fit_xz, kZeroDamping, 1e-2));
   EXPECT_EQ(a.nmp.verdict_from, "iff-plant-fit");
+}
+
+// The vector fits' features carry standard errors (vector_fit_uncertainty from the FRF's std_H):
+// the analytic plants with complex Gaussian noise of 1 % of |H| per part, std_H set to it. Each
+// standard error is positive and small (the feature known to a few per cent at most) and the features
+// lie within 4 standard errors of the truth.
+TEST(ActuatorFrf, VectorFitFeaturesCarryStandardErrors) {
+  dsp::Frf frf = measured();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01;
+  frf.std_H.clear();
+  for (Eigen::VectorXcd& h : frf.H) {
+    Eigen::VectorXd sd = 0.01 * h.cwiseAbs();
+    for (Eigen::Index k = 0; k < h.size(); ++k) h(k) += std::complex<double>(sd(k) * n01(rng), sd(k) * n01(rng));
+    frf.std_H.push_back(sd);
+  }
+  const ActuatorFrfResult r = analyze_actuator_frf(frf, options());
+  const ActuatorFrfAnalysis& a = r.analysis;
+  ASSERT_TRUE(a.resonance_vector_fit_Hz && a.antiresonance_vector_fit_Hz && a.static_gain_vector_fit);
+  ASSERT_TRUE(a.resonance_vector_fit_standard_error_Hz && a.resonance_vector_fit_damping_standard_error);
+  ASSERT_TRUE(a.antiresonance_vector_fit_standard_error_Hz && a.antiresonance_vector_fit_damping_standard_error);
+  ASSERT_TRUE(a.static_gain_vector_fit_standard_error);
+  const auto within = [](double value, double se, double truth, double max_relative_se) {
+    EXPECT_GT(se, 0.0);
+    EXPECT_LT(se, max_relative_se * std::abs(truth));
+    EXPECT_LT(std::abs(value - truth), 4.0 * se) << value << " +- " << se << " against " << truth;
+  };
+  within(*a.resonance_vector_fit_Hz, *a.resonance_vector_fit_standard_error_Hz, kResonanceHz, 0.01);
+  within(*a.resonance_vector_fit_damping, *a.resonance_vector_fit_damping_standard_error, kDamping, 0.2);
+  within(*a.antiresonance_vector_fit_Hz, *a.antiresonance_vector_fit_standard_error_Hz, kAntiResonanceHz, 0.01);
+  within(*a.antiresonance_vector_fit_damping, *a.antiresonance_vector_fit_damping_standard_error, std::abs(kZeroDamping), 1.0);
+  within(*a.static_gain_vector_fit, *a.static_gain_vector_fit_standard_error, kGain, 0.02);
 }
 
 // With R and C_sensor known the corner is 1/(2 pi R C), fixed in the IFF plant fit; the free fit

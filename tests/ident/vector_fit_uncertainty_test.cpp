@@ -61,8 +61,8 @@ Complex fitted_zero(const VectorFittingResult& fit, Complex start) {
 
 // Monte Carlo on the exact model with complex Gaussian noise of known standard deviation (0.003 per
 // part on |H| from 0.05 to 25): over 300 seeds, z = (estimate - truth) / se of the 95 Hz mode's
-// frequency and damping, the 400 Hz mode's damping and the anti-resonance's frequency and damping
-// has a mean within +-0.2 and a standard deviation within 0.85-1.15, and the 95 % interval covers the
+// frequency and damping, the 400 Hz mode's damping, the anti-resonance's frequency and damping and
+// the DC gain (response_covariance at s = 0) has a mean within +-0.2 and a standard deviation within 0.85-1.15, and the 95 % interval covers the
 // truth in 91-98.5 % of the seeds; the same from the residuals' own scatter (no std_H). Measured:
 // mean -0.08..+0.05, standard deviation 0.90-1.01, coverage 94.0-97.0 %; standard errors 20 % too
 // large would fail (standard deviation 0.75-0.84).
@@ -79,7 +79,7 @@ TEST(VectorFitUncertainty, IntervalsOfPolesAndZerosCoverTheTruth) {
   o.asymptote = Asymptote::kConstant;
   o.fail_if_not_converged = false;
   std::vector<std::vector<double>> z(2, std::vector<double>());  // per variant: flattened [seed][quantity]
-  constexpr int kQuantities = 5;
+  constexpr int kQuantities = 6;
   const int seeds = 300;
   for (int variant = 0; variant < 2; ++variant) {
     std::mt19937 rng(11);
@@ -101,7 +101,9 @@ TEST(VectorFitUncertainty, IntervalsOfPolesAndZerosCoverTheTruth) {
           {u.poles[0].damping, u.poles[0].damping_se, -mode(0).real() / std::abs(mode(0))},
           {u.poles[2].damping, u.poles[2].damping_se, -mode(2).real() / std::abs(mode(2))},
           {zu.natural_frequency, zu.natural_frequency_se, std::abs(zero)},
-          {zu.damping, zu.damping_se, -zero.real() / std::abs(zero)}};
+          {zu.damping, zu.damping_se, -zero.real() / std::abs(zero)},
+          {fit.evaluate_at(Complex(0.0, 0.0))(0).real(), std::sqrt(response_covariance(fit, u, 0, Complex(0.0, 0.0))(0, 0)),
+           truth.at(Complex(0.0, 0.0)).real()}};
       for (const auto& v : values) z[static_cast<std::size_t>(variant)].push_back((v[0] - v[2]) / v[1]);
       // The pair's lower member carries the same errors.
       EXPECT_DOUBLE_EQ(u.poles[1].natural_frequency_se, u.poles[0].natural_frequency_se);
@@ -147,6 +149,12 @@ TEST(VectorFitUncertainty, BadSizesAreInputErrors) {
   EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix(), Matrix::Ones(m - 1, 1)), InputError);
   const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, o);
   EXPECT_THROW((void)zero_uncertainty(fit, u, 1, CVector::Zero(1)), InputError);
+  EXPECT_THROW((void)response_covariance(fit, u, 1, Complex(0.0, 0.0)), InputError);
+  VectorFittingOptions two;  // another fit's covariance
+  two.order = 2;
+  const VectorFittingResult fit2 = vector_fit(omega, h, two);
+  const VectorFitUncertainty other = vector_fit_uncertainty(omega, h, fit2, two);
+  EXPECT_THROW((void)response_covariance(fit, other, 0, Complex(0.0, 0.0)), InputError);
   VectorFittingResult reordered = fit;  // a pair's lower member first: not vector_fit's order
   const Index last = reordered.poles.size() - 1;
   ASSERT_LT(reordered.poles(last).imag(), 0.0);

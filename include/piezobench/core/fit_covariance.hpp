@@ -88,6 +88,18 @@ struct ParameterUncertainty {
 // The covariance of y = f(x) from that of x, to first order: G C G^T with G = dy/dx (q x p).
 [[nodiscard]] Eigen::MatrixXd propagate_covariance(const Eigen::MatrixXd& G, const Eigen::MatrixXd& covariance);
 
+constexpr auto describe(Type<FitCovariance>) {
+  using S = FitCovariance;
+  return fields<S>("FitCovariance", "the covariance of a least-squares fit's parameters at the solution",
+      field("covariance", &S::covariance, shown::kNone, "p x p, in the parameters' units"),
+      field("standard_error", &S::standard_error, shown::kNone, "sqrt of the diagonal (inf: singular)"),
+      field("correlation", &S::correlation, shown::kNone, "C_ij / (se_i se_j)"),
+      field("condition_number", &S::condition_number, shown::kRatio, "of J with unit-norm columns"),
+      field("chi2_per_dof", &S::chi2_per_dof, shown::kRatio, "misfit per degree of freedom"),
+      field("singular", &S::singular, shown::kNone, "J^T J not invertible"),
+      field("high_correlations", &S::high_correlations, shown::kNone, "(i, j) with |correlation| > 0.95"));
+}
+
 constexpr auto describe(Type<ParameterUncertainty>) {
   using S = ParameterUncertainty;
   return fields<S>("ParameterUncertainty", "a fit's parameters with their standard errors",

@@ -124,6 +124,9 @@ struct ActuatorFrfAnalysis {
   dsp::FrfProvenance welch;
   std::optional<VectorFitSummary> fit_de, fit_vs;
   std::optional<double> static_gain_vector_fit;  // m/V, vector fit of u -> d_e
+  // Its standard error (ident::response_covariance at s = 0): the model's DC gain only (none for the
+  // data's plateau, FrfFeatures::static_gain_source).
+  std::optional<double> static_gain_vector_fit_standard_error;  // m/V
   std::optional<double> static_gain;             // m/V, the unit's (second-order fit, else vector fit)
   std::string static_gain_source;                // "" when there is none
   std::optional<double> static_gain_vs;          // V/V, vector fit of u -> Vs
@@ -135,6 +138,11 @@ struct ActuatorFrfAnalysis {
   HighPassCorner hpf;
   std::optional<double> resonance_vector_fit_Hz, resonance_vector_fit_damping;
   std::optional<double> antiresonance_vector_fit_Hz, antiresonance_vector_fit_damping;
+  // Their standard errors (ident::vector_fit_uncertainty from the FRF's std_H, else the noise
+  // estimated from the residuals; the zero's by ident::zero_uncertainty); none when the fit's
+  // covariance is singular (a pole with a vanishing residue, as a noise-free FRF gives).
+  std::optional<double> resonance_vector_fit_standard_error_Hz, resonance_vector_fit_damping_standard_error;
+  std::optional<double> antiresonance_vector_fit_standard_error_Hz, antiresonance_vector_fit_damping_standard_error;
   std::optional<double> resonance_Hz, resonance_damping;
   std::optional<double> antiresonance_Hz, antiresonance_damping;  // damping < 0: non-minimum-phase
   std::optional<bool> zero_is_nonminimum_phase;
@@ -150,6 +158,8 @@ constexpr auto describe(core::Type<ActuatorFrfAnalysis>) {
       core::field("fit_de", &S::fit_de, kNone, "vector fit of u -> d_e"),
       core::field("fit_vs", &S::fit_vs, kNone, "vector fit of u -> Vs").key("fit_Vs"),
       core::field("static_gain_vector_fit", &S::static_gain_vector_fit, kMetrePerVoltAsUmPerV, "vector fit of u -> d_e"),
+      core::field("static_gain_vector_fit_standard_error", &S::static_gain_vector_fit_standard_error, kMetrePerVoltAsUmPerV,
+                  "its standard error (the model's DC gain; none for the data's plateau)"),
       core::field("static_gain", &S::static_gain, kMetrePerVoltAsUmPerV, "the unit's (second-order fit, else vector fit)").in_report(),
       core::field("static_gain_source", &S::static_gain_source, kNone, "which fit gave static_gain"),
       core::field("static_gain_vs", &S::static_gain_vs, kVoltPerVolt, "vector fit of u -> Vs").key("static_gain_Vs_V_per_V"),
@@ -164,6 +174,14 @@ constexpr auto describe(core::Type<ActuatorFrfAnalysis>) {
       core::field("resonance_vector_fit_damping", &S::resonance_vector_fit_damping, kRatio, "its damping"),
       core::field("antiresonance_vector_fit_Hz", &S::antiresonance_vector_fit_Hz, kHertz, "anti-resonance of the vector fit"),
       core::field("antiresonance_vector_fit_damping", &S::antiresonance_vector_fit_damping, kRatio, "its damping"),
+      core::field("resonance_vector_fit_standard_error_Hz", &S::resonance_vector_fit_standard_error_Hz, kHertz,
+                  "standard error of resonance_vector_fit_Hz"),
+      core::field("resonance_vector_fit_damping_standard_error", &S::resonance_vector_fit_damping_standard_error, kRatio,
+                  "standard error of its damping"),
+      core::field("antiresonance_vector_fit_standard_error_Hz", &S::antiresonance_vector_fit_standard_error_Hz, kHertz,
+                  "standard error of antiresonance_vector_fit_Hz"),
+      core::field("antiresonance_vector_fit_damping_standard_error", &S::antiresonance_vector_fit_damping_standard_error, kRatio,
+                  "standard error of its damping"),
       core::field("resonance_Hz", &S::resonance_Hz, kHertz, "resonance of u -> d_e").in_report(),
       core::field("resonance_damping", &S::resonance_damping, kRatio, "its damping ratio").in_report(),
       core::field("antiresonance_Hz", &S::antiresonance_Hz, kHertz, "anti-resonance of u -> Vs").in_report(),

@@ -52,6 +52,16 @@ struct VectorFitUncertainty {
   bool from_data_variance = false;     // std_H given; else the noise estimated from the residuals
 };
 
+constexpr auto describe(core::Type<VectorFitUncertainty>) {
+  using S = VectorFitUncertainty;
+  using namespace core::shown;
+  return core::fields<S>("VectorFitUncertainty", "a vector fit's covariance, and its poles with their standard errors",
+      core::field("covariance", &S::covariance, kNone, "of the model's real parameters, in the order of names"),
+      core::field("names", &S::names, kNone, "\"p3.re\", \"p3.im\" (pair), \"p0\" (real pole), \"r1.3.re\" (residue), \"d1\", \"e1\""),
+      core::field("poles", &S::poles, kNone, "one per pole of the fit, same order (a pair's two share errors)"),
+      core::field("from_data_variance", &S::from_data_variance, kNone, "true: the FRF's std_H; false: the noise estimated from the residuals"));
+}
+
 // omega: rad/s, the fit's points; data: points x outputs, as fitted; fit: vector_fit's result on
 // them with `options` and `weights` (the fit's own row weights follow: vector_fitting_weights);
 // std_H: the data's standard deviation per part (points x outputs, data units; empty: unknown).
@@ -65,6 +75,10 @@ struct VectorFitUncertainty {
 // carries one, else the noise estimated from the residuals. Errors as above.
 [[nodiscard]] VectorFitUncertainty vector_fit_uncertainty(const dsp::Frf& frf, const VectorFittingResult& fit,
                                                           const VectorFittingOptions& options);
+
+// The covariance of (Re, Im) of output `output` of the fit at s (rad/s; s = 0: the DC gain, whose Im
+// is 0), from u by the delta method. InputError as zero_uncertainty; infinite when u is singular.
+[[nodiscard]] Eigen::Matrix2d response_covariance(const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output, Complex s);
 
 // The zeros `zeros` (rad/s) of output `output` of the fit, with their standard errors from u.
 [[nodiscard]] std::vector<RootUncertainty> zero_uncertainty(const VectorFittingResult& fit, const VectorFitUncertainty& u,
