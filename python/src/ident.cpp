@@ -1,4 +1,4 @@
-// piezobench.ident: include/piezobench/ident/{vector_fitting,features,modal,plant_fit}.hpp and the
+// piezobench.ident: include/piezobench/ident/{vector_fitting,vector_fit_uncertainty,features,modal,plant_fit}.hpp and the
 // fits' quality verdict (core/fit_quality.hpp)
 #include <cmath>
 
@@ -11,6 +11,7 @@
 #include "piezobench/ident/hysteresis.hpp"
 #include "piezobench/ident/modal.hpp"
 #include "piezobench/ident/plant_fit.hpp"
+#include "piezobench/ident/vector_fit_uncertainty.hpp"
 #include "piezobench/ident/vector_fitting.hpp"
 #include "piezobench/lti/transfer_function.hpp"
 
@@ -385,6 +386,62 @@ void bind_vector_fitting(py::module_& m) {
           .c_str());
 }
 
+// vector_fit_uncertainty, zero_uncertainty and response_covariance (ident/vector_fit_uncertainty.hpp).
+void bind_vector_fit_uncertainty(py::module_& m) {
+  using py::arg;
+  bind_described<VectorFitUncertainty>(m);
+  bound_class<VectorFitUncertainty>().attr("__doc__") = R"(A vector fit's covariance (ident/vector_fit_uncertainty.hpp):
+covariance (core.FitCovariance: covariance, standard_error, correlation, condition_number, chi2_per_dof,
+singular, high_correlations) of the model's real parameters named in names; poles (ident.RootUncertainty:
+root, natural_frequency, natural_frequency_se, damping, damping_se, real_se, imag_se; rad/s), one per
+pole of the fit; from_data_variance. A 95 % interval is value +- 1.96 standard error.)";
+  m.def(
+      "vector_fit_uncertainty",
+      [](py::object omega_or_frf, py::object data_or_fit, py::object fit, py::object weights, py::object std_H, const py::kwargs& kw) {
+        const std::string src = "ident.vector_fit_uncertainty";
+        auto o = vf_options().from_kwargs(kwargs_dict(kw), src);
+        if (py::isinstance<dsp::Frf>(omega_or_frf)) {
+          const auto& f = frf_arg(omega_or_frf, src, "frf");
+          if (!py::isinstance<VectorFittingResult>(data_or_fit)) {
+            throw InputError(src, "fit", "the ident.vector_fit result of this FRF", py::str(py::type::of(data_or_fit).attr("__name__")).cast<std::string>());
+          }
+          const auto& r = data_or_fit.cast<const VectorFittingResult&>();
+          return without_gil([&] { return vector_fit_uncertainty(f, r, o); });
+        }
+        auto [w, h] = data_args(omega_or_frf, data_or_fit, src);
+        if (!py::isinstance<VectorFittingResult>(fit)) {
+          throw InputError(src, "fit", "the ident.vector_fit result of (omega, data)", py::str(py::type::of(fit).attr("__name__")).cast<std::string>());
+        }
+        const auto& r = fit.cast<const VectorFittingResult&>();
+        Matrix wt = weights.is_none() ? Matrix() : to_matrix(weights, src, "weights", true);
+        Matrix sd = std_H.is_none() ? Matrix() : to_matrix(std_H, src, "std_H", true);
+        return without_gil([&] { return vector_fit_uncertainty(w, h, r, o, wt, sd); });
+      },
+      arg("omega"), arg("data"), arg("fit") = py::none(), arg("weights") = py::none(), arg("std_H") = py::none(),
+      "Standard errors of a vector fit: vector_fit_uncertainty(omega, data, fit, weights=None, std_H=None, **options)\n"
+       "with the data (points,) or (points, outputs), weights and options as given to vector_fit, and std_H the\n"
+       "data's standard deviation per part (Re and Im; same shape as data; None: the noise estimated from the\n"
+       "fit's residuals, additive plus proportional); or vector_fit_uncertainty(frf, fit, **options) (the FRF's\n"
+       "std_H when it has one). The covariance of the model's real parameters, linearized at the solution\n"
+       "(core/fit_covariance.hpp), and each pole's natural frequency and damping with their standard errors by\n"
+       "the delta method. Returns an ident.VectorFitUncertainty.\n\nKeywords: as ident.vector_fit.");
+  m.def(
+      "zero_uncertainty",
+      [](const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output, py::object zeros) {
+        return zero_uncertainty(fit, u, output, to_complex_vector(zeros, "ident.zero_uncertainty", "zeros"));
+      },
+      arg("fit"), arg("uncertainty"), arg("output"), arg("zeros"),
+      "The zeros (rad/s, complex) of output `output` of the fit with their standard errors (implicit function\n"
+      "theorem, from vector_fit_uncertainty's covariance): a list of ident.RootUncertainty.");
+  m.def(
+      "response_covariance",
+      [](const VectorFittingResult& fit, const VectorFitUncertainty& u, Index output, std::complex<double> s) {
+        return to_numpy(Eigen::MatrixXd(response_covariance(fit, u, output, s)));
+      },
+      arg("fit"), arg("uncertainty"), arg("output"), arg("s"),
+      "The 2 x 2 covariance of (Re, Im) of output `output` of the fit at s (rad/s, complex; 0: the DC gain).");
+}
+
 // fit_high_pass and fit_second_order (ident/features.hpp).
 void bind_low_order_fits(py::module_& m) {
   using py::arg;
@@ -455,10 +512,11 @@ void bind_ident(py::module_& m) {
   bind_feature_classes(m);
   bind_plant_fits(m);
   bind_vector_fitting(m);
+  bind_vector_fit_uncertainty(m);
   bind_low_order_fits(m);
   bind_modal(m);
   m.def("declarations", [] {
-    return declarations_of<IffPlantFit, DelayedSecondOrderFit, VectorFittingResult, FrfFeatures, HighPassFit, SecondOrderFit,
+    return declarations_of<IffPlantFit, DelayedSecondOrderFit, VectorFittingResult, VectorFitUncertainty, FrfFeatures, HighPassFit, SecondOrderFit,
                            LscfResult, ActuatorPlants, HysteresisFit, CreepFit, LoopMetrics>();
   }, "{declared struct: (its Python class, [field names])} for every declared result ident returns (ident/*.hpp).");
 }
