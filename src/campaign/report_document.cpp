@@ -385,6 +385,33 @@ json frf_section(const std::vector<UnitCurves>& units) {
   columns.insert(columns.end(), {"zero pair", "phase change at the zero [deg]", "HPF corner [Hz]"});
   json tables = json::array({table("FRF features per unit", columns, rows,
                                    "Anti-resonance damping < 0: the zero is in the right half plane.")});
+  // The vector fits' cross-checks, each with half its 95 % interval (kCoverage95 standard errors).
+  json vrows = json::array();
+  const auto half_interval = [](const std::optional<double>& se, double per_si = 1.0) {
+    return se && std::isfinite(*se) ? json(core::kCoverage95 * *se * per_si) : json(nullptr);
+  };
+  for (const auto& u : units) {
+    if (!u.result->frf_analysis) continue;
+    const FrfAnalysis& f = *u.result->frf_analysis;
+    constexpr double um_per_m = core::shown::kMetrePerVoltAsUmPerV.per_si;
+    vrows.push_back(json::array({u.name(), io::to_json(f.resonance_vector_fit_Hz), half_interval(f.resonance_vector_fit_standard_error_Hz),
+                                 io::to_json(f.resonance_vector_fit_damping), half_interval(f.resonance_vector_fit_damping_standard_error),
+                                 io::to_json(f.antiresonance_vector_fit_Hz), half_interval(f.antiresonance_vector_fit_standard_error_Hz),
+                                 io::to_json(f.antiresonance_vector_fit_damping),
+                                 half_interval(f.antiresonance_vector_fit_damping_standard_error),
+                                 io::shown_json(f.static_gain_vector_fit, um_per_m),
+                                 half_interval(f.static_gain_vector_fit_standard_error, um_per_m)}));
+  }
+  if (!vrows.empty()) {
+    tables.push_back(table("Vector fits per unit (cross-checks, +- half the 95 % interval)",
+                           {"unit", "resonance [Hz]", "+- (95 %) [Hz]", "damping", "+- (95 %)", "anti-resonance [Hz]", "+- (95 %) [Hz]",
+                            "zero damping", "+- (95 %)", "static gain [um/V]", "+- (95 %) [um/V]"},
+                           vrows,
+                           "The order-6 vector fits of u -> d_e and u -> Vs, kept as cross-checks of the plant fits above. +-: "
+                           "1.96 standard errors of the fit's random error, from the FRF's variance (docs/uncertainty.md); the "
+                           "model's own bias is not in it (the vector fit spreads the narrow notch of the anti-resonance over its "
+                           "poles, a few per cent). Empty: not found, or its covariance singular."));
+  }
   json warnings = json::array();
   for (const auto& u : units) {
     for (const auto& w : u.result->warnings) warnings.push_back(u.name() + ": " + w);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <set>
 
@@ -83,6 +84,26 @@ stiffness = "s.mat"
   EXPECT_EQ((*spread)["columns"][0], "quantity");
   EXPECT_EQ((*spread)["rows"][0][0], "capacitance of the sensor stack [uF]");
   EXPECT_FALSE(test::contains((*spread).dump(), "_uF")) << (*spread).dump();
+  // The vector fits' cross-checks with half their 95 % intervals (issue 30): results.json's values, and
+  // 1.96 of its standard errors.
+  const json* vf = nullptr;
+  for (const auto& t : doc["sections"][0]["tables"]) {
+    if (test::contains(t["title"].get<std::string>(), "Vector fits per unit")) vf = &t;
+  }
+  ASSERT_NE(vf, nullptr);
+  ASSERT_EQ((*vf)["rows"].size(), 1u);  // unit 1 has the FRF
+  const json& vrow = (*vf)["rows"][0];
+  const json& ufrf = results["units"][0]["frf"];
+  EXPECT_EQ((*vf)["columns"][5], "anti-resonance [Hz]");
+  EXPECT_EQ((*vf)["columns"][6], "+- (95 %) [Hz]");
+  ASSERT_TRUE(ufrf["antiresonance_vector_fit_Hz"].is_number()) << ufrf.dump();
+  ASSERT_TRUE(ufrf["antiresonance_vector_fit_standard_error_Hz"].is_number()) << ufrf.dump();
+  EXPECT_EQ(vrow[5], ufrf["antiresonance_vector_fit_Hz"]);
+  EXPECT_DOUBLE_EQ(vrow[6].get<double>(), 1.959963984540054 * ufrf["antiresonance_vector_fit_standard_error_Hz"].get<double>());
+  EXPECT_GT(vrow[6].get<double>(), 0.0);
+  ASSERT_TRUE(ufrf["static_gain_vector_fit_standard_error_um_per_V"].is_number()) << ufrf.dump();
+  EXPECT_NEAR(vrow[10].get<double>(), 1.959963984540054 * ufrf["static_gain_vector_fit_standard_error_um_per_V"].get<double>(),
+              1e-12 * std::abs(vrow[10].get<double>()));
   // The frequency responses overlay the measurement's 95 % band (issue 30), the measurement (solid)
   // and the model (dashed) of unit 1.
   const json& frf_de = doc["sections"][0]["figures"][0];
