@@ -397,7 +397,8 @@ root, natural_frequency, natural_frequency_se, damping, damping_se, real_se, ima
 pole of the fit; from_data_variance. A 95 % interval is value +- 1.96 standard error.)";
   m.def(
       "vector_fit_uncertainty",
-      [](py::object omega_or_frf, py::object data_or_fit, py::object fit, py::object weights, py::object std_H, const py::kwargs& kw) {
+      [](py::object omega_or_frf, py::object data_or_fit, py::object fit, py::object weights, py::object std_H,
+         py::object adjacent_correlation, const py::kwargs& kw) {
         const std::string src = "ident.vector_fit_uncertainty";
         auto o = vf_options().from_kwargs(kwargs_dict(kw), src);
         if (py::isinstance<dsp::Frf>(omega_or_frf)) {
@@ -415,14 +416,18 @@ pole of the fit; from_data_variance. A 95 % interval is value +- 1.96 standard e
         const auto& r = fit.cast<const VectorFittingResult&>();
         Matrix wt = weights.is_none() ? Matrix() : to_matrix(weights, src, "weights", true);
         Matrix sd = std_H.is_none() ? Matrix() : to_matrix(std_H, src, "std_H", true);
-        return without_gil([&] { return vector_fit_uncertainty(w, h, r, o, wt, sd); });
+        Vector rho = adjacent_correlation.is_none() ? Vector() : to_vector(adjacent_correlation, src, "adjacent_correlation");
+        return without_gil([&] { return vector_fit_uncertainty(w, h, r, o, wt, sd, rho); });
       },
       arg("omega"), arg("data"), arg("fit") = py::none(), arg("weights") = py::none(), arg("std_H") = py::none(),
-      "Standard errors of a vector fit: vector_fit_uncertainty(omega, data, fit, weights=None, std_H=None, **options)\n"
-       "with the data (points,) or (points, outputs), weights and options as given to vector_fit, and std_H the\n"
-       "data's standard deviation per part (Re and Im; same shape as data; None: the noise estimated from the\n"
-       "fit's residuals, additive plus proportional); or vector_fit_uncertainty(frf, fit, **options) (the FRF's\n"
-       "std_H when it has one). The covariance of the model's real parameters, linearized at the solution\n"
+      arg("adjacent_correlation") = py::none(),
+      "Standard errors of a vector fit: vector_fit_uncertainty(omega, data, fit, weights=None, std_H=None,\n"
+       "adjacent_correlation=None, **options) with the data (points,) or (points, outputs), weights and options as\n"
+       "given to vector_fit, std_H the data's standard deviation per part (Re and Im; same shape as data; None:\n"
+       "the noise estimated from the fit's residuals, additive plus proportional) and adjacent_correlation the real\n"
+       "correlation of the data's error between points k and k+1 (len(omega) - 1 values, with std_H); or\n"
+       "vector_fit_uncertainty(frf, fit, **options) (the FRF's std_H when it has one, with the correlation of\n"
+       "neighbouring lines its Welch provenance gives). The covariance of the model's real parameters, linearized at the solution\n"
        "(core/fit_covariance.hpp), and each pole's natural frequency and damping with their standard errors by\n"
        "the delta method. Returns an ident.VectorFitUncertainty.\n\nKeywords: as ident.vector_fit.");
   m.def(

@@ -170,7 +170,7 @@ def test_standard_errors_equal_numpys_linearization():
     assert cdc[1, 1] == pytest.approx(0.0, abs=1e-30)
 
 
-def test_the_frf_form_takes_its_std_H_and_without_it_the_residuals_noise():
+def test_the_frf_form_takes_its_std_H_and_welch_correlation_and_without_std_H_the_residuals_noise():
     omega = _grid()
     sigma = 0.003
     h = _noisy(omega, sigma, np.random.default_rng(6))
@@ -185,6 +185,38 @@ def test_the_frf_form_takes_its_std_H_and_without_it_the_residuals_noise():
     estimated = ident.vector_fit_uncertainty(dsp.Frf(omega / (2 * np.pi), h), fit, **_OPTIONS)
     assert not estimated.from_data_variance
     np.testing.assert_allclose(estimated.covariance.standard_error, direct.covariance.standard_error, rtol=0.15)
+    # A Welch provenance (9 Hann segments of 1000 samples at 50 % overlap, 1 Hz lines): the correlation
+    # of neighbouring lines enters as the array form's adjacent_correlation, rho_1 computed here with
+    # numpy from dsp/frf_variance.hpp's formula (0.457 in its comment); a correlation of 0 changes nothing.
+    nfft, shift, segments = 1000, 500, 9
+    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(nfft) / nfft)
+    n = np.arange(nfft)
+
+    def a_j(j, d):
+        lag = j * shift
+        if lag >= nfft:
+            return 0.0
+        return np.sum(w[:nfft - lag] * w[lag:] * np.exp(2j * np.pi * d * n[:nfft - lag] / nfft))
+
+    js = range(-(segments - 1), segments)
+    rho1 = (sum((segments - abs(j)) * abs(a_j(abs(j), 1)) ** 2 for j in js)
+            / sum((segments - abs(j)) * abs(a_j(abs(j), 0)) ** 2 for j in js))
+    assert rho1 == pytest.approx(0.457, abs=0.001)
+    provenance = {"window": "hann-periodic", "nfft": nfft, "overlap": 0.5, "averages": segments, "sample_rate": 1000.0}
+    f = np.arange(20.0, 420.0)
+    hw = _noisy(2 * np.pi * f, sigma, np.random.default_rng(8))
+    fw = ident.vector_fit(2 * np.pi * f, hw, **_OPTIONS)
+    sd = np.full(f.size, sigma)
+    welch_form = ident.vector_fit_uncertainty(dsp.Frf(f, hw, std_H=sd, provenance=provenance), fw, **_OPTIONS)
+    array_form = ident.vector_fit_uncertainty(2 * np.pi * f, hw, fw, std_H=sd, adjacent_correlation=np.full(f.size - 1, rho1), **_OPTIONS)
+    np.testing.assert_allclose(welch_form.covariance.standard_error, array_form.covariance.standard_error, rtol=1e-9)
+    plain = ident.vector_fit_uncertainty(2 * np.pi * f, hw, fw, std_H=sd, **_OPTIONS)
+    zero_rho = ident.vector_fit_uncertainty(2 * np.pi * f, hw, fw, std_H=sd, adjacent_correlation=np.zeros(f.size - 1), **_OPTIONS)
+    np.testing.assert_allclose(zero_rho.covariance.standard_error, plain.covariance.standard_error, rtol=1e-12)
+    assert np.all(welch_form.covariance.standard_error > plain.covariance.standard_error)
+    with pytest.raises(pb.InputError) as e:
+        ident.vector_fit_uncertainty(2 * np.pi * f, hw, fw, adjacent_correlation=np.zeros(f.size - 1), **_OPTIONS)
+    assert e.value.field == "adjacent_correlation"
     assert set(ident.declarations()["VectorFitUncertainty"][1]) == {"covariance", "names", "poles", "from_data_variance"}
 
 

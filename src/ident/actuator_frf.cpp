@@ -9,6 +9,7 @@
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/dsp/resolution_kernel.hpp"
 #include "piezobench/ident/low_frequency_high_pass.hpp"
 #include "piezobench/ident/vector_fit_uncertainty.hpp"
 
@@ -57,14 +58,21 @@ FrfFeatures vector_fit_features(const dsp::Frf& band, const ActuatorFrfOptions& 
   return frf_features(kTwoPi * band.freq_Hz, band.H[0], vector_fit_options(o));
 }
 
-// The covariance of the features' vector fit of a one-output band (its std_H when it has one); nullopt
-// when it is singular (a pole with a vanishing residue, as a noise-free FRF fitted with more poles
-// than it has gives: its place is undetermined, and so, linearized, is every parameter; the standard
-// errors are then left out, not written as 0 or inf), and with a warning when it cannot be had.
+// The covariance of the features' vector fit of a one-output band: its std_H when it has one, with
+// the correlation of neighbouring lines of `kernel` (the plant fits' resolution kernel, computed once
+// per FRF: its window sums are what cost), else the noise estimated from the residuals. nullopt when
+// it is singular (a pole with a vanishing residue, as a noise-free FRF fitted with more poles than it
+// has gives: its place is undetermined, and so, linearized, is every parameter; the standard errors
+// are then left out, not written as 0 or inf), and with a warning when it cannot be had.
 std::optional<VectorFitUncertainty> features_uncertainty(const dsp::Frf& band, const FrfFeatures& f, const ActuatorFrfOptions& o,
-                                                         const std::string& what, ActuatorFrfResult& r) {
+                                                         const dsp::ResolutionKernel& kernel, const std::string& what,
+                                                         ActuatorFrfResult& r) {
   try {
-    VectorFitUncertainty u = vector_fit_uncertainty(band, f.fit, vector_fit_options(o).fit);
+    const Vector omega = kTwoPi * band.freq_Hz;
+    const bool variance = band.std_H.size() == 1 && band.std_H[0].size() == omega.size();
+    const Matrix std_h = variance ? Matrix(band.std_H[0]) : Matrix();
+    const Vector pairs = variance ? dsp::adjacent_line_pairs(kernel, omega) : Vector();
+    VectorFitUncertainty u = vector_fit_uncertainty(omega, CMatrix(band.H[0]), f.fit, vector_fit_options(o).fit, {}, std_h, pairs);
     if (!u.covariance.singular) return u;
   } catch (const Error& e) {
     r.warnings.push_back("vector fit of " + what + ": no standard errors: " + e.what());
@@ -76,7 +84,8 @@ std::optional<VectorFitUncertainty> features_uncertainty(const dsp::Frf& band, c
 std::optional<double> finite(double x) { return std::isfinite(x) ? std::optional<double>(x) : std::nullopt; }
 
 // u -> d_e by vector fitting: the static gain, and the resonance nearest the peak of |H|.
-std::optional<ModalFeature> de_features(const dsp::Frf& de, const ActuatorFrfOptions& o, ActuatorFrfResult& r) {
+std::optional<ModalFeature> de_features(const dsp::Frf& de, const ActuatorFrfOptions& o, const dsp::ResolutionKernel& kernel,
+                                        ActuatorFrfResult& r) {
   try {
     const FrfFeatures f = vector_fit_features(de, o);
     ActuatorFrfAnalysis& a = r.analysis;
@@ -85,7 +94,7 @@ std::optional<ModalFeature> de_features(const dsp::Frf& de, const ActuatorFrfOpt
     a.static_gain_source = to_string(f.static_gain_source);
     a.fit_de = VectorFitSummary{o.fit_order, f.fit.relative_rms_error, f.fit.converged};
     const ModalFeature* m = nearest(f.resonances, kTwoPi * de.freq_Hz(peak_line(de)));
-    if (const std::optional<VectorFitUncertainty> u = features_uncertainty(de, f, o, "u -> d_e", r)) {
+    if (const std::optional<VectorFitUncertainty> u = features_uncertainty(de, f, o, kernel, "u -> d_e", r)) {
       if (f.static_gain_source == StaticGainSource::kModelDcGain) {
         a.static_gain_vector_fit_standard_error = finite(std::sqrt(response_covariance(f.fit, *u, 0, Complex(0.0, 0.0))(0, 0)));
       }
@@ -106,7 +115,8 @@ std::optional<ModalFeature> de_features(const dsp::Frf& de, const ActuatorFrfOpt
 
 // u -> Vs by vector fitting: the static gain, and the zero nearest the dip of |H| below its peak
 // (the anti-resonance below the resonance) with its phase verdict.
-std::optional<AntiResonance> vs_features(const dsp::Frf& vs, const ActuatorFrfOptions& o, ActuatorFrfResult& r) {
+std::optional<AntiResonance> vs_features(const dsp::Frf& vs, const ActuatorFrfOptions& o, const dsp::ResolutionKernel& kernel,
+                                         ActuatorFrfResult& r) {
   try {
     const FrfFeatures f = vector_fit_features(vs, o);
     const Eigen::VectorXcd& h = vs.H[0];
@@ -118,7 +128,7 @@ std::optional<AntiResonance> vs_features(const dsp::Frf& vs, const ActuatorFrfOp
     const AntiResonance* z = dip >= 0 ? nearest(f.antiresonances, kTwoPi * vs.freq_Hz(dip)) : nullptr;
     if (z) r.analysis.nmp.zero = NmpEvidence::Zero{z->phase_verdict, z->phase_change_deg, z->root, z->nonminimum_phase_model};
     if (z) {
-      if (const std::optional<VectorFitUncertainty> u = features_uncertainty(vs, f, o, "u -> Vs", r)) {
+      if (const std::optional<VectorFitUncertainty> u = features_uncertainty(vs, f, o, kernel, "u -> Vs", r)) {
         const RootUncertainty zu = zero_uncertainty(f.fit, *u, 0, CVector::Constant(1, z->root)).front();
         r.analysis.antiresonance_vector_fit_standard_error_Hz = finite(zu.natural_frequency_se / kTwoPi);
         r.analysis.antiresonance_vector_fit_damping_standard_error = finite(zu.damping_se);
@@ -135,7 +145,8 @@ std::optional<AntiResonance> vs_features(const dsp::Frf& vs, const ActuatorFrfOp
 
 // The plants of `run` and `model tune` (fit_actuator_plants): u -> d_e as a mass-spring-damper
 // with its own delay, u -> Vs as eq. 2.3 with delay (its corner fixed at w_rc when known).
-void fit_plants(const dsp::Frf& frf, Index de, Index vs, const ActuatorFrfOptions& o, double w_rc, ActuatorFrfResult& r) {
+void fit_plants(const dsp::Frf& frf, Index de, Index vs, const ActuatorFrfOptions& o, double w_rc, const dsp::ResolutionKernel& kernel,
+                ActuatorFrfResult& r) {
   ActuatorPlantOptions po;
   po.fmin_Hz = o.fmin_Hz;
   po.fmax_Hz = o.fmax_Hz;
@@ -144,7 +155,7 @@ void fit_plants(const dsp::Frf& frf, Index de, Index vs, const ActuatorFrfOption
   po.fixed_w_hpf = w_rc;
   po.min_coherence = o.min_coherence;
   po.effective_averages = frf.provenance.effective_averages;
-  if (o.window_resolution) po.resolution = dsp::resolution_kernel(frf.provenance);
+  po.resolution = kernel;
   const auto coherence = [&](Index i) { return frf.coherence.empty() ? Eigen::VectorXd() : frf.coherence[static_cast<std::size_t>(i)]; };
   ActuatorPlants plants = fit_actuator_plants(kTwoPi * frf.freq_Hz, frf.H[static_cast<std::size_t>(de)], coherence(de),
                                               frf.H[static_cast<std::size_t>(vs)], coherence(vs), po, fit_source(o));
@@ -331,11 +342,14 @@ ActuatorFrfResult analyze_actuator_frf(const dsp::Frf& frf, const ActuatorFrfOpt
   }
   ActuatorFrfResult r;
   r.analysis.welch = frf.provenance;
-  const std::optional<ModalFeature> resonance = de_features(de, o, r);
+  // The Welch estimate's resolution kernel (inactive without window_resolution or a provenance that
+  // gives it), for the plant fits and the correlation of neighbouring lines in every fit's covariance.
+  const dsp::ResolutionKernel kernel = o.window_resolution ? dsp::resolution_kernel(frf.provenance) : dsp::ResolutionKernel{};
+  const std::optional<ModalFeature> resonance = de_features(de, o, kernel, r);
   // rad/s; 0 when the capacitance is not measured or the bench has no resistor.
   const double w_rc = o.sensor_capacitance_F && o.hpf_resistance_ohm ? 1.0 / (*o.hpf_resistance_ohm * *o.sensor_capacitance_F) : 0.0;
-  fit_plants(frf, de_output, vs_output, o, w_rc, r);
-  const std::optional<AntiResonance> zero = vs_features(vs, o, r);
+  fit_plants(frf, de_output, vs_output, o, w_rc, kernel, r);
+  const std::optional<AntiResonance> zero = vs_features(vs, o, kernel, r);
   high_pass(frf, vs_output, o, w_rc, r);
   choose_features(resonance, zero, o, r);
   ActuatorFrfAnalysis& a = r.analysis;

@@ -8,6 +8,7 @@
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
+#include "piezobench/dsp/resolution_kernel.hpp"
 
 namespace piezobench::ident {
 
@@ -124,7 +125,8 @@ Eigen::Matrix2d block(const Matrix& c, Index i, Index j) {
 }  // namespace fit_uncertainty
 
 VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& data, const VectorFittingResult& fit,
-                                            const VectorFittingOptions& options, const Matrix& user_weights, const Matrix& std_H) {
+                                            const VectorFittingOptions& options, const Matrix& user_weights, const Matrix& std_H,
+                                            const Vector& adjacent_correlation) {
   const Index m = omega.size(), nc = data.cols();
   if (data.rows() != m || fit.outputs() != nc) {
     throw InputError(fit_uncertainty::kSource, "data", std::to_string(m) + " points x " + std::to_string(fit.outputs()) + " outputs",
@@ -137,6 +139,10 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
   const Matrix weights = vector_fitting_weights(data, user_weights, options);
   if (std_H.size() != 0 && (std_H.rows() != m || std_H.cols() != nc)) {
     throw InputError(fit_uncertainty::kSource, "std_H", std::to_string(m) + " x " + std::to_string(nc), std::to_string(std_H.rows()) + " x " + std::to_string(std_H.cols()));
+  }
+  if (adjacent_correlation.size() != 0 && (std_H.size() == 0 || adjacent_correlation.size() != m - 1)) {
+    throw InputError(fit_uncertainty::kSource, "adjacent_correlation", std::to_string(m - 1) + " values with std_H, or none",
+                     std::to_string(adjacent_correlation.size()) + (std_H.size() == 0 ? " without std_H" : ""));
   }
   VectorFitUncertainty out;
   const std::vector<fit_uncertainty::Parameter> params = fit_uncertainty::layout(fit, out.names);
@@ -174,7 +180,13 @@ VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& 
     }
   }
   if (J.rows() <= p) throw InputError(fit_uncertainty::kSource, "data", "more real residuals than the model's " + std::to_string(p) + " parameters", std::to_string(J.rows()));
-  out.covariance = core::fit_covariance(J, r, s);
+  // The complex residuals run output by output: neighbours within an output correlate, across none.
+  Eigen::VectorXcd neighbours;
+  if (adjacent_correlation.size() != 0) {
+    neighbours = Eigen::VectorXcd::Zero(m * nc - 1);
+    for (Index i = 0; i < nc; ++i) neighbours.segment(i * m, m - 1) = adjacent_correlation.cast<Complex>();
+  }
+  out.covariance = core::fit_covariance(J, r, s, neighbours);
   const Matrix& c = out.covariance.covariance;
   for (Index k = 0; k < fit.poles.size(); ++k) {
     const Complex pole = fit.poles(k);
@@ -207,7 +219,9 @@ VectorFitUncertainty vector_fit_uncertainty(const dsp::Frf& frf, const VectorFit
     variance = variance && frf.std_H[io].size() == n;
     if (variance) std_h.col(i) = frf.std_H[io];
   }
-  return vector_fit_uncertainty(kTwoPi * frf.freq_Hz, data, fit, options, {}, variance ? std_h : Matrix());
+  const Vector omega = kTwoPi * frf.freq_Hz;
+  const Vector pairs = variance ? dsp::adjacent_line_pairs(dsp::resolution_kernel(frf.provenance), omega) : Vector();
+  return vector_fit_uncertainty(omega, data, fit, options, {}, variance ? std_h : Matrix(), pairs);
 }
 
 namespace fit_uncertainty {

@@ -132,6 +132,54 @@ TEST(VectorFitUncertainty, IntervalsOfPolesAndZerosCoverTheTruth) {
   }
 }
 
+// Noise correlated between neighbouring points, as a Welch estimate's lines are: e_k = (a_k + a_k-1) /
+// sqrt(2) (complex Gaussian a), correlation 0.5. Over 200 seeds the 95 Hz mode's frequency and the
+// DC gain have root-mean-square z-scores within 0.85-1.15 when adjacent_correlation says so; taken
+// as independent, their standard errors are too small by up to sqrt(1 + 2 * 0.5) for what varies
+// slowly along the points (rms z above 1.25). Measured: 1.02 and 1.04 with it, 1.41 and 1.46 without.
+TEST(VectorFitUncertainty, AdjacentCorrelationOfTheNoise) {
+  const TwoModes truth;
+  const Index m = 800;
+  Vector omega(m);
+  for (Index k = 0; k < m; ++k) omega(k) = kTwoPi * 20.0 * std::pow(50.0, static_cast<double>(k) / static_cast<double>(m - 1));
+  const double sigma = 0.003;
+  VectorFittingOptions o;
+  o.order = 4;
+  o.asymptote = Asymptote::kConstant;
+  o.fail_if_not_converged = false;
+  const Matrix std_h = Matrix::Constant(m, 1, sigma);
+  const Vector rho = Vector::Constant(m - 1, 0.5);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01;
+  const int seeds = 200;
+  double sq[2][2] = {{0.0, 0.0}, {0.0, 0.0}};  // [with, without][frequency, DC gain]
+  for (int seed = 0; seed < seeds; ++seed) {
+    CMatrix h(m, 1);
+    Complex previous(sigma * n01(rng), sigma * n01(rng));
+    for (Index k = 0; k < m; ++k) {
+      const Complex a(sigma * n01(rng), sigma * n01(rng));
+      h(k, 0) = truth.at(Complex(0.0, omega(k))) + (a + previous) / std::sqrt(2.0);
+      previous = a;
+    }
+    const VectorFittingResult fit = vector_fit(omega, h, o);
+    for (int with = 0; with < 2; ++with) {
+      const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, o, Matrix(), std_h, with == 0 ? rho : Vector());
+      const double zf = (u.poles[0].natural_frequency - std::abs(truth.poles(0))) / u.poles[0].natural_frequency_se;
+      const double zg = (fit.evaluate_at(Complex(0.0, 0.0))(0).real() - truth.at(Complex(0.0, 0.0)).real()) /
+                        std::sqrt(response_covariance(fit, u, 0, Complex(0.0, 0.0))(0, 0));
+      sq[with][0] += zf * zf;
+      sq[with][1] += zg * zg;
+    }
+  }
+  for (int q = 0; q < 2; ++q) {
+    SCOPED_TRACE("quantity " + std::to_string(q));
+    const double with = std::sqrt(sq[0][q] / seeds), without = std::sqrt(sq[1][q] / seeds);
+    EXPECT_GT(with, 0.85);
+    EXPECT_LT(with, 1.15);
+    EXPECT_GT(without, 1.25);
+  }
+}
+
 TEST(VectorFitUncertainty, BadSizesAreInputErrors) {
   const TwoModes truth;
   const Index m = 100;
@@ -147,6 +195,8 @@ TEST(VectorFitUncertainty, BadSizesAreInputErrors) {
   EXPECT_THROW((void)vector_fit_uncertainty(omega.head(50), h, fit, o), InputError);
   EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix::Ones(m, 2)), InputError);
   EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix(), Matrix::Ones(m - 1, 1)), InputError);
+  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix(), Matrix(), Vector::Zero(m - 1)), InputError);  // without std_H
+  EXPECT_THROW((void)vector_fit_uncertainty(omega, h, fit, o, Matrix(), Matrix::Ones(m, 1), Vector::Zero(m)), InputError);
   const VectorFitUncertainty u = vector_fit_uncertainty(omega, h, fit, o);
   EXPECT_THROW((void)zero_uncertainty(fit, u, 1, CVector::Zero(1)), InputError);
   EXPECT_THROW((void)response_covariance(fit, u, 1, Complex(0.0, 0.0)), InputError);

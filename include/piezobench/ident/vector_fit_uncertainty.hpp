@@ -65,14 +65,19 @@ constexpr auto describe(core::Type<VectorFitUncertainty>) {
 // omega: rad/s, the fit's points; data: points x outputs, as fitted; fit: vector_fit's result on
 // them with `options` and `weights` (the fit's own row weights follow: vector_fitting_weights);
 // std_H: the data's standard deviation per part (points x outputs, data units; empty: unknown).
+// adjacent_correlation: with std_H, the real correlation of the data's (circular) error between
+// points k and k+1 of every output (omega.size() - 1 values; a Welch estimate's neighbouring lines,
+// dsp::adjacent_line_pairs; empty: none), which core::fit_covariance's sandwich takes in.
 // InputError (source "vector fit uncertainty") for mismatched sizes or fewer residuals than
 // parameters.
 [[nodiscard]] VectorFitUncertainty vector_fit_uncertainty(const Vector& omega, const CMatrix& data, const VectorFittingResult& fit,
                                                           const VectorFittingOptions& options, const Matrix& weights = {},
-                                                          const Matrix& std_H = {});
+                                                          const Matrix& std_H = {}, const Vector& adjacent_correlation = {});
 
 // All outputs of an FRF, as vector_fit(frf, options) fitted them: its std_H when every output
-// carries one, else the noise estimated from the residuals. Errors as above.
+// carries one, with the correlation of neighbouring lines its provenance gives (the Welch window and
+// overlap: dsp::resolution_kernel, as the plant fits take it), else the noise estimated from the
+// residuals. Errors as above.
 [[nodiscard]] VectorFitUncertainty vector_fit_uncertainty(const dsp::Frf& frf, const VectorFittingResult& fit,
                                                           const VectorFittingOptions& options);
 
