@@ -408,9 +408,10 @@ json frf_section(const std::vector<UnitCurves>& units) {
                             "zero damping", "+- (95 %)", "static gain [um/V]", "+- (95 %) [um/V]"},
                            vrows,
                            "The order-6 vector fits of u -> d_e and u -> Vs, kept as cross-checks of the plant fits above. +-: "
-                           "1.96 standard errors of the fit's random error, from the FRF's variance (docs/uncertainty.md); the "
-                           "model's own bias is not in it (the vector fit spreads the narrow notch of the anti-resonance over its "
-                           "poles, a few per cent). Empty: not found, or its covariance singular."));
+                           "1.96 standard errors from the FRF's variance, widened by the fit's local misfit (docs/uncertainty.md "
+                           "section 5); they say how well the cross-check is pinned, not how far the order-6 model is from the "
+                           "unit (its anti-resonance sits a few per cent high: it spreads the narrow notch over its poles). "
+                           "Empty: not found, or the fit's covariance singular."));
   }
   json warnings = json::array();
   for (const auto& u : units) {
