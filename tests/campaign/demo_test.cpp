@@ -59,6 +59,10 @@ TEST(Demo, ResultsAgreeWithTheBenchTruth) {
       EXPECT_LT(fz_se, 0.05 * fz);
       EXPECT_LT(std::abs(fz - t["antiresonance_Hz"].get<double>()), 6.0 * fz_se) << fz << " +- " << fz_se;
       EXPECT_GT(f["antiresonance_vector_fit_damping_standard_error"].get<double>(), 0.0);
+      // The resonance too (it was dropped when a spurious pole-zero pair sat within 2 % of it).
+      ASSERT_FALSE(f["resonance_vector_fit_Hz"].is_null());
+      EXPECT_TRUE(near(f["resonance_vector_fit_Hz"].get<double>(), t["resonance_Hz"].get<double>(), 0.01));
+      EXPECT_GT(f["resonance_vector_fit_standard_error_Hz"].get<double>(), 0.0);
     }
     // Issue 30: the truth, or undetermined (null) when the 95 % interval of xz contains 0; never wrong.
     if (!f["zero_is_nonminimum_phase"].is_null()) {

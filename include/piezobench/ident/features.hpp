@@ -56,7 +56,8 @@ struct FrfFeatureOptions {
   // A pole pair is a resonance when its modal peak |r| / |Re p| is at least this fraction of the
   // fitted response at that frequency (rejects spurious poles with negligible residues).
   double min_significance = 0.1;
-  // A zero and a pole closer than this relative distance cancel and are both ignored.
+  // A zero and a pole closer than this relative distance cancel and are both ignored, one to one
+  // (the closest pairs first: a spurious pole-zero pair beside a resonance leaves the resonance).
   double cancellation_tolerance = 0.02;
   // Relative half-width of the band examined around an anti-resonance for the phase verdict; it is
   // widened to 5 damping ratios for broad zeros and narrowed to half the distance to the nearest
