@@ -655,6 +655,21 @@ PB_KERNEL void triangularize_lanes(double* a, Index rows, Index cols, Index ld, 
     }
     // Trailing columns, G at a time.
     Index j = pn.bulk;
+    if constexpr (G == 4) {
+      // 4 k + 2 columns (the usual case: 2 N + 2 columns): the last 6 in one pass rather than
+      // 4 then 2 (a pass over 2 columns loads V for half the work).
+      if ((cols - j) % 4 == 2 && cols - j >= 6) {
+        for (; j + 6 + G <= cols; j += G) {
+          double* c[G];
+          for (int g = 0; g < G; ++g) c[g] = a + (j + g) * ld;
+          apply_panel<W, P, G>(pn, c);
+        }
+        double* c[6];
+        for (int g = 0; g < 6; ++g) c[g] = a + (j + g) * ld;
+        apply_panel<W, P, 6>(pn, c);
+        j += 6;
+      }
+    }
     for (; j + G <= cols; j += G) {
       double* c[G];
       for (int g = 0; g < G; ++g) c[g] = a + (j + g) * ld;
@@ -768,7 +783,6 @@ class Fitter {
       : data_(data), weights_(weights), opts_(o), ns_(omega.size()), nc_(data.cols()), n_(o.order),
         offs_(asymptote_terms(o.asymptote)) {
     w_ = omega / scale;
-    basis_.resize(ns_, 2 * (n_ + 2));
     col_re_.resize(std::min(kBlockPoints, ns_), 2);
     col_im_.resize(std::min(kBlockPoints, ns_), 2);
     ones_.setOnes(std::min(kBlockPoints, ns_));
@@ -835,11 +849,15 @@ class Fitter {
   // [R_A Q^T B] (TriangularFactor); the column-pivoted QR that solves it then works on the small
   // R_A: the same least-squares solution (||A x - b|| and ||R_A x - (Q^T b)_top|| differ by a
   // constant), for a fraction of the cost of pivoting on the tall matrix.
-  Matrix identify(const CVector& poles) {
-    fill_basis(poles);
+  //
+  // keep_basis: leave the whole basis in basis_ for assess(). Without it (and with weights common
+  // to the outputs) the basis is computed per row block and pole, as in reduce_sigma_blocks.
+  Matrix identify(const CVector& poles, bool keep_basis) {
     const Index cols = n_ + offs_;
     Matrix x(cols, nc_);
     const bool common = weights_.cols() == 1;
+    const bool whole_basis = keep_basis || !common;
+    if (whole_basis) fill_basis(poles);
     const Index passes = common ? 1 : nc_;
     const Index nrhs = common ? nc_ : 1;
     const Index block_points = std::min(kBlockPoints, ns_);
@@ -850,11 +868,23 @@ class Fitter {
       for (Index k0 = 0; k0 < ns_; k0 += block_points) {
         const Index cnt = std::min(block_points, ns_ - k0);
         auto rows = tall_.block(2 * cnt);
-        for (Index j = 0; j < cols; ++j) {
-          for (Index k = 0; k < cnt; ++k) {
-            rows(k, j) = w(k0 + k) * basis_re()(k0 + k, j);
-            rows(cnt + k, j) = w(k0 + k) * basis_im()(k0 + k, j);
+        const double* wk = w.data() + k0;
+        if (whole_basis) {
+          for (Index j = 0; j < cols; ++j) {
+            scaled_rows(cnt, wk, basis_re().col(j).data() + k0, basis_im().col(j).data() + k0, rows.col(j).data());
           }
+        } else {
+          const double* wsc = w_.data() + k0;
+          for (Index j = 0; j < n_;) {
+            const Index c = basis_columns(wsc, cnt, poles(j), col_re_.col(0).data(), col_im_.col(0).data(),
+                                          col_re_.col(1).data(), col_im_.col(1).data());
+            for (Index q = 0; q < c; ++q) {
+              scaled_rows(cnt, wk, col_re_.col(q).data(), col_im_.col(q).data(), rows.col(j + q).data());
+            }
+            j += c;
+          }
+          if (offs_ >= 1) scaled_rows(cnt, wk, ones_.data(), zeros_.data(), rows.col(n_).data());
+          if (offs_ >= 2) scaled_rows(cnt, wk, zeros_.data(), wsc, rows.col(n_ + 1).data());
         }
         for (Index i = 0; i < nrhs; ++i) {
           for (Index k = 0; k < cnt; ++k) {
@@ -1036,6 +1066,7 @@ class Fitter {
   // (1) and s: real parts in the left half of basis_, imaginary parts in the right half (one
   // allocation: two of this size per call cost page faults).
   void fill_basis(const CVector& poles) {
+    basis_.resize(ns_, 2 * (n_ + 2));  // allocated at the first use only
     ident::fill_basis(w_, poles, basis_re(), basis_im());
     basis_re().col(n_).setOnes();
     basis_im().col(n_).setZero();
@@ -1185,9 +1216,10 @@ void VectorFittingOptions::validate() const {
 namespace {
 
 // The model d + s e + sum_n r_n / (s - p_n) of every output at the points s (one row per point),
-// frequencies innermost (their loops vectorize). r / z as r conj(z) / |z|^2 (no overflow concern at
-// frequencies where the model is used), the product in real arithmetic (GCC's complex product
-// checks each result for NaN).
+// frequencies innermost (their loops vectorize; compiled for AVX-512 and AVX2 too, PB_CLONES).
+// r / z as r conj(z) / |z|^2 (no overflow concern at frequencies where the model is used; one
+// reciprocal per term), the product in real arithmetic (GCC's complex product checks each result
+// for NaN).
 PB_CLONES CMatrix model_at(const VectorFittingResult& m, const CVector& s) {
   const Index ns = s.size();
   CMatrix out(ns, m.outputs());
@@ -1202,8 +1234,8 @@ PB_CLONES CMatrix model_at(const VectorFittingResult& m, const CVector& s) {
       Complex* o = out.col(i).data();
       for (Index k = 0; k < ns; ++k) {
         const double zr0 = s(k).real() - pr, zi0 = s(k).imag() - pi;
-        const double n2 = zr0 * zr0 + zi0 * zi0;
-        const double zr = zr0 / n2, zi = -zi0 / n2;
+        const double inv = 1.0 / (zr0 * zr0 + zi0 * zi0);
+        const double zr = zr0 * inv, zi = -zi0 * inv;
         o[k] += Complex(rr * zr - ri * zi, rr * zi + ri * zr);
       }
     }
@@ -1295,7 +1327,7 @@ std::optional<Matrix> relocate_until_settled(Fitter& fitter, const VectorFitting
       break;
     }
     if (!assess_each) continue;
-    x = fitter.identify(poles);
+    x = fitter.identify(poles, /*keep_basis=*/true);
     const double error = fitter.assess(poles, *x, significance);
     result.last_pole_change = pole_change(poles, before, significance, options.significance_floor);
     if (result.last_pole_change < options.pole_tolerance) {
@@ -1452,7 +1484,7 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
                              "); try another order, more iterations, weights or a looser tolerance",
                          /*retry_may_help=*/true);
   }
-  if (!x) x = fitter.identify(poles);
+  if (!x) x = fitter.identify(poles, /*keep_basis=*/false);
   unpack_solution(*x, poles, scale, options, data.cols(), result);
   realize(result);
   assess_quality(omega, data, options.order, result);
