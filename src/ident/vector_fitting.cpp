@@ -797,6 +797,22 @@ class Fitter {
       for (Index k = 0; k < ns_; ++k) wd += w(k) * w(k) * std::norm(data(k, i));
     }
     weighted_data_norm_ = std::sqrt(wd);
+    // Weights common to the outputs: one column, or one constant per output (e.g. "output-scale").
+    // A constant factor c on an output's rows scales its sigma block R22 by c and leaves its
+    // residues alone, so the latter are treated as common (unit) row weights with the factor on
+    // the output's sigma columns (out_scale_): the left block is then shared by the outputs.
+    out_scale_.setOnes(nc_);
+    common_ = weights.cols() == 1;
+    if (common_) {
+      common_w_ = weights.col(0);
+    } else {
+      common_ = true;
+      for (Index i = 0; i < nc_ && common_; ++i) {
+        common_ = (weights.col(i).array() == weights(0, i)).all();
+        out_scale_(i) = weights(0, i);
+      }
+      if (common_) common_w_.setOnes(ns_);
+    }
   }
 
   // Quality of a model with these poles and the coefficients x from identify(): the relative
@@ -855,14 +871,15 @@ class Fitter {
   Matrix identify(const CVector& poles, bool keep_basis) {
     const Index cols = n_ + offs_;
     Matrix x(cols, nc_);
-    const bool common = weights_.cols() == 1;
+    const bool common = common_;
     const bool whole_basis = keep_basis || !common;
     if (whole_basis) fill_basis(poles);
     const Index passes = common ? 1 : nc_;
     const Index nrhs = common ? nc_ : 1;
     const Index block_points = std::min(kBlockPoints, ns_);
     for (Index pass = 0; pass < passes; ++pass) {
-      const auto w = weights_.col(pass);
+      const Eigen::Ref<const Vector> w = common ? Eigen::Ref<const Vector>(common_w_)
+                                                : Eigen::Ref<const Vector>(weights_.col(pass));
       const Index first = common ? 0 : pass;
       tall_.reset(cols + nrhs, 2 * block_points);
       for (Index k0 = 0; k0 < ns_; k0 += block_points) {
@@ -921,8 +938,8 @@ class Fitter {
     stacked_.resize(stacked_rows, nsig);
     stacked_rhs_.setZero(stacked_rows);
 
-    if (weights_.cols() == 1) {
-      reduce_sigma_blocks(poles, weights_.col(0), 0, nc_, relaxed);
+    if (common_) {
+      reduce_sigma_blocks(poles, common_w_, 0, nc_, relaxed);
     } else {
       for (Index i = 0; i < nc_; ++i) reduce_sigma_blocks(poles, weights_.col(i), i, 1, relaxed);
     }
@@ -999,10 +1016,11 @@ class Fitter {
       for (Index i = 0; i < count; ++i) {
         double* wdr = wd_re_.col(i).data();
         double* wdi = wd_im_.col(i).data();
+        const double scale = common_ ? out_scale_(first + i) : 1.0;  // the output's constant weight
         for (Index k = 0; k < cnt; ++k) {
           const Complex h = data_(k0 + k, first + i);
-          wdr[k] = -wk[k] * h.real();
-          wdi[k] = -wk[k] * h.imag();
+          wdr[k] = -wk[k] * scale * h.real();
+          wdi[k] = -wk[k] * scale * h.imag();
         }
         if (!relaxed) {
           // Fixed normalization: sigma's constant is 1, so its term moves to the right-hand side.
@@ -1058,6 +1076,9 @@ class Fitter {
 
   const CMatrix& data_;
   const Matrix& weights_;
+  bool common_ = true;  // the same row weights (common_w_) for all outputs, up to out_scale_
+  Vector common_w_;
+  Vector out_scale_;
   const VectorFittingOptions& opts_;
   Index ns_, nc_, n_, offs_;
   Vector w_;  // omega / scale
