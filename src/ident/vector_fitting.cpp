@@ -49,6 +49,15 @@ CVector canonical_poles(const CVector& raw) {
   return out;
 }
 
+// The loops that build the least-squares rows, the basis and the model's evaluation are compiled
+// for AVX-512 (x86-64-v4), AVX2 (v3) and the baseline; the loader picks one (GCC's target_clones;
+// the build itself stays generic x86-64).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define PB_CLONES [[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]]
+#else
+#define PB_CLONES
+#endif
+
 // Basis of the partial fractions for canonical poles at s = j w (w: the scaled frequencies): 1/(s - p)
 // for a real pole; for a pair, 1/(s - p) + 1/(s - p*) and j/(s - p) - j/(s - p*), so that real
 // coefficients (c', c'') give the residue c' + j c'' on p (Gustavsen & Semlyen 1999, eq. A.3).
@@ -56,14 +65,10 @@ CVector canonical_poles(const CVector& raw) {
 // NaN (a call to __muldc3), which kept these loops from being vectorized. The real and imaginary
 // parts are kept apart (re, im): the loops that build the least-squares rows from them then read
 // contiguous doubles.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define PB_CLONES [[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]]
-#else
-#define PB_CLONES
-#endif
-
+//
 // The columns of pole p (one for a real pole, two for a pair) at the cnt scaled frequencies w.
-PB_CLONES Index basis_columns(const double* w, Index cnt, Complex p, double* re0, double* im0, double* re1, double* im1) {
+PB_CLONES Index basis_columns(const double* w, Index cnt, Complex p, double* re0, double* im0, double* re1,
+                              double* im1) {
   const double a = p.real();
   const double b = p.imag();
   if (b == 0.0) {
@@ -110,6 +115,7 @@ PB_CLONES void product_rows(Index cnt, const double* re, const double* im, const
   }
 }
 
+// The whole basis (points x poles), column by column.
 void fill_basis(const Vector& w, const CVector& poles, Eigen::Ref<Matrix> re, Eigen::Ref<Matrix> im) {
   for (Index i = 0; i < poles.size();) {
     const Index next = std::min(i + 1, poles.size() - 1);
@@ -148,7 +154,9 @@ void real_realization(const CVector& poles, Matrix& a, Vector& b) {
 // matter and the old poles nearest to them.
 double pole_change(const CVector& now, const CVector& before, const Vector& significance, double floor_sig) {
   Vector before_abs(before.size());
-  for (Index j = 0; j < before.size(); ++j) before_abs(j) = std::max(std::abs(before(j)), std::numeric_limits<double>::min());
+  for (Index j = 0; j < before.size(); ++j) {
+    before_abs(j) = std::max(std::abs(before(j)), std::numeric_limits<double>::min());
+  }
   const auto rel = [&](Index i, Index j) { return std::abs(now(i) - before(j)) / before_abs(j); };
   const auto counts = [&](Index i) { return significance.size() == 0 || significance(i) >= floor_sig; };
   double worst = 0.0;
