@@ -17,7 +17,11 @@ Both fits use the same settings: order/2 complex starting poles at -0.01 w + j w
 the band of the data (the automatic starting poles of both); exactly --iterations relaxed pole
 relocations (no early stop: piezobench's tolerances and scikit-rf's max_tol are 0); a constant
 term, no proportional term; then the residues for the final poles (scikit-rf without enforce_dc,
-which piezobench does not do). scikit-rf fits the responses of an n-port network, n^2 of them:
+which piezobench does not do); the same row weights: scikit-rf weighs each response's relocation
+rows by sqrt(||H_i||) (the square root of its weights_responses, the response's 2-norm over the
+band), and piezobench is given those as weights (a constant per output column), so that with
+several outputs both solve the same least-squares problems (with one output a constant weight
+changes nothing). scikit-rf fits the responses of an n-port network, n^2 of them:
 --outputs must be a square (1, 4, ...), and piezobench gets the same n^2 columns.
 
 Prints per fitter the median and minimum CPU time (time.process_time) and wall time
@@ -137,15 +141,19 @@ def main():
                           fit_constant=True, fit_proportional=False, enforce_dc=False)
         return vf.poles
 
+    # scikit-rf's relocation weights (vectorFitting.py: weights_responses = ||H_i||, then sqrt).
+    weights = np.ones((len(f), 1)) * np.sqrt(np.linalg.norm(h, axis=0))[None, :]
+
     def fit_pb():
-        r = ident.vector_fit(omega, h, order=args.order, asymptote="d", max_iterations=args.iterations,
+        r = ident.vector_fit(omega, h, weights, order=args.order, asymptote="d", max_iterations=args.iterations,
                              pole_tolerance=0.0, residual_tolerance=0.0, significance_floor=0.0,
                              fail_if_not_converged=False, starting_damping=0.01, starting_spacing="log")
         return r.poles
 
     out, cpu, wall = timed({"piezobench": fit_pb, "scikit-rf": fit_skrf}, args.repeat)
     print(f"vector fitting: {args.order} poles, {len(f)} points, {h.shape[1]} output(s), noise {args.noise}, "
-          f"{args.iterations} relocations then the residues; {args.repeat} calls each, alternated")
+          f"{args.iterations} relocations then the residues; {args.repeat} calls each, alternated; "
+          "the same starting poles, settings and row weights (scikit-rf's sqrt(||H_i||) per output)")
     print(f"scikit-rf {skrf.__version__}, numpy {np.__version__}, python {sys.version.split()[0]}")
     for k in cpu:
         print(f"  {k:11s} CPU median {1e3 * statistics.median(cpu[k]):8.3f} ms  min {1e3 * min(cpu[k]):8.3f} ms"

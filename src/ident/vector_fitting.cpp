@@ -49,38 +49,78 @@ CVector canonical_poles(const CVector& raw) {
   return out;
 }
 
+// The loops that build the least-squares rows, the basis and the model's evaluation are compiled
+// for AVX-512 (x86-64-v4), AVX2 (v3) and the baseline; the loader picks one (GCC's target_clones;
+// the build itself stays generic x86-64).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define PB_CLONES [[gnu::target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")]]
+#else
+#define PB_CLONES
+#endif
+
 // Basis of the partial fractions for canonical poles at s = j w (w: the scaled frequencies): 1/(s - p)
 // for a real pole; for a pair, 1/(s - p) + 1/(s - p*) and j/(s - p) - j/(s - p*), so that real
 // coefficients (c', c'') give the residue c' + j c'' on p (Gustavsen & Semlyen 1999, eq. A.3).
 // Written in real arithmetic: s is imaginary, and GCC's complex product checks every result for
-// NaN (a call to __muldc3), which kept these loops from being vectorized.
-void fill_basis(const Vector& w, const CVector& poles, CMatrix& basis) {
-  const Index n = poles.size();
-  const Index ns = w.size();
-  for (Index i = 0; i < n; ++i) {
-    const double a = poles(i).real();
-    const double b = poles(i).imag();
-    if (b == 0.0) {
-      // 1/(j w - a) = (-a - j w) / (a^2 + w^2)
-      for (Index k = 0; k < ns; ++k) {
-        const double inv = 1.0 / (a * a + w(k) * w(k));
-        basis(k, i) = Complex(-a * inv, -w(k) * inv);
-      }
-    } else {
-      // 1/(s - p) + 1/(s - p*) = 2 (s - a) / q and j (1/(s - p) - 1/(s - p*)) = -2 b / q with
-      // q = (s - p)(s - p*) = (a^2 + b^2 - w^2) - 2 j a w: one reciprocal per pair.
-      const double m2 = a * a + b * b;
-      for (Index k = 0; k < ns; ++k) {
-        const double qr = m2 - w(k) * w(k);
-        const double qi = -2.0 * a * w(k);
-        const double inv = 1.0 / (qr * qr + qi * qi);
-        const double rr = qr * inv;   // 1/q = (qr - j qi) / |q|^2
-        const double ri = -qi * inv;
-        basis(k, i) = Complex(2.0 * (-a * rr - w(k) * ri), 2.0 * (-a * ri + w(k) * rr));
-        basis(k, i + 1) = Complex(-2.0 * b * rr, -2.0 * b * ri);
-      }
-      ++i;
+// NaN (a call to __muldc3), which kept these loops from being vectorized. The real and imaginary
+// parts are kept apart (re, im): the loops that build the least-squares rows from them then read
+// contiguous doubles.
+//
+// The columns of pole p (one for a real pole, two for a pair) at the cnt scaled frequencies w.
+PB_CLONES Index basis_columns(const double* w, Index cnt, Complex p, double* re0, double* im0, double* re1,
+                              double* im1) {
+  const double a = p.real();
+  const double b = p.imag();
+  if (b == 0.0) {
+    // 1/(j w - a) = (-a - j w) / (a^2 + w^2)
+    for (Index k = 0; k < cnt; ++k) {
+      const double inv = 1.0 / (a * a + w[k] * w[k]);
+      re0[k] = -a * inv;
+      im0[k] = -w[k] * inv;
     }
+    return 1;
+  }
+  // 1/(s - p) + 1/(s - p*) = 2 (s - a) / q and j (1/(s - p) - 1/(s - p*)) = -2 b / q with
+  // q = (s - p)(s - p*) = (a^2 + b^2 - w^2) - 2 j a w: one reciprocal per pair.
+  const double m2 = a * a + b * b;
+  for (Index k = 0; k < cnt; ++k) {
+    const double qr = m2 - w[k] * w[k];
+    const double qi = -2.0 * a * w[k];
+    const double inv = 1.0 / (qr * qr + qi * qi);
+    const double rr = qr * inv;  // 1/q = (qr - j qi) / |q|^2
+    const double ri = -qi * inv;
+    re0[k] = 2.0 * (-a * rr - w[k] * ri);
+    im0[k] = 2.0 * (-a * ri + w[k] * rr);
+    re1[k] = -2.0 * b * rr;
+    im1[k] = -2.0 * b * ri;
+  }
+  return 2;
+}
+
+// Rows of a least-squares column: out[k] = w[k] re[k], out[cnt + k] = w[k] im[k].
+PB_CLONES void scaled_rows(Index cnt, const double* w, const double* re, const double* im, double* out) {
+  for (Index k = 0; k < cnt; ++k) {
+    out[k] = w[k] * re[k];
+    out[cnt + k] = w[k] * im[k];
+  }
+}
+
+// Rows of the complex product (re + j im)(pr + j pi): real parts in out[0..cnt), imaginary parts
+// in out[cnt..2 cnt); in real arithmetic (no NaN check per product, see above).
+PB_CLONES void product_rows(Index cnt, const double* re, const double* im, const double* pr, const double* pi,
+                            double* out) {
+  for (Index k = 0; k < cnt; ++k) {
+    out[k] = re[k] * pr[k] - im[k] * pi[k];
+    out[cnt + k] = re[k] * pi[k] + im[k] * pr[k];
+  }
+}
+
+// The whole basis (points x poles), column by column.
+void fill_basis(const Vector& w, const CVector& poles, Eigen::Ref<Matrix> re, Eigen::Ref<Matrix> im) {
+  for (Index i = 0; i < poles.size();) {
+    const Index next = std::min(i + 1, poles.size() - 1);
+    i += basis_columns(w.data(), w.size(), poles(i), re.col(i).data(), im.col(i).data(), re.col(next).data(),
+                       im.col(next).data());
   }
 }
 
@@ -113,9 +153,11 @@ void real_realization(const CVector& poles, Matrix& a, Vector& b) {
 // `significance` (of `now`; empty = all significant) restricts the measure to the new poles that
 // matter and the old poles nearest to them.
 double pole_change(const CVector& now, const CVector& before, const Vector& significance, double floor_sig) {
-  const auto rel = [&](Index i, Index j) {
-    return std::abs(now(i) - before(j)) / std::max(std::abs(before(j)), std::numeric_limits<double>::min());
-  };
+  Vector before_abs(before.size());
+  for (Index j = 0; j < before.size(); ++j) {
+    before_abs(j) = std::max(std::abs(before(j)), std::numeric_limits<double>::min());
+  }
+  const auto rel = [&](Index i, Index j) { return std::abs(now(i) - before(j)) / before_abs(j); };
   const auto counts = [&](Index i) { return significance.size() == 0 || significance(i) >= floor_sig; };
   double worst = 0.0;
   for (Index i = 0; i < now.size(); ++i) {
@@ -238,7 +280,7 @@ void check_input(const Vector& omega, const CMatrix& data, const Matrix& weights
       }
     }
   }
-  if (data.cwiseAbs().maxCoeff() == 0.0) throw InputError(kSource, "data", "a nonzero response", "all zeros");
+  if (data.cwiseAbs2().maxCoeff() == 0.0) throw InputError(kSource, "data", "a nonzero response", "all zeros");
   if (o.point_weights.size() > 0 && o.point_weights.size() != ns) {
     throw InputError(kSource, "point_weights", std::to_string(ns) + " values (one per frequency)",
                      std::to_string(o.point_weights.size()));
@@ -298,13 +340,19 @@ struct Lanes {
 template <int W>
 PB_KERNEL double dot(const double* x, const double* y, Index n) {
   using V = typename Lanes<W>::Vec;
-  V acc0 = {}, acc1 = {};
+  // Four independent sums: one would wait on the latency of each addition.
+  V acc0 = {}, acc1 = {}, acc2 = {}, acc3 = {};
   Index i = 0;
-  for (; i + 2 * W <= n; i += 2 * W) {
+  for (; i + 4 * W <= n; i += 4 * W) {
     acc0 += *reinterpret_cast<const V*>(x + i) * *reinterpret_cast<const V*>(y + i);
     acc1 += *reinterpret_cast<const V*>(x + i + W) * *reinterpret_cast<const V*>(y + i + W);
+    acc2 += *reinterpret_cast<const V*>(x + i + 2 * W) * *reinterpret_cast<const V*>(y + i + 2 * W);
+    acc3 += *reinterpret_cast<const V*>(x + i + 3 * W) * *reinterpret_cast<const V*>(y + i + 3 * W);
   }
+  for (; i + W <= n; i += W) acc0 += *reinterpret_cast<const V*>(x + i) * *reinterpret_cast<const V*>(y + i);
   acc0 += acc1;
+  acc2 += acc3;
+  acc0 += acc2;
   double sum = 0.0;
   for (int l = 0; l < W; ++l) sum += acc0[l];
   for (; i < n; ++i) sum += x[i] * y[i];
@@ -423,6 +471,147 @@ PB_KERNEL void factor_panel(double* a, Index rows, Index ld, Index top, Index k0
   }
 }
 
+// A full panel (P reflectors) in one pass over its columns per reflector: the pass that scales
+// reflector q and applies it to the panel's later columns also sums what reflector q + 1 needs (the
+// squared norm of the next column below its diagonal and its products with the columns after it:
+// v^T c = u^T c / (x - beta) for the unscaled u) and the products of reflector q with the earlier
+// ones (for T). The same reflectors as factor_panel (to round-off), with about half the passes.
+template <int P>
+struct FusedPanel {
+  double* col[P];
+  Index rows, top, k0;
+  double sig;      // squared norm of the current column below its diagonal
+  double g[P];     // its products with the later columns (same rows)
+  double tau[P];
+  double vv[P][P];  // vv[p][q] = v_p^T v_q, p < q
+};
+
+template <int W>
+PB_KERNEL double hsum(const typename Lanes<W>::Vec& v) {
+  double s = 0.0;
+  for (int l = 0; l < W; ++l) s += v[l];
+  return s;
+}
+
+template <int W, int P, int Q>
+PB_KERNEL void fused_step(FusedPanel<P>& s) {
+  using V = typename Lanes<W>::Vec;
+  double* col[P];
+  for (int q = 0; q < P; ++q) col[q] = s.col[q];
+  const Index rows = s.rows;
+  const Index k = s.k0 + Q;
+  const Index first = std::max(k + 1, s.top);
+  double inv = 1.0;
+  double d[P] = {};
+  s.tau[Q] = 0.0;
+  if (s.sig != 0.0) {  // else the column is already triangular (tau = 0, v = 0 below the diagonal)
+    const double x = col[Q][k];
+    const double norm = std::sqrt(x * x + s.sig);
+    const double beta = x >= 0.0 ? -norm : norm;
+    inv = 1.0 / (x - beta);
+    s.tau[Q] = (beta - x) / beta;
+    col[Q][k] = beta;
+    for (int j = Q + 1; j < P; ++j) {
+      d[j] = s.tau[Q] * (col[j][k] + inv * s.g[j]);
+      col[j][k] -= d[j];
+    }
+  }
+  double vs[P] = {};   // v_p^T v_Q, scalar part
+  double ss = 0.0;     // next column's squared norm, scalar part
+  double gs[P] = {};   // next column's products, scalar part
+  Index i = first;
+  // Row k + 1 is the next column's diagonal: updated, but not in its sums.
+  if (s.top <= k + 1 && i < rows) {
+    const double v = col[Q][i] * inv;
+    col[Q][i] = v;
+    for (int p = 0; p < Q; ++p) vs[p] += col[p][i] * v;
+    for (int j = Q + 1; j < P; ++j) col[j][i] -= d[j] * v;
+    ++i;
+  }
+  V vacc[P > 1 ? P - 1 : 1] = {};
+  V sacc = {};
+  V gacc[P] = {};
+  for (; i + W <= rows; i += W) {
+    const V v = *reinterpret_cast<const V*>(col[Q] + i) * inv;
+    *reinterpret_cast<V*>(col[Q] + i) = v;
+    for (int p = 0; p < Q; ++p) vacc[p] += *reinterpret_cast<const V*>(col[p] + i) * v;
+    if constexpr (Q + 1 < P) {
+      const V c1 = *reinterpret_cast<const V*>(col[Q + 1] + i) - d[Q + 1] * v;
+      *reinterpret_cast<V*>(col[Q + 1] + i) = c1;
+      sacc += c1 * c1;
+      for (int j = Q + 2; j < P; ++j) {
+        const V cj = *reinterpret_cast<const V*>(col[j] + i) - d[j] * v;
+        *reinterpret_cast<V*>(col[j] + i) = cj;
+        gacc[j] += c1 * cj;
+      }
+    }
+  }
+  for (; i < rows; ++i) {
+    const double v = col[Q][i] * inv;
+    col[Q][i] = v;
+    for (int p = 0; p < Q; ++p) vs[p] += col[p][i] * v;
+    if constexpr (Q + 1 < P) {
+      const double c1 = col[Q + 1][i] - d[Q + 1] * v;
+      col[Q + 1][i] = c1;
+      ss += c1 * c1;
+      for (int j = Q + 2; j < P; ++j) {
+        const double cj = col[j][i] - d[j] * v;
+        col[j][i] = cj;
+        gs[j] += c1 * cj;
+      }
+    }
+  }
+  for (int p = 0; p < Q; ++p) s.vv[p][Q] = col[p][k] + (hsum<W>(vacc[p]) + vs[p]);
+  if constexpr (Q + 1 < P) {
+    s.sig = hsum<W>(sacc) + ss;
+    for (int j = Q + 2; j < P; ++j) s.g[j] = hsum<W>(gacc[j]) + gs[j];
+    fused_step<W, P, Q + 1>(s);
+  }
+}
+
+// factor_panel and panel_t for a full panel (nb = P), fused.
+template <int W, int P>
+PB_KERNEL void factor_panel_fused(double* a, Index rows, Index ld, Index top, Panel<P>& pn, double* tau) {
+  using V = typename Lanes<W>::Vec;
+  FusedPanel<P> s;
+  for (int q = 0; q < P; ++q) s.col[q] = a + (pn.k0 + q) * ld;
+  s.rows = rows;
+  s.top = top;
+  s.k0 = pn.k0;
+  {
+    // The first column's sums.
+    const Index first = std::max(pn.k0 + 1, top);
+    V sacc = {};
+    V gacc[P] = {};
+    Index i = first;
+    for (; i + W <= rows; i += W) {
+      const V c0 = *reinterpret_cast<const V*>(s.col[0] + i);
+      sacc += c0 * c0;
+      for (int j = 1; j < P; ++j) gacc[j] += c0 * *reinterpret_cast<const V*>(s.col[j] + i);
+    }
+    double ss = 0.0, gs[P] = {};
+    for (; i < rows; ++i) {
+      ss += s.col[0][i] * s.col[0][i];
+      for (int j = 1; j < P; ++j) gs[j] += s.col[0][i] * s.col[j][i];
+    }
+    s.sig = hsum<W>(sacc) + ss;
+    for (int j = 1; j < P; ++j) s.g[j] = hsum<W>(gacc[j]) + gs[j];
+  }
+  fused_step<W, P, 0>(s);
+  for (int p = 0; p < P; ++p) {
+    tau[p] = s.tau[p];
+    for (int q = 0; q < P; ++q) pn.t[p][q] = 0.0;
+  }
+  for (int q = 0; q < P; ++q) {
+    pn.t[q][q] = tau[q];
+    for (int p = 0; p < q; ++p) {
+      double sum = 0.0;
+      for (int r = p; r < q; ++r) sum += pn.t[p][r] * s.vv[r][q];
+      pn.t[p][q] = -tau[q] * sum;
+    }
+  }
+}
+
 // T (upper triangular): T(q,q) = tau_q, T(0:q,q) = -tau_q T(0:q,0:q) V(:,0:q)^T V(:,q).
 template <int W, int P>
 PB_KERNEL void panel_t(Panel<P>& pn, const double* tau) {
@@ -463,12 +652,32 @@ PB_KERNEL void triangularize_lanes(double* a, Index rows, Index cols, Index ld, 
     pn.dense = std::max(pn.bulk, top);
     pn.rows = rows;
     double tau[P];
-    factor_panel<W, P>(a, rows, ld, top, k0, pn.nb, tau);
-    if (pn.bulk >= cols) continue;
     for (int q = 0; q < P; ++q) pn.vcol[q] = a + (k0 + std::min(q, pn.nb - 1)) * ld;
-    panel_t<W, P>(pn, tau);
+    if (pn.nb == P) {
+      factor_panel_fused<W, P>(a, rows, ld, top, pn, tau);
+      if (pn.bulk >= cols) continue;
+    } else {
+      factor_panel<W, P>(a, rows, ld, top, k0, pn.nb, tau);
+      if (pn.bulk >= cols) continue;
+      panel_t<W, P>(pn, tau);
+    }
     // Trailing columns, G at a time.
     Index j = pn.bulk;
+    if constexpr (G == 4) {
+      // 4 k + 2 columns (the usual case: 2 N + 2 columns): the last 6 in one pass rather than
+      // 4 then 2 (a pass over 2 columns loads V for half the work).
+      if ((cols - j) % 4 == 2 && cols - j >= 6) {
+        for (; j + 6 + G <= cols; j += G) {
+          double* c[G];
+          for (int g = 0; g < G; ++g) c[g] = a + (j + g) * ld;
+          apply_panel<W, P, G>(pn, c);
+        }
+        double* c[6];
+        for (int g = 0; g < 6; ++g) c[g] = a + (j + g) * ld;
+        apply_panel<W, P, 6>(pn, c);
+        j += 6;
+      }
+    }
     for (; j + G <= cols; j += G) {
       double* c[G];
       for (int g = 0; g < G; ++g) c[g] = a + (j + g) * ld;
@@ -582,15 +791,36 @@ class Fitter {
       : data_(data), weights_(weights), opts_(o), ns_(omega.size()), nc_(data.cols()), n_(o.order),
         offs_(asymptote_terms(o.asymptote)) {
     w_ = omega / scale;
-    basis_.resize(ns_, n_ + 2);
-    wd_.resize(std::min(kBlockPoints, ns_));
-    data_max_ = data.cwiseAbs().maxCoeff();
+    col_re_.resize(std::min(kBlockPoints, ns_), 2);
+    col_im_.resize(std::min(kBlockPoints, ns_), 2);
+    ones_.setOnes(std::min(kBlockPoints, ns_));
+    zeros_.setZero(std::min(kBlockPoints, ns_));
+    // max |H| (|.| of the element of largest |.|^2: one hypot instead of one per point)
+    Index kmax = 0, imax = 0;
+    data.cwiseAbs2().maxCoeff(&kmax, &imax);
+    data_max_ = std::abs(data(kmax, imax));
     double wd = 0.0;
     for (Index i = 0; i < nc_; ++i) {
       const auto w = weights.col(weights.cols() == 1 ? 0 : i);
       for (Index k = 0; k < ns_; ++k) wd += w(k) * w(k) * std::norm(data(k, i));
     }
     weighted_data_norm_ = std::sqrt(wd);
+    // Weights common to the outputs: one column, or one constant per output (e.g. "output-scale").
+    // A constant factor c on an output's rows scales its sigma block R22 by c and leaves its
+    // residues alone, so the latter are treated as common (unit) row weights with the factor on
+    // the output's sigma columns (out_scale_): the left block is then shared by the outputs.
+    out_scale_.setOnes(nc_);
+    common_ = weights.cols() == 1;
+    if (common_) {
+      common_w_ = weights.col(0);
+    } else {
+      common_ = true;
+      for (Index i = 0; i < nc_ && common_; ++i) {
+        common_ = (weights.col(i).array() == weights(0, i)).all();
+        out_scale_(i) = weights(0, i);
+      }
+      if (common_) common_w_.setOnes(ns_);
+    }
   }
 
   // Quality of a model with these poles and the coefficients x from identify(): the relative
@@ -602,8 +832,10 @@ class Fitter {
     const Index cols = n_ + offs_;
     for (Index i = 0; i < nc_; ++i) {
       const auto w = weights_.col(weights_.cols() == 1 ? 0 : i);
-      const CVector fit = basis_.leftCols(cols) * x.col(i).cast<Complex>();
-      err += (w.cast<Complex>().cwiseProduct(fit - data_.col(i))).squaredNorm();
+      const Vector fit_re = basis_re().leftCols(cols) * x.col(i);
+      const Vector fit_im = basis_im().leftCols(cols) * x.col(i);
+      err += (w.cwiseProduct(fit_re - data_.col(i).real())).squaredNorm() +
+             (w.cwiseProduct(fit_im - data_.col(i).imag())).squaredNorm();
     }
     significance.setZero(n_);
     for (Index k = 0; k < n_; ++k) {
@@ -623,9 +855,6 @@ class Fitter {
 
   // One pole relocation: returns the zeros of sigma (canonical, possibly unstable).
   CVector relocate(const CVector& poles) {
-    fill_basis(w_, poles, basis_);
-    basis_.col(n_).setOnes();
-    basis_.col(n_ + 1) = kJ * w_.cast<Complex>();
     CVector relocated;
     if (opts_.relaxed) {
       if (solve_sigma(poles, /*relaxed=*/true, relocated)) return relocated;
@@ -644,28 +873,43 @@ class Fitter {
   // [R_A Q^T B] (TriangularFactor); the column-pivoted QR that solves it then works on the small
   // R_A: the same least-squares solution (||A x - b|| and ||R_A x - (Q^T b)_top|| differ by a
   // constant), for a fraction of the cost of pivoting on the tall matrix.
-  Matrix identify(const CVector& poles) {
-    fill_basis(w_, poles, basis_);
-    basis_.col(n_).setOnes();
-    basis_.col(n_ + 1) = kJ * w_.cast<Complex>();
+  //
+  // keep_basis: leave the whole basis in basis_ for assess(). Without it (and with weights common
+  // to the outputs) the basis is computed per row block and pole, as in reduce_sigma_blocks.
+  Matrix identify(const CVector& poles, bool keep_basis) {
     const Index cols = n_ + offs_;
     Matrix x(cols, nc_);
-    const bool common = weights_.cols() == 1;
+    const bool common = common_;
+    const bool whole_basis = keep_basis || !common;
+    if (whole_basis) fill_basis(poles);
     const Index passes = common ? 1 : nc_;
     const Index nrhs = common ? nc_ : 1;
     const Index block_points = std::min(kBlockPoints, ns_);
     for (Index pass = 0; pass < passes; ++pass) {
-      const auto w = weights_.col(pass);
+      const Eigen::Ref<const Vector> w = common ? Eigen::Ref<const Vector>(common_w_)
+                                                : Eigen::Ref<const Vector>(weights_.col(pass));
       const Index first = common ? 0 : pass;
       tall_.reset(cols + nrhs, 2 * block_points);
       for (Index k0 = 0; k0 < ns_; k0 += block_points) {
         const Index cnt = std::min(block_points, ns_ - k0);
         auto rows = tall_.block(2 * cnt);
-        for (Index j = 0; j < cols; ++j) {
-          for (Index k = 0; k < cnt; ++k) {
-            rows(k, j) = w(k0 + k) * basis_(k0 + k, j).real();
-            rows(cnt + k, j) = w(k0 + k) * basis_(k0 + k, j).imag();
+        const double* wk = w.data() + k0;
+        if (whole_basis) {
+          for (Index j = 0; j < cols; ++j) {
+            scaled_rows(cnt, wk, basis_re().col(j).data() + k0, basis_im().col(j).data() + k0, rows.col(j).data());
           }
+        } else {
+          const double* wsc = w_.data() + k0;
+          for (Index j = 0; j < n_;) {
+            const Index c = basis_columns(wsc, cnt, poles(j), col_re_.col(0).data(), col_im_.col(0).data(),
+                                          col_re_.col(1).data(), col_im_.col(1).data());
+            for (Index q = 0; q < c; ++q) {
+              scaled_rows(cnt, wk, col_re_.col(q).data(), col_im_.col(q).data(), rows.col(j + q).data());
+            }
+            j += c;
+          }
+          if (offs_ >= 1) scaled_rows(cnt, wk, ones_.data(), zeros_.data(), rows.col(n_).data());
+          if (offs_ >= 2) scaled_rows(cnt, wk, zeros_.data(), wsc, rows.col(n_ + 1).data());
         }
         for (Index i = 0; i < nrhs; ++i) {
           for (Index k = 0; k < cnt; ++k) {
@@ -702,21 +946,16 @@ class Fitter {
     stacked_.resize(stacked_rows, nsig);
     stacked_rhs_.setZero(stacked_rows);
 
-    if (weights_.cols() == 1) {
-      reduce_sigma_blocks(weights_.col(0), 0, nc_, relaxed);
+    if (common_) {
+      reduce_sigma_blocks(poles, common_w_, 0, nc_, relaxed);
     } else {
-      for (Index i = 0; i < nc_; ++i) reduce_sigma_blocks(weights_.col(i), i, 1, relaxed);
+      for (Index i = 0; i < nc_; ++i) reduce_sigma_blocks(poles, weights_.col(i), i, 1, relaxed);
     }
     if (relaxed) {
       // Relaxed normalization (Gustavsen 2006, eq. 8): Re sum_k sigma(s_k) = Ns, scaled by the
       // size of the data so that the constraint row weighs like the others.
-      double scale = 0.0;
-      for (Index i = 0; i < nc_; ++i) {
-        const auto w = weights_.col(weights_.cols() == 1 ? 0 : i);
-        for (Index k = 0; k < ns_; ++k) scale += w(k) * w(k) * std::norm(data_(k, i));
-      }
-      scale = std::sqrt(scale) / static_cast<double>(ns_);
-      for (Index j = 0; j < nsig; ++j) stacked_(nc_ * nsig, j) = scale * basis_.col(j).sum().real();
+      const double scale = weighted_data_norm_ / static_cast<double>(ns_);
+      for (Index j = 0; j < nsig; ++j) stacked_(nc_ * nsig, j) = scale * basis_sum_(j);
       stacked_rhs_(nc_ * nsig) = static_cast<double>(ns_) * scale;
     }
 
@@ -760,7 +999,12 @@ class Fitter {
   // Q^T applied to every output's [B b]; each output's remaining rows are then reduced on their own
   // (own_[i]). R22 is that of the QR of the output's [A B b] up to the signs of its rows, which do
   // not change the stacked least-squares solution; per output this saves the QR of A.
-  void reduce_sigma_blocks(const Eigen::Ref<const Vector>& w, Index first, Index count, bool relaxed) {
+  //
+  // The basis is computed per row block and column (basis_columns) and used at once, for the left
+  // block and every output's sigma block, instead of being stored whole (it would take L2 cache
+  // from the QR); its real parts are summed on the way for the relaxed normalization (basis_sum_).
+  void reduce_sigma_blocks(const CVector& poles, const Eigen::Ref<const Vector>& w, Index first, Index count,
+                           bool relaxed) {
     const Index left = n_ + offs_;
     const Index nsig = relaxed ? n_ + 1 : n_;
     const Index own_cols = nsig + (relaxed ? 0 : 1);  // B, and b with the fixed normalization
@@ -770,35 +1014,52 @@ class Fitter {
     tall_.reset(left + count * own_cols, 2 * block_points, shared ? left : -1);
     if (static_cast<Index>(own_.size()) < count) own_.resize(static_cast<size_t>(count));
     for (Index i = 0; i < count; ++i) own_[static_cast<size_t>(i)].reset(own_cols, 2 * block_points);
+    basis_sum_.setZero(n_ + 2);
+    wd_re_.resize(block_points, count);
+    wd_im_.resize(block_points, count);
     for (Index k0 = 0; k0 < ns_; k0 += block_points) {
       const Index cnt = std::min(block_points, ns_ - k0);
       auto rows = tall_.block(2 * cnt);
-      for (Index j = 0; j < left; ++j) {
-        for (Index k = 0; k < cnt; ++k) {
-          const Complex v = w(k0 + k) * basis_(k0 + k, j);
-          rows(k, j) = v.real();
-          rows(cnt + k, j) = v.imag();
-        }
-      }
+      const double* wk = w.data() + k0;
       for (Index i = 0; i < count; ++i) {
-        for (Index k = 0; k < cnt; ++k) wd_(k) = -w(k0 + k) * data_(k0 + k, first + i);
-        const Index c0 = left + i * own_cols;
-        for (Index j = 0; j < nsig; ++j) {
-          for (Index k = 0; k < cnt; ++k) {
-            // basis * wd in real arithmetic (no NaN check per product, see fill_basis)
-            const Complex x = basis_(k0 + k, j), y = wd_(k);
-            rows(k, c0 + j) = x.real() * y.real() - x.imag() * y.imag();
-            rows(cnt + k, c0 + j) = x.real() * y.imag() + x.imag() * y.real();
-          }
+        double* wdr = wd_re_.col(i).data();
+        double* wdi = wd_im_.col(i).data();
+        const double scale = common_ ? out_scale_(first + i) : 1.0;  // the output's constant weight
+        for (Index k = 0; k < cnt; ++k) {
+          const Complex h = data_(k0 + k, first + i);
+          wdr[k] = -wk[k] * scale * h.real();
+          wdi[k] = -wk[k] * scale * h.imag();
         }
         if (!relaxed) {
           // Fixed normalization: sigma's constant is 1, so its term moves to the right-hand side.
+          const Index c = left + i * own_cols + nsig;
           for (Index k = 0; k < cnt; ++k) {
-            rows(k, c0 + nsig) = -wd_(k).real();
-            rows(cnt + k, c0 + nsig) = -wd_(k).imag();
+            rows(k, c) = -wdr[k];
+            rows(cnt + k, c) = -wdi[k];
           }
         }
       }
+      // Column j of the basis: the left block's column j and, for j < nsig, each output's sigma column j.
+      const auto put = [&](Index j, const double* bre, const double* bim) {
+        if (j < left) scaled_rows(cnt, wk, bre, bim, rows.col(j).data());
+        if (j >= nsig) return;
+        basis_sum_(j) += Eigen::Map<const Vector>(bre, cnt).sum();  // vectorized (a plain loop sums in order)
+        for (Index i = 0; i < count; ++i) {
+          const double* wdr = wd_re_.col(i).data();
+          const double* wdi = wd_im_.col(i).data();
+          product_rows(cnt, bre, bim, wdr, wdi, rows.col(left + i * own_cols + j).data());
+        }
+      };
+      const double* wsc = w_.data() + k0;
+      for (Index j = 0; j < n_;) {
+        const Index c = basis_columns(wsc, cnt, poles(j), col_re_.col(0).data(), col_im_.col(0).data(),
+                                      col_re_.col(1).data(), col_im_.col(1).data());
+        for (Index q = 0; q < c; ++q) put(j + q, col_re_.col(q).data(), col_im_.col(q).data());
+        j += c;
+      }
+      // sigma's constant and d (1), then e (s).
+      put(n_, ones_.data(), zeros_.data());
+      if (n_ + 1 < std::max(left, nsig)) put(n_ + 1, zeros_.data(), wsc);
       tall_.add_block();
       const auto residual = tall_.residual();
       if (!shared || residual.rows() == 0) continue;
@@ -823,11 +1084,34 @@ class Fitter {
 
   const CMatrix& data_;
   const Matrix& weights_;
+  bool common_ = true;  // the same row weights (common_w_) for all outputs, up to out_scale_
+  Vector common_w_;
+  Vector out_scale_;
   const VectorFittingOptions& opts_;
   Index ns_, nc_, n_, offs_;
   Vector w_;  // omega / scale
-  CMatrix basis_;
-  CVector wd_;  // -w H of one output over one row block
+  // The basis at the scaled frequencies for the current poles (fill_basis), then sigma's constant
+  // (1) and s: real and imaginary parts.
+  // (1) and s: real parts in the left half of basis_, imaginary parts in the right half (one
+  // allocation: two of this size per call cost page faults).
+  void fill_basis(const CVector& poles) {
+    basis_.resize(ns_, 2 * (n_ + 2));  // allocated at the first use only
+    ident::fill_basis(w_, poles, basis_re(), basis_im());
+    basis_re().col(n_).setOnes();
+    basis_im().col(n_).setZero();
+    basis_re().col(n_ + 1).setZero();
+    basis_im().col(n_ + 1) = w_;
+  }
+  Eigen::Block<Matrix, Eigen::Dynamic, Eigen::Dynamic, true> basis_re() { return basis_.leftCols(n_ + 2); }
+  Eigen::Block<Matrix, Eigen::Dynamic, Eigen::Dynamic, true> basis_im() { return basis_.rightCols(n_ + 2); }
+  Eigen::Block<const Matrix, Eigen::Dynamic, Eigen::Dynamic, true> basis_re() const { return basis_.leftCols(n_ + 2); }
+  Eigen::Block<const Matrix, Eigen::Dynamic, Eigen::Dynamic, true> basis_im() const { return basis_.rightCols(n_ + 2); }
+
+  Matrix basis_;
+  Matrix wd_re_, wd_im_;  // -w H of each output over one row block
+  Matrix col_re_, col_im_;  // one pole's basis columns over one row block
+  Vector ones_, zeros_;
+  Vector basis_sum_;  // sum of each basis column's real part over the points
   TriangularFactor tall_;
   std::vector<TriangularFactor> own_;  // per output: the rows of [B b] left by the QR of A
   Matrix stacked_;
@@ -961,10 +1245,11 @@ void VectorFittingOptions::validate() const {
 namespace {
 
 // The model d + s e + sum_n r_n / (s - p_n) of every output at the points s (one row per point),
-// frequencies innermost (their loops vectorize). r / z as r conj(z) / |z|^2 (no overflow concern at
-// frequencies where the model is used), the product in real arithmetic (GCC's complex product
-// checks each result for NaN).
-CMatrix model_at(const VectorFittingResult& m, const CVector& s) {
+// frequencies innermost (their loops vectorize; compiled for AVX-512 and AVX2 too, PB_CLONES).
+// r / z as r conj(z) / |z|^2 (no overflow concern at frequencies where the model is used; one
+// reciprocal per term), the product in real arithmetic (GCC's complex product checks each result
+// for NaN).
+PB_CLONES CMatrix model_at(const VectorFittingResult& m, const CVector& s) {
   const Index ns = s.size();
   CMatrix out(ns, m.outputs());
   for (Index i = 0; i < m.outputs(); ++i) {
@@ -978,8 +1263,8 @@ CMatrix model_at(const VectorFittingResult& m, const CVector& s) {
       Complex* o = out.col(i).data();
       for (Index k = 0; k < ns; ++k) {
         const double zr0 = s(k).real() - pr, zi0 = s(k).imag() - pi;
-        const double n2 = zr0 * zr0 + zi0 * zi0;
-        const double zr = zr0 / n2, zi = -zi0 / n2;
+        const double inv = 1.0 / (zr0 * zr0 + zi0 * zi0);
+        const double zr = zr0 * inv, zi = -zi0 * inv;
         o[k] += Complex(rr * zr - ri * zi, rr * zi + ri * zr);
       }
     }
@@ -1071,7 +1356,7 @@ std::optional<Matrix> relocate_until_settled(Fitter& fitter, const VectorFitting
       break;
     }
     if (!assess_each) continue;
-    x = fitter.identify(poles);
+    x = fitter.identify(poles, /*keep_basis=*/true);
     const double error = fitter.assess(poles, *x, significance);
     result.last_pole_change = pole_change(poles, before, significance, options.significance_floor);
     if (result.last_pole_change < options.pole_tolerance) {
@@ -1228,7 +1513,7 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
                              "); try another order, more iterations, weights or a looser tolerance",
                          /*retry_may_help=*/true);
   }
-  if (!x) x = fitter.identify(poles);
+  if (!x) x = fitter.identify(poles, /*keep_basis=*/false);
   unpack_solution(*x, poles, scale, options, data.cols(), result);
   realize(result);
   assess_quality(omega, data, options.order, result);
