@@ -28,11 +28,16 @@ if(PIEZOBENCH_FUZZ)
   if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
     message(FATAL_ERROR "PIEZOBENCH_FUZZ needs clang (libFuzzer): configure with -DCMAKE_CXX_COMPILER=clang++-14")
   endif()
-  # Everything is instrumented for libFuzzer's coverage (fuzzer-no-link: counters and comparison
-  # hooks; without libFuzzer linked, the sanitizer runtime's empty hooks take them), on top of the
-  # sanitizers above; only the fuzz targets link libFuzzer (fuzz/). clang's `undefined` group already
-  # holds float-cast-overflow; it has no bounds-strict.
-  target_compile_options(piezobench_options INTERFACE -fsanitize=fuzzer-no-link)
+  # The modules that hold a reader the fuzz targets drive (fuzz/: the files, TOML documents,
+  # datagrams and HTTP requests piezobench parses, and what each target runs on the result) are
+  # instrumented for libFuzzer's coverage (fuzzer-no-link: counters and comparison hooks; without
+  # libFuzzer linked, the sanitizer runtime's empty hooks take them), on top of the sanitizers above;
+  # only the fuzz targets link libFuzzer (fuzz/). The numerical modules below them (core, dsp, lti,
+  # ident, control, plant, metrology, report), the app and the test programs are not: the same tree
+  # runs the test suite (scripts/setup.sh test --sanitize), and the hooks on every comparison of the
+  # numerical loops made its tests 1.5-1.9 times as long (docs/performance.md, "Build time"). clang's
+  # `undefined` group already holds float-cast-overflow; it has no bounds-strict.
+  set(PIEZOBENCH_FUZZ_COVERAGE_MODULES io fem apa bench campaign rt station web)
 endif()
 
 # Build time (docs/performance.md, "Build time"): CI builds everything cold, twice. Each module,
@@ -127,6 +132,9 @@ function(piezobench_add_module)
   # The warnings and sanitizer flags are for this build only; an installed module asks for C++20.
   target_link_libraries(${target} PUBLIC "$<BUILD_INTERFACE:piezobench::options>" ${module_deps} ${ARG_DEPS})
   target_compile_features(${target} PUBLIC cxx_std_20)
+  if(PIEZOBENCH_FUZZ AND ARG_NAME IN_LIST PIEZOBENCH_FUZZ_COVERAGE_MODULES)
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON EXPORT_NAME ${ARG_NAME})
   piezobench_unity_build(${target})
   set_property(GLOBAL APPEND PROPERTY PIEZOBENCH_MODULES ${target})

@@ -6,14 +6,15 @@
 #   scripts/setup.sh build [--sanitize]  install what is missing and build
 #   scripts/setup.sh build --fuzz        install what is missing and build the fuzz targets (below)
 #   scripts/setup.sh fuzz                install what is missing, build the readers' libFuzzer
-#                                        targets with clang in build-fuzz/, replay the regression
+#                                        targets in build-sanitize/, replay the regression
 #                                        corpus (fatal) and fuzz for PIEZOBENCH_FUZZ_SECONDS
 #                                        (default 88) in all, findings reported (docs/fuzzing.md)
 #   scripts/setup.sh install             install what is missing, nothing else
 #
 # Installing is idempotent: packages already present are left alone, and nothing is installed
 # (not even an `apt-get update`) when everything is there. --sanitize builds in build-sanitize/
-# with AddressSanitizer and UndefinedBehaviorSanitizer; the normal build lives in build/.
+# with clang, AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer's coverage instrumentation
+# (the same tree holds the fuzz targets); the normal build (g++, Release) lives in build/.
 set -euo pipefail
 
 job="${1:-}"
@@ -99,23 +100,22 @@ fi
 bash "$root/tests/js/install.sh" >/dev/null
 [ "$job" = install ] && exit 0
 
-if [ "$fuzz_tree" -eq 1 ]; then
+if [ "$fuzz_tree" -eq 1 ] || [ "$sanitize" -eq 1 ]; then
+  # One tree for the sanitizers and the fuzz targets: clang with AddressSanitizer, UBSan and
+  # libFuzzer's coverage instrumentation on the modules (PIEZOBENCH_FUZZ, cmake/PiezobenchTargets.cmake).
+  # The test programs run on it (--sanitize), the fuzz targets link the same objects (fuzz, --fuzz:
+  # only the target `fuzzers` and what it links). One clang tree instead of a g++ sanitizer tree and
+  # a clang fuzz tree: about a third less compile CPU in CI (docs/performance.md, "Build time").
   # clang-14 is in the packages list above, so a missing compiler is an error, never a skip.
   command -v clang++-14 >/dev/null || { echo "setup.sh: clang++-14 not found (package clang-14)" >&2; exit 1; }
-  build_dir="$root/build-fuzz"
-  # clang with ASan, UBSan and libFuzzer's coverage instrumentation; only the targets `fuzzers` needs
-  # are built (the reader modules and their dependencies). -O1 -g1: line tables for the stack traces.
-  config=(-DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
-          "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${PIEZOBENCH_FUZZ_CXXFLAGS:--O1 -g1 -DNDEBUG}"
-          -DPIEZOBENCH_FUZZ=ON -DPIEZOBENCH_BUILD_TESTS=OFF -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
-  targets=(--target fuzzers)
-elif [ "$sanitize" -eq 1 ]; then
   build_dir="$root/build-sanitize"
   # No Python module there: python3 would need the sanitizer runtime preloaded to load it.
   # -O1 -g1: line tables for the sanitizers' stack traces at about half the compile time of -O2 -g.
-  config=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
-          -DPIEZOBENCH_SANITIZE=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
+  config=(-DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
+          "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${PIEZOBENCH_FUZZ_CXXFLAGS:--O1 -g1 -DNDEBUG}"
+          -DPIEZOBENCH_FUZZ=ON -DPIEZOBENCH_BUILD_BENCHMARKS=OFF -DPIEZOBENCH_BUILD_PYTHON=OFF)
   targets=()
+  if [ "$fuzz_tree" -eq 1 ]; then targets=(--target fuzzers); fi
 else
   build_dir="$root/build"
   # The Python module is built for Debian's interpreter (where apt puts numpy, scipy and pytest),
@@ -133,7 +133,7 @@ case "$job" in
   fuzz)
     # The regression corpus: known inputs, any failure fails the job.
     bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" regression
-    # Fresh mutations: a finding is reported and kept in build-fuzz/fuzz-artifacts/, not fatal (a
+    # Fresh mutations: a finding is reported and kept in build-sanitize/fuzz-artifacts/, not fatal (a
     # new mutation must not fail CI for an unrelated change); PIEZOBENCH_FUZZ_FINDINGS=fail makes it fatal.
     PIEZOBENCH_FUZZ_FINDINGS="${PIEZOBENCH_FUZZ_FINDINGS:-report}" \
       bash "$root/scripts/fuzz/run_fuzz.sh" "$build_dir" fuzz "${PIEZOBENCH_FUZZ_SECONDS:-88}"

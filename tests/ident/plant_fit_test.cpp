@@ -65,7 +65,9 @@ TEST(IffPlantFit, ResponseMatchesTransferFunction) {
 // The NMP verdict (report section 2.4) on the report's plant with the demo's delay (400 us) and a
 // zero as light as the demo units' (xz = -+0.003: 2 xz f_z = 0.26 Hz wide, about one 0.25 Hz Welch
 // line), with additive noise of 0.5 % of g0 (the sensor's noise does not shrink in the dip). The
-// data's phase change across the dip sits at 180 +- 3 deg in magnitude, within the ambiguity: the
+// data's phase change across the dip sits at 180 +- 4 deg in magnitude (seed 4: 178.3 deg built with
+// g++ -O3, 176.4 deg with clang -O1: the band examined follows the fitted zero's damping, which
+// the compilers' round-off moves), well inside the 20 deg ambiguity: the
 // plant fit decides, and calls the mirrored zero non-minimum-phase for every seed and the
 // minimum-phase one never. (At 0.7 % noise and |xz| <= 0.0025 the fitted xz collapses towards 0
 // and can flip along with the phase: both read the same few lines at the dip.)
@@ -100,8 +102,8 @@ TEST(ZeroPhaseVerdict, AmbiguousPhaseChangeIsDecidedByThePlantFit) {
         if (std::abs(a.natural_frequency / p.wz - 1.0) < 0.01) zero = &a;
       }
       ASSERT_NE(zero, nullptr) << "xz " << xz << " seed " << seed;
-      // Mirrored: 180 +- 3 deg; minimum-phase: the delay takes a few more degrees off.
-      EXPECT_NEAR(std::abs(zero->phase_change_deg), 180.0, xz < 0.0 ? 3.0 : 10.0) << "xz " << xz << " seed " << seed;
+      // Mirrored: 180 +- 4 deg; minimum-phase: the delay takes a few more degrees off.
+      EXPECT_NEAR(std::abs(zero->phase_change_deg), 180.0, xz < 0.0 ? 4.0 : 10.0) << "xz " << xz << " seed " << seed;
       IffPlantFitOptions o;
       o.fmin_Hz = 20.0;
       o.fmax_Hz = 500.0;
