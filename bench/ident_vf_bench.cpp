@@ -51,16 +51,21 @@ Problem make_problem() {
   return pr;
 }
 
-void BM_VectorFit20Poles2000Points5Iterations(benchmark::State& state) {
-  const Problem pr = make_problem();
+// 20 poles and exactly 5 relocations: no early stop and no per-iteration residue identification.
+piezobench::ident::VectorFittingOptions five_relocations() {
   piezobench::ident::VectorFittingOptions o;
   o.order = 20;
   o.max_iterations = 5;
-  // Exactly 5 relocations: no early stop and no per-iteration residue identification.
   o.pole_tolerance = 0.0;
   o.residual_tolerance = 0.0;
   o.significance_floor = 0.0;
   o.fail_if_not_converged = false;
+  return o;
+}
+
+void BM_VectorFit20Poles2000Points5Iterations(benchmark::State& state) {
+  const Problem pr = make_problem();
+  const piezobench::ident::VectorFittingOptions o = five_relocations();
   for (auto _ : state) {
     auto r = piezobench::ident::vector_fit(pr.omega, pr.data, o);
     benchmark::DoNotOptimize(r.poles.data());
@@ -93,13 +98,7 @@ void BM_VectorFit20Poles2000Points4Outputs5Iterations(benchmark::State& state) {
     data.col(o) = (one.data.col(0).array() - 0.1) * (Complex(1.0, 0.2 * o) / (1.0 + o)) + 0.1;
     weights.col(o).setConstant(std::sqrt(data.col(o).norm()));
   }
-  piezobench::ident::VectorFittingOptions o;
-  o.order = 20;
-  o.max_iterations = 5;
-  o.pole_tolerance = 0.0;
-  o.residual_tolerance = 0.0;
-  o.significance_floor = 0.0;
-  o.fail_if_not_converged = false;
+  const piezobench::ident::VectorFittingOptions o = five_relocations();
   for (auto _ : state) {
     auto r = piezobench::ident::vector_fit(one.omega, data, weights, o);
     benchmark::DoNotOptimize(r.poles.data());
