@@ -544,8 +544,8 @@ void add_frf_commands(CLI::App& app, Action& action) {
       ->capture_default_str()
       ->check(parsed_by([](const std::string& x) { (void)ident::asymptote_from_string(x); }, "ASYMPTOTE"));
   fit->add_option("--weighting", v->weighting,
-                  "output-scale (each output by 1/rms|H|: outputs in other units count alike), unit, inverse-magnitude or "
-                  "inverse-sqrt-magnitude")
+                  "output-scale (each output by 1/rms|H|: outputs in other units count alike), unit, inverse-magnitude, "
+                  "inverse-sqrt-magnitude or inverse-std (each point by 1/its standard deviation: the file's std columns)")
       ->capture_default_str()
       ->check(parsed_by([](const std::string& x) { (void)ident::weighting_from_string(x); }, "WEIGHTING"));
   fit->add_option("--max-iterations", v->max_iterations, "pole relocations at most")->capture_default_str();

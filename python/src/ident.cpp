@@ -39,7 +39,8 @@ const Options<VectorFittingOptions>& vf_options() {
                   &pole_spacing_from_string, "\"log\" or \"lin\"")
         .add("starting_damping", &VectorFittingOptions::starting_damping, "damping of the automatic starting poles")
         .add_enum("weighting", &VectorFittingOptions::weighting, &ident::to_string, &weighting_from_string,
-                  "\"unit\", \"inverse-magnitude\" or \"inverse-sqrt-magnitude\"")
+                  "\"unit\", \"output-scale\", \"inverse-magnitude\", \"inverse-sqrt-magnitude\" or \"inverse-std\" "
+                  "(vector_fit(frf) of an FRF with std_H: each point by 1/its standard deviation)")
         .add("point_weights", &VectorFittingOptions::point_weights,
              "one weight per frequency point (e.g. 1/std), multiplying the row weights; empty = none")
         .add("frequency_scale", &VectorFittingOptions::frequency_scale, "rad/s; 0 = the highest omega");

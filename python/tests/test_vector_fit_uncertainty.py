@@ -268,3 +268,24 @@ def test_bad_arguments_are_input_errors():
         ident.zero_uncertainty(fit, u, 1, [1j])
     with pytest.raises(pb.InputError):
         ident.response_covariance(fit, u, 1, 0.0)
+
+
+def test_inverse_std_weighting_of_an_frf_is_the_weighted_fit_of_its_arrays():
+    """weighting="inverse-std" on a dsp.Frf fits, and takes the covariance, with the rows weighted by
+    1 / std_H: the same poles and standard errors as the array form given those weights (computed
+    here with numpy); an Frf without std_H is refused, naming the field."""
+    omega = _grid()
+    sd = 0.001 + 0.002 * np.abs(_model(1j * omega, *_truth(), _D))
+    h = _noisy(omega, 1.0, np.random.default_rng(12))
+    h = _model(1j * omega, *_truth(), _D) + (h - _model(1j * omega, *_truth(), _D)) * sd
+    options = dict(_OPTIONS, weighting="inverse-std")
+    frf = dsp.Frf(omega / (2 * np.pi), h, std_H=sd)
+    by_std = ident.vector_fit(frf, **options)
+    explicit = ident.vector_fit(omega, h, weights=1.0 / sd, **dict(_OPTIONS, weighting="unit"))
+    np.testing.assert_allclose(by_std.poles, explicit.poles, rtol=1e-10)
+    u = ident.vector_fit_uncertainty(frf, by_std, **options)
+    v = ident.vector_fit_uncertainty(omega, h, explicit, weights=1.0 / sd, std_H=sd, **dict(_OPTIONS, weighting="unit"))
+    np.testing.assert_allclose(u.covariance.standard_error, v.covariance.standard_error, rtol=1e-8)
+    with pytest.raises(pb.InputError) as e:
+        ident.vector_fit(dsp.Frf(omega / (2 * np.pi), h), **options)
+    assert "std_H" in e.value.field

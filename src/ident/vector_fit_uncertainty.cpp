@@ -221,7 +221,7 @@ VectorFitUncertainty vector_fit_uncertainty(const dsp::Frf& frf, const VectorFit
   }
   const Vector omega = kTwoPi * frf.freq_Hz;
   const Vector pairs = variance ? dsp::adjacent_line_pairs(dsp::resolution_kernel(frf.provenance), omega) : Vector();
-  return vector_fit_uncertainty(omega, data, fit, options, {}, variance ? std_h : Matrix(), pairs);
+  return vector_fit_uncertainty(omega, data, fit, options, frf_row_weights(frf, options), variance ? std_h : Matrix(), pairs);
 }
 
 namespace fit_uncertainty {

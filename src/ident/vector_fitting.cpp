@@ -231,6 +231,10 @@ CVector automatic_starting_poles(const Vector& omega, const VectorFittingOptions
 Matrix base_weights(const CMatrix& data, const Matrix& user, Weighting weighting) {
   if (user.size() > 0) return user;
   if (weighting == Weighting::kUnit) return Matrix::Ones(data.rows(), 1);
+  if (weighting == Weighting::kInverseStd) {
+    throw InputError(kSource, "weighting", "inverse-std with the data's standard deviations (an FRF with std_H, or explicit weights)",
+                     "none given");
+  }
   Matrix w(data.rows(), data.cols());
   if (weighting == Weighting::kOutputScale) {
     // 1 / rms |f_i|: outputs in different units (m/V and V/V) count alike.
@@ -1174,6 +1178,7 @@ std::string to_string(Weighting w) {
     case Weighting::kInverseMagnitude: return "inverse-magnitude";
     case Weighting::kInverseSqrtMagnitude: return "inverse-sqrt-magnitude";
     case Weighting::kOutputScale: return "output-scale";
+    case Weighting::kInverseStd: return "inverse-std";
   }
   return "unit";
 }
@@ -1183,7 +1188,8 @@ Weighting weighting_from_string(const std::string& s) {
   if (s == "inverse-magnitude") return Weighting::kInverseMagnitude;
   if (s == "inverse-sqrt-magnitude") return Weighting::kInverseSqrtMagnitude;
   if (s == "output-scale") return Weighting::kOutputScale;
-  throw InputError("", "weighting", "one of unit, output-scale, inverse-magnitude, inverse-sqrt-magnitude", "'" + s + "'");
+  if (s == "inverse-std") return Weighting::kInverseStd;
+  throw InputError("", "weighting", "one of unit, output-scale, inverse-magnitude, inverse-sqrt-magnitude, inverse-std", "'" + s + "'");
 }
 
 void VectorFittingOptions::validate() const {
@@ -1520,15 +1526,37 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data, const M
   return result;
 }
 
+Matrix frf_row_weights(const dsp::Frf& frf, const VectorFittingOptions& options) {
+  if (options.weighting != Weighting::kInverseStd) return {};
+  const Index ns = frf.freq_Hz.size();
+  const std::string source = frf.provenance.source.empty() ? std::string(kSource) : frf.provenance.source;
+  Matrix w(ns, static_cast<Index>(frf.H.size()));
+  for (std::size_t i = 0; i < frf.H.size(); ++i) {
+    const std::string field = "std_H of " + (i < frf.outputs.size() ? frf.outputs[i] : "output " + std::to_string(i + 1));
+    if (i >= frf.std_H.size() || frf.std_H[i].size() != ns) {
+      throw InputError(source, field, std::to_string(ns) + " standard deviations (weighting inverse-std)", "none");
+    }
+    for (Index k = 0; k < ns; ++k) {
+      const double sd = frf.std_H[i](k);
+      if (!(std::isfinite(sd) && sd > 0.0)) {
+        throw InputError(source, field + "[" + std::to_string(k) + "]", "finite and > 0 (weighting inverse-std)", format_number(sd));
+      }
+      w(k, static_cast<Index>(i)) = 1.0 / sd;
+    }
+  }
+  return w;
+}
+
 VectorFittingResult vector_fit(const dsp::Frf& frf, const VectorFittingOptions& options) {
   frf.validate(frf.provenance.source);
   const Index ns = frf.freq_Hz.size();
   CMatrix data(ns, static_cast<Index>(frf.H.size()));
   for (size_t i = 0; i < frf.H.size(); ++i) data.col(static_cast<Index>(i)) = frf.H[i];
   const Vector omega = kTwoPi * frf.freq_Hz;
+  const Matrix weights = frf_row_weights(frf, options);
   VectorFittingResult r;
   try {
-    r = vector_fit(omega, data, options);
+    r = vector_fit(omega, data, weights, options);
   } catch (const InputError& e) {
     if (frf.provenance.source.empty()) throw;
     throw e.with_source(frf.provenance.source);

@@ -233,6 +233,11 @@ TEST(FitCli, BothOutputsOfAScipyWelchFrfGiveTheResonance) {
   const test::CliRun text = run_cli("fit " + f + " --order 6 --fmin 20 --fmax 400");
   EXPECT_NE(text.out.find("minimum phase"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("standard errors from the residuals' noise"), std::string::npos) << text.out;
+  // This file has no std columns: weighting by them is refused, naming the file and the output.
+  const test::CliRun by_std = run_cli("fit " + f + " --order 6 --fmin 20 --fmax 400 --weighting inverse-std");
+  EXPECT_EQ(by_std.exit_code, 3) << by_std.err;
+  EXPECT_NE(by_std.err.find("two_dof_welch_frf.csv"), std::string::npos) << by_std.err;
+  EXPECT_NE(by_std.err.find("std_H of de"), std::string::npos) << by_std.err;
 }
 
 // A fit over a band the input did not excite is poor: warning, "quality": "poor", exit 6.

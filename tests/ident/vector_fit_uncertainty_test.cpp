@@ -9,6 +9,7 @@
 
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/units.hpp"
+#include "piezobench/dsp/frf.hpp"
 
 namespace piezobench::ident {
 namespace {
@@ -130,6 +131,87 @@ TEST(VectorFitUncertainty, IntervalsOfPolesAndZerosCoverTheTruth) {
       EXPECT_LE(covered, 0.985);
     }
   }
+}
+
+// Weighting inverse-std (each point by 1 / its std_H, through vector_fit(const dsp::Frf&) and the
+// Frf overload of vector_fit_uncertainty) on noise that grows with |H| as a measured FRF's does:
+// s_k = 0.001 + 0.002 |H_k| per part (0.0011 on the mass line, 0.05 at the 95 Hz peak). Over 200
+// seeds the z-scores of the 95 Hz mode's frequency and damping, the 400 Hz mode's damping and the
+// anti-resonance's frequency and damping have a mean within +-0.2, a standard deviation within
+// 0.85-1.15 and cover the truth in 91-98.5 % of the seeds; and the weighting pays: the 400 Hz mode's
+// damping scatters less than with the default output-scale weighting of the same data. Measured:
+// means -0.07..+0.01, standard deviations 0.89-1.01, coverage 94.0-97.5 %; the 400 Hz damping's rms
+// error 1.63e-5 against 2.18e-5 with output-scale.
+TEST(VectorFitUncertainty, InverseStdWeightingOfAnFrfIsCalibratedAndEfficient) {
+  const TwoModes truth;
+  const Index m = 800;
+  dsp::Frf frf;
+  frf.freq_Hz.resize(m);
+  for (Index k = 0; k < m; ++k) frf.freq_Hz(k) = 20.0 * std::pow(50.0, static_cast<double>(k) / static_cast<double>(m - 1));
+  frf.input = "u";
+  frf.outputs = {"y"};
+  const Complex zero = truth.zero(Complex(-5.0, kTwoPi * 170.0));
+  Vector sd(m);
+  CVector exact(m);
+  for (Index k = 0; k < m; ++k) {
+    exact(k) = truth.at(Complex(0.0, kTwoPi * frf.freq_Hz(k)));
+    sd(k) = 0.001 + 0.002 * std::abs(exact(k));
+  }
+  frf.std_H = {sd};
+  VectorFittingOptions o;
+  o.order = 4;
+  o.fail_if_not_converged = false;
+  o.weighting = Weighting::kInverseStd;
+  VectorFittingOptions plain = o;
+  plain.weighting = Weighting::kOutputScale;
+  constexpr int kQuantities = 5;
+  const int seeds = 200;
+  std::vector<double> z;
+  double sq_weighted = 0.0, sq_plain = 0.0;
+  std::mt19937 rng(23);
+  std::normal_distribution<double> n01;
+  for (int seed = 0; seed < seeds; ++seed) {
+    CVector h(m);
+    for (Index k = 0; k < m; ++k) h(k) = exact(k) + sd(k) * Complex(n01(rng), n01(rng));
+    frf.H = {h};
+    const VectorFittingResult fit = vector_fit(frf, o);
+    ASSERT_EQ(fit.poles.size(), 4);
+    const VectorFitUncertainty u = vector_fit_uncertainty(frf, fit, o);
+    ASSERT_TRUE(u.from_data_variance);
+    const RootUncertainty zu = zero_uncertainty(fit, u, 0, (CVector(1) << fitted_zero(fit, zero)).finished()).front();
+    const double values[kQuantities][3] = {
+        {u.poles[0].natural_frequency, u.poles[0].natural_frequency_se, std::abs(truth.poles(0))},
+        {u.poles[0].damping, u.poles[0].damping_se, -truth.poles(0).real() / std::abs(truth.poles(0))},
+        {u.poles[2].damping, u.poles[2].damping_se, -truth.poles(2).real() / std::abs(truth.poles(2))},
+        {zu.natural_frequency, zu.natural_frequency_se, std::abs(zero)},
+        {zu.damping, zu.damping_se, -zero.real() / std::abs(zero)}};
+    for (const auto& v : values) z.push_back((v[0] - v[2]) / v[1]);
+    sq_weighted += std::pow(values[2][0] - values[2][2], 2);
+    const VectorFittingResult other = vector_fit(frf, plain);
+    ASSERT_EQ(other.poles.size(), 4);
+    sq_plain += std::pow(-other.poles(2).real() / std::abs(other.poles(2)) - values[2][2], 2);
+  }
+  for (int q = 0; q < kQuantities; ++q) {
+    double mean = 0.0, sq = 0.0, covered = 0.0;
+    for (int seed = 0; seed < seeds; ++seed) {
+      const double v = z[static_cast<std::size_t>(seed * kQuantities + q)];
+      mean += v;
+      sq += v * v;
+      covered += std::abs(v) <= 1.959964 ? 1.0 : 0.0;
+    }
+    mean /= seeds;
+    const double sdz = std::sqrt(sq / seeds - mean * mean);
+    covered /= seeds;
+    SCOPED_TRACE("quantity " + std::to_string(q) + ": mean " + std::to_string(mean) + " sd " + std::to_string(sdz) + " covered " +
+                 std::to_string(covered));
+    EXPECT_LT(std::abs(mean), 0.2);
+    EXPECT_GT(sdz, 0.85);
+    EXPECT_LT(sdz, 1.15);
+    EXPECT_GE(covered, 0.91);
+    EXPECT_LE(covered, 0.985);
+  }
+  EXPECT_LT(sq_weighted, sq_plain) << "rms error of the 400 Hz damping: inverse-std " << std::sqrt(sq_weighted / seeds)
+                                   << ", output-scale " << std::sqrt(sq_plain / seeds);
 }
 
 // Noise correlated between neighbouring points, as a Welch estimate's lines are: e_k = (a_k + a_k-1) /

@@ -449,5 +449,40 @@ TEST(VectorFitting, EnumsRoundTripThroughStrings) {
   EXPECT_THROW((void)weighting_from_string("none"), InputError);
 }
 
+// An FRF without std_H cannot be weighted by it: InputError naming the file and the output.
+TEST(VectorFitting, InverseStdWeightingNeedsTheStdH) {
+  dsp::Frf frf;
+  frf.freq_Hz = Vector::LinSpaced(50, 10.0, 500.0);
+  frf.input = "u";
+  frf.outputs = {"d_e"};
+  frf.H = {CVector::Constant(50, Complex(1.0, 0.1))};
+  frf.provenance.source = "lab.csv";
+  VectorFittingOptions o;
+  o.order = 2;
+  o.weighting = Weighting::kInverseStd;
+  try {
+    (void)vector_fit(frf, o);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("std_H of d_e"), std::string::npos) << e.what();
+  }
+  frf.std_H = {Vector::Constant(50, 0.01)};
+  frf.std_H[0](7) = 0.0;  // a computed response's 0: no weight can be had
+  EXPECT_THROW((void)vector_fit(frf, o), InputError);
+  frf.std_H[0](7) = 0.02;
+  const Matrix w = frf_row_weights(frf, o);
+  ASSERT_EQ(w.rows(), 50);
+  EXPECT_DOUBLE_EQ(w(7, 0), 50.0);
+  EXPECT_DOUBLE_EQ(w(0, 0), 100.0);
+  o.weighting = Weighting::kOutputScale;
+  EXPECT_EQ(frf_row_weights(frf, o).size(), 0);
+  EXPECT_EQ(weighting_from_string("inverse-std"), Weighting::kInverseStd);
+  EXPECT_EQ(to_string(Weighting::kInverseStd), "inverse-std");
+  // Without an FRF there is no std_H to weight by.
+  o.weighting = Weighting::kInverseStd;
+  EXPECT_THROW((void)vector_fit(kTwoPi * frf.freq_Hz, CMatrix(frf.H[0]), o), InputError);
+}
+
 }  // namespace
 }  // namespace piezobench::ident

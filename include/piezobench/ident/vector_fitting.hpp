@@ -50,7 +50,10 @@ PoleSpacing pole_spacing_from_string(const std::string& s);  // throws InputErro
 // "inverse-sqrt-magnitude"; the magnitude ones use |f_i(s_k)| per output, as vectfit3 suggests
 // for data with relative noise or a large dynamic range; "output-scale" weighs each output by
 // 1 / rms |f_i| over the band, so that outputs in different units (m/V and V/V) count alike).
-enum class Weighting { kUnit, kInverseMagnitude, kInverseSqrtMagnitude, kOutputScale };
+// kInverseStd: each point of each output by 1 / its standard deviation (an FRF's std_H: the
+// maximum-likelihood fit under the estimate's own noise); only through vector_fit(const dsp::Frf&)
+// and frf_row_weights, which have the std_H, or with explicit weights.
+enum class Weighting { kUnit, kInverseMagnitude, kInverseSqrtMagnitude, kOutputScale, kInverseStd };
 std::string to_string(Weighting w);
 Weighting weighting_from_string(const std::string& s);  // throws InputError
 
@@ -158,6 +161,10 @@ VectorFittingResult vector_fit(const Vector& omega, const CMatrix& data,
 // The verdict names the outputs and is also poor when an output's coherence is below 0.5 at more
 // than half of the points (a band the input did not excite).
 VectorFittingResult vector_fit(const dsp::Frf& frf, const VectorFittingOptions& options);
+// The explicit row weights vector_fit(frf, options) passes: with options.weighting kInverseStd, 1 /
+// std_H (points x outputs; InputError naming frf.provenance.source when an output has no std_H or a
+// value that is not finite and > 0); otherwise empty (options.weighting decides).
+[[nodiscard]] Matrix frf_row_weights(const dsp::Frf& frf, const VectorFittingOptions& options);
 
 // The state space `model` is not declared: it is rebuilt from the poles and residues (evaluate()
 // uses those), so part.json does not carry it.
