@@ -4,6 +4,7 @@
 #include "piezobench/dsp/excitation.hpp"
 #include "piezobench/dsp/frf.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
+#include "piezobench/dsp/leakage_covariance.hpp"
 #include "piezobench/dsp/resolution_kernel.hpp"
 #include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/dsp/welch.hpp"

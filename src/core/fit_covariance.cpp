@@ -37,7 +37,7 @@ MatrixXd noise_middle(const MatrixXd& Js, const VectorXd& s, const Eigen::Vector
 }  // namespace
 
 FitCovariance fit_covariance(const MatrixXd& J, const VectorXd& r, const VectorXd& residual_std,
-                             const Eigen::VectorXcd& adjacent_correlation) {
+                             const Eigen::VectorXcd& adjacent_correlation, const std::vector<ResidualCovarianceBlock>& blocks) {
   const Index m = J.rows(), p = J.cols();
   if (m <= p || p < 1) throw InputError("fit covariance", "Jacobian", "more residuals than parameters (>= 1)", std::to_string(m) + " x " + std::to_string(p));
   if (r.size() != m) throw InputError("fit covariance", "residuals", std::to_string(m) + " values", std::to_string(r.size()));
@@ -47,6 +47,14 @@ FitCovariance fit_covariance(const MatrixXd& J, const VectorXd& r, const VectorX
   if (adjacent_correlation.size() != 0 && (residual_std.size() != m || m % 2 != 0 || adjacent_correlation.size() != m / 2 - 1)) {
     throw InputError("fit covariance", "adjacent_correlation", std::to_string(m / 2 - 1) + " values (complex residuals, residual_std given) or none",
                      std::to_string(adjacent_correlation.size()));
+  }
+  for (const ResidualCovarianceBlock& b : blocks) {
+    const Index n = b.covariance.rows();
+    const bool finite = std::all_of(b.covariance.valuePtr(), b.covariance.valuePtr() + b.covariance.nonZeros(), [](double v) { return std::isfinite(v); });
+    if (residual_std.size() != m || b.covariance.cols() != n || b.first < 0 || b.first + n > m || !finite) {
+      throw InputError("fit covariance", "blocks", "finite square blocks inside the " + std::to_string(m) + " residuals (residual_std given)",
+                       std::to_string(n) + " x " + std::to_string(b.covariance.cols()) + " at " + std::to_string(b.first));
+    }
   }
   FitCovariance out;
   const double inf = std::numeric_limits<double>::infinity();
@@ -78,12 +86,19 @@ FitCovariance fit_covariance(const MatrixXd& J, const VectorXd& r, const VectorX
     // L = (J^T J)^-1 J^T: row j is parameter j's influence of each residual; the local chi2 f_j.
     const MatrixXd L = A * Js.transpose();
     const Eigen::ArrayXXd L2 = L.array().square();
-    const VectorXd noise = (L2.matrix() * residual_std.array().square().matrix());
+    VectorXd variance = residual_std.array().square().matrix();
+    for (const ResidualCovarianceBlock& b : blocks) variance.segment(b.first, b.covariance.rows()) += b.covariance.diagonal();
+    const VectorXd noise = L2.matrix() * variance;
     const VectorXd misfit = (L2.matrix() * r.array().square().matrix());
     VectorXd widen(p);
     const double hc1 = static_cast<double>(m) / dof;  // the residuals' lost degrees of freedom
     for (Index j = 0; j < p; ++j) widen(j) = noise(j) > 0.0 ? std::sqrt(std::max(1.0, hc1 * misfit(j) / noise(j))) : 1.0;
-    const MatrixXd B = noise_middle(Js, residual_std, adjacent_correlation);
+    MatrixXd B = noise_middle(Js, residual_std, adjacent_correlation);
+    for (const ResidualCovarianceBlock& b : blocks) {
+      const auto Jb = Js.middleRows(b.first, b.covariance.rows());
+      const MatrixXd SJ = b.covariance * Jb;
+      B += Jb.transpose() * SJ;
+    }
     Cs = widen.asDiagonal() * (A * B * A) * widen.asDiagonal();
   } else {
     Cs = A * out.chi2_per_dof;

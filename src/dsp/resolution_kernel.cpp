@@ -24,6 +24,7 @@ ResolutionKernel resolution_kernel(WindowType window, Eigen::Index nfft, double 
   const double total = n * w.squaredNorm();  // sum over all bins of |W_j|^2 (Parseval)
   // |W_j|^2 / total for j = 0 .. K; a real window has |W_-j| = |W_j|.
   std::vector<double> side;
+  std::vector<std::complex<double>> bins;
   const long most = std::min<long>(kResolutionKernelMaxHalfWidth, static_cast<long>(nfft / 2));
   for (long j = 0; j <= most; ++j) {
     std::complex<double> bin = 0.0;
@@ -33,6 +34,7 @@ ResolutionKernel resolution_kernel(WindowType window, Eigen::Index nfft, double 
     const double c = std::norm(bin) / total;
     if (j > 0 && c < kResolutionKernelFloor) break;
     side.push_back(c);
+    bins.push_back(bin);
   }
   ResolutionKernel kernel;
   kernel.line_spacing_Hz = sample_rate_Hz / n;
@@ -45,6 +47,12 @@ ResolutionKernel resolution_kernel(WindowType window, Eigen::Index nfft, double 
     sum += c;
   }
   for (double& c : kernel.weights) c /= sum;
+  kernel.nfft = nfft;
+  kernel.window_bins.resize(kernel.weights.size());
+  for (long j = -half; j <= half; ++j) {
+    const std::complex<double> b = bins[static_cast<std::size_t>(std::abs(j))];
+    kernel.window_bins[static_cast<std::size_t>(j + half)] = j < 0 ? std::conj(b) : b;  // a real window
+  }
   return kernel;
 }
 
@@ -60,6 +68,11 @@ ResolutionKernel resolution_kernel(const FrfProvenance& provenance) {
   }
   ResolutionKernel kernel = resolution_kernel(window, provenance.nfft, provenance.sample_rate);
   kernel.adjacent_line_correlation = adjacent_line_correlation(provenance);
+  const auto noverlap = static_cast<Eigen::Index>(std::floor(provenance.overlap * static_cast<double>(provenance.nfft)));
+  if (provenance.averages >= 1 && noverlap >= 0 && noverlap < provenance.nfft) {
+    kernel.segments = provenance.averages;
+    kernel.segment_shift = provenance.nfft - noverlap;
+  }
   return kernel;
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
+#include "piezobench/dsp/leakage_covariance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/ident/features.hpp"
 
@@ -135,8 +137,73 @@ Vector coherence_relative_std(const Vector& c, double effective_averages) {
 
 // The covariance of the solver's parameters at its solution x (core/fit_covariance.hpp).
 core::FitCovariance covariance_at(const core::ResidualFunction& residual, const Eigen::VectorXd& x, const Vector& residual_std,
-                                  const Eigen::VectorXcd& adjacent = {}) {
-  return core::fit_covariance(core::central_difference_jacobian(residual, x), residual(x), residual_std, adjacent);
+                                  const Eigen::VectorXcd& adjacent = {}, const std::vector<core::ResidualCovarianceBlock>& blocks = {}) {
+  return core::fit_covariance(core::central_difference_jacobian(residual, x), residual(x), residual_std, adjacent, blocks);
+}
+
+// Lines whose leakage error counts: its relative variance (1/gamma_leak^2 - 1) / (2 segments) above
+// this fraction of the line's noise variance, and 1/gamma_leak^2 - 1 above kLeakageLinesFraction of its
+// largest value.
+constexpr double kLeakageOfNoise = 0.05;
+constexpr double kLeakageLinesFraction = 1e-4;
+constexpr Index kLeakageMaxLines = 512;  // lines of one block at most (around its largest leakage)
+
+// The Welch estimate's leakage error (dsp/leakage_covariance.hpp) in the residuals a_k (G_k / H_k - 1):
+// u_k = g_k e_k with g_k = -a_k G_k / H_k^2, as covariance blocks of the interleaved (Re, Im) residuals,
+// one per run of consecutive lines where the model's leakage coherence (KernelGrid::leakage_coherence)
+// drops. Without the FRF's variance (residual_std empty) or a provenance that says how the segments
+// were laid out: none.
+std::vector<core::ResidualCovarianceBlock> leakage_blocks(const dsp::ResolutionKernel& kernel, const dsp::KernelGrid& grid, const Vector& w,
+                                                          const CVector& d, const Vector& weight, const Vector& residual_std,
+                                                          const CVector& model_at_nodes,
+                                                          const std::function<CVector(const Vector&)>& response) {
+  if (residual_std.size() != 2 * w.size() || !dsp::knows_leakage(kernel) || w.size() < 2) return {};
+  const Vector leak = grid.leakage_coherence(model_at_nodes);
+  Vector excess(w.size());
+  for (Index k = 0; k < w.size(); ++k) excess(k) = leak(k) > 0.0 ? 1.0 / leak(k) - 1.0 : 0.0;
+  const double most = excess.maxCoeff();
+  if (!(most > 1e-12)) return {};
+  std::vector<bool> counts(static_cast<std::size_t>(w.size()));
+  for (Index k = 0; k < w.size(); ++k) {
+    const double noise = weight(k) > 0.0 ? residual_std(2 * k) / weight(k) : 0.0;  // relative std of the line's noise
+    counts[static_cast<std::size_t>(k)] = excess(k) > kLeakageLinesFraction * most &&
+                                          excess(k) / (2.0 * static_cast<double>(kernel.segments)) > kLeakageOfNoise * noise * noise;
+  }
+  const CVector model = grid.smooth(model_at_nodes);
+  const double step = 2.0 * std::numbers::pi * kernel.line_spacing_Hz;
+  std::vector<core::ResidualCovarianceBlock> blocks;
+  for (Index k = 0; k < w.size();) {
+    if (!counts[static_cast<std::size_t>(k)]) { ++k; continue; }
+    Index end = k + 1;
+    while (end < w.size() && counts[static_cast<std::size_t>(end)] && std::abs(w(end) - w(end - 1) - step) <= 1e-6 * step) ++end;
+    Index first = k, count = end - k;
+    if (count > kLeakageMaxLines) {  // keep the lines around the largest leakage
+      Index peak = k;
+      for (Index i = k; i < end; ++i) if (excess(i) > excess(peak)) peak = i;
+      first = std::clamp<Index>(peak - kLeakageMaxLines / 2, k, end - kLeakageMaxLines);
+      count = kLeakageMaxLines;
+    }
+    k = end;
+    if (count < 2) continue;
+    const dsp::LeakageCovariance lc = dsp::leakage_covariance(kernel, w.segment(first, count), response);
+    Eigen::VectorXcd g(count);
+    for (Index i = 0; i < count; ++i) g(i) = -weight(first + i) * model(first + i) / (d(first + i) * d(first + i));
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<std::size_t>(4 * count * (2 * dsp::kLeakageMaxLineDistance + 1)));
+    for (Index i = 0; i < count; ++i) {
+      for (Index l = std::max<Index>(0, i - dsp::kLeakageMaxLineDistance); l < std::min(count, i + dsp::kLeakageMaxLineDistance + 1); ++l) {
+        const Complex cu = g(i) * lc.covariance(i, l) * std::conj(g(l)), qu = g(i) * lc.pseudo(i, l) * g(l);
+        t.emplace_back(2 * i, 2 * l, 0.5 * (cu + qu).real());
+        t.emplace_back(2 * i + 1, 2 * l + 1, 0.5 * (cu - qu).real());
+        t.emplace_back(2 * i, 2 * l + 1, 0.5 * (qu - cu).imag());
+        t.emplace_back(2 * i + 1, 2 * l, 0.5 * (qu + cu).imag());
+      }
+    }
+    core::ResidualCovarianceBlock block{2 * first, Eigen::SparseMatrix<double>(2 * count, 2 * count)};
+    block.covariance.setFromTriplets(t.begin(), t.end());
+    blocks.push_back(std::move(block));
+  }
+  return blocks;
 }
 
 // c_k of core::fit_covariance for the relative residuals G/H_k - 1 ~ -e_k / H_k of a Welch estimate:
@@ -309,11 +376,27 @@ FitBand fit_band(const Vector& omega, const CVector& h, const Vector& coherence,
 // the Welch estimate's coherence drops by the leakage of a sharp peak, which is not a random error, and
 // B&P's eps would count it as one (the resonance's and the gains' intervals were 1.7-6 times their
 // scatter). The weights keep the measured coherence. Unchanged without a coherence, n_d or kernel.
+//
+// When the leakage's own error is modelled (leakage_blocks: the provenance says how the segments were
+// laid out), the noise is instead the additive + proportional model of dsp::random_frf_std fitted on
+// the lines the leakage leaves clean: at the peak the coherence's leakage part is 10^3-10^5 times the
+// noise's, and what the division leaves there is the kernel's approximation error, not noise (it
+// doubled the resonance's interval on the virtual bench).
 Vector leakage_free_residual_std(const PointWeights& pw, const FitBand& b, double effective_averages, const dsp::KernelGrid& grid,
-                                 const CVector& model_at_nodes) {
+                                 const CVector& model_at_nodes, bool leakage_modelled) {
   if (b.c.size() != b.w.size() || !(effective_averages > 0.0) || pw.residual_std.size() != 2 * b.w.size()) return pw.residual_std;
   const Vector leak = grid.leakage_coherence(model_at_nodes);
   Vector s = pw.residual_std;
+  if (leakage_modelled) {
+    Vector std_h(b.w.size());
+    for (Index k = 0; k < b.w.size(); ++k) std_h(k) = dsp::frf_relative_std(b.c(k), effective_averages) * std::abs(b.d(k));
+    const Vector random = dsp::random_frf_std(b.d, std_h, grid.smooth(model_at_nodes), leak, effective_averages).std;
+    for (Index k = 0; k < b.w.size(); ++k) {
+      const double eps = std::max(random(k) / std::abs(b.d(k)), dsp::kMinFitRelativeStd);
+      s(2 * k) = s(2 * k + 1) = pw.weight(k) * eps;
+    }
+    return s;
+  }
   for (Index k = 0; k < b.w.size(); ++k) {
     const double eps = std::max(dsp::frf_relative_std(std::min(1.0, b.c(k) / leak(k)), effective_averages), dsp::kMinFitRelativeStd);
     s(2 * k) = s(2 * k + 1) = pw.weight(k) * eps;
@@ -476,8 +559,10 @@ core::ParameterUncertainty iff_uncertainty(const IffResidual& residual, const co
                                            const Vector& residual_std, bool from_frf_variance, const dsp::ResolutionKernel& kernel,
                                            const CVector& model_at_nodes) {
   const CVector model = residual.grid.smooth(model_at_nodes);
+  const auto response = [&fit](const Vector& omega) { return plant::iff_plant_response(fit, omega); };
   const core::FitCovariance cov =
-      covariance_at(residual, best.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std));
+      covariance_at(residual, best.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std),
+                    leakage_blocks(kernel, residual.grid, residual.b.w, residual.b.d, residual.weight, residual_std, model_at_nodes, response));
   // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
   const Layout& layout = residual.layout;
   const int hpf = layout.hpf ? 5 : -1, delay = layout.delay ? (layout.hpf ? 6 : 5) : -1;
@@ -533,7 +618,7 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   fit.converged = best.converged();
   fit.status = best.status;
   const CVector at_nodes = plant::iff_plant_response(fit, grid.nodes());  // the solution's model, for both
-  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid, at_nodes);
+  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid, at_nodes, dsp::knows_leakage(options.resolution));
   fit.uncertainty = iff_uncertainty(residual, best, fit, noise, eps.size() > 0, options.resolution, at_nodes);
   fit.quality.check_error("u -> Vs (IFF plant, eq. 2.3)", fit.relative_rms_error);
   check_in_band(fit.quality, "anti-resonance wz", fit.wz, b.w);
@@ -667,8 +752,10 @@ core::ParameterUncertainty second_order_uncertainty(const SecondOrderResidual& r
                                                     bool from_frf_variance, const dsp::ResolutionKernel& kernel,
                                                     const CVector& model_at_nodes) {
   const CVector model = residual.grid.smooth(model_at_nodes);
+  const auto response = [&fit](const Vector& omega) { return fit.response(omega); };
   const core::FitCovariance cov =
-      covariance_at(residual, o.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std));
+      covariance_at(residual, o.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std),
+                    leakage_blocks(kernel, residual.grid, residual.b.w, residual.b.d, residual.weight, residual_std, model_at_nodes, response));
   Eigen::VectorXd value(4), deriv(4);
   value << fit.static_gain, fit.natural_frequency, fit.damping, fit.delay;
   deriv << fit.static_gain, fit.natural_frequency, fit.damping, residual.fit_delay ? kDelayScale : 0.0;
@@ -719,7 +806,7 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   fit.iterations = o.iterations;
   fit.status = o.status;
   const CVector at_nodes = fit.response(grid.nodes());  // the solution's model, for both
-  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid, at_nodes);
+  const Vector noise = leakage_free_residual_std(pw, b, options.effective_averages, grid, at_nodes, dsp::knows_leakage(options.resolution));
   fit.uncertainty = second_order_uncertainty(residual, o, fit, noise, eps.size() > 0, options.resolution, at_nodes);
   fit.quality.check_error("second-order fit", fit.relative_rms_error);
   check_in_band(fit.quality, "natural frequency", fit.natural_frequency, b.w);

@@ -126,6 +126,39 @@ TEST(FitCovariance, AdjacentCorrelationEntersTheSandwichAsItsDenseForm) {
   EXPECT_THROW((void)fit_covariance(J, VectorXd::Zero(m), VectorXd(), c), InputError);
 }
 
+// A block of correlated residuals (a Welch estimate's leakage error) adds to the sandwich's middle
+// exactly its dense form, J^T (diag(s^2) + Sigma_b) J, and its diagonal to f_j's noise: a misfit equal
+// to the block's own scatter does not widen.
+TEST(FitCovariance, CovarianceBlocksEnterTheSandwichAndTheLocalChi2) {
+  const int m = 10;
+  MatrixXd J(m, 2);
+  for (int i = 0; i < m; ++i) J.row(i) << 1.0, 0.2 * i - 0.7;
+  const VectorXd s = VectorXd::Constant(m, 0.1);
+  MatrixXd bd(4, 4);
+  bd << 4.0, 2.0, 1.0, 0.0,
+       2.0, 4.0, 2.0, 1.0,
+       1.0, 2.0, 4.0, 2.0,
+       0.0, 1.0, 2.0, 4.0;
+  bd *= 0.25;
+  const Eigen::SparseMatrix<double> b = bd.sparseView();
+  MatrixXd sigma = MatrixXd(s.cwiseAbs2().asDiagonal());
+  sigma.block(3, 3, 4, 4) += bd;
+  const MatrixXd A = (J.transpose() * J).inverse();
+  const MatrixXd expected = A * J.transpose() * sigma * J * A;
+  const FitCovariance f = fit_covariance(J, VectorXd::Zero(m), s, {}, {ResidualCovarianceBlock{3, b}});
+  EXPECT_LT((f.covariance - expected).norm(), 1e-13 * expected.norm());
+  // Residuals of the block's size (1 on rows 3-6, its variance): with the block no widening beyond
+  // m / (m - p) * misfit / noise; without it the misfit is 100 times the noise there.
+  VectorXd r = VectorXd::Zero(m);
+  r.segment(3, 4).setConstant(1.0);
+  const FitCovariance with = fit_covariance(J, r, s, {}, {ResidualCovarianceBlock{3, b}});
+  const FitCovariance without = fit_covariance(J, r, s);
+  EXPECT_LT(with.standard_error(0), 1.2 * f.standard_error(0));
+  EXPECT_GT(without.standard_error(0), 5.0 * fit_covariance(J, VectorXd::Zero(m), s).standard_error(0));
+  EXPECT_THROW((void)fit_covariance(J, r, s, {}, {ResidualCovarianceBlock{8, b}}), InputError);      // past the residuals
+  EXPECT_THROW((void)fit_covariance(J, r, VectorXd(), {}, {ResidualCovarianceBlock{3, b}}), InputError);  // no residual_std
+}
+
 TEST(FitCovariance, NearlyCollinearColumnsAreFlaggedAndDependentOnesSingular) {
   MatrixXd J(6, 2);
   for (int i = 0; i < 6; ++i) J.row(i) << 1.0 + i, 1.0 + i + 1e-3 * (i % 2);

@@ -21,6 +21,7 @@
 // Units: the caller's (the parameters, residuals and tolerances are in the units of the caller's problem).
 #include "piezobench/core/fields.hpp"
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,9 +55,18 @@ struct FitCovariance {
 // 0 where u_k and u_k+1 are not neighbours; a circular error: E[u_k u_k+1] = 0). The sandwich's
 // middle is then J^T Sigma J with Sigma's off-diagonal blocks s_2k s_2k+2 [[Re c, -Im c], [Im c, Re c]]
 // (rows Re u_k, Im u_k; columns Re u_k+1, Im u_k+1); the local chi2 f_j keeps its diagonal noise.
+//
+// Errors that are correlated over more than neighbours (a Welch estimate's leakage error at a sharp
+// peak, dsp/leakage_covariance.hpp) come as blocks: `covariance` of the residuals first .. first + n - 1,
+// added to Sigma (the sandwich's middle gets J_b^T covariance J_b) and its diagonal to s_i^2 in f_j.
+struct ResidualCovarianceBlock {
+  Eigen::Index first = 0;
+  Eigen::SparseMatrix<double> covariance;  // n x n, symmetric (often banded), the residuals' units squared
+};
 [[nodiscard]] FitCovariance fit_covariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
                                            const Eigen::VectorXd& residual_std = {},
-                                           const Eigen::VectorXcd& adjacent_correlation = {});
+                                           const Eigen::VectorXcd& adjacent_correlation = {},
+                                           const std::vector<ResidualCovarianceBlock>& blocks = {});
 
 // A fit's parameters in their natural units with their standard errors: what results.json, --json,
 // Python and the report print. Built from the FitCovariance of the solver's (scaled) parameters x

@@ -41,6 +41,13 @@ struct ResolutionKernel {
   // adjacent_line_correlation), which the fits' covariances use; 0 when the provenance does not say
   // how the segments overlapped (or for resolution_kernel(window, nfft, rate)).
   double adjacent_line_correlation = 0.0;
+  // What dsp/leakage_covariance.hpp needs of the estimate (0 / empty when unknown): the window's DFT
+  // bins W_j (j = -half_width() .. half_width(), dimensionless, the window's own scale), its nfft,
+  // the segments averaged and the samples between consecutive segments' starts.
+  std::vector<std::complex<double>> window_bins;
+  Eigen::Index nfft = 0;
+  Eigen::Index segments = 0;
+  Eigen::Index segment_shift = 0;
   [[nodiscard]] bool active() const { return line_spacing_Hz > 0.0 && weights.size() > 1; }
   [[nodiscard]] long half_width() const { return static_cast<long>(weights.size() / 2); }
 };
