@@ -15,6 +15,7 @@
 #include "piezobench/campaign/results_json.hpp"
 #include "piezobench/core/units.hpp"
 #include "piezobench/core/fit_covariance.hpp"
+#include "piezobench/core/format.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
 #include "piezobench/dsp/unwrap.hpp"
 #include "piezobench/core/fields.hpp"
@@ -390,6 +391,13 @@ json frf_section(const std::vector<UnitCurves>& units) {
   const auto half_interval = [](const std::optional<double>& se, double per_si = 1.0) {
     return se && std::isfinite(*se) ? json(core::kCoverage95 * *se * per_si) : json(nullptr);
   };
+  // A fit's parameters correlated above 0.95 and its condition number ("none; cond 5.8").
+  const auto correlated = [](const std::optional<ident::VectorFitSummary>& fit) {
+    if (!fit || !fit->condition_number) return json(nullptr);
+    std::string pairs;
+    for (const auto& c : fit->high_correlations) pairs += (pairs.empty() ? "" : ", ") + c;
+    return json(fmt::format("{}; cond {}", pairs.empty() ? "none" : pairs, format_number(*fit->condition_number, 3)));
+  };
   for (const auto& u : units) {
     if (!u.result->frf_analysis) continue;
     const FrfAnalysis& f = *u.result->frf_analysis;
@@ -400,18 +408,22 @@ json frf_section(const std::vector<UnitCurves>& units) {
                                  io::to_json(f.antiresonance_vector_fit_damping),
                                  half_interval(f.antiresonance_vector_fit_damping_standard_error),
                                  io::shown_json(f.static_gain_vector_fit, um_per_m),
-                                 half_interval(f.static_gain_vector_fit_standard_error, um_per_m)}));
+                                 half_interval(f.static_gain_vector_fit_standard_error, um_per_m),
+                                 correlated(f.fit_de), correlated(f.fit_vs)}));
   }
   if (!vrows.empty()) {
     tables.push_back(table("Vector fits per unit (cross-checks, +- half the 95 % interval)",
                            {"unit", "resonance [Hz]", "+- (95 %) [Hz]", "damping", "+- (95 %)", "anti-resonance [Hz]", "+- (95 %) [Hz]",
-                            "zero damping", "+- (95 %)", "static gain [um/V]", "+- (95 %) [um/V]"},
+                            "zero damping", "+- (95 %)", "static gain [um/V]", "+- (95 %) [um/V]", "u -> d_e: correlated > 0.95",
+                            "u -> Vs: correlated > 0.95"},
                            vrows,
                            "The order-6 vector fits of u -> d_e and u -> Vs, kept as cross-checks of the plant fits above. +-: "
                            "1.96 standard errors from the FRF's variance, widened by the fit's local misfit (docs/uncertainty.md "
                            "section 5); they say how well the cross-check is pinned, not how far the order-6 model is from the "
                            "unit (its anti-resonance sits a few per cent high: it spreads the narrow notch over its poles). "
-                           "Empty: not found, or the fit's covariance singular."));
+                           "Empty: not found, or the fit's covariance singular. Correlated: its real parameters (pN: pole N, rI.N: "
+                           "residue of output I at pole N, dI: constant) that trade against each other above 0.95, and the "
+                           "conditioning of the fit's Jacobian."));
   }
   json warnings = json::array();
   for (const auto& u : units) {

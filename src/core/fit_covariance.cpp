@@ -5,6 +5,7 @@
 #include <complex>
 #include <cstdio>
 #include <limits>
+#include <string>
 
 #include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
@@ -32,6 +33,13 @@ MatrixXd noise_middle(const MatrixXd& Js, const VectorXd& s, const Eigen::Vector
     B += term + term.transpose();
   }
   return B;
+}
+
+// "a/b 0.973": a highly correlated pair as results.json and the reports print it.
+std::string correlation_label(const std::string& a, const std::string& b, double correlation) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, " %.3f", correlation);
+  return a + "/" + b + buf;
 }
 
 }  // namespace
@@ -164,14 +172,22 @@ ParameterUncertainty parameter_uncertainty(const std::vector<std::string>& names
       const double sign = (dvalue_dx(i) < 0.0) != (dvalue_dx(j) < 0.0) ? -1.0 : 1.0;
       u.correlation(i, j) = sign * covariance.correlation(a, b);
       if (j > i && std::abs(u.correlation(i, j)) > kHighCorrelation) {
-        char buf[96];
-        std::snprintf(buf, sizeof buf, "%s/%s %.3f", names[static_cast<std::size_t>(i)].c_str(), names[static_cast<std::size_t>(j)].c_str(),
-                      u.correlation(i, j));
-        u.high_correlations.emplace_back(buf);
+        u.high_correlations.push_back(correlation_label(names[static_cast<std::size_t>(i)], names[static_cast<std::size_t>(j)], u.correlation(i, j)));
       }
     }
   }
   return u;
+}
+
+std::vector<std::string> high_correlation_labels(const FitCovariance& covariance, const std::vector<std::string>& names) {
+  if (static_cast<Index>(names.size()) != covariance.correlation.rows()) {
+    throw InputError("high correlations", "names", std::to_string(covariance.correlation.rows()) + " names", std::to_string(names.size()));
+  }
+  std::vector<std::string> out;
+  for (const auto& [i, j] : covariance.high_correlations) {
+    out.push_back(correlation_label(names[static_cast<std::size_t>(i)], names[static_cast<std::size_t>(j)], covariance.correlation(i, j)));
+  }
+  return out;
 }
 
 MatrixXd propagate_covariance(const MatrixXd& G, const MatrixXd& covariance) {

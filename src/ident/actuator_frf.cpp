@@ -80,6 +80,19 @@ std::optional<VectorFitUncertainty> features_uncertainty(const dsp::Frf& band, c
   return std::nullopt;
 }
 
+// The summary of a vector fit, with its covariance's conditioning and flagged correlations when it has one.
+VectorFitSummary summary(const FrfFeatures& f, const ActuatorFrfOptions& o, const std::optional<VectorFitUncertainty>& u) {
+  VectorFitSummary s;
+  s.order = o.fit_order;
+  s.relative_rms_error = f.fit.relative_rms_error;
+  s.converged = f.fit.converged;
+  if (u) {
+    s.condition_number = u->covariance.condition_number;
+    s.high_correlations = core::high_correlation_labels(u->covariance, u->names);
+  }
+  return s;
+}
+
 // x when finite, else nullopt (an undetermined standard error is not written).
 std::optional<double> finite(double x) { return std::isfinite(x) ? std::optional<double>(x) : std::nullopt; }
 
@@ -92,9 +105,10 @@ std::optional<ModalFeature> de_features(const dsp::Frf& de, const ActuatorFrfOpt
     a.static_gain_vector_fit = f.static_gain;
     a.static_gain = f.static_gain;
     a.static_gain_source = to_string(f.static_gain_source);
-    a.fit_de = VectorFitSummary{o.fit_order, f.fit.relative_rms_error, f.fit.converged};
     const ModalFeature* m = nearest(f.resonances, kTwoPi * de.freq_Hz(peak_line(de)));
-    if (const std::optional<VectorFitUncertainty> u = features_uncertainty(de, f, o, kernel, "u -> d_e", r)) {
+    const std::optional<VectorFitUncertainty> u = features_uncertainty(de, f, o, kernel, "u -> d_e", r);
+    a.fit_de = summary(f, o, u);
+    if (u) {
       if (f.static_gain_source == StaticGainSource::kModelDcGain) {
         a.static_gain_vector_fit_standard_error = finite(std::sqrt(response_covariance(f.fit, *u, 0, Complex(0.0, 0.0))(0, 0)));
       }
@@ -127,15 +141,14 @@ std::optional<AntiResonance> vs_features(const dsp::Frf& vs, const ActuatorFrfOp
     }
     const AntiResonance* z = dip >= 0 ? nearest(f.antiresonances, kTwoPi * vs.freq_Hz(dip)) : nullptr;
     if (z) r.analysis.nmp.zero = NmpEvidence::Zero{z->phase_verdict, z->phase_change_deg, z->root, z->nonminimum_phase_model};
-    if (z) {
-      if (const std::optional<VectorFitUncertainty> u = features_uncertainty(vs, f, o, kernel, "u -> Vs", r)) {
-        const RootUncertainty zu = zero_uncertainty(f.fit, *u, 0, CVector::Constant(1, z->root)).front();
-        r.analysis.antiresonance_vector_fit_standard_error_Hz = finite(zu.natural_frequency_se / kTwoPi);
-        r.analysis.antiresonance_vector_fit_damping_standard_error = finite(zu.damping_se);
-      }
+    const std::optional<VectorFitUncertainty> u = z ? features_uncertainty(vs, f, o, kernel, "u -> Vs", r) : std::nullopt;
+    if (u) {
+      const RootUncertainty zu = zero_uncertainty(f.fit, *u, 0, CVector::Constant(1, z->root)).front();
+      r.analysis.antiresonance_vector_fit_standard_error_Hz = finite(zu.natural_frequency_se / kTwoPi);
+      r.analysis.antiresonance_vector_fit_damping_standard_error = finite(zu.damping_se);
     }
     r.analysis.static_gain_vs = f.static_gain;
-    r.analysis.fit_vs = VectorFitSummary{o.fit_order, f.fit.relative_rms_error, f.fit.converged};
+    r.analysis.fit_vs = summary(f, o, u);
     if (z) return *z;
   } catch (const NumericalError& e) {
     r.failed.push_back(std::string("frf u -> Vs features: ") + e.what());

@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <complex>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "piezobench/core/eigen_solvers.hpp"
 #include "piezobench/core/error.hpp"
@@ -165,6 +168,14 @@ TEST(FitCovariance, NearlyCollinearColumnsAreFlaggedAndDependentOnesSingular) {
   const FitCovariance c = fit_covariance(J, VectorXd::Zero(6), VectorXd::Ones(6));
   ASSERT_EQ(c.high_correlations.size(), 1u);
   EXPECT_GT(c.condition_number, 100.0);
+  // Named as results.json and the reports print them: "a/b" and the correlation to 3 decimals.
+  const std::vector<std::string> labels = high_correlation_labels(c, {"gain", "slope"});
+  ASSERT_EQ(labels.size(), 1u);
+  char expected[64];
+  std::snprintf(expected, sizeof expected, "gain/slope %.3f", c.correlation(0, 1));
+  EXPECT_EQ(labels[0], expected);
+  EXPECT_GT(std::abs(c.correlation(0, 1)), 0.95);  // nearly equal columns: the parameters trade, -1.000
+  EXPECT_THROW((void)high_correlation_labels(c, {"gain"}), InputError);
   J.col(1) = 2.0 * J.col(0);
   const FitCovariance s = fit_covariance(J, VectorXd::Zero(6));
   EXPECT_TRUE(s.singular);

@@ -139,6 +139,16 @@ TEST(ActuatorFrf, VectorFitFeaturesCarryStandardErrors) {
   within(*a.antiresonance_vector_fit_Hz, *a.antiresonance_vector_fit_standard_error_Hz, kAntiResonanceHz, 0.01);
   within(*a.antiresonance_vector_fit_damping, *a.antiresonance_vector_fit_damping_standard_error, std::abs(kZeroDamping), 1.0);
   within(*a.static_gain_vector_fit, *a.static_gain_vector_fit_standard_error, kGain, 0.02);
+  // Each fit's covariance summary: its conditioning, and its flagged pairs named by the model's
+  // parameters ("p1/r0.1 -0.958").
+  for (const auto& fit : {a.fit_de, a.fit_vs}) {
+    ASSERT_TRUE(fit && fit->condition_number);
+    EXPECT_GE(*fit->condition_number, 1.0);
+    for (const std::string& c : fit->high_correlations) {
+      EXPECT_NE(c.find('/'), std::string::npos) << c;
+      EXPECT_GT(std::abs(std::stod(c.substr(c.rfind(' ') + 1))), 0.95) << c;
+    }
+  }
 }
 
 // With R and C_sensor known the corner is 1/(2 pi R C), fixed in the IFF plant fit; the free fit

@@ -95,6 +95,10 @@ struct ParameterUncertainty {
                                                          const Eigen::VectorXd& dvalue_dx, const std::vector<int>& fitted,
                                                          const FitCovariance& covariance, bool from_data_variance);
 
+// "a/b 0.973" for each pair of covariance.high_correlations, named by names (one per parameter,
+// InputError when the count differs): how results.json and the reports flag them.
+[[nodiscard]] std::vector<std::string> high_correlation_labels(const FitCovariance& covariance, const std::vector<std::string>& names);
+
 // The covariance of y = f(x) from that of x, to first order: G C G^T with G = dy/dx (q x p).
 [[nodiscard]] Eigen::MatrixXd propagate_covariance(const Eigen::MatrixXd& G, const Eigen::MatrixXd& covariance);
 

@@ -34,6 +34,10 @@ struct VectorFitSummary {
   long order = 0;
   double relative_rms_error = 0.0;
   bool converged = false;
+  // Of its covariance (ident/vector_fit_uncertainty.hpp), when it has one: the conditioning of its
+  // Jacobian and the pairs of its real parameters ("p3.re", "r1.3.im", ...) correlated above 0.95.
+  std::optional<double> condition_number;  // dimensionless
+  std::vector<std::string> high_correlations;
 };
 
 constexpr auto describe(core::Type<VectorFitSummary>) {
@@ -42,7 +46,9 @@ constexpr auto describe(core::Type<VectorFitSummary>) {
   return core::fields<S>("VectorFitSummary", "a vector fit's summary",
       core::field("order", &S::order, kNone, "poles"),
       core::field("relative_rms_error", &S::relative_rms_error, kRatio, "rms |fit - data| / rms |data|"),
-      core::field("converged", &S::converged, kNone, "the poles settled"));
+      core::field("converged", &S::converged, kNone, "the poles settled"),
+      core::field("condition_number", &S::condition_number, kRatio, "of the fit's Jacobian with unit-norm columns (with standard errors)"),
+      core::field("high_correlations", &S::high_correlations, kNone, "\"a/b 0.973\": its parameters correlated above 0.95"));
 }
 
 // Evidence of a non-minimum-phase zero pair in u -> Vs.
