@@ -26,12 +26,12 @@ struct Problem {
   CMatrix data;
 };
 
-// 10 lightly damped pairs (1 % to 2.8 %) log-spaced from 10 Hz to 1 kHz, data from 3.2 Hz to 3.2 kHz.
-Problem make_problem() {
-  constexpr int kPoles = 20, kPoints = 2000;
-  CVector poles(kPoles), residues(kPoles);
-  for (int i = 0; i < kPoles / 2; ++i) {
-    const double wn = kTwoPi * 10.0 * std::pow(100.0, i / (kPoles / 2 - 1.0));
+// pole_count / 2 lightly damped pairs (1 % upward by 0.2 % per pair) log-spaced from 10 Hz to 1 kHz, data
+// from 3.2 Hz to 3.2 kHz at point_count log-spaced frequencies (vf_bench.py's problem).
+Problem make_problem(int pole_count = 20, int point_count = 2000) {
+  CVector poles(pole_count), residues(pole_count);
+  for (int i = 0; i < pole_count / 2; ++i) {
+    const double wn = kTwoPi * 10.0 * std::pow(100.0, i / (pole_count / 2 - 1.0));
     const double zeta = 0.01 + 0.002 * i;
     const Complex p(-zeta * wn, wn * std::sqrt(1.0 - zeta * zeta));
     poles(2 * i) = p;
@@ -40,21 +40,21 @@ Problem make_problem() {
     residues(2 * i + 1) = std::conj(residues(2 * i));
   }
   Problem pr;
-  pr.omega.resize(kPoints);
-  pr.data.resize(kPoints, 1);
-  for (int k = 0; k < kPoints; ++k) {
-    pr.omega(k) = kTwoPi * std::pow(10.0, 0.5 + 3.0 * k / (kPoints - 1.0));
+  pr.omega.resize(point_count);
+  pr.data.resize(point_count, 1);
+  for (int k = 0; k < point_count; ++k) {
+    pr.omega(k) = kTwoPi * std::pow(10.0, 0.5 + 3.0 * k / (point_count - 1.0));
     Complex v(0.1, 0.0);
-    for (int n = 0; n < kPoles; ++n) v += residues(n) / (Complex(0.0, pr.omega(k)) - poles(n));
+    for (int n = 0; n < pole_count; ++n) v += residues(n) / (Complex(0.0, pr.omega(k)) - poles(n));
     pr.data(k, 0) = v;
   }
   return pr;
 }
 
-// 20 poles and exactly 5 relocations: no early stop and no per-iteration residue identification.
-piezobench::ident::VectorFittingOptions five_relocations() {
+// `order` poles and exactly 5 relocations: no early stop and no per-iteration residue identification.
+piezobench::ident::VectorFittingOptions five_relocations(int order = 20) {
   piezobench::ident::VectorFittingOptions o;
-  o.order = 20;
+  o.order = order;
   o.max_iterations = 5;
   o.pole_tolerance = 0.0;
   o.residual_tolerance = 0.0;
@@ -107,5 +107,16 @@ void BM_VectorFit20Poles2000Points4Outputs5Iterations(benchmark::State& state) {
 BENCHMARK(BM_VectorFit20Poles2000Points4Outputs5Iterations)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 }  // namespace
+
+// The small case of vf_bench.py (--order 10 --points 800), where fixed costs weigh most.
+void BM_VectorFit10Poles800Points5Iterations(benchmark::State& state) {
+  const Problem pr = make_problem(10, 800);
+  const piezobench::ident::VectorFittingOptions o = five_relocations(10);
+  for (auto _ : state) {
+    auto r = piezobench::ident::vector_fit(pr.omega, pr.data, o);
+    benchmark::DoNotOptimize(r.poles.data());
+  }
+}
+BENCHMARK(BM_VectorFit10Poles800Points5Iterations)->Unit(benchmark::kMicrosecond)->MeasureProcessCPUTime();
 
 BENCHMARK_MAIN();
