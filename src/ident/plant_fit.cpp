@@ -188,6 +188,9 @@ std::vector<core::ResidualCovarianceBlock> leakage_blocks(const dsp::ResolutionK
     const dsp::LeakageCovariance lc = dsp::leakage_covariance(kernel, w.segment(first, count), response);
     Eigen::VectorXcd g(count);
     for (Index i = 0; i < count; ++i) g(i) = -weight(first + i) * model(first + i) / (d(first + i) * d(first + i));
+    // A model or a line that gives no finite covariance leaves the run to the noise alone (the
+    // intervals then miss the leakage there) rather than failing the fit's standard errors.
+    if (!g.allFinite() || !lc.upper.allFinite() || !lc.upper_pseudo.allFinite()) continue;
     std::vector<Eigen::Triplet<double>> t;
     t.reserve(static_cast<std::size_t>(4 * count * (2 * dsp::kLeakageMaxLineDistance + 1)));
     for (Index i = 0; i < count; ++i) {
