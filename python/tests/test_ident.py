@@ -259,7 +259,8 @@ def test_the_fits_see_their_model_through_the_welch_windows_resolution_kernel():
     assert abs(smoothed[peak] / response(f[peak])) < 0.95
 
 
-def test_resonance_standard_error_matches_the_scatter_of_welch_estimates_with_a_random_input():
+@pytest.mark.parametrize("band, most", [((20.0, 500.0), 1.8), ((60.0, 150.0), 2.6)])
+def test_resonance_standard_error_matches_the_scatter_of_welch_estimates_with_a_random_input(band, most):
     # The random input's own error at a sharp resonance (the window's leakage, dsp/leakage_covariance.hpp):
     # 60 records of 20 s at 2 kHz, a mass-spring-damper at 95.6 Hz, zeta 0.006 (4.6 lines of 0.25 Hz
     # wide, the virtual bench's resonance), 200 us delay, a Gaussian input with a continuous spectrum
@@ -267,7 +268,10 @@ def test_resonance_standard_error_matches_the_scatter_of_welch_estimates_with_a_
     # 50 %. The fit's standard errors against the estimates' scatter: 1.26 for the natural frequency
     # and 0.90 for the damping here (1.23-1.27 and 1.08 over 100 records at 0.1 % and 1 % noise;
     # docs/uncertainty.md section 2). Without the leakage error's covariance the frequency's was 4-5
-    # times the scatter.
+    # times the scatter. In a band narrow around the peak (60-150 Hz) too few lines are clean of the
+    # leakage for a noise model: the noise is then the coherence with the leakage divided out, and the
+    # frequency's standard error about 2 times its scatter (5.2 when the measured std, leakage and
+    # all, was kept there and the leakage counted twice).
     fs, n, nfft = 2000.0, 40000, 8000
     wn, zeta, delay = 2 * np.pi * 95.6, 0.006, 2e-4
     period = 8 * n
@@ -283,13 +287,13 @@ def test_resonance_standard_error_matches_the_scatter_of_welch_estimates_with_a_
         y = np.fft.irfft(h * x_spectrum, period)[:n]
         y = y + 1e-3 * np.std(y) * rng.standard_normal(n)
         frf = pb.dsp.frf(x, y[None, :], fs, outputs=["de"], nfft=nfft, overlap=0.5, window="hann-periodic", detrend="mean").frf
-        fit = ident.fit_delayed_second_order(frf, "de", fmin_Hz=20.0, fmax_Hz=500.0)
+        fit = ident.fit_delayed_second_order(frf, "de", fmin_Hz=band[0], fmax_Hz=band[1])
         frequency.append(fit.natural_frequency)
         frequency_se.append(fit.uncertainty.standard_error_of("natural_frequency"))
         damping.append(fit.damping)
         damping_se.append(fit.uncertainty.standard_error_of("damping"))
     frequency_ratio = np.median(frequency_se) / np.std(frequency, ddof=1)
     damping_ratio = np.median(damping_se) / np.std(damping, ddof=1)
-    assert 0.8 <= frequency_ratio <= 1.8, frequency_ratio
+    assert 0.8 <= frequency_ratio <= most, frequency_ratio
     assert 0.7 <= damping_ratio <= 1.5, damping_ratio
     assert abs(np.mean(frequency) / wn - 1.0) < 1e-4  # the fit through the window's kernel is unbiased

@@ -384,7 +384,7 @@ FitBand fit_band(const Vector& omega, const CVector& h, const Vector& coherence,
 // laid out), the noise is instead the additive + proportional model of dsp::random_frf_std fitted on
 // the lines the leakage leaves clean: at the peak the coherence's leakage part is 10^3-10^5 times the
 // noise's, and what the division leaves there is the kernel's approximation error, not noise (it
-// doubled the resonance's interval on the virtual bench).
+// doubled the resonance's interval on the virtual bench). Without such a model, the division.
 Vector leakage_free_residual_std(const PointWeights& pw, const FitBand& b, double effective_averages, const dsp::KernelGrid& grid,
                                  const CVector& model_at_nodes, bool leakage_modelled) {
   if (b.c.size() != b.w.size() || !(effective_averages > 0.0) || pw.residual_std.size() != 2 * b.w.size()) return pw.residual_std;
@@ -393,12 +393,18 @@ Vector leakage_free_residual_std(const PointWeights& pw, const FitBand& b, doubl
   if (leakage_modelled) {
     Vector std_h(b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) std_h(k) = dsp::frf_relative_std(b.c(k), effective_averages) * std::abs(b.d(k));
-    const Vector random = dsp::random_frf_std(b.d, std_h, grid.smooth(model_at_nodes), leak, effective_averages).std;
-    for (Index k = 0; k < b.w.size(); ++k) {
-      const double eps = std::max(random(k) / std::abs(b.d(k)), dsp::kMinFitRelativeStd);
-      s(2 * k) = s(2 * k + 1) = pw.weight(k) * eps;
+    const dsp::RandomFrfStd random = dsp::random_frf_std(b.d, std_h, grid.smooth(model_at_nodes), leak, effective_averages);
+    // Without a noise model (too few clean lines: a band narrow around the peak, a noise-free record)
+    // random_frf_std keeps the measured std, leakage and all, which the blocks would then count twice
+    // (the resonance's standard error 5 times its scatter): the coherence with the leakage divided out
+    // instead (2 times).
+    if (random.noise.additive_std > 0.0 || random.noise.relative_std > 0.0) {
+      for (Index k = 0; k < b.w.size(); ++k) {
+        const double eps = std::max(random.std(k) / std::abs(b.d(k)), dsp::kMinFitRelativeStd);
+        s(2 * k) = s(2 * k + 1) = pw.weight(k) * eps;
+      }
+      return s;
     }
-    return s;
   }
   for (Index k = 0; k < b.w.size(); ++k) {
     const double eps = std::max(dsp::frf_relative_std(std::min(1.0, b.c(k) / leak(k)), effective_averages), dsp::kMinFitRelativeStd);
