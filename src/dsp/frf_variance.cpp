@@ -61,14 +61,6 @@ double adjacent_line_correlation(WindowType window, Index nfft, Index noverlap, 
   return den > 0.0 ? num / den : 0.0;
 }
 
-namespace {
-
-// The Welch layout an FRF's provenance records; nullopt when the window, nfft, overlap or averages
-// are missing, or the window is one piezobench does not know (no variance rather than a wrong one).
-struct WelchLayout {
-  WindowType window{};
-  Index noverlap = 0;
-};
 std::optional<WelchLayout> welch_layout(const FrfProvenance& p) {
   if (p.window.empty() || p.nfft < 2 || p.averages < 1) return std::nullopt;
   WelchLayout l;
@@ -81,8 +73,6 @@ std::optional<WelchLayout> welch_layout(const FrfProvenance& p) {
   if (l.noverlap < 0 || l.noverlap >= p.nfft) return std::nullopt;
   return l;
 }
-
-}  // namespace
 
 double adjacent_line_correlation(const FrfProvenance& p) {
   const auto l = welch_layout(p);

@@ -114,7 +114,7 @@ LeakageCovariance leakage_covariance(const ResolutionKernel& kernel, const Eigen
   std::vector<Complex> v(static_cast<std::size_t>(width)), u(static_cast<std::size_t>(width));
   for (long d = 0; d < reach && d < n; ++d) {
     for (const Lag& lag : lags) {
-      Complex a = 0.0, sum_v = 0.0, sum_u = 0.0;
+      Complex a = 0.0, sum_u = 0.0;  // A_j = sum v (also the v's sum in B), and the u's sum
       for (long i = d * P; i < width; ++i) {
         const Complex pair = std::conj(w[static_cast<std::size_t>(i)]) * w[static_cast<std::size_t>(i - d * P)];
         const Complex ph = lag.phase[static_cast<std::size_t>(i)];
@@ -123,7 +123,6 @@ LeakageCovariance leakage_covariance(const ResolutionKernel& kernel, const Eigen
         a += v[static_cast<std::size_t>(i)];
         sum_u += u[static_cast<std::size_t>(i)];
       }
-      sum_v = a;
       for (Index k = 0; k + d < n; ++k) {
         const Index l = k + d;
         Complex vhh = 0.0, vh = 0.0, vhc = 0.0, uh = 0.0, uch = 0.0;  // sums of conj(v) |h|^2, conj(v) h, conj(v) h^*, u h, conj(u) h
@@ -138,7 +137,7 @@ LeakageCovariance leakage_covariance(const ResolutionKernel& kernel, const Eigen
         }
         const Complex mk = mean(k), ml = mean(l);
         // B = sum conj(v) (h - mk)(h - ml)^* = vhh - ml^* vh - mk vhc + mk ml^* sum conj(v)
-        const Complex b = vhh - std::conj(ml) * vh - mk * vhc + mk * std::conj(ml) * std::conj(sum_v);
+        const Complex b = vhh - std::conj(ml) * vh - mk * vhc + mk * std::conj(ml) * std::conj(a);
         const Complex q1 = uh - ml * sum_u;                 // sum u (h - ml)
         const Complex q2 = uch - mk * std::conj(sum_u);     // sum conj(u) (h - mk)
         out.upper(k, d) += lag.weight * a * b * scale;

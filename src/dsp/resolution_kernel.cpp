@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
 
 #include "piezobench/core/error.hpp"
 
@@ -68,10 +69,9 @@ ResolutionKernel resolution_kernel(const FrfProvenance& provenance) {
   }
   ResolutionKernel kernel = resolution_kernel(window, provenance.nfft, provenance.sample_rate);
   kernel.adjacent_line_correlation = adjacent_line_correlation(provenance);
-  const auto noverlap = static_cast<Eigen::Index>(std::floor(provenance.overlap * static_cast<double>(provenance.nfft)));
-  if (provenance.averages >= 1 && noverlap >= 0 && noverlap < provenance.nfft) {
+  if (const std::optional<WelchLayout> l = welch_layout(provenance)) {
     kernel.segments = provenance.averages;
-    kernel.segment_shift = provenance.nfft - noverlap;
+    kernel.segment_shift = provenance.nfft - l->noverlap;
   }
   return kernel;
 }

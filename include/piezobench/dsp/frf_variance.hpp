@@ -20,7 +20,7 @@
 // for K segments of the window w shifted by D = nfft - noverlap samples (hann at 50 %: rho(1) = 1/6,
 // n_d = K / 1.056 for large K; rectangular without overlap: n_d = K).
 #include <Eigen/Dense>
-
+#include <optional>
 #include <vector>
 
 #include "piezobench/dsp/frf.hpp"
@@ -63,6 +63,15 @@ inline constexpr double kFitModelRelativeError = 0.05;
 [[nodiscard]] double adjacent_line_correlation(WindowType window, Eigen::Index nfft, Eigen::Index noverlap, Eigen::Index segments);
 // From an FRF's provenance (window, nfft, overlap, averages); 0 (independent) when one is unknown.
 [[nodiscard]] double adjacent_line_correlation(const FrfProvenance& provenance);
+
+// The Welch layout an FRF's provenance records (window, and noverlap = floor(overlap nfft) samples);
+// nullopt when the window, nfft, overlap or averages are missing, or the window is one piezobench does
+// not know (no variance rather than a wrong one).
+struct WelchLayout {
+  WindowType window{};
+  Eigen::Index noverlap = 0;
+};
+[[nodiscard]] std::optional<WelchLayout> welch_layout(const FrfProvenance& provenance);
 
 // The noise of an FRF whose variance nothing records (no coherence, or no Welch provenance), estimated
 // from the residuals of a model fitted to it: each part of H_k - G_k has the variance
