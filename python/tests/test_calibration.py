@@ -92,9 +92,11 @@ def test_resonance_interval_against_the_truth(records):
     # z = (value - truth) / se of the d_e fit's natural frequency, the truth its pseudo-true value (the
     # same estimator on the bench's exact sampled response, calibrate.reference_fits). Its scatter is the
     # random input's, through the window's leakage at the peak (the noise-free record scatters as much),
-    # which the leakage error's covariance (dsp/leakage_covariance.hpp) carries: mean z^2 0.31 over
-    # these 8 seeds (z sd 0.72 over 200 seeds: the interval is a little wide). The bounds fail the former
-    # interval, 4-5 times the scatter (mean z^2 ~0.015 here), and a standard error 2.5 times too small (1.95).
+    # which the leakage error's covariance (dsp/leakage_covariance.hpp) carries: mean z^2 0.61 over
+    # these 8 seeds (z sd 0.99 over 200 seeds since the plant fits' second pass weighted by the model's
+    # variance; 0.31 and 0.72 before, the weights following each record's coherence). The bounds fail
+    # the interval of 4-5 times the scatter (mean z^2 ~0.015 here) and a standard error 2.5 times too
+    # small (1.95).
     z = []
     for frf, _, band, truth in records:
         est, _ = calibrate.fitted(frf, 20.0, 500.0)

@@ -374,41 +374,66 @@ FitBand fit_band(const Vector& omega, const CVector& h, const Vector& coherence,
   return b;
 }
 
+// The relative random error of each line from the additive + proportional noise model of
+// dsp::random_frf_std, fitted on the lines the window's leakage leaves clean (the model at the
+// solution, at the grid's nodes, predicts where it does not); empty when no such model can be fitted
+// (fewer than 8 clean lines: a band narrow around the peak, a noise-free record) or the coherence or
+// n_d is unknown.
+Vector noise_model_relative_std(const FitBand& b, double effective_averages, const dsp::KernelGrid& grid, const CVector& model_at_nodes,
+                                const Vector& leak) {
+  if (b.c.size() != b.w.size() || !(effective_averages > 0.0)) return {};
+  Vector std_h(b.w.size());
+  for (Index k = 0; k < b.w.size(); ++k) std_h(k) = dsp::frf_relative_std(b.c(k), effective_averages) * std::abs(b.d(k));
+  const dsp::RandomFrfStd random = dsp::random_frf_std(b.d, std_h, grid.smooth(model_at_nodes), leak, effective_averages);
+  if (!(random.noise.additive_std > 0.0 || random.noise.relative_std > 0.0)) return {};
+  Vector eps(b.w.size());
+  for (Index k = 0; k < b.w.size(); ++k) eps(k) = random.std(k) / std::abs(b.d(k));
+  return eps;
+}
+
+// The weights' eps_k for a second pass of the fits, from the model at the first pass's solution
+// rather than from each line's measured coherence: the noise model's variance plus the leakage's,
+// (1/gamma_leak^2 - 1) / (2 n_d) (B&P's eps with the model's leakage coherence). The measured
+// coherence near a sharp resonance is lowered by the same leakage realization whose error is large
+// at that line, so weights taken from it down-weight the fit's own largest errors, and a covariance
+// that takes the weights as fixed overstated the natural frequency's scatter 1.25-1.4 times
+// (docs/uncertainty.md, section 6). Empty (keep the first pass) when the leakage is not modelled
+// (the provenance does not say how the segments were laid out) or there is no noise model.
+Vector smooth_relative_std(const FitBand& b, double effective_averages, const dsp::KernelGrid& grid, const CVector& model_at_nodes,
+                           const dsp::ResolutionKernel& kernel) {
+  if (!dsp::knows_leakage(kernel) || b.c.size() != b.w.size() || !(effective_averages > 0.0)) return {};
+  const Vector leak = grid.leakage_coherence(model_at_nodes);
+  Vector eps = noise_model_relative_std(b, effective_averages, grid, model_at_nodes, leak);
+  for (Index k = 0; k < eps.size(); ++k) {
+    const double q = leak(k) > 0.0 ? 1.0 / leak(k) - 1.0 : 0.0;
+    eps(k) = std::sqrt(eps(k) * eps(k) + q / (2.0 * effective_averages));
+  }
+  return eps.allFinite() ? eps : Vector{};
+}
+
 // The residuals' noise (PointWeights::residual_std) from the coherence with the window's leakage
 // divided out (dsp::KernelGrid::leakage_coherence of the model at the solution): near the resonance
 // the Welch estimate's coherence drops by the leakage of a sharp peak, which is not a random error, and
 // B&P's eps would count it as one (the resonance's and the gains' intervals were 1.7-6 times their
-// scatter). The weights keep the measured coherence. Unchanged without a coherence, n_d or kernel.
+// scatter). Unchanged without a coherence, n_d or kernel.
 //
 // When the leakage's own error is modelled (leakage_blocks: the provenance says how the segments were
-// laid out), the noise is instead the additive + proportional model of dsp::random_frf_std fitted on
-// the lines the leakage leaves clean: at the peak the coherence's leakage part is 10^3-10^5 times the
-// noise's, and what the division leaves there is the kernel's approximation error, not noise (it
-// doubled the resonance's interval on the virtual bench). Without such a model, the division.
+// laid out), the noise is instead noise_model_relative_std: at the peak the coherence's leakage part is
+// 10^3-10^5 times the noise's, and what the division leaves there is the kernel's approximation error,
+// not noise (it doubled the resonance's interval on the virtual bench). Without such a model, the
+// division.
 Vector leakage_free_residual_std(const PointWeights& pw, const FitBand& b, double effective_averages, const dsp::KernelGrid& grid,
                                  const CVector& model_at_nodes, bool leakage_modelled) {
   if (b.c.size() != b.w.size() || !(effective_averages > 0.0) || pw.residual_std.size() != 2 * b.w.size()) return pw.residual_std;
   const Vector leak = grid.leakage_coherence(model_at_nodes);
   Vector s = pw.residual_std;
-  if (leakage_modelled) {
-    Vector std_h(b.w.size());
-    for (Index k = 0; k < b.w.size(); ++k) std_h(k) = dsp::frf_relative_std(b.c(k), effective_averages) * std::abs(b.d(k));
-    const dsp::RandomFrfStd random = dsp::random_frf_std(b.d, std_h, grid.smooth(model_at_nodes), leak, effective_averages);
-    // Without a noise model (too few clean lines: a band narrow around the peak, a noise-free record)
-    // random_frf_std keeps the measured std, leakage and all, which the blocks would then count twice
-    // (the resonance's standard error 5 times its scatter): the coherence with the leakage divided out
-    // instead (2 times).
-    if (random.noise.additive_std > 0.0 || random.noise.relative_std > 0.0) {
-      for (Index k = 0; k < b.w.size(); ++k) {
-        const double eps = std::max(random.std(k) / std::abs(b.d(k)), dsp::kMinFitRelativeStd);
-        s(2 * k) = s(2 * k + 1) = pw.weight(k) * eps;
-      }
-      return s;
-    }
-  }
+  // Without a noise model random_frf_std keeps the measured std, leakage and all, which the blocks
+  // would then count twice (the resonance's standard error 5 times its scatter): the coherence with
+  // the leakage divided out instead (2 times).
+  const Vector noise = leakage_modelled ? noise_model_relative_std(b, effective_averages, grid, model_at_nodes, leak) : Vector{};
   for (Index k = 0; k < b.w.size(); ++k) {
-    const double eps = std::max(dsp::frf_relative_std(std::min(1.0, b.c(k) / leak(k)), effective_averages), dsp::kMinFitRelativeStd);
-    s(2 * k) = s(2 * k + 1) = pw.weight(k) * eps;
+    const double eps = noise.size() > 0 ? noise(k) : dsp::frf_relative_std(std::min(1.0, b.c(k) / leak(k)), effective_averages);
+    s(2 * k) = s(2 * k + 1) = pw.weight(k) * std::max(eps, dsp::kMinFitRelativeStd);
   }
   return s;
 }
@@ -601,14 +626,24 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   };
   double initial_cost = 0.0;
   core::LmResult best = best_iff_solution(residual_with(pw), start, options.max_iterations, initial_cost, source);
-  if (eps.size() == 0) {
+  const auto at = [&](const Eigen::VectorXd& x) { return plant::iff_plant_response(from_x(x, sign, layout, options.fixed_w_hpf), grid.nodes()); };
+  if (eps.size() > 0) {
+    // A second pass weighted by the model's variance, not the record's (as fit_delayed_second_order).
+    if (const Vector smooth = smooth_relative_std(b, options.effective_averages, grid, at(best.x), options.resolution); smooth.size() > 0) {
+      pw = point_weights(b.w, smooth);
+      const core::LmResult second = least_squares(residual_with(pw), best.x, options.max_iterations);
+      if (!std::isfinite(second.cost)) {
+        throw NumericalError("IFF plant fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
+      }
+      best = second;
+    }
+  } else {
     // No variance recorded: the noise this fit's residuals show (additive and proportional) weights
     // a second fit, whose residuals give the noise of its standard errors (two-step feasible
     // generalized least squares). Without it the lines of the dip, where the sensor's noise is
     // largest relative to H, would decide xz with a standard error taken from the average line.
     for (int round = 0; round < 2; ++round) {
-      const IffPlantFit f = from_x(best.x, sign, layout, options.fixed_w_hpf);
-      const CVector g = grid.smooth(plant::iff_plant_response(f, grid.nodes()));
+      const CVector g = grid.smooth(at(best.x));
       pw = point_weights(b.w, dsp::estimate_frf_noise(b.d, g).relative_std_at(g));
       if (round == 0) best = best_iff_solution(residual_with(pw), start, options.max_iterations, initial_cost, source);
     }
@@ -788,23 +823,28 @@ DelayedSecondOrderFit fit_delayed_second_order(const Vector& omega, const CVecto
   if (!SecondOrderResidual{b, pw.weight, sign, options.fit_delay, grid}(x0).allFinite()) {
     throw NumericalError("second-order fit (" + source + ")", "the starting point gives a non-finite error", true);
   }
-  const auto solve = [&](const PointWeights& weights) {
-    const core::LmResult o = least_squares(SecondOrderResidual{b, weights.weight, sign, options.fit_delay, grid}, x0, options.max_iterations);
+  const auto solve = [&](const PointWeights& weights, const Eigen::VectorXd& from) {
+    const core::LmResult o = least_squares(SecondOrderResidual{b, weights.weight, sign, options.fit_delay, grid}, from, options.max_iterations);
     if (!std::isfinite(o.cost)) {
       throw NumericalError("second-order fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
     }
     return o;
   };
-  core::LmResult o = solve(pw);
+  core::LmResult o = solve(pw, x0);
+  const auto unpack = [&](const Eigen::VectorXd& x) { return SecondOrderResidual{b, pw.weight, sign, options.fit_delay, grid}.unpack(x); };
   if (eps.size() == 0) {
     // No variance recorded: the noise of this fit's residuals weights a second fit and gives the
     // standard errors (as fit_iff_plant does).
     for (int round = 0; round < 2; ++round) {
-      const DelayedSecondOrderFit f = SecondOrderResidual{b, pw.weight, sign, options.fit_delay, grid}.unpack(o.x);
-      const CVector g = grid.smooth(f.response(grid.nodes()));
+      const CVector g = grid.smooth(unpack(o.x).response(grid.nodes()));
       pw = point_weights(b.w, dsp::estimate_frf_noise(b.d, g).relative_std_at(g));
-      if (round == 0) o = solve(pw);
+      if (round == 0) o = solve(pw, x0);
     }
+  } else if (const Vector smooth = smooth_relative_std(b, options.effective_averages, grid, unpack(o.x).response(grid.nodes()), options.resolution);
+             smooth.size() > 0) {
+    // A second pass weighted by the model's variance, not the record's.
+    pw = point_weights(b.w, smooth);
+    o = solve(pw, o.x);
   }
   const SecondOrderResidual residual{b, pw.weight, sign, options.fit_delay, grid};
   DelayedSecondOrderFit fit = residual.unpack(o.x);
