@@ -135,10 +135,12 @@ Vector coherence_relative_std(const Vector& c, double effective_averages) {
   return eps;
 }
 
-// The covariance of the solver's parameters at its solution x (core/fit_covariance.hpp).
-core::FitCovariance covariance_at(const core::ResidualFunction& residual, const Eigen::VectorXd& x, const Vector& residual_std,
+// The covariance of the solver's parameters at its solution x (core/fit_covariance.hpp), with the
+// residual's analytic Jacobian.
+template <class Residual>
+core::FitCovariance covariance_at(const Residual& residual, const Eigen::VectorXd& x, const Vector& residual_std,
                                   const Eigen::VectorXcd& adjacent = {}, const std::vector<core::ResidualCovarianceBlock>& blocks = {}) {
-  return core::fit_covariance(core::central_difference_jacobian(residual, x), residual(x), residual_std, adjacent, blocks);
+  return core::fit_covariance(residual.jacobian(x), residual(x), residual_std, adjacent, blocks);
 }
 
 // Lines whose leakage error counts: its relative variance (1/gamma_leak^2 - 1) / (2 segments) above
@@ -280,11 +282,29 @@ void check_lm(core::FitQuality& q, core::LmStatus status) {
   if (status == core::LmStatus::kMaxIterations) q.add_problem("Levenberg-Marquardt stopped at its iteration limit");
 }
 
-// Levenberg-Marquardt on the scaled parameters (core/least_squares.hpp).
-core::LmResult least_squares(const core::ResidualFunction& residual, const Eigen::VectorXd& x0, int max_iterations) {
+// Levenberg-Marquardt on the scaled parameters (core/least_squares.hpp), with the residual's analytic
+// Jacobian (a residual type with jacobian(x): one model evaluation per step instead of 2 size(x) + 1).
+template <class Residual>
+core::LmResult least_squares(const Residual& residual, const Eigen::VectorXd& x0, int max_iterations) {
   core::LmOptions o;
   o.max_iterations = max_iterations;
-  return core::levenberg_marquardt(residual, x0, o);
+  return core::levenberg_marquardt(residual, [&residual](const Eigen::VectorXd& x) { return residual.jacobian(x); }, x0, o);
+}
+
+// The rows of d r / d x for residuals r_k = a_k (G_k / H_k - 1): the model's derivatives at the grid's
+// nodes (one column per parameter) through the kernel, over H_k, weighted; interleaved (Re, Im) as r.
+Eigen::MatrixXd relative_residual_jacobian(const dsp::KernelGrid& grid, const Eigen::MatrixXcd& dg_at_nodes, const CVector& d,
+                                           const Vector& weight) {
+  const Eigen::MatrixXcd dg = grid.smooth(dg_at_nodes);
+  Eigen::MatrixXd j(2 * d.size(), dg.cols());
+  for (Index c = 0; c < dg.cols(); ++c) {
+    for (Index k = 0; k < d.size(); ++k) {
+      const Complex e = core::divide(dg(k, c), d(k)) * weight(k);
+      j(2 * k, c) = e.real();
+      j(2 * k + 1, c) = e.imag();
+    }
+  }
+  return j;
 }
 
 }  // namespace
@@ -552,6 +572,28 @@ struct IffResidual {
   double fixed_w_hpf;
   dsp::KernelGrid grid;  // b.w through the FRF's resolution kernel: the model at each line once
 
+  // d r / d x: G's derivatives in the scaled parameters, from its factors (eq. 2.3).
+  [[nodiscard]] Eigen::MatrixXd jacobian(const Eigen::VectorXd& x) const {
+    const IffPlantFit p = from_x(x, sign, layout, fixed_w_hpf);
+    const Vector& nodes = grid.nodes();
+    Eigen::MatrixXcd dg(nodes.size(), layout.size());
+    for (Index i = 0; i < nodes.size(); ++i) {
+      const Complex s(0.0, nodes(i));
+      const Complex g = plant::iff_plant_response(p, nodes(i));
+      const Complex num = 1.0 + 2.0 * p.xz * s / p.wz + s * s / (p.wz * p.wz);
+      const Complex den = 1.0 + 2.0 * p.xp * s / p.wp + s * s / (p.wp * p.wp);
+      dg(i, 0) = g;                                                                        // log|g0|
+      dg(i, 1) = -core::divide(g * (2.0 * p.xz * s / p.wz + 2.0 * s * s / (p.wz * p.wz)), num);  // log wz
+      dg(i, 2) = core::divide(g * (kXzScale * 2.0 * s / p.wz), num);                          // xz / 0.01
+      dg(i, 3) = core::divide(g * (2.0 * p.xp * s / p.wp + 2.0 * s * s / (p.wp * p.wp)), den);   // log wp
+      dg(i, 4) = -core::divide(g * (2.0 * p.xp * s / p.wp), den);                             // log xp
+      Index c = 5;
+      if (layout.hpf) dg(i, c++) = -core::divide(g * p.w_hpf, p.w_hpf + s);                  // log w_hpf
+      if (layout.delay) dg(i, c++) = -g * s * kDelayScale;                                  // delay / 100 us
+    }
+    return relative_residual_jacobian(grid, dg, b.d, weight);
+  }
+
   Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
     const IffPlantFit p = from_x(x, sign, layout, fixed_w_hpf);
     const CVector g = grid.smooth(plant::iff_plant_response(p, grid.nodes()));
@@ -766,6 +808,24 @@ struct SecondOrderResidual {
     p.damping = std::exp(x(2));
     p.delay = fit_delay ? x(3) * kDelayScale : 0.0;
     return p;
+  }
+
+  // d r / d x: log|k|, log wn, log zeta, [delay / 1e-4].
+  [[nodiscard]] Eigen::MatrixXd jacobian(const Eigen::VectorXd& x) const {
+    const DelayedSecondOrderFit p = unpack(x);
+    const Vector& nodes = grid.nodes();
+    const double wn = p.natural_frequency;
+    Eigen::MatrixXcd dg(nodes.size(), fit_delay ? 4 : 3);
+    for (Index i = 0; i < nodes.size(); ++i) {
+      const Complex s(0.0, nodes(i));
+      const Complex g = second_order(p, nodes(i));
+      const Complex den = s * s + 2.0 * p.damping * wn * s + wn * wn;
+      dg(i, 0) = g;
+      dg(i, 1) = g * (2.0 - core::divide(2.0 * p.damping * wn * s + 2.0 * wn * wn, den));
+      dg(i, 2) = -core::divide(g * (2.0 * p.damping * wn * s), den);
+      if (fit_delay) dg(i, 3) = -g * s * kDelayScale;
+    }
+    return relative_residual_jacobian(grid, dg, b.d, weight);
   }
 
   Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
