@@ -15,6 +15,7 @@
 #include "piezobench/core/fit_covariance.hpp"
 #include "piezobench/core/least_squares.hpp"
 #include "piezobench/dsp/frf_variance.hpp"
+#include "piezobench/dsp/leakage_covariance.hpp"
 #include "piezobench/dsp/resolution_kernel.hpp"
 #include "piezobench/core/format.hpp"
 #include "piezobench/core/units.hpp"
@@ -385,6 +386,35 @@ Vector random_residual_std(const FitData& d, const TwoDofParams& p, const Weight
   return s;
 }
 
+// The window's leakage error in residuals() (dsp::leakage_residual_blocks): the random input's own error
+// at the resonance and the dip, which random_residual_std leaves out. A residual (G_k - H_k) w_k carries
+// u_k = -w_k e_k; e_k is the actuator's own (the chain divided out of the data is smooth over a line,
+// so its leakage is the actuator model's times the chain). The lines' noise from random_sd (w_k std_k).
+// d_e's rows first, as residuals().
+std::vector<core::ResidualCovarianceBlock> leakage_blocks(const FitData& d, const TwoDofParams& p, const Weights& wt, const Vector& random_sd) {
+  const Index n = d.omega.size();
+  if (random_sd.size() != 4 * n || !dsp::knows_leakage(d.kernel)) return {};
+  TwoDofBench bare;
+  bare.amplifier_gain = 1.0;
+  const lti::CMatrix at_nodes = two_dof_response(p, bare, d.grid.nodes());
+  std::vector<core::ResidualCovarianceBlock> blocks;
+  for (const Index o : {kOutputDe, kOutputVs}) {
+    const CVector& h = o == kOutputDe ? d.de : d.vs;
+    const Vector& w = o == kOutputDe ? wt.de : wt.vs;
+    Eigen::VectorXcd g(n);
+    Vector noise(n);
+    for (Index k = 0; k < n; ++k) {
+      g(k) = -w(k);
+      noise(k) = w(k) > 0.0 ? random_sd(2 * n * o + 2 * k) / (w(k) * std::abs(h(k))) : 0.0;
+    }
+    const auto response = [&](const Vector& omega) -> CVector { return two_dof_response(p, bare, omega).col(o); };
+    for (auto& b : dsp::leakage_residual_blocks(d.kernel, d.grid, d.omega, g, noise, at_nodes.col(o), response, 2 * n * o)) {
+      blocks.push_back(std::move(b));
+    }
+  }
+  return blocks;
+}
+
 // c_k of core::fit_covariance for residuals(): the Welch estimate's error correlates between
 // neighbouring lines (dsp::adjacent_line_pairs), within each output's block of n complex residuals,
 // not between the last d_e line and the first Vs line. The chain divided out of the data rotates the
@@ -593,8 +623,12 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
     // times the scatter over 200 noise seeds; with the leakage counted as noise, those of ka, ga, gs
     // were 1.6 times (docs/uncertainty.md, section 6). The misfit, against the measured variance,
     // still decides which parameters are undetermined (uncertainty_with_misfit).
-    core::FitCovariance random =
-        from_variance ? core::fit_covariance(jacobian, Vector::Zero(res.size()), random_residual_std(d, out.params, wt), adjacent) : with_misfit;
+    // The leakage's own random error at the resonance and the dip (leakage_blocks) is in it.
+    core::FitCovariance random = with_misfit;
+    if (from_variance) {
+      const Vector random_sd = random_residual_std(d, out.params, wt);
+      random = core::fit_covariance(jacobian, Vector::Zero(res.size()), random_sd, adjacent, leakage_blocks(d, out.params, wt, random_sd));
+    }
     random.chi2_per_dof = with_misfit.chi2_per_dof;
     out.uncertainty = tuning_uncertainty(out.params, layout, keep, random, from_variance);
     out.uncertainty_with_misfit = tuning_uncertainty(out.params, layout, keep, with_misfit, from_variance);

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Sparse>
+
 #include "piezobench/core/error.hpp"
 #include "piezobench/core/format.hpp"
 
@@ -146,6 +148,66 @@ LeakageCovariance leakage_covariance(const ResolutionKernel& kernel, const Eigen
     }
   }
   return out;
+}
+
+std::vector<core::ResidualCovarianceBlock> leakage_residual_blocks(const ResolutionKernel& kernel, const KernelGrid& grid,
+                                                                   const Eigen::VectorXd& lines, const Eigen::VectorXcd& g,
+                                                                   const Eigen::VectorXd& noise_relative_std,
+                                                                   const Eigen::VectorXcd& model_at_nodes,
+                                                                   const std::function<Eigen::VectorXcd(const Eigen::VectorXd&)>& response,
+                                                                   Index first_row) {
+  const Index n = lines.size();
+  if (!knows_leakage(kernel) || n < 2 || g.size() != n || noise_relative_std.size() != n) return {};
+  const Eigen::VectorXd leak = grid.leakage_coherence(model_at_nodes);
+  Eigen::VectorXd excess(n);
+  for (Index k = 0; k < n; ++k) excess(k) = leak(k) > 0.0 ? 1.0 / leak(k) - 1.0 : 0.0;
+  const double most = excess.maxCoeff();
+  if (!(most > 1e-12)) return {};
+  std::vector<bool> counts(static_cast<std::size_t>(n));
+  for (Index k = 0; k < n; ++k) {
+    const double noise = noise_relative_std(k);
+    counts[static_cast<std::size_t>(k)] = excess(k) > kLeakageLinesFraction * most &&
+                                          excess(k) / (2.0 * static_cast<double>(kernel.segments)) > kLeakageOfNoise * noise * noise;
+  }
+  const double step = 2.0 * std::numbers::pi * kernel.line_spacing_Hz;
+  std::vector<core::ResidualCovarianceBlock> blocks;
+  for (Index k = 0; k < n;) {
+    if (!counts[static_cast<std::size_t>(k)]) {
+      ++k;
+      continue;
+    }
+    Index end = k + 1;
+    while (end < n && counts[static_cast<std::size_t>(end)] && std::abs(lines(end) - lines(end - 1) - step) <= 1e-6 * step) ++end;
+    Index first = k, count = end - k;
+    if (count > kLeakageMaxLines) {  // keep the lines around the largest leakage
+      Index peak = k;
+      for (Index i = k; i < end; ++i) {
+        if (excess(i) > excess(peak)) peak = i;
+      }
+      first = std::clamp<Index>(peak - kLeakageMaxLines / 2, k, end - kLeakageMaxLines);
+      count = kLeakageMaxLines;
+    }
+    k = end;
+    if (count < 2) continue;
+    const LeakageCovariance lc = leakage_covariance(kernel, lines.segment(first, count), response);
+    const Eigen::VectorXcd gi = g.segment(first, count);
+    if (!gi.allFinite() || !lc.upper.allFinite() || !lc.upper_pseudo.allFinite()) continue;
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<std::size_t>(4 * count * (2 * kLeakageMaxLineDistance + 1)));
+    for (Index i = 0; i < count; ++i) {
+      for (Index l = std::max<Index>(0, i - kLeakageMaxLineDistance); l < std::min(count, i + kLeakageMaxLineDistance + 1); ++l) {
+        const std::complex<double> cu = gi(i) * lc.covariance(i, l) * std::conj(gi(l)), qu = gi(i) * lc.pseudo(i, l) * gi(l);
+        t.emplace_back(2 * i, 2 * l, 0.5 * (cu + qu).real());
+        t.emplace_back(2 * i + 1, 2 * l + 1, 0.5 * (cu - qu).real());
+        t.emplace_back(2 * i, 2 * l + 1, 0.5 * (qu - cu).imag());
+        t.emplace_back(2 * i + 1, 2 * l, 0.5 * (qu + cu).imag());
+      }
+    }
+    core::ResidualCovarianceBlock block{first_row + 2 * first, Eigen::SparseMatrix<double>(2 * count, 2 * count)};
+    block.covariance.setFromTriplets(t.begin(), t.end());
+    blocks.push_back(std::move(block));
+  }
+  return blocks;
 }
 
 }  // namespace piezobench::dsp

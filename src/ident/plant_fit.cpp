@@ -143,72 +143,22 @@ core::FitCovariance covariance_at(const Residual& residual, const Eigen::VectorX
   return core::fit_covariance(residual.jacobian(x), residual(x), residual_std, adjacent, blocks);
 }
 
-// Lines whose leakage error counts: its relative variance (1/gamma_leak^2 - 1) / (2 segments) above
-// this fraction of the line's noise variance, and 1/gamma_leak^2 - 1 above kLeakageLinesFraction of its
-// largest value.
-constexpr double kLeakageOfNoise = 0.05;
-constexpr double kLeakageLinesFraction = 1e-4;
-constexpr Index kLeakageMaxLines = 512;  // lines of one block at most (around its largest leakage)
-
-// The Welch estimate's leakage error (dsp/leakage_covariance.hpp) in the residuals a_k (G_k / H_k - 1):
-// u_k = g_k e_k with g_k = -a_k G_k / H_k^2, as covariance blocks of the interleaved (Re, Im) residuals,
-// one per run of consecutive lines where the model's leakage coherence (KernelGrid::leakage_coherence)
-// drops. Without the FRF's variance (residual_std empty) or a provenance that says how the segments
-// were laid out: none.
+// The Welch estimate's leakage error in the residuals a_k (G_k / H_k - 1): u_k = g_k e_k with
+// g_k = -a_k G_k / H_k^2 (dsp::leakage_residual_blocks), the lines' noise from residual_std / a_k. Without
+// the FRF's variance (residual_std empty) or a provenance that says how the segments were laid out: none.
 std::vector<core::ResidualCovarianceBlock> leakage_blocks(const dsp::ResolutionKernel& kernel, const dsp::KernelGrid& grid, const Vector& w,
                                                           const CVector& d, const Vector& weight, const Vector& residual_std,
                                                           const CVector& model_at_nodes,
                                                           const std::function<CVector(const Vector&)>& response) {
   if (residual_std.size() != 2 * w.size() || !dsp::knows_leakage(kernel) || w.size() < 2) return {};
-  const Vector leak = grid.leakage_coherence(model_at_nodes);
-  Vector excess(w.size());
-  for (Index k = 0; k < w.size(); ++k) excess(k) = leak(k) > 0.0 ? 1.0 / leak(k) - 1.0 : 0.0;
-  const double most = excess.maxCoeff();
-  if (!(most > 1e-12)) return {};
-  std::vector<bool> counts(static_cast<std::size_t>(w.size()));
-  for (Index k = 0; k < w.size(); ++k) {
-    const double noise = weight(k) > 0.0 ? residual_std(2 * k) / weight(k) : 0.0;  // relative std of the line's noise
-    counts[static_cast<std::size_t>(k)] = excess(k) > kLeakageLinesFraction * most &&
-                                          excess(k) / (2.0 * static_cast<double>(kernel.segments)) > kLeakageOfNoise * noise * noise;
-  }
   const CVector model = grid.smooth(model_at_nodes);
-  const double step = 2.0 * std::numbers::pi * kernel.line_spacing_Hz;
-  std::vector<core::ResidualCovarianceBlock> blocks;
-  for (Index k = 0; k < w.size();) {
-    if (!counts[static_cast<std::size_t>(k)]) { ++k; continue; }
-    Index end = k + 1;
-    while (end < w.size() && counts[static_cast<std::size_t>(end)] && std::abs(w(end) - w(end - 1) - step) <= 1e-6 * step) ++end;
-    Index first = k, count = end - k;
-    if (count > kLeakageMaxLines) {  // keep the lines around the largest leakage
-      Index peak = k;
-      for (Index i = k; i < end; ++i) if (excess(i) > excess(peak)) peak = i;
-      first = std::clamp<Index>(peak - kLeakageMaxLines / 2, k, end - kLeakageMaxLines);
-      count = kLeakageMaxLines;
-    }
-    k = end;
-    if (count < 2) continue;
-    const dsp::LeakageCovariance lc = dsp::leakage_covariance(kernel, w.segment(first, count), response);
-    Eigen::VectorXcd g(count);
-    for (Index i = 0; i < count; ++i) g(i) = -weight(first + i) * model(first + i) / (d(first + i) * d(first + i));
-    // A model or a line that gives no finite covariance leaves the run to the noise alone (the
-    // intervals then miss the leakage there) rather than failing the fit's standard errors.
-    if (!g.allFinite() || !lc.upper.allFinite() || !lc.upper_pseudo.allFinite()) continue;
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<std::size_t>(4 * count * (2 * dsp::kLeakageMaxLineDistance + 1)));
-    for (Index i = 0; i < count; ++i) {
-      for (Index l = std::max<Index>(0, i - dsp::kLeakageMaxLineDistance); l < std::min(count, i + dsp::kLeakageMaxLineDistance + 1); ++l) {
-        const Complex cu = g(i) * lc.covariance(i, l) * std::conj(g(l)), qu = g(i) * lc.pseudo(i, l) * g(l);
-        t.emplace_back(2 * i, 2 * l, 0.5 * (cu + qu).real());
-        t.emplace_back(2 * i + 1, 2 * l + 1, 0.5 * (cu - qu).real());
-        t.emplace_back(2 * i, 2 * l + 1, 0.5 * (qu - cu).imag());
-        t.emplace_back(2 * i + 1, 2 * l, 0.5 * (qu + cu).imag());
-      }
-    }
-    core::ResidualCovarianceBlock block{2 * first, Eigen::SparseMatrix<double>(2 * count, 2 * count)};
-    block.covariance.setFromTriplets(t.begin(), t.end());
-    blocks.push_back(std::move(block));
+  Eigen::VectorXcd g(w.size());
+  Vector noise(w.size());
+  for (Index k = 0; k < w.size(); ++k) {
+    g(k) = -weight(k) * model(k) / (d(k) * d(k));
+    noise(k) = weight(k) > 0.0 ? residual_std(2 * k) / weight(k) : 0.0;
   }
-  return blocks;
+  return dsp::leakage_residual_blocks(kernel, grid, w, g, noise, model_at_nodes, response);
 }
 
 // c_k of core::fit_covariance for the relative residuals G/H_k - 1 ~ -e_k / H_k of a Welch estimate:

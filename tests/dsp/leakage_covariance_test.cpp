@@ -126,5 +126,58 @@ TEST(LeakageCovariance, NeedsTheSegmentsLayoutAndConsecutiveLines) {
   EXPECT_LT(none.upper_pseudo.cwiseAbs().maxCoeff(), 1e-20);
 }
 
+// The blocks a fit's covariance gets (leakage_residual_blocks): a resonance of 40 lines (10 Hz, zeta 0.05
+// at 64 Hz, 256-sample hann at 50 %), the residuals u_k = g_k e_k. Each block's 2 x 2 entries are the
+// real and imaginary parts' covariances of g_i e_i and g_l e_l from leakage_covariance; the rows start at
+// first_row + 2 (first line); a line left out of the band ends a run; a line whose leakage variance is
+// below a twentieth of its noise variance is left to the noise.
+TEST(LeakageCovariance, ResidualBlocksCarryTheSensitivityAndSplitAtGaps) {
+  const Resonator res(10.0, 0.05);
+  FrfProvenance p;
+  p.window = "hann-periodic";
+  p.nfft = 256;
+  p.overlap = 0.5;
+  p.averages = 9;
+  p.sample_rate = 64.0;
+  const ResolutionKernel k = resolution_kernel(p);
+  const double step = 2.0 * std::numbers::pi * 0.25;
+  std::vector<double> w;
+  for (int i = 20; i <= 60; ++i) {
+    if (i != 45) w.push_back(i * step);  // line 45 (11.25 Hz) left out
+  }
+  const Eigen::VectorXd lines = Eigen::Map<const Eigen::VectorXd>(w.data(), static_cast<Eigen::Index>(w.size()));
+  const KernelGrid grid(k, lines);
+  const auto response = [&res](const Eigen::VectorXd& omega) {
+    Eigen::VectorXcd h(omega.size());
+    for (Eigen::Index i = 0; i < omega.size(); ++i) h(i) = res.h(omega(i));
+    return h;
+  };
+  const Eigen::VectorXcd at_nodes = response(grid.nodes());
+  const Eigen::Index n = lines.size();
+  Eigen::VectorXcd g(n);
+  for (Eigen::Index i = 0; i < n; ++i) g(i) = std::polar(0.5 + 0.01 * i, 0.1 * i);
+  const Eigen::VectorXd quiet = Eigen::VectorXd::Zero(n);
+  const auto blocks = leakage_residual_blocks(k, grid, lines, g, quiet, at_nodes, response, 100);
+  ASSERT_EQ(blocks.size(), 2U);  // split at the gap
+  EXPECT_EQ(blocks[0].first, 100);
+  EXPECT_EQ(blocks[0].covariance.rows(), 2 * 25);  // lines 20 .. 44
+  EXPECT_EQ(blocks[1].first, 100 + 2 * 25);
+  EXPECT_EQ(blocks[1].covariance.rows(), 2 * 15);  // lines 46 .. 60
+  // One entry against leakage_covariance directly: lines 30 and 32 (i = 10, 12) of the first run.
+  const LeakageCovariance lc = leakage_covariance(k, lines.head(25), response);
+  const Complex cu = g(10) * lc.covariance(10, 12) * std::conj(g(12)), qu = g(10) * lc.pseudo(10, 12) * g(12);
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(blocks[0].covariance);
+  EXPECT_NEAR(dense(20, 24), 0.5 * (cu + qu).real(), 1e-12 * std::abs(cu));
+  EXPECT_NEAR(dense(21, 25), 0.5 * (cu - qu).real(), 1e-12 * std::abs(cu));
+  EXPECT_NEAR(dense(20, 25), 0.5 * (qu - cu).imag(), 1e-12 * std::abs(cu));
+  EXPECT_NEAR(dense(21, 24), 0.5 * (qu + cu).imag(), 1e-12 * std::abs(cu));
+  EXPECT_NEAR((dense - dense.transpose()).cwiseAbs().maxCoeff(), 0.0, 1e-12 * dense.cwiseAbs().maxCoeff());
+  // Loud noise everywhere: no block.
+  EXPECT_TRUE(leakage_residual_blocks(k, grid, lines, g, Eigen::VectorXd::Constant(n, 10.0), at_nodes, response).empty());
+  // A kernel without the segments' layout: none.
+  const ResolutionKernel bare = resolution_kernel(WindowType::kHannPeriodic, 256, 64.0);
+  EXPECT_TRUE(leakage_residual_blocks(bare, KernelGrid(bare, lines), lines, g, quiet, at_nodes, response).empty());
+}
+
 }  // namespace
 }  // namespace piezobench::dsp

@@ -24,6 +24,9 @@
 #include <Eigen/Dense>
 #include <complex>
 #include <functional>
+#include <vector>
+
+#include "piezobench/core/fit_covariance.hpp"
 
 #include "piezobench/dsp/resolution_kernel.hpp"
 
@@ -52,5 +55,26 @@ struct LeakageCovariance {
 // does not know the leakage (knows_leakage) or the lines are not consecutive.
 [[nodiscard]] LeakageCovariance leakage_covariance(const ResolutionKernel& kernel, const Eigen::VectorXd& lines,
                                                    const std::function<Eigen::VectorXcd(const Eigen::VectorXd&)>& response);
+
+// Lines whose leakage error a fit's covariance counts: its relative variance (1/gamma_leak^2 - 1) /
+// (2 segments) above kLeakageOfNoise of the line's relative noise variance, and 1/gamma_leak^2 - 1 above
+// kLeakageLinesFraction of its largest value (gamma_leak: KernelGrid::leakage_coherence of the model).
+inline constexpr double kLeakageOfNoise = 0.05;
+inline constexpr double kLeakageLinesFraction = 1e-4;
+inline constexpr Eigen::Index kLeakageMaxLines = 512;  // lines of one block at most (around its largest leakage)
+
+// The leakage error in a fit's residuals u_k = g_k e_k (e_k the estimate's leakage error at line k,
+// g_k the residual's complex sensitivity to it: -a_k G_k / H_k^2 for a_k (G_k / H_k - 1), -a_k for
+// a_k (G_k - H_k)), as covariance blocks of the interleaved residuals [Re u_k, Im u_k] starting at row
+// first_row (the residual vector's units squared), one per run of consecutive lines whose leakage
+// counts (above). lines: the fit's lines (rad/s; a run ends where a line is left out); grid: their
+// KernelGrid; noise_relative_std: each line's relative noise std (dimensionless); model_at_nodes: the
+// model at grid.nodes(); response: the model at any omega. A run whose covariance or g is not finite is
+// left out (its intervals then miss the leakage there) rather than failing the fit's standard errors.
+// Empty when the kernel does not know the leakage (knows_leakage) or there are fewer than 2 lines.
+[[nodiscard]] std::vector<core::ResidualCovarianceBlock> leakage_residual_blocks(
+    const ResolutionKernel& kernel, const KernelGrid& grid, const Eigen::VectorXd& lines, const Eigen::VectorXcd& g,
+    const Eigen::VectorXd& noise_relative_std, const Eigen::VectorXcd& model_at_nodes,
+    const std::function<Eigen::VectorXcd(const Eigen::VectorXd&)>& response, Eigen::Index first_row = 0);
 
 }  // namespace piezobench::dsp
