@@ -31,6 +31,17 @@ struct Resonator {
   }
 };
 
+// The kernel of a Welch estimate with the segments' layout: hann, 256 samples at 64 Hz, 50 %, 9 segments.
+ResolutionKernel hann_kernel_of_nine_segments() {
+  FrfProvenance p;
+  p.window = "hann-periodic";
+  p.nfft = 256;
+  p.overlap = 0.5;
+  p.averages = 9;
+  p.sample_rate = 64.0;
+  return resolution_kernel(p);
+}
+
 // The leakage error of noise-free H1 estimates of a sharp resonance (10 Hz, zeta 0.05: four 0.25 Hz lines
 // wide, as the virtual bench's resonance is 4.6 of its lines), hann at 50 %, 9 segments of 256 samples per
 // record, 800 records: the empirical covariance E[e e^*], the one of the next line and the pseudo-covariance
@@ -109,13 +120,7 @@ TEST(LeakageCovariance, NeedsTheSegmentsLayoutAndConsecutiveLines) {
   const auto flat = [](const Eigen::VectorXd& omega) { return Eigen::VectorXcd::Ones(omega.size()); };
   const Eigen::VectorXd lines = Eigen::VectorXd::LinSpaced(5, 10.0, 10.0 + 4.0 * 2.0 * std::numbers::pi * 0.25);
   EXPECT_THROW((void)leakage_covariance(bare, lines, flat), InputError);
-  FrfProvenance p;
-  p.window = "hann-periodic";
-  p.nfft = 256;
-  p.overlap = 0.5;
-  p.averages = 9;
-  p.sample_rate = 64.0;
-  const ResolutionKernel k = resolution_kernel(p);
+  const ResolutionKernel k = hann_kernel_of_nine_segments();
   ASSERT_TRUE(knows_leakage(k));
   Eigen::VectorXd gap = lines;
   gap(4) += 2.0 * std::numbers::pi * 0.25;
@@ -133,13 +138,7 @@ TEST(LeakageCovariance, NeedsTheSegmentsLayoutAndConsecutiveLines) {
 // below a twentieth of its noise variance is left to the noise.
 TEST(LeakageCovariance, ResidualBlocksCarryTheSensitivityAndSplitAtGaps) {
   const Resonator res(10.0, 0.05);
-  FrfProvenance p;
-  p.window = "hann-periodic";
-  p.nfft = 256;
-  p.overlap = 0.5;
-  p.averages = 9;
-  p.sample_rate = 64.0;
-  const ResolutionKernel k = resolution_kernel(p);
+  const ResolutionKernel k = hann_kernel_of_nine_segments();
   const double step = 2.0 * std::numbers::pi * 0.25;
   std::vector<double> w;
   for (int i = 20; i <= 60; ++i) {
