@@ -144,18 +144,20 @@ core::FitCovariance covariance_at(const Residual& residual, const Eigen::VectorX
 }
 
 // The Welch estimate's leakage error in the residuals a_k (G_k / H_k - 1): u_k = g_k e_k with
-// g_k = -a_k G_k / H_k^2 (dsp::leakage_residual_blocks), the lines' noise from residual_std / a_k. Without
+// g_k = -a_k G_k / H_k^2, or in a_k (G_k - H_k) / R_k (ref: R, a fixed reference): g_k = -a_k / R_k
+// (dsp::leakage_residual_blocks); the lines' noise from residual_std / a_k (relative to |H_k|). Without
 // the FRF's variance (residual_std empty) or a provenance that says how the segments were laid out: none.
 std::vector<core::ResidualCovarianceBlock> leakage_blocks(const dsp::ResolutionKernel& kernel, const dsp::KernelGrid& grid, const Vector& w,
                                                           const CVector& d, const Vector& weight, const Vector& residual_std,
                                                           const CVector& model_at_nodes,
-                                                          const std::function<CVector(const Vector&)>& response) {
+                                                          const std::function<CVector(const Vector&)>& response,
+                                                          const CVector* ref = nullptr) {
   if (residual_std.size() != 2 * w.size() || !dsp::knows_leakage(kernel) || w.size() < 2) return {};
   const CVector model = grid.smooth(model_at_nodes);
   Eigen::VectorXcd g(w.size());
   Vector noise(w.size());
   for (Index k = 0; k < w.size(); ++k) {
-    g(k) = -weight(k) * model(k) / (d(k) * d(k));
+    g(k) = ref != nullptr ? -weight(k) / (*ref)(k) : -weight(k) * model(k) / (d(k) * d(k));
     noise(k) = weight(k) > 0.0 ? residual_std(2 * k) / weight(k) : 0.0;
   }
   return dsp::leakage_residual_blocks(kernel, grid, w, g, noise, model_at_nodes, response);
@@ -408,6 +410,18 @@ Vector leakage_free_residual_std(const PointWeights& pw, const FitBand& b, doubl
   return s;
 }
 
+// The residuals' noise relative to |H_k| (PointWeights::residual_std) as that of (G_k - H_k) / R_k:
+// times |H_k| / |R_k|.
+Vector referred(Vector residual_std, const CVector& d, const CVector& ref) {
+  if (residual_std.size() != 2 * d.size()) return residual_std;
+  for (Index k = 0; k < d.size(); ++k) {
+    const double f = std::abs(d(k)) / std::abs(ref(k));
+    residual_std(2 * k) *= f;
+    residual_std(2 * k + 1) *= f;
+  }
+  return residual_std;
+}
+
 // Half the width between the half-power points around `peak` over its frequency, clamped to
 // [lo_clamp, hi_clamp]; the lower point is searched down to `lowest`.
 double half_power_damping(const FitBand& b, Index peak, Index lowest, double lo_clamp, double hi_clamp) {
@@ -517,6 +531,10 @@ IffPlantFit iff_start(const FitBand& b, const IffPlantFitOptions& options, const
 struct IffResidual {
   const FitBand& b;
   const Vector& weight;
+  // The residual's reference: none, G / H_k - 1 (the first pass); R, (G - H_k) / R_k with R the first
+  // pass's model at the lines (the second pass: not divided by the noisy H, whose inverse near the dip
+  // is biased towards 0).
+  const CVector* ref;
   double sign;
   Layout layout;
   double fixed_w_hpf;
@@ -541,7 +559,7 @@ struct IffResidual {
       if (layout.hpf) dg(i, c++) = -core::divide(g * p.w_hpf, p.w_hpf + s);                  // log w_hpf
       if (layout.delay) dg(i, c++) = -g * s * kDelayScale;                                  // delay / 100 us
     }
-    return relative_residual_jacobian(grid, dg, b.d, weight);
+    return relative_residual_jacobian(grid, dg, ref != nullptr ? *ref : b.d, weight);
   }
 
   Eigen::VectorXd operator()(const Eigen::VectorXd& x) const {
@@ -549,7 +567,7 @@ struct IffResidual {
     const CVector g = grid.smooth(plant::iff_plant_response(p, grid.nodes()));
     Eigen::VectorXd r(2 * b.w.size());
     for (Index k = 0; k < b.w.size(); ++k) {
-      const Complex e = (core::divide(g(k), b.d(k)) - 1.0) * weight(k);
+      const Complex e = (ref != nullptr ? core::divide(g(k) - b.d(k), (*ref)(k)) : core::divide(g(k), b.d(k)) - 1.0) * weight(k);
       r(2 * k) = e.real();
       r(2 * k + 1) = e.imag();
     }
@@ -586,9 +604,11 @@ core::ParameterUncertainty iff_uncertainty(const IffResidual& residual, const co
                                            const CVector& model_at_nodes) {
   const CVector model = residual.grid.smooth(model_at_nodes);
   const auto response = [&fit](const Vector& omega) { return plant::iff_plant_response(fit, omega); };
+  const Vector sd = residual.ref != nullptr ? referred(residual_std, residual.b.d, *residual.ref) : residual_std;
   const core::FitCovariance cov =
-      covariance_at(residual, best.x, residual_std, adjacent_correlation(kernel, residual.b.w, model, residual_std),
-                    leakage_blocks(kernel, residual.grid, residual.b.w, residual.b.d, residual.weight, residual_std, model_at_nodes, response));
+      covariance_at(residual, best.x, sd, adjacent_correlation(kernel, residual.b.w, model, sd),
+                    leakage_blocks(kernel, residual.grid, residual.b.w, residual.b.d, residual.weight, residual_std, model_at_nodes, response,
+                                   residual.ref));
   // Solver parameters: log|g0|, log wz, xz / 0.01, log wp, log xp, [log w_hpf], [delay / 1e-4].
   const Layout& layout = residual.layout;
   const int hpf = layout.hpf ? 5 : -1, delay = layout.delay ? (layout.hpf ? 6 : 5) : -1;
@@ -613,16 +633,22 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
   PointWeights pw = point_weights(b.w, eps);
   const Layout layout{options.fixed_w_hpf == 0.0, options.fit_delay};
   const dsp::KernelGrid grid(options.resolution, b.w);
+  CVector ref;  // the second pass's reference (IffResidual::ref)
   const auto residual_with = [&](const PointWeights& weights) {
-    return IffResidual{b, weights.weight, sign, layout, options.fixed_w_hpf, grid};
+    return IffResidual{b, weights.weight, ref.size() > 0 ? &ref : nullptr, sign, layout, options.fixed_w_hpf, grid};
   };
   double initial_cost = 0.0;
   core::LmResult best = best_iff_solution(residual_with(pw), start, options.max_iterations, initial_cost, source);
   const auto at = [&](const Eigen::VectorXd& x) { return plant::iff_plant_response(from_x(x, sign, layout, options.fixed_w_hpf), grid.nodes()); };
   if (eps.size() > 0) {
-    // A second pass weighted by the model's variance, not the record's (as fit_delayed_second_order).
+    // A second pass weighted by the model's variance, not the record's (as fit_delayed_second_order),
+    // its errors referred to the first pass's model rather than to the noisy H: near the dip 1/H is
+    // biased towards 0, which moved wz by +1.1 of its standard errors from the noise-free record's on
+    // the virtual bench (+0.85 referred to the model; docs/uncertainty.md section 6). Not in the
+    // second-order fit, which has no dip: there it made the resonance's interval too narrow.
     if (const Vector smooth = smooth_relative_std(b, options.effective_averages, grid, at(best.x), options.resolution); smooth.size() > 0) {
       pw = point_weights(b.w, smooth);
+      ref = grid.smooth(at(best.x));
       const core::LmResult second = least_squares(residual_with(pw), best.x, options.max_iterations);
       if (!std::isfinite(second.cost)) {
         throw NumericalError("IFF plant fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);

@@ -55,7 +55,8 @@ struct IffPlantFitOptions {
   // the segments' layout, a second pass from that solution takes eps from the first pass's model (the
   // noise model of dsp::random_frf_std plus the window's predicted leakage) instead of the record's
   // coherence: weights from each record's own coherence follow its leakage realization and made the
-  // resonance's standard error 1.25-1.4 times its scatter.
+  // resonance's standard error 1.25-1.4 times its scatter. The IFF plant's second pass also refers its
+  // errors to the first pass's model, (G - H_k) / G_1(j w_k), not to the noisy H_k (biased at the dip).
   double effective_averages = 0.0;
   // The Welch estimate's resolution kernel of the FRF (dsp::resolution_kernel of its provenance;
   // dsp/resolution_kernel.hpp): active, the model is compared with the data through it,
