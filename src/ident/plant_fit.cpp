@@ -243,8 +243,9 @@ core::LmResult least_squares(const Residual& residual, const Eigen::VectorXd& x0
   return core::levenberg_marquardt(residual, [&residual](const Eigen::VectorXd& x) { return residual.jacobian(x); }, x0, o);
 }
 
-// The rows of d r / d x for residuals r_k = a_k (G_k / H_k - 1): the model's derivatives at the grid's
-// nodes (one column per parameter) through the kernel, over H_k, weighted; interleaved (Re, Im) as r.
+// The rows of d r / d x for residuals r_k = a_k (G_k / H_k - 1) or a_k (G_k - H_k) / R_k: the model's
+// derivatives at the grid's nodes (one column per parameter) through the kernel, over `d` (H_k or R_k),
+// weighted; interleaved (Re, Im) as r.
 Eigen::MatrixXd relative_residual_jacobian(const dsp::KernelGrid& grid, const Eigen::MatrixXcd& dg_at_nodes, const CVector& d,
                                            const Vector& weight) {
   const Eigen::MatrixXcd dg = grid.smooth(dg_at_nodes);
