@@ -313,11 +313,12 @@ bool usable(const TwoDofParams& p) {
 // tuning compares with the data at every step: through the Welch estimate's resolution kernel when
 // it is active, sum_j c_j H(omega + j 2 pi df) (dsp/resolution_kernel.hpp; the chain divided out of
 // the data is smooth over a line and left outside the kernel).
-lti::CMatrix actuator_response(const TwoDofParams& p, const FitData& d) {
+lti::CMatrix actuator_at(const TwoDofParams& p, const Vector& omega) {
   TwoDofBench bare;
   bare.amplifier_gain = 1.0;
-  return d.grid.smooth(two_dof_response(p, bare, d.grid.nodes()));
+  return two_dof_response(p, bare, omega);
 }
+lti::CMatrix actuator_response(const TwoDofParams& p, const FitData& d) { return d.grid.smooth(actuator_at(p, d.grid.nodes())); }
 
 // Per-point weights of the complex errors H_model - H_data of each output, relative to a reference
 // model's response G0 (the previous pass's): v_k / |G0_k| with v_k = 1 (unknown variance) or
@@ -366,15 +367,13 @@ Vector residual_std(const Weights& w) {
   return s;
 }
 
-// residual_std() from the FRF's random error alone (dsp::random_frf_std at the model p: the window's
-// leakage at the resonance and the dip left out), for the intervals; the measured one without n_d.
-Vector random_residual_std(const FitData& d, const TwoDofParams& p, const Weights& wt) {
+// residual_std() from the FRF's random error alone (dsp::random_frf_std at the model, at_nodes its
+// actuator_at(p, d.grid.nodes()): the window's leakage at the resonance and the dip left out), for the
+// intervals; the measured one without n_d.
+Vector random_residual_std(const FitData& d, const lti::CMatrix& at_nodes, const Weights& wt) {
   Vector s = residual_std(wt);
   const Index n = d.omega.size();
   if (s.size() == 0 || !(d.effective_averages > 0.0)) return s;
-  TwoDofBench bare;
-  bare.amplifier_gain = 1.0;
-  const lti::CMatrix at_nodes = two_dof_response(p, bare, d.grid.nodes());
   const lti::CMatrix at_lines = d.grid.smooth(at_nodes);
   for (const Index o : {kOutputDe, kOutputVs}) {
     const CVector& h = o == kOutputDe ? d.de : d.vs;
@@ -390,13 +389,11 @@ Vector random_residual_std(const FitData& d, const TwoDofParams& p, const Weight
 // at the resonance and the dip, which random_residual_std leaves out. A residual (G_k - H_k) w_k carries
 // u_k = -w_k e_k; e_k is the actuator's own (the chain divided out of the data is smooth over a line,
 // so its leakage is the actuator model's times the chain). The lines' noise from random_sd (w_k std_k).
-// d_e's rows first, as residuals().
-std::vector<core::ResidualCovarianceBlock> leakage_blocks(const FitData& d, const TwoDofParams& p, const Weights& wt, const Vector& random_sd) {
+// d_e's rows first, as residuals(). at_nodes: actuator_at(p, d.grid.nodes()).
+std::vector<core::ResidualCovarianceBlock> leakage_blocks(const FitData& d, const TwoDofParams& p, const lti::CMatrix& at_nodes,
+                                                          const Weights& wt, const Vector& random_sd) {
   const Index n = d.omega.size();
   if (random_sd.size() != 4 * n || !dsp::knows_leakage(d.kernel)) return {};
-  TwoDofBench bare;
-  bare.amplifier_gain = 1.0;
-  const lti::CMatrix at_nodes = two_dof_response(p, bare, d.grid.nodes());
   std::vector<core::ResidualCovarianceBlock> blocks;
   for (const Index o : {kOutputDe, kOutputVs}) {
     const CVector& h = o == kOutputDe ? d.de : d.vs;
@@ -407,7 +404,7 @@ std::vector<core::ResidualCovarianceBlock> leakage_blocks(const FitData& d, cons
       g(k) = -w(k);
       noise(k) = w(k) > 0.0 ? random_sd(2 * n * o + 2 * k) / (w(k) * std::abs(h(k))) : 0.0;
     }
-    const auto response = [&](const Vector& omega) -> CVector { return two_dof_response(p, bare, omega).col(o); };
+    const auto response = [&](const Vector& omega) -> CVector { return actuator_at(p, omega).col(o); };
     for (auto& b : dsp::leakage_residual_blocks(d.kernel, d.grid, d.omega, g, noise, at_nodes.col(o), response, 2 * n * o)) {
       blocks.push_back(std::move(b));
     }
@@ -626,8 +623,9 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
     // The leakage's own random error at the resonance and the dip (leakage_blocks) is in it.
     core::FitCovariance random = with_misfit;
     if (from_variance) {
-      const Vector random_sd = random_residual_std(d, out.params, wt);
-      random = core::fit_covariance(jacobian, Vector::Zero(res.size()), random_sd, adjacent, leakage_blocks(d, out.params, wt, random_sd));
+      const lti::CMatrix at_nodes = actuator_at(out.params, d.grid.nodes());
+      const Vector random_sd = random_residual_std(d, at_nodes, wt);
+      random = core::fit_covariance(jacobian, Vector::Zero(res.size()), random_sd, adjacent, leakage_blocks(d, out.params, at_nodes, wt, random_sd));
     }
     random.chi2_per_dof = with_misfit.chi2_per_dof;
     out.uncertainty = tuning_uncertainty(out.params, layout, keep, random, from_variance);

@@ -647,9 +647,10 @@ IffPlantFit fit_iff_plant(const Vector& omega, const CVector& h, const Vector& c
     // biased towards 0, which moved wz by +1.1 of its standard errors from the noise-free record's on
     // the virtual bench (+0.85 referred to the model; docs/uncertainty.md section 6). Not in the
     // second-order fit, which has no dip: there it made the resonance's interval too narrow.
-    if (const Vector smooth = smooth_relative_std(b, options.effective_averages, grid, at(best.x), options.resolution); smooth.size() > 0) {
+    const CVector first = at(best.x);
+    if (const Vector smooth = smooth_relative_std(b, options.effective_averages, grid, first, options.resolution); smooth.size() > 0) {
       pw = point_weights(b.w, smooth);
-      ref = grid.smooth(at(best.x));
+      ref = grid.smooth(first);
       const core::LmResult second = least_squares(residual_with(pw), best.x, options.max_iterations);
       if (!std::isfinite(second.cost)) {
         throw NumericalError("IFF plant fit (" + source + ")", "Levenberg-Marquardt found no finite error", true);
