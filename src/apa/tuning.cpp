@@ -309,15 +309,16 @@ bool usable(const TwoDofParams& p) {
   return p.k1 > 0.0 && p.ke > 0.0 && p.ka > 0.0 && p.ca + p.ce > 0.0 && p.ga != 0.0 && p.gs != 0.0;
 }
 
-// The model's u -> d_e and u -> Vs of the actuator alone (a bench of unit amplifier gain), what the
-// tuning compares with the data at every step: through the Welch estimate's resolution kernel when
-// it is active, sum_j c_j H(omega + j 2 pi df) (dsp/resolution_kernel.hpp; the chain divided out of
-// the data is smooth over a line and left outside the kernel).
+// The model's u -> d_e and u -> Vs of the actuator alone (a bench of unit amplifier gain) at omega
+// (rad/s), columns kOutputDe and kOutputVs.
 lti::CMatrix actuator_at(const TwoDofParams& p, const Vector& omega) {
   TwoDofBench bare;
   bare.amplifier_gain = 1.0;
   return two_dof_response(p, bare, omega);
 }
+// What the tuning compares with the data at every step: actuator_at through the Welch estimate's
+// resolution kernel when it is active, sum_j c_j H(omega + j 2 pi df) (dsp/resolution_kernel.hpp; the
+// chain divided out of the data is smooth over a line and left outside the kernel).
 lti::CMatrix actuator_response(const TwoDofParams& p, const FitData& d) { return d.grid.smooth(actuator_at(p, d.grid.nodes())); }
 
 // Per-point weights of the complex errors H_model - H_data of each output, relative to a reference
