@@ -48,7 +48,7 @@ struct RootLocusOptions {
   // order n (rejected steps included) and throws NumericalError (retry may help: a larger budget,
   // or fewer points) when they do not suffice.
   int max_order = 200;
-  double max_work = 5e8;  // a count of operations (n^3 per eigenvalue problem)
+  double max_work = 1e8;  // a count of operations (n^3 per eigenvalue problem)
   void validate() const;  // InputError naming the field
 };
 
