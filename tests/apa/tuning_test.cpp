@@ -274,6 +274,43 @@ TEST(Tuning, AdditiveOutputNoiseNeitherBiasesNorMiscalibrates) {
   }
 }
 
+// The third step (apa/tuning.cpp, reweight_stiffnesses; docs/uncertainty.md, section 4): with the
+// FRF's std_H and n_d k1, ka and gs are refitted with the model's variance as weights, the dampers
+// and ga held. Without n_d (std_H alone) the first two passes see the same weights (from std_H) and
+// there is no third step: the dampers and ga come out the same to round-off, k1, ka and gs move by a
+// fraction of their standard error.
+TEST(Tuning, ThirdStepRefitsTheStiffnessesAndGainsAndHoldsTheDampers) {
+  const TwoDofParams p = truth();
+  const lti::Vector f = lti::Vector::LinSpaced(400, 20.0, 400.0);
+  dsp::Frf with_nd = make_frf(p, TwoDofBench{}, f, 0.0, 1);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  with_nd.std_H.clear();
+  for (auto& h : with_nd.H) {
+    const double sigma = 0.004 * h.cwiseAbs().mean();
+    for (Index k = 0; k < f.size(); ++k) h(k) += sigma * Complex(gauss(rng), gauss(rng));
+    with_nd.std_H.emplace_back(Eigen::VectorXd::Constant(f.size(), sigma));
+  }
+  dsp::Frf without_nd = with_nd;
+  with_nd.provenance.effective_averages = 20.0;
+  TuningOptions o;
+  o.mass = p.m;
+  const TwoDofTuning a = tune_two_dof(with_nd, o), b = tune_two_dof(without_nd, o);
+  EXPECT_NE(a.message.find("weighted by the model's variance"), std::string::npos) << a.message;
+  EXPECT_EQ(b.message.find("weighted by the model's variance"), std::string::npos) << b.message;
+  for (const char* n : {"c1", "ca", "ce", "ga"}) EXPECT_TRUE(near(a.params.get(n), b.params.get(n), 1e-12)) << n;
+  bool moved = false;
+  for (const char* n : {"k1", "ka", "gs"}) {
+    const double se = a.uncertainty.standard_error_of(n);
+    ASSERT_TRUE(std::isfinite(se) && se > 0.0) << n;
+    EXPECT_LT(std::abs(a.params.get(n) - b.params.get(n)), se) << n;
+    moved = moved || a.params.get(n) != b.params.get(n);
+    EXPECT_TRUE(near(a.params.get(n), p.get(n), kStiffnessAndGain)) << n;
+  }
+  EXPECT_TRUE(moved);
+  EXPECT_NEAR(a.params.ke, 2.0 * a.params.ka, 1e-9 * a.params.ke);
+}
+
 TEST(Tuning, BadInput) {
   const TwoDofParams p = truth();
   dsp::Frf frf = make_frf(p, TwoDofBench{}, lti::logspace(0.0, 3.0, 100), 0.0, 1);

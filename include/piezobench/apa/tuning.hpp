@@ -24,6 +24,9 @@
 //   the point's relative standard deviation (dsp/frf_variance.hpp); v normalized per output (each
 //   output weighted equally). The data are never in a denominator: 1/H of a noisy point near the
 //   anti-resonance is biased towards 0, which biased the dampings (issue 30).
+// Step 3, with the FRF's variance and n_d known: k1, ka, gs (ke when free) refitted with v_k from the
+//   model's variance (its noise model and the window's leakage) instead of the record's coherence,
+//   the dampers and ga held; their standard errors from that weighting (docs/uncertainty.md, section 4).
 //   With 1 % relative complex noise on FRFs of a 2-DoF actuator from 1 Hz to 2 kHz, the stiffnesses
 //   and gains come back within 2 % and the dampings ca, ce within 10 % (tests/apa/tuning_test.cpp).
 //
