@@ -574,8 +574,8 @@ void fit_gains(const FitData& d, TwoDofParams& p) {
 // d.grid.nodes()): at_nodes) rather than from the record's coherence: the noise model of
 // dsp::random_frf_std plus the window's leakage, |G_k|^2 (1/gamma_leak^2 - 1)/(2 n_d). The record's own
 // coherence follows its leakage realization: weights taken from it down-weight the lines whose error
-// is largest, and their fit's stiffnesses and gains scatter less than the sandwich with the model's
-// variance says (unit 6 of the calibration: k1, ka, gs covering 98.5-99 %, docs/uncertainty.md,
+// is largest, and that fit's stiffnesses scatter less than the sandwich with the model's variance
+// says (unit 6 of the calibration: k1, ka, gs covering 98.5-99 %, docs/uncertainty.md,
 // section 6). Needs the FRF's variance and n_d.
 Weights model_weights(const FitData& d, const lti::CMatrix& at_nodes) {
   const Index n = d.omega.size();
@@ -615,11 +615,11 @@ Vector within_reach(const Vector& x, const Vector& start) {
 // weights the undetermined dampers moved by 6-10 % (ca -10 %, c1 +6 % on the virtual bench,
 // docs/uncertainty.md, section 6); nor is ga, whose pseudo-true value moved with the weights by 1.7
 // of its standard errors (the 2-DoF model misses the bench, so each weighting has its own best fit),
-// while step 2's ga covers its truth in 97 %. Keeps step 2's correlations; returns false (nothing
-// changed) when the FRF's variance or n_d is unknown or the pass fails.
-bool reweight_stiffnesses(const FitData& d, const Layout& layout, const Vector& start, const std::vector<Index>& keep,
+// while step 2's ga covers its truth in 97 %. Keeps step 2's correlations; changes nothing when the
+// FRF's variance or n_d is unknown or the pass does not converge.
+void reweight_stiffnesses(const FitData& d, const Layout& layout, const Vector& start, const std::vector<Index>& keep,
                           Vector& x, TwoDofTuning& out, const core::LmOptions& lm) {
-  if (d.eps_de.size() != d.omega.size() || !(d.effective_averages > 0.0)) return false;
+  if (d.eps_de.size() != d.omega.size() || !(d.effective_averages > 0.0)) return;
   const Weights wt = model_weights(d, actuator_at(layout.unpack(x), d.grid.nodes()));
   std::vector<Index> free = {0, 2, 5};  // k1, ka, gs (Layout)
   if (layout.ke_ratio == 0.0) free.push_back(6);
@@ -632,7 +632,7 @@ bool reweight_stiffnesses(const FitData& d, const Layout& layout, const Vector& 
   const core::LmResult r = core::levenberg_marquardt(sub, x(free), lm);
   const Vector y = full(r.x);
   const TwoDofParams p = layout.unpack(y);
-  if (!r.converged() || !y.allFinite() || !usable(p)) return false;
+  if (!r.converged() || !y.allFinite() || !usable(p)) return;
   const core::ResidualFunction residual = [&](const Vector& v) { return residuals(layout.unpack(within_reach(v, start)), d, wt); };
   const Eigen::MatrixXd jacobian = core::central_difference_jacobian(residual, y)(Eigen::all, keep);
   const lti::CMatrix at_nodes = actuator_at(p, d.grid.nodes());
@@ -650,10 +650,9 @@ bool reweight_stiffnesses(const FitData& d, const Layout& layout, const Vector& 
   out.uncertainty_with_misfit.value = u.value;
   out.params = p;
   out.iterations += r.iterations;
-  out.message += fmt::format("; the stiffnesses and gains weighted by the model's variance: {} steps, cost {} -> {}", r.iterations,
+  out.message += fmt::format("; k1, ka, gs refitted weighted by the model's variance: {} steps, cost {} -> {}", r.iterations,
                              format_number(r.initial_cost, 4), format_number(r.cost, 4));
   x = y;
-  return true;
 }
 
 // Step 2: Levenberg-Marquardt on the log-parameters from the report's procedure's.
@@ -725,7 +724,7 @@ void refine_tuning(const FitData& d, const TuningOptions& o, TwoDofTuning& out) 
       fmt::format("Levenberg-Marquardt: {} after {} steps ({} evaluations), cost {} -> {}", core::to_string(r.status),
                   r.iterations, r.evaluations, format_number(r.initial_cost, 4), format_number(r.cost, 4));
   if (r.converged() && !out.uncertainty.empty() && out.uncertainty.from_data_variance) {
-    (void)reweight_stiffnesses(d, layout, start, keep, r.x, out, lm);
+    reweight_stiffnesses(d, layout, start, keep, r.x, out, lm);
   }
   std::tie(out.fit_error_de, out.fit_error_vs) = fit_errors(out.params, d);
 }
