@@ -333,21 +333,25 @@ struct Weights {
   Vector de, vs;       // v_k / |G0_k|: multiply H_model - H_data
   Vector std_de, std_vs;  // the weighted residual's standard deviation, v_k std_k / |G0_k|; empty without the variance
 };
+// One output's weights from the reference's |G0_k| (mag) and each point's standard deviation relative
+// to it (relative_std; empty when the variance is unknown, v_k = 1), as Weights: w = v / |G0|, sd = v
+// relative_std (left untouched without the variance).
+void output_weights(const Vector& mag, const Vector& relative_std, Vector& w, Vector& sd) {
+  const bool variance = relative_std.size() > 0;
+  Vector v = variance ? Vector(relative_std.unaryExpr([](double e) { return 1.0 / std::hypot(e, dsp::kFitModelRelativeError); }))
+                      : Vector(Vector::Ones(mag.size()));
+  v *= 1.0 / std::sqrt(v.squaredNorm());  // mean square 1/n
+  w = v.cwiseQuotient(mag);
+  if (variance) sd = relative_std.cwiseProduct(v);
+}
+
 Weights weights(const FitData& d, const TwoDofParams& reference) {
-  const Index n = d.omega.size();
   const lti::CMatrix g0 = actuator_response(reference, d);
-  const bool variance = d.eps_de.size() == n;
+  const bool variance = d.eps_de.size() == d.omega.size();
   Weights out;
   const auto one = [&](Index o, const CVector& h, const Vector& eps, Vector& w, Vector& sd) {
     const Vector mag = g0.col(o).cwiseAbs();
-    Vector v = Vector::Ones(n);
-    if (variance) {
-      sd = eps.cwiseProduct(h.cwiseAbs()).cwiseQuotient(mag);  // std_k / |G0_k|
-      v = sd.unaryExpr([](double e) { return 1.0 / std::hypot(e, dsp::kFitModelRelativeError); });
-    }
-    v *= 1.0 / std::sqrt(v.squaredNorm());  // mean square 1/n
-    w = v.cwiseQuotient(mag);
-    if (variance) sd = sd.cwiseProduct(v);
+    output_weights(mag, variance ? Vector(eps.cwiseProduct(h.cwiseAbs()).cwiseQuotient(mag)) : Vector(), w, sd);  // std_k / |G0_k|
   };
   one(kOutputDe, d.de, d.eps_de, out.de, out.std_de);
   one(kOutputVs, d.vs, d.eps_vs, out.vs, out.std_vs);
@@ -585,17 +589,13 @@ Weights model_weights(const FitData& d, const lti::CMatrix& at_nodes) {
     const Vector leak = d.grid.leakage_coherence(at_nodes.col(o)).cwiseMax(1e-12);
     const Vector random = dsp::random_frf_std(h, eps.cwiseProduct(h.cwiseAbs()), at_lines.col(o), leak, d.effective_averages).std;
     const Vector mag = at_lines.col(o).cwiseAbs();
-    sd.resize(n);
-    Vector v(n);
+    Vector relative_std(n);
     for (Index k = 0; k < n; ++k) {
       const double relative_noise = random(k) / mag(k);
-      sd(k) = std::max(std::sqrt(relative_noise * relative_noise + (1.0 / leak(k) - 1.0) / (2.0 * d.effective_averages)),
-                       dsp::kMinFitRelativeStd);
-      v(k) = 1.0 / std::hypot(sd(k), dsp::kFitModelRelativeError);
+      relative_std(k) = std::max(std::sqrt(relative_noise * relative_noise + (1.0 / leak(k) - 1.0) / (2.0 * d.effective_averages)),
+                                 dsp::kMinFitRelativeStd);
     }
-    v *= 1.0 / std::sqrt(v.squaredNorm());  // mean square 1/n
-    w = v.cwiseQuotient(mag);
-    sd = sd.cwiseProduct(v);
+    output_weights(mag, relative_std, w, sd);
   };
   one(kOutputDe, d.de, d.eps_de, out.de, out.std_de);
   one(kOutputVs, d.vs, d.eps_vs, out.vs, out.std_vs);
@@ -618,7 +618,7 @@ Vector within_reach(const Vector& x, const Vector& start) {
 // while step 2's ga covers its truth in 97 %. Keeps step 2's correlations; changes nothing when the
 // FRF's variance or n_d is unknown or the pass does not converge.
 void reweight_stiffnesses(const FitData& d, const Layout& layout, const Vector& start, const std::vector<Index>& keep,
-                          Vector& x, TwoDofTuning& out, const core::LmOptions& lm) {
+                          const Vector& x, TwoDofTuning& out, const core::LmOptions& lm) {
   if (d.eps_de.size() != d.omega.size() || !(d.effective_averages > 0.0)) return;
   const Weights wt = model_weights(d, actuator_at(layout.unpack(x), d.grid.nodes()));
   std::vector<Index> free = {0, 2, 5};  // k1, ka, gs (Layout)
@@ -652,7 +652,6 @@ void reweight_stiffnesses(const FitData& d, const Layout& layout, const Vector& 
   out.iterations += r.iterations;
   out.message += fmt::format("; k1, ka, gs refitted weighted by the model's variance: {} steps, cost {} -> {}", r.iterations,
                              format_number(r.initial_cost, 4), format_number(r.cost, 4));
-  x = y;
 }
 
 // Step 2: Levenberg-Marquardt on the log-parameters from the report's procedure's.
